@@ -1,0 +1,152 @@
+/*
+ * The navigation controller (paper §3.1-3.3). Each control tick it takes N sonar sector
+ * ranges and the destination bearing, gives each of the 360 candidate paths a quality in
+ * [0, 1), turns to the best path and sets the speed linearly from its quality. Nothing is
+ * remembered between ticks. Fixed point only, no heap, no float, no writable file-scope
+ * state: a population of controllers lives side by side in one process.
+ *
+ * Use: qnav_ctrl_config_default() -> edit fields -> qnav_ctrl_init() (or
+ * qnav_ctrl_init_table()) -> qnav_ctrl_step() every tick. See docs/controller-api.md.
+ */
+#ifndef QNAV_CTRL_H
+#define QNAV_CTRL_H
+
+#include "qnav/fixed.h"
+#include "qnav/policy.h"
+#include "qnav/qnav_config.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Results of functions that can fail. 0 is success, negatives are errors. */
+typedef enum {
+    QNAV_OK = 0,
+    QNAV_E_NULL = -1,         /* a required pointer was null */
+    QNAV_E_SECTORS = -2,      /* n_sectors outside 1..QNAV_MAX_SECTORS */
+    QNAV_E_RANGE = -3,        /* max_range_mm is 0 */
+    QNAV_E_SPEED = -4,        /* full_speed_quality outside (0, 1) */
+    QNAV_E_POLICY_KIND = -5,  /* policy kind unknown */
+    QNAV_E_HIDDEN = -6,       /* hidden units outside 1..QNAV_MAX_HIDDEN */
+    QNAV_E_PROB_PARAM = -7    /* a probabilistic parameter outside (0, 64] */
+} qnav_status_t;
+
+/* Output flags: the step never fails; it reports what it had to do here. */
+#define QNAV_FLAG_RANGE_CLIPPED 0x01u  /* a range exceeded max_range_mm and was clipped */
+#define QNAV_FLAG_NOT_READY 0x02u      /* controller not initialised or input null: stop */
+#define QNAV_FLAG_NO_PATH 0x04u        /* every path has quality 0: stop */
+#define QNAV_FLAG_FULL_SPEED 0x08u     /* quality at or above full_speed_quality: speed capped */
+
+/* Runtime configuration. Obtain with qnav_ctrl_config_default(), then edit. */
+typedef struct {
+    uint16_t n_sectors;               /* sonar sectors N, 1..360, evenly spaced, sector 0
+                                         centred straight ahead, counter-clockwise */
+    qnav_mm_t max_range_mm;           /* sonar maximum range, mm, 1..65535 */
+    qnav_q1_15_t full_speed_quality;  /* quality giving full speed (F is linear through 0),
+                                         Q1.15 in (0, 1); default 0.9 */
+} qnav_ctrl_config_t;
+
+/* One control tick's input. */
+typedef struct {
+    const qnav_mm_t *ranges_mm;       /* n_sectors ranges, mm; above max_range_mm clipped */
+    qnav_cdeg_t goal_bearing_cdeg;    /* destination bearing in the robot frame, 0.01 deg,
+                                         counter-clockwise positive; any value (wrapped) */
+} qnav_ctrl_input_t;
+
+/* One control tick's decision. */
+typedef struct {
+    qnav_deg_t heading_deg;   /* chosen path alpha, robot frame, degrees, -179..180 */
+    qnav_q1_15_t speed;       /* F(X(alpha)): fraction of maximum speed, Q1.15, [0, 1) */
+    qnav_q1_15_t quality;     /* X(alpha), Q1.15, [0, 1) */
+    uint8_t flags;            /* QNAV_FLAG_* */
+} qnav_ctrl_output_t;
+
+/* Derived, per-hidden-unit network parameters (docs/qformats.md, "network step"). */
+typedef struct {
+    int32_t bias_z;    /* hidden bias, Q4.12 units held in int32 */
+    int32_t per_deg;   /* weight per degree of dtheta, 2^-16 Q4.12 units (Q4.28) */
+    int32_t per_level; /* weight per distance level, Q4.12 units */
+    int16_t out;       /* output weight, Q8.8 */
+} qnav_ctrl_unit_t;
+
+/* The controller. Caller-owned (a static on an MCU, a vector element on a host); fields
+ * are private: reach them through the functions below. */
+typedef struct {
+    uint16_t magic;                   /* set by a successful init */
+    uint8_t kind;                     /* QNAV_POLICY_PROB, QNAV_POLICY_NET, or 0 for table */
+    uint8_t hidden;
+    uint16_t n_sectors;
+    qnav_mm_t max_range_mm;
+    uint32_t level_scale;             /* distance level = (range * scale + 2^15) >> 16 */
+    uint32_t speed_scale;             /* speed = min(MAX, (quality * scale) >> 15) */
+    qnav_q1_15_t full_speed_quality;
+    const qnav_q1_15_t *table;        /* table mode: [QNAV_DIST_LEVELS][181] qualities */
+    int32_t out_bias_z;               /* network output bias, Q4.12 units */
+    union {
+        struct {
+            qnav_q1_15_t goal[QNAV_DTHETA_MAX + 1]; /* P_goal by dtheta */
+            qnav_q1_15_t safe[QNAV_DIST_LEVELS];    /* P_safe by distance level */
+        } prob;
+        qnav_ctrl_unit_t unit[QNAV_MAX_HIDDEN];
+    } p;
+} qnav_ctrl_t;
+
+/* Number of entries of a quality table: QNAV_DIST_LEVELS * 181, row-major by level. */
+#define QNAV_QTABLE_ENTRIES ((uint16_t)(QNAV_DIST_LEVELS * (QNAV_DTHETA_MAX + 1)))
+
+/* Defaults: 16 sectors, 5000 mm, full speed at quality 0.9. */
+void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg);
+
+/*
+ * Check cfg and policy and derive the step's parameters into ctrl.
+ * Returns QNAV_OK, or QNAV_E_NULL, QNAV_E_SECTORS, QNAV_E_RANGE, QNAV_E_SPEED,
+ * QNAV_E_POLICY_KIND, QNAV_E_HIDDEN, QNAV_E_PROB_PARAM; on error ctrl is left not ready
+ * (a step then commands a stop). The policy is not referenced after init returns.
+ */
+qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
+                             const qnav_policy_t *policy);
+
+/*
+ * Table mode: like qnav_ctrl_init() but the step reads qualities from a compiled table of
+ * QNAV_QTABLE_ENTRIES entries (made by qnav_ctrl_build_table() or the policy-to-header
+ * tool) and does no multiplies per path. With QNAV_TABLES_IN_FLASH the table must be in
+ * program memory. The table must outlive ctrl. Same statuses as qnav_ctrl_init().
+ */
+qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
+                                   const qnav_q1_15_t *table);
+
+/*
+ * One control tick. Never fails: a range above max_range_mm is clipped and flagged; an
+ * uninitialised controller or null input gives a stop (speed 0, heading 0) and
+ * QNAV_FLAG_NOT_READY. qualities, when not null, receives X(theta_i) for i = 0..359
+ * (path i points i degrees counter-clockwise of straight ahead).
+ * Ties go to the smaller dtheta, then the smaller turn, then counter-clockwise.
+ */
+void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
+                    qnav_ctrl_output_t *out, qnav_q1_15_t *qualities);
+
+/*
+ * The quality the policy gives one (distance level, dtheta) pair: the single function that
+ * both the network/probabilistic step and every compiled table evaluate.
+ * level is clamped to 0..QNAV_DIST_LEVELS-1, dtheta_deg to 0..180. 0 if not ready.
+ */
+qnav_q1_15_t qnav_ctrl_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta_deg);
+
+/*
+ * Compile the controller's policy into a quality table of QNAV_QTABLE_ENTRIES entries
+ * (caller's buffer, in RAM). Returns QNAV_OK, QNAV_E_NULL, or QNAV_E_POLICY_KIND when ctrl
+ * is not initialised with a policy.
+ */
+qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_q1_15_t *table);
+
+/* The distance level a range maps to under this controller (clipped to max range). */
+uint8_t qnav_ctrl_level(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm);
+
+/* The sector (0..n_sectors-1) that contains path i (0..359). */
+uint16_t qnav_ctrl_sector_of_path(uint16_t n_sectors, uint16_t path_deg);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* QNAV_CTRL_H */

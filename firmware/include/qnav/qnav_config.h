@@ -1,0 +1,56 @@
+/*
+ * Every compile-time knob of libqnav, listed once. Each can be overridden with -D on the
+ * compiler line; invalid combinations stop the build with #error. Runtime settings (sector
+ * count, maximum range, policy parameters) live in qnav_ctrl_config_t, not here.
+ */
+#ifndef QNAV_CONFIG_H
+#define QNAV_CONFIG_H
+
+/* Number of candidate paths, 1 degree apart. Fixed by the paper's action space. */
+#define QNAV_PATHS 360
+
+/* Largest wrapped angular distance between a path and the destination, in degrees. */
+#define QNAV_DTHETA_MAX 180
+
+/* Distance levels: each sector range is quantized to 0..QNAV_DIST_LEVELS-1 before a policy
+ * sees it, identically in network, probabilistic and table mode. A quality table holds
+ * QNAV_DIST_LEVELS * (QNAV_DTHETA_MAX + 1) entries of 2 bytes (32 levels: 11 584 bytes). */
+#ifndef QNAV_DIST_LEVELS
+#define QNAV_DIST_LEVELS 32
+#endif
+
+/* Largest number of hidden units a network policy may have. */
+#ifndef QNAV_MAX_HIDDEN
+#define QNAV_MAX_HIDDEN 32
+#endif
+
+/* Hidden units of a newly made network policy when nothing else is asked for. */
+#define QNAV_DEFAULT_HIDDEN 12
+
+/* Largest number of sonar sectors. */
+#define QNAV_MAX_SECTORS 360
+
+/* 1: lookup tables and compiled quality tables are read from program memory (AVR flash);
+ * 0: they are ordinary const data. Defaults to 1 on AVR. */
+#ifndef QNAV_TABLES_IN_FLASH
+#if defined(__AVR__)
+#define QNAV_TABLES_IN_FLASH 1
+#else
+#define QNAV_TABLES_IN_FLASH 0
+#endif
+#endif
+
+#if QNAV_DIST_LEVELS < 2 || QNAV_DIST_LEVELS > 256
+#error "QNAV_DIST_LEVELS must be in 2..256"
+#endif
+#if QNAV_MAX_HIDDEN < 1 || QNAV_MAX_HIDDEN > 32
+#error "QNAV_MAX_HIDDEN must be in 1..32"
+#endif
+#if QNAV_DEFAULT_HIDDEN > QNAV_MAX_HIDDEN
+#error "QNAV_DEFAULT_HIDDEN must not exceed QNAV_MAX_HIDDEN"
+#endif
+#if QNAV_TABLES_IN_FLASH && !defined(__AVR__)
+#error "QNAV_TABLES_IN_FLASH is for AVR targets only"
+#endif
+
+#endif /* QNAV_CONFIG_H */
