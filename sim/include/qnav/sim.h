@@ -1,0 +1,245 @@
+/*
+ * The qnav simulator's C API: a Box2D world with a two-wheeled robot carrying N sonar
+ * sectors, sensor and actuation noise, collision recovery and the paper's episodes and
+ * fitness (Knudson & Tumer §3.3-3.4, Eq. 1-3). The controller that drives the simulated
+ * robot is libqnav itself (qnav_ctrl_t), linked unchanged. C++17 inside, this C API
+ * outside, so that simevo, navbridge and tests all drive it the same way.
+ *
+ * Use: qnav_sim_robot_load() + qnav_sim_env_load() (immutable, shareable between
+ * contexts and threads) -> qnav_sim_config_default() -> edit -> qnav_sim_create() ->
+ * either qnav_sim_run_episode() (whole episodes) or the step-wise API
+ * (qnav_sim_reset / qnav_sim_scan / qnav_sim_command / qnav_sim_advance / qnav_sim_state /
+ * qnav_sim_result) -> qnav_sim_destroy(). One context is used by one thread at a time;
+ * different contexts may run in parallel. See docs/sim.md.
+ *
+ * Frames and units: world frame x right, y up, metres; headings in the world frame are
+ * radians counter-clockwise from +x. Robot-frame angles (scan, bearing, command) are
+ * counter-clockwise positive, 0 = straight ahead, as in libqnav. Time is counted in
+ * control ticks of QNAV_SIM_TICK_S seconds.
+ */
+#ifndef QNAV_SIM_H
+#define QNAV_SIM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "qnav/ctrl.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Control tick, seconds. Fixed (DESIGN.md §4): tau_c counts these ticks. */
+#define QNAV_SIM_TICK_S 0.1
+
+/* Size of an error buffer that always holds a full message. */
+#define QNAV_SIM_ERRLEN 512
+
+/* Results of functions that can fail. 0 is success, negatives are errors. Every failing
+ * function that takes err/errlen writes one line there: "FILE:LINE: problem" for files,
+ * "FIELD: problem" for parameters. */
+typedef enum {
+    QNAV_SIM_OK = 0,
+    QNAV_SIM_E_NULL = -1,    /* a required pointer was null */
+    QNAV_SIM_E_IO = -2,      /* a file could not be opened or read */
+    QNAV_SIM_E_PARSE = -3,   /* a file is malformed or has a bad or missing value */
+    QNAV_SIM_E_PARAM = -4,   /* an impossible parameter (sector count, noise, controller
+                                that does not match the context, ...) */
+    QNAV_SIM_E_WORLD = -5,   /* an inconsistent world (start zone inside an obstacle or
+                                outside the arena, destination unreachable by geometry) */
+    QNAV_SIM_E_STATE = -6,   /* step-wise call out of order (no episode reset yet) */
+    QNAV_SIM_E_NOMEM = -7    /* allocation failed */
+} qnav_sim_status_t;
+
+/* A robot profile (data/robots/*.toml) and an environment (data/envs/*.toml). Opaque,
+ * immutable after loading; one loaded object may be shared by many contexts. */
+typedef struct qnav_sim_robot qnav_sim_robot_t;
+typedef struct qnav_sim_env qnav_sim_env_t;
+/* A simulation context: one Box2D world, one robot, its generators. Holds one episode at
+ * a time and may run any number of them in sequence. */
+typedef struct qnav_sim qnav_sim_t;
+
+/*
+ * Load a robot profile. spec is a file path, or a bare name (no '/', no ".toml") looked
+ * up as <data>/robots/<name>.toml, where <data> is $QNAV_DATA_DIR if set, else the
+ * source tree's data/ folder. Returns QNAV_SIM_OK and *out (free with
+ * qnav_sim_robot_free), or QNAV_SIM_E_NULL / _IO / _PARSE / _NOMEM with *out = NULL and
+ * "FILE:LINE: problem" in err.
+ */
+qnav_sim_status_t qnav_sim_robot_load(const char *spec, qnav_sim_robot_t **out, char *err,
+                                      size_t errlen);
+/* Same from TOML text in memory; name stands in for the file name in messages. */
+qnav_sim_status_t qnav_sim_robot_parse(const char *text, size_t len, const char *name,
+                                       qnav_sim_robot_t **out, char *err, size_t errlen);
+void qnav_sim_robot_free(qnav_sim_robot_t *robot);
+
+/* Environments: as for robots, bare names are looked up as <data>/envs/<name>.toml.
+ * A start zone that overlaps an obstacle or leaves the arena, or a destination inside an
+ * obstacle, is refused with QNAV_SIM_E_WORLD. */
+qnav_sim_status_t qnav_sim_env_load(const char *spec, qnav_sim_env_t **out, char *err,
+                                    size_t errlen);
+qnav_sim_status_t qnav_sim_env_parse(const char *text, size_t len, const char *name,
+                                     qnav_sim_env_t **out, char *err, size_t errlen);
+void qnav_sim_env_free(qnav_sim_env_t *env);
+
+/* What a loaded robot profile says (read-only view). */
+typedef struct {
+    const char *name;          /* profile name, e.g. "pioneer3dx"; owned by the robot */
+    double radius_m;           /* collision radius of the body, m */
+    double v_max_mps;          /* maximum forward speed, m/s */
+    double accel_mps2;         /* maximum acceleration, m/s^2 */
+    double decel_mps2;         /* maximum deceleration, m/s^2 */
+    double turn_rate_max_dps;  /* maximum turn rate, deg/s */
+    double range_min_m;        /* sonar minimum range (closer reads this), m */
+    double range_max_m;        /* sonar maximum range (farther is clipped), m */
+    uint16_t default_sectors;  /* sector count when the config asks for 0 */
+} qnav_sim_robot_info_t;
+void qnav_sim_robot_info(const qnav_sim_robot_t *robot, qnav_sim_robot_info_t *info);
+
+/* What a loaded environment says (read-only view). */
+typedef struct {
+    const char *name;          /* environment name; owned by the env */
+    double width_m, height_m;  /* arena, walls at x = 0, x = width, y = 0, y = height, m */
+    double dest_x_m, dest_y_m; /* destination centre, world frame, m */
+    double dest_radius_m;      /* reached when the robot centre is this close, m */
+    double episode_limit_s;    /* episode time limit, s */
+    uint32_t n_obstacles;      /* circles + boxes */
+    uint32_t n_start_zones;    /* rectangles the start point is drawn from */
+} qnav_sim_env_info_t;
+void qnav_sim_env_info(const qnav_sim_env_t *env, qnav_sim_env_info_t *info);
+
+/* Context settings. Obtain with qnav_sim_config_default(), then edit. */
+typedef struct {
+    uint16_t n_sectors;        /* sonar sectors N, 1..360; 0 = the profile's default */
+    double sensor_noise;       /* p_s >= 0 (0.05 = 5 %): range*(1+p_s*n), bearing
+                                  + p_s*pi*n rad, n ~ N(0,1) fresh per reading */
+    double actuation_noise;    /* p_a >= 0: commanded speed*(1+p_a*n), commanded heading
+                                  + p_a*pi*n rad, fresh per tick */
+    uint64_t seed;             /* context seed; an episode's randomness depends only on
+                                  (seed, episode_seed), never on earlier episodes */
+    double episode_limit_s;    /* episode time limit, s; 0 = the environment's */
+} qnav_sim_config_t;
+
+/* Defaults: profile's sectors, no noise, seed 1, the environment's limit. */
+void qnav_sim_config_default(qnav_sim_config_t *cfg);
+
+/*
+ * Create a context for (robot, env, cfg). robot and env must outlive it. Returns
+ * QNAV_SIM_OK and *out, or QNAV_SIM_E_NULL / _PARAM (n_sectors > 360, negative or
+ * non-finite noise, limit < 0) / _NOMEM with a "FIELD: problem" line in err.
+ */
+qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_env_t *env,
+                                  const qnav_sim_config_t *cfg, qnav_sim_t **out, char *err,
+                                  size_t errlen);
+void qnav_sim_destroy(qnav_sim_t *sim);
+
+/* The controller configuration that matches this context: n_sectors and max_range_mm
+ * (the profile's maximum range in mm) set, full_speed_quality left at its default. */
+void qnav_sim_ctrl_config(const qnav_sim_t *sim, qnav_ctrl_config_t *cfg);
+
+/* The episode's figures (paper Eq. 1-3; definitions in docs/sim.md). */
+typedef struct {
+    double l;                  /* path length driven, m (sum of per-tick displacement) */
+    double beta_l;             /* best path length: straight line from the start to the
+                                  edge of the destination circle, m */
+    double tau_l;              /* time used, s (ticks * QNAV_SIM_TICK_S) */
+    double beta_tau;           /* shortest possible time: beta_l from rest at the
+                                  profile's v_max and accel, s */
+    double f1;                 /* Eq. 2: l/beta_l if l <= beta_l else beta_l/l */
+    double f2;                 /* Eq. 3: tau_l/beta_tau if tau_l <= beta_tau else
+                                  beta_tau/tau_l */
+    uint32_t tau_c;            /* ticks spent in collision recovery */
+    double R;                  /* Eq. 1: eta1*f1 + eta2*f2 - tau_c, eta1 = 1, eta2 = 10 */
+    bool reached;              /* the robot centre came within dest_radius_m */
+    uint32_t ticks;            /* control ticks run */
+    uint32_t collisions;       /* recovery manoeuvres started */
+    double start_x_m, start_y_m;     /* start point, world frame, m */
+    double start_heading_rad;        /* start heading, world frame, rad */
+} qnav_sim_result_t;
+
+/* One trajectory sample, delivered after every tick (and once after reset, tick 0). */
+typedef struct {
+    uint32_t tick;             /* ticks since reset */
+    double x_m, y_m;           /* robot centre, world frame, m */
+    double heading_rad;        /* true heading, world frame, rad, (-pi, pi] */
+    double speed_mps;          /* forward speed, m/s */
+    qnav_deg_t cmd_heading_deg;  /* command applied this tick, robot frame, deg */
+    double cmd_speed;          /* commanded speed fraction of v_max, [0, 1] */
+    bool recovering;           /* in a collision recovery manoeuvre */
+    bool collided;             /* a new collision started this tick */
+} qnav_sim_sample_t;
+
+/* Called once per sample; user is passed through. */
+typedef void (*qnav_sim_trace_fn)(void *user, const qnav_sim_sample_t *sample);
+
+/*
+ * Run one whole episode: reset with episode_seed, then every tick scan -> qnav_ctrl_step
+ * -> command -> advance, until the destination is reached or the limit expires. ctrl is
+ * an initialised libqnav controller (network, probabilistic or table mode) whose n_sectors
+ * and max_range_mm match qnav_sim_ctrl_config(); it is only read. trace may be NULL.
+ * Returns QNAV_SIM_OK with *res, or QNAV_SIM_E_NULL / QNAV_SIM_E_PARAM (controller not
+ * ready or not matching).
+ */
+qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
+                                       uint64_t episode_seed, qnav_sim_result_t *res,
+                                       qnav_sim_trace_fn trace, void *user);
+
+/* ---- Step-wise API (software in the loop) ---------------------------------------- */
+
+/* One tick's sensing, exactly what the controller takes. */
+typedef struct {
+    uint16_t n_sectors;                    /* N */
+    qnav_mm_t max_range_mm;                /* profile's maximum range, mm */
+    qnav_mm_t ranges_mm[QNAV_MAX_SECTORS]; /* sector k centred on k*360/N deg, robot
+                                              frame, CCW; nearest obstacle in its cone,
+                                              noisy, clipped to [min, max] range, mm */
+    qnav_cdeg_t goal_bearing_cdeg;         /* destination bearing, robot frame, 0.01 deg,
+                                              -18000..17999, from the noisy heading */
+} qnav_sim_scan_t;
+
+/* The robot's true state. */
+typedef struct {
+    uint32_t tick;             /* ticks since reset */
+    double x_m, y_m;           /* robot centre, world frame, m */
+    double heading_rad;        /* true heading, world frame, rad, (-pi, pi] */
+    double speed_mps;          /* forward speed, m/s */
+    double goal_distance_m;    /* robot centre to destination centre, m */
+    bool recovering;           /* in a collision recovery manoeuvre (commands ignored) */
+    uint32_t recovery_ticks_left;  /* ticks of the manoeuvre still to run */
+    uint32_t collisions;       /* recovery manoeuvres started so far */
+    bool done;                 /* episode over: reached, or the limit expired */
+    bool reached;              /* destination reached */
+} qnav_sim_state_t;
+
+/* Start a new episode: random start point in a random start zone (zones weighted by
+ * area), random heading, robot at rest. Computes the first scan. */
+qnav_sim_status_t qnav_sim_reset(qnav_sim_t *sim, uint64_t episode_seed);
+
+/* Copy this tick's scan (computed once per tick at reset/advance, so reading it twice
+ * gives the same values). QNAV_SIM_E_STATE before the first reset. */
+qnav_sim_status_t qnav_sim_scan(const qnav_sim_t *sim, qnav_sim_scan_t *scan);
+
+/* Set the command for the next advance. heading is robot-frame deg (wrapped), speed is a
+ * fraction of v_max (clamped to [0, 1]). Kept until replaced; ignored while recovering. */
+qnav_sim_status_t qnav_sim_command(qnav_sim_t *sim, const qnav_ctrl_output_t *out);
+qnav_sim_status_t qnav_sim_command_raw(qnav_sim_t *sim, double heading_deg, double speed);
+
+/* Advance one tick (QNAV_SIM_TICK_S): actuation noise, heading controller, wheels and
+ * slip, Box2D step, collision detection and recovery, then the next scan. Does nothing
+ * once the episode is done. QNAV_SIM_E_STATE before the first reset. */
+qnav_sim_status_t qnav_sim_advance(qnav_sim_t *sim);
+
+/* The true state, and the figures so far (final once state.done). */
+qnav_sim_status_t qnav_sim_state(const qnav_sim_t *sim, qnav_sim_state_t *state);
+qnav_sim_status_t qnav_sim_result(const qnav_sim_t *sim, qnav_sim_result_t *res);
+
+/* Fitness of an episode from its raw figures (Eq. 1-3), for tests and tools. Fills f1,
+ * f2 and R of res from l, beta_l, tau_l, beta_tau and tau_c. */
+void qnav_sim_fitness(qnav_sim_result_t *res);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* QNAV_SIM_H */
