@@ -52,7 +52,7 @@ typedef enum {
     QNAV_SIM_E_NOMEM = -7    /* allocation failed */
 } qnav_sim_status_t;
 
-/* A robot profile (data/robots/*.toml) and an environment (data/envs/*.toml). Opaque,
+/* A robot profile (a TOML file in data/robots/) and an environment (data/envs/). Opaque,
  * immutable after loading; one loaded object may be shared by many contexts. */
 typedef struct qnav_sim_robot qnav_sim_robot_t;
 typedef struct qnav_sim_env qnav_sim_env_t;
