@@ -34,12 +34,12 @@ static int32_t div_round(int32_t num, int32_t den)
 }
 
 /*
- * e^-u for u in Q16.16 (u >= 0), result Q1.15 in [0, 32767]. Range reduction by ln 2,
- * then 7 terms of the series in Q0.16; error at most 2 LSB of Q1.15.
+ * e^-u for u in Q16.16 (u >= 0), result in units of 2^-15 in [0, 32768] (1.0 included).
+ * Range reduction by ln 2, then 9 terms of the series in Q0.16; error at most 2 LSB.
  * @par Scaling and overflow: all products are r * t with r < 45426 and t <= 65536, which
  * fit uint32.
  */
-static qnav_q1_15_t exp_neg_q15(uint32_t u_q16)
+static uint16_t exp_neg_q15(uint32_t u_q16)
 {
     const uint32_t ln2_q16 = 45426u;
     uint32_t n = u_q16 / ln2_q16;
@@ -54,7 +54,7 @@ static qnav_q1_15_t exp_neg_q15(uint32_t u_q16)
         t = 65536u - ((r * t) / k >> 16);
     }
     v = (t + (1u << n)) >> (n + 1u);
-    return (qnav_q1_15_t)(v > 32767u ? 32767u : v);
+    return (uint16_t)v;
 }
 
 void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg)
@@ -108,13 +108,14 @@ static qnav_status_t init_prob(qnav_ctrl_t *ctrl, const qnav_prob_params_t *p)
     }
     for (i = 0; i <= QNAV_DTHETA_MAX; ++i) {
         uint32_t u = ((uint32_t)p->k_goal * i * 256u + QNAV_DTHETA_MAX / 2u) / QNAV_DTHETA_MAX;
-        ctrl->p.prob.goal[i] = exp_neg_q15(u);
+        uint16_t g = exp_neg_q15(u);
+        ctrl->p.prob.goal[i] = (qnav_q1_15_t)(g > 32767u ? 32767u : g);
     }
     for (i = 0; i < QNAV_DIST_LEVELS; ++i) {
         uint32_t u = ((uint32_t)p->k_safe * i * 256u + (QNAV_DIST_LEVELS - 1u) / 2u) /
                      (QNAV_DIST_LEVELS - 1u);
-        int32_t s = 32768 - (int32_t)exp_neg_q15(u);
-        ctrl->p.prob.safe[i] = (qnav_q1_15_t)(s > 32767 ? 32767 : s);
+        ctrl->p.prob.safe[i] = (qnav_q1_15_t)(32768u - exp_neg_q15(u) > 32767u
+                                                  ? 32767u : 32768u - exp_neg_q15(u));
     }
     return QNAV_OK;
 }
@@ -128,12 +129,12 @@ static qnav_status_t init_net(qnav_ctrl_t *ctrl, const qnav_net_t *net)
     ctrl->hidden = net->hidden;
     for (j = 0; j < net->hidden; ++j) {
         qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
-        u->bias_z = (int32_t)net->b_hidden[j] * 4096;
-        u->per_deg = div_round((int32_t)net->w_theta[j] * 4096, QNAV_DTHETA_MAX);
-        u->per_level = div_round((int32_t)net->w_dist[j] * 4096, QNAV_DIST_LEVELS - 1);
+        u->bias_z = (int32_t)net->b_hidden[j] * 16384;
+        u->per_deg = div_round((int32_t)net->w_theta[j] * 16384, QNAV_DTHETA_MAX);
+        u->per_level = div_round((int32_t)net->w_dist[j] * 16384, QNAV_DIST_LEVELS - 1);
         u->out = net->w_out[j];
     }
-    ctrl->out_bias_z = (int32_t)net->b_out * 16;
+    ctrl->out_bias_z = (int32_t)net->b_out * 128;
     return QNAV_OK;
 }
 
@@ -178,20 +179,22 @@ qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *
 }
 
 /*
- * One hidden unit's share of the output pre-activation, Q4.12 in int32.
- * zf is the unit's pre-activation in units of 2^-20 (|zf| < 3 * 2^27).
- * @par Scaling and overflow: (zf + 128) >> 8 is Q4.12, saturated to [-8, 8); out (Q8.8)
- * times h (Q1.15) is below 2^30; >> 11 gives Q4.12, below 2^19 per unit.
+ * One hidden unit's share of the output pre-activation, in units of 2^-15.
+ * zf is the unit's pre-activation in units of 2^-22 (|zf| < 3 * 2^29).
+ * @par Scaling and overflow: (zf + 2^10) >> 11 is Q5.11, saturated to [-16, 16); out
+ * (Q8.8) times h (Q1.15) is below 2^30; >> 8 leaves units of 2^-15, below 2^22 per unit,
+ * so 32 units sum below 2^27.
  */
 static int32_t unit_share(int32_t zf, int16_t out)
 {
-    int16_t h = qnav_sigmoid_q4_12(sat16((zf + 128) >> 8));
-    return ((int32_t)out * h + 1024) >> 11;
+    int16_t h = qnav_sigmoid_q5_11(sat16((zf + 1024) >> 11));
+    return ((int32_t)out * h + 128) >> 8;
 }
 
+/* Output unit: acc in units of 2^-15, rounded to Q5.11 and saturated. */
 static qnav_q1_15_t net_output(int32_t acc)
 {
-    return qnav_sigmoid_q4_12(sat16(acc));
+    return qnav_sigmoid_q5_11(sat16((acc + 8) >> 4));
 }
 
 static qnav_q1_15_t prob_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)

@@ -1,6 +1,6 @@
 /*
- * The sigmoid lookup table shared by the network's hidden and output units (private).
- * 4096 entries of Q1.15, indexed by the top 12 bits of a Q4.12 input offset by 8.
+ * The sigmoid lookup table shared by the network's hidden and output units (private):
+ * 4097 Q1.15 entries on a 1/128 grid over [-16, 16], read with linear interpolation.
  */
 #ifndef QNAV_SIGMOID_LUT_H
 #define QNAV_SIGMOID_LUT_H
@@ -8,16 +8,25 @@
 #include <stdint.h>
 #include "qnav/flash.h"
 
-#define QNAV_SIGMOID_LUT_SIZE 4096
+#define QNAV_SIGMOID_LUT_SIZE 4097
 
 extern const uint16_t qnav_sigmoid_lut[QNAV_SIGMOID_LUT_SIZE] QNAV_FLASH;
 
-/* sigmoid(z) for z in Q4.12 ([-8, 8)), result Q1.15 in [0, 32767].
- * @par Scaling and overflow: input covers the whole int16 range, no overflow. */
-static inline int16_t qnav_sigmoid_q4_12(int16_t z)
+/*
+ * sigmoid(z) for z in Q5.11 ([-16, 16)), result Q1.15 in [0, 32767].
+ * @par Scaling and overflow: u = z + 16 in units of 2^-11 is a uint16; its top 12 bits
+ * pick the grid point below z (at most 4095, so entry + 1 exists), its low 4 bits the
+ * fraction. Neighbouring entries differ by at most 64, so diff * frac < 2^10.
+ * Error: interpolation below 1e-6, rounding at most 2^-15.
+ */
+static inline int16_t qnav_sigmoid_q5_11(int16_t z)
 {
-    uint16_t index = (uint16_t)((uint16_t)((uint16_t)z ^ 0x8000u) >> 4);
-    return (int16_t)QNAV_FLASH_READ_U16(&qnav_sigmoid_lut[index]);
+    uint16_t u = (uint16_t)((uint16_t)z ^ 0x8000u);
+    uint16_t i = (uint16_t)(u >> 4);
+    uint16_t lo = QNAV_FLASH_READ_U16(&qnav_sigmoid_lut[i]);
+    uint16_t hi = QNAV_FLASH_READ_U16(&qnav_sigmoid_lut[i + 1u]);
+    uint16_t frac = (uint16_t)(u & 15u);
+    return (int16_t)(lo + (uint16_t)(((uint16_t)(hi - lo) * frac + 8u) >> 4));
 }
 
 #endif /* QNAV_SIGMOID_LUT_H */

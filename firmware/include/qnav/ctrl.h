@@ -63,9 +63,9 @@ typedef struct {
 
 /* Derived, per-hidden-unit network parameters (docs/qformats.md, "network step"). */
 typedef struct {
-    int32_t bias_z;    /* hidden bias, Q4.12 units held in int32 */
-    int32_t per_deg;   /* weight per degree of dtheta, 2^-16 Q4.12 units (Q4.28) */
-    int32_t per_level; /* weight per distance level, Q4.12 units */
+    int32_t bias_z;    /* hidden bias, units of 2^-22 */
+    int32_t per_deg;   /* weight per degree of dtheta, units of 2^-22 */
+    int32_t per_level; /* weight per distance level, units of 2^-22 */
     int16_t out;       /* output weight, Q8.8 */
 } qnav_ctrl_unit_t;
 
@@ -81,7 +81,7 @@ typedef struct {
     uint32_t speed_scale;             /* speed = min(MAX, (quality * scale) >> 15) */
     qnav_q1_15_t full_speed_quality;
     const qnav_q1_15_t *table;        /* table mode: [QNAV_DIST_LEVELS][181] qualities */
-    int32_t out_bias_z;               /* network output bias, Q4.12 units */
+    int32_t out_bias_z;               /* network output bias, units of 2^-15 */
     union {
         struct {
             qnav_q1_15_t goal[QNAV_DTHETA_MAX + 1]; /* P_goal by dtheta */

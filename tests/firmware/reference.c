@@ -1,0 +1,70 @@
+/*
+ * Double-precision reference of the probabilistic and network policies (tests only).
+ */
+#include "reference.h"
+
+#include <math.h>
+
+static double sigmoid(double z) { return 1.0 / (1.0 + exp(-z)); }
+
+double ref_quality(const qnav_policy_t *policy, unsigned level, unsigned dtheta)
+{
+    double xt = dtheta / 180.0;
+    double xd = level / (double)(QNAV_DIST_LEVELS - 1);
+    if (policy->kind == QNAV_POLICY_PROB) {
+        double kg = policy->u.prob.k_goal / 256.0;
+        double ks = policy->u.prob.k_safe / 256.0;
+        return exp(-kg * xt) * (1.0 - exp(-ks * xd));
+    }
+    const qnav_net_t *n = &policy->u.net;
+    double y = n->b_out / 256.0;
+    for (unsigned j = 0; j < n->hidden; ++j) {
+        double z = n->w_theta[j] / 256.0 * xt + n->w_dist[j] / 256.0 * xd + n->b_hidden[j] / 256.0;
+        y += n->w_out[j] / 256.0 * sigmoid(z);
+    }
+    return sigmoid(y);
+}
+
+double ref_quality_bound(const qnav_policy_t *policy)
+{
+    if (policy->kind == QNAV_POLICY_PROB) {
+        return 2.5e-4;
+    }
+    const qnav_net_t *n = &policy->u.net;
+    double sum_out = 0.0;
+    for (unsigned j = 0; j < n->hidden; ++j) {
+        sum_out += fabs(n->w_out[j] / 256.0);
+    }
+    /* docs/qformats.md: pre-activation rounding 2^-12 + weight rounding 106 * 2^-22,
+     * times the largest slope 1/4, plus the table's rounding and interpolation 2^-15 */
+    const double e_z = 1.0 / 4096 + 106.0 / 4194304.0;
+    const double e_sig = 1.0 / 32768 + 1e-6;
+    const double e_hidden = 0.25 * e_z + e_sig;
+    const double e_share = 1.0 / 65536;    /* rounding of each unit's share */
+    const double e_y = 1.0 / 4096;         /* rounding of the output to Q5.11 */
+    return 0.25 * (sum_out * e_hidden + n->hidden * e_share + e_y) + e_sig;
+}
+
+unsigned ref_goal_deg(qnav_cdeg_t bearing_cdeg)
+{
+    long d = lround(bearing_cdeg / 100.0);
+    d %= 360;
+    return (unsigned)(d < 0 ? d + 360 : d);
+}
+
+unsigned ref_dtheta(unsigned path, unsigned goal)
+{
+    unsigned d = (path + 360u - goal) % 360u;
+    return d <= 180u ? d : 360u - d;
+}
+
+void ref_path_qualities(const qnav_ctrl_t *ctrl, const qnav_policy_t *policy,
+                        const qnav_ctrl_input_t *in, double out[QNAV_PATHS])
+{
+    unsigned goal = ref_goal_deg(in->goal_bearing_cdeg);
+    for (unsigned i = 0; i < QNAV_PATHS; ++i) {
+        uint16_t s = qnav_ctrl_sector_of_path(ctrl->n_sectors, (uint16_t)i);
+        unsigned level = qnav_ctrl_level(ctrl, in->ranges_mm[s]);
+        out[i] = ref_quality(policy, level, ref_dtheta(i, goal));
+    }
+}

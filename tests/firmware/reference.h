@@ -1,0 +1,28 @@
+/*
+ * Double-precision reference of both policies, for tests only: the same quantized inputs
+ * (distance level, whole-degree dtheta) as the controller, real arithmetic everywhere else.
+ */
+#ifndef QNAV_TEST_REFERENCE_H
+#define QNAV_TEST_REFERENCE_H
+
+#include "qnav/ctrl.h"
+
+/* Quality in [0, 1] the policy gives (level, dtheta) in real arithmetic. */
+double ref_quality(const qnav_policy_t *policy, unsigned level, unsigned dtheta);
+
+/* The stated bound on |fixed-point quality - reference| for this policy
+ * (docs/qformats.md, "error bound"). */
+double ref_quality_bound(const qnav_policy_t *policy);
+
+/* Reference qualities of all 360 paths for a scan, using the controller's own input
+ * quantization (qnav_ctrl_level, qnav_ctrl_sector_of_path). */
+void ref_path_qualities(const qnav_ctrl_t *ctrl, const qnav_policy_t *policy,
+                        const qnav_ctrl_input_t *in, double out[QNAV_PATHS]);
+
+/* Whole-degree destination bearing (0..359) as the controller rounds it. */
+unsigned ref_goal_deg(qnav_cdeg_t bearing_cdeg);
+
+/* Wrapped angular distance between path i and the goal degree, 0..180. */
+unsigned ref_dtheta(unsigned path, unsigned goal);
+
+#endif
