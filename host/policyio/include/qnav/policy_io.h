@@ -34,6 +34,78 @@ int qnav_policy_parse(const char *text, size_t len, const char *name, qnav_polic
 int qnav_policy_write(const char *path, const qnav_policy_t *policy, const char *comment,
                       char *err, size_t errlen);
 
+/* ---- Additions: format limits, metadata, in-memory rendering, checks ---------------- */
+
+/* The format version this library reads and writes (line 1: "qnav-policy 1"). */
+#define QNAV_POLICY_FORMAT_VERSION 1
+/* Longest line, in bytes, not counting the line ending. */
+#define QNAV_POLICY_LINE_MAX 256
+/* Largest file the reader accepts, in bytes. */
+#define QNAV_POLICY_FILE_MAX (1024L * 1024L)
+/* Longest comment qnav_policy_write() accepts, in bytes. */
+#define QNAV_POLICY_COMMENT_MAX 4096
+/* Metadata limits: entries per file, name length, value length (bytes, without NUL). */
+#define QNAV_POLICY_META_MAX 16
+#define QNAV_POLICY_META_NAME_MAX 31
+#define QNAV_POLICY_META_VALUE_MAX 200
+
+/* One "meta NAME TEXT" line. */
+typedef struct {
+    char name[QNAV_POLICY_META_NAME_MAX + 1];   /* [A-Za-z0-9_.-], 1..31 bytes */
+    char value[QNAV_POLICY_META_VALUE_MAX + 1]; /* 1..200 bytes, no '#', no control
+                                                   characters, no surrounding blanks */
+} qnav_policy_meta_entry_t;
+
+/* The metadata of one file, in file order. Zero it with qnav_policy_meta_clear(). */
+typedef struct {
+    size_t count; /* 0..QNAV_POLICY_META_MAX */
+    qnav_policy_meta_entry_t entry[QNAV_POLICY_META_MAX];
+} qnav_policy_meta_t;
+
+void qnav_policy_meta_clear(qnav_policy_meta_t *meta);
+
+/* Add or replace an entry. 0, or -1 with a message in err when the name or value breaks
+ * the rules above or the table is full. */
+int qnav_policy_meta_set(qnav_policy_meta_t *meta, const char *name, const char *value,
+                         char *err, size_t errlen);
+
+/* The value of an entry, or null when there is none. */
+const char *qnav_policy_meta_get(const qnav_policy_meta_t *meta, const char *name);
+
+/* qnav_policy_read / qnav_policy_parse that also keep the metadata lines (meta may be
+ * null). On failure neither *out nor *meta is touched. */
+int qnav_policy_read_meta(const char *path, qnav_policy_t *out, qnav_policy_meta_t *meta,
+                          char *err, size_t errlen);
+int qnav_policy_parse_meta(const char *text, size_t len, const char *name,
+                           qnav_policy_t *out, qnav_policy_meta_t *meta, char *err,
+                           size_t errlen);
+
+/* qnav_policy_write with metadata lines (meta may be null). */
+int qnav_policy_write_meta(const char *path, const qnav_policy_t *policy,
+                           const qnav_policy_meta_t *meta, const char *comment, char *err,
+                           size_t errlen);
+
+/*
+ * Render a policy file into buf (buflen bytes, NUL-terminated when buflen > 0), like
+ * snprintf: returns the length of the full text (without NUL), which is >= buflen when buf
+ * was too small; or -1 with err when the policy, metadata or comment is invalid.
+ */
+int qnav_policy_format(const qnav_policy_t *policy, const qnav_policy_meta_t *meta,
+                       const char *comment, char *buf, size_t buflen, char *err,
+                       size_t errlen);
+
+/* Check a policy in memory against the rules of the format (which are those of
+ * qnav_ctrl_init). 0, or -1 with "what is wrong" (no file prefix) in err. */
+int qnav_policy_check(const qnav_policy_t *policy, char *err, size_t errlen);
+
+/* 1 when a and b are the same policy (kind, shape and every weight in use), else 0. */
+int qnav_policy_equal(const qnav_policy_t *a, const qnav_policy_t *b);
+
+/* Write len bytes to path atomically (temporary file in the same directory, fsync,
+ * rename, fsync of the directory). 0, or -1 with "PATH: what failed" in err. */
+int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, char *err,
+                                size_t errlen);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,1085 @@
+/*
+ * Policy files on the host: the strict reader, the renderer and the atomic writer of the
+ * text format in docs/policy-format.md. The reader works on a length-delimited buffer
+ * (never relying on a terminating NUL), copies each line into a bounded local buffer after
+ * checking its length, and refuses anything malformed with one "FILE:LINE: problem" line.
+ * A parsed policy is finally run through qnav_ctrl_init(), so the reader accepts exactly
+ * what the controller accepts.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include "qnav/policy_io.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "qnav/ctrl.h"
+
+#define MAGIC "qnav-policy"
+#define K_RAW_MAX (64L * 256L) /* 64.0 in Q8.8: largest probabilistic parameter */
+#define MAX_TOKENS 8           /* the longest valid line has 6 tokens */
+
+/* ---- small helpers ------------------------------------------------------------------- */
+
+static void set_err(char *err, size_t errlen, const char *fmt, ...)
+{
+    va_list ap;
+    if (err == NULL || errlen == 0) {
+        return;
+    }
+    va_start(ap, fmt);
+    (void)vsnprintf(err, errlen, fmt, ap);
+    va_end(ap);
+}
+
+/* Copy s into out (outlen bytes) for a one-line message: printable ASCII kept, anything
+ * else as \xNN, cut with "..." after max bytes of input. */
+static void quote_bytes(const char *s, size_t n, size_t max, char *out, size_t outlen)
+{
+    size_t i;
+    size_t o = 0;
+    if (outlen == 0) {
+        return;
+    }
+    for (i = 0; i < n && i < max; ++i) {
+        unsigned char c = (unsigned char)s[i];
+        char tmp[5];
+        size_t tl;
+        if (c >= 0x20 && c < 0x7f) {
+            tmp[0] = (char)c;
+            tmp[1] = '\0';
+        } else {
+            (void)snprintf(tmp, sizeof tmp, "\\x%02X", (unsigned)c);
+        }
+        tl = strlen(tmp);
+        if (o + tl + 1 > outlen) {
+            break;
+        }
+        memcpy(out + o, tmp, tl);
+        o += tl;
+    }
+    if (n > max && o + 4 <= outlen) {
+        memcpy(out + o, "...", 3);
+        o += 3;
+    }
+    out[o] = '\0';
+}
+
+static const char *policy_kind_name(uint8_t kind)
+{
+    return kind == (uint8_t)QNAV_POLICY_NET ? "network" : "probabilistic";
+}
+
+/* ---- checks on a policy in memory ---------------------------------------------------- */
+
+int qnav_policy_check(const qnav_policy_t *policy, char *err, size_t errlen)
+{
+    if (policy == NULL) {
+        set_err(err, errlen, "no policy (null pointer)");
+        return -1;
+    }
+    if (policy->kind == (uint8_t)QNAV_POLICY_NET) {
+        if (policy->u.net.hidden < 1u || policy->u.net.hidden > QNAV_MAX_HIDDEN) {
+            set_err(err, errlen, "hidden %u outside 1..%d", (unsigned)policy->u.net.hidden,
+                    QNAV_MAX_HIDDEN);
+            return -1;
+        }
+        return 0;
+    }
+    if (policy->kind == (uint8_t)QNAV_POLICY_PROB) {
+        if (policy->u.prob.k_goal <= 0 || policy->u.prob.k_goal > K_RAW_MAX) {
+            set_err(err, errlen, "k_goal %d outside (0, 64]: raw Q8.8 must be 1..%ld",
+                    (int)policy->u.prob.k_goal, K_RAW_MAX);
+            return -1;
+        }
+        if (policy->u.prob.k_safe <= 0 || policy->u.prob.k_safe > K_RAW_MAX) {
+            set_err(err, errlen, "k_safe %d outside (0, 64]: raw Q8.8 must be 1..%ld",
+                    (int)policy->u.prob.k_safe, K_RAW_MAX);
+            return -1;
+        }
+        return 0;
+    }
+    set_err(err, errlen, "unknown policy kind %u", (unsigned)policy->kind);
+    return -1;
+}
+
+int qnav_policy_equal(const qnav_policy_t *a, const qnav_policy_t *b)
+{
+    unsigned j;
+    if (a == NULL || b == NULL || a->kind != b->kind) {
+        return 0;
+    }
+    if (a->kind == (uint8_t)QNAV_POLICY_PROB) {
+        return a->u.prob.k_goal == b->u.prob.k_goal && a->u.prob.k_safe == b->u.prob.k_safe;
+    }
+    if (a->kind != (uint8_t)QNAV_POLICY_NET || a->u.net.hidden != b->u.net.hidden ||
+        a->u.net.hidden > QNAV_MAX_HIDDEN || a->u.net.b_out != b->u.net.b_out) {
+        return 0;
+    }
+    for (j = 0; j < a->u.net.hidden; ++j) {
+        if (a->u.net.w_theta[j] != b->u.net.w_theta[j] ||
+            a->u.net.w_dist[j] != b->u.net.w_dist[j] ||
+            a->u.net.b_hidden[j] != b->u.net.b_hidden[j] ||
+            a->u.net.w_out[j] != b->u.net.w_out[j]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* ---- metadata ------------------------------------------------------------------------ */
+
+static int meta_name_ok(const char *s, size_t n)
+{
+    size_t i;
+    if (n < 1 || n > QNAV_POLICY_META_NAME_MAX) {
+        return 0;
+    }
+    for (i = 0; i < n; ++i) {
+        unsigned char c = (unsigned char)s[i];
+        if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+              c == '_' || c == '.' || c == '-')) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Checks a value as the reader would deliver it: 1..200 bytes, no '#', no control
+ * characters, no blanks at either end. Returns NULL or the reason. */
+static const char *meta_value_problem(const char *s, size_t n)
+{
+    size_t i;
+    if (n < 1) {
+        return "is empty";
+    }
+    if (n > QNAV_POLICY_META_VALUE_MAX) {
+        return "is longer than 200 bytes";
+    }
+    if (s[0] == ' ' || s[0] == '\t' || s[n - 1] == ' ' || s[n - 1] == '\t') {
+        return "starts or ends with a blank";
+    }
+    for (i = 0; i < n; ++i) {
+        unsigned char c = (unsigned char)s[i];
+        if (c == '#') {
+            return "contains '#' (it would start a comment)";
+        }
+        if ((c < 0x20 && c != '\t') || c == 0x7f) {
+            return "contains a control character";
+        }
+    }
+    return NULL;
+}
+
+void qnav_policy_meta_clear(qnav_policy_meta_t *meta)
+{
+    if (meta != NULL) {
+        memset(meta, 0, sizeof *meta);
+    }
+}
+
+const char *qnav_policy_meta_get(const qnav_policy_meta_t *meta, const char *name)
+{
+    size_t i;
+    if (meta == NULL || name == NULL) {
+        return NULL;
+    }
+    for (i = 0; i < meta->count && i < QNAV_POLICY_META_MAX; ++i) {
+        if (strcmp(meta->entry[i].name, name) == 0) {
+            return meta->entry[i].value;
+        }
+    }
+    return NULL;
+}
+
+int qnav_policy_meta_set(qnav_policy_meta_t *meta, const char *name, const char *value,
+                         char *err, size_t errlen)
+{
+    size_t i;
+    size_t nl;
+    size_t vl;
+    const char *why;
+    char q[80];
+    if (meta == NULL || name == NULL || value == NULL) {
+        set_err(err, errlen, "meta: null argument");
+        return -1;
+    }
+    nl = strlen(name);
+    vl = strlen(value);
+    if (!meta_name_ok(name, nl)) {
+        quote_bytes(name, nl, 40, q, sizeof q);
+        set_err(err, errlen, "meta name '%s' must be 1..31 of A-Z a-z 0-9 _ . -", q);
+        return -1;
+    }
+    why = meta_value_problem(value, vl);
+    if (why != NULL) {
+        set_err(err, errlen, "meta %s: value %s", name, why);
+        return -1;
+    }
+    for (i = 0; i < meta->count && i < QNAV_POLICY_META_MAX; ++i) {
+        if (strcmp(meta->entry[i].name, name) == 0) {
+            memcpy(meta->entry[i].value, value, vl + 1);
+            return 0;
+        }
+    }
+    if (meta->count >= QNAV_POLICY_META_MAX) {
+        set_err(err, errlen, "meta %s: more than %d metadata entries", name,
+                QNAV_POLICY_META_MAX);
+        return -1;
+    }
+    memcpy(meta->entry[meta->count].name, name, nl + 1);
+    memcpy(meta->entry[meta->count].value, value, vl + 1);
+    meta->count++;
+    return 0;
+}
+
+/* ---- the reader ---------------------------------------------------------------------- */
+
+typedef struct {
+    const char *p;
+    size_t n;
+} token_t;
+
+typedef struct {
+    const char *name; /* file name for messages */
+    char *err;
+    size_t errlen;
+    unsigned long line; /* current line, 1-based */
+    qnav_policy_t pol;
+    qnav_policy_meta_t meta;
+    unsigned long kind_line;
+    unsigned long qformat_line;
+    unsigned long hidden_line;
+    unsigned long b_out_line;
+    unsigned long k_goal_line;
+    unsigned long k_safe_line;
+    unsigned long end_line;
+    unsigned long meta_line[QNAV_POLICY_META_MAX];
+    unsigned long unit_line[QNAV_MAX_HIDDEN];
+    unsigned next_unit;
+} parser_t;
+
+static int fail(parser_t *ps, const char *fmt, ...)
+{
+    char msg[QNAV_POLICY_IO_ERRLEN];
+    char nm[200];
+    va_list ap;
+    va_start(ap, fmt);
+    (void)vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    quote_bytes(ps->name, strlen(ps->name), 160, nm, sizeof nm);
+    set_err(ps->err, ps->errlen, "%s:%lu: %s", nm, ps->line, msg);
+    return -1;
+}
+
+static int tok_is(const token_t *t, const char *s)
+{
+    size_t n = strlen(s);
+    return t->n == n && memcmp(t->p, s, n) == 0;
+}
+
+/* Decimal integer with optional sign. 0 ok, -1 not an integer, -2 too large for int32. */
+static int parse_int(const token_t *t, long *out)
+{
+    size_t i = 0;
+    long v = 0;
+    int neg = 0;
+    if (t->n == 0) {
+        return -1;
+    }
+    if (t->p[0] == '-' || t->p[0] == '+') {
+        neg = t->p[0] == '-';
+        i = 1;
+    }
+    if (i >= t->n) {
+        return -1;
+    }
+    for (; i < t->n; ++i) {
+        char c = t->p[i];
+        if (c < '0' || c > '9') {
+            return -1;
+        }
+        if (v > 100000000L) {
+            v = 1000000000L; /* saturate: any such value is out of every range here */
+        } else {
+            v = v * 10 + (c - '0');
+        }
+    }
+    *out = neg ? -v : v;
+    return 0;
+}
+
+/* A Q8.8 value; what names it in messages (e.g. "unit 3: " or "b_out "). */
+static int parse_q88(parser_t *ps, const token_t *t, const char *what, qnav_q8_8_t *out)
+{
+    long v = 0;
+    char q[80];
+    quote_bytes(t->p, t->n, 40, q, sizeof q);
+    if (parse_int(t, &v) != 0) {
+        return fail(ps, "%s'%s' is not an integer (weights are raw Q8.8: value * 256)", what,
+                    q);
+    }
+    if (v < -32768L || v > 32767L) {
+        return fail(ps, "%svalue %s outside the Q8.8 range -32768..32767", what, q);
+    }
+    *out = (qnav_q8_8_t)v;
+    return 0;
+}
+
+static int once(parser_t *ps, unsigned long *seen, const char *key)
+{
+    if (*seen != 0) {
+        return fail(ps, "duplicate '%s' (first on line %lu)", key, *seen);
+    }
+    *seen = ps->line;
+    return 0;
+}
+
+static int want_values(parser_t *ps, size_t ntok, size_t want, const char *key)
+{
+    if (ntok - 1 != want) {
+        return fail(ps, "'%s' takes %zu value%s, found %zu", key, want, want == 1 ? "" : "s",
+                    ntok - 1);
+    }
+    return 0;
+}
+
+static int line_magic(parser_t *ps, const token_t *tok, size_t ntok)
+{
+    long v = 0;
+    char q[80];
+    if (ntok == 0 || !tok_is(&tok[0], MAGIC)) {
+        return fail(ps, "not a qnav policy file: line 1 must be 'qnav-policy %d'",
+                    QNAV_POLICY_FORMAT_VERSION);
+    }
+    if (ntok != 2) {
+        return fail(ps, "line 1 must be 'qnav-policy %d' (two tokens, found %zu)",
+                    QNAV_POLICY_FORMAT_VERSION, ntok);
+    }
+    quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
+    if (parse_int(&tok[1], &v) != 0) {
+        return fail(ps, "format version '%s' is not an integer", q);
+    }
+    if (v != QNAV_POLICY_FORMAT_VERSION) {
+        return fail(ps, "unsupported format version %s (this reader reads version %d)", q,
+                    QNAV_POLICY_FORMAT_VERSION);
+    }
+    return 0;
+}
+
+static int line_unit(parser_t *ps, const token_t *tok, size_t ntok)
+{
+    long j = 0;
+    unsigned h = ps->pol.u.net.hidden;
+    char q[80];
+    char what[32];
+    qnav_q8_8_t w[4];
+    size_t k;
+    if (ps->hidden_line == 0) {
+        return fail(ps, "'unit' before 'hidden'");
+    }
+    if (ntok < 2) {
+        return fail(ps, "'unit' needs an index and 4 weights");
+    }
+    quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
+    if (parse_int(&tok[1], &j) != 0) {
+        return fail(ps, "unit index '%s' is not an integer", q);
+    }
+    if (j < 0 || j >= (long)h) {
+        return fail(ps, "unit %s outside 0..%u (hidden %u)", q, h - 1u, h);
+    }
+    if ((unsigned)j < ps->next_unit) {
+        return fail(ps, "duplicate unit %ld (first on line %lu)", j, ps->unit_line[j]);
+    }
+    if ((unsigned)j > ps->next_unit) {
+        return fail(ps, "unit %ld out of order: expected unit %u", j, ps->next_unit);
+    }
+    if (ntok != 6) {
+        return fail(ps, "unit %ld: expected 4 weights (w_theta w_dist b_hidden w_out), found %zu",
+                    j, ntok - 2);
+    }
+    (void)snprintf(what, sizeof what, "unit %ld: ", j);
+    for (k = 0; k < 4; ++k) {
+        if (parse_q88(ps, &tok[2 + k], what, &w[k]) != 0) {
+            return -1;
+        }
+    }
+    ps->pol.u.net.w_theta[j] = w[0];
+    ps->pol.u.net.w_dist[j] = w[1];
+    ps->pol.u.net.b_hidden[j] = w[2];
+    ps->pol.u.net.w_out[j] = w[3];
+    ps->unit_line[j] = ps->line;
+    ps->next_unit++;
+    return 0;
+}
+
+static int line_meta(parser_t *ps, const char *body, size_t blen, const token_t *tok,
+                     size_t ntok)
+{
+    char q[80];
+    size_t i;
+    const char *v;
+    size_t vl;
+    const char *why;
+    qnav_policy_meta_entry_t *e;
+    if (ntok < 3) {
+        return fail(ps, "'meta' needs a name and a value");
+    }
+    quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
+    if (!meta_name_ok(tok[1].p, tok[1].n)) {
+        return fail(ps, "meta name '%s' must be 1..31 of A-Z a-z 0-9 _ . -", q);
+    }
+    for (i = 0; i < ps->meta.count; ++i) {
+        if (tok_is(&tok[1], ps->meta.entry[i].name)) {
+            return fail(ps, "duplicate meta '%s' (first on line %lu)", q, ps->meta_line[i]);
+        }
+    }
+    if (ps->meta.count >= QNAV_POLICY_META_MAX) {
+        return fail(ps, "more than %d meta lines", QNAV_POLICY_META_MAX);
+    }
+    /* the value runs from the third token to the end of the (comment-stripped) body */
+    v = tok[2].p;
+    vl = (size_t)((body + blen) - v);
+    while (vl > 0 && (v[vl - 1] == ' ' || v[vl - 1] == '\t')) {
+        vl--;
+    }
+    why = meta_value_problem(v, vl);
+    if (why != NULL) {
+        return fail(ps, "meta %s: value %s", q, why);
+    }
+    e = &ps->meta.entry[ps->meta.count];
+    memcpy(e->name, tok[1].p, tok[1].n);
+    e->name[tok[1].n] = '\0';
+    memcpy(e->value, v, vl);
+    e->value[vl] = '\0';
+    ps->meta_line[ps->meta.count] = ps->line;
+    ps->meta.count++;
+    return 0;
+}
+
+static int line_end(parser_t *ps, size_t ntok)
+{
+    qnav_ctrl_t ctrl;
+    qnav_ctrl_config_t cfg;
+    qnav_status_t st;
+    if (ntok != 1) {
+        return fail(ps, "'end' takes no values");
+    }
+    ps->end_line = ps->line;
+    if (ps->qformat_line == 0) {
+        return fail(ps, "missing 'qformat'");
+    }
+    if (ps->pol.kind == (uint8_t)QNAV_POLICY_NET) {
+        if (ps->hidden_line == 0) {
+            return fail(ps, "missing 'hidden'");
+        }
+        if (ps->next_unit < ps->pol.u.net.hidden) {
+            return fail(ps, "missing unit %u (hidden %u needs units 0..%u)", ps->next_unit,
+                        (unsigned)ps->pol.u.net.hidden, ps->pol.u.net.hidden - 1u);
+        }
+        if (ps->b_out_line == 0) {
+            return fail(ps, "missing 'b_out'");
+        }
+    } else {
+        if (ps->k_goal_line == 0) {
+            return fail(ps, "missing 'k_goal'");
+        }
+        if (ps->k_safe_line == 0) {
+            return fail(ps, "missing 'k_safe'");
+        }
+    }
+    /* final word to the controller: the file is good exactly when init accepts it */
+    qnav_ctrl_config_default(&cfg);
+    st = qnav_ctrl_init(&ctrl, &cfg, &ps->pol);
+    if (st != QNAV_OK) {
+        return fail(ps, "policy refused by qnav_ctrl_init (status %d)", (int)st);
+    }
+    return 0;
+}
+
+static int line_key(parser_t *ps, const char *body, size_t blen, const token_t *tok,
+                    size_t ntok)
+{
+    char q[80];
+    int net;
+    const token_t *key = &tok[0];
+    quote_bytes(key->p, key->n, 40, q, sizeof q);
+    if (ps->end_line != 0) {
+        return fail(ps, "content after 'end' (line %lu)", ps->end_line);
+    }
+    if (ps->kind_line == 0) {
+        if (!tok_is(key, "kind")) {
+            return fail(ps, "expected 'kind' as the first key, found '%s'", q);
+        }
+        if (want_values(ps, ntok, 1, "kind") != 0) {
+            return -1;
+        }
+        if (tok_is(&tok[1], "network")) {
+            ps->pol.kind = (uint8_t)QNAV_POLICY_NET;
+        } else if (tok_is(&tok[1], "probabilistic")) {
+            ps->pol.kind = (uint8_t)QNAV_POLICY_PROB;
+        } else {
+            quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
+            return fail(ps, "unknown kind '%s' (expected 'network' or 'probabilistic')", q);
+        }
+        ps->kind_line = ps->line;
+        return 0;
+    }
+    net = ps->pol.kind == (uint8_t)QNAV_POLICY_NET;
+    if (tok_is(key, "kind")) {
+        return once(ps, &ps->kind_line, "kind");
+    }
+    if (tok_is(key, "qformat")) {
+        if (once(ps, &ps->qformat_line, "qformat") != 0 ||
+            want_values(ps, ntok, 1, "qformat") != 0) {
+            return -1;
+        }
+        if (!tok_is(&tok[1], "Q8.8")) {
+            quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
+            return fail(ps, "unsupported qformat '%s' (version 1 has only Q8.8)", q);
+        }
+        return 0;
+    }
+    if (tok_is(key, "meta")) {
+        return line_meta(ps, body, blen, tok, ntok);
+    }
+    if (tok_is(key, "end")) {
+        return line_end(ps, ntok);
+    }
+    if (tok_is(key, "hidden") || tok_is(key, "unit") || tok_is(key, "b_out")) {
+        if (!net) {
+            return fail(ps, "'%s' is not a key of kind probabilistic", q);
+        }
+        if (tok_is(key, "unit")) {
+            return line_unit(ps, tok, ntok);
+        }
+        if (tok_is(key, "b_out")) {
+            if (once(ps, &ps->b_out_line, "b_out") != 0 ||
+                want_values(ps, ntok, 1, "b_out") != 0) {
+                return -1;
+            }
+            return parse_q88(ps, &tok[1], "b_out: ", &ps->pol.u.net.b_out);
+        }
+        {
+            long h = 0;
+            if (once(ps, &ps->hidden_line, "hidden") != 0 ||
+                want_values(ps, ntok, 1, "hidden") != 0) {
+                return -1;
+            }
+            quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
+            if (parse_int(&tok[1], &h) != 0) {
+                return fail(ps, "hidden '%s' is not an integer", q);
+            }
+            if (h < 1 || h > QNAV_MAX_HIDDEN) {
+                return fail(ps, "hidden %s outside 1..%d", q, QNAV_MAX_HIDDEN);
+            }
+            ps->pol.u.net.hidden = (uint8_t)h;
+            return 0;
+        }
+    }
+    if (tok_is(key, "k_goal") || tok_is(key, "k_safe")) {
+        int goal = tok_is(key, "k_goal");
+        qnav_q8_8_t v = 0;
+        if (net) {
+            return fail(ps, "'%s' is not a key of kind network", q);
+        }
+        if (once(ps, goal ? &ps->k_goal_line : &ps->k_safe_line, q) != 0 ||
+            want_values(ps, ntok, 1, q) != 0) {
+            return -1;
+        }
+        if (parse_q88(ps, &tok[1], goal ? "k_goal: " : "k_safe: ", &v) != 0) {
+            return -1;
+        }
+        if (v <= 0 || v > K_RAW_MAX) {
+            return fail(ps, "%s %d outside (0, 64]: raw Q8.8 must be 1..%ld", q, (int)v,
+                        K_RAW_MAX);
+        }
+        if (goal) {
+            ps->pol.u.prob.k_goal = v;
+        } else {
+            ps->pol.u.prob.k_safe = v;
+        }
+        return 0;
+    }
+    return fail(ps, "unknown key '%s'", q);
+}
+
+int qnav_policy_parse_meta(const char *text, size_t len, const char *name,
+                           qnav_policy_t *out, qnav_policy_meta_t *meta, char *err,
+                           size_t errlen)
+{
+    parser_t *ps;
+    size_t pos = 0;
+    int rc = 0;
+    if (name == NULL) {
+        name = "(policy)";
+    }
+    if (out == NULL || (text == NULL && len > 0)) {
+        set_err(err, errlen, "%s: null argument", name);
+        return -1;
+    }
+    /* the parser state holds a whole policy and metadata: keep it off the stack */
+    ps = (parser_t *)calloc(1, sizeof *ps);
+    if (ps == NULL) {
+        set_err(err, errlen, "%s: out of memory", name);
+        return -1;
+    }
+    ps->name = name;
+    ps->err = err;
+    ps->errlen = errlen;
+    if (len == 0) {
+        ps->line = 1;
+        rc = fail(ps, "empty file (line 1 must be 'qnav-policy %d')",
+                  QNAV_POLICY_FORMAT_VERSION);
+    } else if (len > (size_t)QNAV_POLICY_FILE_MAX) {
+        ps->line = 1;
+        rc = fail(ps, "file larger than %ld bytes", QNAV_POLICY_FILE_MAX);
+    }
+    while (rc == 0 && pos < len) {
+        char buf[QNAV_POLICY_LINE_MAX + 1];
+        token_t tok[MAX_TOKENS];
+        size_t ntok = 0;
+        size_t start = pos;
+        size_t eol = pos;
+        size_t n;
+        size_t i;
+        size_t blen;
+        while (eol < len && text[eol] != '\n') {
+            eol++;
+        }
+        pos = eol < len ? eol + 1 : len;
+        ps->line++;
+        n = eol - start;
+        if (n > 0 && eol < len && text[eol - 1] == '\r') {
+            n--; /* CRLF line ending: accepted (docs/policy-format.md) */
+        }
+        if (n > QNAV_POLICY_LINE_MAX) {
+            rc = fail(ps, "line longer than %d bytes", QNAV_POLICY_LINE_MAX);
+            break;
+        }
+        for (i = 0; i < n; ++i) {
+            unsigned char c = (unsigned char)text[start + i];
+            if (c == 0) {
+                rc = fail(ps, "NUL byte at column %zu", i + 1);
+            } else if (c == '\r') {
+                rc = fail(ps, "carriage return not followed by a line feed at column %zu",
+                          i + 1);
+            } else if ((c < 0x20 && c != '\t') || c == 0x7f) {
+                rc = fail(ps, "control character 0x%02X at column %zu", (unsigned)c, i + 1);
+            }
+            if (rc != 0) {
+                break;
+            }
+        }
+        if (rc != 0) {
+            break;
+        }
+        memcpy(buf, text + start, n);
+        buf[n] = '\0';
+        if (ps->line == 1 && n >= 3 && memcmp(buf, "\xEF\xBB\xBF", 3) == 0) {
+            rc = fail(ps, "byte order mark before 'qnav-policy': save without BOM");
+            break;
+        }
+        /* comments: from '#' to the end of the line, on every line but the first */
+        blen = n;
+        if (ps->line > 1) {
+            char *hash = memchr(buf, '#', n);
+            if (hash != NULL) {
+                blen = (size_t)(hash - buf);
+            }
+        }
+        for (i = 0; i < blen;) {
+            while (i < blen && (buf[i] == ' ' || buf[i] == '\t')) {
+                i++;
+            }
+            if (i >= blen) {
+                break;
+            }
+            if (ntok == MAX_TOKENS) {
+                ntok++; /* more than any key takes: counted as "too many" below */
+                break;
+            }
+            tok[ntok].p = buf + i;
+            while (i < blen && buf[i] != ' ' && buf[i] != '\t') {
+                i++;
+            }
+            tok[ntok].n = (size_t)((buf + i) - tok[ntok].p);
+            ntok++;
+        }
+        if (ntok > MAX_TOKENS) {
+            /* a meta value is free text; every other line is short */
+            if (!tok_is(&tok[0], "meta")) {
+                rc = fail(ps, "too many values on one line (more than %d tokens)",
+                          MAX_TOKENS);
+                break;
+            }
+            ntok = MAX_TOKENS;
+        }
+        if (ps->line == 1) {
+            rc = line_magic(ps, tok, ntok);
+        } else if (ntok > 0) {
+            rc = line_key(ps, buf, blen, tok, ntok);
+        }
+    }
+    if (rc == 0 && ps->end_line == 0) {
+        rc = fail(ps, "truncated: no 'end' line");
+    }
+    if (rc == 0) {
+        *out = ps->pol;
+        if (meta != NULL) {
+            *meta = ps->meta;
+        }
+    }
+    free(ps);
+    return rc;
+}
+
+int qnav_policy_parse(const char *text, size_t len, const char *name, qnav_policy_t *out,
+                      char *err, size_t errlen)
+{
+    return qnav_policy_parse_meta(text, len, name, out, NULL, err, errlen);
+}
+
+int qnav_policy_read_meta(const char *path, qnav_policy_t *out, qnav_policy_meta_t *meta,
+                          char *err, size_t errlen)
+{
+    FILE *f;
+    char *buf;
+    size_t cap = (size_t)QNAV_POLICY_FILE_MAX + 1;
+    size_t len = 0;
+    int rc;
+    char nm[200];
+    if (path == NULL) {
+        set_err(err, errlen, "(null path): cannot open");
+        return -1;
+    }
+    quote_bytes(path, strlen(path), 160, nm, sizeof nm);
+    f = fopen(path, "rb");
+    if (f == NULL) {
+        set_err(err, errlen, "%s: cannot open (%s)", nm, strerror(errno));
+        return -1;
+    }
+    buf = (char *)malloc(cap);
+    if (buf == NULL) {
+        fclose(f);
+        set_err(err, errlen, "%s: out of memory", nm);
+        return -1;
+    }
+    /* read one byte more than the limit so that an oversized file is detected */
+    while (len < cap) {
+        size_t got = fread(buf + len, 1, cap - len, f);
+        if (got == 0) {
+            break;
+        }
+        len += got;
+    }
+    if (ferror(f)) {
+        int e = errno;
+        fclose(f);
+        free(buf);
+        set_err(err, errlen, "%s: read error (%s)", nm, strerror(e));
+        return -1;
+    }
+    fclose(f);
+    if (len > (size_t)QNAV_POLICY_FILE_MAX) {
+        unsigned long line = 1;
+        size_t i;
+        for (i = 0; i < (size_t)QNAV_POLICY_FILE_MAX; ++i) {
+            line += buf[i] == '\n';
+        }
+        free(buf);
+        set_err(err, errlen, "%s:%lu: file larger than %ld bytes", nm, line,
+                QNAV_POLICY_FILE_MAX);
+        return -1;
+    }
+    rc = qnav_policy_parse_meta(buf, len, path, out, meta, err, errlen);
+    free(buf);
+    return rc;
+}
+
+int qnav_policy_read(const char *path, qnav_policy_t *out, char *err, size_t errlen)
+{
+    return qnav_policy_read_meta(path, out, NULL, err, errlen);
+}
+
+/* ---- rendering ----------------------------------------------------------------------- */
+
+typedef struct {
+    char *buf;
+    size_t cap;
+    size_t len; /* length of the full text, even past cap */
+} out_t;
+
+static void emit(out_t *o, const char *fmt, ...)
+{
+    va_list ap;
+    int n;
+    char *dst = NULL;
+    size_t room = 0;
+    if (o->buf != NULL && o->len < o->cap) {
+        dst = o->buf + o->len;
+        room = o->cap - o->len;
+    }
+    va_start(ap, fmt);
+    n = vsnprintf(dst, room, fmt, ap);
+    va_end(ap);
+    if (n > 0) {
+        o->len += (size_t)n;
+    }
+}
+
+/* A Q8.8 value as a comment: 4 decimals, sign always shown. */
+static void emit_real(out_t *o, int raw)
+{
+    emit(o, " %+.4f", (double)raw / 256.0);
+}
+
+/* The comment as '#' lines: split at newlines and so that no line exceeds the limit;
+ * control characters become '?'. */
+static void emit_comment(out_t *o, const char *c)
+{
+    const size_t width = QNAV_POLICY_LINE_MAX - 2; /* room after the "# " prefix */
+    size_t n = strlen(c);
+    size_t i = 0;
+    do {
+        size_t end = i;
+        size_t s = i;
+        while (end < n && c[end] != '\n') {
+            end++;
+        }
+        do {
+            char line[QNAV_POLICY_LINE_MAX + 1];
+            size_t k = end - s < width ? end - s : width;
+            size_t m;
+            for (m = 0; m < k; ++m) {
+                unsigned char ch = (unsigned char)c[s + m];
+                line[m] = ((ch < 0x20 && ch != '\t') || ch == 0x7f) ? '?' : (char)ch;
+            }
+            line[k] = '\0';
+            if (k > 0) {
+                emit(o, "# %s\n", line);
+            } else {
+                emit(o, "#\n");
+            }
+            s += k;
+        } while (s < end);
+        i = end + 1;
+    } while (i < n);
+}
+
+int qnav_policy_format(const qnav_policy_t *policy, const qnav_policy_meta_t *meta,
+                       const char *comment, char *buf, size_t buflen, char *err,
+                       size_t errlen)
+{
+    out_t o;
+    size_t i;
+    if (qnav_policy_check(policy, err, errlen) != 0) {
+        return -1;
+    }
+    if (comment != NULL && strlen(comment) > QNAV_POLICY_COMMENT_MAX) {
+        set_err(err, errlen, "comment longer than %d bytes", QNAV_POLICY_COMMENT_MAX);
+        return -1;
+    }
+    if (meta != NULL) {
+        if (meta->count > QNAV_POLICY_META_MAX) {
+            set_err(err, errlen, "more than %d metadata entries", QNAV_POLICY_META_MAX);
+            return -1;
+        }
+        for (i = 0; i < meta->count; ++i) {
+            const qnav_policy_meta_entry_t *e = &meta->entry[i];
+            size_t nl = strnlen(e->name, sizeof e->name);
+            size_t vl = strnlen(e->value, sizeof e->value);
+            const char *why = meta_value_problem(e->value, vl);
+            size_t k;
+            if (nl == sizeof e->name || vl == sizeof e->value || !meta_name_ok(e->name, nl)) {
+                set_err(err, errlen, "metadata entry %zu: bad name or unterminated text", i);
+                return -1;
+            }
+            if (why != NULL) {
+                set_err(err, errlen, "meta %s: value %s", e->name, why);
+                return -1;
+            }
+            for (k = 0; k < i; ++k) {
+                if (strcmp(meta->entry[k].name, e->name) == 0) {
+                    set_err(err, errlen, "meta %s appears twice", e->name);
+                    return -1;
+                }
+            }
+        }
+    }
+    o.buf = buf;
+    o.cap = buflen;
+    o.len = 0;
+    if (buf != NULL && buflen > 0) {
+        buf[0] = '\0';
+    }
+    emit(&o, "%s %d\n", MAGIC, QNAV_POLICY_FORMAT_VERSION);
+    if (comment != NULL) {
+        emit_comment(&o, comment);
+    }
+    emit(&o, "kind %s\n", policy_kind_name(policy->kind));
+    emit(&o, "qformat Q8.8\n");
+    if (policy->kind == (uint8_t)QNAV_POLICY_NET) {
+        emit(&o, "hidden %u\n", (unsigned)policy->u.net.hidden);
+    }
+    for (i = 0; meta != NULL && i < meta->count; ++i) {
+        emit(&o, "meta %s %s\n", meta->entry[i].name, meta->entry[i].value);
+    }
+    if (policy->kind == (uint8_t)QNAV_POLICY_NET) {
+        const qnav_net_t *n = &policy->u.net;
+        emit(&o, "# unit j  w_theta  w_dist b_hidden   w_out   (raw Q8.8 = value * 256)\n");
+        for (i = 0; i < n->hidden; ++i) {
+            emit(&o, "unit %2zu  %7d %7d %8d %7d   #", i, (int)n->w_theta[i],
+                 (int)n->w_dist[i], (int)n->b_hidden[i], (int)n->w_out[i]);
+            emit_real(&o, n->w_theta[i]);
+            emit_real(&o, n->w_dist[i]);
+            emit_real(&o, n->b_hidden[i]);
+            emit_real(&o, n->w_out[i]);
+            emit(&o, "\n");
+        }
+        emit(&o, "b_out %d   #", (int)n->b_out);
+        emit_real(&o, n->b_out);
+        emit(&o, "\n");
+    } else {
+        emit(&o, "k_goal %d   #", (int)policy->u.prob.k_goal);
+        emit_real(&o, policy->u.prob.k_goal);
+        emit(&o, "\nk_safe %d   #", (int)policy->u.prob.k_safe);
+        emit_real(&o, policy->u.prob.k_safe);
+        emit(&o, "\n");
+    }
+    emit(&o, "end\n");
+    return (int)o.len;
+}
+
+/* ---- writing ------------------------------------------------------------------------- */
+
+int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, char *err,
+                                size_t errlen)
+{
+    char *tmp;
+    char *dir;
+    char *slash;
+    size_t pl;
+    int fd;
+    size_t done = 0;
+    char nm[200];
+    if (path == NULL || (data == NULL && len > 0)) {
+        set_err(err, errlen, "(null): null argument");
+        return -1;
+    }
+    quote_bytes(path, strlen(path), 160, nm, sizeof nm);
+    pl = strlen(path);
+    if (pl == 0) {
+        set_err(err, errlen, "(empty path): cannot write");
+        return -1;
+    }
+    tmp = (char *)malloc(pl + 16);
+    dir = (char *)malloc(pl + 2);
+    if (tmp == NULL || dir == NULL) {
+        free(tmp);
+        free(dir);
+        set_err(err, errlen, "%s: out of memory", nm);
+        return -1;
+    }
+    memcpy(tmp, path, pl);
+    memcpy(tmp + pl, ".tmpXXXXXX", 11);
+    fd = mkstemp(tmp);
+    if (fd < 0) {
+        set_err(err, errlen, "%s: cannot create a temporary file beside it (%s)", nm,
+                strerror(errno));
+        free(tmp);
+        free(dir);
+        return -1;
+    }
+    if (fchmod(fd, 0644) != 0) {
+        goto io_error;
+    }
+    while (done < len) {
+        ssize_t w = write(fd, (const char *)data + done, len - done);
+        if (w < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            goto io_error;
+        }
+        done += (size_t)w;
+    }
+    if (fsync(fd) != 0) {
+        goto io_error;
+    }
+    if (close(fd) != 0) {
+        fd = -1;
+        goto io_error;
+    }
+    fd = -1;
+    if (rename(tmp, path) != 0) {
+        goto io_error;
+    }
+    /* make the rename itself durable: fsync the directory that holds the file */
+    memcpy(dir, path, pl + 1);
+    slash = strrchr(dir, '/');
+    if (slash == NULL) {
+        memcpy(dir, ".", 2);
+    } else if (slash == dir) {
+        dir[1] = '\0';
+    } else {
+        *slash = '\0';
+    }
+    fd = open(dir, O_RDONLY);
+    if (fd >= 0) {
+        (void)fsync(fd); /* some file systems refuse fsync on a directory: not an error */
+        (void)close(fd);
+    }
+    free(tmp);
+    free(dir);
+    return 0;
+
+io_error:
+    set_err(err, errlen, "%s: cannot write (%s)", nm, strerror(errno));
+    if (fd >= 0) {
+        (void)close(fd);
+    }
+    (void)unlink(tmp);
+    free(tmp);
+    free(dir);
+    return -1;
+}
+
+int qnav_policy_write_meta(const char *path, const qnav_policy_t *policy,
+                           const qnav_policy_meta_t *meta, const char *comment, char *err,
+                           size_t errlen)
+{
+    char msg[QNAV_POLICY_IO_ERRLEN];
+    char nm[200];
+    char *buf;
+    int n;
+    int rc;
+    const char *p = path != NULL ? path : "(null)";
+    quote_bytes(p, strlen(p), 160, nm, sizeof nm);
+    n = qnav_policy_format(policy, meta, comment, NULL, 0, msg, sizeof msg);
+    if (n < 0) {
+        set_err(err, errlen, "%s: refusing to write an invalid policy: %s", nm, msg);
+        return -1;
+    }
+    buf = (char *)malloc((size_t)n + 1);
+    if (buf == NULL) {
+        set_err(err, errlen, "%s: out of memory", nm);
+        return -1;
+    }
+    (void)qnav_policy_format(policy, meta, comment, buf, (size_t)n + 1, NULL, 0);
+    rc = qnav_policy_io_write_atomic(path, buf, (size_t)n, err, errlen);
+    free(buf);
+    return rc;
+}
+
+int qnav_policy_write(const char *path, const qnav_policy_t *policy, const char *comment,
+                      char *err, size_t errlen)
+{
+    return qnav_policy_write_meta(path, policy, NULL, comment, err, errlen);
+}
