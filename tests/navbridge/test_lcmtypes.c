@@ -1,0 +1,237 @@
+/*
+ * Round trip of every qnav LCM type through an in-process LCM bus (memq://): publish a
+ * message with distinctive values in every field, receive it through the generated
+ * subscribe function, and compare field by field. Nothing leaves the process.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+#include <lcm/lcm.h>
+
+#include "qnav_command_t.h"
+#include "qnav_goal_t.h"
+#include "qnav_link_status_t.h"
+#include "qnav_path_qualities_t.h"
+#include "qnav_pose_t.h"
+#include "qnav_scan_t.h"
+
+static lcm_t *bus(void)
+{
+    lcm_t *lcm = lcm_create("memq://");
+    assert_non_null(lcm);
+    return lcm;
+}
+
+/* Deliver one queued message; fail if none arrives within a second. */
+static void deliver(lcm_t *lcm)
+{
+    assert_int_equal(lcm_handle_timeout(lcm, 1000), 1);
+}
+
+#define DEFINE_CATCHER(T)                                                                   \
+    static T got_##T;                                                                       \
+    static int n_##T;                                                                       \
+    static void on_##T(const lcm_recv_buf_t *rbuf, const char *ch, const T *msg, void *u)   \
+    {                                                                                       \
+        (void)rbuf;                                                                         \
+        (void)ch;                                                                           \
+        (void)u;                                                                            \
+        got_##T = *msg;                                                                     \
+        n_##T++;                                                                            \
+    }
+
+DEFINE_CATCHER(qnav_scan_t)
+DEFINE_CATCHER(qnav_goal_t)
+DEFINE_CATCHER(qnav_command_t)
+DEFINE_CATCHER(qnav_path_qualities_t)
+DEFINE_CATCHER(qnav_pose_t)
+DEFINE_CATCHER(qnav_link_status_t)
+
+static void test_scan_round_trips_over_memq(void **state)
+{
+    lcm_t *lcm = bus();
+    qnav_scan_t m;
+    int k;
+    (void)state;
+    memset(&m, 0, sizeof m);
+    m.utime = 1700000000123456LL;
+    m.seq = 65535;
+    m.board_ms = 4294967295LL;
+    m.n_sectors = 360;
+    m.max_range_mm = 5000;
+    m.goal_bearing_cdeg = -17999;
+    m.goal_id = 7;
+    for (k = 0; k < 360; ++k) {
+        m.ranges_mm[k] = 65535 - k;
+    }
+    qnav_scan_t_subscription_t *sub = qnav_scan_t_subscribe(lcm, "QNAV_SCAN", on_qnav_scan_t, NULL);
+    assert_int_equal(qnav_scan_t_publish(lcm, "QNAV_SCAN", &m), 0);
+    deliver(lcm);
+    assert_int_equal(n_qnav_scan_t, 1);
+    assert_memory_equal(&got_qnav_scan_t, &m, sizeof m);
+    qnav_scan_t_unsubscribe(lcm, sub);
+    lcm_destroy(lcm);
+}
+
+static void test_goal_round_trips_over_memq(void **state)
+{
+    lcm_t *lcm = bus();
+    qnav_goal_t m = {123, 65535, 9000, 2000000};
+    (void)state;
+    qnav_goal_t_subscription_t *sub = qnav_goal_t_subscribe(lcm, "QNAV_GOAL", on_qnav_goal_t, NULL);
+    assert_int_equal(qnav_goal_t_publish(lcm, "QNAV_GOAL", &m), 0);
+    deliver(lcm);
+    assert_int_equal(n_qnav_goal_t, 1);
+    assert_int_equal(got_qnav_goal_t.goal_id, 65535);
+    assert_int_equal(got_qnav_goal_t.bearing_cdeg, 9000);
+    assert_int_equal(got_qnav_goal_t.distance_mm, 2000000);
+    qnav_goal_t_unsubscribe(lcm, sub);
+    lcm_destroy(lcm);
+}
+
+static void test_command_round_trips_over_memq(void **state)
+{
+    lcm_t *lcm = bus();
+    qnav_command_t m;
+    (void)state;
+    memset(&m, 0, sizeof m);
+    m.utime = 5;
+    m.scan_seq = 1234;
+    m.heading_deg = -179;
+    m.speed_q15 = 32767;
+    m.quality_q15 = 16384;
+    m.speed = 32767.0 / 32768.0;
+    m.quality = 0.5;
+    m.flags = 8;
+    m.stop_reason = 1;
+    m.source = 2;
+    m.policy_crc = 0xBEEF;
+    qnav_command_t_subscription_t *sub = qnav_command_t_subscribe(lcm, "QNAV_COMMAND", on_qnav_command_t, NULL);
+    assert_int_equal(qnav_command_t_publish(lcm, "QNAV_COMMAND", &m), 0);
+    deliver(lcm);
+    assert_int_equal(n_qnav_command_t, 1);
+    assert_int_equal(got_qnav_command_t.heading_deg, -179);
+    assert_int_equal(got_qnav_command_t.speed_q15, 32767);
+    assert_int_equal(got_qnav_command_t.quality_q15, 16384);
+    assert_true(got_qnav_command_t.quality == 0.5);
+    assert_int_equal(got_qnav_command_t.flags, 8);
+    assert_int_equal(got_qnav_command_t.stop_reason, 1);
+    assert_int_equal(got_qnav_command_t.source, 2);
+    assert_int_equal(got_qnav_command_t.policy_crc, 0xBEEF);
+    qnav_command_t_unsubscribe(lcm, sub);
+    lcm_destroy(lcm);
+}
+
+static void test_path_qualities_round_trip_all_360_over_memq(void **state)
+{
+    lcm_t *lcm = bus();
+    static qnav_path_qualities_t m;
+    int k;
+    (void)state;
+    m.utime = 9;
+    m.scan_seq = 77;
+    m.best_deg = 45;
+    for (k = 0; k < 360; ++k) {
+        m.quality_q15[k] = (int16_t)(k * 91);
+        m.quality[k] = (float)k / 360.0f;
+    }
+    qnav_path_qualities_t_subscription_t *sub = qnav_path_qualities_t_subscribe(lcm, "QNAV_QUALITIES", on_qnav_path_qualities_t, NULL);
+    assert_int_equal(qnav_path_qualities_t_publish(lcm, "QNAV_QUALITIES", &m), 0);
+    deliver(lcm);
+    assert_int_equal(n_qnav_path_qualities_t, 1);
+    assert_memory_equal(&got_qnav_path_qualities_t, &m, sizeof m);
+    qnav_path_qualities_t_unsubscribe(lcm, sub);
+    lcm_destroy(lcm);
+}
+
+static void test_pose_round_trips_over_memq(void **state)
+{
+    lcm_t *lcm = bus();
+    qnav_pose_t m;
+    (void)state;
+    memset(&m, 0, sizeof m);
+    m.utime = 11;
+    m.tick = 300;
+    m.x_m = 1.25;
+    m.y_m = -3.5;
+    m.heading_deg = 179.5;
+    m.speed_mps = 0.75;
+    m.goal_distance_m = 2.0;
+    m.recovering = 1;
+    m.collisions = 3;
+    m.reached = 0;
+    qnav_pose_t_subscription_t *sub = qnav_pose_t_subscribe(lcm, "QNAV_POSE", on_qnav_pose_t, NULL);
+    assert_int_equal(qnav_pose_t_publish(lcm, "QNAV_POSE", &m), 0);
+    deliver(lcm);
+    assert_int_equal(n_qnav_pose_t, 1);
+    assert_memory_equal(&got_qnav_pose_t, &m, sizeof m);
+    qnav_pose_t_unsubscribe(lcm, sub);
+    lcm_destroy(lcm);
+}
+
+static void test_link_status_round_trips_over_memq(void **state)
+{
+    lcm_t *lcm = bus();
+    qnav_link_status_t m;
+    (void)state;
+    memset(&m, 0, sizeof m);
+    m.utime = 13;
+    m.mode = 2;
+    m.rx_frames = 1LL << 40;
+    m.tx_frames = 99;
+    m.rx_bytes = 12345;
+    m.drop_cobs = 1;
+    m.drop_short = 2;
+    m.drop_overflow = 3;
+    m.drop_crc = 4;
+    m.drop_unknown = 5;
+    m.drop_length = 6;
+    m.drop_seq = 7;
+    m.seq_gaps = 8;
+    m.last_heartbeat_age_ms = 120;
+    m.last_scan_age_ms = -1;
+    m.watchdog_stop = 1;
+    m.board_rx_ok = 65535;
+    m.board_rx_dropped = 9;
+    m.board_state = 5;
+    m.board_policy_crc = 0x1234;
+    m.last_upload_status = -2;
+    qnav_link_status_t_subscription_t *sub = qnav_link_status_t_subscribe(lcm, "QNAV_LINK_STATUS", on_qnav_link_status_t, NULL);
+    assert_int_equal(qnav_link_status_t_publish(lcm, "QNAV_LINK_STATUS", &m), 0);
+    deliver(lcm);
+    assert_int_equal(n_qnav_link_status_t, 1);
+    assert_memory_equal(&got_qnav_link_status_t, &m, sizeof m);
+    qnav_link_status_t_unsubscribe(lcm, sub);
+    lcm_destroy(lcm);
+}
+
+static void test_decoder_refuses_truncated_buffer(void **state)
+{
+    qnav_command_t m, out;
+    uint8_t buf[256];
+    int n;
+    (void)state;
+    memset(&m, 0, sizeof m);
+    n = qnav_command_t_encode(buf, 0, (int)sizeof buf, &m);
+    assert_int_equal(n, qnav_command_t_encoded_size(&m));
+    assert_true(qnav_command_t_decode(buf, 0, n - 1, &out) < 0);
+    assert_int_equal(qnav_command_t_decode(buf, 0, n, &out), n);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_scan_round_trips_over_memq),
+        cmocka_unit_test(test_goal_round_trips_over_memq),
+        cmocka_unit_test(test_command_round_trips_over_memq),
+        cmocka_unit_test(test_path_qualities_round_trip_all_360_over_memq),
+        cmocka_unit_test(test_pose_round_trips_over_memq),
+        cmocka_unit_test(test_link_status_round_trips_over_memq),
+        cmocka_unit_test(test_decoder_refuses_truncated_buffer),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
