@@ -1,0 +1,34 @@
+# qnav_add_target_program(NAME SOURCES src...): a plain C99 program that runs unchanged on
+# the host, on the ATmega128 under simavr and on the Cortex-M4 under qemu (shared test
+# vectors, benchmarks). It links libqnav and tests/target/target_io.c (output and exit
+# for each platform). On AVR it finds simavr's avr_mcu_section.h (Debian libsimavr-dev).
+include_guard(GLOBAL)
+
+if(CMAKE_SYSTEM_PROCESSOR STREQUAL "avr")
+  find_path(QNAV_SIMAVR_INCLUDE_DIR avr_mcu_section.h
+            PATHS /usr/include/simavr/avr NO_CMAKE_FIND_ROOT_PATH NO_DEFAULT_PATH)
+  if(NOT QNAV_SIMAVR_INCLUDE_DIR)
+    message(FATAL_ERROR "avr_mcu_section.h not found: install Debian package libsimavr-dev")
+  endif()
+endif()
+
+set(QNAV_TARGET_WARNINGS -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wdouble-promotion)
+if(QNAV_WERROR)
+  list(APPEND QNAV_TARGET_WARNINGS -Werror)
+endif()
+
+function(qnav_add_target_program name)
+  cmake_parse_arguments(T "" "" "SOURCES" ${ARGN})
+  add_executable(${name} ${T_SOURCES} ${PROJECT_SOURCE_DIR}/tests/target/target_io.c)
+  target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/target)
+  target_link_libraries(${name} PRIVATE qnav::ctrl)
+  target_compile_options(${name} PRIVATE ${QNAV_TARGET_WARNINGS})
+  set_target_properties(${name} PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
+  if(CMAKE_SYSTEM_PROCESSOR STREQUAL "avr")
+    # avr_mcu_section.h is not -Wpedantic clean: include it as a system header.
+    target_include_directories(${name} SYSTEM PRIVATE ${QNAV_SIMAVR_INCLUDE_DIR})
+    target_compile_definitions(${name} PRIVATE QNAV_MCU_NAME="${QNAV_MCU}")
+    # Keep simavr's .mmcu tags (console register) through --gc-sections.
+    target_link_options(${name} PRIVATE -Wl,--undefined=_mmcu)
+  endif()
+endfunction()

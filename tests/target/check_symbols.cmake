@@ -1,0 +1,36 @@
+# Fails when a library or object references (nm: undefined symbol) the heap, printf-family
+# output or, with FORBID_FLOAT, a soft-float or libm routine: libqnav must run on an MCU
+# with no heap, no stdio and no FPU. Prints the offending symbols.
+#   cmake -DNM=avr-nm -DLIB=libqnav_ctrl.a [-DFORBID_FLOAT=ON] -P check_symbols.cmake
+cmake_minimum_required(VERSION 3.25)
+if(NOT DEFINED NM OR NOT DEFINED LIB)
+  message(FATAL_ERROR "check_symbols.cmake: NM and LIB must be set")
+endif()
+execute_process(COMMAND "${NM}" -u "${LIB}" OUTPUT_VARIABLE out ERROR_VARIABLE err
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${NM} -u ${LIB} failed (${rc}): ${err}")
+endif()
+set(heap_io "^(malloc|calloc|realloc|free|aligned_alloc|posix_memalign|memalign|_malloc_r|_free_r|_realloc_r|_calloc_r|printf|sprintf|snprintf|vprintf|vsprintf|vsnprintf|fprintf|vfprintf|puts|fputs|putchar|_printf_r|_sprintf_r|_vfprintf_r|iprintf|siprintf)$")
+# GCC soft-float helpers (AVR and generic names) and the ARM EABI ones, plus libm.
+set(soft_float "^(__(add|sub|mul|div|neg)[sdtx]f3|__(fix|fixuns)[sdtx]f[sdt]i|__float(un)?[sdt]i[sdtx]f|__(eq|ne|lt|le|gt|ge|cmp|unord)[sdtx]f2|__(extend|trunc)[sdtx]f[sdtx]f2|__aeabi_[fd].*|__fp_.*|(exp|log|pow|sqrt|sin|cos|tan|atan2?|floor|ceil|round|fabs|ldexp|frexp|modf|fmod)f?)$")
+string(REPLACE "\n" ";" lines "${out}")
+set(bad "")
+set(n 0)
+foreach(l IN LISTS lines)
+  string(STRIP "${l}" l)
+  if(NOT l MATCHES "^U[ \t]+(.+)$")
+    continue()
+  endif()
+  set(sym "${CMAKE_MATCH_1}")
+  math(EXPR n "${n} + 1")
+  if(sym MATCHES "${heap_io}" OR (FORBID_FLOAT AND sym MATCHES "${soft_float}"))
+    list(APPEND bad "${sym}")
+  endif()
+endforeach()
+if(bad)
+  list(REMOVE_DUPLICATES bad)
+  string(REPLACE ";" " " bad "${bad}")
+  message(FATAL_ERROR "${LIB}: references forbidden symbols: ${bad}")
+endif()
+message(STATUS "${LIB}: ${n} undefined references, none forbidden")
