@@ -288,10 +288,232 @@ static uint16_t bearing_deg(qnav_cdeg_t cdeg)
     return (uint16_t)(d < 0 ? d + QNAV_PATHS : d);
 }
 
-/* Turn from straight ahead to path i, degrees in -179..180. */
-static qnav_deg_t heading_of(uint16_t path)
+/*
+ * A run: consecutive paths in one sector along which dtheta moves one way. Within a run
+ * the distance level is fixed and each hidden unit's pre-activation is monotone, which is
+ * what lets the network step bound a whole run from its two ends (docs/architecture.md).
+ */
+typedef struct {
+    uint16_t first;      /* first path, degrees */
+    uint16_t count;      /* paths in the run, >= 1 */
+    uint8_t level;       /* distance level of the run's sector */
+    uint8_t dtheta0;     /* dtheta of the first path */
+    int8_t dir;          /* +1 or -1: change of dtheta from one path to the next */
+    qnav_q1_15_t bound;  /* network: no path of the run's interior exceeds it; -1 if done */
+} run_t;
+
+/* The best path so far under the controller's total order (quality, then smaller
+ * dtheta, then smaller turn, then counter-clockwise). */
+typedef struct {
+    qnav_q1_15_t q;
+    uint8_t dtheta;
+    qnav_deg_t heading;
+} best_t;
+
+static void consider(best_t *best, qnav_q1_15_t q, uint16_t path, uint8_t dtheta)
 {
-    return (qnav_deg_t)(path <= 180u ? (int16_t)path : (int16_t)path - 360);
+    qnav_deg_t heading;
+    int16_t turn;
+    int16_t best_turn;
+    if (q < best->q) {
+        return;
+    }
+    heading = (qnav_deg_t)(path <= 180u ? (int16_t)path : (int16_t)path - 360);
+    if (q == best->q) {
+        if (dtheta != best->dtheta) {
+            if (dtheta > best->dtheta) {
+                return;
+            }
+        } else {
+            turn = (int16_t)(heading < 0 ? -heading : heading);
+            best_turn = (int16_t)(best->heading < 0 ? -best->heading : best->heading);
+            if (turn > best_turn || (turn == best_turn && heading < best->heading)) {
+                return;
+            }
+        }
+    }
+    best->q = q;
+    best->dtheta = dtheta;
+    best->heading = heading;
+}
+
+/* Walks the 360 paths once and hands out their runs in path order. */
+typedef struct {
+    const qnav_ctrl_t *ctrl;
+    const qnav_mm_t *ranges;
+    uint16_t path;    /* next path to place */
+    uint16_t sector;  /* sector of that path */
+    uint16_t phase;   /* path * N + 180, modulo 360: the sector steps when it wraps */
+    uint16_t offset;  /* (path - goal) modulo 360 */
+    uint8_t level;    /* distance level of the current sector */
+    uint8_t flags;    /* QNAV_FLAG_RANGE_CLIPPED once a clipped range was seen */
+} run_iter_t;
+
+static void run_iter_start(run_iter_t *it, const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges,
+                           uint16_t goal)
+{
+    it->ctrl = ctrl;
+    it->ranges = ranges;
+    it->path = 0;
+    it->sector = 0;
+    it->phase = QNAV_PATHS / 2u;
+    it->offset = (uint16_t)((QNAV_PATHS - goal) % QNAV_PATHS);
+    it->level = 0;
+    it->flags = 0;
+}
+
+static void run_iter_enter_sector(run_iter_t *it)
+{
+    qnav_mm_t r = it->ranges[it->sector];
+    if (r > it->ctrl->max_range_mm) {
+        r = it->ctrl->max_range_mm;
+        it->flags |= QNAV_FLAG_RANGE_CLIPPED;
+    }
+    it->level = level_of(it->ctrl, r);
+}
+
+/* The next run into *r; 0 when all 360 paths have been handed out. A run ends where the
+ * sector changes, where dtheta turns (at the goal and opposite it) and at path 359. */
+static uint8_t run_iter_next(run_iter_t *it, run_t *r)
+{
+    if (it->path >= QNAV_PATHS) {
+        return 0;
+    }
+    if (it->path == 0u) {
+        run_iter_enter_sector(it);
+    }
+    r->first = it->path;
+    r->count = 0;
+    r->level = it->level;
+    r->dtheta0 = (uint8_t)(it->offset <= QNAV_DTHETA_MAX ? it->offset : QNAV_PATHS - it->offset);
+    r->dir = (int8_t)(it->offset < QNAV_DTHETA_MAX ? 1 : -1);
+    r->bound = -1;
+    for (;;) {
+        r->count++;
+        it->path++;
+        it->phase = (uint16_t)(it->phase + it->ctrl->n_sectors);
+        it->offset = (uint16_t)(it->offset + 1u == QNAV_PATHS ? 0u : it->offset + 1u);
+        if (it->path == QNAV_PATHS) {
+            return 1;
+        }
+        if (it->phase >= QNAV_PATHS) {
+            it->phase = (uint16_t)(it->phase - QNAV_PATHS);
+            it->sector = (uint16_t)(it->sector + 1u == it->ctrl->n_sectors ? 0u : it->sector + 1u);
+            run_iter_enter_sector(it);
+            return 1;
+        }
+        if (it->offset == 0u || it->offset == QNAV_DTHETA_MAX) {
+            return 1;
+        }
+    }
+}
+
+static uint8_t run_dtheta(const run_t *r, uint16_t k)
+{
+    return (uint8_t)(r->dir > 0 ? r->dtheta0 + k : r->dtheta0 - k);
+}
+
+/* Evaluate paths k0..k1-1 of a run exactly; qualities (null or [360]) receives them. */
+static void eval_run(const qnav_ctrl_t *ctrl, const run_t *r, uint16_t k0, uint16_t k1,
+                     best_t *best, qnav_q1_15_t *qualities)
+{
+    uint16_t k;
+    uint8_t dtheta = run_dtheta(r, k0);
+    if (ctrl->kind == QNAV_KIND_TABLE) {
+        const qnav_q1_15_t *row = &ctrl->table[(uint16_t)r->level * QNAV_TABLE_STRIDE];
+        for (k = k0; k < k1; ++k, dtheta = (uint8_t)(dtheta + r->dir)) {
+            qnav_q1_15_t q = QNAV_FLASH_READ_I16(&row[dtheta]);
+            if (qualities != 0) {
+                qualities[r->first + k] = q;
+            }
+            if (q >= best->q) {
+                consider(best, q, (uint16_t)(r->first + k), dtheta);
+            }
+        }
+    } else if (ctrl->kind == (uint8_t)QNAV_POLICY_PROB) {
+        for (k = k0; k < k1; ++k, dtheta = (uint8_t)(dtheta + r->dir)) {
+            qnav_q1_15_t q = prob_quality(ctrl, r->level, dtheta);
+            if (qualities != 0) {
+                qualities[r->first + k] = q;
+            }
+            consider(best, q, (uint16_t)(r->first + k), dtheta);
+        }
+    } else {
+        int32_t base[QNAV_MAX_HIDDEN];
+        uint8_t j;
+        for (j = 0; j < ctrl->hidden; ++j) {
+            base[j] = ctrl->p.unit[j].bias_z + ctrl->p.unit[j].per_level * r->level;
+        }
+        for (k = k0; k < k1; ++k, dtheta = (uint8_t)(dtheta + r->dir)) {
+            int32_t acc = ctrl->out_bias_z;
+            qnav_q1_15_t q;
+            for (j = 0; j < ctrl->hidden; ++j) {
+                acc += unit_share(base[j] + ctrl->p.unit[j].per_deg * dtheta, ctrl->p.unit[j].out);
+            }
+            q = net_output(acc);
+            if (qualities != 0) {
+                qualities[r->first + k] = q;
+            }
+            consider(best, q, (uint16_t)(r->first + k), dtheta);
+        }
+    }
+}
+
+/*
+ * Network: evaluate a run's two end paths exactly and bound its interior. Each hidden
+ * unit's share is monotone in dtheta along the run (its pre-activation is linear, and
+ * rounding, saturation, the interpolated sigmoid and the output weight keep order), so
+ * summing each unit's larger end share bounds every interior path's output exactly.
+ */
+static void bound_run(const qnav_ctrl_t *ctrl, run_t *r, best_t *best)
+{
+    uint16_t last = (uint16_t)(r->count - 1u);
+    uint8_t d0 = r->dtheta0;
+    uint8_t d1 = run_dtheta(r, last);
+    int32_t acc0 = ctrl->out_bias_z;
+    int32_t acc1 = ctrl->out_bias_z;
+    int32_t accmax = ctrl->out_bias_z;
+    uint8_t j;
+    for (j = 0; j < ctrl->hidden; ++j) {
+        const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
+        int32_t a = u->bias_z + u->per_level * r->level;
+        int32_t s0 = unit_share(a + u->per_deg * d0, u->out);
+        int32_t s1 = unit_share(a + u->per_deg * d1, u->out);
+        acc0 += s0;
+        acc1 += s1;
+        accmax += (s0 > s1) ? s0 : s1;
+    }
+    consider(best, net_output(acc0), r->first, d0);
+    consider(best, net_output(acc1), (uint16_t)(r->first + last), d1);
+    r->bound = (r->count > 2u) ? net_output(accmax) : (qnav_q1_15_t)-1;
+}
+
+/* Best-first over the runs' bounds: stop when no run left can reach the best. */
+static void search_runs(const qnav_ctrl_t *ctrl, run_t *runs, uint16_t n, best_t *best)
+{
+    uint16_t i;
+    for (;;) {
+        run_t *top = 0;
+        for (i = 0; i < n; ++i) {
+            if (runs[i].bound >= 0 && (top == 0 || runs[i].bound > top->bound)) {
+                top = &runs[i];
+            }
+        }
+        if (top == 0 || top->bound < best->q) {
+            return;
+        }
+        eval_run(ctrl, top, 1u, (uint16_t)(top->count - 1u), best, 0);
+        top->bound = -1;
+    }
+}
+
+/* Probabilistic: quality falls with dtheta at a fixed level, so a run's best path is its
+ * end nearest the goal, which the tie order also prefers. */
+static void prob_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best)
+{
+    uint16_t k = (uint16_t)(r->dir > 0 ? 0u : r->count - 1u);
+    uint8_t dtheta = run_dtheta(r, k);
+    consider(best, prob_quality(ctrl, r->level, dtheta), (uint16_t)(r->first + k), dtheta);
 }
 
 static void stop_output(qnav_ctrl_output_t *out, uint8_t flags, qnav_q1_15_t *qualities)
@@ -308,43 +530,15 @@ static void stop_output(qnav_ctrl_output_t *out, uint8_t flags, qnav_q1_15_t *qu
     }
 }
 
-/* Does candidate (q, dtheta, turn) beat the best so far? Ties: smaller dtheta, smaller
- * turn, then counter-clockwise (positive heading). */
-static uint8_t beats(qnav_q1_15_t q, uint8_t dtheta, qnav_deg_t heading, qnav_q1_15_t best_q,
-                     uint8_t best_dtheta, qnav_deg_t best_heading)
-{
-    int16_t turn;
-    int16_t best_turn;
-    if (q != best_q) {
-        return (uint8_t)(q > best_q);
-    }
-    if (dtheta != best_dtheta) {
-        return (uint8_t)(dtheta < best_dtheta);
-    }
-    turn = (int16_t)(heading < 0 ? -heading : heading);
-    best_turn = (int16_t)(best_heading < 0 ? -best_heading : best_heading);
-    if (turn != best_turn) {
-        return (uint8_t)(turn < best_turn);
-    }
-    return (uint8_t)(heading > best_heading);
-}
-
 void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
                     qnav_ctrl_output_t *out, qnav_q1_15_t *qualities)
 {
-    int32_t base[QNAV_MAX_HIDDEN];
-    const qnav_q1_15_t *row = 0;
-    uint16_t goal;
-    uint16_t path;
-    uint16_t sector = 0;
-    uint16_t phase;         /* path * N + 180, reduced modulo 360: sector advances at wrap */
-    uint16_t offset;        /* (path - goal) mod 360 */
-    uint8_t level = 0;
-    uint8_t flags = 0;
-    uint8_t j;
-    qnav_q1_15_t best_q = -1;
-    uint8_t best_dtheta = 0;
-    qnav_deg_t best_heading = 0;
+    run_t runs[QNAV_MAX_RUNS];
+    run_iter_t it;
+    run_t r;
+    best_t best;
+    uint16_t n = 0;
+    uint8_t flags;
     uint32_t speed;
 
     if (out == 0) {
@@ -354,74 +548,44 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
         stop_output(out, QNAV_FLAG_NOT_READY, qualities);
         return;
     }
-    goal = bearing_deg(in->goal_bearing_cdeg);
-    offset = (uint16_t)((QNAV_PATHS - goal) % QNAV_PATHS);
-    phase = QNAV_PATHS / 2u;
-
-    for (path = 0; path < QNAV_PATHS; ++path) {
-        uint8_t dtheta = (uint8_t)(offset <= QNAV_DTHETA_MAX ? offset : QNAV_PATHS - offset);
-        qnav_deg_t heading = heading_of(path);
-        qnav_q1_15_t q;
-
-        if (path == 0u || phase >= QNAV_PATHS) {
-            qnav_mm_t r;
-            if (phase >= QNAV_PATHS) {
-                phase = (uint16_t)(phase - QNAV_PATHS);
-                sector = (uint16_t)(sector + 1u == ctrl->n_sectors ? 0u : sector + 1u);
-            }
-            r = in->ranges_mm[sector];
-            if (r > ctrl->max_range_mm) {
-                r = ctrl->max_range_mm;
-                flags |= QNAV_FLAG_RANGE_CLIPPED;
-            }
-            level = level_of(ctrl, r);
-            if (ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
-                for (j = 0; j < ctrl->hidden; ++j) {
-                    base[j] = ctrl->p.unit[j].bias_z + ctrl->p.unit[j].per_level * level;
-                }
-            } else if (ctrl->kind == QNAV_KIND_TABLE) {
-                row = &ctrl->table[(uint16_t)level * QNAV_TABLE_STRIDE];
-            }
-        }
-
-        if (ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
-            int32_t acc = ctrl->out_bias_z;
-            for (j = 0; j < ctrl->hidden; ++j) {
-                acc += unit_share(base[j] + ctrl->p.unit[j].per_deg * dtheta, ctrl->p.unit[j].out);
-            }
-            q = net_output(acc);
+    best.q = -1;
+    best.dtheta = 0;
+    best.heading = 0;
+    run_iter_start(&it, ctrl, in->ranges_mm, bearing_deg(in->goal_bearing_cdeg));
+    while (run_iter_next(&it, &r)) {
+        if (qualities != 0 || ctrl->kind == QNAV_KIND_TABLE) {
+            eval_run(ctrl, &r, 0u, r.count, &best, qualities);
         } else if (ctrl->kind == (uint8_t)QNAV_POLICY_PROB) {
-            q = prob_quality(ctrl, level, dtheta);
+            prob_run(ctrl, &r, &best);
         } else {
-            q = QNAV_FLASH_READ_I16(&row[dtheta]);
+            bound_run(ctrl, &r, &best);
+            if (r.bound >= 0) {
+                if (n < QNAV_MAX_RUNS) {
+                    runs[n++] = r;
+                } else {
+                    /* no room to defer it: evaluate it now, same answer */
+                    eval_run(ctrl, &r, 1u, (uint16_t)(r.count - 1u), &best, 0);
+                }
+            }
         }
-
-        if (qualities != 0) {
-            qualities[path] = q;
-        }
-        if (beats(q, dtheta, heading, best_q, best_dtheta, best_heading)) {
-            best_q = q;
-            best_dtheta = dtheta;
-            best_heading = heading;
-        }
-        phase = (uint16_t)(phase + ctrl->n_sectors);
-        offset = (uint16_t)(offset + 1u == QNAV_PATHS ? 0u : offset + 1u);
     }
+    search_runs(ctrl, runs, n, &best);
+    flags = it.flags;
 
-    if (best_q <= 0) {
+    if (best.q <= 0) {
         out->heading_deg = 0;
         out->speed = 0;
         out->quality = 0;
         out->flags = (uint8_t)(flags | QNAV_FLAG_NO_PATH);
         return;
     }
-    speed = ((uint32_t)best_q * ctrl->speed_scale) >> 15;
-    if (best_q >= ctrl->full_speed_quality || speed > QNAV_Q1_15_MAX) {
+    speed = ((uint32_t)best.q * ctrl->speed_scale) >> 15;
+    if (best.q >= ctrl->full_speed_quality || speed > QNAV_Q1_15_MAX) {
         speed = QNAV_Q1_15_MAX;
         flags |= QNAV_FLAG_FULL_SPEED;
     }
-    out->heading_deg = best_heading;
+    out->heading_deg = best.heading;
     out->speed = (qnav_q1_15_t)speed;
-    out->quality = best_q;
+    out->quality = best.q;
     out->flags = flags;
 }

@@ -466,6 +466,14 @@ static void test_argmax_matches_reference_on_random_scans(void **state)
 
 /* --- table mode --- */
 
+static void assert_same_output(const qnav_ctrl_output_t *a, const qnav_ctrl_output_t *b)
+{
+    assert_int_equal(a->heading_deg, b->heading_deg);
+    assert_int_equal(a->speed, b->speed);
+    assert_int_equal(a->quality, b->quality);
+    assert_int_equal(a->flags, b->flags);
+}
+
 static void check_table_mode_identical(const qnav_policy_t *p, uint16_t n)
 {
     static qnav_q1_15_t table[QNAV_QTABLE_ENTRIES];
@@ -487,9 +495,16 @@ static void check_table_mode_identical(const qnav_policy_t *p, uint16_t n)
     for (int k = 0; k < 50; ++k) {
         random_scan(ranges, n, 3000);
         qnav_ctrl_input_t in = {ranges, (qnav_cdeg_t)rng_range(-32768, 32767)};
+        qnav_ctrl_output_t on;
+        qnav_ctrl_output_t otn;
         qnav_ctrl_step(&direct, &in, &od, qd);
         qnav_ctrl_step(&tab, &in, &ot, qt);
         assert_memory_equal(qd, qt, sizeof qd);
+        /* without qualities the step searches best first: it must decide the same */
+        qnav_ctrl_step(&direct, &in, &on, NULL);
+        qnav_ctrl_step(&tab, &in, &otn, NULL);
+        assert_same_output(&on, &od);
+        assert_same_output(&otn, &od);
         assert_int_equal(od.heading_deg, ot.heading_deg);
         assert_int_equal(od.speed, ot.speed);
         assert_int_equal(od.quality, ot.quality);
@@ -500,12 +515,14 @@ static void check_table_mode_identical(const qnav_policy_t *p, uint16_t n)
 static void test_table_mode_is_bit_identical_to_network_mode(void **state)
 {
     (void)state;
-    static const uint16_t sectors[] = {1, 7, 8, 16, 32, 180, 360};
+    static const uint16_t sectors[] = {1, 2, 3, 7, 8, 16, 32, 64, 180, 359, 360};
     qnav_policy_t p;
     for (size_t s = 0; s < sizeof sectors / sizeof sectors[0]; ++s) {
         random_net(&p, (uint8_t)rng_range(1, QNAV_MAX_HIDDEN), 32767);
         check_table_mode_identical(&p, sectors[s]);
         random_net(&p, 12, 1024);
+        check_table_mode_identical(&p, sectors[s]);
+        random_net(&p, 12, 256);
         check_table_mode_identical(&p, sectors[s]);
     }
 }
