@@ -93,6 +93,9 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     ctrl->level_scale = ((uint32_t)(QNAV_DIST_LEVELS - 1) * 65536u + cfg->max_range_mm / 2u) /
                         cfg->max_range_mm;
     ctrl->speed_scale = (32768u * 32768u + q_full / 2u) / q_full;
+    ctrl->sector_paths = (uint16_t)(QNAV_PATHS / cfg->n_sectors);
+    ctrl->sector_span = (uint16_t)(ctrl->sector_paths * cfg->n_sectors);
+    ctrl->first_sector_paths = (uint16_t)((QNAV_PATHS / 2u + cfg->n_sectors - 1u) / cfg->n_sectors);
     ctrl->table = 0;
     ctrl->hidden = 0u;
     ctrl->out_bias_z = 0;
@@ -337,30 +340,19 @@ static void consider(best_t *best, qnav_q1_15_t q, uint16_t path, uint8_t dtheta
     best->heading = heading;
 }
 
-/* Walks the 360 paths once and hands out their runs in path order. */
+/* Walks the 360 paths once and hands out their runs in path order, a run at a time. */
 typedef struct {
     const qnav_ctrl_t *ctrl;
     const qnav_mm_t *ranges;
-    uint16_t path;    /* next path to place */
-    uint16_t sector;  /* sector of that path */
-    uint16_t phase;   /* path * N + 180, modulo 360: the sector steps when it wraps */
-    uint16_t offset;  /* (path - goal) modulo 360 */
-    uint8_t level;    /* distance level of the current sector */
-    uint8_t flags;    /* QNAV_FLAG_RANGE_CLIPPED once a clipped range was seen */
+    uint16_t path;        /* next path to hand out */
+    uint16_t sector;      /* its sector */
+    uint16_t left;        /* paths of that sector still to hand out */
+    uint16_t phase;       /* first path of the sector * N + 180, modulo 360 */
+    uint16_t count;       /* paths in the sector */
+    uint16_t offset;      /* (path - goal) modulo 360 */
+    uint8_t level;        /* distance level of the sector */
+    uint8_t flags;        /* QNAV_FLAG_RANGE_CLIPPED once a clipped range was seen */
 } run_iter_t;
-
-static void run_iter_start(run_iter_t *it, const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges,
-                           uint16_t goal)
-{
-    it->ctrl = ctrl;
-    it->ranges = ranges;
-    it->path = 0;
-    it->sector = 0;
-    it->phase = QNAV_PATHS / 2u;
-    it->offset = (uint16_t)((QNAV_PATHS - goal) % QNAV_PATHS);
-    it->level = 0;
-    it->flags = 0;
-}
 
 static void run_iter_enter_sector(run_iter_t *it)
 {
@@ -370,42 +362,60 @@ static void run_iter_enter_sector(run_iter_t *it)
         it->flags |= QNAV_FLAG_RANGE_CLIPPED;
     }
     it->level = level_of(it->ctrl, r);
+    it->left = it->count;
+}
+
+static void run_iter_start(run_iter_t *it, const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges,
+                           uint16_t goal)
+{
+    it->ctrl = ctrl;
+    it->ranges = ranges;
+    it->path = 0;
+    it->sector = 0;
+    it->phase = QNAV_PATHS / 2u;
+    it->count = ctrl->first_sector_paths;
+    it->offset = (uint16_t)((QNAV_PATHS - goal) % QNAV_PATHS);
+    it->flags = 0;
+    run_iter_enter_sector(it);
 }
 
 /* The next run into *r; 0 when all 360 paths have been handed out. A run ends where the
- * sector changes, where dtheta turns (at the goal and opposite it) and at path 359. */
+ * sector ends, where dtheta turns (at the goal and opposite it) and after path 359.
+ * Sector lengths follow from path * N + 180 wrapping past 360: a sector whose first path
+ * has phase p holds q = 360 / N paths, or q + 1 when p + q * N is still below 360. */
 static uint8_t run_iter_next(run_iter_t *it, run_t *r)
 {
+    uint16_t n;
+    uint16_t to_turn;
     if (it->path >= QNAV_PATHS) {
         return 0;
     }
-    if (it->path == 0u) {
+    if (it->left == 0u) {
+        const qnav_ctrl_t *c = it->ctrl;
+        it->phase = (uint16_t)(it->phase + it->count * c->n_sectors - QNAV_PATHS);
+        it->count = (uint16_t)(c->sector_paths + (it->phase + c->sector_span < QNAV_PATHS ? 1u : 0u));
+        it->sector = (uint16_t)(it->sector + 1u == c->n_sectors ? 0u : it->sector + 1u);
         run_iter_enter_sector(it);
     }
+    to_turn = (uint16_t)(it->offset < QNAV_DTHETA_MAX ? QNAV_DTHETA_MAX - it->offset
+                                                      : QNAV_PATHS - it->offset);
+    n = it->left < to_turn ? it->left : to_turn;
+    if (n > QNAV_PATHS - it->path) {
+        n = (uint16_t)(QNAV_PATHS - it->path);
+    }
     r->first = it->path;
-    r->count = 0;
+    r->count = n;
     r->level = it->level;
     r->dtheta0 = (uint8_t)(it->offset <= QNAV_DTHETA_MAX ? it->offset : QNAV_PATHS - it->offset);
     r->dir = (int8_t)(it->offset < QNAV_DTHETA_MAX ? 1 : -1);
     r->bound = -1;
-    for (;;) {
-        r->count++;
-        it->path++;
-        it->phase = (uint16_t)(it->phase + it->ctrl->n_sectors);
-        it->offset = (uint16_t)(it->offset + 1u == QNAV_PATHS ? 0u : it->offset + 1u);
-        if (it->path == QNAV_PATHS) {
-            return 1;
-        }
-        if (it->phase >= QNAV_PATHS) {
-            it->phase = (uint16_t)(it->phase - QNAV_PATHS);
-            it->sector = (uint16_t)(it->sector + 1u == it->ctrl->n_sectors ? 0u : it->sector + 1u);
-            run_iter_enter_sector(it);
-            return 1;
-        }
-        if (it->offset == 0u || it->offset == QNAV_DTHETA_MAX) {
-            return 1;
-        }
+    it->path = (uint16_t)(it->path + n);
+    it->left = (uint16_t)(it->left - n);
+    it->offset = (uint16_t)(it->offset + n);
+    if (it->offset >= QNAV_PATHS) {
+        it->offset = (uint16_t)(it->offset - QNAV_PATHS);
     }
+    return 1;
 }
 
 static uint8_t run_dtheta(const run_t *r, uint16_t k)

@@ -464,6 +464,34 @@ static void test_argmax_matches_reference_on_random_scans(void **state)
     assert_true(clear_same * 100u >= clear * 99u);
 }
 
+static void test_every_path_reads_its_own_sector_and_dtheta(void **state)
+{
+    (void)state;
+    qnav_policy_t p;
+    qnav_ctrl_t c;
+    qnav_mm_t ranges[QNAV_MAX_SECTORS];
+    qnav_q1_15_t q[QNAV_PATHS];
+    qnav_ctrl_output_t out;
+    random_net(&p, 6, 1024);
+    for (uint16_t n = 1; n <= QNAV_MAX_SECTORS; n = (uint16_t)(n < 40 ? n + 1 : n + 23)) {
+        init_or_fail(&c, n, 3000, &p);
+        for (int k = 0; k < 3; ++k) {
+            random_scan(ranges, n, 3000);
+            qnav_ctrl_input_t in = {ranges, (qnav_cdeg_t)rng_range(-18000, 18000)};
+            unsigned goal = ref_goal_deg(in.goal_bearing_cdeg);
+            qnav_ctrl_step(&c, &in, &out, q);
+            for (uint16_t i = 0; i < QNAV_PATHS; ++i) {
+                uint8_t level = qnav_ctrl_level(&c, ranges[qnav_ctrl_sector_of_path(n, i)]);
+                uint8_t dt = (uint8_t)ref_dtheta(i, goal);
+                if (q[i] != qnav_ctrl_quality(&c, level, dt)) {
+                    fail_msg("N %u path %u: quality %d, expected %d", n, i, q[i],
+                             qnav_ctrl_quality(&c, level, dt));
+                }
+            }
+        }
+    }
+}
+
 /* --- table mode --- */
 
 static void assert_same_output(const qnav_ctrl_output_t *a, const qnav_ctrl_output_t *b)
@@ -591,6 +619,7 @@ int main(void)
         cmocka_unit_test(test_all_zero_quality_stops_and_flags),
         cmocka_unit_test(test_qualities_are_within_bound_of_double_reference),
         cmocka_unit_test(test_argmax_matches_reference_on_random_scans),
+        cmocka_unit_test(test_every_path_reads_its_own_sector_and_dtheta),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_network_mode),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_probabilistic_mode),
         cmocka_unit_test(test_build_table_refuses_a_table_controller),

@@ -79,6 +79,9 @@ typedef struct {
     qnav_mm_t max_range_mm;
     uint32_t level_scale;             /* distance level = (range * scale + 2^15) >> 16 */
     uint32_t speed_scale;             /* speed = min(MAX, (quality * scale) >> 15) */
+    uint16_t sector_paths;            /* 360 / N: paths in a sector, or one more */
+    uint16_t sector_span;             /* sector_paths * N */
+    uint16_t first_sector_paths;      /* paths 0.. that lie in sector 0: ceil(180 / N) */
     qnav_q1_15_t full_speed_quality;
     const qnav_q1_15_t *table;        /* table mode: [QNAV_DIST_LEVELS][181] qualities */
     int32_t out_bias_z;               /* network output bias, units of 2^-15 */
