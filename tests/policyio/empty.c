@@ -1,0 +1,1 @@
+/* An empty translation unit: the generated header under test is force-included. */
