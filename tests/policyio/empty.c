@@ -1,1 +1,0 @@
-/* An empty translation unit: the generated header under test is force-included. */
