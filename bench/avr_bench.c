@@ -220,6 +220,23 @@ int main(void)
         if (mode == QNAV_BENCH_NET) {
             net_mean = sum / QNAV_BENCH_SCANS;
         }
+        if (mode != QNAV_BENCH_PROB) {
+            /* Cost of one path's quality through the public function: how many path
+             * evaluations a step's cycles amount to. */
+            volatile qnav_q1_15_t q;
+            uint8_t lv;
+            timer_start();
+            for (lv = 0; lv < 16u; ++lv) {
+                q = qnav_ctrl_quality(&ctrl, (uint8_t)(lv * 2u), (uint8_t)(lv * 11u));
+            }
+            c = timer_stop() - overhead;
+            (void)q;
+            qnav_target_put("  one qnav_ctrl_quality() call: ");
+            qnav_target_put_u32((c + 8u) / 16u);
+            qnav_target_put(" cycles (mean of 16); step = ");
+            qnav_target_put_u32((sum / QNAV_BENCH_SCANS + (c + 8u) / 32u) / ((c + 8u) / 16u));
+            qnav_target_put(" such calls\n");
+        }
     }
 
     qnav_target_put("sizeof(qnav_ctrl_t) ");

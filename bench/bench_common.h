@@ -21,7 +21,7 @@
 enum { QNAV_BENCH_NET = 0, QNAV_BENCH_PROB, QNAV_BENCH_TABLE, QNAV_BENCH_MODES };
 
 static const char *const qnav_bench_mode_names[QNAV_BENCH_MODES] = {
-    "network H=12", "probabilistic", "table (flash)"};
+    "network H=12", "probabilistic", "table"};
 
 /* Scan k (0..QNAV_BENCH_SCANS-1) into ranges[QNAV_BENCH_SECTORS]; returns its bearing. */
 static inline qnav_cdeg_t qnav_bench_scan(uint8_t k, qnav_mm_t *ranges)
