@@ -1,0 +1,181 @@
+/*
+ * The ε-greedy evolutionary algorithm of paper Fig. 4 and its mutation operator.
+ */
+#include "evolution.h"
+
+#include <cmath>
+#include <limits>
+
+namespace qnav {
+
+const char *evolution_params_problem(const EvolutionParams &p)
+{
+    if (p.population < 2 || p.population > 100000) {
+        return "population: must be 2..100000";
+    }
+    if (!(p.epsilon >= 0.0 && p.epsilon <= 1.0)) {
+        return "epsilon: must be in [0, 1]";
+    }
+    if (p.hidden < 1 || p.hidden > QNAV_MAX_HIDDEN) {
+        return "hidden: must be 1..32 (QNAV_MAX_HIDDEN)";
+    }
+    if (!(p.mutation_scale > 0.0 && p.mutation_scale <= 128.0)) {
+        return "mutation_scale: must be in (0, 128]";
+    }
+    if (!(p.mutation_clip > 0.0 && p.mutation_clip <= 256.0)) {
+        return "mutation_clip: must be in (0, 256]";
+    }
+    if (!(p.init_scale > 0.0 && p.init_scale <= 128.0)) {
+        return "init_scale: must be in (0, 128]";
+    }
+    return "";
+}
+
+namespace {
+qnav_q8_8_t to_q8_8_saturated(double raw)
+{
+    const double r = std::round(raw); // half away from zero
+    if (r >= static_cast<double>(QNAV_Q8_8_MAX)) {
+        return QNAV_Q8_8_MAX;
+    }
+    if (r <= static_cast<double>(QNAV_Q8_8_MIN)) {
+        return QNAV_Q8_8_MIN;
+    }
+    return static_cast<qnav_q8_8_t>(r);
+}
+
+uint16_t weight_count(const qnav_net_t &net) { return static_cast<uint16_t>(QNAV_NET_WEIGHTS(net.hidden)); }
+} // namespace
+
+void mutate_network(qnav_net_t &net, Rng &rng, double scale, double clip)
+{
+    const uint16_t n = weight_count(net);
+    for (uint16_t k = 0; k < n; ++k) {
+        qnav_q8_8_t *w = qnav_net_weight(&net, k);
+        const double delta = rng.cauchy_clipped(scale, clip);
+        *w = to_q8_8_saturated(static_cast<double>(*w) + delta * QNAV_Q8_8_ONE);
+    }
+}
+
+uint32_t policy_fingerprint(const qnav_policy_t &policy)
+{
+    uint64_t h = fnv1a64(&policy.kind, 1);
+    if (policy.kind == QNAV_POLICY_NET) {
+        qnav_net_t net = policy.u.net;
+        h = fnv1a64(&net.hidden, 1, h);
+        const uint16_t n = weight_count(net);
+        for (uint16_t k = 0; k < n; ++k) {
+            const int16_t w = *qnav_net_weight(&net, k);
+            const unsigned char b[2] = {static_cast<unsigned char>(w & 0xff),
+                                        static_cast<unsigned char>((w >> 8) & 0xff)};
+            h = fnv1a64(b, 2, h);
+        }
+    } else {
+        const int16_t p[2] = {policy.u.prob.k_goal, policy.u.prob.k_safe};
+        h = fnv1a64(p, sizeof p, h);
+    }
+    return static_cast<uint32_t>(h ^ (h >> 32));
+}
+
+Evolution::Evolution(const EvolutionParams &params, uint64_t seed)
+    : params_(params), rng_(seed), pop_(params.population),
+      best_so_far_(-std::numeric_limits<double>::infinity())
+{
+    for (Member &m : pop_) {
+        qnav_policy_net_zero(&m.policy, static_cast<uint8_t>(params_.hidden));
+        qnav_net_t &net = m.policy.u.net;
+        const uint16_t n = weight_count(net);
+        for (uint16_t k = 0; k < n; ++k) {
+            const double x = params_.init == InitKind::Cauchy
+                                 ? rng_.cauchy_clipped(params_.init_scale, params_.mutation_clip)
+                                 : (2.0 * rng_.uniform01() - 1.0) * params_.init_scale;
+            *qnav_net_weight(&net, k) = to_q8_8_saturated(x * QNAV_Q8_8_ONE);
+        }
+    }
+    init_order_.resize(pop_.size());
+    for (uint32_t i = 0; i < init_order_.size(); ++i) {
+        init_order_[i] = i;
+    }
+    for (uint32_t i = static_cast<uint32_t>(init_order_.size()); i > 1; --i) {
+        const uint32_t j = rng_.below(i);
+        std::swap(init_order_[i - 1], init_order_[j]);
+    }
+}
+
+Evolution::Evolution(const EvolutionParams &params, uint64_t seed, const qnav_policy_t &source)
+    : Evolution(params, seed)
+{
+    // The random members drawn above are discarded; the draws keep transfer and direct
+    // runs on the same generator positions, which is harmless and keeps one code path.
+    for (uint32_t i = 0; i < pop_.size(); ++i) {
+        pop_[i].policy = source;
+        if (i > 0) {
+            mutate_network(pop_[i].policy.u.net, rng_, params_.mutation_scale,
+                           params_.mutation_clip);
+        }
+    }
+}
+
+int32_t Evolution::best_index() const
+{
+    int32_t best = -1;
+    for (uint32_t i = 0; i < pop_.size(); ++i) {
+        if (pop_[i].evaluated && (best < 0 || pop_[i].fitness > pop_[best].fitness)) {
+            best = static_cast<int32_t>(i);
+        }
+    }
+    return best;
+}
+
+int32_t Evolution::worst_index() const
+{
+    int32_t worst = -1;
+    for (uint32_t i = 0; i < pop_.size(); ++i) {
+        if (!pop_[i].evaluated) {
+            return static_cast<int32_t>(i);
+        }
+        if (worst < 0 || pop_[i].fitness < pop_[worst].fitness) {
+            worst = static_cast<int32_t>(i);
+        }
+    }
+    return worst;
+}
+
+Candidate Evolution::propose()
+{
+    Candidate c;
+    c.episode = episode_;
+    if (episode_ < init_order_.size()) {
+        c.slot = static_cast<int32_t>(init_order_[episode_]);
+        c.policy = pop_[c.slot].policy;
+    } else {
+        // Fig. 4 step 1: both draws every time, so the stream does not depend on ε.
+        const double u = rng_.uniform01();
+        const uint32_t pick = rng_.below(static_cast<uint32_t>(pop_.size()));
+        c.explored = u < params_.epsilon;
+        c.parent = c.explored ? static_cast<int32_t>(pick) : best_index();
+        c.policy = pop_[c.parent].policy;
+        mutate_network(c.policy.u.net, rng_, params_.mutation_scale, params_.mutation_clip);
+        c.slot = -1; // decided in accept(): the worst member at that time
+    }
+    pending_ = true;
+    return c;
+}
+
+void Evolution::accept(const Candidate &c, const EpisodeOutcome &out)
+{
+    if (!pending_ || c.episode != episode_) {
+        return;
+    }
+    pending_ = false;
+    const int32_t slot = c.slot >= 0 ? c.slot : worst_index();
+    pop_[slot].policy = c.policy;
+    pop_[slot].fitness = out.R;
+    pop_[slot].evaluated = true;
+    if (out.R > best_so_far_) {
+        best_so_far_ = out.R;
+    }
+    ++episode_;
+}
+
+} // namespace qnav

@@ -1,0 +1,119 @@
+/*
+ * The ε-greedy steady-state neuro-evolution of paper Fig. 4, independent of any simulator:
+ * a population of Q8.8 network policies; each episode picks a random member with
+ * probability ε (else the best), adds a clipped Cauchy sample to every weight, runs one
+ * episode through an EpisodeRunner, and the mutant replaces the worst member with its R
+ * as fitness. Everything random comes from one seeded Rng, so the sequence of candidates
+ * is a pure function of (parameters, seed, the R values returned): that is what lets a
+ * run be resumed by replaying its episode log (docs/simevo.md, "Resuming").
+ */
+#ifndef QNAV_SIMEVO_EVOLUTION_H
+#define QNAV_SIMEVO_EVOLUTION_H
+
+#include <cstdint>
+#include <vector>
+
+#include "qnav/policy.h"
+#include "rng.h"
+
+namespace qnav {
+
+/* What one episode returned (paper Eq. 1-3). */
+struct EpisodeOutcome {
+    double R = 0.0;       /* fitness, Eq. 1 */
+    double f1 = 0.0;      /* path-length feature, Eq. 2, (0, 1] */
+    double f2 = 0.0;      /* time feature, Eq. 3, (0, 1] */
+    uint32_t tau_c = 0;   /* ticks spent in collision recovery */
+    bool reached = false; /* destination reached */
+};
+
+/* Runs one episode with a policy. Implementations: the Box2D simulator (SimRunner) and
+ * fakes in tests. episode_seed alone fixes the episode's randomness. */
+class EpisodeRunner {
+public:
+    virtual ~EpisodeRunner() = default;
+    virtual EpisodeOutcome run(const qnav_policy_t &policy, uint64_t episode_seed) = 0;
+};
+
+/* How the initial random population is drawn. */
+enum class InitKind {
+    Cauchy, /* every weight an independent clipped Cauchy sample (scale init_scale,
+               clip mutation_clip): the mutation operator applied to the zero network */
+    Uniform /* every weight uniform in [-init_scale, init_scale] */
+};
+
+struct EvolutionParams {
+    uint32_t population = 40;      /* members, >= 2 */
+    double epsilon = 0.1;          /* probability of mutating a random member, [0, 1] */
+    uint32_t hidden = 12;          /* hidden units of new networks, 1..QNAV_MAX_HIDDEN */
+    double mutation_scale = 1.0;   /* Cauchy scale, weight units (assumed; paper: none) */
+    double mutation_clip = 10.0;   /* Cauchy samples clipped to [-clip, clip] (paper) */
+    InitKind init = InitKind::Cauchy;
+    double init_scale = 1.0;       /* see InitKind, weight units */
+};
+
+/* Returns "" when p is valid, else "FIELD: problem". */
+const char *evolution_params_problem(const EvolutionParams &p);
+
+/* Add a clipped Cauchy sample (scale, clip in weight units) to every weight of net, round
+ * to the nearest Q8.8 step (half away from zero) and saturate to [-128, 128 - 1/256]. */
+void mutate_network(qnav_net_t &net, Rng &rng, double scale, double clip);
+
+/* 32-bit fingerprint of a network's shape and weights (journal check). */
+uint32_t policy_fingerprint(const qnav_policy_t &policy);
+
+struct Member {
+    qnav_policy_t policy{};
+    double fitness = 0.0;   /* R of the episode it was scored on */
+    bool evaluated = false; /* false until its first episode */
+};
+
+/* The candidate for one episode. */
+struct Candidate {
+    uint64_t episode = 0;   /* 0-based episode index in this evolution */
+    qnav_policy_t policy{}; /* the network to run */
+    int32_t parent = -1;    /* member mutated to make it; -1 in the initial evaluation */
+    bool explored = false;  /* the parent was the random pick (probability ε) */
+    int32_t slot = -1;      /* member the result is stored in */
+};
+
+class Evolution {
+public:
+    /* Random initial population (see InitKind). */
+    Evolution(const EvolutionParams &params, uint64_t seed);
+    /* Transfer (paper §4): member 0 is `source`, the others mutants of it. */
+    Evolution(const EvolutionParams &params, uint64_t seed, const qnav_policy_t &source);
+
+    /*
+     * The next candidate. The first population-size episodes score the initial members
+     * once each, in a random order (so the first episode runs a random member); after
+     * that, Fig. 4: with probability ε a random member else the best, mutated; the
+     * result replaces the worst member.
+     */
+    Candidate propose();
+    /* Record the candidate's outcome (must follow the matching propose()). */
+    void accept(const Candidate &c, const EpisodeOutcome &out);
+
+    uint64_t episodes_done() const { return episode_; }
+    /* Index of the best evaluated member (ties: lowest index); -1 if none evaluated. */
+    int32_t best_index() const;
+    /* Index of the member to replace: an unevaluated one first, else the lowest fitness
+     * (ties: lowest index). */
+    int32_t worst_index() const;
+    const std::vector<Member> &members() const { return pop_; }
+    double best_so_far() const { return best_so_far_; }
+    const EvolutionParams &params() const { return params_; }
+
+private:
+    EvolutionParams params_;
+    Rng rng_;
+    std::vector<Member> pop_;
+    std::vector<uint32_t> init_order_;
+    uint64_t episode_ = 0;
+    bool pending_ = false;
+    double best_so_far_;
+};
+
+} // namespace qnav
+
+#endif

@@ -1,0 +1,703 @@
+/*
+ * Experiment orchestration: task plan, thread pool, progress display, summary, plots.
+ */
+#include "experiment.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <set>
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+#include "files.h"
+#include "qnav/ctrl.h"
+#include "qnav/policy_io.h"
+#include "rng.h"
+#include "sim_runner.h"
+#include "stats.h"
+
+namespace qnav {
+
+namespace {
+
+uint64_t label_hash(const std::string &s) { return fnv1a64(s.data(), s.size()); }
+
+std::string run_dir(const std::string &exp_dir, uint32_t run)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "run-%03u", run + 1);
+    return join_path(exp_dir, buf);
+}
+
+/* ---- progress -------------------------------------------------------------------- */
+
+class Progress {
+public:
+    Progress(uint64_t total, bool enabled, std::string title)
+        : total_(total), enabled_(enabled), title_(std::move(title)),
+          t0_(std::chrono::steady_clock::now())
+    {
+        if (enabled_) {
+            printer_ = std::thread([this] { loop(); });
+        }
+    }
+    ~Progress() { finish(); }
+
+    void finish()
+    {
+        {
+            std::lock_guard<std::mutex> l(mu_);
+            if (finished_) {
+                return;
+            }
+            finished_ = true;
+        }
+        cv_.notify_all();
+        if (printer_.joinable()) {
+            printer_.join();
+            print_line();
+            std::fputc('\n', stderr);
+        }
+    }
+
+    void add(uint64_t n, bool replayed)
+    {
+        done_ += n;
+        if (replayed) {
+            replayed_ += n;
+        }
+    }
+    void best(const std::string &label, double r)
+    {
+        std::lock_guard<std::mutex> l(mu_);
+        // Strip the run-independent part: best over all runs of a condition.
+        auto it = best_.find(label);
+        if (it == best_.end() || r > it->second) {
+            best_[label] = r;
+        }
+    }
+
+private:
+    void loop()
+    {
+        std::unique_lock<std::mutex> l(mu_);
+        while (!finished_) {
+            cv_.wait_for(l, std::chrono::milliseconds(500));
+            if (finished_) {
+                break;
+            }
+            l.unlock();
+            print_line();
+            l.lock();
+        }
+    }
+    void print_line()
+    {
+        const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+        const uint64_t done = done_.load();
+        const uint64_t fresh = done - replayed_.load();
+        const double rate = secs > 0 ? static_cast<double>(fresh) / secs : 0.0;
+        const double left = rate > 0 ? static_cast<double>(total_ - std::min(done, total_)) / rate : 0.0;
+        const long eta = static_cast<long>(left);
+        std::string bests;
+        {
+            std::lock_guard<std::mutex> l(mu_);
+            for (auto &kv : best_) {
+                char b[96];
+                std::snprintf(b, sizeof b, " %s %.2f", kv.first.c_str(), kv.second);
+                bests += b;
+            }
+        }
+        std::fprintf(stderr, "\r\033[K[%s] %" PRIu64 "/%" PRIu64 " episodes %5.1f%%  %.0f ep/s  ETA %ld:%02ld:%02ld  best R:%s",
+                     title_.c_str(), done, total_, total_ ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 100.0,
+                     rate, eta / 3600, (eta / 60) % 60, eta % 60, bests.c_str());
+        std::fflush(stderr);
+    }
+
+    std::atomic<uint64_t> done_{0}, replayed_{0};
+    uint64_t total_;
+    bool enabled_;
+    std::string title_;
+    std::chrono::steady_clock::time_point t0_;
+    std::mutex mu_;
+    std::condition_variable cv_;
+    bool finished_ = false;
+    std::map<std::string, double> best_;
+    std::thread printer_;
+};
+
+std::string fmt(double v, int prec = 2)
+{
+    if (!std::isfinite(v)) {
+        return "n/a";
+    }
+    char b[64];
+    std::snprintf(b, sizeof b, "%.*f", prec, v);
+    return b;
+}
+
+std::string fmt_p(const TestResult &t)
+{
+    if (!t.valid) {
+        return "n/a";
+    }
+    char b[64];
+    if (t.p < 1e-4) {
+        std::snprintf(b, sizeof b, "%.1e", t.p);
+    } else {
+        std::snprintf(b, sizeof b, "%.4f", t.p);
+    }
+    return b;
+}
+
+std::string json_num(double v)
+{
+    if (!std::isfinite(v)) {
+        return "null";
+    }
+    char b[64];
+    std::snprintf(b, sizeof b, "%.10g", v);
+    return b;
+}
+
+std::string json_str(const std::string &s)
+{
+    std::string o = "\"";
+    for (char c : s) {
+        if (c == '"' || c == '\\') {
+            o += '\\';
+            o += c;
+        } else if (static_cast<unsigned char>(c) < 0x20) {
+            char b[8];
+            std::snprintf(b, sizeof b, "\\u%04x", c);
+            o += b;
+        } else {
+            o += c;
+        }
+    }
+    return o + "\"";
+}
+
+} // namespace
+
+/* ---- plan ------------------------------------------------------------------------ */
+
+std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &exp_dir)
+{
+    std::vector<TaskDef> tasks;
+    const uint64_t eval_base = mix_seed(spec.eval_seed, label_hash("held-out evaluation"));
+    for (uint32_t r = 0; r < spec.runs; ++r) {
+        const uint64_t run_seed = mix_seed(spec.seed, r + 1);
+        const std::string rdir = run_dir(exp_dir, r);
+        // Transfer and direct runs of one run face the same episode sequence (common
+        // random numbers): the comparison is paired by construction.
+        const uint64_t target_episodes_base = mix_seed(run_seed, label_hash("episodes:target"));
+        for (const SourceSpec &s : spec.sources) {
+            int src_index = -1;
+            if (s.policy_file.empty()) {
+                TaskDef src;
+                src.label = "source-" + s.label;
+                src.dir = join_path(rdir, src.label);
+                src.run = r;
+                src.scenario = s.scenario;
+                src.context_seed = spec.seed;
+                src.episodes = s.episodes;
+                src.evolution = spec.evolution;
+                src.evolution_seed = mix_seed(run_seed, label_hash("evolution:" + src.label));
+                src.episode_seed_base = mix_seed(run_seed, label_hash("episodes:" + src.label));
+                tasks.push_back(src);
+                src_index = static_cast<int>(tasks.size() - 1);
+            }
+            TaskDef tr;
+            tr.label = "transfer-" + s.label;
+            tr.dir = join_path(rdir, tr.label);
+            tr.run = r;
+            tr.scenario = spec.target;
+            tr.context_seed = spec.seed;
+            tr.episodes = spec.target_episodes;
+            tr.evolution = spec.evolution;
+            tr.evolution_seed = mix_seed(run_seed, label_hash("evolution:" + tr.label));
+            tr.episode_seed_base = target_episodes_base;
+            tr.source_task = src_index;
+            tr.source_policy_file = s.policy_file;
+            tr.eval_episodes = spec.eval_episodes;
+            tr.eval_seed_base = eval_base;
+            tasks.push_back(tr);
+        }
+        TaskDef d;
+        d.label = "direct";
+        d.dir = join_path(rdir, d.label);
+        d.run = r;
+        d.scenario = spec.target;
+        d.context_seed = spec.seed;
+        d.episodes = spec.target_episodes;
+        d.evolution = spec.evolution;
+        d.evolution_seed = mix_seed(run_seed, label_hash("evolution:direct"));
+        d.episode_seed_base = target_episodes_base;
+        d.eval_episodes = spec.eval_episodes;
+        d.eval_seed_base = eval_base;
+        tasks.push_back(d);
+    }
+    TaskDef p;
+    p.kind = TaskKind::EvalProbabilistic;
+    p.label = "probabilistic";
+    p.dir = join_path(exp_dir, "probabilistic");
+    p.scenario = spec.target;
+    p.context_seed = spec.seed;
+    p.eval_episodes = spec.eval_episodes;
+    p.eval_seed_base = eval_base;
+    tasks.push_back(p);
+    return tasks;
+}
+
+/* ---- pool ------------------------------------------------------------------------ */
+
+void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, unsigned jobs,
+               bool progress, const std::string &title)
+{
+    uint64_t total = 0;
+    for (const TaskDef &t : tasks) {
+        total += task_total_episodes(t);
+    }
+    Progress prog(total, progress, title);
+    TaskObserver obs;
+    obs.episodes_done = [&prog](uint64_t n, bool replayed) { prog.add(n, replayed); };
+    obs.best = [&prog](const std::string &label, double r) { prog.best(label, r); };
+
+    enum State { Pending, Running, Done, Failed };
+    std::vector<State> state(tasks.size(), Pending);
+    std::mutex mu;
+    std::condition_variable cv;
+    std::atomic<bool> stop{false};
+    std::string first_error;
+
+    auto worker = [&]() {
+        std::unique_lock<std::mutex> l(mu);
+        for (;;) {
+            if (stop.load()) {
+                return;
+            }
+            std::size_t pick = tasks.size();
+            bool any_pending = false;
+            for (std::size_t i = 0; i < tasks.size(); ++i) {
+                if (state[i] != Pending) {
+                    continue;
+                }
+                any_pending = true;
+                const int src = tasks[i].source_task;
+                if (src < 0 || state[static_cast<std::size_t>(src)] == Done) {
+                    pick = i;
+                    break;
+                }
+            }
+            if (!any_pending) {
+                return;
+            }
+            if (pick == tasks.size()) {
+                cv.wait(l);
+                continue;
+            }
+            state[pick] = Running;
+            l.unlock();
+            const TaskDef &t = tasks[pick];
+            std::string source_path;
+            if (t.source_task >= 0) {
+                source_path = join_path(tasks[static_cast<std::size_t>(t.source_task)].dir, "best.policy");
+            } else if (!t.source_policy_file.empty()) {
+                source_path = t.source_policy_file;
+            }
+            bool ok = false;
+            std::string error;
+            try {
+                ok = run_task(t, source_path, make, obs, stop);
+            } catch (const std::exception &e) {
+                error = e.what();
+            }
+            l.lock();
+            state[pick] = ok ? Done : Failed;
+            if (!ok) {
+                if (first_error.empty() && !error.empty()) {
+                    first_error = error;
+                }
+                stop = true;
+            }
+            cv.notify_all();
+        }
+    };
+    if (jobs == 0) {
+        jobs = std::max(1u, std::thread::hardware_concurrency());
+    }
+    std::vector<std::thread> pool;
+    for (unsigned i = 0; i < jobs; ++i) {
+        pool.emplace_back(worker);
+    }
+    for (auto &th : pool) {
+        th.join();
+    }
+    prog.finish();
+    if (!first_error.empty()) {
+        throw UserError(first_error);
+    }
+    if (stop.load()) {
+        throw UserError(title + ": stopped before completion");
+    }
+}
+
+/* ---- summary --------------------------------------------------------------------- */
+
+ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks)
+{
+    ExperimentSummary S;
+    S.curve_bin = spec.curve_bin;
+    S.episodes = spec.target_episodes;
+    std::vector<std::string> labels;
+    for (const SourceSpec &s : spec.sources) {
+        labels.push_back("transfer-" + s.label);
+    }
+    labels.push_back("direct");
+    const uint64_t nbins = (spec.target_episodes + spec.curve_bin - 1) / spec.curve_bin;
+
+    for (const std::string &label : labels) {
+        ConditionSummary c;
+        c.label = label;
+        std::vector<std::vector<double>> bins(nbins);
+        double best_final = -std::numeric_limits<double>::infinity();
+        uint64_t reached = 0, evals = 0;
+        for (const TaskDef &t : tasks) {
+            if (t.label != label) {
+                continue;
+            }
+            const auto ev = read_eval(join_path(t.dir, "eval.csv"));
+            std::vector<double> r;
+            for (const auto &o : ev) {
+                r.push_back(o.R);
+                reached += o.reached ? 1 : 0;
+                ++evals;
+            }
+            const double m = mean_of(r);
+            c.final_per_run.push_back(m);
+            if (m > best_final) {
+                best_final = m;
+                c.best_run = static_cast<int>(t.run);
+            }
+            const auto R = read_journal_R(join_path(t.dir, "episodes.csv"));
+            if (R.size() != spec.target_episodes) {
+                throw UserError(join_path(t.dir, "episodes.csv") + ": has " + std::to_string(R.size()) +
+                                " episodes, expected " + std::to_string(spec.target_episodes));
+            }
+            for (uint64_t b = 0; b < nbins; ++b) {
+                const uint64_t lo = b * spec.curve_bin;
+                const uint64_t hi = std::min<uint64_t>(lo + spec.curve_bin, R.size());
+                std::vector<double> part(R.begin() + static_cast<long>(lo), R.begin() + static_cast<long>(hi));
+                bins[b].push_back(mean_of(part));
+            }
+        }
+        c.final_mean = mean_of(c.final_per_run);
+        c.final_sd = sd_of(c.final_per_run);
+        c.final_ci = ci95_half_width(c.final_per_run);
+        c.reached_rate = evals ? static_cast<double>(reached) / static_cast<double>(evals) : 0.0;
+        for (auto &b : bins) {
+            c.curve_mean.push_back(mean_of(b));
+            c.curve_ci.push_back(ci95_half_width(b));
+        }
+        if (!c.curve_mean.empty()) {
+            c.start = c.curve_mean.front();
+            c.end = c.curve_mean.back();
+            if (c.end > c.start) {
+                const double goal = c.start + 0.9 * (c.end - c.start);
+                for (uint64_t b = 0; b < nbins; ++b) {
+                    if (c.curve_mean[b] >= goal) {
+                        c.episodes_to_90 = static_cast<double>(std::min<uint64_t>((b + 1) * spec.curve_bin, spec.target_episodes));
+                        break;
+                    }
+                }
+            }
+        }
+        S.conditions.push_back(c);
+    }
+    ConditionSummary prob;
+    prob.label = "probabilistic";
+    for (const TaskDef &t : tasks) {
+        if (t.kind == TaskKind::EvalProbabilistic) {
+            uint64_t reached = 0;
+            const auto ev = read_eval(join_path(t.dir, "eval.csv"));
+            for (const auto &o : ev) {
+                prob.final_per_run.push_back(o.R);
+                reached += o.reached ? 1 : 0;
+            }
+            prob.reached_rate = ev.empty() ? 0.0 : static_cast<double>(reached) / static_cast<double>(ev.size());
+        }
+    }
+    prob.final_mean = mean_of(prob.final_per_run);
+    prob.final_sd = sd_of(prob.final_per_run);
+    prob.final_ci = ci95_half_width(prob.final_per_run);
+    prob.start = prob.end = prob.final_mean;
+    S.conditions.push_back(prob);
+
+    const ConditionSummary &direct = S.conditions[labels.size() - 1];
+    auto pct = [](double a, double b) { return b != 0.0 ? (a - b) / std::fabs(b) * 100.0 : std::nan(""); };
+    for (std::size_t i = 0; i + 1 < labels.size(); ++i) {
+        const ConditionSummary &c = S.conditions[i];
+        Comparison cmp;
+        cmp.a = c.label;
+        cmp.b = "direct";
+        cmp.improvement_pct = pct(c.final_mean, direct.final_mean);
+        cmp.speedup_pct = (c.episodes_to_90 > 0 && direct.episodes_to_90 > 0)
+                              ? (direct.episodes_to_90 - c.episodes_to_90) / direct.episodes_to_90 * 100.0
+                              : std::nan("");
+        cmp.test = "welch";
+        cmp.t = welch_t_test(c.final_per_run, direct.final_per_run);
+        cmp.mann_whitney = mann_whitney(c.final_per_run, direct.final_per_run);
+        S.comparisons.push_back(cmp);
+    }
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        const ConditionSummary &c = S.conditions[i];
+        Comparison cmp;
+        cmp.a = c.label;
+        cmp.b = "probabilistic";
+        cmp.improvement_pct = pct(c.final_mean, prob.final_mean);
+        cmp.speedup_pct = std::nan("");
+        cmp.test = "one-sample";
+        cmp.t = one_sample_t_test(c.final_per_run, prob.final_mean);
+        S.comparisons.push_back(cmp);
+    }
+    return S;
+}
+
+/* ---- outputs --------------------------------------------------------------------- */
+
+namespace {
+
+std::string curves_csv(const ExperimentSummary &S)
+{
+    std::ostringstream o;
+    o << "condition,episode,mean,ci_low,ci_high\n";
+    for (const ConditionSummary &c : S.conditions) {
+        for (std::size_t b = 0; b < c.curve_mean.size(); ++b) {
+            const uint64_t ep = std::min<uint64_t>((b + 1) * S.curve_bin, S.episodes);
+            o << c.label << "," << ep << "," << json_num(c.curve_mean[b]) << ","
+              << json_num(c.curve_mean[b] - c.curve_ci[b]) << "," << json_num(c.curve_mean[b] + c.curve_ci[b]) << "\n";
+        }
+    }
+    return o.str();
+}
+
+std::string quality_csv(const ExperimentSpec &spec, const ExperimentSummary &S, const std::string &exp_dir,
+                        const qnav_ctrl_config_t &ccfg)
+{
+    std::vector<std::pair<std::string, qnav_policy_t>> policies;
+    qnav_policy_t prob;
+    qnav_policy_prob_default(&prob);
+    policies.emplace_back("probabilistic", prob);
+    for (const ConditionSummary &c : S.conditions) {
+        if (c.label == "probabilistic" || c.best_run < 0) {
+            continue;
+        }
+        const std::string path = join_path(join_path(run_dir(exp_dir, static_cast<uint32_t>(c.best_run)), c.label), "best.policy");
+        qnav_policy_t p;
+        char err[QNAV_POLICY_IO_ERRLEN] = {0};
+        if (qnav_policy_read(path.c_str(), &p, err, sizeof err) != 0) {
+            throw UserError(err);
+        }
+        policies.emplace_back(c.label + " (run " + std::to_string(c.best_run + 1) + ")", p);
+    }
+    (void)spec;
+    std::ostringstream o;
+    o << "policy,level,distance_m,dtheta_deg,quality\n";
+    for (auto &pp : policies) {
+        qnav_ctrl_t ctrl;
+        if (qnav_ctrl_init(&ctrl, &ccfg, &pp.second) != QNAV_OK) {
+            throw UserError("quality map: controller refused policy " + pp.first);
+        }
+        for (uint32_t level = 0; level < QNAV_DIST_LEVELS; ++level) {
+            const double dist = static_cast<double>(level) / (QNAV_DIST_LEVELS - 1) * ccfg.max_range_mm / 1000.0;
+            for (uint32_t dt = 0; dt <= QNAV_DTHETA_MAX; ++dt) {
+                const qnav_q1_15_t q = qnav_ctrl_quality(&ctrl, static_cast<uint8_t>(level), static_cast<uint8_t>(dt));
+                char b[200];
+                std::snprintf(b, sizeof b, "%s,%u,%.4f,%u,%.6f\n", pp.first.c_str(), level, dist, dt, q / 32768.0);
+                o << b;
+            }
+        }
+    }
+    return o.str();
+}
+
+std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt)
+{
+    std::ostringstream o;
+    o << "{\n  \"name\": " << json_str(spec.name) << ",\n  \"title\": " << json_str(spec.title)
+      << ",\n  \"figure\": " << json_str(spec.figure) << ",\n  \"preset\": " << json_str(opt.preset)
+      << ",\n  \"runs\": " << spec.runs << ",\n  \"episodes\": " << spec.target_episodes
+      << ",\n  \"eval_episodes\": " << spec.eval_episodes << ",\n  \"curve_bin\": " << spec.curve_bin
+      << ",\n  \"target\": " << json_str(spec.target.describe()) << ",\n  \"sources\": [";
+    for (std::size_t i = 0; i < spec.sources.size(); ++i) {
+        const SourceSpec &s = spec.sources[i];
+        o << (i ? ", " : "") << "{\"label\": " << json_str(s.label) << ", \"scenario\": "
+          << json_str(s.policy_file.empty() ? s.scenario.describe() : "policy file " + s.policy_file)
+          << ", \"episodes\": " << (s.policy_file.empty() ? s.episodes : 0) << "}";
+    }
+    o << "],\n  \"conditions\": [\n";
+    for (std::size_t i = 0; i < S.conditions.size(); ++i) {
+        const ConditionSummary &c = S.conditions[i];
+        o << "    {\"label\": " << json_str(c.label) << ", \"final_mean\": " << json_num(c.final_mean)
+          << ", \"final_ci95\": " << json_num(c.final_ci) << ", \"final_sd\": " << json_num(c.final_sd)
+          << ", \"n\": " << c.final_per_run.size() << ", \"start\": " << json_num(c.start)
+          << ", \"end\": " << json_num(c.end) << ", \"episodes_to_90\": "
+          << (c.episodes_to_90 > 0 ? json_num(c.episodes_to_90) : "null")
+          << ", \"reached_rate\": " << json_num(c.reached_rate) << ", \"best_run\": " << (c.best_run + 1) << "}"
+          << (i + 1 < S.conditions.size() ? "," : "") << "\n";
+    }
+    o << "  ],\n  \"comparisons\": [\n";
+    for (std::size_t i = 0; i < S.comparisons.size(); ++i) {
+        const Comparison &c = S.comparisons[i];
+        o << "    {\"a\": " << json_str(c.a) << ", \"b\": " << json_str(c.b)
+          << ", \"improvement_pct\": " << json_num(c.improvement_pct)
+          << ", \"speedup_pct\": " << json_num(c.speedup_pct) << ", \"test\": " << json_str(c.test)
+          << ", \"t\": " << json_num(c.t.valid ? c.t.statistic : std::nan(""))
+          << ", \"df\": " << json_num(c.t.valid ? c.t.df : std::nan(""))
+          << ", \"p\": " << json_num(c.t.valid ? c.t.p : std::nan(""))
+          << ", \"mann_whitney_p\": " << json_num(c.mann_whitney.valid ? c.mann_whitney.p : std::nan("")) << "}"
+          << (i + 1 < S.comparisons.size() ? "," : "") << "\n";
+    }
+    o << "  ]\n}\n";
+    return o.str();
+}
+
+std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt,
+                       const std::string &exp_dir, bool plots)
+{
+    std::ostringstream o;
+    o << "# " << spec.name << (spec.figure.empty() ? "" : " (paper " + spec.figure + ")") << "\n\n"
+      << spec.title << "\n\n"
+      << "Preset `" << opt.preset << "`: " << spec.runs << " runs, " << spec.target_episodes
+      << " target episodes per run, population " << spec.evolution.population << ", epsilon "
+      << fmt(spec.evolution.epsilon, 2) << ", " << spec.evolution.hidden << " hidden units; final performance = mean R of each run's best policy over "
+      << spec.eval_episodes << " held-out episodes (the same set for every run and condition).\n\n"
+      << "Target: " << spec.target.describe() << "\n\n";
+    for (const SourceSpec &s : spec.sources) {
+        o << "Source `" << s.label << "`: "
+          << (s.policy_file.empty() ? s.scenario.describe() + ", " + std::to_string(s.episodes) + " episodes"
+                                    : "policy file " + s.policy_file)
+          << "\n\n";
+    }
+    o << "| condition | final R (mean ± 95% CI) | sd | first " << S.curve_bin
+      << " episodes | last " << S.curve_bin << " episodes | episodes to 90% | goal reached |\n"
+      << "|---|---|---|---|---|---|---|\n";
+    for (const ConditionSummary &c : S.conditions) {
+        const bool prob = c.label == "probabilistic";
+        o << "| " << c.label << " | " << fmt(c.final_mean) << " ± " << fmt(c.final_ci) << " | " << fmt(c.final_sd)
+          << " | " << (prob ? "-" : fmt(c.start)) << " | " << (prob ? "-" : fmt(c.end)) << " | "
+          << (prob ? "-" : (c.episodes_to_90 > 0 ? fmt(c.episodes_to_90, 0) : "n/a")) << " | "
+          << fmt(100.0 * c.reached_rate, 0) << "% |\n";
+    }
+    o << "\n| comparison | improvement | faster to 90% | test | p | Mann-Whitney p |\n|---|---|---|---|---|---|\n";
+    for (const Comparison &c : S.comparisons) {
+        o << "| " << c.a << " vs " << c.b << " | " << fmt(c.improvement_pct, 1) << "% | "
+          << (std::isfinite(c.speedup_pct) ? fmt(c.speedup_pct, 0) + "%" : "-") << " | "
+          << (c.test == "welch" ? "Welch t" : "one-sample t") << " | " << fmt_p(c.t) << " | "
+          << (c.b == "probabilistic" ? "-" : fmt_p(c.mann_whitney)) << " |\n";
+    }
+    o << "\nImprovement = (mean_a − mean_b) / |mean_b|. Episodes to 90% = first learning-curve point at "
+         "which the mean curve has covered 90% of its rise from its first to its last point. "
+         "The probabilistic policy's p-value is a one-sample t-test of the runs against its held-out mean.\n\n";
+    if (plots) {
+        o << "![learning curves](learning.png)\n\n![policy quality](policy.png)\n\n";
+    }
+    o << "Regenerate: `simevo run " << spec.name << " --preset " << opt.preset << "` (with the same `--out`)\n";
+    (void)exp_dir;
+    return o.str();
+}
+
+void run_plot(const RunOptions &opt, const std::string &script, const std::string &exp_dir)
+{
+    const std::string path = join_path(opt.tools_dir, script);
+    if (!file_exists(path)) {
+        throw UserError(path + ": plot script not found (set --tools-dir or QNAV_TOOLS_DIR, or use --no-plot)");
+    }
+    const pid_t pid = ::fork();
+    if (pid < 0) {
+        throw UserError("cannot start " + opt.python);
+    }
+    if (pid == 0) {
+        ::execl(opt.python.c_str(), opt.python.c_str(), path.c_str(), exp_dir.c_str(), static_cast<char *>(nullptr));
+        std::fprintf(stderr, "%s: cannot run (%s)\n", opt.python.c_str(), std::strerror(errno));
+        ::_exit(127);
+    }
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        throw UserError(path + ": plotting failed for " + exp_dir +
+                        " (results are complete except plots; STATUS says so)");
+    }
+}
+
+} // namespace
+
+std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
+{
+    const std::string exp_dir = join_path(opt.out_dir, spec.name);
+    make_dirs(exp_dir);
+    const std::string status_path = join_path(exp_dir, "STATUS");
+    write_file_atomic(status_path, "incomplete: running or interrupted; rerun the same command to resume\n");
+
+    const std::vector<TaskDef> tasks = plan_tasks(spec, exp_dir);
+    SimWorlds worlds;
+    // Load every robot and environment up front so a bad name fails before any work.
+    std::unique_ptr<SimRunner> target_runner;
+    std::set<std::string> probed;
+    for (const TaskDef &t : tasks) {
+        if (probed.insert(t.scenario.describe()).second) {
+            SimRunner probe(worlds, t.scenario, t.context_seed, opt.use_table);
+        }
+    }
+    target_runner = std::make_unique<SimRunner>(worlds, spec.target, spec.seed, opt.use_table);
+    for (const SourceSpec &s : spec.sources) {
+        if (!s.policy_file.empty()) {
+            qnav_policy_t p;
+            char err[QNAV_POLICY_IO_ERRLEN] = {0};
+            if (!file_exists(s.policy_file)) {
+                throw UserError(s.policy_file + ": policy file not found (source '" + s.label + "' of " + spec.file + ")");
+            }
+            if (qnav_policy_read(s.policy_file.c_str(), &p, err, sizeof err) != 0) {
+                throw UserError(err);
+            }
+            if (p.kind != QNAV_POLICY_NET) {
+                throw UserError(s.policy_file + ": incompatible policy: kind is not 'net' (a transfer seeds a population of networks)");
+            }
+        }
+    }
+
+    const bool use_table = opt.use_table;
+    RunnerFactory make = [&worlds, use_table](const Scenario &sc, uint64_t seed) -> std::unique_ptr<EpisodeRunner> {
+        return std::make_unique<SimRunner>(worlds, sc, seed, use_table);
+    };
+    const bool progress = opt.progress < 0 ? ::isatty(2) != 0 : opt.progress != 0;
+    run_tasks(tasks, make, opt.jobs, progress, spec.name);
+
+    const ExperimentSummary S = summarize(spec, tasks);
+    write_file_atomic(join_path(exp_dir, "curves.csv"), curves_csv(S));
+    write_file_atomic(join_path(exp_dir, "quality.csv"), quality_csv(spec, S, exp_dir, target_runner->ctrl_config()));
+    write_file_atomic(join_path(exp_dir, "summary.json"), summary_json(spec, S, opt));
+    if (opt.plots) {
+        write_file_atomic(status_path, "incomplete: runs finished, plots missing\n");
+        run_plot(opt, "plot_learning.py", exp_dir);
+        run_plot(opt, "plot_policy.py", exp_dir);
+    }
+    write_file_atomic(join_path(exp_dir, "summary.md"), summary_md(spec, S, opt, exp_dir, opt.plots));
+    write_file_atomic(status_path, "complete\n");
+    return exp_dir;
+}
+
+} // namespace qnav

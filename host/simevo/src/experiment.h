@@ -1,0 +1,78 @@
+/*
+ * Running a whole experiment: expand a spec into resumable tasks (per run: source
+ * evolutions, transfers seeded from them, direct evolution from a random population; once:
+ * the probabilistic policy on the held-out set), run them on a pool of threads (each with
+ * its own simulator context and controllers), show progress on a terminal, then compute
+ * the summary (final performance, episodes to 90%, improvement, significance), write
+ * curves.csv / quality.csv / summary.json, draw the plots and write summary.md last.
+ */
+#ifndef QNAV_SIMEVO_EXPERIMENT_H
+#define QNAV_SIMEVO_EXPERIMENT_H
+
+#include <string>
+#include <vector>
+
+#include "spec.h"
+#include "stats.h"
+#include "task.h"
+
+namespace qnav {
+
+struct RunOptions {
+    std::string out_dir = "runs";   /* experiment folder = out_dir/<name> */
+    unsigned jobs = 0;              /* worker threads; 0 = all cores */
+    int progress = -1;              /* 1 on, 0 off, -1 when stderr is a terminal */
+    bool plots = true;              /* run tools/plot_*.py at the end */
+    std::string tools_dir;          /* where plot_*.py live */
+    std::string python = "/usr/bin/python3";
+    bool use_table = true;          /* table-mode controller (bit-identical, faster) */
+    std::string preset = "full";    /* recorded in the summary's command line */
+};
+
+/* Tasks of an experiment, in an order where every source precedes its transfers. */
+std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &exp_dir);
+
+/* Run tasks on `jobs` threads; a task with source_task waits for it. Throws UserError on
+ * the first failure (others are stopped). */
+void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, unsigned jobs,
+               bool progress, const std::string &title);
+
+/* Summary statistics of a finished experiment, from its task folders only. */
+struct ConditionSummary {
+    std::string label;               /* "transfer-open", "direct", "probabilistic" */
+    std::vector<double> final_per_run; /* held-out mean R per run (probabilistic: per episode) */
+    double final_mean = 0, final_ci = 0, final_sd = 0;
+    std::vector<double> curve_mean, curve_ci; /* per bin, over runs */
+    double start = 0;                /* first bin of the mean curve */
+    double end = 0;                  /* last bin of the mean curve */
+    double episodes_to_90 = -1;      /* first bin end reaching start + 0.9 (end - start); -1 n/a */
+    int best_run = -1;               /* run whose best policy scored highest held out */
+    double reached_rate = 0;         /* fraction of held-out episodes that reached the goal */
+};
+
+struct Comparison {
+    std::string a, b;
+    double improvement_pct = 0;  /* (mean_a - mean_b) / |mean_b| * 100 */
+    double speedup_pct = 0;      /* (T90_b - T90_a) / T90_b * 100; NaN if n/a */
+    std::string test;            /* "welch" (runs vs runs) or "one-sample" (runs vs the
+                                    probabilistic policy's held-out mean) */
+    TestResult t;                /* the t test named above */
+    TestResult mann_whitney;     /* runs vs runs only */
+};
+
+struct ExperimentSummary {
+    std::vector<ConditionSummary> conditions; /* transfers, direct, probabilistic */
+    std::vector<Comparison> comparisons;      /* each transfer vs direct, vs probabilistic */
+    uint32_t curve_bin = 0;
+    uint64_t episodes = 0;
+};
+
+ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks);
+
+/* Run a spec end to end (resuming what is there). Returns the experiment folder. Throws
+ * UserError. */
+std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt);
+
+} // namespace qnav
+
+#endif

@@ -1,0 +1,117 @@
+/*
+ * File helpers (POSIX): atomic writes by rename, reads, mkdir -p.
+ */
+#include "files.h"
+
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <thread>
+#include <unistd.h>
+
+#include "spec.h"
+
+namespace qnav {
+
+namespace {
+std::string errno_text() { return std::strerror(errno); }
+} // namespace
+
+std::string join_path(const std::string &a, const std::string &b)
+{
+    if (a.empty()) {
+        return b;
+    }
+    return a.back() == '/' ? a + b : a + "/" + b;
+}
+
+void write_file_atomic(const std::string &path, const std::string &content)
+{
+    const std::string tmp = path + ".tmp" + std::to_string(::getpid()) + "-" +
+                            std::to_string(std::hash<std::thread::id>()(std::this_thread::get_id()) % 100000);
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        throw UserError(path + ": cannot write (" + errno_text() + ")");
+    }
+    std::size_t off = 0;
+    while (off < content.size()) {
+        const ssize_t n = ::write(fd, content.data() + off, content.size() - off);
+        if (n < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            const std::string e = errno_text();
+            ::close(fd);
+            ::unlink(tmp.c_str());
+            throw UserError(path + ": write failed (" + e + ")");
+        }
+        off += static_cast<std::size_t>(n);
+    }
+    if (::close(fd) != 0 || ::rename(tmp.c_str(), path.c_str()) != 0) {
+        const std::string e = errno_text();
+        ::unlink(tmp.c_str());
+        throw UserError(path + ": cannot write (" + e + ")");
+    }
+}
+
+bool read_file(const std::string &path, std::string &out)
+{
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) {
+        if (errno == ENOENT) {
+            return false;
+        }
+        throw UserError(path + ": cannot read (" + errno_text() + ")");
+    }
+    out.clear();
+    char buf[65536];
+    for (;;) {
+        const ssize_t n = ::read(fd, buf, sizeof buf);
+        if (n < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            const std::string e = errno_text();
+            ::close(fd);
+            throw UserError(path + ": read failed (" + e + ")");
+        }
+        if (n == 0) {
+            break;
+        }
+        out.append(buf, static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+    return true;
+}
+
+bool file_exists(const std::string &path)
+{
+    struct stat st;
+    return ::stat(path.c_str(), &st) == 0;
+}
+
+void make_dirs(const std::string &path)
+{
+    if (path.empty()) {
+        return;
+    }
+    std::string cur;
+    std::size_t pos = 0;
+    while (pos != std::string::npos) {
+        pos = path.find('/', pos + 1);
+        cur = path.substr(0, pos);
+        if (cur.empty() || cur == "/") {
+            continue;
+        }
+        if (::mkdir(cur.c_str(), 0755) != 0 && errno != EEXIST) {
+            throw UserError(cur + ": cannot create directory (" + errno_text() + ")");
+        }
+    }
+    struct stat st;
+    if (::stat(path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+        throw UserError(path + ": not a directory");
+    }
+}
+
+} // namespace qnav

@@ -1,0 +1,277 @@
+/*
+ * simevo: evolve navigation policies in the simulator with the paper's ε-greedy
+ * neuro-evolution, transfer them between situations, and run the paper's five transfer
+ * experiments with summaries and plots. Subcommands: run, list, evolve, eval.
+ * Every bad input ends in one line on stderr and exit status 1 (2 for usage errors).
+ */
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cinttypes>
+#include <cstdio>
+#include <cstdlib>
+#include <dirent.h>
+#include <algorithm>
+#include <unistd.h>
+
+#include "experiment.h"
+#include "files.h"
+#include "qnav/policy_io.h"
+#include "sim_runner.h"
+#include "stats.h"
+
+#ifndef QNAV_SOURCE_DIR
+#define QNAV_SOURCE_DIR "."
+#endif
+
+using namespace qnav;
+
+namespace {
+
+std::string env_or(const char *name, const std::string &fallback)
+{
+    const char *v = std::getenv(name);
+    return (v && *v) ? std::string(v) : fallback;
+}
+
+std::vector<std::string> list_experiments(const std::string &dir)
+{
+    std::vector<std::string> names;
+    DIR *d = ::opendir(dir.c_str());
+    if (!d) {
+        throw UserError(dir + ": cannot open the experiments folder (set --experiments or QNAV_EXPERIMENTS_DIR)");
+    }
+    while (dirent *e = ::readdir(d)) {
+        std::string n = e->d_name;
+        if (n.size() > 5 && n.compare(n.size() - 5, 5, ".toml") == 0) {
+            names.push_back(n.substr(0, n.size() - 5));
+        }
+    }
+    ::closedir(d);
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+std::string resolve_experiment(const std::string &arg, const std::string &dir)
+{
+    if (arg.find('/') != std::string::npos || (arg.size() > 5 && arg.compare(arg.size() - 5, 5, ".toml") == 0)) {
+        return arg;
+    }
+    const std::string path = join_path(dir, arg + ".toml");
+    if (!file_exists(path)) {
+        std::string known;
+        for (const auto &n : list_experiments(dir)) {
+            known += (known.empty() ? "" : ", ") + n;
+        }
+        throw UserError("unknown experiment '" + arg + "' (known: " + known + ", all)");
+    }
+    return path;
+}
+
+Scenario scenario_from(const std::string &env, const std::string &robot, uint32_t sectors, double noise,
+                       double sensor_noise, double actuation_noise)
+{
+    Scenario s;
+    s.environment = env;
+    s.robot = robot;
+    s.sectors = sectors;
+    s.sensor_noise = sensor_noise >= 0 ? sensor_noise : noise;
+    s.actuation_noise = actuation_noise >= 0 ? actuation_noise : noise;
+    return s;
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+    CLI::App app{"simevo: ε-greedy neuro-evolution and policy transfer for qnav (paper §3.3, §4)"};
+    app.require_subcommand(1);
+    std::string experiments_dir = env_or("QNAV_EXPERIMENTS_DIR", std::string(QNAV_SOURCE_DIR) + "/experiments");
+    app.add_option("--experiments", experiments_dir, "folder of experiment files")->capture_default_str();
+
+    // run
+    auto *run = app.add_subcommand("run", "run named experiments (resumes an interrupted run in the same --out)");
+    std::vector<std::string> names;
+    RunOptions opt;
+    opt.tools_dir = env_or("QNAV_TOOLS_DIR", std::string(QNAV_SOURCE_DIR) + "/tools");
+    std::string preset = "full";
+    int64_t runs = 0, episodes = 0, source_episodes = 0, eval_episodes = 0, seed = -1;
+    bool no_plot = false, no_progress = false, network_mode = false;
+    run->add_option("experiment", names, "experiment name(s), a .toml path, or 'all'")->required();
+    run->add_option("--preset", preset, "'full' (the file's values) or a preset the file defines, e.g. 'quick'")->capture_default_str();
+    run->add_option("--out", opt.out_dir, "output folder; results go to OUT/<experiment>")->capture_default_str();
+    run->add_option("-j,--jobs", opt.jobs, "worker threads (0 = all cores)")->capture_default_str();
+    run->add_option("--runs", runs, "override the number of independent runs")->check(CLI::Range(int64_t(1), int64_t(10000)));
+    run->add_option("--episodes", episodes, "override target episodes")->check(CLI::Range(int64_t(1), int64_t(100000000)));
+    run->add_option("--source-episodes", source_episodes, "override source episodes")->check(CLI::Range(int64_t(1), int64_t(100000000)));
+    run->add_option("--eval-episodes", eval_episodes, "override held-out evaluation episodes")->check(CLI::Range(int64_t(1), int64_t(1000000)));
+    run->add_option("--seed", seed, "override the master seed")->check(CLI::Range(int64_t(0), INT64_MAX));
+    run->add_option("--tools-dir", opt.tools_dir, "folder with plot_learning.py and plot_policy.py")->capture_default_str();
+    run->add_flag("--no-plot", no_plot, "skip the PNG plots");
+    run->add_flag("--no-progress", no_progress, "no progress line even on a terminal");
+    run->add_flag("--network-mode", network_mode, "run the controller in network mode instead of table mode");
+
+    auto *lst = app.add_subcommand("list", "list the experiment files");
+
+    // evolve: one evolution, optionally seeded from a policy file (transfer)
+    auto *evolve = app.add_subcommand("evolve", "evolve one population in one situation (transfer with --from)");
+    std::string env = "dense", robot = "tekbot", from, out_dir = "runs/evolve";
+    uint32_t sectors = 0;
+    double noise = 0, sensor_noise = -1, actuation_noise = -1;
+    uint64_t ev_episodes = 1000, ev_seed = 1;
+    uint32_t ev_eval = 50;
+    EvolutionParams ep;
+    for (auto *sc : {evolve}) {
+        sc->add_option("--env", env, "environment name or file")->capture_default_str();
+        sc->add_option("--robot", robot, "robot profile name or file")->capture_default_str();
+        sc->add_option("--sectors", sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
+        sc->add_option("--noise", noise, "sensor and actuation noise level p (0.05 = 5%)")->check(CLI::Range(0.0, 10.0));
+        sc->add_option("--sensor-noise", sensor_noise, "sensor noise only")->check(CLI::Range(0.0, 10.0));
+        sc->add_option("--actuation-noise", actuation_noise, "actuation noise only")->check(CLI::Range(0.0, 10.0));
+    }
+    evolve->add_option("--from", from, "policy file to seed the population from (transfer)");
+    evolve->add_option("--episodes", ev_episodes, "episodes")->capture_default_str()->check(CLI::Range(uint64_t(1), uint64_t(100000000)));
+    evolve->add_option("--eval-episodes", ev_eval, "held-out evaluation episodes of the best")->capture_default_str();
+    evolve->add_option("--seed", ev_seed, "seed")->capture_default_str();
+    evolve->add_option("--population", ep.population, "population size")->capture_default_str();
+    evolve->add_option("--epsilon", ep.epsilon, "probability of mutating a random member")->capture_default_str();
+    evolve->add_option("--hidden", ep.hidden, "hidden units of random networks")->capture_default_str();
+    evolve->add_option("--mutation-scale", ep.mutation_scale, "Cauchy scale, weight units")->capture_default_str();
+    evolve->add_option("--mutation-clip", ep.mutation_clip, "Cauchy clip, weight units")->capture_default_str();
+    evolve->add_option("--out", out_dir, "output folder")->capture_default_str();
+
+    // eval: a policy over held-out episodes
+    auto *eval = app.add_subcommand("eval", "evaluate a policy file ('prob' = the probabilistic policy) over episodes");
+    std::string policy_arg;
+    std::string e_env = "dense", e_robot = "tekbot";
+    uint32_t e_sectors = 0, e_episodes = 50;
+    double e_noise = 0;
+    uint64_t e_seed = 1;
+    eval->add_option("policy", policy_arg, "policy file, or 'prob'")->required();
+    eval->add_option("--env", e_env, "environment")->capture_default_str();
+    eval->add_option("--robot", e_robot, "robot profile")->capture_default_str();
+    eval->add_option("--sectors", e_sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
+    eval->add_option("--noise", e_noise, "noise level p")->check(CLI::Range(0.0, 10.0));
+    eval->add_option("--episodes", e_episodes, "episodes")->capture_default_str();
+    eval->add_option("--seed", e_seed, "seed")->capture_default_str();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp &e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp &e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError &e) {
+        std::fprintf(stderr, "simevo: %s\n", e.what());
+        return 2;
+    }
+
+    try {
+        if (*lst) {
+            for (const auto &n : list_experiments(experiments_dir)) {
+                const ExperimentSpec s = load_experiment(join_path(experiments_dir, n + ".toml"));
+                std::printf("%-20s %-8s %s\n", n.c_str(), s.figure.c_str(), s.title.c_str());
+            }
+            return 0;
+        }
+        if (*run) {
+            std::vector<std::string> paths;
+            for (const auto &n : names) {
+                if (n == "all") {
+                    for (const auto &k : list_experiments(experiments_dir)) {
+                        paths.push_back(join_path(experiments_dir, k + ".toml"));
+                    }
+                } else {
+                    paths.push_back(resolve_experiment(n, experiments_dir));
+                }
+            }
+            // Parse everything first: a bad file fails before any work starts.
+            std::vector<ExperimentSpec> specs;
+            for (const auto &p : paths) {
+                ExperimentSpec s = load_experiment(p);
+                apply_preset(s, preset);
+                if (runs > 0) s.runs = static_cast<uint32_t>(runs);
+                if (episodes > 0) s.target_episodes = static_cast<uint64_t>(episodes);
+                if (source_episodes > 0) for (auto &src : s.sources) src.episodes = static_cast<uint64_t>(source_episodes);
+                if (eval_episodes > 0) s.eval_episodes = static_cast<uint32_t>(eval_episodes);
+                if (seed >= 0) s.seed = static_cast<uint64_t>(seed);
+                specs.push_back(s);
+            }
+            opt.plots = !no_plot;
+            opt.progress = no_progress ? 0 : -1;
+            opt.use_table = !network_mode;
+            opt.preset = preset;
+            for (const auto &s : specs) {
+                const auto t0 = std::chrono::steady_clock::now();
+                const std::string dir = run_experiment(s, opt);
+                const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                std::printf("%s: complete in %.1f s; summary %s/summary.md\n", s.name.c_str(), secs, dir.c_str());
+                if (opt.plots) {
+                    std::printf("%s: plot %s/learning.png\n", s.name.c_str(), dir.c_str());
+                }
+                std::fflush(stdout);
+            }
+            return 0;
+        }
+        if (*evolve) {
+            if (const char *p = evolution_params_problem(ep); *p) {
+                throw UserError(std::string("--") + p);
+            }
+            TaskDef t;
+            t.label = from.empty() ? "direct" : "transfer";
+            t.dir = out_dir;
+            t.scenario = scenario_from(env, robot, sectors, noise, sensor_noise, actuation_noise);
+            t.context_seed = ev_seed;
+            t.episodes = ev_episodes;
+            t.evolution = ep;
+            t.evolution_seed = mix_seed(ev_seed, 1);
+            t.episode_seed_base = mix_seed(ev_seed, 2);
+            t.eval_episodes = ev_eval;
+            t.eval_seed_base = mix_seed(ev_seed, 3);
+            t.source_policy_file = from;
+            SimWorlds worlds;
+            RunnerFactory make = [&worlds](const Scenario &sc, uint64_t s) -> std::unique_ptr<EpisodeRunner> {
+                return std::make_unique<SimRunner>(worlds, sc, s, true);
+            };
+            run_tasks({t}, make, 1, ::isatty(2) != 0, "evolve");
+            std::printf("best policy %s/best.policy; episodes %s/episodes.csv; held-out %s/eval.csv\n",
+                        out_dir.c_str(), out_dir.c_str(), out_dir.c_str());
+            return 0;
+        }
+        if (*eval) {
+            qnav_policy_t p;
+            if (policy_arg == "prob") {
+                qnav_policy_prob_default(&p);
+            } else {
+                char err[QNAV_POLICY_IO_ERRLEN] = {0};
+                if (!file_exists(policy_arg)) {
+                    throw UserError(policy_arg + ": policy file not found");
+                }
+                if (qnav_policy_read(policy_arg.c_str(), &p, err, sizeof err) != 0) {
+                    throw UserError(err);
+                }
+            }
+            SimWorlds worlds;
+            SimRunner runner(worlds, scenario_from(e_env, e_robot, e_sectors, e_noise, -1, -1), e_seed, true);
+            std::vector<double> R;
+            uint32_t reached = 0, tau = 0;
+            for (uint32_t i = 0; i < e_episodes; ++i) {
+                const EpisodeOutcome o = runner.run(p, mix_seed(e_seed, i));
+                R.push_back(o.R);
+                reached += o.reached;
+                tau += o.tau_c;
+            }
+            std::printf("episodes %u  mean R %.3f ± %.3f (95%% CI)  sd %.3f  reached %.0f%%  mean tau_c %.1f ticks\n",
+                        e_episodes, mean_of(R), ci95_half_width(R), sd_of(R),
+                        100.0 * reached / std::max(1u, e_episodes), static_cast<double>(tau) / std::max(1u, e_episodes));
+            return 0;
+        }
+    } catch (const UserError &e) {
+        std::fprintf(stderr, "simevo: %s\n", e.what());
+        return 1;
+    } catch (const std::exception &e) {
+        std::fprintf(stderr, "simevo: internal error: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

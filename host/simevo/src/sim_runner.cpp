@@ -1,0 +1,104 @@
+/*
+ * Simulator-backed episode runner: controller set-up per episode and error mapping.
+ */
+#include "sim_runner.h"
+
+#include <cstdio>
+
+namespace qnav {
+
+SimWorlds::~SimWorlds()
+{
+    for (auto &kv : robots_) {
+        qnav_sim_robot_free(kv.second);
+    }
+    for (auto &kv : envs_) {
+        qnav_sim_env_free(kv.second);
+    }
+}
+
+const qnav_sim_robot_t *SimWorlds::robot(const std::string &spec)
+{
+    std::lock_guard<std::mutex> lock(mu_);
+    auto it = robots_.find(spec);
+    if (it != robots_.end()) {
+        return it->second;
+    }
+    char err[QNAV_SIM_ERRLEN] = {0};
+    qnav_sim_robot_t *r = nullptr;
+    if (qnav_sim_robot_load(spec.c_str(), &r, err, sizeof err) != QNAV_SIM_OK) {
+        throw UserError(std::string("robot '") + spec + "': " + err);
+    }
+    robots_[spec] = r;
+    return r;
+}
+
+const qnav_sim_env_t *SimWorlds::env(const std::string &spec)
+{
+    std::lock_guard<std::mutex> lock(mu_);
+    auto it = envs_.find(spec);
+    if (it != envs_.end()) {
+        return it->second;
+    }
+    char err[QNAV_SIM_ERRLEN] = {0};
+    qnav_sim_env_t *e = nullptr;
+    if (qnav_sim_env_load(spec.c_str(), &e, err, sizeof err) != QNAV_SIM_OK) {
+        throw UserError(std::string("environment '") + spec + "': " + err);
+    }
+    envs_[spec] = e;
+    return e;
+}
+
+SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t context_seed,
+                     bool use_table)
+    : use_table_(use_table), table_(QNAV_QTABLE_ENTRIES)
+{
+    const qnav_sim_robot_t *robot = worlds.robot(scenario.robot);
+    const qnav_sim_env_t *env = worlds.env(scenario.environment);
+    qnav_sim_config_t cfg;
+    qnav_sim_config_default(&cfg);
+    cfg.n_sectors = static_cast<uint16_t>(scenario.sectors);
+    cfg.sensor_noise = scenario.sensor_noise;
+    cfg.actuation_noise = scenario.actuation_noise;
+    cfg.seed = context_seed;
+    cfg.episode_limit_s = scenario.episode_limit_s;
+    char err[QNAV_SIM_ERRLEN] = {0};
+    if (qnav_sim_create(robot, env, &cfg, &sim_, err, sizeof err) != QNAV_SIM_OK) {
+        throw UserError(std::string("simulator (") + scenario.describe() + "): " + err);
+    }
+    qnav_sim_ctrl_config(sim_, &ctrl_cfg_);
+}
+
+SimRunner::~SimRunner() { qnav_sim_destroy(sim_); }
+
+EpisodeOutcome SimRunner::run(const qnav_policy_t &policy, uint64_t episode_seed)
+{
+    qnav_ctrl_t ctrl;
+    qnav_status_t st = qnav_ctrl_init(&ctrl, &ctrl_cfg_, &policy);
+    if (st != QNAV_OK) {
+        throw UserError("controller: qnav_ctrl_init refused the policy (status " +
+                        std::to_string(static_cast<int>(st)) + ")");
+    }
+    if (use_table_ && policy.kind == QNAV_POLICY_NET) {
+        if (qnav_ctrl_build_table(&ctrl, table_.data()) != QNAV_OK ||
+            qnav_ctrl_init_table(&ctrl, &ctrl_cfg_, table_.data()) != QNAV_OK) {
+            throw UserError("controller: could not compile the policy into a quality table");
+        }
+    }
+    qnav_sim_result_t res;
+    char msg[64];
+    const qnav_sim_status_t s = qnav_sim_run_episode(sim_, &ctrl, episode_seed, &res, nullptr, nullptr);
+    if (s != QNAV_SIM_OK) {
+        std::snprintf(msg, sizeof msg, "simulator: episode failed (status %d)", static_cast<int>(s));
+        throw UserError(msg);
+    }
+    EpisodeOutcome out;
+    out.R = res.R;
+    out.f1 = res.f1;
+    out.f2 = res.f2;
+    out.tau_c = res.tau_c;
+    out.reached = res.reached;
+    return out;
+}
+
+} // namespace qnav

@@ -1,0 +1,64 @@
+/*
+ * The EpisodeRunner that drives the Box2D simulator (sim/include/qnav/sim.h) with the
+ * fixed-point libqnav controller. A network policy is compiled once per episode into a
+ * quality table (qnav_ctrl_build_table + qnav_ctrl_init_table): bit-identical to network
+ * mode by libqnav's design, and much cheaper over an episode's ticks. One SimRunner owns
+ * one simulator context and is used by one thread; robots and environments are loaded
+ * once (SimWorlds) and shared read-only.
+ */
+#ifndef QNAV_SIMEVO_SIM_RUNNER_H
+#define QNAV_SIMEVO_SIM_RUNNER_H
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "evolution.h"
+#include "qnav/sim.h"
+#include "spec.h"
+
+namespace qnav {
+
+/* Loaded robot profiles and environments by name, shared by all threads. */
+class SimWorlds {
+public:
+    SimWorlds() = default;
+    ~SimWorlds();
+    SimWorlds(const SimWorlds &) = delete;
+    SimWorlds &operator=(const SimWorlds &) = delete;
+    /* Load (once) what the scenario names. Throws UserError with the sim's message. */
+    const qnav_sim_robot_t *robot(const std::string &spec);
+    const qnav_sim_env_t *env(const std::string &spec);
+
+private:
+    std::mutex mu_;
+    std::map<std::string, qnav_sim_robot_t *> robots_;
+    std::map<std::string, qnav_sim_env_t *> envs_;
+};
+
+class SimRunner : public EpisodeRunner {
+public:
+    /* context_seed: qnav_sim_config_t.seed. use_table: table mode (default) or network
+     * mode (for the equivalence check). Throws UserError on bad scenarios. */
+    SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t context_seed,
+              bool use_table = true);
+    ~SimRunner() override;
+    SimRunner(const SimRunner &) = delete;
+    SimRunner &operator=(const SimRunner &) = delete;
+
+    EpisodeOutcome run(const qnav_policy_t &policy, uint64_t episode_seed) override;
+    /* The controller configuration of this context (sectors, max range). */
+    const qnav_ctrl_config_t &ctrl_config() const { return ctrl_cfg_; }
+
+private:
+    qnav_sim_t *sim_ = nullptr;
+    qnav_ctrl_config_t ctrl_cfg_{};
+    bool use_table_;
+    std::vector<qnav_q1_15_t> table_;
+};
+
+} // namespace qnav
+
+#endif

@@ -1,0 +1,383 @@
+/*
+ * TOML experiment files -> ExperimentSpec, with strict checking of every key and value.
+ */
+#include "spec.h"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+namespace qnav {
+
+std::string Scenario::describe() const
+{
+    std::ostringstream o;
+    o.precision(17);
+    o << "environment=" << environment << " robot=" << robot << " sectors=" << sectors
+      << " sensor_noise=" << sensor_noise << " actuation_noise=" << actuation_noise
+      << " episode_limit_s=" << episode_limit_s;
+    return o.str();
+}
+
+namespace {
+
+class Parser {
+public:
+    explicit Parser(std::string name) : name_(std::move(name)) {}
+
+    [[noreturn]] void fail(const toml::node &n, const std::string &what) const
+    {
+        throw UserError(name_ + ":" + std::to_string(n.source().begin.line) + ": " + what);
+    }
+    [[noreturn]] void fail_line(std::size_t line, const std::string &what) const
+    {
+        throw UserError(name_ + ":" + std::to_string(line) + ": " + what);
+    }
+
+    void only_keys(const toml::table &t, const std::set<std::string> &allowed,
+                   const std::string &where) const
+    {
+        for (auto &&[k, v] : t) {
+            if (allowed.count(std::string(k.str())) == 0) {
+                fail(v, "unknown key '" + std::string(k.str()) + "'" +
+                            (where.empty() ? "" : " in [" + where + "]"));
+            }
+        }
+    }
+
+    std::string str(const toml::node &n, const std::string &key) const
+    {
+        if (!n.is_string()) {
+            fail(n, key + ": expected a string");
+        }
+        return *n.value<std::string>();
+    }
+    int64_t integer(const toml::node &n, const std::string &key, int64_t lo, int64_t hi) const
+    {
+        if (!n.is_integer()) {
+            fail(n, key + ": expected an integer");
+        }
+        const int64_t v = *n.value<int64_t>();
+        if (v < lo || v > hi) {
+            fail(n, key + ": " + std::to_string(v) + " is outside " + std::to_string(lo) +
+                        ".." + std::to_string(hi));
+        }
+        return v;
+    }
+    double number(const toml::node &n, const std::string &key, double lo, double hi) const
+    {
+        double v;
+        if (n.is_integer()) {
+            v = static_cast<double>(*n.value<int64_t>());
+        } else if (n.is_floating_point()) {
+            v = *n.value<double>();
+        } else {
+            fail(n, key + ": expected a number");
+        }
+        if (!std::isfinite(v) || v < lo || v > hi) {
+            std::ostringstream o;
+            o << key << ": " << v << " is outside [" << lo << ", " << hi << "]";
+            fail(n, o.str());
+        }
+        return v;
+    }
+    const toml::table &table(const toml::node &n, const std::string &key) const
+    {
+        if (!n.is_table()) {
+            fail(n, key + ": expected a table");
+        }
+        return *n.as_table();
+    }
+
+    /* Scenario keys shared by [target] and [[source]]. Returns true if key was one. */
+    bool scenario_key(Scenario &s, const std::string &k, const toml::node &v,
+                      bool &noise_set, bool &split_noise_set) const
+    {
+        if (k == "environment") {
+            s.environment = str(v, k);
+            if (s.environment.empty()) {
+                fail(v, "environment: must not be empty");
+            }
+        } else if (k == "robot") {
+            s.robot = str(v, k);
+            if (s.robot.empty()) {
+                fail(v, "robot: must not be empty");
+            }
+        } else if (k == "sectors") {
+            s.sectors = static_cast<uint32_t>(integer(v, k, 0, QNAV_MAX_SECTORS));
+        } else if (k == "noise") {
+            s.sensor_noise = s.actuation_noise = number(v, k, 0.0, 10.0);
+            noise_set = true;
+        } else if (k == "sensor_noise") {
+            s.sensor_noise = number(v, k, 0.0, 10.0);
+            split_noise_set = true;
+        } else if (k == "actuation_noise") {
+            s.actuation_noise = number(v, k, 0.0, 10.0);
+            split_noise_set = true;
+        } else if (k == "episode_limit_s") {
+            s.episode_limit_s = number(v, k, 0.0, 1e6);
+        } else {
+            return false;
+        }
+        if (noise_set && split_noise_set) {
+            fail(v, "noise: give either 'noise' or 'sensor_noise'/'actuation_noise', not both");
+        }
+        return true;
+    }
+
+    const std::string &name() const { return name_; }
+
+private:
+    std::string name_;
+};
+
+bool valid_name(const std::string &s)
+{
+    if (s.empty() || s.size() > 64) {
+        return false;
+    }
+    for (char c : s) {
+        if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_')) {
+            return false;
+        }
+    }
+    return true;
+}
+
+} // namespace
+
+ExperimentSpec parse_experiment(const std::string &text, const std::string &name)
+{
+    Parser p(name);
+    toml::table root;
+    try {
+        root = toml::parse(text, name);
+    } catch (const toml::parse_error &e) {
+        throw UserError(name + ":" + std::to_string(e.source().begin.line) + ": " +
+                        std::string(e.description()));
+    }
+    ExperimentSpec spec;
+    spec.file = name;
+    p.only_keys(root, {"name", "title", "figure", "runs", "seed", "curve_bin", "evolution",
+                       "target", "source", "evaluation", "preset"},
+                "");
+    if (!root.contains("name")) {
+        p.fail_line(1, "name: missing (the experiment's identifier)");
+    }
+    spec.name = p.str(*root.get("name"), "name");
+    if (!valid_name(spec.name)) {
+        p.fail(*root.get("name"), "name: use 1-64 characters a-z, 0-9, '-', '_'");
+    }
+    if (auto *n = root.get("title")) {
+        spec.title = p.str(*n, "title");
+    }
+    if (auto *n = root.get("figure")) {
+        spec.figure = p.str(*n, "figure");
+    }
+    if (auto *n = root.get("runs")) {
+        spec.runs = static_cast<uint32_t>(p.integer(*n, "runs", 1, 10000));
+    }
+    if (auto *n = root.get("seed")) {
+        spec.seed = static_cast<uint64_t>(p.integer(*n, "seed", 0, INT64_MAX));
+    }
+    if (auto *n = root.get("curve_bin")) {
+        spec.curve_bin = static_cast<uint32_t>(p.integer(*n, "curve_bin", 1, 100000));
+    }
+
+    if (auto *n = root.get("evolution")) {
+        const toml::table &t = p.table(*n, "evolution");
+        p.only_keys(t, {"population", "epsilon", "hidden", "mutation_scale", "mutation_clip",
+                        "init", "init_scale"},
+                    "evolution");
+        EvolutionParams &e = spec.evolution;
+        if (auto *v = t.get("population")) {
+            e.population = static_cast<uint32_t>(p.integer(*v, "population", 2, 100000));
+        }
+        if (auto *v = t.get("epsilon")) {
+            e.epsilon = p.number(*v, "epsilon", 0.0, 1.0);
+        }
+        if (auto *v = t.get("hidden")) {
+            e.hidden = static_cast<uint32_t>(p.integer(*v, "hidden", 1, QNAV_MAX_HIDDEN));
+        }
+        if (auto *v = t.get("mutation_scale")) {
+            e.mutation_scale = p.number(*v, "mutation_scale", 1e-6, 128.0);
+        }
+        if (auto *v = t.get("mutation_clip")) {
+            e.mutation_clip = p.number(*v, "mutation_clip", 1e-6, 256.0);
+        }
+        if (auto *v = t.get("init")) {
+            const std::string s = p.str(*v, "init");
+            if (s == "cauchy") {
+                e.init = InitKind::Cauchy;
+            } else if (s == "uniform") {
+                e.init = InitKind::Uniform;
+            } else {
+                p.fail(*v, "init: '" + s + "' is not one of cauchy, uniform");
+            }
+        }
+        if (auto *v = t.get("init_scale")) {
+            e.init_scale = p.number(*v, "init_scale", 1e-6, 128.0);
+        }
+    }
+
+    if (!root.contains("target")) {
+        p.fail_line(1, "[target]: missing (the situation transfer and direct evolution share)");
+    }
+    {
+        const toml::table &t = p.table(*root.get("target"), "target");
+        bool ns = false, ss = false;
+        for (auto &&[k, v] : t) {
+            const std::string key(k.str());
+            if (p.scenario_key(spec.target, key, v, ns, ss)) {
+                continue;
+            }
+            if (key == "episodes") {
+                spec.target_episodes = static_cast<uint64_t>(p.integer(v, key, 1, 100000000));
+            } else {
+                p.fail(v, "unknown key '" + key + "' in [target]");
+            }
+        }
+    }
+
+    if (auto *n = root.get("source")) {
+        if (!n->is_array_of_tables()) {
+            p.fail(*n, "source: expected [[source]] tables");
+        }
+        std::set<std::string> labels;
+        for (auto &&el : *n->as_array()) {
+            const toml::table &t = *el.as_table();
+            SourceSpec s;
+            s.scenario = spec.target;
+            s.episodes = spec.target_episodes;
+            bool ns = false, ss = false;
+            bool has_label = false;
+            for (auto &&[k, v] : t) {
+                const std::string key(k.str());
+                if (p.scenario_key(s.scenario, key, v, ns, ss)) {
+                    continue;
+                }
+                if (key == "label") {
+                    s.label = p.str(v, key);
+                    has_label = true;
+                    if (!valid_name(s.label)) {
+                        p.fail(v, "label: use 1-64 characters a-z, 0-9, '-', '_'");
+                    }
+                    if (!labels.insert(s.label).second) {
+                        p.fail(v, "label: '" + s.label + "' is used by another [[source]]");
+                    }
+                } else if (key == "episodes") {
+                    s.episodes = static_cast<uint64_t>(p.integer(v, key, 1, 100000000));
+                } else if (key == "policy") {
+                    s.policy_file = p.str(v, key);
+                    if (s.policy_file.empty()) {
+                        p.fail(v, "policy: must not be empty");
+                    }
+                } else {
+                    p.fail(v, "unknown key '" + key + "' in [[source]]");
+                }
+            }
+            if (!has_label) {
+                p.fail(el, "[[source]]: missing label");
+            }
+            spec.sources.push_back(s);
+        }
+    }
+    if (spec.sources.empty()) {
+        p.fail_line(1, "[[source]]: at least one source situation is needed for a transfer");
+    }
+
+    if (auto *n = root.get("evaluation")) {
+        const toml::table &t = p.table(*n, "evaluation");
+        p.only_keys(t, {"episodes", "seed"}, "evaluation");
+        if (auto *v = t.get("episodes")) {
+            spec.eval_episodes = static_cast<uint32_t>(p.integer(*v, "episodes", 1, 1000000));
+        }
+        if (auto *v = t.get("seed")) {
+            spec.eval_seed = static_cast<uint64_t>(p.integer(*v, "seed", 0, INT64_MAX));
+        }
+    }
+
+    if (auto *n = root.get("preset")) {
+        const toml::table &all = p.table(*n, "preset");
+        for (auto &&[k, v] : all) {
+            const std::string pname(k.str());
+            if (pname == "full") {
+                p.fail(v, "preset.full: reserved (it means the file's own values)");
+            }
+            const toml::table &t = p.table(v, "preset." + pname);
+            p.only_keys(t, {"runs", "episodes", "source_episodes", "eval_episodes", "curve_bin"},
+                        "preset." + pname);
+            Preset pr;
+            if (auto *x = t.get("runs")) {
+                pr.runs = static_cast<uint32_t>(p.integer(*x, "runs", 1, 10000));
+            }
+            if (auto *x = t.get("episodes")) {
+                pr.episodes = static_cast<uint64_t>(p.integer(*x, "episodes", 1, 100000000));
+            }
+            if (auto *x = t.get("source_episodes")) {
+                pr.source_episodes =
+                    static_cast<uint64_t>(p.integer(*x, "source_episodes", 1, 100000000));
+            }
+            if (auto *x = t.get("eval_episodes")) {
+                pr.eval_episodes = static_cast<uint32_t>(p.integer(*x, "eval_episodes", 1, 1000000));
+            }
+            if (auto *x = t.get("curve_bin")) {
+                pr.curve_bin = static_cast<uint32_t>(p.integer(*x, "curve_bin", 1, 100000));
+            }
+            spec.presets[pname] = pr;
+        }
+    }
+    return spec;
+}
+
+ExperimentSpec load_experiment(const std::string &path)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        throw UserError(path + ": cannot open experiment file");
+    }
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (in.bad()) {
+        throw UserError(path + ": read error");
+    }
+    return parse_experiment(ss.str(), path);
+}
+
+void apply_preset(ExperimentSpec &spec, const std::string &preset)
+{
+    if (preset.empty() || preset == "full") {
+        return;
+    }
+    auto it = spec.presets.find(preset);
+    if (it == spec.presets.end()) {
+        std::string known = "full";
+        for (auto &kv : spec.presets) {
+            known += ", " + kv.first;
+        }
+        throw UserError(spec.file + ": no preset '" + preset + "' (known: " + known + ")");
+    }
+    const Preset &p = it->second;
+    if (p.runs) {
+        spec.runs = *p.runs;
+    }
+    if (p.episodes) {
+        spec.target_episodes = *p.episodes;
+    }
+    if (p.source_episodes) {
+        for (auto &s : spec.sources) {
+            s.episodes = *p.source_episodes;
+        }
+    }
+    if (p.eval_episodes) {
+        spec.eval_episodes = *p.eval_episodes;
+    }
+    if (p.curve_bin) {
+        spec.curve_bin = *p.curve_bin;
+    }
+}
+
+} // namespace qnav

@@ -1,0 +1,83 @@
+/*
+ * Experiment specifications: the TOML files in experiments/ that describe one of the
+ * paper's transfer experiments (target situation, source situations, evolution settings,
+ * runs, held-out evaluation, presets). Parsing checks every key and value and reports the
+ * first problem as "FILE:LINE: what is wrong"; unknown keys are errors, so a typo never
+ * silently falls back to a default. Format: docs/simevo.md, "Experiment files".
+ */
+#ifndef QNAV_SIMEVO_SPEC_H
+#define QNAV_SIMEVO_SPEC_H
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "evolution.h"
+
+namespace qnav {
+
+/* One-line, user-facing error ("FILE:LINE: problem" or "OPTION: problem"). */
+class UserError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+/* The situation a policy is evolved or evaluated in. */
+struct Scenario {
+    std::string environment = "dense"; /* sim environment: name or file */
+    std::string robot = "tekbot";       /* sim robot profile: name or file */
+    uint32_t sectors = 0;               /* sonar sectors, 1..360; 0 = the robot's default */
+    double sensor_noise = 0.0;          /* p_s, fraction (0.05 = 5 %) */
+    double actuation_noise = 0.0;       /* p_a, fraction */
+    double episode_limit_s = 0.0;       /* s; 0 = the environment's limit */
+
+    /* Canonical one-line description (also part of task fingerprints). */
+    std::string describe() const;
+};
+
+/* A source situation whose best policy seeds a transfer population. */
+struct SourceSpec {
+    std::string label;        /* short name: condition "transfer-<label>" */
+    Scenario scenario;        /* fields not given inherit from [target] */
+    uint64_t episodes = 1000; /* evolution episodes in the source situation */
+    std::string policy_file;  /* non-empty: transfer from this file, no source evolution */
+};
+
+struct Preset {
+    std::optional<uint32_t> runs;
+    std::optional<uint64_t> episodes;        /* target episodes */
+    std::optional<uint64_t> source_episodes;
+    std::optional<uint32_t> eval_episodes;
+    std::optional<uint32_t> curve_bin;
+};
+
+struct ExperimentSpec {
+    std::string file;            /* where it was read from */
+    std::string name;            /* identifier, [a-z0-9-] */
+    std::string title;           /* one line for plots and summaries */
+    std::string figure;          /* paper figure it reproduces, e.g. "Fig. 7" */
+    uint32_t runs = 30;          /* independent runs per condition */
+    uint64_t seed = 1;           /* master seed: everything random derives from it */
+    uint32_t curve_bin = 20;     /* episodes per learning-curve point */
+    EvolutionParams evolution;
+    Scenario target;
+    uint64_t target_episodes = 1000;
+    std::vector<SourceSpec> sources;
+    uint32_t eval_episodes = 50; /* held-out evaluation episodes per best policy */
+    uint64_t eval_seed = 0x5eed;  /* seeds the held-out episode set (same for all runs) */
+    std::map<std::string, Preset> presets;
+};
+
+/* Parse a spec from text; name is used in messages. Throws UserError. */
+ExperimentSpec parse_experiment(const std::string &text, const std::string &name);
+/* Read and parse a file. Throws UserError (missing file, parse error). */
+ExperimentSpec load_experiment(const std::string &path);
+/* Apply a preset by name ("full" or "" = the spec's own values). Throws UserError. */
+void apply_preset(ExperimentSpec &spec, const std::string &preset);
+
+} // namespace qnav
+
+#endif

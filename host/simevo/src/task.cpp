@@ -1,0 +1,434 @@
+/*
+ * Resumable tasks: journal replay, evolution loop, best policy and held-out evaluation.
+ */
+#include "task.h"
+
+#include <cerrno>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fcntl.h>
+#include <sstream>
+#include <unistd.h>
+
+#include "files.h"
+#include "qnav/policy_io.h"
+#include "rng.h"
+
+namespace qnav {
+
+namespace {
+
+const char *kJournalHeader = "episode,R,f1,f2,tau_c,reached,parent,explored,policy,best_so_far\n";
+const char *kEvalHeader = "eval_episode,R,f1,f2,tau_c,reached\n";
+
+std::vector<std::string> split_csv(const std::string &line)
+{
+    std::vector<std::string> f;
+    std::size_t start = 0;
+    for (;;) {
+        const std::size_t c = line.find(',', start);
+        f.push_back(line.substr(start, c == std::string::npos ? std::string::npos : c - start));
+        if (c == std::string::npos) {
+            break;
+        }
+        start = c + 1;
+    }
+    return f;
+}
+
+bool parse_double(const std::string &s, double &v)
+{
+    if (s.empty()) {
+        return false;
+    }
+    char *end = nullptr;
+    errno = 0;
+    v = std::strtod(s.c_str(), &end);
+    return end == s.c_str() + s.size() && errno == 0;
+}
+
+bool parse_u64(const std::string &s, uint64_t &v)
+{
+    if (s.empty() || s[0] == '-') {
+        return false;
+    }
+    char *end = nullptr;
+    errno = 0;
+    v = std::strtoull(s.c_str(), &end, 10);
+    return end == s.c_str() + s.size() && errno == 0;
+}
+
+std::string fmt_outcome(const EpisodeOutcome &o)
+{
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%.17g,%.6f,%.6f,%" PRIu32 ",%d", o.R, o.f1, o.f2, o.tau_c,
+                  o.reached ? 1 : 0);
+    return buf;
+}
+
+/* Parses "R,f1,f2,tau_c,reached" starting at field k. */
+bool parse_outcome(const std::vector<std::string> &f, std::size_t k, EpisodeOutcome &o)
+{
+    uint64_t tau = 0;
+    uint64_t reached = 0;
+    if (!parse_double(f[k], o.R) || !parse_double(f[k + 1], o.f1) ||
+        !parse_double(f[k + 2], o.f2) || !parse_u64(f[k + 3], tau) ||
+        !parse_u64(f[k + 4], reached) || reached > 1 || tau > UINT32_MAX) {
+        return false;
+    }
+    o.tau_c = static_cast<uint32_t>(tau);
+    o.reached = reached == 1;
+    return true;
+}
+
+/* Lines of a text, each with its end offset; a last line without '\n' is reported as
+ * incomplete. */
+struct Lines {
+    std::vector<std::string> lines;
+    std::vector<std::size_t> ends; /* offset just past each complete line's '\n' */
+};
+Lines split_lines(const std::string &text)
+{
+    Lines L;
+    std::size_t start = 0;
+    while (start < text.size()) {
+        const std::size_t nl = text.find('\n', start);
+        if (nl == std::string::npos) {
+            break; // partial last line: the episode in flight when the run was killed
+        }
+        L.lines.push_back(text.substr(start, nl - start));
+        L.ends.push_back(nl + 1);
+        start = nl + 1;
+    }
+    return L;
+}
+
+void write_all(int fd, const std::string &s, const std::string &path)
+{
+    std::size_t off = 0;
+    while (off < s.size()) {
+        const ssize_t n = ::write(fd, s.data() + off, s.size() - off);
+        if (n < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            throw UserError(path + ": write failed (" + std::strerror(errno) + ")");
+        }
+        off += static_cast<std::size_t>(n);
+    }
+}
+
+qnav_policy_t load_source_policy(const std::string &path)
+{
+    qnav_policy_t p;
+    char err[QNAV_POLICY_IO_ERRLEN] = {0};
+    if (!file_exists(path)) {
+        throw UserError(path + ": policy file not found");
+    }
+    if (qnav_policy_read(path.c_str(), &p, err, sizeof err) != 0) {
+        throw UserError(err);
+    }
+    if (p.kind != QNAV_POLICY_NET) {
+        throw UserError(path + ": incompatible policy: kind is not 'net' (a transfer seeds a "
+                               "population of networks)");
+    }
+    if (p.u.net.hidden < 1 || p.u.net.hidden > QNAV_MAX_HIDDEN) {
+        throw UserError(path + ": incompatible policy: hidden units outside 1..32");
+    }
+    return p;
+}
+
+/* Held-out evaluation, journaled like the evolution (eval.partial, one line per episode)
+ * and renamed to eval.csv when complete. Returns false when stopped. */
+bool run_eval(EpisodeRunner &runner, const qnav_policy_t &policy, const TaskDef &t,
+              const TaskObserver &obs, const std::atomic<bool> &stop)
+{
+    const std::string partial = join_path(t.dir, "eval.partial");
+    const std::string final_path = join_path(t.dir, "eval.csv");
+    if (file_exists(final_path)) { // killed between the rename and "done"
+        if (obs.episodes_done) {
+            obs.episodes_done(static_cast<uint32_t>(read_eval(final_path).size()), true);
+        }
+        return true;
+    }
+    std::string text;
+    std::size_t keep = 0;
+    uint32_t have = 0;
+    if (read_file(partial, text) && !text.empty()) {
+        const Lines L = split_lines(text);
+        if (!L.lines.empty()) {
+            if (L.lines[0] + "\n" != kEvalHeader) {
+                throw UserError(partial + ":1: not a simevo evaluation file");
+            }
+            keep = L.ends[0];
+            for (std::size_t i = 1; i < L.lines.size() && have < t.eval_episodes; ++i) {
+                const auto f = split_csv(L.lines[i]);
+                EpisodeOutcome o;
+                uint64_t idx = 0;
+                if (f.size() != 6 || !parse_u64(f[0], idx) || idx != have || !parse_outcome(f, 1, o)) {
+                    throw UserError(partial + ":" + std::to_string(i + 1) + ": malformed row");
+                }
+                ++have;
+                keep = L.ends[i];
+            }
+        }
+    }
+    if (obs.episodes_done && have > 0) {
+        obs.episodes_done(have, true);
+    }
+    const int fd = ::open(partial.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        throw UserError(partial + ": cannot open (" + std::strerror(errno) + ")");
+    }
+    struct FdGuard {
+        int fd;
+        ~FdGuard() { ::close(fd); }
+    } guard{fd};
+    if (::ftruncate(fd, static_cast<off_t>(keep)) != 0 ||
+        ::lseek(fd, static_cast<off_t>(keep), SEEK_SET) < 0) {
+        throw UserError(partial + ": cannot truncate (" + std::strerror(errno) + ")");
+    }
+    if (keep == 0) {
+        write_all(fd, kEvalHeader, partial);
+    }
+    for (uint32_t i = have; i < t.eval_episodes; ++i) {
+        if (stop.load()) {
+            return false;
+        }
+        const EpisodeOutcome o = runner.run(policy, mix_seed(t.eval_seed_base, i));
+        write_all(fd, std::to_string(i) + "," + fmt_outcome(o) + "\n", partial);
+        if (obs.episodes_done) {
+            obs.episodes_done(1, false);
+        }
+    }
+    if (::rename(partial.c_str(), final_path.c_str()) != 0) {
+        throw UserError(final_path + ": cannot write (" + std::strerror(errno) + ")");
+    }
+    return true;
+}
+
+} // namespace
+
+std::string task_settings_text(const TaskDef &t, const std::string &source_fingerprint)
+{
+    std::ostringstream o;
+    o.precision(17);
+    const EvolutionParams &e = t.evolution;
+    o << "# simevo task settings; a resumed task must match them exactly\n"
+      << "kind=" << (t.kind == TaskKind::Evolve ? "evolve" : "eval-probabilistic") << "\n"
+      << "label=" << t.label << "\nrun=" << t.run << "\n"
+      << "scenario=" << t.scenario.describe() << "\n"
+      << "context_seed=" << t.context_seed << "\n";
+    if (t.kind == TaskKind::Evolve) {
+        o << "episodes=" << t.episodes << "\n"
+          << "population=" << e.population << " epsilon=" << e.epsilon
+          << " hidden=" << e.hidden << " mutation_scale=" << e.mutation_scale
+          << " mutation_clip=" << e.mutation_clip
+          << " init=" << (e.init == InitKind::Cauchy ? "cauchy" : "uniform")
+          << " init_scale=" << e.init_scale << "\n"
+          << "evolution_seed=" << t.evolution_seed << "\n"
+          << "episode_seed_base=" << t.episode_seed_base << "\n"
+          << "source=" << (source_fingerprint.empty() ? "none (random population)" : source_fingerprint)
+          << "\n";
+    }
+    o << "eval_episodes=" << t.eval_episodes << "\neval_seed_base=" << t.eval_seed_base << "\n";
+    return o.str();
+}
+
+uint64_t task_total_episodes(const TaskDef &t)
+{
+    return (t.kind == TaskKind::Evolve ? t.episodes : 0) + t.eval_episodes;
+}
+
+std::vector<double> read_journal_R(const std::string &csv_path)
+{
+    std::string text;
+    if (!read_file(csv_path, text)) {
+        throw UserError(csv_path + ": missing");
+    }
+    const Lines L = split_lines(text);
+    if (L.lines.empty() || L.lines[0] + "\n" != kJournalHeader) {
+        throw UserError(csv_path + ":1: not a simevo episode journal");
+    }
+    std::vector<double> R;
+    for (std::size_t i = 1; i < L.lines.size(); ++i) {
+        const auto f = split_csv(L.lines[i]);
+        double r = 0.0;
+        if (f.size() != 10 || !parse_double(f[1], r)) {
+            throw UserError(csv_path + ":" + std::to_string(i + 1) + ": malformed row");
+        }
+        R.push_back(r);
+    }
+    return R;
+}
+
+std::vector<EpisodeOutcome> read_eval(const std::string &csv_path)
+{
+    std::string text;
+    if (!read_file(csv_path, text)) {
+        throw UserError(csv_path + ": missing");
+    }
+    const Lines L = split_lines(text);
+    if (L.lines.empty() || L.lines[0] + "\n" != kEvalHeader) {
+        throw UserError(csv_path + ":1: not a simevo evaluation file");
+    }
+    std::vector<EpisodeOutcome> v;
+    for (std::size_t i = 1; i < L.lines.size(); ++i) {
+        const auto f = split_csv(L.lines[i]);
+        EpisodeOutcome o;
+        if (f.size() != 6 || !parse_outcome(f, 1, o)) {
+            throw UserError(csv_path + ":" + std::to_string(i + 1) + ": malformed row");
+        }
+        v.push_back(o);
+    }
+    return v;
+}
+
+bool run_task(const TaskDef &t, const std::string &source_policy_path, const RunnerFactory &make,
+              const TaskObserver &obs, const std::atomic<bool> &stop)
+{
+    make_dirs(t.dir);
+    const std::string settings_path = join_path(t.dir, "task.txt");
+    const std::string journal_path = join_path(t.dir, "episodes.csv");
+    const std::string best_path = join_path(t.dir, "best.policy");
+    const std::string done_path = join_path(t.dir, "done");
+
+    qnav_policy_t source{};
+    std::string source_fp;
+    if (t.kind == TaskKind::Evolve && !source_policy_path.empty()) {
+        source = load_source_policy(source_policy_path);
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "policy %08" PRIx32 " (hidden %u)",
+                      policy_fingerprint(source), static_cast<unsigned>(source.u.net.hidden));
+        source_fp = buf;
+    }
+    const std::string settings = task_settings_text(t, source_fp);
+    std::string existing;
+    if (read_file(settings_path, existing)) {
+        if (existing != settings) {
+            throw UserError(settings_path +
+                            ": this output folder was made with different settings; use another "
+                            "--out (or delete the folder to start over)");
+        }
+    } else {
+        write_file_atomic(settings_path, settings);
+    }
+    if (file_exists(done_path)) {
+        if (obs.episodes_done) {
+            obs.episodes_done(task_total_episodes(t), true);
+        }
+        return true;
+    }
+
+    std::unique_ptr<EpisodeRunner> runner = make(t.scenario, t.context_seed);
+
+    if (t.kind == TaskKind::EvalProbabilistic) {
+        qnav_policy_t prob;
+        qnav_policy_prob_default(&prob);
+        if (!run_eval(*runner, prob, t, obs, stop)) {
+            return false;
+        }
+        write_file_atomic(done_path, "complete\n");
+        return true;
+    }
+
+    Evolution evo = source_policy_path.empty()
+                        ? Evolution(t.evolution, t.evolution_seed)
+                        : Evolution(t.evolution, t.evolution_seed, source);
+
+    // Replay the journal (if any): same proposals, recorded outcomes, no simulation.
+    std::string text;
+    std::size_t keep = 0;
+    if (read_file(journal_path, text) && !text.empty()) {
+        const Lines L = split_lines(text);
+        if (L.lines.empty()) {
+            keep = 0; // killed while writing the header
+        } else {
+            if (L.lines[0] + "\n" != kJournalHeader) {
+                throw UserError(journal_path + ":1: not a simevo episode journal");
+            }
+            keep = L.ends[0];
+            for (std::size_t i = 1; i < L.lines.size() && evo.episodes_done() < t.episodes; ++i) {
+                const std::string where = journal_path + ":" + std::to_string(i + 1) + ": ";
+                const auto f = split_csv(L.lines[i]);
+                uint64_t ep = 0;
+                EpisodeOutcome o;
+                if (f.size() != 10 || !parse_u64(f[0], ep) || !parse_outcome(f, 1, o)) {
+                    throw UserError(where + "malformed journal row");
+                }
+                const Candidate c = evo.propose();
+                char fp[16];
+                std::snprintf(fp, sizeof fp, "%08" PRIx32, policy_fingerprint(c.policy));
+                if (ep != c.episode || f[8] != fp) {
+                    throw UserError(where + "journal does not match this program and settings "
+                                            "(episode or policy differs); use another --out");
+                }
+                evo.accept(c, o);
+                keep = L.ends[i];
+            }
+            if (obs.episodes_done && evo.episodes_done() > 0) {
+                obs.episodes_done(evo.episodes_done(), true);
+            }
+        }
+    }
+    const int fd = ::open(journal_path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        throw UserError(journal_path + ": cannot open (" + std::strerror(errno) + ")");
+    }
+    struct FdGuard {
+        int fd;
+        ~FdGuard() { ::close(fd); }
+    } guard{fd};
+    if (::ftruncate(fd, static_cast<off_t>(keep)) != 0 ||
+        ::lseek(fd, static_cast<off_t>(keep), SEEK_SET) < 0) {
+        throw UserError(journal_path + ": cannot truncate (" + std::strerror(errno) + ")");
+    }
+    if (keep == 0) {
+        write_all(fd, kJournalHeader, journal_path);
+    }
+    if (obs.best && evo.episodes_done() > 0) {
+        obs.best(t.label, evo.best_so_far());
+    }
+
+    while (evo.episodes_done() < t.episodes) {
+        if (stop.load()) {
+            return false;
+        }
+        const Candidate c = evo.propose();
+        const EpisodeOutcome o = runner->run(c.policy, mix_seed(t.episode_seed_base, c.episode));
+        evo.accept(c, o);
+        char row[320];
+        std::snprintf(row, sizeof row, "%" PRIu64 ",%s,%d,%d,%08" PRIx32 ",%.17g\n", c.episode,
+                      fmt_outcome(o).c_str(), static_cast<int>(c.parent), c.explored ? 1 : 0,
+                      policy_fingerprint(c.policy), evo.best_so_far());
+        write_all(fd, row, journal_path);
+        if (obs.episodes_done) {
+            obs.episodes_done(1, false);
+        }
+        if (obs.best) {
+            obs.best(t.label, evo.best_so_far());
+        }
+    }
+
+    const int32_t b = evo.best_index();
+    const qnav_policy_t best = evo.members()[static_cast<std::size_t>(b)].policy;
+    char comment[200];
+    std::snprintf(comment, sizeof comment, "simevo %s run %u: best of %" PRIu64 " episodes, R = %.6f",
+                  t.label.c_str(), t.run + 1, t.episodes, evo.members()[static_cast<std::size_t>(b)].fitness);
+    char err[QNAV_POLICY_IO_ERRLEN] = {0};
+    if (qnav_policy_write(best_path.c_str(), &best, comment, err, sizeof err) != 0) {
+        throw UserError(err);
+    }
+    if (t.eval_episodes > 0) {
+        if (!run_eval(*runner, best, t, obs, stop)) {
+            return false;
+        }
+    }
+    write_file_atomic(done_path, "complete\n");
+    return true;
+}
+
+} // namespace qnav

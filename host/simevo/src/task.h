@@ -1,0 +1,80 @@
+/*
+ * One unit of work of an experiment, resumable: an evolution in one situation (source,
+ * transfer or direct; with or without a held-out evaluation of its best policy), or the
+ * held-out evaluation of the probabilistic policy. A task lives in its own folder:
+ *   task.txt      the resolved settings (a resumed task must match them exactly)
+ *   episodes.csv  the episode journal: one line per finished episode, appended with one
+ *                 write(); a kill leaves at most a partial last line, which resume drops
+ *   best.policy   the best member at the end (policy file, atomic)
+ *   eval.csv      held-out episodes of the best (or probabilistic) policy (atomic)
+ *   done          written last (atomic): the task is complete
+ * Resuming replays the journal through Evolution (same draws, recorded R values) without
+ * simulating, so the finished files equal those of an uninterrupted run byte for byte.
+ */
+#ifndef QNAV_SIMEVO_TASK_H
+#define QNAV_SIMEVO_TASK_H
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "evolution.h"
+#include "spec.h"
+
+namespace qnav {
+
+enum class TaskKind { Evolve, EvalProbabilistic };
+
+struct TaskDef {
+    TaskKind kind = TaskKind::Evolve;
+    std::string dir;                 /* output folder */
+    std::string label;               /* condition, e.g. "transfer-open", "direct" */
+    uint32_t run = 0;                /* run index, 0-based */
+    Scenario scenario;
+    uint64_t context_seed = 1;       /* qnav_sim_config_t.seed */
+    uint64_t episodes = 0;           /* evolution episodes */
+    EvolutionParams evolution;
+    uint64_t evolution_seed = 0;     /* seeds the Evolution's Rng */
+    uint64_t episode_seed_base = 0;  /* episode T runs with mix_seed(base, T) */
+    int source_task = -1;            /* index of the task whose best.policy seeds this */
+    std::string source_policy_file;  /* or a policy file that seeds it */
+    uint32_t eval_episodes = 0;      /* held-out evaluation of the best; 0 = none */
+    uint64_t eval_seed_base = 0;     /* held-out episode i runs with mix_seed(base, i) */
+};
+
+/* Creates the runner a task uses (the simulator, or a fake in tests). */
+using RunnerFactory = std::function<std::unique_ptr<EpisodeRunner>(const Scenario &, uint64_t)>;
+
+/* Progress callbacks (thread-safe implementations required). */
+struct TaskObserver {
+    std::function<void(uint64_t n, bool replayed)> episodes_done; /* n more episodes */
+    std::function<void(const std::string &label, double best_R)> best;
+};
+
+/* Held-out evaluation result per episode. */
+struct EvalRow {
+    EpisodeOutcome out;
+};
+
+/* Run (or resume, or skip if done) a task. source_policy_path is the file that seeds a
+ * transfer ("" for none). stop is polled between episodes. Throws UserError. Returns
+ * true when complete, false when stopped. */
+bool run_task(const TaskDef &t, const std::string &source_policy_path, const RunnerFactory &make,
+              const TaskObserver &obs, const std::atomic<bool> &stop);
+
+/* Episodes a task still has to simulate (for progress totals) and has in total. */
+uint64_t task_total_episodes(const TaskDef &t);
+
+/* Reading finished task outputs. Throw UserError on malformed files. */
+std::vector<double> read_journal_R(const std::string &csv_path);
+std::vector<EpisodeOutcome> read_eval(const std::string &csv_path);
+
+/* The canonical settings text written to task.txt. */
+std::string task_settings_text(const TaskDef &t, const std::string &source_fingerprint);
+
+} // namespace qnav
+
+#endif
