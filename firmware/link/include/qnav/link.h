@@ -110,7 +110,7 @@ typedef enum {
     QNAV_LINK_E_SPACE = -2,     /* the output buffer is too small */
     QNAV_LINK_E_LENGTH = -3,    /* payload length wrong for the message */
     QNAV_LINK_E_VALUE = -4      /* a field is out of its range */
-} qnav_link_status_t;
+} qnav_link_result_t;
 
 /* Why the decoder dropped a frame. */
 typedef enum {

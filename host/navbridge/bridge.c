@@ -1,0 +1,501 @@
+/*
+ * navbridge's core (bridge.h): link frames in, commands and LCM messages out, a watchdog
+ * that stops the robot when the board goes quiet, and the onboard policy upload. No I/O of
+ * its own: bytes leave through the write callback, messages through LCM and the log.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "bridge.h"
+
+#include <string.h>
+#include <time.h>
+
+#include "qnav_link_status_t.h"
+#include "qnav_path_qualities_t.h"
+
+/* Largest encoded LCM message we publish (path qualities: 360 * 6 bytes + header). */
+#define PUBLISH_BUF 4096
+
+int64_t qnav_bridge_utime(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+uint16_t qnav_bridge_policy_crc(const qnav_policy_t *policy)
+{
+    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
+    int32_t n = qnav_link_policy_to_blob(policy, blob, sizeof blob);
+    if (n <= 0) {
+        return 0;
+    }
+    return qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n);
+}
+
+void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg,
+                           const qnav_policy_t *policy)
+{
+    memset(bc, 0, sizeof *bc);
+    bc->cfg = *cfg;
+    bc->policy = *policy;
+    bc->policy_crc = qnav_bridge_policy_crc(policy);
+    bc->ready = qnav_ctrl_init(&bc->ctrl, &bc->cfg, &bc->policy) == QNAV_OK;
+}
+
+void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
+                           qnav_command_t *cmd, int16_t *qualities)
+{
+    qnav_mm_t ranges[QNAV_MAX_SECTORS];
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+    int k;
+    int n = scan->n_sectors;
+
+    if (n < 1 || n > QNAV_MAX_SECTORS) {
+        n = 0;
+    }
+    if (n > 0 && scan->max_range_mm > 0 && scan->max_range_mm <= 65535 &&
+        (n != bc->cfg.n_sectors || scan->max_range_mm != bc->cfg.max_range_mm || !bc->ready)) {
+        bc->cfg.n_sectors = (uint16_t)n;
+        bc->cfg.max_range_mm = (qnav_mm_t)scan->max_range_mm;
+        bc->ready = qnav_ctrl_init(&bc->ctrl, &bc->cfg, &bc->policy) == QNAV_OK;
+    }
+    for (k = 0; k < n; ++k) {
+        int32_t r = scan->ranges_mm[k];
+        ranges[k] = (qnav_mm_t)(r < 0 ? 0 : (r > 65535 ? 65535 : r));
+    }
+    in.ranges_mm = ranges;
+    in.goal_bearing_cdeg = scan->goal_bearing_cdeg;
+    if (n == 0 || !bc->ready) {
+        /* a scan the controller cannot take: the step reports not-ready and stops */
+        qnav_ctrl_t dead;
+        memset(&dead, 0, sizeof dead);
+        qnav_ctrl_step(&dead, &in, &out, NULL);
+        if (qualities != NULL) {
+            memset(qualities, 0, sizeof(int16_t) * QNAV_PATHS);
+        }
+    } else {
+        qnav_ctrl_step(&bc->ctrl, &in, &out, qualities);
+    }
+    memset(cmd, 0, sizeof *cmd);
+    cmd->utime = scan->utime;
+    cmd->scan_seq = scan->seq;
+    cmd->heading_deg = out.heading_deg;
+    cmd->speed_q15 = out.speed;
+    cmd->quality_q15 = out.quality;
+    cmd->speed = out.speed / 32768.0;
+    cmd->quality = out.quality / 32768.0;
+    cmd->flags = (int8_t)out.flags;
+    cmd->stop_reason = QNAV_STOP_NONE;
+    cmd->source = QNAV_SOURCE_BRIDGE;
+    cmd->policy_crc = bc->policy_crc;
+}
+
+void qnav_bridge_config_default(qnav_bridge_config_t *cfg)
+{
+    memset(cfg, 0, sizeof *cfg);
+    cfg->mode = QNAV_LINK_MODE_OFFBOARD;
+    cfg->timeout_ms = 300;
+    cfg->heartbeat_ms = 100;
+    cfg->status_ms = 500;
+    qnav_ctrl_config_default(&cfg->ctrl);
+    qnav_policy_prob_default(&cfg->policy);
+    cfg->have_policy = 1;
+}
+
+void qnav_bridge_publish(qnav_bridge_t *b, const char *channel, const void *data, int len)
+{
+    if (b->lcm != NULL) {
+        lcm_publish(b->lcm, channel, data, (unsigned int)len);
+    }
+    if (b->log != NULL) {
+        lcm_eventlog_event_t ev;
+        memset(&ev, 0, sizeof ev);
+        ev.timestamp = qnav_bridge_utime();
+        ev.channellen = (int32_t)strlen(channel);
+        ev.datalen = len;
+        ev.channel = (char *)channel;
+        ev.data = (void *)data;
+        lcm_eventlog_write_event(b->log, &ev);
+        fflush(b->log->f);
+    }
+}
+
+#define PUBLISH(b, ch, T, msg)                                                              \
+    do {                                                                                    \
+        uint8_t buf_[PUBLISH_BUF];                                                          \
+        int n_ = T##_encode(buf_, 0, (int)sizeof buf_, (msg));                              \
+        if (n_ > 0) {                                                                       \
+            qnav_bridge_publish((b), (ch), buf_, n_);                                       \
+        }                                                                                   \
+    } while (0)
+
+static void send_frame(qnav_bridge_t *b, uint8_t id, const uint8_t *payload, int32_t len)
+{
+    uint8_t wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
+    int32_t n;
+    if (len < 0) {
+        return;
+    }
+    n = qnav_link_encode(&b->tx, id, payload, (uint16_t)len, wire, (uint16_t)sizeof wire);
+    if (n > 0 && b->write != NULL) {
+        b->write(b->write_user, wire, (size_t)n);
+    }
+}
+
+static void send_command(qnav_bridge_t *b, const qnav_command_t *c, int stop)
+{
+    qnav_link_command_t lc;
+    uint8_t p[QNAV_LINK_COMMAND_BYTES];
+    memset(&lc, 0, sizeof lc);
+    lc.scan_seq = (uint16_t)(c->scan_seq < 0 ? 0 : c->scan_seq);
+    lc.heading_deg = stop ? 0 : c->heading_deg;
+    lc.speed = stop ? 0 : c->speed_q15;
+    lc.quality = c->quality_q15;
+    lc.flags = (uint8_t)((uint8_t)c->flags | (stop ? QNAV_LINK_CMD_STOP : 0u));
+    send_frame(b, QNAV_LINK_MSG_COMMAND, p, qnav_link_command_pack(&lc, p, sizeof p));
+    if (stop) {
+        b->stops_sent++;
+    } else {
+        b->commands_sent++;
+    }
+}
+
+static void send_heartbeat(qnav_bridge_t *b)
+{
+    qnav_link_heartbeat_t hb;
+    uint8_t p[QNAV_LINK_HEARTBEAT_BYTES];
+    memset(&hb, 0, sizeof hb);
+    hb.uptime_ms = (uint32_t)(b->now_ms - b->started_ms);
+    hb.mode = b->cfg.mode;
+    hb.state = (uint8_t)((b->last_rx_ms >= 0 && b->now_ms - b->last_rx_ms <=
+                                                    (int64_t)b->cfg.timeout_ms
+                              ? QNAV_LINK_STATE_LINK_OK
+                              : 0u) |
+                         (b->watchdog_stop || b->shutting_down ? QNAV_LINK_STATE_STOPPED : 0u) |
+                         (b->cfg.have_policy ? QNAV_LINK_STATE_POLICY : 0u));
+    hb.rx_ok = (uint16_t)b->rx.stats.frames_ok;
+    hb.rx_dropped = (uint16_t)qnav_link_rx_dropped_total(&b->rx);
+    hb.policy_crc = b->cfg.have_policy ? b->bc.policy_crc : 0u;
+    send_frame(b, QNAV_LINK_MSG_HEARTBEAT, p, qnav_link_heartbeat_pack(&hb, p, sizeof p));
+}
+
+static void send_goal(qnav_bridge_t *b)
+{
+    uint8_t p[QNAV_LINK_GOAL_BYTES];
+    send_frame(b, QNAV_LINK_MSG_GOAL, p, qnav_link_goal_pack(&b->goal, p, sizeof p));
+}
+
+/* A stop: sent to the board and published once per event. */
+static void command_stop(qnav_bridge_t *b, int8_t reason)
+{
+    qnav_command_t c;
+    memset(&c, 0, sizeof c);
+    c.utime = qnav_bridge_utime();
+    c.scan_seq = -1;
+    c.flags = (int8_t)QNAV_LINK_CMD_STOP;
+    c.stop_reason = reason;
+    c.source = QNAV_SOURCE_BRIDGE;
+    c.policy_crc = b->bc.policy_crc;
+    send_command(b, &c, 1);
+    PUBLISH(b, QNAV_CH_COMMAND, qnav_command_t, &c);
+}
+
+static void publish_status(qnav_bridge_t *b)
+{
+    qnav_link_status_t s;
+    memset(&s, 0, sizeof s);
+    s.utime = qnav_bridge_utime();
+    s.mode = (int8_t)b->cfg.mode;
+    s.rx_frames = (int64_t)b->rx.stats.frames_ok;
+    s.tx_frames = (int64_t)b->tx.frames_sent;
+    s.rx_bytes = (int64_t)b->rx_bytes;
+    s.drop_cobs = b->rx.stats.dropped[QNAV_LINK_DROP_COBS];
+    s.drop_short = b->rx.stats.dropped[QNAV_LINK_DROP_SHORT];
+    s.drop_overflow = b->rx.stats.dropped[QNAV_LINK_DROP_OVERFLOW];
+    s.drop_crc = b->rx.stats.dropped[QNAV_LINK_DROP_CRC];
+    s.drop_unknown = b->rx.stats.dropped[QNAV_LINK_DROP_UNKNOWN];
+    s.drop_length = b->rx.stats.dropped[QNAV_LINK_DROP_LENGTH];
+    s.drop_seq = b->rx.stats.dropped[QNAV_LINK_DROP_SEQ];
+    s.seq_gaps = b->rx.stats.seq_gaps;
+    s.last_heartbeat_age_ms =
+        b->last_heartbeat_ms < 0 ? -1 : (int32_t)(b->now_ms - b->last_heartbeat_ms);
+    s.last_scan_age_ms = b->last_scan_ms < 0 ? -1 : (int32_t)(b->now_ms - b->last_scan_ms);
+    s.watchdog_stop = (int8_t)(b->watchdog_stop != 0);
+    s.board_rx_ok = b->board_hb.rx_ok;
+    s.board_rx_dropped = b->board_hb.rx_dropped;
+    s.board_state = (int8_t)b->board_hb.state;
+    s.board_policy_crc = b->board_hb.policy_crc;
+    s.last_upload_status = b->last_upload_status;
+    PUBLISH(b, QNAV_CH_LINK_STATUS, qnav_link_status_t, &s);
+}
+
+void qnav_bridge_init(qnav_bridge_t *b, const qnav_bridge_config_t *cfg, lcm_t *lcm,
+                      lcm_eventlog_t *log, qnav_bridge_write_fn write, void *write_user,
+                      int64_t now_ms)
+{
+    memset(b, 0, sizeof *b);
+    b->cfg = *cfg;
+    b->lcm = lcm;
+    b->log = log;
+    b->write = write;
+    b->write_user = write_user;
+    qnav_link_rx_init(&b->rx);
+    qnav_link_tx_init(&b->tx);
+    qnav_bridge_ctrl_init(&b->bc, &cfg->ctrl, &cfg->policy);
+    b->now_ms = now_ms;
+    b->started_ms = now_ms;
+    b->last_scan_ms = -1;
+    b->last_heartbeat_ms = -1;
+    b->last_rx_ms = -1;
+    b->next_heartbeat_ms = now_ms;
+    b->next_status_ms = now_ms + cfg->status_ms;
+    b->upload_state = (cfg->upload && cfg->have_policy) ? 1 : 0;
+    b->last_upload_status = 1;
+}
+
+static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
+{
+    qnav_link_scan_t ls;
+    qnav_scan_t s;
+    qnav_command_t c;
+    qnav_path_qualities_t q;
+    int k;
+
+    if (qnav_link_scan_unpack(f->payload, f->len, &ls) != QNAV_LINK_OK) {
+        return;
+    }
+    b->last_scan_ms = b->now_ms;
+    memset(&s, 0, sizeof s);
+    s.utime = qnav_bridge_utime();
+    s.seq = f->seq;
+    s.board_ms = ls.board_ms;
+    s.n_sectors = (int16_t)ls.n_sectors;
+    s.max_range_mm = ls.max_range_mm;
+    s.goal_bearing_cdeg = ls.goal_bearing_cdeg;
+    s.goal_id = ls.goal_id;
+    for (k = 0; k < ls.n_sectors; ++k) {
+        s.ranges_mm[k] = ls.ranges_mm[k];
+    }
+    PUBLISH(b, QNAV_CH_SCAN, qnav_scan_t, &s);
+
+    if (b->goal.goal_id != 0u && ls.goal_id != b->goal.goal_id) {
+        send_goal(b); /* the board has not got the current goal yet */
+    }
+    if (b->cfg.mode == QNAV_LINK_MODE_ONBOARD && !b->cfg.have_policy) {
+        return; /* nothing to compute qualities with */
+    }
+    memset(&q, 0, sizeof q);
+    qnav_bridge_ctrl_step(&b->bc, &s, &c, q.quality_q15);
+    if (b->cfg.mode == QNAV_LINK_MODE_OFFBOARD && !b->shutting_down) {
+        if (b->watchdog_stop && b->diag != NULL) {
+            fprintf(b->diag, "navbridge: scans are back: resuming commands\n");
+        }
+        b->watchdog_stop = 0;
+        send_command(b, &c, 0);
+        PUBLISH(b, QNAV_CH_COMMAND, qnav_command_t, &c);
+    }
+    q.utime = s.utime;
+    q.scan_seq = s.seq;
+    q.best_deg = c.heading_deg;
+    for (k = 0; k < QNAV_PATHS; ++k) {
+        q.quality[k] = (float)q.quality_q15[k] / 32768.0f;
+    }
+    PUBLISH(b, QNAV_CH_QUALITIES, qnav_path_qualities_t, &q);
+}
+
+static void on_board_command(qnav_bridge_t *b, const qnav_link_frame_t *f)
+{
+    qnav_link_command_t lc;
+    qnav_command_t c;
+    if (b->cfg.mode != QNAV_LINK_MODE_ONBOARD) {
+        return; /* offboard: commands only flow to the board */
+    }
+    if (qnav_link_command_unpack(f->payload, f->len, &lc) != QNAV_LINK_OK) {
+        return;
+    }
+    memset(&c, 0, sizeof c);
+    c.utime = qnav_bridge_utime();
+    c.scan_seq = lc.scan_seq;
+    c.heading_deg = lc.heading_deg;
+    c.speed_q15 = lc.speed;
+    c.quality_q15 = lc.quality;
+    c.speed = lc.speed / 32768.0;
+    c.quality = lc.quality / 32768.0;
+    c.flags = (int8_t)(lc.flags & 0x7Fu);
+    c.stop_reason = (lc.flags & QNAV_LINK_CMD_STOP) ? QNAV_STOP_BOARD : QNAV_STOP_NONE;
+    c.source = QNAV_SOURCE_BOARD;
+    c.policy_crc = b->board_hb.policy_crc;
+    PUBLISH(b, QNAV_CH_COMMAND, qnav_command_t, &c);
+}
+
+static void on_ack(qnav_bridge_t *b, const qnav_link_frame_t *f)
+{
+    qnav_link_policy_ack_t a;
+    if (qnav_link_policy_ack_unpack(f->payload, f->len, &a) != QNAV_LINK_OK ||
+        b->upload_state != 2) {
+        return;
+    }
+    b->last_upload_status = a.status;
+    b->upload_state = 3;
+    if (b->diag != NULL) {
+        if (a.status == QNAV_LINK_ACK_OK) {
+            fprintf(b->diag, "navbridge: policy upload: ok (crc 0x%04x)\n", a.crc);
+        } else {
+            fprintf(b->diag, "navbridge: policy upload: refused by the board (status %d)\n",
+                    a.status);
+        }
+    }
+}
+
+static void send_upload(qnav_bridge_t *b)
+{
+    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
+    uint8_t p[QNAV_LINK_CHUNK_MAX_BYTES];
+    qnav_link_policy_chunk_t c;
+    qnav_link_policy_commit_t cm;
+    int32_t n = qnav_link_policy_to_blob(&b->cfg.policy, blob, sizeof blob);
+    uint16_t off = 0;
+    if (n <= 0) {
+        b->upload_state = 3;
+        b->last_upload_status = QNAV_LINK_ACK_BAD_POLICY;
+        return;
+    }
+    while (off < (uint16_t)n) {
+        uint16_t len = (uint16_t)((uint16_t)n - off);
+        if (len > QNAV_LINK_CHUNK_BYTES) {
+            len = QNAV_LINK_CHUNK_BYTES;
+        }
+        c.offset = off;
+        c.total = (uint16_t)n;
+        c.len = (uint8_t)len;
+        memcpy(c.data, &blob[off], len);
+        send_frame(b, QNAV_LINK_MSG_POLICY_CHUNK, p,
+                   qnav_link_policy_chunk_pack(&c, p, sizeof p));
+        off = (uint16_t)(off + len);
+    }
+    cm.total = (uint16_t)n;
+    cm.crc = qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n);
+    send_frame(b, QNAV_LINK_MSG_POLICY_COMMIT, p,
+               qnav_link_policy_commit_pack(&cm, p, sizeof p));
+    b->upload_state = 2;
+    b->upload_tries++;
+    b->upload_sent_ms = b->now_ms;
+}
+
+void qnav_bridge_on_bytes(qnav_bridge_t *b, const uint8_t *bytes, size_t n, int64_t now_ms)
+{
+    size_t i;
+    qnav_link_frame_t f;
+    b->now_ms = now_ms;
+    b->rx_bytes += n;
+    for (i = 0; i < n; ++i) {
+        if (!qnav_link_rx_feed(&b->rx, bytes[i], &f)) {
+            continue;
+        }
+        b->last_rx_ms = now_ms;
+        switch (f.msg_id) {
+        case QNAV_LINK_MSG_SCAN:
+            on_scan(b, &f);
+            break;
+        case QNAV_LINK_MSG_COMMAND:
+            on_board_command(b, &f);
+            break;
+        case QNAV_LINK_MSG_HEARTBEAT:
+            if (qnav_link_heartbeat_unpack(f.payload, f.len, &b->board_hb) == QNAV_LINK_OK) {
+                b->last_heartbeat_ms = now_ms;
+                if (b->cfg.mode == QNAV_LINK_MODE_ONBOARD && b->watchdog_stop) {
+                    b->watchdog_stop = 0;
+                    if (b->diag != NULL) {
+                        fprintf(b->diag, "navbridge: heartbeats are back\n");
+                    }
+                }
+            }
+            break;
+        case QNAV_LINK_MSG_POLICY_ACK:
+            on_ack(b, &f);
+            break;
+        default:
+            break; /* goals and uploads only flow to the board */
+        }
+    }
+}
+
+void qnav_bridge_on_goal(qnav_bridge_t *b, const qnav_goal_t *goal, int64_t now_ms)
+{
+    b->now_ms = now_ms;
+    b->goal.goal_id = (uint16_t)goal->goal_id;
+    b->goal.bearing_cdeg = goal->bearing_cdeg;
+    b->goal.distance_mm = goal->distance_mm < 0 ? 0u : (uint32_t)goal->distance_mm;
+    send_goal(b);
+}
+
+void qnav_bridge_poll(qnav_bridge_t *b, int64_t now_ms)
+{
+    int64_t last;
+    b->now_ms = now_ms;
+    if (now_ms >= b->next_heartbeat_ms) {
+        send_heartbeat(b);
+        b->next_heartbeat_ms = now_ms + b->cfg.heartbeat_ms;
+    }
+    /* watchdog: the mode's lifeline is scans (offboard) or heartbeats (onboard); before
+     * the first one arrives the clock runs from start-up */
+    last = b->cfg.mode == QNAV_LINK_MODE_OFFBOARD ? b->last_scan_ms : b->last_heartbeat_ms;
+    if (last < 0) {
+        last = b->started_ms;
+    }
+    if (!b->shutting_down && now_ms - last > (int64_t)b->cfg.timeout_ms) {
+        if (!b->watchdog_stop) {
+            b->watchdog_stop = 1;
+            command_stop(b, QNAV_STOP_WATCHDOG);
+            b->next_stop_repeat_ms = now_ms + b->cfg.heartbeat_ms;
+            /* the board may have restarted: take its next frame whatever its number */
+            qnav_link_rx_reset_seq(&b->rx);
+            if (b->diag != NULL) {
+                fprintf(b->diag, "navbridge: no %s for %lld ms: robot stopped\n",
+                        b->cfg.mode == QNAV_LINK_MODE_OFFBOARD ? "scans" : "heartbeats",
+                        (long long)(now_ms - last));
+            }
+        } else if (now_ms >= b->next_stop_repeat_ms) {
+            /* repeat on the wire (a stop may be lost) without flooding LCM */
+            qnav_command_t c;
+            memset(&c, 0, sizeof c);
+            c.scan_seq = -1;
+            send_command(b, &c, 1);
+            b->next_stop_repeat_ms = now_ms + b->cfg.heartbeat_ms;
+        }
+    }
+    if (b->upload_state == 1 && b->last_heartbeat_ms >= 0) {
+        send_upload(b);
+    } else if (b->upload_state == 2 && now_ms - b->upload_sent_ms > 1000) {
+        if (b->upload_tries < 3) {
+            send_upload(b);
+        } else {
+            b->upload_state = 3;
+            b->last_upload_status = QNAV_LINK_ACK_BAD_LENGTH;
+            if (b->diag != NULL) {
+                fprintf(b->diag, "navbridge: policy upload: no answer from the board\n");
+            }
+        }
+    }
+    if (now_ms >= b->next_status_ms) {
+        publish_status(b);
+        b->next_status_ms = now_ms + b->cfg.status_ms;
+    }
+}
+
+void qnav_bridge_shutdown(qnav_bridge_t *b, int64_t now_ms)
+{
+    int i;
+    b->now_ms = now_ms;
+    b->shutting_down = 1;
+    command_stop(b, QNAV_STOP_SHUTDOWN);
+    for (i = 0; i < 2; ++i) {
+        qnav_command_t c;
+        memset(&c, 0, sizeof c);
+        c.scan_seq = -1;
+        send_command(b, &c, 1);
+    }
+    send_heartbeat(b);
+    publish_status(b);
+}

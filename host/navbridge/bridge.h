@@ -1,0 +1,147 @@
+/*
+ * navbridge's core, free of any I/O: it takes bytes from the serial port, LCM goals and the
+ * clock, and answers with bytes for the serial port and LCM messages. main.c wires it to a
+ * real serial port and LCM bus; tests drive it directly. Offboard mode runs libqnav on the
+ * board's scans and returns commands; onboard mode relays goals, heartbeats and policy
+ * uploads while the board runs libqnav. Both publish everything they see on LCM. A
+ * watchdog commands a stop when the board's scans (offboard) or heartbeats (onboard) stop
+ * for longer than the timeout.
+ */
+#ifndef QNAV_NAVBRIDGE_BRIDGE_H
+#define QNAV_NAVBRIDGE_BRIDGE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include <lcm/lcm.h>
+#include <lcm/eventlog.h>
+
+#include "qnav/ctrl.h"
+#include "qnav/link.h"
+#include "qnav_command_t.h"
+#include "qnav_goal_t.h"
+#include "qnav_scan_t.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* LCM channels. */
+#define QNAV_CH_SCAN "QNAV_SCAN"
+#define QNAV_CH_GOAL "QNAV_GOAL"
+#define QNAV_CH_COMMAND "QNAV_COMMAND"
+#define QNAV_CH_QUALITIES "QNAV_QUALITIES"
+#define QNAV_CH_POSE "QNAV_POSE"
+#define QNAV_CH_LINK_STATUS "QNAV_LINK_STATUS"
+
+/* command_t.stop_reason and .source values. */
+#define QNAV_STOP_NONE 0
+#define QNAV_STOP_WATCHDOG 1
+#define QNAV_STOP_SHUTDOWN 2
+#define QNAV_STOP_BOARD 3
+#define QNAV_SOURCE_BRIDGE 1
+#define QNAV_SOURCE_BOARD 2
+
+/* Writes bytes to the serial port; returns 0 or -1. */
+typedef int (*qnav_bridge_write_fn)(void *user, const uint8_t *bytes, size_t n);
+
+typedef struct {
+    uint8_t mode;                 /* QNAV_LINK_MODE_OFFBOARD or _ONBOARD */
+    uint32_t timeout_ms;          /* watchdog: stop after this long without scans
+                                     (offboard) or heartbeats (onboard), ms */
+    uint32_t heartbeat_ms;        /* bridge heartbeat period, ms (100) */
+    uint32_t status_ms;           /* link status publish period, ms (500) */
+    qnav_ctrl_config_t ctrl;      /* n_sectors is taken from each scan */
+    int have_policy;              /* 1 when policy is set */
+    qnav_policy_t policy;         /* offboard: drives the robot; onboard: qualities shown */
+    int upload;                   /* onboard: upload policy to the board */
+} qnav_bridge_config_t;
+
+/* The controller step of the bridge, shared with the replay: re-initialises when the
+ * scan's sector count or range changes. */
+typedef struct {
+    qnav_ctrl_t ctrl;
+    qnav_ctrl_config_t cfg;
+    qnav_policy_t policy;
+    int ready;                    /* qnav_ctrl_init succeeded for cfg */
+    uint16_t policy_crc;          /* CRC-16 of the policy blob */
+} qnav_bridge_ctrl_t;
+
+void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg,
+                           const qnav_policy_t *policy);
+/* Run the controller on an LCM scan; fills cmd (integer and float fields, source BRIDGE)
+ * and qualities (360 Q1.15 values, may be NULL). */
+void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
+                           qnav_command_t *cmd, int16_t *qualities);
+/* CRC-16 of a policy's link blob (0 if it cannot be serialised). */
+uint16_t qnav_bridge_policy_crc(const qnav_policy_t *policy);
+
+typedef struct {
+    qnav_bridge_config_t cfg;
+    lcm_t *lcm;                   /* may be NULL (no publishing) */
+    lcm_eventlog_t *log;          /* may be NULL: also write every publish here */
+    qnav_bridge_write_fn write;
+    void *write_user;
+
+    qnav_link_rx_t rx;
+    qnav_link_tx_t tx;
+    qnav_bridge_ctrl_t bc;
+
+    int64_t now_ms;               /* monotonic clock given to the last call, ms */
+    int64_t started_ms;
+    int64_t last_scan_ms;         /* -1 never */
+    int64_t last_heartbeat_ms;    /* -1 never */
+    int64_t last_rx_ms;           /* any good frame, -1 never */
+    int64_t next_heartbeat_ms;
+    int64_t next_status_ms;
+    int64_t next_stop_repeat_ms;
+    int watchdog_stop;            /* holding a stop because the link went quiet */
+    int shutting_down;
+
+    qnav_link_heartbeat_t board_hb;   /* last heartbeat from the board */
+    qnav_link_goal_t goal;            /* last goal relayed (goal_id 0 none) */
+
+    /* policy upload (onboard) */
+    int upload_state;             /* 0 idle, 1 waiting for the board, 2 sent, 3 done */
+    int upload_tries;
+    int64_t upload_sent_ms;
+    int8_t last_upload_status;    /* QNAV_LINK_ACK_*, or 1 none yet */
+
+    uint64_t rx_bytes;
+    uint64_t commands_sent;
+    uint64_t stops_sent;
+    FILE *diag;                   /* one-line notices (upload result, link lost), or NULL */
+} qnav_bridge_t;
+
+void qnav_bridge_config_default(qnav_bridge_config_t *cfg);
+
+/* Start a bridge at monotonic time now_ms. lcm and log may be NULL. */
+void qnav_bridge_init(qnav_bridge_t *b, const qnav_bridge_config_t *cfg, lcm_t *lcm,
+                      lcm_eventlog_t *log, qnav_bridge_write_fn write, void *write_user,
+                      int64_t now_ms);
+
+/* Bytes read from the serial port at now_ms. */
+void qnav_bridge_on_bytes(qnav_bridge_t *b, const uint8_t *bytes, size_t n, int64_t now_ms);
+
+/* A goal from LCM: relayed to the board and remembered (resent with each heartbeat
+ * period until the board's scans report it). */
+void qnav_bridge_on_goal(qnav_bridge_t *b, const qnav_goal_t *goal, int64_t now_ms);
+
+/* Periodic work (call at least every 20 ms): heartbeats, watchdog, status, upload. */
+void qnav_bridge_poll(qnav_bridge_t *b, int64_t now_ms);
+
+/* Stop the robot before exiting: sends stop commands (and a stopped heartbeat). */
+void qnav_bridge_shutdown(qnav_bridge_t *b, int64_t now_ms);
+
+/* Publish one encoded LCM message on channel, to the bus and the log. */
+void qnav_bridge_publish(qnav_bridge_t *b, const char *channel, const void *data, int len);
+
+/* Microseconds since the epoch, for utime fields. */
+int64_t qnav_bridge_utime(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* QNAV_NAVBRIDGE_BRIDGE_H */

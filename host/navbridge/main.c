@@ -1,0 +1,293 @@
+/*
+ * navbridge: joins an LCM bus and the serial link to a robot board (or the SIL robot on a
+ * pseudo-terminal). Offboard mode runs libqnav here on the board's scans and streams
+ * commands back; onboard mode relays goals and telemetry and can upload a policy file to
+ * the board. Everything is published on LCM. When the board goes quiet for --timeout-ms
+ * it commands a stop; SIGINT/SIGTERM stop the robot before exiting. --replay re-runs a
+ * recorded trial's scans through the controller and checks the commands are identical.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <getopt.h>
+#include <limits.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <lcm/eventlog.h>
+#include <lcm/lcm.h>
+
+#include "bridge.h"
+#include "qnav/policy_io.h"
+#include "qnav_goal_t.h"
+#include "replay.h"
+#include "serial.h"
+
+static volatile sig_atomic_t g_stop_signal = 0;
+
+static void on_signal(int sig)
+{
+    g_stop_signal = sig;
+}
+
+static int64_t mono_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: navbridge --device PATH [--baud N] [--lcm-url URL] [--mode offboard|onboard]\n"
+            "                 [--policy FILE] [--upload] [--timeout-ms N] [--log FILE]\n"
+            "       navbridge --replay LOG [--policy FILE]\n"
+            "  --device PATH      serial port to the board (or the SIL robot's pty)\n"
+            "  --baud N           serial rate, default 57600\n"
+            "  --lcm-url URL      LCM provider URL, default LCM's own default\n"
+            "  --mode M           offboard (bridge runs libqnav, default) or onboard\n"
+            "  --policy FILE      policy file; default: hand-tuned probabilistic policy\n"
+            "  --upload           onboard: upload --policy to the board at start\n"
+            "  --timeout-ms N     stop the robot after N ms without scans/heartbeats (300)\n"
+            "  --log FILE         also write every published message to an LCM log\n"
+            "  --replay LOG       re-run LOG's scans, compare with its commands, exit\n");
+}
+
+/* Parse a whole decimal number in [lo, hi]; 0 or -1. */
+static int parse_long(const char *s, long lo, long hi, long *out)
+{
+    char *end = NULL;
+    long v;
+    errno = 0;
+    v = strtol(s, &end, 10);
+    if (errno != 0 || end == s || *end != '\0' || v < lo || v > hi) {
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+typedef struct {
+    qnav_bridge_t *bridge;
+} goal_ctx_t;
+
+static void on_goal(const lcm_recv_buf_t *rbuf, const char *channel, const qnav_goal_t *msg,
+                    void *user)
+{
+    goal_ctx_t *g = (goal_ctx_t *)user;
+    (void)rbuf;
+    (void)channel;
+    qnav_bridge_on_goal(g->bridge, msg, mono_ms());
+}
+
+static int write_serial(void *user, const uint8_t *bytes, size_t n)
+{
+    return qnav_serial_write_all(*(int *)user, bytes, n);
+}
+
+int main(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        {"device", required_argument, NULL, 'd'},  {"baud", required_argument, NULL, 'b'},
+        {"lcm-url", required_argument, NULL, 'u'}, {"mode", required_argument, NULL, 'm'},
+        {"policy", required_argument, NULL, 'p'},  {"upload", no_argument, NULL, 'U'},
+        {"timeout-ms", required_argument, NULL, 't'}, {"log", required_argument, NULL, 'l'},
+        {"replay", required_argument, NULL, 'r'},  {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
+    const char *device = NULL, *lcm_url = NULL, *policy_path = NULL, *log_path = NULL;
+    const char *replay_path = NULL;
+    long baud = 57600, timeout_ms = 300;
+    char err[QNAV_POLICY_IO_ERRLEN];
+    qnav_bridge_config_t cfg;
+    static qnav_bridge_t bridge;
+    lcm_t *lcm;
+    lcm_eventlog_t *log = NULL;
+    goal_ctx_t gctx;
+    qnav_goal_t_subscription_t *sub;
+    int fd, c, exit_code = 0;
+    struct sigaction sa;
+
+    qnav_bridge_config_default(&cfg);
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+        switch (c) {
+        case 'd': device = optarg; break;
+        case 'u': lcm_url = optarg; break;
+        case 'p': policy_path = optarg; break;
+        case 'l': log_path = optarg; break;
+        case 'r': replay_path = optarg; break;
+        case 'U': cfg.upload = 1; break;
+        case 'b':
+            if (parse_long(optarg, 1, LONG_MAX, &baud) != 0 || !qnav_serial_baud_ok(baud)) {
+                fprintf(stderr, "navbridge: --baud %s: unsupported rate (9600, 19200, 38400, "
+                                "57600, 115200, 230400, 460800, 500000, 1000000)\n", optarg);
+                return 2;
+            }
+            break;
+        case 't':
+            if (parse_long(optarg, 20, 60000, &timeout_ms) != 0) {
+                fprintf(stderr, "navbridge: --timeout-ms %s: expected a whole number of "
+                                "milliseconds in 20..60000\n", optarg);
+                return 2;
+            }
+            break;
+        case 'm':
+            if (strcmp(optarg, "offboard") == 0) {
+                cfg.mode = QNAV_LINK_MODE_OFFBOARD;
+            } else if (strcmp(optarg, "onboard") == 0) {
+                cfg.mode = QNAV_LINK_MODE_ONBOARD;
+            } else {
+                fprintf(stderr, "navbridge: --mode %s: expected offboard or onboard\n", optarg);
+                return 2;
+            }
+            break;
+        case 'h': usage(stdout); return 0;
+        default:
+            if (optopt != 0) {
+                const struct option *o = opts;
+                while (o->name != NULL && o->val != optopt) {
+                    ++o;
+                }
+                fprintf(stderr, "navbridge: --%s: missing its value (see --help)\n",
+                        o->name != NULL ? o->name : "?");
+            } else {
+                fprintf(stderr, "navbridge: %s: unknown option or missing value (see --help)\n",
+                        argv[optind - 1]);
+            }
+            return 2;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "navbridge: %s: unexpected argument (see --help)\n", argv[optind]);
+        return 2;
+    }
+    cfg.timeout_ms = (uint32_t)timeout_ms;
+    if (policy_path != NULL) {
+        if (qnav_policy_read(policy_path, &cfg.policy, err, sizeof err) != 0) {
+            fprintf(stderr, "%s\n", err);
+            return 2;
+        }
+    }
+    if (cfg.upload && (policy_path == NULL || cfg.mode != QNAV_LINK_MODE_ONBOARD)) {
+        fprintf(stderr, "navbridge: --upload: needs --mode onboard and --policy FILE\n");
+        return 2;
+    }
+
+    if (replay_path != NULL) {
+        qnav_replay_result_t res;
+        if (qnav_replay_log(replay_path, &cfg.ctrl, &cfg.policy, &res, stdout, err,
+                            sizeof err) != 0) {
+            fprintf(stderr, "navbridge: %s\n", err);
+            return 2;
+        }
+        printf("replay: %llu scans, %llu commands compared: %llu identical, %llu differ "
+               "(%llu stops not compared)\n",
+               (unsigned long long)res.scans, (unsigned long long)res.compared,
+               (unsigned long long)res.identical, (unsigned long long)res.differ,
+               (unsigned long long)res.stops);
+        if (res.compared == 0) {
+            fprintf(stderr, "navbridge: %s: no commands answering scans in this log\n",
+                    replay_path);
+            return 1;
+        }
+        return res.differ == 0 ? 0 : 1;
+    }
+
+    if (device == NULL) {
+        fprintf(stderr, "navbridge: --device: required (see --help)\n");
+        return 2;
+    }
+    fd = qnav_serial_open(device, baud, err, sizeof err);
+    if (fd < 0) {
+        fprintf(stderr, "navbridge: %s\n", err);
+        return 2;
+    }
+    lcm = lcm_create(lcm_url);
+    if (lcm == NULL) {
+        fprintf(stderr, "navbridge: --lcm-url %s: cannot join the LCM bus\n",
+                lcm_url != NULL ? lcm_url : "(default)");
+        close(fd);
+        return 2;
+    }
+    if (log_path != NULL) {
+        log = lcm_eventlog_create(log_path, "w");
+        if (log == NULL) {
+            fprintf(stderr, "navbridge: --log %s: %s\n", log_path, strerror(errno));
+            lcm_destroy(lcm);
+            close(fd);
+            return 2;
+        }
+    }
+
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+
+    qnav_bridge_init(&bridge, &cfg, lcm, log, write_serial, &fd, mono_ms());
+    bridge.diag = stderr;
+    gctx.bridge = &bridge;
+    sub = qnav_goal_t_subscribe(lcm, QNAV_CH_GOAL, on_goal, &gctx);
+    fprintf(stderr, "navbridge: %s mode on %s at %ld baud, watchdog %ld ms\n",
+            cfg.mode == QNAV_LINK_MODE_OFFBOARD ? "offboard" : "onboard", device, baud,
+            timeout_ms);
+
+    while (!g_stop_signal) {
+        struct pollfd p[2];
+        int lfd = lcm_get_fileno(lcm);
+        int n;
+        p[0].fd = fd;
+        p[0].events = POLLIN;
+        p[0].revents = 0;
+        p[1].fd = lfd;
+        p[1].events = POLLIN;
+        p[1].revents = 0;
+        n = poll(p, 2, 10);
+        if (n < 0 && errno != EINTR) {
+            fprintf(stderr, "navbridge: poll: %s\n", strerror(errno));
+            exit_code = 1;
+            break;
+        }
+        if (n > 0 && (p[0].revents & POLLIN)) {
+            uint8_t buf[512];
+            ssize_t r = read(fd, buf, sizeof buf);
+            if (r > 0) {
+                qnav_bridge_on_bytes(&bridge, buf, (size_t)r, mono_ms());
+            } else if (r < 0 && errno != EAGAIN && errno != EINTR) {
+                fprintf(stderr, "navbridge: %s: %s: link lost\n", device, strerror(errno));
+                exit_code = 3;
+                break;
+            }
+        } else if (n > 0 && (p[0].revents & (POLLHUP | POLLERR))) {
+            fprintf(stderr, "navbridge: %s: device hung up: link lost\n", device);
+            exit_code = 3;
+            break;
+        }
+        if (n > 0 && (p[1].revents & POLLIN)) {
+            lcm_handle_timeout(lcm, 0);
+        }
+        qnav_bridge_poll(&bridge, mono_ms());
+    }
+    /* stop the robot before leaving, whatever made us leave */
+    qnav_bridge_shutdown(&bridge, mono_ms());
+    tcdrain(fd);
+    if (g_stop_signal) {
+        fprintf(stderr, "navbridge: %s: robot stopped, exiting\n",
+                g_stop_signal == SIGINT ? "SIGINT" : "SIGTERM");
+    }
+    qnav_goal_t_unsubscribe(lcm, sub);
+    if (log != NULL) {
+        lcm_eventlog_destroy(log);
+    }
+    lcm_destroy(lcm);
+    close(fd);
+    return exit_code;
+}

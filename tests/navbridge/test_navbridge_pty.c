@@ -1,0 +1,408 @@
+/*
+ * End-to-end tests of the navbridge program against a fake board on a pseudo-terminal:
+ * offboard commands equal libqnav's for every scan, corrupted and replayed frames are not
+ * answered, the watchdog stops the robot within its timeout, SIGTERM and SIGINT stop the
+ * robot before exit, a recorded trial replays to identical commands, a policy uploads to
+ * an onboard board, and bad options or files fail with one line. LCM is memq:// (nothing
+ * leaves the process).
+ */
+#define _XOPEN_SOURCE 700
+#define _DEFAULT_SOURCE
+#include <setjmp.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "fakeboard.h"
+#include "qnav/ctrl.h"
+#include "qnav/link.h"
+#include "qnav/policy_io.h"
+
+static char g_dir[256];
+static char g_policy[300];
+
+static const char *const EXE = NAVBRIDGE_EXE;
+
+static int setup_dir(void **state)
+{
+    qnav_policy_t p;
+    char err[QNAV_POLICY_IO_ERRLEN];
+    uint16_t k;
+    (void)state;
+    snprintf(g_dir, sizeof g_dir, "/tmp/qnav_navbridge_test.XXXXXX");
+    if (mkdtemp(g_dir) == NULL) {
+        return -1;
+    }
+    /* a network policy with spread weights: its commands differ from the default's */
+    qnav_policy_net_zero(&p, 6);
+    for (k = 0; k < QNAV_NET_WEIGHTS(6); ++k) {
+        *qnav_net_weight(&p.u.net, k) = (qnav_q8_8_t)((int)((k * 977u) % 2048u) - 1024);
+    }
+    snprintf(g_policy, sizeof g_policy, "%s/net.policy", g_dir);
+    return qnav_policy_write(g_policy, &p, "test network", err, sizeof err);
+}
+
+static int teardown_dir(void **state)
+{
+    char cmd[300];
+    (void)state;
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+/* A scan with an obstacle that moves with i, and a bearing that sweeps. */
+static uint16_t scan_payload(int i, uint16_t n, uint8_t *out, qnav_link_scan_t *s)
+{
+    uint16_t k;
+    memset(s, 0, sizeof *s);
+    s->board_ms = (uint32_t)(i * 100);
+    s->goal_bearing_cdeg = (qnav_cdeg_t)(((i * 2377) % 36000) - 18000);
+    s->max_range_mm = 5000;
+    s->n_sectors = n;
+    for (k = 0; k < n; ++k) {
+        s->ranges_mm[k] = (qnav_mm_t)(k == (uint16_t)(i % n) ? 300 : 200 + (k * 613 + i * 97) % 5200);
+    }
+    return (uint16_t)qnav_link_scan_pack(s, out, QNAV_LINK_MAX_PAYLOAD);
+}
+
+static void expected_command(const qnav_policy_t *p, const qnav_link_scan_t *s,
+                             qnav_ctrl_output_t *out)
+{
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_t c;
+    qnav_ctrl_input_t in;
+    qnav_ctrl_config_default(&cfg);
+    cfg.n_sectors = s->n_sectors;
+    cfg.max_range_mm = s->max_range_mm;
+    assert_int_equal(qnav_ctrl_init(&c, &cfg, p), QNAV_OK);
+    in.ranges_mm = s->ranges_mm;
+    in.goal_bearing_cdeg = s->goal_bearing_cdeg;
+    qnav_ctrl_step(&c, &in, out, NULL);
+}
+
+/* Wait for the bridge's first heartbeat: it is up and reading. */
+static void wait_bridge_up(fakeboard_t *fb)
+{
+    uint8_t p[64];
+    assert_true(fakeboard_wait(fb, QNAV_LINK_MSG_HEARTBEAT, 3000, p, sizeof p, NULL) > 0);
+}
+
+/* Read frames until a COMMAND answering scan_seq arrives (others skipped). */
+static int wait_command_for(fakeboard_t *fb, uint16_t scan_seq, qnav_link_command_t *c)
+{
+    uint8_t p[64];
+    int64_t end = fakeboard_ms() + 2000;
+    while (fakeboard_ms() < end) {
+        int n = fakeboard_wait(fb, QNAV_LINK_MSG_COMMAND, 200, p, sizeof p, NULL);
+        if (n > 0 && qnav_link_command_unpack(p, (uint16_t)n, c) == QNAV_LINK_OK &&
+            (c->flags & QNAV_LINK_CMD_STOP) == 0 && c->scan_seq == scan_seq) {
+            return 0;
+        }
+    }
+    return -1;
+}
+
+/* Wait for a STOP command; returns 0 when one came. */
+static int wait_stop(fakeboard_t *fb, int timeout_ms)
+{
+    uint8_t p[64];
+    qnav_link_command_t c;
+    int64_t end = fakeboard_ms() + timeout_ms;
+    while (fakeboard_ms() < end) {
+        int n = fakeboard_wait(fb, QNAV_LINK_MSG_COMMAND, (int)(end - fakeboard_ms()), p,
+                               sizeof p, NULL);
+        if (n > 0 && qnav_link_command_unpack(p, (uint16_t)n, &c) == QNAV_LINK_OK &&
+            (c.flags & QNAV_LINK_CMD_STOP) != 0) {
+            assert_int_equal(c.speed, 0);
+            return 0;
+        }
+    }
+    return -1;
+}
+
+static void test_offboard_commands_equal_libqnav_and_replay_identically(void **state)
+{
+    char log[320], out[320], err[320], text[4096];
+    const char *args[] = {"--lcm-url", "memq://", "--policy", g_policy, "--log", log, NULL};
+    fakeboard_t fb;
+    qnav_policy_t policy;
+    char perr[QNAV_POLICY_IO_ERRLEN];
+    int i;
+    (void)state;
+    snprintf(log, sizeof log, "%s/trial.lcmlog", g_dir);
+    snprintf(out, sizeof out, "%s/replay.out", g_dir);
+    snprintf(err, sizeof err, "%s/replay.err", g_dir);
+    assert_int_equal(qnav_policy_read(g_policy, &policy, perr, sizeof perr), 0);
+    assert_int_equal(fakeboard_start(&fb, EXE, g_dir, args), 0);
+    wait_bridge_up(&fb);
+
+    for (i = 0; i < 40; ++i) {
+        uint8_t p[QNAV_LINK_MAX_PAYLOAD];
+        qnav_link_scan_t s;
+        qnav_link_command_t c;
+        qnav_ctrl_output_t want;
+        uint16_t seq = fb.tx.next_seq;
+        uint16_t n = scan_payload(i, i < 20 ? 16 : 32, p, &s);
+        assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_SCAN, p, n), 0);
+        assert_int_equal(wait_command_for(&fb, seq, &c), 0);
+        expected_command(&policy, &s, &want);
+        assert_int_equal(c.heading_deg, want.heading_deg);
+        assert_int_equal(c.speed, want.speed);
+        assert_int_equal(c.quality, want.quality);
+        assert_int_equal(c.flags, want.flags);
+    }
+    /* SIGTERM: a stop reaches the board, then a clean exit */
+    kill(fb.pid, SIGTERM);
+    assert_int_equal(wait_stop(&fb, 2000), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, 3000), 0);
+    fakeboard_close(&fb);
+
+    {
+        const char *replay[] = {EXE, "--replay", log, "--policy", g_policy, NULL};
+        const char *wrong[] = {EXE, "--replay", log, NULL}; /* default policy: must differ */
+        assert_int_equal(run_program(replay, out, err), 0);
+        assert_true(read_text(out, text, sizeof text) > 0);
+        assert_non_null(strstr(text, "40 commands compared: 40 identical, 0 differ"));
+        assert_int_equal(run_program(wrong, out, err), 1);
+        assert_true(read_text(out, text, sizeof text) > 0);
+        assert_null(strstr(text, " 0 differ"));
+    }
+}
+
+static void test_corrupted_and_replayed_scans_are_not_answered(void **state)
+{
+    const char *args[] = {"--lcm-url", "memq://", NULL};
+    uint8_t p[QNAV_LINK_MAX_PAYLOAD], wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
+    uint8_t q[64];
+    fakeboard_t fb;
+    qnav_link_scan_t s;
+    qnav_link_command_t c;
+    qnav_link_tx_t old;
+    uint16_t n, seq;
+    int32_t w;
+    int got;
+    (void)state;
+    assert_int_equal(fakeboard_start(&fb, EXE, g_dir, args), 0);
+    wait_bridge_up(&fb);
+    n = scan_payload(1, 16, p, &s);
+
+    /* a good scan is answered */
+    old = fb.tx;
+    seq = fb.tx.next_seq;
+    assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_SCAN, p, n), 0);
+    assert_int_equal(wait_command_for(&fb, seq, &c), 0);
+
+    /* the same frame again (old sequence number): dropped */
+    w = qnav_link_encode(&old, QNAV_LINK_MSG_SCAN, p, n, wire, sizeof wire);
+    assert_true(w > 0);
+    assert_int_equal(write(fb.master, wire, (size_t)w), w);
+    /* a corrupted frame with a fresh number: dropped */
+    w = qnav_link_encode(&fb.tx, QNAV_LINK_MSG_SCAN, p, n, wire, sizeof wire);
+    wire[w / 2] = (uint8_t)(wire[w / 2] == 0x5A ? 0x5B : 0x5A);
+    assert_int_equal(write(fb.master, wire, (size_t)w), w);
+    /* no command answers either within 150 ms (the watchdog is 300 ms) */
+    got = 0;
+    {
+        int64_t end = fakeboard_ms() + 150;
+        while (fakeboard_ms() < end) {
+            int m = fakeboard_wait(&fb, QNAV_LINK_MSG_COMMAND, 50, q, sizeof q, NULL);
+            if (m > 0 && qnav_link_command_unpack(q, (uint16_t)m, &c) == QNAV_LINK_OK &&
+                (c.flags & QNAV_LINK_CMD_STOP) == 0) {
+                got++;
+            }
+        }
+    }
+    assert_int_equal(got, 0);
+    /* and the next good frame is answered again */
+    seq = fb.tx.next_seq;
+    assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_SCAN, p, n), 0);
+    assert_int_equal(wait_command_for(&fb, seq, &c), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGINT, 3000), 0);
+    fakeboard_close(&fb);
+}
+
+static void test_watchdog_stops_robot_within_its_timeout(void **state)
+{
+    const char *args[] = {"--lcm-url", "memq://", "--timeout-ms", "300", NULL};
+    uint8_t p[QNAV_LINK_MAX_PAYLOAD];
+    fakeboard_t fb;
+    qnav_link_scan_t s;
+    qnav_link_command_t c;
+    int64_t t_last, elapsed;
+    int i;
+    (void)state;
+    assert_int_equal(fakeboard_start(&fb, EXE, g_dir, args), 0);
+    wait_bridge_up(&fb);
+    for (i = 0; i < 5; ++i) {
+        uint16_t seq = fb.tx.next_seq;
+        uint16_t n = scan_payload(i, 16, p, &s);
+        assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_SCAN, p, n), 0);
+        assert_int_equal(wait_command_for(&fb, seq, &c), 0);
+    }
+    t_last = fakeboard_ms();
+    /* scans stop: a stop must come after about 300 ms (tolerant bounds: loaded machine) */
+    assert_int_equal(wait_stop(&fb, 3000), 0);
+    elapsed = fakeboard_ms() - t_last;
+    print_message("watchdog stop after %lld ms (timeout 300 ms)\n", (long long)elapsed);
+    assert_true(elapsed >= 250);
+    assert_true(elapsed <= 1300);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, 3000), 0);
+    fakeboard_close(&fb);
+}
+
+static void test_sigint_stops_robot_before_exit(void **state)
+{
+    const char *args[] = {"--lcm-url", "memq://", "--timeout-ms", "5000", NULL};
+    uint8_t p[QNAV_LINK_MAX_PAYLOAD];
+    fakeboard_t fb;
+    qnav_link_scan_t s;
+    qnav_link_command_t c;
+    uint16_t seq, n;
+    char text[1024];
+    (void)state;
+    assert_int_equal(fakeboard_start(&fb, EXE, g_dir, args), 0);
+    wait_bridge_up(&fb);
+    seq = fb.tx.next_seq;
+    n = scan_payload(3, 8, p, &s);
+    assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_SCAN, p, n), 0);
+    assert_int_equal(wait_command_for(&fb, seq, &c), 0);
+    kill(fb.pid, SIGINT);
+    assert_int_equal(wait_stop(&fb, 2000), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, 3000), 0);
+    assert_true(read_text(fb.stderr_path, text, sizeof text) > 0);
+    assert_non_null(strstr(text, "SIGINT: robot stopped"));
+    fakeboard_close(&fb);
+}
+
+static void test_onboard_upload_delivers_the_policy_file_to_the_board(void **state)
+{
+    const char *args[] = {"--lcm-url", "memq://", "--mode", "onboard", "--policy", g_policy,
+                          "--upload", NULL};
+    uint8_t p[QNAV_LINK_MAX_PAYLOAD];
+    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES], want[QNAV_LINK_POLICY_MAX_BYTES];
+    fakeboard_t fb;
+    qnav_link_heartbeat_t hb;
+    qnav_link_upload_t up;
+    qnav_policy_t file_policy, got;
+    char perr[QNAV_POLICY_IO_ERRLEN], text[2048];
+    int8_t status = 99;
+    int32_t nwant;
+    int64_t end, next_hb = 0;
+    (void)state;
+    assert_int_equal(qnav_policy_read(g_policy, &file_policy, perr, sizeof perr), 0);
+    nwant = qnav_link_policy_to_blob(&file_policy, want, sizeof want);
+    assert_true(nwant > 0);
+    qnav_link_upload_init(&up);
+    assert_int_equal(fakeboard_start(&fb, EXE, g_dir, args), 0);
+    /* the bridge asks for onboard mode in its heartbeats */
+    assert_true(fakeboard_wait(&fb, QNAV_LINK_MSG_HEARTBEAT, 3000, p, sizeof p, NULL) > 0);
+    assert_int_equal(qnav_link_heartbeat_unpack(p, QNAV_LINK_HEARTBEAT_BYTES, &hb), 0);
+    assert_int_equal(hb.mode, QNAV_LINK_MODE_ONBOARD);
+
+    end = fakeboard_ms() + 4000;
+    while (fakeboard_ms() < end && status == 99) {
+        int n;
+        uint16_t seq;
+        if (fakeboard_ms() >= next_hb) {
+            qnav_link_heartbeat_t mine = {0, QNAV_LINK_MODE_ONBOARD, QNAV_LINK_STATE_POLICY,
+                                          0, 0, 0};
+            uint8_t hp[QNAV_LINK_HEARTBEAT_BYTES];
+            qnav_link_heartbeat_pack(&mine, hp, sizeof hp);
+            assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_HEARTBEAT, hp, sizeof hp), 0);
+            next_hb = fakeboard_ms() + 50;
+        }
+        n = fakeboard_wait(&fb, 0, 50, p, sizeof p, &seq);
+        if (n <= 0) {
+            continue;
+        }
+        if (fb.last_id == QNAV_LINK_MSG_POLICY_CHUNK) {
+            qnav_link_policy_chunk_t ch;
+            assert_int_equal(qnav_link_policy_chunk_unpack(p, (uint16_t)n, &ch), 0);
+            assert_int_equal(qnav_link_upload_chunk(&up, &ch), 0);
+        } else if (fb.last_id == QNAV_LINK_MSG_POLICY_COMMIT) {
+            qnav_link_policy_commit_t cm;
+            qnav_link_policy_ack_t ack;
+            uint8_t ap[QNAV_LINK_POLICY_ACK_BYTES];
+            assert_int_equal(qnav_link_policy_commit_unpack(p, (uint16_t)n, &cm), 0);
+            memcpy(blob, up.blob, sizeof blob);
+            status = qnav_link_upload_commit(&up, &cm, &got);
+            ack.status = status;
+            ack.reserved = 0;
+            ack.crc = cm.crc;
+            qnav_link_policy_ack_pack(&ack, ap, sizeof ap);
+            assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_POLICY_ACK, ap, sizeof ap), 0);
+        }
+    }
+    assert_int_equal(status, QNAV_LINK_ACK_OK);
+    assert_memory_equal(blob, want, (size_t)nwant);
+    assert_int_equal(got.kind, QNAV_POLICY_NET);
+    assert_int_equal(got.u.net.hidden, file_policy.u.net.hidden);
+    assert_memory_equal(got.u.net.w_theta, file_policy.u.net.w_theta,
+                        sizeof got.u.net.w_theta);
+    usleep(100000); /* let the bridge read the ack */
+    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, 3000), 0);
+    assert_true(read_text(fb.stderr_path, text, sizeof text) > 0);
+    assert_non_null(strstr(text, "policy upload: ok"));
+    fakeboard_close(&fb);
+}
+
+/* Run navbridge with args; expect exit 2 and one stderr line containing needle. */
+static void expect_refusal(const char *const *argv, const char *needle)
+{
+    char out[320], err[320], text[1024];
+    char *nl;
+    snprintf(out, sizeof out, "%s/refuse.out", g_dir);
+    snprintf(err, sizeof err, "%s/refuse.err", g_dir);
+    assert_int_equal(run_program(argv, out, err), 2);
+    assert_true(read_text(err, text, sizeof text) > 0);
+    assert_non_null(strstr(text, needle));
+    nl = strchr(text, '\n');
+    assert_non_null(nl);
+    assert_int_equal(nl[1], '\0'); /* exactly one line */
+}
+
+static void test_bad_options_and_files_fail_with_one_line(void **state)
+{
+    char bad_policy[320];
+    FILE *f;
+    const char *baud[] = {EXE, "--device", "/dev/null", "--baud", "12345", NULL};
+    const char *dev[] = {EXE, "--device", "/nonexistent/ttyX", NULL};
+    const char *notty[] = {EXE, "--device", "/dev/null", NULL};
+    const char *mode[] = {EXE, "--device", "/dev/null", "--mode", "sideways", NULL};
+    const char *tmo[] = {EXE, "--device", "/dev/null", "--timeout-ms", "abc", NULL};
+    const char *pol[] = {EXE, "--device", "/dev/null", "--policy", bad_policy, NULL};
+    const char *unknown[] = {EXE, "--frobnicate", NULL};
+    (void)state;
+    snprintf(bad_policy, sizeof bad_policy, "%s/bad.policy", g_dir);
+    f = fopen(bad_policy, "w");
+    assert_non_null(f);
+    fputs("qnav-policy 1\nkind banana\n", f);
+    fclose(f);
+    expect_refusal(baud, "--baud 12345");
+    expect_refusal(dev, "/nonexistent/ttyX: No such file or directory");
+    expect_refusal(notty, "/dev/null: not a serial port");
+    expect_refusal(mode, "--mode sideways");
+    expect_refusal(tmo, "--timeout-ms abc");
+    expect_refusal(pol, "bad.policy:");
+    expect_refusal(unknown, "--frobnicate");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_offboard_commands_equal_libqnav_and_replay_identically),
+        cmocka_unit_test(test_corrupted_and_replayed_scans_are_not_answered),
+        cmocka_unit_test(test_watchdog_stops_robot_within_its_timeout),
+        cmocka_unit_test(test_sigint_stops_robot_before_exit),
+        cmocka_unit_test(test_onboard_upload_delivers_the_policy_file_to_the_board),
+        cmocka_unit_test(test_bad_options_and_files_fail_with_one_line),
+    };
+    return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+}
