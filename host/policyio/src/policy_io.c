@@ -27,6 +27,14 @@
 
 /* ---- small helpers ------------------------------------------------------------------- */
 
+#if defined(__GNUC__)
+#define QNAV_PRINTF_LIKE(f, a) __attribute__((format(printf, f, a)))
+#else
+#define QNAV_PRINTF_LIKE(f, a)
+#endif
+
+static void set_err(char *err, size_t errlen, const char *fmt, ...) QNAV_PRINTF_LIKE(3, 4);
+
 static void set_err(char *err, size_t errlen, const char *fmt, ...)
 {
     va_list ap;
@@ -265,6 +273,7 @@ typedef struct {
     unsigned next_unit;
 } parser_t;
 
+static int fail(parser_t *ps, const char *fmt, ...) QNAV_PRINTF_LIKE(2, 3);
 static int fail(parser_t *ps, const char *fmt, ...)
 {
     char msg[QNAV_POLICY_IO_ERRLEN];
@@ -816,6 +825,7 @@ typedef struct {
     size_t len; /* length of the full text, even past cap */
 } out_t;
 
+static void emit(out_t *o, const char *fmt, ...) QNAV_PRINTF_LIKE(2, 3);
 static void emit(out_t *o, const char *fmt, ...)
 {
     va_list ap;

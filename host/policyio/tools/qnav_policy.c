@@ -27,6 +27,13 @@ static const char *const usage_text =
     "       qnav-policy header --mode network|probabilistic|table --name NAME IN OUT.h\n"
     "Policy files are described in docs/policy-format.md.\n";
 
+#if defined(__GNUC__)
+#define QNAV_PRINTF_LIKE(f, a) __attribute__((format(printf, f, a)))
+#else
+#define QNAV_PRINTF_LIKE(f, a)
+#endif
+
+static int usage_error(const char *fmt, ...) QNAV_PRINTF_LIKE(1, 2);
 static int usage_error(const char *fmt, ...)
 {
     va_list ap;
@@ -265,6 +272,7 @@ typedef struct {
     int failed;
 } text_t;
 
+static void put(text_t *t, const char *fmt, ...) QNAV_PRINTF_LIKE(2, 3);
 static void put(text_t *t, const char *fmt, ...)
 {
     va_list ap;
@@ -406,6 +414,9 @@ static int header_body(int argc, char **argv, const char *cmd)
     }
     in = argv[optind];
     out = argv[optind + 1];
+    if (strcmp(in, out) == 0) {
+        return usage_error("header: OUT.h must not be the policy file IN");
+    }
     if (qnav_policy_read(in, &p, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
         return EXIT_BAD_INPUT;
