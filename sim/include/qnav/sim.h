@@ -94,6 +94,8 @@ typedef struct {
     double range_min_m;        /* sonar minimum range (closer reads this), m */
     double range_max_m;        /* sonar maximum range (farther is clipped), m */
     uint16_t default_sectors;  /* sector count when the config asks for 0 */
+    double sensor_noise;       /* the profile's typical p_s (qnav-sim's default) */
+    double actuation_noise;    /* the profile's typical p_a (qnav-sim's default) */
 } qnav_sim_robot_info_t;
 void qnav_sim_robot_info(const qnav_sim_robot_t *robot, qnav_sim_robot_info_t *info);
 
@@ -215,6 +217,11 @@ typedef struct {
 /* Start a new episode: random start point in a random start zone (zones weighted by
  * area), random heading, robot at rest. Computes the first scan. */
 qnav_sim_status_t qnav_sim_reset(qnav_sim_t *sim, uint64_t episode_seed);
+
+/* For tests and tools: move the robot of the current episode (reset first) to a pose
+ * (world frame, m and rad) at rest, clear collisions and figures (the start becomes this
+ * pose) and compute a new scan. QNAV_SIM_E_PARAM for a pose outside the arena. */
+qnav_sim_status_t qnav_sim_place(qnav_sim_t *sim, double x_m, double y_m, double heading_rad);
 
 /* Copy this tick's scan (computed once per tick at reset/advance, so reading it twice
  * gives the same values). QNAV_SIM_E_STATE before the first reset. */

@@ -1,0 +1,293 @@
+// The simulator's C API (qnav/sim.h): handles over the C++ objects, exceptions turned into
+// statuses and one-line messages. Nothing here throws across the C boundary.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <string>
+
+#include "capi_internal.hpp"
+#include "error.hpp"
+#include "tomlread.hpp"
+
+#ifndef QNAV_SIM_DATA_DIR
+#define QNAV_SIM_DATA_DIR "data"
+#endif
+
+namespace {
+
+void put_err(char *err, std::size_t errlen, const std::string &msg) {
+    if (!err || errlen == 0) return;
+    std::snprintf(err, errlen, "%s", msg.c_str());
+}
+
+template <typename F>
+qnav_sim_status_t guarded(char *err, std::size_t errlen, F &&f) {
+    try {
+        f();
+        return QNAV_SIM_OK;
+    } catch (const qnav::SimError &e) {
+        put_err(err, errlen, e.what());
+        return e.status();
+    } catch (const std::bad_alloc &) {
+        put_err(err, errlen, "out of memory");
+        return QNAV_SIM_E_NOMEM;
+    } catch (const std::exception &e) {
+        put_err(err, errlen, e.what());
+        return QNAV_SIM_E_PARSE;
+    }
+}
+
+}  // namespace
+
+namespace qnav {
+std::string resolve_data_spec(const char *spec, const char *kind) {
+    std::string s(spec);
+    const bool is_path = s.find('/') != std::string::npos ||
+                         (s.size() > 5 && s.compare(s.size() - 5, 5, ".toml") == 0);
+    if (is_path) return s;
+    const char *dir = std::getenv("QNAV_DATA_DIR");
+    std::string base = dir && *dir ? dir : QNAV_SIM_DATA_DIR;
+    return base + "/" + kind + "/" + s + ".toml";
+}
+}  // namespace qnav
+
+extern "C" {
+
+qnav_sim_status_t qnav_sim_robot_parse(const char *text, size_t len, const char *name,
+                                       qnav_sim_robot_t **out, char *err, size_t errlen) {
+    if (!out) return QNAV_SIM_E_NULL;
+    *out = nullptr;
+    if (!text || !name) {
+        put_err(err, errlen, "robot: null argument");
+        return QNAV_SIM_E_NULL;
+    }
+    return guarded(err, errlen, [&] {
+        auto *r = new qnav_sim_robot;
+        try {
+            r->profile = qnav::parse_robot_profile(std::string_view(text, len), name);
+        } catch (...) {
+            delete r;
+            throw;
+        }
+        *out = r;
+    });
+}
+
+qnav_sim_status_t qnav_sim_robot_load(const char *spec, qnav_sim_robot_t **out, char *err,
+                                      size_t errlen) {
+    if (!out) return QNAV_SIM_E_NULL;
+    *out = nullptr;
+    if (!spec) {
+        put_err(err, errlen, "robot: null path");
+        return QNAV_SIM_E_NULL;
+    }
+    std::string text, path;
+    const qnav_sim_status_t st = guarded(err, errlen, [&] {
+        path = qnav::resolve_data_spec(spec, "robots");
+        text = qnav::TomlReader::read_file(path);
+    });
+    if (st != QNAV_SIM_OK) return st;
+    return qnav_sim_robot_parse(text.data(), text.size(), path.c_str(), out, err, errlen);
+}
+
+void qnav_sim_robot_free(qnav_sim_robot_t *robot) { delete robot; }
+
+qnav_sim_status_t qnav_sim_env_parse(const char *text, size_t len, const char *name,
+                                     qnav_sim_env_t **out, char *err, size_t errlen) {
+    if (!out) return QNAV_SIM_E_NULL;
+    *out = nullptr;
+    if (!text || !name) {
+        put_err(err, errlen, "env: null argument");
+        return QNAV_SIM_E_NULL;
+    }
+    return guarded(err, errlen, [&] {
+        auto *e = new qnav_sim_env;
+        try {
+            e->env = qnav::parse_environment(std::string_view(text, len), name);
+        } catch (...) {
+            delete e;
+            throw;
+        }
+        *out = e;
+    });
+}
+
+qnav_sim_status_t qnav_sim_env_load(const char *spec, qnav_sim_env_t **out, char *err,
+                                    size_t errlen) {
+    if (!out) return QNAV_SIM_E_NULL;
+    *out = nullptr;
+    if (!spec) {
+        put_err(err, errlen, "env: null path");
+        return QNAV_SIM_E_NULL;
+    }
+    std::string text, path;
+    const qnav_sim_status_t st = guarded(err, errlen, [&] {
+        path = qnav::resolve_data_spec(spec, "envs");
+        text = qnav::TomlReader::read_file(path);
+    });
+    if (st != QNAV_SIM_OK) return st;
+    return qnav_sim_env_parse(text.data(), text.size(), path.c_str(), out, err, errlen);
+}
+
+void qnav_sim_env_free(qnav_sim_env_t *env) { delete env; }
+
+void qnav_sim_robot_info(const qnav_sim_robot_t *robot, qnav_sim_robot_info_t *info) {
+    if (!robot || !info) return;
+    const qnav::RobotProfile &p = robot->profile;
+    info->name = p.name.c_str();
+    info->radius_m = p.radius_m;
+    info->v_max_mps = p.v_max_mps;
+    info->accel_mps2 = p.accel_mps2;
+    info->decel_mps2 = p.decel_mps2;
+    info->turn_rate_max_dps = p.turn_rate_max_dps;
+    info->range_min_m = p.range_min_m;
+    info->range_max_m = p.range_max_m;
+    info->default_sectors = p.default_sectors;
+    info->sensor_noise = p.noise_sensor;
+    info->actuation_noise = p.noise_actuation;
+}
+
+void qnav_sim_env_info(const qnav_sim_env_t *env, qnav_sim_env_info_t *info) {
+    if (!env || !info) return;
+    const qnav::Environment &e = env->env;
+    info->name = e.name.c_str();
+    info->width_m = e.width_m;
+    info->height_m = e.height_m;
+    info->dest_x_m = e.dest_x_m;
+    info->dest_y_m = e.dest_y_m;
+    info->dest_radius_m = e.dest_radius_m;
+    info->episode_limit_s = e.episode_limit_s;
+    info->n_obstacles = static_cast<uint32_t>(e.circles.size() + e.boxes.size());
+    info->n_start_zones = static_cast<uint32_t>(e.start_zones.size());
+}
+
+void qnav_sim_config_default(qnav_sim_config_t *cfg) {
+    if (!cfg) return;
+    cfg->n_sectors = 0;
+    cfg->sensor_noise = 0.0;
+    cfg->actuation_noise = 0.0;
+    cfg->seed = 1;
+    cfg->episode_limit_s = 0.0;
+}
+
+qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_env_t *env,
+                                  const qnav_sim_config_t *cfg, qnav_sim_t **out, char *err,
+                                  size_t errlen) {
+    if (!out) return QNAV_SIM_E_NULL;
+    *out = nullptr;
+    if (!robot || !env || !cfg) {
+        put_err(err, errlen, "create: null robot, env or config");
+        return QNAV_SIM_E_NULL;
+    }
+    auto bad = [&](const char *msg) {
+        put_err(err, errlen, msg);
+        return QNAV_SIM_E_PARAM;
+    };
+    if (cfg->n_sectors > QNAV_MAX_SECTORS) return bad("n_sectors: must be 1..360 (0 = profile default)");
+    if (!std::isfinite(cfg->sensor_noise) || cfg->sensor_noise < 0 || cfg->sensor_noise > 1)
+        return bad("sensor_noise: must be in [0, 1]");
+    if (!std::isfinite(cfg->actuation_noise) || cfg->actuation_noise < 0 || cfg->actuation_noise > 1)
+        return bad("actuation_noise: must be in [0, 1]");
+    if (!std::isfinite(cfg->episode_limit_s) || cfg->episode_limit_s < 0 || cfg->episode_limit_s > 36000)
+        return bad("episode_limit_s: must be in [0, 36000] (0 = environment's)");
+    return guarded(err, errlen, [&] {
+        qnav::check_clearance(env->env, robot->profile.radius_m);
+        qnav::SimConfig sc;
+        sc.n_sectors = cfg->n_sectors ? cfg->n_sectors : robot->profile.default_sectors;
+        sc.sensor_noise = cfg->sensor_noise;
+        sc.actuation_noise = cfg->actuation_noise;
+        sc.seed = cfg->seed;
+        sc.episode_limit_s = cfg->episode_limit_s;
+        auto *s = new qnav_sim;
+        try {
+            s->sim = std::make_unique<qnav::Simulation>(robot->profile, env->env, sc);
+        } catch (...) {
+            delete s;
+            throw;
+        }
+        *out = s;
+    });
+}
+
+void qnav_sim_destroy(qnav_sim_t *sim) { delete sim; }
+
+void qnav_sim_ctrl_config(const qnav_sim_t *sim, qnav_ctrl_config_t *cfg) {
+    if (!sim || !cfg) return;
+    qnav_ctrl_config_default(cfg);
+    cfg->n_sectors = sim->sim->config().n_sectors;
+    cfg->max_range_mm = sim->sim->max_range_mm();
+}
+
+qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
+                                       uint64_t episode_seed, qnav_sim_result_t *res,
+                                       qnav_sim_trace_fn trace, void *user) {
+    if (!sim || !ctrl || !res) return QNAV_SIM_E_NULL;
+    return guarded(nullptr, 0, [&] { *res = sim->sim->run_episode(ctrl, episode_seed, trace, user); });
+}
+
+qnav_sim_status_t qnav_sim_reset(qnav_sim_t *sim, uint64_t episode_seed) {
+    if (!sim) return QNAV_SIM_E_NULL;
+    return guarded(nullptr, 0, [&] { sim->sim->reset(episode_seed); });
+}
+
+qnav_sim_status_t qnav_sim_place(qnav_sim_t *sim, double x_m, double y_m, double heading_rad) {
+    if (!sim) return QNAV_SIM_E_NULL;
+    if (!std::isfinite(x_m) || !std::isfinite(y_m) || !std::isfinite(heading_rad))
+        return QNAV_SIM_E_PARAM;
+    const qnav::Environment &e = sim->sim->env();
+    if (x_m < 0 || y_m < 0 || x_m > e.width_m || y_m > e.height_m) return QNAV_SIM_E_PARAM;
+    return guarded(nullptr, 0, [&] { sim->sim->place(x_m, y_m, heading_rad); });
+}
+
+qnav_sim_status_t qnav_sim_scan(const qnav_sim_t *sim, qnav_sim_scan_t *scan) {
+    if (!sim || !scan) return QNAV_SIM_E_NULL;
+    if (!sim->sim->started()) return QNAV_SIM_E_STATE;
+    const qnav_sim_scan_t &s = sim->sim->scan();
+    scan->n_sectors = s.n_sectors;
+    scan->max_range_mm = s.max_range_mm;
+    std::memcpy(scan->ranges_mm, s.ranges_mm, sizeof(qnav_mm_t) * s.n_sectors);
+    scan->goal_bearing_cdeg = s.goal_bearing_cdeg;
+    return QNAV_SIM_OK;
+}
+
+qnav_sim_status_t qnav_sim_command(qnav_sim_t *sim, const qnav_ctrl_output_t *out) {
+    if (!sim || !out) return QNAV_SIM_E_NULL;
+    if (!sim->sim->started()) return QNAV_SIM_E_STATE;
+    sim->sim->command(out->heading_deg, out->speed / 32768.0);
+    return QNAV_SIM_OK;
+}
+
+qnav_sim_status_t qnav_sim_command_raw(qnav_sim_t *sim, double heading_deg, double speed) {
+    if (!sim) return QNAV_SIM_E_NULL;
+    if (!sim->sim->started()) return QNAV_SIM_E_STATE;
+    sim->sim->command(heading_deg, speed);
+    return QNAV_SIM_OK;
+}
+
+qnav_sim_status_t qnav_sim_advance(qnav_sim_t *sim) {
+    if (!sim) return QNAV_SIM_E_NULL;
+    if (!sim->sim->started()) return QNAV_SIM_E_STATE;
+    return guarded(nullptr, 0, [&] { sim->sim->advance(); });
+}
+
+qnav_sim_status_t qnav_sim_state(const qnav_sim_t *sim, qnav_sim_state_t *state) {
+    if (!sim || !state) return QNAV_SIM_E_NULL;
+    if (!sim->sim->started()) return QNAV_SIM_E_STATE;
+    *state = sim->sim->state();
+    return QNAV_SIM_OK;
+}
+
+qnav_sim_status_t qnav_sim_result(const qnav_sim_t *sim, qnav_sim_result_t *res) {
+    if (!sim || !res) return QNAV_SIM_E_NULL;
+    if (!sim->sim->started()) return QNAV_SIM_E_STATE;
+    *res = sim->sim->result();
+    return QNAV_SIM_OK;
+}
+
+void qnav_sim_fitness(qnav_sim_result_t *res) {
+    if (res) qnav::compute_fitness(res);
+}
+
+}  // extern "C"

@@ -1,0 +1,25 @@
+// The C API's opaque types, defined for the simulator's own C++ programs (CLI, pictures)
+// that need to reach the C++ objects behind a handle.
+#pragma once
+
+#include <memory>
+
+#include "env.hpp"
+#include "qnav/sim.h"
+#include "robot.hpp"
+#include "simulation.hpp"
+
+struct qnav_sim_robot {
+    qnav::RobotProfile profile;
+};
+struct qnav_sim_env {
+    qnav::Environment env;
+};
+struct qnav_sim {
+    std::unique_ptr<qnav::Simulation> sim;
+};
+
+namespace qnav {
+// Resolve a robot/env spec: a path is kept, a bare name becomes <data>/<kind>/<name>.toml.
+std::string resolve_data_spec(const char *spec, const char *kind);
+}  // namespace qnav

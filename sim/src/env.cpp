@@ -1,0 +1,292 @@
+// Environment files: parsing and checking, the random generator and the TOML writer.
+#include "env.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <sstream>
+
+#include "error.hpp"
+#include "rng.hpp"
+#include "tomlread.hpp"
+
+namespace qnav {
+
+std::vector<Shape> Environment::obstacle_shapes() const {
+    std::vector<Shape> out;
+    out.reserve(circles.size() + boxes.size());
+    for (const auto &c : circles) out.push_back(make_circle(c.x_m, c.y_m, c.r_m));
+    for (const auto &b : boxes) out.push_back(make_box(b.x_m, b.y_m, b.w_m, b.h_m, b.angle_deg));
+    return out;
+}
+
+std::vector<Shape> Environment::wall_shapes() const {
+    const Vec2 a{0, 0}, b{width_m, 0}, c{width_m, height_m}, d{0, height_m};
+    return {make_segment(a, b), make_segment(b, c), make_segment(c, d), make_segment(d, a)};
+}
+
+static Shape zone_shape(const StartZone &z) {
+    return make_box(z.x_m + z.w_m / 2, z.y_m + z.h_m / 2, z.w_m, z.h_m, 0.0);
+}
+
+static std::string line_prefix(const std::string &name, int line) {
+    return name + ":" + std::to_string(line) + ": ";
+}
+
+Environment parse_environment(std::string_view text, const std::string &name) {
+    TomlReader r(text, name);
+    const toml::table &root = r.root();
+    r.only_keys(root, {"name", "episode_limit_s", "arena", "destination", "start_zone",
+                       "circle", "box"});
+    Environment env;
+    env.name = r.string(root, "name");
+    if (env.name.empty()) r.fail(root, "'name' must not be empty");
+    env.episode_limit_s = r.number(root, "episode_limit_s", 0.1, 36000.0);
+
+    const toml::table &arena = r.table(root, "arena");
+    r.only_keys(arena, {"width_m", "height_m"});
+    env.width_m = r.number(arena, "width_m", 0.5, 1000.0);
+    env.height_m = r.number(arena, "height_m", 0.5, 1000.0);
+
+    const toml::table &dest = r.table(root, "destination");
+    r.only_keys(dest, {"x_m", "y_m", "radius_m"});
+    env.dest_x_m = r.number(dest, "x_m", 0.0, env.width_m);
+    env.dest_y_m = r.number(dest, "y_m", 0.0, env.height_m);
+    env.dest_radius_m = r.number(dest, "radius_m", 0.01, 100.0);
+
+    auto array_of_tables = [&](const char *key, bool required) -> const toml::array * {
+        const toml::node *n = root.get(key);
+        if (!n) {
+            if (required) r.fail(root, std::string("missing [[") + key + "]] (at least one)");
+            return nullptr;
+        }
+        const toml::array *a = n->as_array();
+        if (!a || !a->is_array_of_tables())
+            r.fail(*n, std::string("'") + key + "' must be written as [[" + key + "]] tables");
+        return a;
+    };
+
+    std::vector<int> circle_lines, box_lines;
+    if (const toml::array *zones = array_of_tables("start_zone", true)) {
+        for (const toml::node &n : *zones) {
+            const toml::table &t = *n.as_table();
+            r.only_keys(t, {"x_m", "y_m", "w_m", "h_m"});
+            StartZone z;
+            z.x_m = r.number(t, "x_m", -1e6, 1e6);
+            z.y_m = r.number(t, "y_m", -1e6, 1e6);
+            z.w_m = r.number(t, "w_m", 0.0, 1e6);
+            z.h_m = r.number(t, "h_m", 0.0, 1e6);
+            const int line = static_cast<int>(t.source().begin.line);
+            if (z.x_m < 0 || z.y_m < 0 || z.x_m + z.w_m > env.width_m ||
+                z.y_m + z.h_m > env.height_m)
+                throw SimError(QNAV_SIM_E_WORLD,
+                               line_prefix(name, line) + "start zone leaves the arena");
+            env.start_zones.push_back(z);
+            env.zone_lines.push_back(line);
+        }
+    }
+    if (const toml::array *cs = array_of_tables("circle", false)) {
+        for (const toml::node &n : *cs) {
+            const toml::table &t = *n.as_table();
+            r.only_keys(t, {"x_m", "y_m", "r_m"});
+            CircleObstacle c;
+            c.x_m = r.number(t, "x_m", -1e6, 1e6);
+            c.y_m = r.number(t, "y_m", -1e6, 1e6);
+            c.r_m = r.number(t, "r_m", 0.001, 1e6);
+            env.circles.push_back(c);
+            circle_lines.push_back(static_cast<int>(t.source().begin.line));
+        }
+    }
+    if (const toml::array *bs = array_of_tables("box", false)) {
+        for (const toml::node &n : *bs) {
+            const toml::table &t = *n.as_table();
+            r.only_keys(t, {"x_m", "y_m", "w_m", "h_m", "angle_deg"});
+            BoxObstacle b;
+            b.x_m = r.number(t, "x_m", -1e6, 1e6);
+            b.y_m = r.number(t, "y_m", -1e6, 1e6);
+            b.w_m = r.number(t, "w_m", 0.001, 1e6);
+            b.h_m = r.number(t, "h_m", 0.001, 1e6);
+            b.angle_deg = r.number(t, "angle_deg", -360.0, 360.0, true, 0.0);
+            env.boxes.push_back(b);
+            box_lines.push_back(static_cast<int>(t.source().begin.line));
+        }
+    }
+
+    // World consistency: start zones and the destination must be free.
+    const std::vector<Shape> obs = env.obstacle_shapes();
+    std::vector<int> obs_lines = circle_lines;
+    obs_lines.insert(obs_lines.end(), box_lines.begin(), box_lines.end());
+    const Shape dest_shape = make_circle(env.dest_x_m, env.dest_y_m, env.dest_radius_m);
+    for (std::size_t z = 0; z < env.start_zones.size(); ++z) {
+        const Shape zs = zone_shape(env.start_zones[z]);
+        for (std::size_t k = 0; k < obs.size(); ++k) {
+            if (shape_distance(zs, obs[k]) <= 0.0)
+                throw SimError(QNAV_SIM_E_WORLD,
+                               line_prefix(name, env.zone_lines[z]) +
+                                   "start zone overlaps the obstacle at line " +
+                                   std::to_string(obs_lines[k]));
+        }
+        if (shape_distance(zs, dest_shape) <= 0.0)
+            throw SimError(QNAV_SIM_E_WORLD, line_prefix(name, env.zone_lines[z]) +
+                                                 "start zone overlaps the destination");
+    }
+    for (std::size_t k = 0; k < obs.size(); ++k) {
+        Vec2 q;
+        if (nearest_point(obs[k], {env.dest_x_m, env.dest_y_m}, &q) <= 0.0)
+            throw SimError(QNAV_SIM_E_WORLD, r.where(dest) + ": destination lies inside "
+                                                 "the obstacle at line " +
+                                                 std::to_string(obs_lines[k]));
+    }
+    return env;
+}
+
+void check_clearance(const Environment &env, double clearance_m) {
+    const std::vector<Shape> obs = env.obstacle_shapes();
+    const std::vector<Shape> walls = env.wall_shapes();
+    for (std::size_t z = 0; z < env.start_zones.size(); ++z) {
+        const Shape zs = zone_shape(env.start_zones[z]);
+        const int line = z < env.zone_lines.size() ? env.zone_lines[z] : 0;
+        auto refuse = [&](const char *what) {
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%.3f", clearance_m);
+            throw SimError(QNAV_SIM_E_WORLD, line_prefix(env.name, line) + "start zone is closer than the robot radius (" + buf + " m) to " + what);
+        };
+        for (const Shape &s : obs)
+            if (shape_distance(zs, s) < clearance_m) refuse("an obstacle");
+        for (const Shape &s : walls)
+            if (shape_distance(zs, s) < clearance_m) refuse("an arena wall");
+    }
+}
+
+bool environment_connected(const Environment &env, double clearance_m, double cell_m) {
+    const int nx = static_cast<int>(std::ceil(env.width_m / cell_m));
+    const int ny = static_cast<int>(std::ceil(env.height_m / cell_m));
+    const std::vector<Shape> obs = env.obstacle_shapes();
+    std::vector<char> free(static_cast<std::size_t>(nx) * ny, 0);
+    for (int j = 0; j < ny; ++j) {
+        for (int i = 0; i < nx; ++i) {
+            const Vec2 p{(i + 0.5) * cell_m, (j + 0.5) * cell_m};
+            bool ok = p.x >= clearance_m && p.y >= clearance_m &&
+                      p.x <= env.width_m - clearance_m && p.y <= env.height_m - clearance_m;
+            Vec2 q;
+            for (std::size_t k = 0; ok && k < obs.size(); ++k)
+                if (nearest_point(obs[k], p, &q) < clearance_m) ok = false;
+            free[static_cast<std::size_t>(j) * nx + i] = ok;
+        }
+    }
+    auto cell = [&](double x, double y) {
+        const int i = std::clamp(static_cast<int>(x / cell_m), 0, nx - 1);
+        const int j = std::clamp(static_cast<int>(y / cell_m), 0, ny - 1);
+        return j * nx + i;
+    };
+    const int goal = cell(env.dest_x_m, env.dest_y_m);
+    // Flood from the destination's free neighbourhood (within its radius).
+    std::vector<char> seen(free.size(), 0);
+    std::deque<int> q;
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+            const double dx = (i + 0.5) * cell_m - env.dest_x_m, dy = (j + 0.5) * cell_m - env.dest_y_m;
+            const int k = j * nx + i;
+            if (free[k] && dx * dx + dy * dy <= env.dest_radius_m * env.dest_radius_m) {
+                seen[k] = 1;
+                q.push_back(k);
+            }
+        }
+    if (q.empty() && free[goal]) {
+        seen[goal] = 1;
+        q.push_back(goal);
+    }
+    while (!q.empty()) {
+        const int k = q.front();
+        q.pop_front();
+        const int i = k % nx, j = k / nx;
+        const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+        for (int d = 0; d < 4; ++d) {
+            const int a = i + di[d], b = j + dj[d];
+            if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
+            const int m = b * nx + a;
+            if (free[m] && !seen[m]) {
+                seen[m] = 1;
+                q.push_back(m);
+            }
+        }
+    }
+    for (const auto &z : env.start_zones)
+        if (!seen[cell(z.x_m + z.w_m / 2, z.y_m + z.h_m / 2)]) return false;
+    return true;
+}
+
+Environment generate_environment(double density, std::uint64_t seed, double clearance_m) {
+    Environment env;
+    char nm[64];
+    std::snprintf(nm, sizeof nm, "generated-d%.2f-s%llu", density,
+                  static_cast<unsigned long long>(seed));
+    env.name = nm;
+    env.width_m = 10;
+    env.height_m = 10;
+    env.dest_x_m = 5;
+    env.dest_y_m = 9;
+    env.dest_radius_m = 0.4;
+    env.episode_limit_s = 40;
+    env.start_zones = {{0.6, 0.6, 2.0, 1.0}, {4.0, 0.6, 2.0, 1.0}, {7.4, 0.6, 2.0, 1.0}};
+    env.zone_lines = {0, 0, 0};
+    Rng rng;
+    rng.seed(seed, 0x67656e, 0);
+    // Obstacles live in the band y in [2.2, 8.2]; keep the destination area free.
+    const double band_lo = 2.2, band_hi = 8.2;
+    const double band_area = env.width_m * (band_hi - band_lo);
+    double covered = 0;
+    const double target = std::clamp(density, 0.0, 0.5) * band_area;
+    for (int attempt = 0; attempt < 4000 && covered < target; ++attempt) {
+        const bool circle = rng.uniform() < 0.5;
+        const double x = rng.uniform(0.3, env.width_m - 0.3);
+        const double y = rng.uniform(band_lo, band_hi);
+        Environment trial = env;
+        double area;
+        if (circle) {
+            const double r = rng.uniform(0.2, 0.7);
+            trial.circles.push_back({x, y, r});
+            area = kPi * r * r;
+        } else {
+            const double w = rng.uniform(0.3, 1.8), h = rng.uniform(0.3, 1.8);
+            const double a = std::floor(rng.uniform(0.0, 4.0)) * 15.0;  // 0, 15, 30, 45
+            trial.boxes.push_back({x, y, w, h, a});
+            area = w * h;
+        }
+        const Shape s = circle ? trial.obstacle_shapes()[trial.circles.size() - 1]
+                               : trial.obstacle_shapes().back();
+        Vec2 q;
+        if (nearest_point(s, {env.dest_x_m, env.dest_y_m}, &q) < env.dest_radius_m + 2 * clearance_m)
+            continue;
+        bool bad = false;
+        for (const auto &z : env.start_zones)
+            if (shape_distance(zone_shape(z), s) < 2 * clearance_m) bad = true;
+        if (bad || !environment_connected(trial, clearance_m, 0.1)) continue;
+        env = std::move(trial);
+        covered += area;
+    }
+    return env;
+}
+
+std::string environment_to_toml(const Environment &env) {
+    std::ostringstream os;
+    os.precision(6);
+    os << "# qnav environment (format: docs/sim.md). Units: metres, degrees, seconds.\n";
+    os << "name = \"" << env.name << "\"\n";
+    os << "episode_limit_s = " << env.episode_limit_s << "\n\n";
+    os << "[arena]\nwidth_m = " << env.width_m << "\nheight_m = " << env.height_m << "\n\n";
+    os << "[destination]\nx_m = " << env.dest_x_m << "\ny_m = " << env.dest_y_m
+       << "\nradius_m = " << env.dest_radius_m << "\n";
+    for (const auto &z : env.start_zones)
+        os << "\n[[start_zone]]\nx_m = " << z.x_m << "\ny_m = " << z.y_m << "\nw_m = " << z.w_m
+           << "\nh_m = " << z.h_m << "\n";
+    for (const auto &c : env.circles)
+        os << "\n[[circle]]\nx_m = " << c.x_m << "\ny_m = " << c.y_m << "\nr_m = " << c.r_m << "\n";
+    for (const auto &b : env.boxes)
+        os << "\n[[box]]\nx_m = " << b.x_m << "\ny_m = " << b.y_m << "\nw_m = " << b.w_m
+           << "\nh_m = " << b.h_m << "\nangle_deg = " << b.angle_deg << "\n";
+    return os.str();
+}
+
+}  // namespace qnav

@@ -1,0 +1,63 @@
+// Environments: a rectangular walled arena with circular and box obstacles, start zones
+// and one destination (data/envs/*.toml, format in docs/sim.md). Also the random
+// environment generator (density, seed) and the writer used by `qnav-sim gen-env`.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "geometry.hpp"
+
+namespace qnav {
+
+struct CircleObstacle {
+    double x_m, y_m, r_m;  // centre and radius, m
+};
+struct BoxObstacle {
+    double x_m, y_m, w_m, h_m;  // centre, width (along x before rotation), height, m
+    double angle_deg;           // rotation, counter-clockwise, deg
+};
+struct StartZone {
+    double x_m, y_m, w_m, h_m;  // lower-left corner, width, height, m (axis-aligned)
+};
+
+struct Environment {
+    std::string name;
+    double width_m = 10, height_m = 10;  // arena [0, width] x [0, height], m
+    double dest_x_m = 5, dest_y_m = 9, dest_radius_m = 0.3;
+    double episode_limit_s = 30;
+    std::vector<StartZone> start_zones;
+    std::vector<CircleObstacle> circles;
+    std::vector<BoxObstacle> boxes;
+    std::vector<int> zone_lines;  // source line of each start zone (for later messages)
+
+    // Obstacles as shapes: circles first, then boxes (not the walls).
+    std::vector<Shape> obstacle_shapes() const;
+    // The four arena walls as segments.
+    std::vector<Shape> wall_shapes() const;
+};
+
+// Parse and check an environment (TOML text). Throws SimError: _PARSE for malformed
+// files, _WORLD for a start zone inside an obstacle or outside the arena, a destination
+// inside an obstacle or a start zone.
+Environment parse_environment(std::string_view text, const std::string &name);
+
+// Check that every start zone keeps clearance_m (a robot's radius) from obstacles and
+// walls; throws SimError(QNAV_SIM_E_WORLD, "NAME:LINE: ...") otherwise.
+void check_clearance(const Environment &env, double clearance_m);
+
+// A random dense environment: 10 m x 10 m arena, start zones along the bottom, the
+// destination at the top, obstacles covering about `density` (0..0.5) of the middle band,
+// every start zone connected to the destination for a robot of radius clearance_m.
+Environment generate_environment(double density, std::uint64_t seed, double clearance_m);
+
+// TOML text of an environment (the format parse_environment reads).
+std::string environment_to_toml(const Environment &env);
+
+// Grid check that a disc of radius clearance_m can drive from the centre of every start
+// zone to the destination (cells of cell_m).
+bool environment_connected(const Environment &env, double clearance_m, double cell_m = 0.1);
+
+}  // namespace qnav

@@ -1,0 +1,67 @@
+// Loading and checking robot profiles from TOML (format in docs/sim.md).
+#include "robot.hpp"
+
+#include "error.hpp"
+#include "tomlread.hpp"
+
+namespace qnav {
+
+RobotProfile parse_robot_profile(std::string_view text, const std::string &name) {
+    TomlReader r(text, name);
+    const toml::table &root = r.root();
+    r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery"});
+    RobotProfile p;
+    p.name = r.string(root, "name");
+    if (p.name.empty()) r.fail(root, "'name' must not be empty");
+
+    const toml::table &body = r.table(root, "body");
+    r.only_keys(body, {"radius_m", "mass_kg", "wheel_base_m"});
+    p.radius_m = r.number(body, "radius_m", 0.01, 2.0);
+    p.mass_kg = r.number(body, "mass_kg", 0.01, 1000.0);
+    p.wheel_base_m = r.number(body, "wheel_base_m", 0.01, 4.0);
+    if (p.wheel_base_m > 2.0 * p.radius_m)
+        r.fail(body, "'wheel_base_m' is wider than the body (2 * radius_m)");
+
+    const toml::table &drive = r.table(root, "drive");
+    r.only_keys(drive, {"v_max_mps", "accel_mps2", "decel_mps2", "turn_rate_max_dps",
+                        "heading_gain_per_s"});
+    p.v_max_mps = r.number(drive, "v_max_mps", 0.01, 20.0);
+    p.accel_mps2 = r.number(drive, "accel_mps2", 0.01, 100.0);
+    p.decel_mps2 = r.number(drive, "decel_mps2", 0.01, 100.0);
+    p.turn_rate_max_dps = r.number(drive, "turn_rate_max_dps", 1.0, 3600.0);
+    p.heading_gain_per_s = r.number(drive, "heading_gain_per_s", 0.1, 100.0);
+
+    const toml::table &slip = r.table(root, "slip");
+    r.only_keys(slip, {"turn", "lateral_s"});
+    p.slip_turn = r.number(slip, "turn", 0.0, 0.9);
+    p.slip_lateral_s = r.number(slip, "lateral_s", 0.0, 1.0);
+
+    const toml::table &sonar = r.table(root, "sonar");
+    r.only_keys(sonar, {"range_min_m", "range_max_m", "default_sectors"});
+    p.range_min_m = r.number(sonar, "range_min_m", 0.0, 10.0);
+    p.range_max_m = r.number(sonar, "range_max_m", 0.05, 65.0);
+    if (p.range_min_m >= p.range_max_m)
+        r.fail(*sonar.get("range_min_m"), "'range_min_m' must be below 'range_max_m'");
+    p.default_sectors =
+        static_cast<std::uint16_t>(r.integer(sonar, "default_sectors", 1, 360));
+
+    if (root.get("noise")) {
+        const toml::table &noise = r.table(root, "noise");
+        r.only_keys(noise, {"sensor", "actuation"});
+        p.noise_sensor = r.number(noise, "sensor", 0.0, 1.0, true, 0.0);
+        p.noise_actuation = r.number(noise, "actuation", 0.0, 1.0, true, 0.0);
+    }
+
+    const toml::table &rec = r.table(root, "recovery");
+    r.only_keys(rec, {"ticks", "back_ticks", "back_speed_mps", "turn_deg"});
+    p.recovery_ticks = static_cast<std::uint32_t>(r.integer(rec, "ticks", 1, 1000));
+    p.recovery_back_ticks =
+        static_cast<std::uint32_t>(r.integer(rec, "back_ticks", 0, 1000));
+    if (p.recovery_back_ticks > p.recovery_ticks)
+        r.fail(*rec.get("back_ticks"), "'back_ticks' exceeds 'ticks'");
+    p.recovery_back_speed_mps = r.number(rec, "back_speed_mps", 0.0, p.v_max_mps);
+    p.recovery_turn_deg = r.number(rec, "turn_deg", 0.0, 360.0);
+    return p;
+}
+
+}  // namespace qnav

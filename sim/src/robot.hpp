@@ -1,0 +1,44 @@
+// Robot profiles: the physical description of a two-wheeled robot with a caster and a
+// ring of sonar (data/robots/*.toml, format in docs/sim.md). Loaded once, immutable,
+// shared by every context that simulates that robot.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace qnav {
+
+struct RobotProfile {
+    std::string name;
+    // body
+    double radius_m = 0.2;          // collision radius (circumscribed circle), m
+    double mass_kg = 5.0;           // mass, kg
+    double wheel_base_m = 0.3;      // distance between the driven wheels, m
+    // drive
+    double v_max_mps = 0.5;         // maximum wheel / forward speed, m/s
+    double accel_mps2 = 1.0;        // wheel acceleration limit (speeding up), m/s^2
+    double decel_mps2 = 1.0;        // wheel deceleration limit (slowing down), m/s^2
+    double turn_rate_max_dps = 180; // turn-rate limit of the heading controller, deg/s
+    double heading_gain_per_s = 4;  // heading controller: turn rate = gain * error, 1/s
+    // slip
+    double slip_turn = 0.0;         // fraction of the wheel turn rate lost at full speed
+    double slip_lateral_s = 0.0;    // sideways skid speed per (speed * turn rate), s
+    // sonar
+    double range_min_m = 0.05;      // closer obstacles read this, m
+    double range_max_m = 3.0;       // farther obstacles are not seen (read max), m
+    std::uint16_t default_sectors = 16;
+    // typical noise levels (used by the CLI when none are given)
+    double noise_sensor = 0.0;      // p_s
+    double noise_actuation = 0.0;   // p_a
+    // collision recovery manoeuvre
+    std::uint32_t recovery_ticks = 10;      // whole manoeuvre, ticks of 0.1 s
+    std::uint32_t recovery_back_ticks = 5;  // of which backing up, ticks
+    double recovery_back_speed_mps = 0.2;   // backing-up speed, m/s
+    double recovery_turn_deg = 60;          // turn away from the obstacle after, deg
+};
+
+// Parse a profile (TOML text); name is used in error messages. Throws SimError.
+RobotProfile parse_robot_profile(std::string_view text, const std::string &name);
+
+}  // namespace qnav

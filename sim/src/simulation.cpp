@@ -1,0 +1,431 @@
+// One simulation context (see simulation.hpp): world building, the drive model, sensing
+// with noise, collision recovery, episode bookkeeping and the fitness of Eq. 1-3.
+#include "simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <box2d/box2d.h>
+
+#include "error.hpp"
+
+namespace qnav {
+
+namespace {
+
+constexpr int kSubsteps = 2;           // physics substeps per 0.1 s control tick
+constexpr int kVelocityIterations = 4;  // one dynamic disc: few iterations suffice
+constexpr int kPositionIterations = 2;
+constexpr double kTouchSlack_m = 0.012;  // Box2D keeps ~0.01 m polygon skin; touching
+                                         // means within the body radius plus this
+constexpr double kEta1 = 1.0, kEta2 = 10.0;
+
+// Robot-frame degrees -> (-180, 180] in centidegrees as the controller wants them.
+qnav_cdeg_t to_cdeg(double rad) {
+    double cd = std::round(wrap_pi(rad) * 18000.0 / kPi);
+    if (cd >= 18000.0) cd -= 36000.0;
+    if (cd < -18000.0) cd += 36000.0;
+    return static_cast<qnav_cdeg_t>(cd);
+}
+
+double approach(double cur, double target, double accel, double decel, double dt) {
+    // Speeding up (same sign, larger magnitude) is limited by accel, everything else
+    // (slowing, reversing through zero) by decel.
+    const bool speeding_up = (cur >= 0 && target > cur) || (cur <= 0 && target < cur);
+    const double step = (speeding_up ? accel : decel) * dt;
+    if (target > cur) return std::min(target, cur + step);
+    return std::max(target, cur - step);
+}
+
+}  // namespace
+
+double shortest_time(double d_m, double v, double a) {
+    if (d_m <= 0) return 0.0;
+    const double d_acc = v * v / (2.0 * a);
+    if (d_m <= d_acc) return std::sqrt(2.0 * d_m / a);
+    return v / a + (d_m - d_acc) / v;
+}
+
+void compute_fitness(qnav_sim_result_t *res) {
+    if (res->beta_l > 0)
+        res->f1 = res->l <= res->beta_l ? res->l / res->beta_l : res->beta_l / res->l;
+    else
+        res->f1 = 1.0;
+    if (res->beta_tau > 0)
+        res->f2 = res->tau_l <= res->beta_tau ? res->tau_l / res->beta_tau
+                                               : res->beta_tau / res->tau_l;
+    else
+        res->f2 = 1.0;
+    res->R = kEta1 * res->f1 + kEta2 * res->f2 - static_cast<double>(res->tau_c);
+}
+
+static std::vector<Shape> all_shapes(const Environment &env) {
+    std::vector<Shape> s = env.obstacle_shapes();
+    for (const Shape &w : env.wall_shapes()) s.push_back(w);
+    return s;
+}
+
+Simulation::Simulation(const RobotProfile &robot, const Environment &env, const SimConfig &cfg)
+    : robot_(robot),
+      env_(env),
+      cfg_(cfg),
+      sonar_(all_shapes(env), cfg.n_sectors, robot.range_max_m + robot.radius_m) {
+    max_range_mm_ = static_cast<std::uint16_t>(
+        std::min(65535.0, std::round(robot_.range_max_m * 1000.0)));
+    const double limit_s = cfg_.episode_limit_s > 0 ? cfg_.episode_limit_s : env_.episode_limit_s;
+    limit_ticks_ = static_cast<std::uint32_t>(std::max(1.0, std::round(limit_s / QNAV_SIM_TICK_S)));
+    true_dist_.assign(cfg_.n_sectors, kInf);
+    scan_.n_sectors = cfg_.n_sectors;
+    scan_.max_range_mm = max_range_mm_;
+}
+
+Simulation::~Simulation() = default;
+
+void Simulation::build_world() {
+    // A fresh world per episode: nothing (contact caches, broad-phase tree shape) carries
+    // over from earlier episodes, so an episode depends only on its seeds.
+    world_ = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));
+    b2BodyDef sd;
+    sd.type = b2_staticBody;
+    b2Body *ground = world_->CreateBody(&sd);
+    for (const auto &c : env_.circles) {
+        b2CircleShape cs;
+        cs.m_p.Set(static_cast<float>(c.x_m), static_cast<float>(c.y_m));
+        cs.m_radius = static_cast<float>(c.r_m);
+        ground->CreateFixture(&cs, 0.0f);
+    }
+    for (const auto &b : env_.boxes) {
+        b2PolygonShape ps;
+        ps.SetAsBox(static_cast<float>(b.w_m / 2), static_cast<float>(b.h_m / 2),
+                    b2Vec2(static_cast<float>(b.x_m), static_cast<float>(b.y_m)),
+                    static_cast<float>(b.angle_deg * kPi / 180.0));
+        ground->CreateFixture(&ps, 0.0f);
+    }
+    // Walls: 1 m thick boxes just outside the arena.
+    const float w = static_cast<float>(env_.width_m), h = static_cast<float>(env_.height_m);
+    const float t = 0.5f;
+    const b2Vec2 centres[4] = {{w / 2, -t}, {w / 2, h + t}, {-t, h / 2}, {w + t, h / 2}};
+    const b2Vec2 halves[4] = {{w / 2 + 2 * t, t}, {w / 2 + 2 * t, t}, {t, h / 2 + 2 * t}, {t, h / 2 + 2 * t}};
+    for (int i = 0; i < 4; ++i) {
+        b2PolygonShape ps;
+        ps.SetAsBox(halves[i].x, halves[i].y, centres[i], 0.0f);
+        ground->CreateFixture(&ps, 0.0f);
+    }
+    b2BodyDef bd;
+    bd.type = b2_dynamicBody;
+    bd.position.Set(static_cast<float>(pos_.x), static_cast<float>(pos_.y));
+    bd.angle = static_cast<float>(heading_);
+    bd.bullet = false;
+    body_ = world_->CreateBody(&bd);
+    b2CircleShape rs;
+    rs.m_radius = static_cast<float>(robot_.radius_m);
+    b2FixtureDef fd;
+    fd.shape = &rs;
+    fd.density = static_cast<float>(robot_.mass_kg / (kPi * robot_.radius_m * robot_.radius_m));
+    fd.friction = 0.0f;  // the robot slides along walls; no contact torque on the disc
+    fd.restitution = 0.0f;
+    body_->CreateFixture(&fd);
+}
+
+void Simulation::reset(std::uint64_t episode_seed) {
+    rng_start_.seed(cfg_.seed, episode_seed, 1);
+    rng_sensor_.seed(cfg_.seed, episode_seed, 2);
+    rng_act_.seed(cfg_.seed, episode_seed, 3);
+    // Start zone weighted by area (equal weights when all are points or lines).
+    double total = 0;
+    for (const auto &z : env_.start_zones) total += z.w_m * z.h_m;
+    std::size_t zi = 0;
+    const double pick = rng_start_.uniform();
+    if (total > 0) {
+        double acc = 0;
+        for (zi = 0; zi + 1 < env_.start_zones.size(); ++zi) {
+            acc += env_.start_zones[zi].w_m * env_.start_zones[zi].h_m / total;
+            if (pick < acc) break;
+        }
+    } else {
+        zi = std::min(env_.start_zones.size() - 1,
+                      static_cast<std::size_t>(pick * static_cast<double>(env_.start_zones.size())));
+    }
+    const StartZone &z = env_.start_zones[zi];
+    const double x = z.x_m + rng_start_.uniform() * z.w_m;
+    const double y = z.y_m + rng_start_.uniform() * z.h_m;
+    const double hd = rng_start_.uniform(-kPi, kPi);
+    place(x, y, hd);
+}
+
+void Simulation::place(double x_m, double y_m, double heading_rad) {
+    pos_ = {x_m, y_m};
+    heading_ = wrap_pi(heading_rad);
+    start_ = pos_;
+    start_heading_ = heading_;
+    build_world();
+    started_ = true;
+    done_ = false;
+    reached_ = false;
+    tick_ = tau_c_ = collisions_ = recovery_left_ = 0;
+    collided_this_tick_ = false;
+    l_m_ = 0;
+    wheel_l_ = wheel_r_ = 0;
+    cmd_heading_deg_ = cmd_speed_ = 0;
+    target_heading_ = heading_;
+    target_speed_ = 0;
+    marks_.clear();
+    const double dx = env_.dest_x_m - pos_.x, dy = env_.dest_y_m - pos_.y;
+    if (std::sqrt(dx * dx + dy * dy) <= env_.dest_radius_m) reached_ = done_ = true;
+    compute_scan();
+}
+
+void Simulation::command(double heading_deg, double speed) {
+    cmd_heading_deg_ = std::isfinite(heading_deg) ? heading_deg : 0.0;
+    cmd_speed_ = std::isfinite(speed) ? std::clamp(speed, 0.0, 1.0) : 0.0;
+}
+
+void Simulation::compute_scan() {
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point t0;
+    if (profiling_) t0 = Clock::now();
+    sonar_.measure(pos_, heading_, true_dist_.data());
+    const double ps = cfg_.sensor_noise;
+    const double r = robot_.radius_m, rmin = robot_.range_min_m, rmax = robot_.range_max_m;
+    for (std::uint16_t k = 0; k < cfg_.n_sectors; ++k) {
+        double range = true_dist_[k] - r;  // measured from the body surface
+        if (!(range <= rmax)) {
+            range = rmax;  // no echo within range
+        } else {
+            if (ps > 0) range *= 1.0 + ps * rng_sensor_.normal();
+            range = std::clamp(range, rmin, rmax);
+        }
+        scan_.ranges_mm[k] = static_cast<qnav_mm_t>(std::lround(range * 1000.0));
+    }
+    double hd = heading_;
+    if (ps > 0) hd += ps * kPi * rng_sensor_.normal();
+    const double bearing = std::atan2(env_.dest_y_m - pos_.y, env_.dest_x_m - pos_.x) - hd;
+    scan_.goal_bearing_cdeg = to_cdeg(bearing);
+    if (profiling_) prof_.sonar_s += std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+bool Simulation::touching(Vec2 *contact) const {
+    const double lim = robot_.radius_m + kTouchSlack_m;
+    double best = kInf;
+    // Obstacles and walls, same shapes the sonar sees.
+    for (const Shape &s : sonar_.shapes()) {
+        const Vec2 dc = s.c - pos_;
+        const double bound = s.r + lim;
+        if (dot(dc, dc) > bound * bound) continue;
+        Vec2 q;
+        const double d = nearest_point(s, pos_, &q);
+        if (d <= lim && d < best) {
+            best = d;
+            *contact = q;
+        }
+    }
+    return best <= lim;
+}
+
+void Simulation::drive_substep(double dt) {
+    const double b = robot_.wheel_base_m, vmax = robot_.v_max_mps;
+    if (recovery_left_ > 0) {
+        // The fixed manoeuvre sets the wheels directly: back away, then turn in place.
+        const std::uint32_t phase = robot_.recovery_ticks - recovery_left_;
+        if (phase < robot_.recovery_back_ticks) {
+            wheel_l_ = wheel_r_ = recovery_back_sign_ * robot_.recovery_back_speed_mps;
+        } else {
+            const std::uint32_t turn_ticks = robot_.recovery_ticks - robot_.recovery_back_ticks;
+            const double omega = recovery_turn_sign_ * robot_.recovery_turn_deg * kPi / 180.0 /
+                                 (turn_ticks * QNAV_SIM_TICK_S);
+            wheel_l_ = std::clamp(-omega * b / 2, -vmax, vmax);
+            wheel_r_ = -wheel_l_;
+        }
+    } else {
+        // Heading controller: turn rate proportional to the heading error, forward speed
+        // reduced by cos(error) (no driving while facing away), then per-wheel
+        // acceleration limits.
+        const double e = wrap_pi(target_heading_ - heading_);
+        const double wmax = robot_.turn_rate_max_dps * kPi / 180.0;
+        const double omega_d = std::clamp(robot_.heading_gain_per_s * e, -wmax, wmax);
+        const double v_d = target_speed_ * vmax * std::max(0.0, std::cos(e));
+        double tl = v_d - omega_d * b / 2, tr = v_d + omega_d * b / 2;
+        const double over = std::max(std::fabs(tl), std::fabs(tr)) / vmax;
+        if (over > 1.0) {
+            // Keep the turn, give up forward speed.
+            const double om = std::clamp(omega_d, -2 * vmax / b, 2 * vmax / b);
+            const double v = std::clamp(v_d, -(vmax - std::fabs(om) * b / 2), vmax - std::fabs(om) * b / 2);
+            tl = v - om * b / 2;
+            tr = v + om * b / 2;
+        }
+        wheel_l_ = approach(wheel_l_, tl, robot_.accel_mps2, robot_.decel_mps2, dt);
+        wheel_r_ = approach(wheel_r_, tr, robot_.accel_mps2, robot_.decel_mps2, dt);
+    }
+    const double v = 0.5 * (wheel_l_ + wheel_r_);
+    const double omega = (wheel_r_ - wheel_l_) / b;
+    // Slip: turning loses some of its rate at speed, and the body skids outwards.
+    const double omega_a = omega * (1.0 - robot_.slip_turn * std::min(1.0, std::fabs(v) / vmax));
+    const double v_lat = -robot_.slip_lateral_s * v * omega_a;
+    const double ch = std::cos(heading_), sh = std::sin(heading_);
+    body_->SetLinearVelocity(b2Vec2(static_cast<float>(v * ch - v_lat * sh),
+                                    static_cast<float>(v * sh + v_lat * ch)));
+    body_->SetAngularVelocity(static_cast<float>(omega_a));
+    world_->Step(static_cast<float>(dt), kVelocityIterations, kPositionIterations);
+    const b2Vec2 p = body_->GetPosition();
+    pos_ = {p.x, p.y};
+    heading_ = wrap_pi(body_->GetAngle());
+}
+
+void Simulation::advance() {
+    if (!started_) throw SimError(QNAV_SIM_E_STATE, "advance: no episode (call reset first)");
+    if (done_) return;
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point t0;
+    if (profiling_) t0 = Clock::now();
+    const bool recovering = recovery_left_ > 0;
+    if (!recovering) {
+        double he = cmd_heading_deg_ * kPi / 180.0, sp = cmd_speed_;
+        const double pa = cfg_.actuation_noise;
+        if (pa > 0) {
+            he += pa * kPi * rng_act_.normal();
+            sp = std::clamp(sp * (1.0 + pa * rng_act_.normal()), 0.0, 1.0);
+        }
+        target_heading_ = wrap_pi(heading_ + he);
+        target_speed_ = sp;
+    }
+    const Vec2 before = pos_;
+    const double dt = QNAV_SIM_TICK_S / kSubsteps;
+    bool touched = false;
+    Vec2 contact{};
+    for (int i = 0; i < kSubsteps; ++i) {
+        drive_substep(dt);
+        if (!recovering && !touched) touched = touching(&contact);
+    }
+    if (recovering) {
+        --recovery_left_;
+        ++tau_c_;
+    }
+    l_m_ += norm(pos_ - before);
+    ++tick_;
+    collided_this_tick_ = false;
+    if (touched && recovery_left_ == 0 && !recovering) {
+        // A new collision: stop the wheels and start the fixed manoeuvre next tick.
+        collided_this_tick_ = true;
+        ++collisions_;
+        recovery_left_ = robot_.recovery_ticks;
+        wheel_l_ = wheel_r_ = 0;
+        const Vec2 d = contact - pos_;
+        const double rel = wrap_pi(std::atan2(d.y, d.x) - heading_);
+        recovery_back_sign_ = std::cos(rel) >= 0 ? -1.0 : 1.0;
+        recovery_turn_sign_ = rel > 0 ? -1 : 1;
+        marks_.push_back({tick_, pos_, contact});
+    } else if (recovering && recovery_left_ == 0 && touching(&contact)) {
+        // Still touching after the manoeuvre: start another one.
+        collided_this_tick_ = true;
+        ++collisions_;
+        recovery_left_ = robot_.recovery_ticks;
+        wheel_l_ = wheel_r_ = 0;
+        const Vec2 d = contact - pos_;
+        const double rel = wrap_pi(std::atan2(d.y, d.x) - heading_);
+        recovery_back_sign_ = std::cos(rel) >= 0 ? -1.0 : 1.0;
+        recovery_turn_sign_ = rel > 0 ? -1 : 1;
+        marks_.push_back({tick_, pos_, contact});
+    }
+    if (profiling_) prof_.physics_s += std::chrono::duration<double>(Clock::now() - t0).count();
+    ++prof_.ticks;
+    const double dx = env_.dest_x_m - pos_.x, dy = env_.dest_y_m - pos_.y;
+    if (dx * dx + dy * dy <= env_.dest_radius_m * env_.dest_radius_m) {
+        reached_ = true;
+        done_ = true;
+    } else if (tick_ >= limit_ticks_) {
+        done_ = true;
+    }
+    if (!done_) compute_scan();
+}
+
+qnav_sim_state_t Simulation::state() const {
+    qnav_sim_state_t s{};
+    s.tick = tick_;
+    s.x_m = pos_.x;
+    s.y_m = pos_.y;
+    s.heading_rad = heading_;
+    if (body_) {
+        const b2Vec2 v = body_->GetLinearVelocity();
+        s.speed_mps = v.x * std::cos(heading_) + v.y * std::sin(heading_);
+    }
+    s.goal_distance_m = norm(Vec2{env_.dest_x_m, env_.dest_y_m} - pos_);
+    s.recovering = recovery_left_ > 0;
+    s.recovery_ticks_left = recovery_left_;
+    s.collisions = collisions_;
+    s.done = done_;
+    s.reached = reached_;
+    return s;
+}
+
+qnav_sim_result_t Simulation::result() const {
+    qnav_sim_result_t r{};
+    r.l = l_m_;
+    r.beta_l = std::max(0.0, norm(Vec2{env_.dest_x_m, env_.dest_y_m} - start_) - env_.dest_radius_m);
+    r.tau_l = tick_ * QNAV_SIM_TICK_S;
+    r.beta_tau = shortest_time(r.beta_l, robot_.v_max_mps, robot_.accel_mps2);
+    r.tau_c = tau_c_;
+    r.reached = reached_;
+    r.ticks = tick_;
+    r.collisions = collisions_;
+    r.start_x_m = start_.x;
+    r.start_y_m = start_.y;
+    r.start_heading_rad = start_heading_;
+    compute_fitness(&r);
+    return r;
+}
+
+qnav_sim_sample_t Simulation::sample() const {
+    qnav_sim_sample_t s{};
+    s.tick = tick_;
+    s.x_m = pos_.x;
+    s.y_m = pos_.y;
+    s.heading_rad = heading_;
+    if (body_) {
+        const b2Vec2 v = body_->GetLinearVelocity();
+        s.speed_mps = v.x * std::cos(heading_) + v.y * std::sin(heading_);
+    }
+    s.cmd_heading_deg = static_cast<qnav_deg_t>(std::lround(cmd_heading_deg_));
+    s.cmd_speed = cmd_speed_;
+    s.recovering = recovery_left_ > 0;
+    s.collided = collided_this_tick_;
+    return s;
+}
+
+qnav_sim_result_t Simulation::run_episode(const qnav_ctrl_t *ctrl, std::uint64_t episode_seed,
+                                          qnav_sim_trace_fn trace, void *user) {
+    if (ctrl->n_sectors != cfg_.n_sectors)
+        throw SimError(QNAV_SIM_E_PARAM, "controller: n_sectors " + std::to_string(ctrl->n_sectors) +
+                                             " does not match the simulation's " +
+                                             std::to_string(cfg_.n_sectors));
+    if (ctrl->max_range_mm != max_range_mm_)
+        throw SimError(QNAV_SIM_E_PARAM, "controller: max_range_mm " + std::to_string(ctrl->max_range_mm) +
+                                             " does not match the robot's " +
+                                             std::to_string(max_range_mm_));
+    using Clock = std::chrono::steady_clock;
+    reset(episode_seed);
+    if (trace) {
+        const qnav_sim_sample_t s = sample();
+        trace(user, &s);
+    }
+    qnav_ctrl_input_t in;
+    in.ranges_mm = scan_.ranges_mm;
+    qnav_ctrl_output_t out;
+    while (!done_) {
+        in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
+        Clock::time_point t0;
+        if (profiling_) t0 = Clock::now();
+        qnav_ctrl_step(ctrl, &in, &out, nullptr);
+        if (profiling_) prof_.controller_s += std::chrono::duration<double>(Clock::now() - t0).count();
+        if (out.flags & QNAV_FLAG_NOT_READY)
+            throw SimError(QNAV_SIM_E_PARAM, "controller: not initialised (qnav_ctrl_init failed or was not called)");
+        command(out.heading_deg, out.speed / 32768.0);
+        advance();
+        if (trace) {
+            const qnav_sim_sample_t s = sample();
+            trace(user, &s);
+        }
+    }
+    return result();
+}
+
+}  // namespace qnav

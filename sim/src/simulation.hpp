@@ -1,0 +1,120 @@
+// One simulation context: a Box2D world holding the arena walls and obstacles as one
+// static body and the robot as a dynamic disc; the drive model (heading controller,
+// acceleration-limited wheels, slip), the analytic sonar, noise, collision recovery, and
+// the episode's figures (paper Eq. 1-3). The C API in capi.cpp is a thin shell over this.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "env.hpp"
+#include "qnav/sim.h"
+#include "rng.hpp"
+#include "robot.hpp"
+#include "sonar.hpp"
+
+class b2World;
+class b2Body;
+
+namespace qnav {
+
+struct SimConfig {
+    std::uint16_t n_sectors = 16;   // 1..360 (0 resolved to the profile's default before)
+    double sensor_noise = 0;        // p_s
+    double actuation_noise = 0;     // p_a
+    std::uint64_t seed = 1;
+    double episode_limit_s = 0;     // 0 = environment's
+};
+
+// Where time went (only counted when profiling is on), seconds.
+struct SimProfile {
+    double physics_s = 0, sonar_s = 0, controller_s = 0;
+    std::uint64_t ticks = 0;
+};
+
+struct CollisionMark {
+    std::uint32_t tick;  // tick at which it was detected
+    Vec2 robot;          // robot centre, m
+    Vec2 contact;        // contact point, m
+};
+
+class Simulation {
+public:
+    Simulation(const RobotProfile &robot, const Environment &env, const SimConfig &cfg);
+    ~Simulation();
+    Simulation(const Simulation &) = delete;
+    Simulation &operator=(const Simulation &) = delete;
+
+    void reset(std::uint64_t episode_seed);
+    // Move the robot (at rest) to a pose; the episode's figures restart from there.
+    void place(double x_m, double y_m, double heading_rad);
+    void command(double heading_deg, double speed);
+    void advance();
+    bool started() const { return started_; }
+    bool done() const { return done_; }
+
+    const qnav_sim_scan_t &scan() const { return scan_; }
+    // True centre distances of the last scan before noise (m, kInf = nothing in reach).
+    const std::vector<double> &true_distances() const { return true_dist_; }
+    qnav_sim_state_t state() const;
+    qnav_sim_result_t result() const;
+    qnav_sim_sample_t sample() const;
+    const std::vector<CollisionMark> &collision_marks() const { return marks_; }
+
+    // Whole episode with a libqnav controller; throws SimError on a mismatched controller.
+    qnav_sim_result_t run_episode(const qnav_ctrl_t *ctrl, std::uint64_t episode_seed,
+                                  qnav_sim_trace_fn trace, void *user);
+
+    void set_profiling(bool on) { profiling_ = on; }
+    SimProfile &profile() { return prof_; }
+
+    const RobotProfile &robot() const { return robot_; }
+    const Environment &env() const { return env_; }
+    const SimConfig &config() const { return cfg_; }
+    std::uint16_t max_range_mm() const { return max_range_mm_; }
+
+private:
+    void build_world();
+    void compute_scan();
+    void drive_substep(double dt);
+    bool touching(Vec2 *contact) const;
+
+    RobotProfile robot_;
+    Environment env_;
+    SimConfig cfg_;
+    SonarRing sonar_;
+    std::uint16_t max_range_mm_;
+    std::uint32_t limit_ticks_;
+
+    std::unique_ptr<b2World> world_;
+    b2Body *body_ = nullptr;
+
+    Rng rng_start_, rng_sensor_, rng_act_;
+    bool started_ = false, done_ = false, reached_ = false;
+    std::uint32_t tick_ = 0, tau_c_ = 0, collisions_ = 0;
+    std::uint32_t recovery_left_ = 0;
+    int recovery_turn_sign_ = 1;    // +1 counter-clockwise, -1 clockwise
+    double recovery_back_sign_ = -1;
+    bool collided_this_tick_ = false;
+    double l_m_ = 0;
+    Vec2 start_{}, pos_{};
+    double start_heading_ = 0, heading_ = 0;
+    double wheel_l_ = 0, wheel_r_ = 0;  // wheel surface speeds, m/s
+    double cmd_heading_deg_ = 0, cmd_speed_ = 0;  // last command, as given
+    double target_heading_ = 0, target_speed_ = 0;  // this tick, with actuation noise
+    std::vector<double> true_dist_;
+    qnav_sim_scan_t scan_{};
+    std::vector<CollisionMark> marks_;
+
+    bool profiling_ = false;
+    SimProfile prof_;
+};
+
+// Eq. 1-3 on res's l, beta_l, tau_l, beta_tau, tau_c.
+void compute_fitness(qnav_sim_result_t *res);
+// Shortest time to drive d metres from rest with acceleration a and top speed v, s.
+double shortest_time(double d_m, double v_max_mps, double accel_mps2);
+
+}  // namespace qnav

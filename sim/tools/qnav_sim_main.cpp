@@ -1,0 +1,354 @@
+// qnav-sim: the simulator's command-line program. `run` simulates a policy file (or the
+// hand-tuned probabilistic policy) in a named environment with a chosen robot, sector
+// count and noise, prints the episode's figures (paper Eq. 1-3) and writes its picture;
+// `draw-env` draws an environment like the paper's Fig. 6; `gen-env` writes a random
+// environment of a given density; `bench` measures episodes per second per core with the
+// time split into physics, sonar and controller. Bad input: one line, non-zero exit.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "capi_internal.hpp"
+#include "error.hpp"
+#include "qnav/ctrl.h"
+#include "qnav/sim.h"
+#include "rng.hpp"
+#include "svg.hpp"
+#ifdef QNAV_SIM_HAVE_POLICYIO
+#include "qnav/policy_io.h"
+#endif
+
+namespace {
+
+using qnav::SimError;
+
+struct Loaded {
+    qnav_sim_robot_t *robot = nullptr;
+    qnav_sim_env_t *env = nullptr;
+    qnav_sim_t *sim = nullptr;
+    ~Loaded() {
+        qnav_sim_destroy(sim);
+        qnav_sim_env_free(env);
+        qnav_sim_robot_free(robot);
+    }
+};
+
+void check(qnav_sim_status_t st, const char *err) {
+    if (st != QNAV_SIM_OK) throw SimError(st, err);
+}
+
+void load(Loaded &l, const std::string &robot, const std::string &env) {
+    char err[QNAV_SIM_ERRLEN] = "";
+    check(qnav_sim_robot_load(robot.c_str(), &l.robot, err, sizeof err), err);
+    check(qnav_sim_env_load(env.c_str(), &l.env, err, sizeof err), err);
+}
+
+void make_sim(Loaded &l, int sectors, double ps, double pa, std::uint64_t seed) {
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_config_t cfg;
+    qnav_sim_config_default(&cfg);
+    cfg.n_sectors = static_cast<std::uint16_t>(sectors);
+    cfg.sensor_noise = ps;
+    cfg.actuation_noise = pa;
+    cfg.seed = seed;
+    check(qnav_sim_create(l.robot, l.env, &cfg, &l.sim, err, sizeof err), err);
+}
+
+qnav_policy_t read_policy(const std::string &path) {
+    qnav_policy_t pol;
+    if (path.empty()) {
+        qnav_policy_prob_default(&pol);
+        return pol;
+    }
+#ifdef QNAV_SIM_HAVE_POLICYIO
+    char err[QNAV_POLICY_IO_ERRLEN] = "";
+    if (qnav_policy_read(path.c_str(), &pol, err, sizeof err) != 0)
+        throw SimError(QNAV_SIM_E_PARSE, err);
+    return pol;
+#else
+    throw SimError(QNAV_SIM_E_PARAM, "--policy: this build has no policy-file reader (qnav_policyio)");
+#endif
+}
+
+// Initialise ctrl for sim from a policy, in network/probabilistic or table mode.
+void init_ctrl(const qnav_sim_t *sim, const qnav_policy_t &pol, bool table,
+               std::vector<qnav_q1_15_t> &table_buf, qnav_ctrl_t *ctrl) {
+    qnav_ctrl_config_t cc;
+    qnav_sim_ctrl_config(sim, &cc);
+    qnav_status_t st = qnav_ctrl_init(ctrl, &cc, &pol);
+    if (st != QNAV_OK)
+        throw SimError(QNAV_SIM_E_PARAM, "policy: rejected by qnav_ctrl_init (status " + std::to_string(st) + ")");
+    if (table) {
+        table_buf.assign(QNAV_QTABLE_ENTRIES, 0);
+        st = qnav_ctrl_build_table(ctrl, table_buf.data());
+        if (st == QNAV_OK) st = qnav_ctrl_init_table(ctrl, &cc, table_buf.data());
+        if (st != QNAV_OK)
+            throw SimError(QNAV_SIM_E_PARAM, "policy: table mode failed (status " + std::to_string(st) + ")");
+    }
+}
+
+void print_result(unsigned long long episode, const qnav_sim_result_t &r) {
+    std::printf("episode %llu: %s in %u ticks  l %.3f m  beta_l %.3f m  tau_l %.1f s  "
+                "beta_tau %.2f s  f1 %.3f  f2 %.3f  tau_c %u  collisions %u  R %.3f\n",
+                episode, r.reached ? "reached" : "not reached", r.ticks, r.l, r.beta_l, r.tau_l,
+                r.beta_tau, r.f1, r.f2, r.tau_c, r.collisions, r.R);
+}
+
+struct RunOpts {
+    std::string robot = "pioneer3dx", env = "dense", policy, svg;
+    int sectors = 0;
+    double ps = -1, pa = -1;
+    std::uint64_t seed = 1, episode = 0;
+    unsigned episodes = 1;
+    bool table = false;
+    long svg_tick = -1;
+};
+
+int cmd_run(const RunOpts &o) {
+    Loaded l;
+    load(l, o.robot, o.env);
+    qnav_sim_robot_info_t ri;
+    qnav_sim_robot_info(l.robot, &ri);
+    const double ps = o.ps >= 0 ? o.ps : ri.sensor_noise;
+    const double pa = o.pa >= 0 ? o.pa : ri.actuation_noise;
+    make_sim(l, o.sectors, ps, pa, o.seed);
+    qnav::Simulation &sim = *l.sim->sim;
+    const qnav_policy_t pol = read_policy(o.policy);
+    std::vector<qnav_q1_15_t> tbuf;
+    qnav_ctrl_t ctrl;
+    init_ctrl(l.sim, pol, o.table, tbuf, &ctrl);
+    std::printf("robot %s  env %s  sectors %u  sensor noise %.3f  actuation noise %.3f  seed %llu  "
+                "policy %s%s\n",
+                ri.name, sim.env().name.c_str(), sim.config().n_sectors, ps, pa,
+                static_cast<unsigned long long>(o.seed),
+                o.policy.empty() ? "probabilistic (default)" : o.policy.c_str(),
+                o.table ? " (table mode)" : "");
+    double sum_r = 0;
+    unsigned reached = 0;
+    for (unsigned e = 0; e < o.episodes; ++e) {
+        const std::uint64_t es = o.episode + e;
+        qnav::EpisodePicture pic;
+        bool want_pic = e == 0 && !o.svg.empty();
+        // Step the episode here (same loop as qnav_sim_run_episode) to catch the sonar at
+        // the chosen tick for the picture.
+        sim.reset(es);
+        qnav_ctrl_input_t in;
+        qnav_ctrl_output_t out;
+        in.ranges_mm = sim.scan().ranges_mm;
+        auto grab = [&](std::uint32_t tick) {
+            if (!want_pic) return;
+            const qnav_sim_state_t st = sim.state();
+            pic.path.push_back({st.x_m, st.y_m});
+            if (static_cast<long>(tick) == o.svg_tick || (o.svg_tick < 0 && tick == 0)) {
+                pic.sonar_tick = tick;
+                pic.sonar_pos = {st.x_m, st.y_m};
+                pic.sonar_heading = st.heading_rad;
+                pic.sonar_ranges_m.clear();
+                for (unsigned k = 0; k < sim.config().n_sectors; ++k)
+                    pic.sonar_ranges_m.push_back(sim.scan().ranges_mm[k] / 1000.0);
+            }
+        };
+        grab(0);
+        while (!sim.done()) {
+            in.goal_bearing_cdeg = sim.scan().goal_bearing_cdeg;
+            qnav_ctrl_step(&ctrl, &in, &out, nullptr);
+            sim.command(out.heading_deg, out.speed / 32768.0);
+            sim.advance();
+            grab(sim.state().tick);
+        }
+        const qnav_sim_result_t r = sim.result();
+        print_result(static_cast<unsigned long long>(es), r);
+        sum_r += r.R;
+        reached += r.reached;
+        if (want_pic) {
+            pic.collisions = sim.collision_marks();
+            pic.reached = r.reached;
+            char cap[256];
+            std::snprintf(cap, sizeof cap, "%s, %s, %u sectors, episode %llu: R %.2f, %s, sonar at tick %u",
+                          ri.name, sim.env().name.c_str(), sim.config().n_sectors,
+                          static_cast<unsigned long long>(es), r.R, r.reached ? "reached" : "not reached",
+                          pic.sonar_tick);
+            pic.caption = cap;
+            qnav::write_file_atomic(o.svg, qnav::render_svg(sim.env(), ri.radius_m, &pic));
+            std::printf("picture: %s\n", o.svg.c_str());
+        }
+    }
+    if (o.episodes > 1)
+        std::printf("mean R %.3f over %u episodes, %u reached\n", sum_r / o.episodes, o.episodes, reached);
+    return 0;
+}
+
+int cmd_draw_env(const std::string &env, const std::string &robot, const std::string &outp) {
+    Loaded l;
+    load(l, robot, env);
+    qnav_sim_robot_info_t ri;
+    qnav_sim_robot_info(l.robot, &ri);
+    qnav::write_file_atomic(outp, qnav::render_svg(l.env->env, ri.radius_m, nullptr));
+    std::printf("picture: %s\n", outp.c_str());
+    return 0;
+}
+
+int cmd_gen_env(double density, std::uint64_t seed, const std::string &robot,
+                const std::string &name, const std::string &outp) {
+    Loaded l;
+    char err[QNAV_SIM_ERRLEN] = "";
+    check(qnav_sim_robot_load(robot.c_str(), &l.robot, err, sizeof err), err);
+    qnav::Environment env = qnav::generate_environment(density, seed, l.robot->profile.radius_m);
+    if (!name.empty()) env.name = name;
+    const std::string text = qnav::environment_to_toml(env);
+    // Check that what we write reads back.
+    qnav::parse_environment(text, outp);
+    qnav::write_file_atomic(outp, text);
+    std::printf("environment %s: %zu circles, %zu boxes -> %s\n", env.name.c_str(),
+                env.circles.size(), env.boxes.size(), outp.c_str());
+    return 0;
+}
+
+struct BenchOpts {
+    std::string robot = "pioneer3dx", env = "dense", policy;
+    int sectors = 32, hidden = 12;
+    unsigned episodes = 1000;
+    std::string mode = "table";
+    std::uint64_t seed = 1;
+    double ps = 0, pa = 0;
+};
+
+int cmd_bench(const BenchOpts &o) {
+    Loaded l;
+    load(l, o.robot, o.env);
+    make_sim(l, o.sectors, o.ps, o.pa, o.seed);
+    qnav::Simulation &sim = *l.sim->sim;
+    qnav_policy_t pol;
+    if (!o.policy.empty()) {
+        pol = read_policy(o.policy);
+    } else {
+        // A seeded random network, like a member of an early evolving population.
+        qnav_policy_net_zero(&pol, static_cast<std::uint8_t>(o.hidden));
+        qnav::Rng rng;
+        rng.seed(o.seed, 0xbe7c, 0);
+        for (std::uint16_t k = 0; k < QNAV_NET_WEIGHTS(pol.u.net.hidden); ++k)
+            *qnav_net_weight(&pol.u.net, k) = static_cast<qnav_q8_8_t>(std::lround(rng.uniform(-4.0, 4.0) * 256.0));
+    }
+    std::vector<qnav_q1_15_t> tbuf;
+    qnav_ctrl_t ctrl;
+    init_ctrl(l.sim, pol, o.mode == "table", tbuf, &ctrl);
+    using Clock = std::chrono::steady_clock;
+    auto pass = [&](bool profiling, std::uint64_t *ticks, double *sum_r) {
+        sim.set_profiling(profiling);
+        sim.profile() = qnav::SimProfile{};
+        *ticks = 0;
+        *sum_r = 0;
+        const auto t0 = Clock::now();
+        for (unsigned e = 0; e < o.episodes; ++e) {
+            const qnav_sim_result_t r = sim.run_episode(&ctrl, e, nullptr, nullptr);
+            *ticks += r.ticks;
+            *sum_r += r.R;
+        }
+        return std::chrono::duration<double>(Clock::now() - t0).count();
+    };
+    std::uint64_t ticks;
+    double sum_r;
+    const double wall = pass(false, &ticks, &sum_r);
+    std::uint64_t ticks2;
+    double sum_r2;
+    const double wall_p = pass(true, &ticks2, &sum_r2);
+    const qnav::SimProfile p = sim.profile();
+    const double other = wall_p - p.physics_s - p.sonar_s - p.controller_s;
+    std::printf("bench: robot %s  env %s  sectors %d  policy %s  controller %s mode  episodes %u  "
+                "noise %.3f/%.3f\n",
+                o.robot.c_str(), sim.env().name.c_str(), o.sectors,
+                o.policy.empty() ? ("random network, " + std::to_string(o.hidden) + " hidden").c_str() : o.policy.c_str(),
+                o.mode.c_str(), o.episodes, o.ps, o.pa);
+    std::printf("episodes/s per core: %.1f   (%.0f ticks/s, %.1f ticks/episode, %.2f us/tick, mean R %.3f)\n",
+                o.episodes / wall, ticks / wall, static_cast<double>(ticks) / o.episodes,
+                1e6 * wall / static_cast<double>(ticks), sum_r / o.episodes);
+    std::printf("time split (profiled pass, %.3f s): physics %.1f%%  sonar %.1f%%  controller %.1f%%  "
+                "other %.1f%%\n",
+                wall_p, 100 * p.physics_s / wall_p, 100 * p.sonar_s / wall_p,
+                100 * p.controller_s / wall_p, 100 * other / wall_p);
+    std::printf("per tick: physics %.2f us  sonar %.2f us  controller %.2f us\n",
+                1e6 * p.physics_s / static_cast<double>(ticks2), 1e6 * p.sonar_s / static_cast<double>(ticks2),
+                1e6 * p.controller_s / static_cast<double>(ticks2));
+    if (ticks != ticks2 || sum_r != sum_r2) {
+        std::fprintf(stderr, "bench: profiled and plain passes differ (determinism broken)\n");
+        return 1;
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+    CLI::App app{"qnav-sim: Box2D simulator of TekBot-class and Pioneer 3-DX robots (docs/sim.md)"};
+    app.require_subcommand(1);
+
+    RunOpts ro;
+    CLI::App *run = app.add_subcommand("run", "simulate a policy and print the episode's figures");
+    run->add_option("--policy", ro.policy, "policy file (default: the hand-tuned probabilistic policy)")->check(CLI::ExistingFile);
+    run->add_option("--robot", ro.robot, "robot profile name or file")->capture_default_str();
+    run->add_option("--env", ro.env, "environment name or file")->capture_default_str();
+    run->add_option("--sectors", ro.sectors, "sonar sectors 1..360 (default: the profile's)")->check(CLI::Range(1, 360));
+    run->add_option("--sensor-noise", ro.ps, "p_s in [0, 1] (default: the profile's typical)")->check(CLI::Range(0.0, 1.0));
+    run->add_option("--actuation-noise", ro.pa, "p_a in [0, 1] (default: the profile's typical)")->check(CLI::Range(0.0, 1.0));
+    run->add_option("--seed", ro.seed, "context seed")->capture_default_str();
+    run->add_option("--episode", ro.episode, "first episode seed")->capture_default_str();
+    run->add_option("--episodes", ro.episodes, "number of episodes")->check(CLI::Range(1u, 1000000u))->capture_default_str();
+    run->add_flag("--table", ro.table, "run the controller in table mode");
+    run->add_option("--svg", ro.svg, "write the first episode's picture here");
+    run->add_option("--svg-tick", ro.svg_tick, "tick whose sonar sectors are drawn (default 0)")->check(CLI::NonNegativeNumber);
+
+    std::string de_env = "dense", de_robot = "pioneer3dx", de_out;
+    CLI::App *draw = app.add_subcommand("draw-env", "draw an environment (like the paper's Fig. 6) to SVG");
+    draw->add_option("--env", de_env, "environment name or file")->capture_default_str();
+    draw->add_option("--robot", de_robot, "robot whose size sets the direct lines' clearance")->capture_default_str();
+    draw->add_option("--out", de_out, "SVG file")->required();
+
+    double g_density = 0.2;
+    std::uint64_t g_seed = 1;
+    std::string g_robot = "pioneer3dx", g_name, g_out;
+    CLI::App *gen = app.add_subcommand("gen-env", "write a random environment file");
+    gen->add_option("--density", g_density, "fraction of the obstacle band covered, 0..0.5")->check(CLI::Range(0.0, 0.5))->capture_default_str();
+    gen->add_option("--seed", g_seed, "generator seed")->capture_default_str();
+    gen->add_option("--robot", g_robot, "robot that must fit through (clearance)")->capture_default_str();
+    gen->add_option("--name", g_name, "environment name (default: generated-d<density>-s<seed>)");
+    gen->add_option("--out", g_out, "TOML file to write")->required();
+
+    BenchOpts bo;
+    CLI::App *bench = app.add_subcommand("bench", "episodes per second per core, time split");
+    bench->add_option("--robot", bo.robot, "robot profile")->capture_default_str();
+    bench->add_option("--env", bo.env, "environment")->capture_default_str();
+    bench->add_option("--sectors", bo.sectors, "sonar sectors")->check(CLI::Range(1, 360))->capture_default_str();
+    bench->add_option("--hidden", bo.hidden, "hidden units of the random network")->check(CLI::Range(1, QNAV_MAX_HIDDEN))->capture_default_str();
+    bench->add_option("--policy", bo.policy, "use this policy file instead of a random network")->check(CLI::ExistingFile);
+    bench->add_option("--episodes", bo.episodes, "episodes per pass")->check(CLI::Range(1u, 10000000u))->capture_default_str();
+    bench->add_option("--mode", bo.mode, "controller mode")->check(CLI::IsMember({"table", "network"}))->capture_default_str();
+    bench->add_option("--seed", bo.seed, "context and network seed")->capture_default_str();
+    bench->add_option("--sensor-noise", bo.ps, "p_s")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+    bench->add_option("--actuation-noise", bo.pa, "p_a")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError &e) {
+        if (e.get_exit_code() == 0) return app.exit(e);
+        std::fprintf(stderr, "qnav-sim: %s\n", e.what());
+        return 2;
+    }
+    try {
+        if (*run) return cmd_run(ro);
+        if (*draw) return cmd_draw_env(de_env, de_robot, de_out);
+        if (*gen) return cmd_gen_env(g_density, g_seed, g_robot, g_name, g_out);
+        if (*bench) return cmd_bench(bo);
+    } catch (const SimError &e) {
+        std::fprintf(stderr, "%s\n", e.what());
+        return 1;
+    } catch (const std::exception &e) {
+        std::fprintf(stderr, "qnav-sim: %s\n", e.what());
+        return 1;
+    }
+    return 1;
+}
