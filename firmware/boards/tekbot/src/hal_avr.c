@@ -1,0 +1,202 @@
+/*
+ * Reference hardware layer for an ATmega128 TekBot at 16 MHz (qnav/board_hal.h):
+ *   tick    Timer0 compare interrupt every 1 ms
+ *   UART    USART0 (PE0 RXD, PE1 TXD), 57600 baud 8N1 with U2X (-0.8 % error),
+ *           interrupt-driven receive into a 64-byte ring, polled transmit
+ *   sonar   8 analog sonars (MaxBotix LV-EZ class, AN output ~ Vcc/512 per inch) on
+ *           ADC0..ADC7, sector k on ADCk; AVcc reference
+ *   motors  Timer1 8-bit fast PWM on OC1A (PB5, left) and OC1B (PB6, right); direction on
+ *           PB0 (left) and PB1 (right), high = forward
+ *   heading wheel-encoder odometry: INT0 (PD0, left) and INT1 (PD1, right), the sign of
+ *           each tick taken from that wheel's direction pin
+ * Pin choices and scale factors are the knobs at the top; docs/hil.md lists the wiring.
+ */
+#include <avr/interrupt.h>
+#include <avr/io.h>
+
+#include "hal_avr.h"
+
+#ifndef QNAV_TEKBOT_BAUD
+#define QNAV_TEKBOT_BAUD 57600UL
+#endif
+/* mm of range per ADC count (x10): LV-EZ at 5 V: 9.8 mV/in, 4.88 mV/count -> 12.7 mm */
+#ifndef QNAV_TEKBOT_MM_PER_COUNT_X10
+#define QNAV_TEKBOT_MM_PER_COUNT_X10 127UL
+#endif
+/* heading change per differential encoder tick, 0.01 deg: wheel 70 mm diameter, 32 ticks
+ * per turn, track 120 mm -> (pi*70/32)/120 rad = 3.28 deg */
+#ifndef QNAV_TEKBOT_CDEG_PER_TICK
+#define QNAV_TEKBOT_CDEG_PER_TICK 328L
+#endif
+
+#define RX_RING 64u
+
+static volatile uint32_t g_ms;
+static volatile uint8_t g_rx[RX_RING];
+static volatile uint8_t g_rx_head;
+static volatile uint8_t g_rx_tail;
+static volatile int32_t g_odo; /* right ticks minus left ticks */
+
+ISR(TIMER0_COMP_vect)
+{
+    g_ms++;
+}
+
+ISR(USART0_RX_vect)
+{
+    uint8_t b = UDR0;
+    uint8_t next = (uint8_t)((g_rx_head + 1u) % RX_RING);
+    if (next != g_rx_tail) { /* full: the byte is lost and the frame's CRC catches it */
+        g_rx[g_rx_head] = b;
+        g_rx_head = next;
+    }
+}
+
+ISR(INT0_vect)
+{
+    g_odo += (PORTB & _BV(PB0)) ? -1 : 1; /* left forward turns clockwise */
+}
+
+ISR(INT1_vect)
+{
+    g_odo += (PORTB & _BV(PB1)) ? 1 : -1;
+}
+
+static uint32_t avr_millis(void *ctx)
+{
+    uint32_t t;
+    uint8_t sreg = SREG;
+    (void)ctx;
+    cli();
+    t = g_ms;
+    SREG = sreg;
+    return t;
+}
+
+static uint16_t adc_read(uint8_t ch)
+{
+    ADMUX = (uint8_t)(_BV(REFS0) | (ch & 0x07u));
+    ADCSRA |= _BV(ADSC);
+    while (ADCSRA & _BV(ADSC)) {
+    }
+    return ADCW;
+}
+
+static uint16_t avr_sonar_read(void *ctx, qnav_mm_t *ranges_mm, uint16_t max)
+{
+    uint16_t k;
+    uint16_t n = max < 8u ? max : 8u;
+    (void)ctx;
+    for (k = 0; k < n; ++k) {
+        uint32_t mm = ((uint32_t)adc_read((uint8_t)k) * QNAV_TEKBOT_MM_PER_COUNT_X10) / 10u;
+        ranges_mm[k] = (qnav_mm_t)(mm > 65535u ? 65535u : mm);
+    }
+    return n;
+}
+
+static qnav_cdeg_t avr_heading_cdeg(void *ctx)
+{
+    int32_t odo;
+    int32_t a;
+    uint8_t sreg = SREG;
+    (void)ctx;
+    cli();
+    odo = g_odo;
+    SREG = sreg;
+    a = (odo * QNAV_TEKBOT_CDEG_PER_TICK) % 36000L;
+    if (a >= 18000L) {
+        a -= 36000L;
+    } else if (a < -18000L) {
+        a += 36000L;
+    }
+    return (qnav_cdeg_t)a;
+}
+
+static uint8_t duty(qnav_q1_15_t v)
+{
+    uint16_t m = (uint16_t)(v < 0 ? -(int32_t)v : v);
+    return (uint8_t)(m >> 7); /* Q1.15 magnitude -> 0..255 */
+}
+
+static void avr_motors_set(void *ctx, qnav_q1_15_t left, qnav_q1_15_t right)
+{
+    (void)ctx;
+    if (left >= 0) {
+        PORTB |= _BV(PB0);
+    } else {
+        PORTB &= (uint8_t)~_BV(PB0);
+    }
+    if (right >= 0) {
+        PORTB |= _BV(PB1);
+    } else {
+        PORTB &= (uint8_t)~_BV(PB1);
+    }
+    OCR1A = duty(left);
+    OCR1B = duty(right);
+}
+
+static int16_t avr_uart_read(void *ctx)
+{
+    int16_t b = -1;
+    uint8_t sreg = SREG;
+    (void)ctx;
+    cli();
+    if (g_rx_tail != g_rx_head) {
+        b = g_rx[g_rx_tail];
+        g_rx_tail = (uint8_t)((g_rx_tail + 1u) % RX_RING);
+    }
+    SREG = sreg;
+    return b;
+}
+
+static void avr_uart_write(void *ctx, const uint8_t *bytes, uint16_t n)
+{
+    uint16_t i;
+    (void)ctx;
+    for (i = 0; i < n; ++i) {
+        while (!(UCSR0A & _BV(UDRE0))) {
+        }
+        UDR0 = bytes[i];
+    }
+}
+
+void qnav_tekbot_hal_avr_init(qnav_board_hal_t *hal)
+{
+    const uint16_t ubrr = (uint16_t)((F_CPU / (8UL * QNAV_TEKBOT_BAUD)) - 1UL + 0UL);
+
+    /* Timer0: CTC, clk/64, 250 counts = 1 ms at 16 MHz */
+    TCCR0 = (uint8_t)(_BV(WGM01) | _BV(CS02));
+    OCR0 = (uint8_t)((F_CPU / 64UL / 1000UL) - 1UL);
+    TIMSK |= _BV(OCIE0);
+
+    /* USART0: U2X, 8N1, receive interrupt */
+    UBRR0H = (uint8_t)(ubrr >> 8);
+    UBRR0L = (uint8_t)(ubrr & 0xFFu);
+    UCSR0A = _BV(U2X0);
+    UCSR0C = (uint8_t)(_BV(UCSZ01) | _BV(UCSZ00));
+    UCSR0B = (uint8_t)(_BV(RXEN0) | _BV(TXEN0) | _BV(RXCIE0));
+
+    /* Timer1: 8-bit fast PWM, clk/8 (7.8 kHz), non-inverting on OC1A/OC1B */
+    DDRB |= (uint8_t)(_BV(PB0) | _BV(PB1) | _BV(PB5) | _BV(PB6));
+    OCR1A = 0;
+    OCR1B = 0;
+    TCCR1A = (uint8_t)(_BV(COM1A1) | _BV(COM1B1) | _BV(WGM10));
+    TCCR1B = (uint8_t)(_BV(WGM12) | _BV(CS11));
+
+    /* ADC: enabled, clk/128 = 125 kHz */
+    ADCSRA = (uint8_t)(_BV(ADEN) | _BV(ADPS2) | _BV(ADPS1) | _BV(ADPS0));
+
+    /* encoders: falling edges on INT0/INT1 with pull-ups */
+    PORTD |= (uint8_t)(_BV(PD0) | _BV(PD1));
+    EICRA = (uint8_t)(_BV(ISC01) | _BV(ISC11));
+    EIMSK |= (uint8_t)(_BV(INT0) | _BV(INT1));
+
+    hal->ctx = 0;
+    hal->millis = avr_millis;
+    hal->sonar_read = avr_sonar_read;
+    hal->heading_cdeg = avr_heading_cdeg;
+    hal->motors_set = avr_motors_set;
+    hal->uart_read = avr_uart_read;
+    hal->uart_write = avr_uart_write;
+    sei();
+}

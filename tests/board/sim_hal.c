@@ -1,0 +1,71 @@
+/*
+ * The simulated TekBot hardware layer (sim_hal.h).
+ */
+#include "sim_hal.h"
+
+#include <string.h>
+
+static uint32_t sim_millis(void *ctx)
+{
+    return ((sim_hal_t *)ctx)->now_ms;
+}
+
+static uint16_t sim_sonar(void *ctx, qnav_mm_t *ranges, uint16_t max)
+{
+    sim_hal_t *s = (sim_hal_t *)ctx;
+    uint16_t n = s->n_ranges < max ? s->n_ranges : max;
+    memcpy(ranges, s->ranges_mm, n * sizeof ranges[0]);
+    return n;
+}
+
+static qnav_cdeg_t sim_heading(void *ctx)
+{
+    return ((sim_hal_t *)ctx)->heading_cdeg;
+}
+
+static void sim_motors(void *ctx, qnav_q1_15_t left, qnav_q1_15_t right)
+{
+    sim_hal_t *s = (sim_hal_t *)ctx;
+    s->left = left;
+    s->right = right;
+    s->motor_calls++;
+}
+
+static int16_t sim_uart_read(void *ctx)
+{
+    sim_hal_t *s = (sim_hal_t *)ctx;
+    if (s->to_board_tail == s->to_board_head) {
+        return -1;
+    }
+    return s->to_board[s->to_board_tail++ % SIM_HAL_QUEUE];
+}
+
+static void sim_uart_write(void *ctx, const uint8_t *b, uint16_t n)
+{
+    sim_hal_t *s = (sim_hal_t *)ctx;
+    uint16_t i;
+    for (i = 0; i < n && s->from_board_n < SIM_HAL_QUEUE; ++i) {
+        s->from_board[s->from_board_n++] = b[i];
+    }
+}
+
+void sim_hal_init(sim_hal_t *sim, qnav_board_hal_t *hal)
+{
+    memset(sim, 0, sizeof *sim);
+    sim->now_ms = 1000;
+    hal->ctx = sim;
+    hal->millis = sim_millis;
+    hal->sonar_read = sim_sonar;
+    hal->heading_cdeg = sim_heading;
+    hal->motors_set = sim_motors;
+    hal->uart_read = sim_uart_read;
+    hal->uart_write = sim_uart_write;
+}
+
+void sim_hal_to_board(sim_hal_t *sim, const uint8_t *bytes, uint32_t n)
+{
+    uint32_t i;
+    for (i = 0; i < n; ++i) {
+        sim->to_board[sim->to_board_head++ % SIM_HAL_QUEUE] = bytes[i];
+    }
+}

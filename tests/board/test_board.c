@@ -1,0 +1,409 @@
+/*
+ * Host tests of the TekBot board application with a simulated hardware layer: motors stop
+ * when the link goes quiet, without a goal and on a commanded stop; onboard decisions are
+ * libqnav's; offboard commands are applied and expire; policy uploads are checked before
+ * use; corrupted frames are not acted on; and the board runs against navbridge's core in
+ * one process (memq:// LCM) in both modes.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "bridge.h"
+#include "qnav/link.h"
+#include "qnav/tekbot.h"
+#include "sim_hal.h"
+
+typedef struct {
+    sim_hal_t sim;
+    qnav_board_hal_t hal;
+    qnav_tekbot_t bot;
+    qnav_link_tx_t btx;           /* the bridge's sender */
+    qnav_link_rx_t brx;           /* the bridge's receiver */
+    uint32_t read_upto;           /* bytes of from_board already decoded */
+    uint32_t scans, telemetry, acks;
+    qnav_link_command_t last_tel;
+    uint16_t last_scan_seq;
+    qnav_link_scan_t last_scan;
+    qnav_link_policy_ack_t last_ack;
+} bench_t;
+
+static bench_t g;
+
+static void bench_start(uint16_t sectors)
+{
+    qnav_tekbot_config_t cfg;
+    uint16_t k;
+    memset(&g, 0, sizeof g);
+    sim_hal_init(&g.sim, &g.hal);
+    g.sim.n_ranges = sectors;
+    for (k = 0; k < sectors; ++k) {
+        g.sim.ranges_mm[k] = (qnav_mm_t)(1500 + 250 * k);
+    }
+    qnav_tekbot_config_default(&cfg);
+    cfg.n_sectors = sectors;
+    assert_int_equal(qnav_tekbot_init(&g.bot, &cfg, &g.hal), QNAV_TEKBOT_OK);
+    qnav_link_tx_init(&g.btx);
+    qnav_link_rx_init(&g.brx);
+}
+
+static void to_board(uint8_t id, const uint8_t *p, int32_t n)
+{
+    uint8_t wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
+    int32_t w;
+    assert_true(n >= 0);
+    w = qnav_link_encode(&g.btx, id, p, (uint16_t)n, wire, sizeof wire);
+    assert_true(w > 0);
+    sim_hal_to_board(&g.sim, wire, (uint32_t)w);
+}
+
+static void heartbeat(uint8_t mode, uint8_t state)
+{
+    qnav_link_heartbeat_t hb = {0, mode, state, 0, 0, 0};
+    uint8_t p[QNAV_LINK_HEARTBEAT_BYTES];
+    to_board(QNAV_LINK_MSG_HEARTBEAT, p, qnav_link_heartbeat_pack(&hb, p, sizeof p));
+}
+
+static void goal(uint16_t id, qnav_cdeg_t bearing)
+{
+    qnav_link_goal_t gl = {id, bearing, 3000};
+    uint8_t p[QNAV_LINK_GOAL_BYTES];
+    to_board(QNAV_LINK_MSG_GOAL, p, qnav_link_goal_pack(&gl, p, sizeof p));
+}
+
+static void command(qnav_deg_t heading, qnav_q1_15_t speed, uint8_t flags)
+{
+    qnav_link_command_t c = {0, heading, speed, 20000, flags, 0};
+    uint8_t p[QNAV_LINK_COMMAND_BYTES];
+    to_board(QNAV_LINK_MSG_COMMAND, p, qnav_link_command_pack(&c, p, sizeof p));
+}
+
+/* Decode what the board sent since last time. */
+static void read_board(void)
+{
+    qnav_link_frame_t f;
+    while (g.read_upto < g.sim.from_board_n) {
+        if (!qnav_link_rx_feed(&g.brx, g.sim.from_board[g.read_upto++], &f)) {
+            continue;
+        }
+        if (f.msg_id == QNAV_LINK_MSG_SCAN) {
+            assert_int_equal(qnav_link_scan_unpack(f.payload, f.len, &g.last_scan), 0);
+            g.last_scan_seq = f.seq;
+            g.scans++;
+        } else if (f.msg_id == QNAV_LINK_MSG_COMMAND) {
+            assert_int_equal(qnav_link_command_unpack(f.payload, f.len, &g.last_tel), 0);
+            g.telemetry++;
+        } else if (f.msg_id == QNAV_LINK_MSG_POLICY_ACK) {
+            assert_int_equal(qnav_link_policy_ack_unpack(f.payload, f.len, &g.last_ack), 0);
+            g.acks++;
+        }
+    }
+}
+
+/* Advance the simulated clock in 10 ms steps, polling the board. */
+static void run_ms(uint32_t ms)
+{
+    uint32_t t;
+    for (t = 0; t < ms; t += 10) {
+        g.sim.now_ms += 10;
+        qnav_tekbot_poll(&g.bot);
+        read_board();
+    }
+}
+
+/* Keep the link alive in the given mode for ms (heartbeat every 100 ms). */
+static void run_with_heartbeats(uint8_t mode, uint8_t state, uint32_t ms)
+{
+    uint32_t t;
+    for (t = 0; t < ms; t += 100) {
+        heartbeat(mode, state);
+        run_ms(100);
+    }
+}
+
+static int moving(void)
+{
+    return g.sim.left != 0 || g.sim.right != 0;
+}
+
+static void test_mix_turns_counter_clockwise_with_the_right_wheel(void **state)
+{
+    qnav_q1_15_t l, r;
+    (void)state;
+    qnav_tekbot_mix(30, 20000, 60, &l, &r);
+    assert_true(r > l);
+    qnav_tekbot_mix(-30, 20000, 60, &l, &r);
+    assert_true(l > r);
+    qnav_tekbot_mix(0, 20000, 60, &l, &r);
+    assert_int_equal(l, 20000);
+    assert_int_equal(r, 20000);
+    qnav_tekbot_mix(120, 20000, 60, &l, &r); /* beyond spin: turn in place */
+    assert_int_equal(l, -r);
+    qnav_tekbot_mix(45, 0, 60, &l, &r); /* no speed: no motion at all */
+    assert_int_equal(l, 0);
+    assert_int_equal(r, 0);
+}
+
+static void test_board_is_stopped_until_it_hears_the_bridge(void **state)
+{
+    (void)state;
+    bench_start(8);
+    run_ms(1000);
+    assert_false(moving());
+    assert_true(g.sim.motor_calls >= 10u); /* set to 0 every tick, not just once */
+    assert_true(g.scans >= 9u);            /* scans go out regardless, to find the bridge */
+}
+
+static void test_onboard_board_drives_with_libqnav_decision(void **state)
+{
+    qnav_ctrl_t c;
+    qnav_ctrl_config_t cc;
+    qnav_policy_t p;
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t want;
+    (void)state;
+    bench_start(8);
+    g.sim.heading_cdeg = 1000;
+    goal(1, 5500);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 500);
+    assert_true(moving());
+    assert_true(g.telemetry > 0u);
+    /* the telemetry is exactly libqnav's step on the reported scan */
+    assert_int_equal(g.last_scan.goal_bearing_cdeg, 4500);
+    qnav_ctrl_config_default(&cc);
+    cc.n_sectors = 8;
+    cc.max_range_mm = 5000;
+    qnav_policy_prob_default(&p);
+    assert_int_equal(qnav_ctrl_init(&c, &cc, &p), QNAV_OK);
+    in.ranges_mm = g.last_scan.ranges_mm;
+    in.goal_bearing_cdeg = g.last_scan.goal_bearing_cdeg;
+    qnav_ctrl_step(&c, &in, &want, NULL);
+    assert_int_equal(g.last_tel.heading_deg, want.heading_deg);
+    assert_int_equal(g.last_tel.speed, want.speed);
+    assert_int_equal(g.last_tel.quality, want.quality);
+    assert_int_equal(g.last_tel.scan_seq, g.last_scan_seq);
+}
+
+static void test_board_stops_motors_when_link_goes_quiet(void **state)
+{
+    uint32_t t, quiet_ms = 0;
+    (void)state;
+    bench_start(8);
+    goal(1, 0);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 500);
+    assert_true(moving());
+    /* nothing from the bridge any more: stopped within timeout + one tick */
+    for (t = 0; t < 1000 && moving(); t += 10) {
+        run_ms(10);
+        quiet_ms += 10;
+    }
+    assert_false(moving());
+    assert_true(quiet_ms >= 300u);
+    assert_true(quiet_ms <= 300u + 100u + 10u);
+    assert_int_equal(g.bot.stats.link_lost, 1);
+}
+
+static void test_board_without_goal_stays_stopped(void **state)
+{
+    (void)state;
+    bench_start(8);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 600);
+    assert_false(moving());
+    assert_true(g.telemetry > 0u);
+    assert_true((g.last_tel.flags & QNAV_LINK_CMD_STOP) != 0u);
+}
+
+static void test_offboard_board_applies_commands_and_drops_stale_ones(void **state)
+{
+    uint32_t t;
+    (void)state;
+    bench_start(8);
+    goal(1, 0);
+    for (t = 0; t < 5; ++t) {
+        heartbeat(QNAV_LINK_MODE_OFFBOARD, 0);
+        command(0, 16384, 0);
+        run_ms(100);
+    }
+    assert_int_equal(g.sim.left, 16384);
+    assert_int_equal(g.sim.right, 16384);
+    assert_int_equal(g.telemetry, 0); /* offboard: the board does not decide */
+    /* heartbeats continue but commands stop: the last command expires */
+    for (t = 0; t < 5; ++t) {
+        heartbeat(QNAV_LINK_MODE_OFFBOARD, 0);
+        run_ms(100);
+    }
+    assert_false(moving());
+}
+
+static void test_stop_command_holds_until_the_bridge_clears_it(void **state)
+{
+    (void)state;
+    bench_start(8);
+    goal(1, 0);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 300);
+    assert_true(moving());
+    command(0, 0, QNAV_LINK_CMD_STOP);
+    run_ms(100);
+    assert_false(moving());
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, QNAV_LINK_STATE_STOPPED, 300);
+    assert_false(moving());
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 300);
+    assert_true(moving());
+}
+
+static void test_corrupted_goal_is_not_acted_on(void **state)
+{
+    uint8_t wire[64], p[QNAV_LINK_GOAL_BYTES];
+    qnav_link_goal_t gl = {0x0101u, 0x0202, 0x01020304u};
+    int32_t w;
+    (void)state;
+    bench_start(8);
+    w = qnav_link_encode(&g.btx, QNAV_LINK_MSG_GOAL, p,
+                         (uint16_t)qnav_link_goal_pack(&gl, p, sizeof p), wire, sizeof wire);
+    assert_true(w > 8);
+    wire[6] ^= 0x10;
+    sim_hal_to_board(&g.sim, wire, (uint32_t)w);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 500);
+    assert_false(moving());
+    assert_int_equal(g.last_scan.goal_id, 0);
+    assert_true(qnav_link_rx_dropped_total(&g.bot.rx) >= 1u);
+}
+
+/* Upload a policy blob to the board in chunks, with the given CRC in the commit. */
+static void upload(const qnav_policy_t *pol, int break_crc)
+{
+    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES], p[QNAV_LINK_CHUNK_MAX_BYTES];
+    qnav_link_policy_chunk_t c;
+    qnav_link_policy_commit_t cm;
+    int32_t n = qnav_link_policy_to_blob(pol, blob, sizeof blob);
+    uint16_t off = 0;
+    assert_true(n > 0);
+    while (off < (uint16_t)n) {
+        uint16_t len = (uint16_t)((uint16_t)n - off);
+        if (len > QNAV_LINK_CHUNK_BYTES) {
+            len = QNAV_LINK_CHUNK_BYTES;
+        }
+        c.offset = off;
+        c.total = (uint16_t)n;
+        c.len = (uint8_t)len;
+        memcpy(c.data, &blob[off], len);
+        to_board(QNAV_LINK_MSG_POLICY_CHUNK, p, qnav_link_policy_chunk_pack(&c, p, sizeof p));
+        off = (uint16_t)(off + len);
+    }
+    cm.total = (uint16_t)n;
+    cm.crc = (uint16_t)(qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) ^
+                        (break_crc ? 0x0100u : 0u));
+    to_board(QNAV_LINK_MSG_POLICY_COMMIT, p, qnav_link_policy_commit_pack(&cm, p, sizeof p));
+}
+
+static void test_uploaded_policy_is_used_and_a_bad_one_is_refused(void **state)
+{
+    qnav_policy_t net;
+    uint16_t k, crc_before;
+    (void)state;
+    bench_start(8);
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    crc_before = g.bot.policy_crc;
+    qnav_policy_net_zero(&net, 4);
+    for (k = 0; k < QNAV_NET_WEIGHTS(4); ++k) {
+        *qnav_net_weight(&net.u.net, k) = (qnav_q8_8_t)(k * 300 - 2000);
+    }
+    upload(&net, 1);
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    assert_int_equal(g.acks, 1);
+    assert_int_equal(g.last_ack.status, QNAV_LINK_ACK_BAD_CRC);
+    assert_int_equal(g.bot.policy_crc, crc_before);
+    assert_int_equal(g.bot.policy.kind, QNAV_POLICY_PROB);
+
+    upload(&net, 0);
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    assert_int_equal(g.acks, 2);
+    assert_int_equal(g.last_ack.status, QNAV_LINK_ACK_OK);
+    assert_int_equal(g.bot.policy.kind, QNAV_POLICY_NET);
+    assert_int_equal(g.bot.policy.u.net.w_out[3], net.u.net.w_out[3]);
+    assert_int_not_equal(g.bot.policy_crc, crc_before);
+    assert_int_equal(g.last_ack.crc, g.bot.policy_crc);
+}
+
+/* ---- the board against navbridge's core, in one process ---- */
+
+static int bridge_write(void *user, const uint8_t *bytes, size_t n)
+{
+    (void)user;
+    sim_hal_to_board(&g.sim, bytes, (uint32_t)n);
+    return 0;
+}
+
+static void run_with_bridge(qnav_bridge_t *b, uint32_t ms)
+{
+    uint32_t t;
+    for (t = 0; t < ms; t += 10) {
+        g.sim.now_ms += 10;
+        qnav_tekbot_poll(&g.bot);
+        if (g.read_upto < g.sim.from_board_n) {
+            qnav_bridge_on_bytes(b, &g.sim.from_board[g.read_upto],
+                                 g.sim.from_board_n - g.read_upto, g.sim.now_ms);
+            g.read_upto = g.sim.from_board_n;
+        }
+        qnav_bridge_poll(b, g.sim.now_ms);
+    }
+}
+
+static void test_board_and_bridge_drive_together_in_both_modes(void **state)
+{
+    static qnav_bridge_t b;
+    qnav_bridge_config_t cfg;
+    qnav_goal_t gl;
+    lcm_t *lcm = lcm_create("memq://");
+    uint8_t mode;
+    (void)state;
+    assert_non_null(lcm);
+    for (mode = QNAV_LINK_MODE_OFFBOARD; mode <= QNAV_LINK_MODE_ONBOARD; ++mode) {
+        bench_start(8);
+        qnav_bridge_config_default(&cfg);
+        cfg.mode = mode;
+        qnav_bridge_init(&b, &cfg, lcm, NULL, bridge_write, NULL, g.sim.now_ms);
+        memset(&gl, 0, sizeof gl);
+        gl.goal_id = 5;
+        gl.bearing_cdeg = 3000;
+        qnav_bridge_on_goal(&b, &gl, g.sim.now_ms);
+        run_with_bridge(&b, 1000);
+        assert_true(moving());
+        assert_int_equal(g.bot.mode, mode);
+        assert_int_equal(g.bot.goal.goal_id, 5);
+        assert_int_equal(b.watchdog_stop, 0);
+        assert_true(b.rx.stats.frames_ok >= 20u);
+        assert_int_equal(qnav_link_rx_dropped_total(&b.rx), 0);
+        /* the bridge shuts down: the board stops at once (stop command) */
+        qnav_bridge_shutdown(&b, g.sim.now_ms);
+        g.sim.now_ms += 10;
+        qnav_tekbot_poll(&g.bot);
+        qnav_tekbot_tick(&g.bot);
+        assert_false(moving());
+    }
+    lcm_destroy(lcm);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_mix_turns_counter_clockwise_with_the_right_wheel),
+        cmocka_unit_test(test_board_is_stopped_until_it_hears_the_bridge),
+        cmocka_unit_test(test_onboard_board_drives_with_libqnav_decision),
+        cmocka_unit_test(test_board_stops_motors_when_link_goes_quiet),
+        cmocka_unit_test(test_board_without_goal_stays_stopped),
+        cmocka_unit_test(test_offboard_board_applies_commands_and_drops_stale_ones),
+        cmocka_unit_test(test_stop_command_holds_until_the_bridge_clears_it),
+        cmocka_unit_test(test_corrupted_goal_is_not_acted_on),
+        cmocka_unit_test(test_uploaded_policy_is_used_and_a_bad_one_is_refused),
+        cmocka_unit_test(test_board_and_bridge_drive_together_in_both_modes),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
