@@ -132,9 +132,9 @@ static qnav_status_t init_net(qnav_ctrl_t *ctrl, const qnav_net_t *net)
     ctrl->hidden = net->hidden;
     for (j = 0; j < net->hidden; ++j) {
         qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
-        u->bias_z = (int32_t)net->b_hidden[j] * 16384;
-        u->per_deg = div_round((int32_t)net->w_theta[j] * 16384, QNAV_DTHETA_MAX);
-        u->per_level = div_round((int32_t)net->w_dist[j] * 16384, QNAV_DIST_LEVELS - 1);
+        u->bias_z = (int32_t)net->b_hidden[j] * 2048;
+        u->per_deg = div_round((int32_t)net->w_theta[j] * 2048, QNAV_DTHETA_MAX);
+        u->per_level = div_round((int32_t)net->w_dist[j] * 2048, QNAV_DIST_LEVELS - 1);
         u->out = net->w_out[j];
     }
     ctrl->out_bias_z = (int32_t)net->b_out * 128;
@@ -183,14 +183,14 @@ qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *
 
 /*
  * One hidden unit's share of the output pre-activation, in units of 2^-15.
- * zf is the unit's pre-activation in units of 2^-22 (|zf| < 3 * 2^29).
- * @par Scaling and overflow: (zf + 2^10) >> 11 is Q5.11, saturated to [-16, 16); out
- * (Q8.8) times h (Q1.15) is below 2^30; >> 8 leaves units of 2^-15, below 2^22 per unit,
- * so 32 units sum below 2^27.
+ * z is the unit's pre-activation in units of 2^-19 (|z| < 3 * 2^26).
+ * @par Scaling and overflow: (z + 2^7) >> 8 is Q5.11 (a byte move on AVR), saturated to
+ * [-16, 16); out (Q8.8) times h (Q1.15) is below 2^30; >> 8 leaves units of 2^-15, below
+ * 2^22 per unit, so 32 units sum below 2^27.
  */
-static int32_t unit_share(int32_t zf, int16_t out)
+static int32_t unit_share(int32_t z, int16_t out)
 {
-    int16_t h = qnav_sigmoid_q5_11(sat16((zf + 1024) >> 11));
+    int16_t h = qnav_sigmoid_q5_11(sat16((z + 128) >> 8));
     return ((int32_t)out * h + 128) >> 8;
 }
 
@@ -206,14 +206,24 @@ static qnav_q1_15_t prob_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t
     return (qnav_q1_15_t)((q + 16384u) >> 15);
 }
 
+/* a * b for a small unsigned b: avr-gcc then uses its 32x16 multiply, not 32x32. */
+static int32_t mul_u8(int32_t a, uint8_t b)
+{
+    return a * (int32_t)b;
+}
+
+static int32_t unit_base(const qnav_ctrl_unit_t *u, uint8_t level)
+{
+    return u->bias_z + mul_u8(u->per_level, level);
+}
+
 static qnav_q1_15_t net_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
 {
     int32_t acc = ctrl->out_bias_z;
     uint8_t j;
     for (j = 0; j < ctrl->hidden; ++j) {
         const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
-        int32_t zf = u->bias_z + u->per_level * level + u->per_deg * dtheta;
-        acc += unit_share(zf, u->out);
+        acc += unit_share(unit_base(u, level) + mul_u8(u->per_deg, dtheta), u->out);
     }
     return net_output(acc);
 }
@@ -298,12 +308,19 @@ static uint16_t bearing_deg(qnav_cdeg_t cdeg)
  */
 typedef struct {
     uint16_t first;      /* first path, degrees */
-    uint16_t count;      /* paths in the run, >= 1 */
+    uint8_t count;       /* paths in the run, 1..180 */
     uint8_t level;       /* distance level of the run's sector */
     uint8_t dtheta0;     /* dtheta of the first path */
     int8_t dir;          /* +1 or -1: change of dtheta from one path to the next */
-    qnav_q1_15_t bound;  /* network: no path of the run's interior exceeds it; -1 if done */
 } run_t;
+
+/* A run kept for the network's best-first search, with its bound. */
+typedef struct {
+    uint16_t first;
+    uint8_t count;
+    uint8_t level;
+    qnav_q1_15_t bound;  /* no path of the run exceeds it; -1 once evaluated */
+} pending_t;
 
 /* The best path so far under the controller's total order (quality, then smaller
  * dtheta, then smaller turn, then counter-clockwise). */
@@ -344,12 +361,12 @@ static void consider(best_t *best, qnav_q1_15_t q, uint16_t path, uint8_t dtheta
 typedef struct {
     const qnav_ctrl_t *ctrl;
     const qnav_mm_t *ranges;
+    uint16_t goal;        /* destination, whole degrees 0..359 */
     uint16_t path;        /* next path to hand out */
     uint16_t sector;      /* its sector */
     uint16_t left;        /* paths of that sector still to hand out */
     uint16_t phase;       /* first path of the sector * N + 180, modulo 360 */
     uint16_t count;       /* paths in the sector */
-    uint16_t offset;      /* (path - goal) modulo 360 */
     uint8_t level;        /* distance level of the sector */
     uint8_t flags;        /* QNAV_FLAG_RANGE_CLIPPED once a clipped range was seen */
 } run_iter_t;
@@ -370,13 +387,21 @@ static void run_iter_start(run_iter_t *it, const qnav_ctrl_t *ctrl, const qnav_m
 {
     it->ctrl = ctrl;
     it->ranges = ranges;
+    it->goal = goal;
     it->path = 0;
     it->sector = 0;
     it->phase = QNAV_PATHS / 2u;
     it->count = ctrl->first_sector_paths;
-    it->offset = (uint16_t)((QNAV_PATHS - goal) % QNAV_PATHS);
     it->flags = 0;
     run_iter_enter_sector(it);
+}
+
+/* dtheta of a run's first path and its direction, from the path and the goal. */
+static void run_shape(run_t *r, uint16_t goal)
+{
+    uint16_t offset = (uint16_t)(r->first >= goal ? r->first - goal : r->first + QNAV_PATHS - goal);
+    r->dtheta0 = (uint8_t)(offset <= QNAV_DTHETA_MAX ? offset : QNAV_PATHS - offset);
+    r->dir = (int8_t)(offset < QNAV_DTHETA_MAX ? 1 : -1);
 }
 
 /* The next run into *r; 0 when all 360 paths have been handed out. A run ends where the
@@ -397,113 +422,164 @@ static uint8_t run_iter_next(run_iter_t *it, run_t *r)
         it->sector = (uint16_t)(it->sector + 1u == c->n_sectors ? 0u : it->sector + 1u);
         run_iter_enter_sector(it);
     }
-    to_turn = (uint16_t)(it->offset < QNAV_DTHETA_MAX ? QNAV_DTHETA_MAX - it->offset
-                                                      : QNAV_PATHS - it->offset);
+    r->first = it->path;
+    run_shape(r, it->goal);
+    to_turn = (uint16_t)(r->dir > 0 ? QNAV_DTHETA_MAX - r->dtheta0 : r->dtheta0);
+    if (to_turn == 0u) {
+        to_turn = QNAV_DTHETA_MAX; /* starts at the goal, or opposite it going down */
+    }
     n = it->left < to_turn ? it->left : to_turn;
     if (n > QNAV_PATHS - it->path) {
         n = (uint16_t)(QNAV_PATHS - it->path);
     }
-    r->first = it->path;
-    r->count = n;
+    r->count = (uint8_t)n;
     r->level = it->level;
-    r->dtheta0 = (uint8_t)(it->offset <= QNAV_DTHETA_MAX ? it->offset : QNAV_PATHS - it->offset);
-    r->dir = (int8_t)(it->offset < QNAV_DTHETA_MAX ? 1 : -1);
-    r->bound = -1;
     it->path = (uint16_t)(it->path + n);
     it->left = (uint16_t)(it->left - n);
-    it->offset = (uint16_t)(it->offset + n);
-    if (it->offset >= QNAV_PATHS) {
-        it->offset = (uint16_t)(it->offset - QNAV_PATHS);
-    }
     return 1;
 }
 
-static uint8_t run_dtheta(const run_t *r, uint16_t k)
+/* Table mode: read a run's row. Along the run the tie order prefers earlier paths when
+ * dtheta rises and later ones when it falls, so only the run's winner is considered. */
+static void eval_table_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best,
+                           qnav_q1_15_t *qualities)
 {
-    return (uint8_t)(r->dir > 0 ? r->dtheta0 + k : r->dtheta0 - k);
+    const qnav_q1_15_t *p = &ctrl->table[(uint16_t)r->level * QNAV_TABLE_STRIDE + r->dtheta0];
+    qnav_q1_15_t top = -1;
+    uint8_t top_k = 0;
+    uint8_t k;
+    for (k = 0; k < r->count; ++k, p += r->dir) {
+        qnav_q1_15_t q = QNAV_FLASH_READ_I16(p);
+        if (qualities != 0) {
+            qualities[r->first + k] = q;
+        }
+        if (q > top || (q == top && r->dir < 0)) {
+            top = q;
+            top_k = k;
+        }
+    }
+    consider(best, top, (uint16_t)(r->first + top_k),
+             (uint8_t)(r->dir > 0 ? r->dtheta0 + top_k : r->dtheta0 - top_k));
 }
 
-/* Evaluate paths k0..k1-1 of a run exactly; qualities (null or [360]) receives them. */
-static void eval_run(const qnav_ctrl_t *ctrl, const run_t *r, uint16_t k0, uint16_t k1,
-                     best_t *best, qnav_q1_15_t *qualities)
+static void eval_prob_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best,
+                          qnav_q1_15_t *qualities)
 {
-    uint16_t k;
-    uint8_t dtheta = run_dtheta(r, k0);
-    if (ctrl->kind == QNAV_KIND_TABLE) {
-        const qnav_q1_15_t *row = &ctrl->table[(uint16_t)r->level * QNAV_TABLE_STRIDE];
-        for (k = k0; k < k1; ++k, dtheta = (uint8_t)(dtheta + r->dir)) {
-            qnav_q1_15_t q = QNAV_FLASH_READ_I16(&row[dtheta]);
-            if (qualities != 0) {
-                qualities[r->first + k] = q;
-            }
-            if (q >= best->q) {
-                consider(best, q, (uint16_t)(r->first + k), dtheta);
-            }
+    uint8_t k;
+    uint8_t dtheta = r->dtheta0;
+    for (k = 0; k < r->count; ++k, dtheta = (uint8_t)(dtheta + r->dir)) {
+        qnav_q1_15_t q = prob_quality(ctrl, r->level, dtheta);
+        if (qualities != 0) {
+            qualities[r->first + k] = q;
         }
-    } else if (ctrl->kind == (uint8_t)QNAV_POLICY_PROB) {
-        for (k = k0; k < k1; ++k, dtheta = (uint8_t)(dtheta + r->dir)) {
-            qnav_q1_15_t q = prob_quality(ctrl, r->level, dtheta);
-            if (qualities != 0) {
-                qualities[r->first + k] = q;
-            }
-            consider(best, q, (uint16_t)(r->first + k), dtheta);
-        }
-    } else {
-        int32_t base[QNAV_MAX_HIDDEN];
-        uint8_t j;
+        consider(best, q, (uint16_t)(r->first + k), dtheta);
+    }
+}
+
+/* Network: every path of a run; pre-activations walk by one degree's weight per path. */
+static void eval_net_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best,
+                         qnav_q1_15_t *qualities)
+{
+    int32_t z[QNAV_MAX_HIDDEN];
+    uint8_t k;
+    uint8_t j;
+    uint8_t dtheta = r->dtheta0;
+    for (j = 0; j < ctrl->hidden; ++j) {
+        const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
+        z[j] = unit_base(u, r->level) + mul_u8(u->per_deg, r->dtheta0);
+    }
+    for (k = 0; k < r->count; ++k, dtheta = (uint8_t)(dtheta + r->dir)) {
+        int32_t acc = ctrl->out_bias_z;
+        qnav_q1_15_t q;
         for (j = 0; j < ctrl->hidden; ++j) {
-            base[j] = ctrl->p.unit[j].bias_z + ctrl->p.unit[j].per_level * r->level;
+            const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
+            acc += unit_share(z[j], u->out);
+            z[j] = (r->dir > 0) ? z[j] + u->per_deg : z[j] - u->per_deg;
         }
-        for (k = k0; k < k1; ++k, dtheta = (uint8_t)(dtheta + r->dir)) {
-            int32_t acc = ctrl->out_bias_z;
-            qnav_q1_15_t q;
-            for (j = 0; j < ctrl->hidden; ++j) {
-                acc += unit_share(base[j] + ctrl->p.unit[j].per_deg * dtheta, ctrl->p.unit[j].out);
-            }
-            q = net_output(acc);
-            if (qualities != 0) {
-                qualities[r->first + k] = q;
-            }
-            consider(best, q, (uint16_t)(r->first + k), dtheta);
+        q = net_output(acc);
+        if (qualities != 0) {
+            qualities[r->first + k] = q;
         }
+        consider(best, q, (uint16_t)(r->first + k), dtheta);
     }
 }
 
 /*
- * Network: evaluate a run's two end paths exactly and bound its interior. Each hidden
- * unit's share is monotone in dtheta along the run (its pre-activation is linear, and
- * rounding, saturation, the interpolated sigmoid and the output weight keep order), so
- * summing each unit's larger end share bounds every interior path's output exactly.
+ * Network, first pass: bound every run. Along a run each hidden unit's pre-activation is
+ * linear in dtheta, and rounding, saturation, the interpolated sigmoid and the output
+ * weight all keep order, so a unit's share is largest at one end, the end where
+ * out * z is larger: one sigmoid per unit bounds the whole run. The dtheta term
+ * c = per_deg * dtheta is carried from run to run (neighbouring paths differ by one
+ * degree) and across a run by precomputed multiples, so the pass multiplies once per
+ * unit per run (the level term). Runs beyond cap are evaluated at once (same answer).
+ * Returns the number of runs kept in runs[].
  */
-static void bound_run(const qnav_ctrl_t *ctrl, run_t *r, best_t *best)
+static uint16_t bound_runs(const qnav_ctrl_t *ctrl, run_iter_t *it, pending_t *runs,
+                           uint16_t cap, best_t *best)
 {
-    uint16_t last = (uint16_t)(r->count - 1u);
-    uint8_t d0 = r->dtheta0;
-    uint8_t d1 = run_dtheta(r, last);
-    int32_t acc0 = ctrl->out_bias_z;
-    int32_t acc1 = ctrl->out_bias_z;
-    int32_t accmax = ctrl->out_bias_z;
+    int32_t c[QNAV_MAX_HIDDEN];     /* per_deg * dtheta at the end of the previous run */
+    int32_t span_q[QNAV_MAX_HIDDEN]; /* per_deg * (sector_paths - 1) */
+    uint8_t q1 = (uint8_t)(ctrl->sector_paths > 180u ? 179u : ctrl->sector_paths - 1u);
+    uint8_t prev_end = 0;
+    uint16_t n = 0;
+    uint8_t first = 1;
     uint8_t j;
+    run_t r;
     for (j = 0; j < ctrl->hidden; ++j) {
-        const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
-        int32_t a = u->bias_z + u->per_level * r->level;
-        int32_t s0 = unit_share(a + u->per_deg * d0, u->out);
-        int32_t s1 = unit_share(a + u->per_deg * d1, u->out);
-        acc0 += s0;
-        acc1 += s1;
-        accmax += (s0 > s1) ? s0 : s1;
+        span_q[j] = mul_u8(ctrl->p.unit[j].per_deg, q1);
     }
-    consider(best, net_output(acc0), r->first, d0);
-    consider(best, net_output(acc1), (uint16_t)(r->first + last), d1);
-    r->bound = (r->count > 2u) ? net_output(accmax) : (qnav_q1_15_t)-1;
+    while (run_iter_next(it, &r)) {
+        uint8_t span = (uint8_t)(r.count - 1u);
+        uint8_t end = (uint8_t)(r.dir > 0 ? r.dtheta0 + span : r.dtheta0 - span);
+        int32_t acc = ctrl->out_bias_z;
+        for (j = 0; j < ctrl->hidden; ++j) {
+            const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
+            int32_t base = unit_base(u, r.level);
+            int32_t dz;
+            int32_t z0;
+            int32_t z1;
+            if (first) {
+                c[j] = mul_u8(u->per_deg, r.dtheta0);
+            } else {
+                c[j] = (r.dtheta0 > prev_end) ? c[j] + u->per_deg : c[j] - u->per_deg;
+            }
+            if (span == q1) {
+                dz = span_q[j];
+            } else if (span == q1 + 1u) {
+                dz = span_q[j] + u->per_deg;
+            } else {
+                dz = mul_u8(u->per_deg, span);
+            }
+            z0 = base + c[j];
+            c[j] = (r.dir > 0) ? c[j] + dz : c[j] - dz;
+            z1 = base + c[j];
+            acc += unit_share(((u->out >= 0) == (z1 > z0)) ? z1 : z0, u->out);
+        }
+        first = 0;
+        prev_end = end;
+        if (r.count == 1u) {
+            consider(best, net_output(acc), r.first, r.dtheta0); /* the bound is exact */
+        } else if (n < cap) {
+            runs[n].first = r.first;
+            runs[n].count = r.count;
+            runs[n].level = r.level;
+            runs[n].bound = net_output(acc);
+            ++n;
+        } else {
+            eval_net_run(ctrl, &r, best, 0);
+        }
+    }
+    return n;
 }
 
 /* Best-first over the runs' bounds: stop when no run left can reach the best. */
-static void search_runs(const qnav_ctrl_t *ctrl, run_t *runs, uint16_t n, best_t *best)
+static void search_runs(const qnav_ctrl_t *ctrl, pending_t *runs, uint16_t n, uint16_t goal,
+                        best_t *best)
 {
     uint16_t i;
     for (;;) {
-        run_t *top = 0;
+        pending_t *top = 0;
+        run_t r;
         for (i = 0; i < n; ++i) {
             if (runs[i].bound >= 0 && (top == 0 || runs[i].bound > top->bound)) {
                 top = &runs[i];
@@ -512,7 +588,11 @@ static void search_runs(const qnav_ctrl_t *ctrl, run_t *runs, uint16_t n, best_t
         if (top == 0 || top->bound < best->q) {
             return;
         }
-        eval_run(ctrl, top, 1u, (uint16_t)(top->count - 1u), best, 0);
+        r.first = top->first;
+        r.count = top->count;
+        r.level = top->level;
+        run_shape(&r, goal);
+        eval_net_run(ctrl, &r, best, 0);
         top->bound = -1;
     }
 }
@@ -521,8 +601,8 @@ static void search_runs(const qnav_ctrl_t *ctrl, run_t *runs, uint16_t n, best_t
  * end nearest the goal, which the tie order also prefers. */
 static void prob_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best)
 {
-    uint16_t k = (uint16_t)(r->dir > 0 ? 0u : r->count - 1u);
-    uint8_t dtheta = run_dtheta(r, k);
+    uint8_t k = (uint8_t)(r->dir > 0 ? 0u : r->count - 1u);
+    uint8_t dtheta = (uint8_t)(r->dir > 0 ? r->dtheta0 : r->dtheta0 - k);
     consider(best, prob_quality(ctrl, r->level, dtheta), (uint16_t)(r->first + k), dtheta);
 }
 
@@ -543,7 +623,7 @@ static void stop_output(qnav_ctrl_output_t *out, uint8_t flags, qnav_q1_15_t *qu
 void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
                     qnav_ctrl_output_t *out, qnav_q1_15_t *qualities)
 {
-    run_t runs[QNAV_MAX_RUNS];
+    pending_t runs[QNAV_MAX_RUNS];
     run_iter_t it;
     run_t r;
     best_t best;
@@ -562,24 +642,24 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     best.dtheta = 0;
     best.heading = 0;
     run_iter_start(&it, ctrl, in->ranges_mm, bearing_deg(in->goal_bearing_cdeg));
-    while (run_iter_next(&it, &r)) {
-        if (qualities != 0 || ctrl->kind == QNAV_KIND_TABLE) {
-            eval_run(ctrl, &r, 0u, r.count, &best, qualities);
-        } else if (ctrl->kind == (uint8_t)QNAV_POLICY_PROB) {
-            prob_run(ctrl, &r, &best);
-        } else {
-            bound_run(ctrl, &r, &best);
-            if (r.bound >= 0) {
-                if (n < QNAV_MAX_RUNS) {
-                    runs[n++] = r;
+    if (ctrl->kind == (uint8_t)QNAV_POLICY_NET && qualities == 0) {
+        n = bound_runs(ctrl, &it, runs, QNAV_MAX_RUNS, &best);
+        search_runs(ctrl, runs, n, it.goal, &best);
+    } else {
+        while (run_iter_next(&it, &r)) {
+            if (ctrl->kind == QNAV_KIND_TABLE) {
+                eval_table_run(ctrl, &r, &best, qualities);
+            } else if (qualities != 0) {
+                if (ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
+                    eval_net_run(ctrl, &r, &best, qualities);
                 } else {
-                    /* no room to defer it: evaluate it now, same answer */
-                    eval_run(ctrl, &r, 1u, (uint16_t)(r.count - 1u), &best, 0);
+                    eval_prob_run(ctrl, &r, &best, qualities);
                 }
+            } else {
+                prob_run(ctrl, &r, &best);
             }
         }
     }
-    search_runs(ctrl, runs, n, &best);
     flags = it.flags;
 
     if (best.q <= 0) {

@@ -35,9 +35,9 @@ double ref_quality_bound(const qnav_policy_t *policy)
     for (unsigned j = 0; j < n->hidden; ++j) {
         sum_out += fabs(n->w_out[j] / 256.0);
     }
-    /* docs/qformats.md: pre-activation rounding 2^-12 + weight rounding 106 * 2^-22,
+    /* docs/qformats.md: pre-activation rounding 2^-12 + weight rounding 211 * 2^-20,
      * times the largest slope 1/4, plus the table's rounding and interpolation 2^-15 */
-    const double e_z = 1.0 / 4096 + 106.0 / 4194304.0;
+    const double e_z = 1.0 / 4096 + 211.0 / 1048576.0;
     const double e_sig = 1.0 / 32768 + 1e-6;
     const double e_hidden = 0.25 * e_z + e_sig;
     const double e_share = 1.0 / 65536;    /* rounding of each unit's share */

@@ -63,9 +63,9 @@ typedef struct {
 
 /* Derived, per-hidden-unit network parameters (docs/qformats.md, "network step"). */
 typedef struct {
-    int32_t bias_z;    /* hidden bias, units of 2^-22 */
-    int32_t per_deg;   /* weight per degree of dtheta, units of 2^-22 */
-    int32_t per_level; /* weight per distance level, units of 2^-22 */
+    int32_t bias_z;    /* hidden bias, units of 2^-19 */
+    int32_t per_deg;   /* weight per degree of dtheta, units of 2^-19 */
+    int32_t per_level; /* weight per distance level, units of 2^-19 */
     int16_t out;       /* output weight, Q8.8 */
 } qnav_ctrl_unit_t;
 

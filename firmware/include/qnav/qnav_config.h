@@ -19,9 +19,14 @@
 #define QNAV_DIST_LEVELS 32
 #endif
 
-/* Largest number of hidden units a network policy may have. */
+/* Largest number of hidden units a network policy may have. It sizes qnav_net_t and
+ * the step's scratch arrays; the ATmega128 (4 KB RAM) defaults to 16. */
 #ifndef QNAV_MAX_HIDDEN
+#if defined(__AVR__)
+#define QNAV_MAX_HIDDEN 16
+#else
 #define QNAV_MAX_HIDDEN 32
+#endif
 #endif
 
 /* Hidden units of a newly made network policy when nothing else is asked for. */
@@ -31,11 +36,11 @@
 #define QNAV_MAX_SECTORS 360
 
 /* Network mode keeps up to this many runs of paths (docs/architecture.md) on the stack,
- * 8 bytes each, to search them best first; a scan with more runs (more sectors) evaluates
+ * 6 bytes each, to search them best first; a scan with more runs (more sectors) evaluates
  * the rest at once, with the same result. A scan of N sectors has at most N + 3 runs. */
 #ifndef QNAV_MAX_RUNS
 #if defined(__AVR__)
-#define QNAV_MAX_RUNS 40
+#define QNAV_MAX_RUNS 36
 #else
 #define QNAV_MAX_RUNS (QNAV_MAX_SECTORS + 3)
 #endif
