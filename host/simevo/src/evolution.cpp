@@ -25,6 +25,9 @@ const char *evolution_params_problem(const EvolutionParams &p)
     if (!(p.mutation_clip > 0.0 && p.mutation_clip <= 256.0)) {
         return "mutation_clip: must be in (0, 256]";
     }
+    if (p.episodes_per_candidate < 1 || p.episodes_per_candidate > 1000) {
+        return "episodes_per_candidate: must be 1..1000";
+    }
     if (!(p.init_scale > 0.0 && p.init_scale <= 128.0)) {
         return "init_scale: must be in (0, 128]";
     }
@@ -162,19 +165,23 @@ Candidate Evolution::propose()
     return c;
 }
 
-void Evolution::accept(const Candidate &c, const EpisodeOutcome &out)
+void Evolution::accept(const Candidate &c, const EpisodeOutcome &out, const EpisodeOutcome *parent_out)
 {
     if (!pending_ || c.episode != episode_) {
         return;
     }
     pending_ = false;
+    if (parent_out != nullptr && c.parent >= 0) {
+        Member &p = pop_[static_cast<std::size_t>(c.parent)];
+        p.fitness = (p.fitness * p.evaluations + parent_out->R) / (p.evaluations + 1);
+        ++p.evaluations;
+    }
     const int32_t slot = c.slot >= 0 ? c.slot : worst_index();
     pop_[slot].policy = c.policy;
     pop_[slot].fitness = out.R;
+    pop_[slot].evaluations = 1;
     pop_[slot].evaluated = true;
-    if (out.R > best_so_far_) {
-        best_so_far_ = out.R;
-    }
+    best_so_far_ = pop_[static_cast<std::size_t>(best_index())].fitness;
     ++episode_;
 }
 

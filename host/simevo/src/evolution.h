@@ -46,8 +46,13 @@ struct EvolutionParams {
     uint32_t population = 40;      /* members, >= 2 */
     double epsilon = 0.1;          /* probability of mutating a random member, [0, 1] */
     uint32_t hidden = 12;          /* hidden units of new networks, 1..QNAV_MAX_HIDDEN */
-    double mutation_scale = 1.0;   /* Cauchy scale, weight units (assumed; paper: none) */
+    double mutation_scale = 0.3;   /* Cauchy scale, weight units (assumed; paper: none) */
     double mutation_clip = 10.0;   /* Cauchy samples clipped to [-clip, clip] (paper) */
+    uint32_t episodes_per_candidate = 1; /* episodes averaged into one fitness value (paper:
+                                            1; assumed larger in docs/simevo.md) */
+    bool reevaluate_parent = true;   /* each step also runs the parent for one episode and
+                                        folds it into the parent's mean fitness (noisy
+                                        fitness; docs/simevo.md, "Deviations") */
     InitKind init = InitKind::Cauchy;
     double init_scale = 1.0;       /* see InitKind, weight units */
 };
@@ -64,7 +69,8 @@ uint32_t policy_fingerprint(const qnav_policy_t &policy);
 
 struct Member {
     qnav_policy_t policy{};
-    double fitness = 0.0;   /* R of the episode it was scored on */
+    double fitness = 0.0;   /* mean R of the episodes it was scored on */
+    uint32_t evaluations = 0; /* episodes behind fitness */
     bool evaluated = false; /* false until its first episode */
 };
 
@@ -91,8 +97,10 @@ public:
      * result replaces the worst member.
      */
     Candidate propose();
-    /* Record the candidate's outcome (must follow the matching propose()). */
-    void accept(const Candidate &c, const EpisodeOutcome &out);
+    /* Record the candidate's outcome (must follow the matching propose()). parent_out,
+     * when not null, is the re-evaluation of the parent (reevaluate_parent). */
+    void accept(const Candidate &c, const EpisodeOutcome &out,
+                const EpisodeOutcome *parent_out = nullptr);
 
     uint64_t episodes_done() const { return episode_; }
     /* Index of the best evaluated member (ties: lowest index); -1 if none evaluated. */
@@ -101,6 +109,7 @@ public:
      * (ties: lowest index). */
     int32_t worst_index() const;
     const std::vector<Member> &members() const { return pop_; }
+    /* Fitness of the best member after the last accept() (-inf before any). */
     double best_so_far() const { return best_so_far_; }
     const EvolutionParams &params() const { return params_; }
 

@@ -138,6 +138,8 @@ int main(int argc, char **argv)
     evolve->add_option("--hidden", ep.hidden, "hidden units of random networks")->capture_default_str();
     evolve->add_option("--mutation-scale", ep.mutation_scale, "Cauchy scale, weight units")->capture_default_str();
     evolve->add_option("--mutation-clip", ep.mutation_clip, "Cauchy clip, weight units")->capture_default_str();
+    evolve->add_option("--per-candidate", ep.episodes_per_candidate, "episodes averaged per fitness value")->capture_default_str();
+    evolve->add_flag("--reevaluate-parent", ep.reevaluate_parent, "also re-run the parent each step (noisy fitness)");
     evolve->add_option("--out", out_dir, "output folder")->capture_default_str();
 
     // eval: a policy over held-out episodes

@@ -190,7 +190,7 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
     if (auto *n = root.get("evolution")) {
         const toml::table &t = p.table(*n, "evolution");
         p.only_keys(t, {"population", "epsilon", "hidden", "mutation_scale", "mutation_clip",
-                        "init", "init_scale"},
+                        "episodes_per_candidate", "reevaluate_parent", "init", "init_scale"},
                     "evolution");
         EvolutionParams &e = spec.evolution;
         if (auto *v = t.get("population")) {
@@ -207,6 +207,15 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
         }
         if (auto *v = t.get("mutation_clip")) {
             e.mutation_clip = p.number(*v, "mutation_clip", 1e-6, 256.0);
+        }
+        if (auto *v = t.get("episodes_per_candidate")) {
+            e.episodes_per_candidate = static_cast<uint32_t>(p.integer(*v, "episodes_per_candidate", 1, 1000));
+        }
+        if (auto *v = t.get("reevaluate_parent")) {
+            if (!v->is_boolean()) {
+                p.fail(*v, "reevaluate_parent: expected true or false");
+            }
+            e.reevaluate_parent = *v->value<bool>();
         }
         if (auto *v = t.get("init")) {
             const std::string s = p.str(*v, "init");

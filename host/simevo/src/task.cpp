@@ -21,7 +21,7 @@ namespace qnav {
 
 namespace {
 
-const char *kJournalHeader = "episode,R,f1,f2,tau_c,reached,parent,explored,policy,best_so_far\n";
+const char *kJournalHeader = "episode,R,f1,f2,tau_c,reached,parent,explored,policy,parent_R,best_fitness\n";
 const char *kEvalHeader = "eval_episode,R,f1,f2,tau_c,reached\n";
 
 std::vector<std::string> split_csv(const std::string &line)
@@ -210,6 +210,32 @@ bool run_eval(EpisodeRunner &runner, const qnav_policy_t &policy, const TaskDef 
     return true;
 }
 
+/* Fitness of a policy over k episodes: mean R, f1, f2; tau_c summed; reached = all
+ * reached. Episode j of evaluation `index` runs with mix_seed(base, index * k + j). */
+EpisodeOutcome run_k(EpisodeRunner &runner, const qnav_policy_t &policy, uint64_t base, uint64_t index, uint32_t k)
+{
+    if (k <= 1) {
+        return runner.run(policy, mix_seed(base, index));
+    }
+    EpisodeOutcome sum;
+    sum.reached = true;
+    for (uint32_t j = 0; j < k; ++j) {
+        const EpisodeOutcome o = runner.run(policy, mix_seed(base, index * k + j));
+        sum.R += o.R;
+        sum.f1 += o.f1;
+        sum.f2 += o.f2;
+        sum.tau_c += o.tau_c;
+        sum.reached = sum.reached && o.reached;
+    }
+    sum.R /= k;
+    sum.f1 /= k;
+    sum.f2 /= k;
+    return sum;
+}
+
+/* Seeds of parent re-evaluations: a stream apart from the candidates'. */
+uint64_t parent_base(const TaskDef &t) { return mix_seed(t.episode_seed_base, 0x706172656e74ull); }
+
 } // namespace
 
 std::string task_settings_text(const TaskDef &t, const std::string &source_fingerprint)
@@ -226,7 +252,8 @@ std::string task_settings_text(const TaskDef &t, const std::string &source_finge
         o << "episodes=" << t.episodes << "\n"
           << "population=" << e.population << " epsilon=" << e.epsilon
           << " hidden=" << e.hidden << " mutation_scale=" << e.mutation_scale
-          << " mutation_clip=" << e.mutation_clip
+          << " mutation_clip=" << e.mutation_clip << " episodes_per_candidate=" << e.episodes_per_candidate
+          << " reevaluate_parent=" << (e.reevaluate_parent ? 1 : 0)
           << " init=" << (e.init == InitKind::Cauchy ? "cauchy" : "uniform")
           << " init_scale=" << e.init_scale << "\n"
           << "evolution_seed=" << t.evolution_seed << "\n"
@@ -257,7 +284,7 @@ std::vector<double> read_journal_R(const std::string &csv_path)
     for (std::size_t i = 1; i < L.lines.size(); ++i) {
         const auto f = split_csv(L.lines[i]);
         double r = 0.0;
-        if (f.size() != 10 || !parse_double(f[1], r)) {
+        if (f.size() != 11 || !parse_double(f[1], r)) {
             throw UserError(csv_path + ":" + std::to_string(i + 1) + ": malformed row");
         }
         R.push_back(r);
@@ -356,17 +383,22 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
                 const auto f = split_csv(L.lines[i]);
                 uint64_t ep = 0;
                 EpisodeOutcome o;
-                if (f.size() != 10 || !parse_u64(f[0], ep) || !parse_outcome(f, 1, o)) {
+                if (f.size() != 11 || !parse_u64(f[0], ep) || !parse_outcome(f, 1, o)) {
                     throw UserError(where + "malformed journal row");
                 }
                 const Candidate c = evo.propose();
+                EpisodeOutcome po;
+                const bool has_parent = t.evolution.reevaluate_parent && c.parent >= 0;
+                if (has_parent != !f[9].empty() || (has_parent && !parse_double(f[9], po.R))) {
+                    throw UserError(where + "parent re-evaluation missing or unexpected");
+                }
                 char fp[16];
                 std::snprintf(fp, sizeof fp, "%08" PRIx32, policy_fingerprint(c.policy));
                 if (ep != c.episode || f[8] != fp) {
                     throw UserError(where + "journal does not match this program and settings "
                                             "(episode or policy differs); use another --out");
                 }
-                evo.accept(c, o);
+                evo.accept(c, o, has_parent ? &po : nullptr);
                 keep = L.ends[i];
             }
             if (obs.episodes_done && evo.episodes_done() > 0) {
@@ -398,12 +430,20 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
             return false;
         }
         const Candidate c = evo.propose();
-        const EpisodeOutcome o = runner->run(c.policy, mix_seed(t.episode_seed_base, c.episode));
-        evo.accept(c, o);
-        char row[320];
-        std::snprintf(row, sizeof row, "%" PRIu64 ",%s,%d,%d,%08" PRIx32 ",%.17g\n", c.episode,
+        const uint32_t k = t.evolution.episodes_per_candidate;
+        const EpisodeOutcome o = run_k(*runner, c.policy, t.episode_seed_base, c.episode, k);
+        const bool has_parent = t.evolution.reevaluate_parent && c.parent >= 0;
+        EpisodeOutcome po;
+        char parent_r[40] = "";
+        if (has_parent) {
+            po = run_k(*runner, evo.members()[static_cast<std::size_t>(c.parent)].policy, parent_base(t), c.episode, k);
+            std::snprintf(parent_r, sizeof parent_r, "%.17g", po.R);
+        }
+        evo.accept(c, o, has_parent ? &po : nullptr);
+        char row[360];
+        std::snprintf(row, sizeof row, "%" PRIu64 ",%s,%d,%d,%08" PRIx32 ",%s,%.17g\n", c.episode,
                       fmt_outcome(o).c_str(), static_cast<int>(c.parent), c.explored ? 1 : 0,
-                      policy_fingerprint(c.policy), evo.best_so_far());
+                      policy_fingerprint(c.policy), parent_r, evo.best_so_far());
         write_all(fd, row, journal_path);
         if (obs.episodes_done) {
             obs.episodes_done(1, false);
