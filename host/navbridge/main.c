@@ -47,6 +47,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: navbridge --device PATH [--baud N] [--lcm-url URL] [--mode offboard|onboard]\n"
             "                 [--policy FILE] [--upload] [--timeout-ms N] [--log FILE]\n"
+            "                 [--goal DEG[:METRES]]\n"
             "       navbridge --replay LOG [--policy FILE]\n"
             "  --device PATH      serial port to the board (or the SIL robot's pty)\n"
             "  --baud N           serial rate, default 57600\n"
@@ -56,6 +57,9 @@ static void usage(FILE *f)
             "  --upload           onboard: upload --policy to the board at start\n"
             "  --timeout-ms N     stop the robot after N ms without scans/heartbeats (300)\n"
             "  --log FILE         also write every published message to an LCM log\n"
+            "  --goal DEG[:M]     start with a goal: bearing in the board's heading frame,\n"
+            "                     degrees CCW, optional distance in metres (QNAV_GOAL later\n"
+            "                     messages replace it)\n"
             "  --replay LOG       re-run LOG's scans, compare with its commands, exit\n");
 }
 
@@ -99,10 +103,13 @@ int main(int argc, char **argv)
         {"policy", required_argument, NULL, 'p'},  {"upload", no_argument, NULL, 'U'},
         {"timeout-ms", required_argument, NULL, 't'}, {"log", required_argument, NULL, 'l'},
         {"replay", required_argument, NULL, 'r'},  {"help", no_argument, NULL, 'h'},
+        {"goal", required_argument, NULL, 'g'},
         {NULL, 0, NULL, 0}};
     const char *device = NULL, *lcm_url = NULL, *policy_path = NULL, *log_path = NULL;
     const char *replay_path = NULL;
     long baud = 57600, timeout_ms = 300;
+    int have_goal = 0;
+    qnav_goal_t start_goal;
     char err[QNAV_POLICY_IO_ERRLEN];
     qnav_bridge_config_t cfg;
     static qnav_bridge_t bridge;
@@ -147,6 +154,28 @@ int main(int argc, char **argv)
                 return 2;
             }
             break;
+        case 'g': {
+            char *end = NULL;
+            double deg = strtod(optarg, &end);
+            double dist = 0.0;
+            if (end != optarg && *end == ':') {
+                char *end2 = NULL;
+                dist = strtod(end + 1, &end2);
+                end = (end2 == end + 1) ? end : end2;
+            }
+            if (end == optarg || *end != '\0' || !(deg >= -180.0 && deg <= 180.0) ||
+                !(dist >= 0.0 && dist <= 2000.0)) {
+                fprintf(stderr, "navbridge: --goal %s: expected DEG[:METRES], DEG in "
+                                "-180..180, METRES in 0..2000\n", optarg);
+                return 2;
+            }
+            memset(&start_goal, 0, sizeof start_goal);
+            start_goal.goal_id = 1;
+            start_goal.bearing_cdeg = (int16_t)(deg >= 180.0 ? -18000 : (int)(deg * 100.0));
+            start_goal.distance_mm = (int32_t)(dist * 1000.0);
+            have_goal = 1;
+            break;
+        }
         case 'h': usage(stdout); return 0;
         default:
             if (optopt != 0) {
@@ -236,6 +265,10 @@ int main(int argc, char **argv)
     bridge.diag = stderr;
     gctx.bridge = &bridge;
     sub = qnav_goal_t_subscribe(lcm, QNAV_CH_GOAL, on_goal, &gctx);
+    if (have_goal) {
+        start_goal.utime = qnav_bridge_utime();
+        qnav_bridge_on_goal(&bridge, &start_goal, mono_ms());
+    }
     fprintf(stderr, "navbridge: %s mode on %s at %ld baud, watchdog %ld ms\n",
             cfg.mode == QNAV_LINK_MODE_OFFBOARD ? "offboard" : "onboard", device, baud,
             timeout_ms);

@@ -353,6 +353,25 @@ static void test_onboard_upload_delivers_the_policy_file_to_the_board(void **sta
     fakeboard_close(&fb);
 }
 
+static void test_start_goal_is_relayed_to_the_board(void **state)
+{
+    const char *args[] = {"--lcm-url", "memq://", "--goal", "-30.5:4", NULL};
+    uint8_t p[64];
+    fakeboard_t fb;
+    qnav_link_goal_t g;
+    int n;
+    (void)state;
+    assert_int_equal(fakeboard_start(&fb, EXE, g_dir, args), 0);
+    n = fakeboard_wait(&fb, QNAV_LINK_MSG_GOAL, 3000, p, sizeof p, NULL);
+    assert_int_equal(n, QNAV_LINK_GOAL_BYTES);
+    assert_int_equal(qnav_link_goal_unpack(p, (uint16_t)n, &g), 0);
+    assert_int_equal(g.goal_id, 1);
+    assert_int_equal(g.bearing_cdeg, -3050);
+    assert_int_equal(g.distance_mm, 4000);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, 3000), 0);
+    fakeboard_close(&fb);
+}
+
 /* Run navbridge with args; expect exit 2 and one stderr line containing needle. */
 static void expect_refusal(const char *const *argv, const char *needle)
 {
@@ -379,6 +398,7 @@ static void test_bad_options_and_files_fail_with_one_line(void **state)
     const char *tmo[] = {EXE, "--device", "/dev/null", "--timeout-ms", "abc", NULL};
     const char *pol[] = {EXE, "--device", "/dev/null", "--policy", bad_policy, NULL};
     const char *unknown[] = {EXE, "--frobnicate", NULL};
+    const char *goal[] = {EXE, "--device", "/dev/null", "--goal", "200", NULL};
     (void)state;
     snprintf(bad_policy, sizeof bad_policy, "%s/bad.policy", g_dir);
     f = fopen(bad_policy, "w");
@@ -392,6 +412,7 @@ static void test_bad_options_and_files_fail_with_one_line(void **state)
     expect_refusal(tmo, "--timeout-ms abc");
     expect_refusal(pol, "bad.policy:");
     expect_refusal(unknown, "--frobnicate");
+    expect_refusal(goal, "--goal 200");
 }
 
 int main(void)
@@ -402,6 +423,7 @@ int main(void)
         cmocka_unit_test(test_watchdog_stops_robot_within_its_timeout),
         cmocka_unit_test(test_sigint_stops_robot_before_exit),
         cmocka_unit_test(test_onboard_upload_delivers_the_policy_file_to_the_board),
+        cmocka_unit_test(test_start_goal_is_relayed_to_the_board),
         cmocka_unit_test(test_bad_options_and_files_fail_with_one_line),
     };
     return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
