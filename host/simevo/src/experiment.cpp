@@ -446,12 +446,13 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
     S.conditions.push_back(prob);
 
     const ConditionSummary &direct = S.conditions[labels.size() - 1];
-    auto pct = [](double a, double b) { return b != 0.0 ? (a - b) / std::fabs(b) * 100.0 : std::nan(""); };
+    auto pct = [](double a, double b) { return std::fabs(b) >= 1.0 ? (a - b) / std::fabs(b) * 100.0 : std::nan(""); };
     for (std::size_t i = 0; i + 1 < labels.size(); ++i) {
         const ConditionSummary &c = S.conditions[i];
         Comparison cmp;
         cmp.a = c.label;
         cmp.b = "direct";
+        cmp.difference = c.final_mean - direct.final_mean;
         cmp.improvement_pct = pct(c.final_mean, direct.final_mean);
         cmp.speedup_pct = (c.episodes_to_90 > 0 && direct.episodes_to_90 > 0)
                               ? (direct.episodes_to_90 - c.episodes_to_90) / direct.episodes_to_90 * 100.0
@@ -466,6 +467,7 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
         Comparison cmp;
         cmp.a = c.label;
         cmp.b = "probabilistic";
+        cmp.difference = c.final_mean - prob.final_mean;
         cmp.improvement_pct = pct(c.final_mean, prob.final_mean);
         cmp.speedup_pct = std::nan("");
         cmp.test = "one-sample";
@@ -562,6 +564,7 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
     for (std::size_t i = 0; i < S.comparisons.size(); ++i) {
         const Comparison &c = S.comparisons[i];
         o << "    {\"a\": " << json_str(c.a) << ", \"b\": " << json_str(c.b)
+          << ", \"difference\": " << json_num(c.difference)
           << ", \"improvement_pct\": " << json_num(c.improvement_pct)
           << ", \"speedup_pct\": " << json_num(c.speedup_pct) << ", \"test\": " << json_str(c.test)
           << ", \"t\": " << json_num(c.t.valid ? c.t.statistic : std::nan(""))
@@ -601,14 +604,15 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
           << (prob ? "-" : (c.episodes_to_90 > 0 ? fmt(c.episodes_to_90, 0) : "n/a")) << " | "
           << fmt(100.0 * c.reached_rate, 0) << "% |\n";
     }
-    o << "\n| comparison | improvement | faster to 90% | test | p | Mann-Whitney p |\n|---|---|---|---|---|---|\n";
+    o << "\n| comparison | difference in R | improvement | faster to 90% | test | p | Mann-Whitney p |\n|---|---|---|---|---|---|---|\n";
     for (const Comparison &c : S.comparisons) {
-        o << "| " << c.a << " vs " << c.b << " | " << fmt(c.improvement_pct, 1) << "% | "
+        o << "| " << c.a << " vs " << c.b << " | " << fmt(c.difference) << " | "
+          << (std::isfinite(c.improvement_pct) ? fmt(c.improvement_pct, 1) + "%" : "n/a") << " | "
           << (std::isfinite(c.speedup_pct) ? fmt(c.speedup_pct, 0) + "%" : "-") << " | "
           << (c.test == "welch" ? "Welch t" : "one-sample t") << " | " << fmt_p(c.t) << " | "
           << (c.b == "probabilistic" ? "-" : fmt_p(c.mann_whitney)) << " |\n";
     }
-    o << "\nImprovement = (mean_a − mean_b) / |mean_b|. Episodes to 90% = first learning-curve point at "
+    o << "\nImprovement = (mean_a − mean_b) / |mean_b| (n/a when |mean_b| < 1). Episodes to 90% = first learning-curve point at "
          "which the mean curve has covered 90% of its rise from its first to its last point. "
          "The probabilistic policy's p-value is a one-sample t-test of the runs against its held-out mean.\n\n";
     if (plots) {

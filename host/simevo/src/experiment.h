@@ -52,7 +52,9 @@ struct ConditionSummary {
 
 struct Comparison {
     std::string a, b;
-    double improvement_pct = 0;  /* (mean_a - mean_b) / |mean_b| * 100 */
+    double difference = 0;       /* mean_a - mean_b, R units */
+    double improvement_pct = 0;  /* (mean_a - mean_b) / |mean_b| * 100; NaN when
+                                    |mean_b| < 1 (a percentage of almost nothing) */
     double speedup_pct = 0;      /* (T90_b - T90_a) / T90_b * 100; NaN if n/a */
     std::string test;            /* "welch" (runs vs runs) or "one-sample" (runs vs the
                                     probabilistic policy's held-out mean) */
