@@ -40,6 +40,7 @@ Environment parse_environment(std::string_view text, const std::string &name) {
     r.only_keys(root, {"name", "episode_limit_s", "arena", "destination", "start_zone",
                        "circle", "box"});
     Environment env;
+    env.source = name;
     env.name = r.string(root, "name");
     if (env.name.empty()) r.fail(root, "'name' must not be empty");
     env.episode_limit_s = r.number(root, "episode_limit_s", 0.1, 36000.0);
@@ -150,7 +151,7 @@ void check_clearance(const Environment &env, double clearance_m) {
         auto refuse = [&](const char *what) {
             char buf[64];
             std::snprintf(buf, sizeof buf, "%.3f", clearance_m);
-            throw SimError(QNAV_SIM_E_WORLD, line_prefix(env.name, line) + "start zone is closer than the robot radius (" + buf + " m) to " + what);
+            throw SimError(QNAV_SIM_E_WORLD, line_prefix(env.source.empty() ? env.name : env.source, line) + "start zone is closer than the robot radius (" + buf + " m) to " + what);
         };
         for (const Shape &s : obs)
             if (shape_distance(zs, s) < clearance_m) refuse("an obstacle");

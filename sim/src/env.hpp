@@ -25,6 +25,7 @@ struct StartZone {
 
 struct Environment {
     std::string name;
+    std::string source;                  // file (or name) it was read from, for messages
     double width_m = 10, height_m = 10;  // arena [0, width] x [0, height], m
     double dest_x_m = 5, dest_y_m = 9, dest_radius_m = 0.3;
     double episode_limit_s = 30;

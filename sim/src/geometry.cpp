@@ -108,11 +108,13 @@ double ray_hit(const Shape &s, Vec2 p, Vec2 u) {
 }
 
 bool angular_span(const Shape &s, Vec2 p, double *lo, double *hi) {
+    constexpr double kWiden = 1e-4;
     if (s.kind == Shape::kCircle) {
         const Vec2 d = s.c - p;
-        const double dist = norm(d);
-        if (dist <= s.r) return false;
-        const double mid = std::atan2(d.y, d.x), half = std::asin(s.r / dist);
+        const double d2 = dot(d, d), r2 = s.r * s.r;
+        if (d2 <= r2) return false;
+        const double mid = fast_atan2(d.y, d.x);
+        const double half = fast_atan2(s.r, std::sqrt(d2 - r2)) + kWiden;
         *lo = wrap_pi(mid - half);
         *hi = *lo + 2.0 * half;
         return true;
@@ -122,18 +124,17 @@ bool angular_span(const Shape &s, Vec2 p, double *lo, double *hi) {
     // shape seen from outside spans less than pi, so the relative angles do not wrap.
     const Vec2 d0 = s.v[0] - p;
     if (dot(d0, d0) == 0.0) return false;
-    const double ref = std::atan2(d0.y, d0.x);
     double mn = 0, mx = 0;
     for (int i = 1; i < s.n; ++i) {
         const Vec2 d = s.v[i] - p;
         if (dot(d, d) == 0.0) return false;
-        const double a = wrap_pi(std::atan2(d.y, d.x) - ref);
+        const double a = fast_atan2(cross(d0, d), dot(d0, d));
         mn = std::min(mn, a);
         mx = std::max(mx, a);
     }
-    if (mx - mn >= kPi) return false;  // p on the segment's line between its ends
-    *lo = wrap_pi(ref + mn);
-    *hi = *lo + (mx - mn);
+    if (mx - mn >= kPi - 1e-9) return false;  // p on the segment's line between its ends
+    *lo = wrap_pi(fast_atan2(d0.y, d0.x) + mn - kWiden);
+    *hi = *lo + (mx - mn) + 2.0 * kWiden;
     return true;
 }
 

@@ -23,10 +23,25 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Wrap an angle to (-pi, pi].
 inline double wrap_pi(double a) {
-    a = std::fmod(a, 2.0 * kPi);
-    if (a <= -kPi) a += 2.0 * kPi;
-    if (a > kPi) a -= 2.0 * kPi;
+    if (a > 8.0 * kPi || a < -8.0 * kPi) a = std::fmod(a, 2.0 * kPi);
+    while (a <= -kPi) a += 2.0 * kPi;
+    while (a > kPi) a -= 2.0 * kPi;
     return a;
+}
+
+// atan2 to within 1e-5 rad (Abramowitz & Stegun 4.4.49 polynomial after reduction to
+// [-1, 1]); used where the sonar only needs to know which sectors an angle falls in.
+inline double fast_atan2(double y, double x) {
+    const double ax = std::fabs(x), ay = std::fabs(y);
+    if (ax == 0.0 && ay == 0.0) return 0.0;
+    const bool swap = ay > ax;
+    const double t = swap ? ax / ay : ay / ax;
+    const double t2 = t * t;
+    double r = t * (0.99997726 + t2 * (-0.33262347 + t2 * (0.19354346 + t2 * (-0.11643287 +
+                   t2 * (0.05265332 + t2 * -0.01172120)))));
+    if (swap) r = 0.5 * kPi - r;
+    if (x < 0) r = kPi - r;
+    return y < 0 ? -r : r;
 }
 
 struct Shape {
@@ -48,6 +63,8 @@ double nearest_point(const Shape &s, Vec2 p, Vec2 *out);
 double ray_hit(const Shape &s, Vec2 p, Vec2 u);
 // Angular extent [lo, hi] (rad, hi - lo < pi, lo in (-pi, pi]) of the shape seen from p,
 // which must be outside it. Returns false when p is inside or on the shape.
+// Computed with fast_atan2 and widened by 1e-4 rad on each side (a superset is harmless:
+// callers only use it to decide which rays to test).
 bool angular_span(const Shape &s, Vec2 p, double *lo, double *hi);
 // Smallest distance between two shapes (0 when they touch or overlap).
 double shape_distance(const Shape &a, const Shape &b);

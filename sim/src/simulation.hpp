@@ -79,7 +79,7 @@ private:
     void build_world();
     void compute_scan();
     void drive_substep(double dt);
-    bool touching(Vec2 *contact) const;
+    bool touching(Vec2 *contact);
 
     RobotProfile robot_;
     Environment env_;
@@ -102,6 +102,10 @@ private:
     Vec2 start_{}, pos_{};
     double start_heading_ = 0, heading_ = 0;
     double wheel_l_ = 0, wheel_r_ = 0;  // wheel surface speeds, m/s
+    Vec2 vel_{};                        // body velocity, world frame, m/s
+    double omega_ = 0;                  // body turn rate, rad/s
+    double clearance_m_ = 0;            // centre to nearest surface after the last step, m
+    bool body_stale_ = false;           // Box2D body not moved since free steps
     double cmd_heading_deg_ = 0, cmd_speed_ = 0;  // last command, as given
     double target_heading_ = 0, target_speed_ = 0;  // this tick, with actuation noise
     std::vector<double> true_dist_;

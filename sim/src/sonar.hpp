@@ -4,7 +4,9 @@
 // casting a Box2D ray per degree: for a convex shape the nearest point inside a wedge is
 // either the shape's nearest point (when that lies in the wedge) or a hit of one of the
 // wedge's two boundary rays, so a tick costs one nearest-point test per shape and one ray
-// test per sector boundary the shape spans.
+// test per sector boundary the shape spans. The arena walls (the inside of a rectangle)
+// are treated apart: a ray's wall distance is its exit distance from the rectangle, and
+// each wall's nearest point is the foot of the perpendicular.
 #pragma once
 
 #include <cstdint>
@@ -16,9 +18,10 @@ namespace qnav {
 
 class SonarRing {
 public:
-    // shapes: every obstacle and wall; n_sectors 1..360; reach_m: centre distances beyond
-    // it are not computed (reported as kInf).
-    SonarRing(std::vector<Shape> shapes, std::uint16_t n_sectors, double reach_m);
+    // shapes: every obstacle; the arena is [0, width] x [0, height]; n_sectors 1..360;
+    // reach_m: obstacles farther than this from the centre are skipped (kInf).
+    SonarRing(std::vector<Shape> shapes, double width_m, double height_m,
+              std::uint16_t n_sectors, double reach_m);
     // True centre distances (m) of the nearest obstacle point per sector for a robot at
     // pos with heading (rad, world frame); kInf where nothing is within reach.
     void measure(Vec2 pos, double heading, double *dist_m) const;
@@ -29,6 +32,7 @@ public:
 
 private:
     std::vector<Shape> shapes_;
+    double width_m_, height_m_;
     std::uint16_t n_;
     double width_;      // sector width, rad
     double reach_;      // m

@@ -1,0 +1,264 @@
+/*
+ * Bad input: malformed robot profiles and environments, a start zone inside an obstacle
+ * or outside the arena, a destination inside an obstacle, impossible parameters and a
+ * mismatched controller each give one "FILE:LINE: problem" (or "FIELD: problem") line and
+ * an error status, never a crash; qnav-sim prints that line and exits non-zero, and its
+ * good runs write complete pictures and environment files.
+ */
+#include "sim_test_util.hpp"
+
+#include <cmath>
+#include <string>
+#include <unistd.h>
+#include <sys/wait.h>
+
+#include "qnav/ctrl.h"
+#include "qnav/policy.h"
+
+static qnav_sim_status_t parse_env(const std::string &text, std::string *msg) {
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_env_t *env = (qnav_sim_env_t *)0x1;
+    const qnav_sim_status_t st = qnav_sim_env_parse(text.data(), text.size(), "bad.toml", &env, err, sizeof err);
+    if (st == QNAV_SIM_OK) qnav_sim_env_free(env);
+    else assert_null(env);
+    *msg = err;
+    return st;
+}
+
+static std::string read_data(const char *rel) {
+    const std::string path = std::string(QNAV_TEST_DATA_DIR) + "/" + rel;
+    std::FILE *f = std::fopen(path.c_str(), "rb");
+    assert_non_null(f);
+    std::string text;
+    char buf[4096];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+    std::fclose(f);
+    return text;
+}
+
+static qnav_sim_status_t parse_robot(const std::string &text, std::string *msg) {
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_robot_t *r = nullptr;
+    const qnav_sim_status_t st = qnav_sim_robot_parse(text.data(), text.size(), "bad.toml", &r, err, sizeof err);
+    if (st == QNAV_SIM_OK) qnav_sim_robot_free(r);
+    *msg = err;
+    return st;
+}
+
+static bool starts_with(const std::string &s, const char *p) { return s.rfind(p, 0) == 0; }
+static bool one_line(const std::string &s) { return !s.empty() && s.find('\n') == std::string::npos; }
+
+static void test_committed_profiles_and_environments_load(void **state) {
+    (void)state;
+    const char *robots[] = {"robots/pioneer3dx.toml", "robots/tekbot.toml"};
+    const char *envs[] = {"envs/open.toml", "envs/single.toml", "envs/dense.toml"};
+    std::string msg;
+    for (const char *r : robots) assert_int_equal(parse_robot(read_data(r), &msg), QNAV_SIM_OK);
+    for (const char *e : envs) assert_int_equal(parse_env(read_data(e), &msg), QNAV_SIM_OK);
+}
+
+static void test_toml_syntax_error_names_file_and_line(void **state) {
+    (void)state;
+    std::string msg;
+    assert_int_equal(parse_env("name = \"x\"\nepisode_limit_s = 3\n[arena\nwidth_m = 1\n", &msg), QNAV_SIM_E_PARSE);
+    assert_true(starts_with(msg, "bad.toml:3:"));
+    assert_true(one_line(msg));
+}
+
+static void test_missing_table_and_bad_values_name_their_line(void **state) {
+    (void)state;
+    std::string msg;
+    std::string text = test_env_text("");
+    std::string no_dest = text;
+    no_dest.erase(no_dest.find("[destination]"), std::string("[destination]\nx_m = 9.0\ny_m = 9.0\nradius_m = 0.3\n").size());
+    assert_int_equal(parse_env(no_dest, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("missing table [destination]") != std::string::npos);
+
+    std::string neg = text;
+    neg.replace(neg.find("radius_m = 0.3"), 14, "radius_m = -1.0");
+    assert_int_equal(parse_env(neg, &msg), QNAV_SIM_E_PARSE);
+    assert_true(starts_with(msg, "bad.toml:9:"));
+    assert_true(msg.find("radius_m") != std::string::npos);
+
+    std::string typo = text + "[[circle]]\nx_m = 5.0\ny_m = 5.0\nraduis_m = 1.0\n";
+    assert_int_equal(parse_env(typo, &msg), QNAV_SIM_E_PARSE);
+    assert_true(starts_with(msg, "bad.toml:18:"));
+    assert_true(msg.find("unknown key 'raduis_m'") != std::string::npos);
+
+    std::string word = text;
+    word.replace(word.find("width_m = 10.0"), 14, "width_m = \"ten\"");
+    assert_int_equal(parse_env(word, &msg), QNAV_SIM_E_PARSE);
+    assert_true(starts_with(msg, "bad.toml:4:"));
+    assert_true(msg.find("must be a number") != std::string::npos);
+}
+
+static void test_start_zone_inside_an_obstacle_is_refused_with_its_line(void **state) {
+    (void)state;
+    std::string msg;
+    // The start zone (lines 10-14) is at (0.5..1, 0.5..1); a circle at (1, 1).
+    assert_int_equal(parse_env(test_env_text("[[circle]]\nx_m = 1.0\ny_m = 1.0\nr_m = 0.4\n"), &msg),
+                     QNAV_SIM_E_WORLD);
+    assert_true(starts_with(msg, "bad.toml:10:"));
+    assert_true(msg.find("overlaps the obstacle at line 15") != std::string::npos);
+    std::string out = test_env_text("");
+    out.replace(out.find("w_m = 0.5"), 9, "w_m = 20.0");
+    assert_int_equal(parse_env(out, &msg), QNAV_SIM_E_WORLD);
+    assert_true(msg.find("leaves the arena") != std::string::npos);
+    assert_int_equal(parse_env(test_env_text("[[box]]\nx_m = 9.0\ny_m = 9.0\nw_m = 1\nh_m = 1\n"), &msg),
+                     QNAV_SIM_E_WORLD);
+    assert_true(msg.find("destination lies inside") != std::string::npos);
+}
+
+static void test_bad_robot_profiles_are_refused(void **state) {
+    (void)state;
+    std::string good = read_data("robots/pioneer3dx.toml"), msg;
+    std::string t1 = good;
+    t1.replace(t1.find("range_min_m = 0.1"), 17, "range_min_m = 6.0");
+    assert_int_equal(parse_robot(t1, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("'range_min_m' must be below 'range_max_m'") != std::string::npos);
+    std::string t2 = good;
+    t2.replace(t2.find("back_ticks = 5"), 14, "back_ticks = 50");
+    assert_int_equal(parse_robot(t2, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("'back_ticks' exceeds 'ticks'") != std::string::npos);
+    std::string t3 = good;
+    t3.erase(t3.find("v_max_mps"), t3.find('\n', t3.find("v_max_mps")) - t3.find("v_max_mps") + 1);
+    assert_int_equal(parse_robot(t3, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("missing key 'v_max_mps'") != std::string::npos);
+    std::string t4 = good;
+    t4.replace(t4.find("default_sectors = 16"), 20, "default_sectors = 400");
+    assert_int_equal(parse_robot(t4, &msg), QNAV_SIM_E_PARSE);
+    assert_true(starts_with(msg, "bad.toml:"));
+    assert_true(one_line(msg));
+}
+
+static void test_missing_file_is_an_io_error_naming_it(void **state) {
+    (void)state;
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_env_t *env = nullptr;
+    assert_int_equal(qnav_sim_env_load("/nonexistent/x.toml", &env, err, sizeof err), QNAV_SIM_E_IO);
+    assert_null(env);
+    assert_string_equal(err, "/nonexistent/x.toml:0: cannot open file");
+}
+
+static void test_impossible_parameters_are_refused_by_field(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_config_t cfg;
+    qnav_sim_t *sim = nullptr;
+    qnav_sim_config_default(&cfg);
+    cfg.n_sectors = 361;
+    assert_int_equal(qnav_sim_create(t.robot, t.env, &cfg, &sim, err, sizeof err), QNAV_SIM_E_PARAM);
+    assert_true(starts_with(err, "n_sectors:"));
+    qnav_sim_config_default(&cfg);
+    cfg.sensor_noise = -0.1;
+    assert_int_equal(qnav_sim_create(t.robot, t.env, &cfg, &sim, err, sizeof err), QNAV_SIM_E_PARAM);
+    assert_true(starts_with(err, "sensor_noise:"));
+    qnav_sim_config_default(&cfg);
+    cfg.actuation_noise = NAN;
+    assert_int_equal(qnav_sim_create(t.robot, t.env, &cfg, &sim, err, sizeof err), QNAV_SIM_E_PARAM);
+    assert_true(starts_with(err, "actuation_noise:"));
+    assert_null(sim);
+    // A start zone that a small robot fits but the Pioneer does not.
+    qnav_sim_env_t *tight = nullptr;
+    const std::string text = test_env_text("[[circle]]\nx_m = 1.25\ny_m = 1.3\nr_m = 0.2\n");
+    assert_int_equal(qnav_sim_env_parse(text.data(), text.size(), "tight.toml", &tight, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_config_default(&cfg);
+    assert_int_equal(qnav_sim_create(t.robot, tight, &cfg, &sim, err, sizeof err), QNAV_SIM_E_WORLD);
+    assert_true(starts_with(err, "tight.toml:10: start zone is closer than the robot radius"));
+    qnav_sim_env_free(tight);
+}
+
+static void test_mismatched_controller_is_refused(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
+    qnav_policy_t pol;
+    qnav_policy_prob_default(&pol);
+    qnav_ctrl_config_t cc;
+    qnav_ctrl_config_default(&cc);
+    cc.n_sectors = 8;
+    cc.max_range_mm = 5000;
+    qnav_ctrl_t ctrl;
+    assert_int_equal(qnav_ctrl_init(&ctrl, &cc, &pol), QNAV_OK);
+    qnav_sim_result_t r;
+    assert_int_equal(qnav_sim_run_episode(t.sim, &ctrl, 0, &r, NULL, NULL), QNAV_SIM_E_PARAM);
+}
+
+// Run qnav-sim with args; returns its exit status and its stderr+stdout.
+static int run_tool(const std::string &args, std::string *out) {
+    const std::string cmd = std::string(QNAV_SIM_TOOL) + " " + args + " 2>&1";
+    FILE *p = popen(cmd.c_str(), "r");
+    assert_non_null(p);
+    char buf[1024];
+    out->clear();
+    while (fgets(buf, sizeof buf, p)) out->append(buf);
+    const int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static void test_cli_prints_one_line_and_fails_on_bad_input(void **state) {
+    (void)state;
+    std::string out;
+    assert_int_not_equal(run_tool("run --env /nonexistent/env.toml", &out), 0);
+    assert_string_equal(out.c_str(), "/nonexistent/env.toml:0: cannot open file\n");
+    assert_int_not_equal(run_tool("run --sectors 400", &out), 0);
+    assert_true(one_line(out.substr(0, out.size() - 1)));
+    assert_true(out.find("--sectors") != std::string::npos);
+    assert_int_not_equal(run_tool("run --sensor-noise -1", &out), 0);
+    assert_int_not_equal(run_tool("gen-env --density 0.9 --out /tmp/never.toml", &out), 0);
+    assert_int_not_equal(access("/tmp/never.toml", F_OK), 0);
+}
+
+static void test_cli_runs_an_episode_and_writes_a_complete_picture(void **state) {
+    (void)state;
+    char dir[] = "/tmp/qnav_sim_test_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    const std::string svg = std::string(dir) + "/ep.svg", envf = std::string(dir) + "/gen.toml";
+    std::string out;
+    const std::string data = std::string("--robot ") + QNAV_TEST_DATA_DIR + "/robots/tekbot.toml --env " +
+                             QNAV_TEST_DATA_DIR + "/envs/dense.toml";
+    assert_int_equal(run_tool("run " + data + " --sectors 16 --sensor-noise 0 --actuation-noise 0 --svg " + svg + " --svg-tick 5", &out), 0);
+    assert_true(out.find("episode 0:") != std::string::npos);
+    assert_true(out.find(" R ") != std::string::npos);
+    std::FILE *f = std::fopen(svg.c_str(), "rb");
+    assert_non_null(f);
+    std::string text;
+    char buf[4096];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+    std::fclose(f);
+    assert_true(starts_with(text, "<?xml"));
+    assert_true(text.find("</svg>") != std::string::npos);
+    assert_true(text.find("<polyline") != std::string::npos);  // the path
+    assert_int_equal(run_tool("gen-env --density 0.15 --seed 3 --robot " + std::string(QNAV_TEST_DATA_DIR) +
+                              "/robots/pioneer3dx.toml --out " + envf, &out), 0);
+    char err[QNAV_SIM_ERRLEN];
+    qnav_sim_env_t *env = nullptr;
+    assert_int_equal(qnav_sim_env_load(envf.c_str(), &env, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_env_info_t info;
+    qnav_sim_env_info(env, &info);
+    assert_true(info.n_obstacles >= 5);
+    qnav_sim_env_free(env);
+    std::remove(svg.c_str());
+    std::remove(envf.c_str());
+    rmdir(dir);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_committed_profiles_and_environments_load),
+        cmocka_unit_test(test_toml_syntax_error_names_file_and_line),
+        cmocka_unit_test(test_missing_table_and_bad_values_name_their_line),
+        cmocka_unit_test(test_start_zone_inside_an_obstacle_is_refused_with_its_line),
+        cmocka_unit_test(test_bad_robot_profiles_are_refused),
+        cmocka_unit_test(test_missing_file_is_an_io_error_naming_it),
+        cmocka_unit_test(test_impossible_parameters_are_refused_by_field),
+        cmocka_unit_test(test_mismatched_controller_is_refused),
+        cmocka_unit_test(test_cli_prints_one_line_and_fails_on_bad_input),
+        cmocka_unit_test(test_cli_runs_an_episode_and_writes_a_complete_picture),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

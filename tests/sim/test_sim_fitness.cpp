@@ -1,0 +1,116 @@
+/*
+ * Fitness (paper Eq. 1-3): f1 and f2 are the ratio of actual to best, inverted past the
+ * best; R = 1 f1 + 10 f2 - tau_c; a robot that never moves has l < beta_l (footnote 1);
+ * beta_tau is the shortest time from rest with the profile's acceleration and top speed;
+ * reaching the destination ends the episode.
+ */
+#include "sim_test_util.hpp"
+
+#include <cmath>
+
+#include "qnav/ctrl.h"
+#include "qnav/policy.h"
+
+static const double kPiD = 3.14159265358979323846;
+
+static void test_f1_f2_and_R_follow_equations_1_to_3(void **state) {
+    (void)state;
+    qnav_sim_result_t r{};
+    r.l = 5;
+    r.beta_l = 10;
+    r.tau_l = 30;
+    r.beta_tau = 10;
+    r.tau_c = 4;
+    qnav_sim_fitness(&r);
+    assert_true(std::fabs(r.f1 - 0.5) < 1e-12);
+    assert_true(std::fabs(r.f2 - 1.0 / 3.0) < 1e-12);
+    assert_true(std::fabs(r.R - (0.5 + 10.0 / 3.0 - 4.0)) < 1e-12);
+    r.l = 20;  // longer than best: inverted
+    r.tau_l = 5;  // faster than "best": ratio
+    r.tau_c = 0;
+    qnav_sim_fitness(&r);
+    assert_true(std::fabs(r.f1 - 0.5) < 1e-12);
+    assert_true(std::fabs(r.f2 - 0.5) < 1e-12);
+    assert_true(std::fabs(r.R - 5.5) < 1e-12);
+    r.l = 10;
+    r.tau_l = 10;
+    qnav_sim_fitness(&r);
+    assert_true(std::fabs(r.R - 11.0) < 1e-12);  // the best possible episode
+}
+
+static void test_robot_that_never_moves_scores_only_the_time_term(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
+    qnav_sim_reset(t.sim, 4);
+    qnav_sim_command_raw(t.sim, 0.0, 0.0);
+    qnav_sim_state_t st;
+    int n = 0;
+    do {
+        qnav_sim_advance(t.sim);
+        qnav_sim_state(t.sim, &st);
+        ++n;
+    } while (!st.done && n < 1000);
+    qnav_sim_result_t r;
+    qnav_sim_result(t.sim, &r);
+    assert_false(r.reached);
+    assert_int_equal(r.ticks, 200);  // the 20 s limit
+    assert_true(r.l < 1e-9);
+    assert_true(r.f1 < 1e-9);  // footnote: l < beta_l, so f1 = l / beta_l = 0
+    assert_true(std::fabs(r.tau_l - 20.0) < 1e-9);
+    assert_true(std::fabs(r.f2 - r.beta_tau / 20.0) < 1e-12);
+    assert_true(std::fabs(r.R - 10.0 * r.beta_tau / 20.0) < 1e-12);
+}
+
+static void test_beta_l_and_beta_tau_come_from_the_start_and_the_profile(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
+    qnav_sim_reset(t.sim, 4);
+    qnav_sim_place(t.sim, 1.0, 1.0, 0.0);
+    qnav_sim_result_t r;
+    qnav_sim_result(t.sim, &r);
+    const double beta_l = std::sqrt(2.0) * 8.0 - 0.3;  // to the edge of the destination
+    assert_true(std::fabs(r.beta_l - beta_l) < 1e-9);
+    // From rest at 0.3 m/s^2 to 1 m/s (1.667 m), then cruise.
+    const double beta_tau = 1.0 / 0.3 + (beta_l - 1.0 / 0.6) / 1.0;
+    assert_true(std::fabs(r.beta_tau - beta_tau) < 1e-9);
+}
+
+static void test_reaching_the_destination_ends_the_episode_with_a_high_score(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", "", "open", 16, 0, 0);
+    qnav_policy_t pol;
+    qnav_policy_prob_default(&pol);
+    qnav_ctrl_config_t cc;
+    qnav_sim_ctrl_config(t.sim, &cc);
+    assert_int_equal(cc.n_sectors, 16);
+    assert_int_equal(cc.max_range_mm, 5000);
+    qnav_ctrl_t ctrl;
+    assert_int_equal(qnav_ctrl_init(&ctrl, &cc, &pol), QNAV_OK);
+    qnav_sim_result_t r;
+    int reached = 0;
+    for (uint64_t e = 0; e < 5; ++e) {
+        assert_int_equal(qnav_sim_run_episode(t.sim, &ctrl, e, &r, NULL, NULL), QNAV_SIM_OK);
+        if (!r.reached) continue;
+        ++reached;
+        assert_true(r.ticks < 300);
+        assert_int_equal(r.tau_c, 0);
+        assert_true(r.f1 > 0.8);
+        assert_true(r.R > 5.0);
+        assert_true(std::fabs(r.tau_l - r.ticks * QNAV_SIM_TICK_S) < 1e-9);
+    }
+    assert_true(reached >= 4);  // the open arena is easy for the hand-tuned policy
+    (void)kPiD;
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_f1_f2_and_R_follow_equations_1_to_3),
+        cmocka_unit_test(test_robot_that_never_moves_scores_only_the_time_term),
+        cmocka_unit_test(test_beta_l_and_beta_tau_come_from_the_start_and_the_profile),
+        cmocka_unit_test(test_reaching_the_destination_ends_the_episode_with_a_high_score),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,190 @@
+/*
+ * Sensing: a known obstacle at a known bearing appears in the right sector with the right
+ * range (robot frame counter-clockwise, ranges from the body surface, clipped to the
+ * profile's [min, max]); the destination bearing; and the analytic sonar against a
+ * brute-force fan of fine rays at random poses in the dense environment.
+ */
+#include "sim_test_util.hpp"
+
+#include <cmath>
+#include <vector>
+
+#include "env.hpp"
+#include "geometry.hpp"
+#include "rng.hpp"
+#include "sonar.hpp"
+
+static const double kPiD = 3.14159265358979323846;
+
+// Circle of radius 0.3 m whose centre is 2 m from (5, 5) at world angle 45 deg.
+static std::string env_with_circle_at_45() {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "[[circle]]\nx_m = %.9f\ny_m = %.9f\nr_m = 0.3\n",
+                  5.0 + 2.0 * std::cos(kPiD / 4), 5.0 + 2.0 * std::sin(kPiD / 4));
+    return test_env_text(buf);
+}
+
+static void test_obstacle_at_45_deg_appears_in_sector_2_of_16_at_surface_range(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", env_with_circle_at_45(), nullptr, 16, 0, 0);
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
+    qnav_sim_scan_t s;
+    assert_int_equal(qnav_sim_scan(t.sim, &s), QNAV_SIM_OK);
+    assert_int_equal(s.n_sectors, 16);
+    assert_int_equal(s.max_range_mm, 5000);
+    // 2.0 m to the centre - 0.3 m obstacle radius - 0.26 m robot radius.
+    assert_int_equal(s.ranges_mm[2], 1440);
+    // Neighbours see the walls, not the circle (it spans 45 +- 8.6 deg, inside 33.75..56.25).
+    assert_true(s.ranges_mm[1] > 4000);
+    assert_true(s.ranges_mm[3] > 4000);
+    // Sector 0 faces the wall x = 10 square on: 5 m - 0.26 m.
+    assert_int_equal(s.ranges_mm[0], 4740);
+    // Sector 4 faces y = 10: same.
+    assert_int_equal(s.ranges_mm[4], 4740);
+}
+
+static void test_sector_without_perpendicular_foot_reads_its_nearest_edge_ray(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
+    qnav_sim_reset(t.sim, 1);
+    qnav_sim_place(t.sim, 5.0, 5.0, 0.0);
+    qnav_sim_scan_t s;
+    qnav_sim_scan(t.sim, &s);
+    // Sector 1 spans 11.25..33.75 deg: its nearest wall point lies on the 11.25 deg edge.
+    const double expect = 5.0 / std::cos(11.25 * kPiD / 180.0) - 0.26;
+    assert_int_equal(s.ranges_mm[1], (int)std::lround(expect * 1000.0));
+    assert_int_equal(s.ranges_mm[15], (int)std::lround(expect * 1000.0));
+}
+
+static void test_turned_robot_sees_the_obstacle_clockwise_of_ahead(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", env_with_circle_at_45(), nullptr, 16, 0, 0);
+    qnav_sim_reset(t.sim, 1);
+    qnav_sim_place(t.sim, 5.0, 5.0, kPiD / 2);  // facing +y: obstacle at -45 deg
+    qnav_sim_scan_t s;
+    qnav_sim_scan(t.sim, &s);
+    assert_int_equal(s.ranges_mm[14], 1440);
+    assert_true(s.ranges_mm[2] > 4000);
+}
+
+static void test_ranges_clip_to_profile_min_and_max(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 4, 0, 0);
+    qnav_sim_reset(t.sim, 1);
+    // 0.3 m from the wall x = 10: surface gap 0.04 m, below the 0.1 m minimum.
+    qnav_sim_place(t.sim, 9.7, 5.0, 0.0);
+    qnav_sim_scan_t s;
+    qnav_sim_scan(t.sim, &s);
+    assert_int_equal(s.ranges_mm[0], 100);
+    // Behind: 9.7 m to x = 0, beyond the 5 m maximum.
+    assert_int_equal(s.ranges_mm[2], 5000);
+}
+
+static void test_goal_bearing_is_robot_relative_in_centidegrees(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 8, 0, 0);
+    qnav_sim_reset(t.sim, 1);
+    qnav_sim_place(t.sim, 5.0, 5.0, 0.0);  // destination (9, 9): 45 deg left
+    qnav_sim_scan_t s;
+    qnav_sim_scan(t.sim, &s);
+    assert_int_equal(s.goal_bearing_cdeg, 4500);
+    qnav_sim_place(t.sim, 5.0, 5.0, kPiD / 2);
+    qnav_sim_scan(t.sim, &s);
+    assert_int_equal(s.goal_bearing_cdeg, -4500);
+    qnav_sim_place(t.sim, 5.0, 5.0, -3.0 * kPiD / 4);  // facing away
+    qnav_sim_scan(t.sim, &s);
+    assert_int_equal(s.goal_bearing_cdeg, -18000);
+}
+
+static void test_one_sector_reads_the_nearest_obstacle_all_round(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", env_with_circle_at_45(), nullptr, 1, 0, 0);
+    qnav_sim_reset(t.sim, 1);
+    qnav_sim_place(t.sim, 5.0, 5.0, 1.0);
+    qnav_sim_scan_t s;
+    qnav_sim_scan(t.sim, &s);
+    assert_int_equal(s.ranges_mm[0], 1440);
+}
+
+// Brute force: nearest hit over a fan of rays 0.01 deg apart inside each sector.
+static void test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment(void **state) {
+    (void)state;
+    char err[QNAV_SIM_ERRLEN];
+    qnav_sim_env_t *env = nullptr;
+    const std::string path = std::string(QNAV_TEST_DATA_DIR) + "/envs/dense.toml";
+    assert_int_equal(qnav_sim_env_load(path.c_str(), &env, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_env_info_t info;
+    qnav_sim_env_info(env, &info);
+    qnav::Environment e;
+    {
+        // Re-read through the C++ loader to get the shapes.
+        std::FILE *f = std::fopen(path.c_str(), "rb");
+        assert_non_null(f);
+        std::string text;
+        char buf[4096];
+        size_t n;
+        while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+        std::fclose(f);
+        e = qnav::parse_environment(text, path);
+    }
+    std::vector<qnav::Shape> shapes = e.obstacle_shapes();
+    std::vector<qnav::Shape> all = shapes;
+    for (const auto &w : e.wall_shapes()) all.push_back(w);
+    qnav::Rng rng;
+    rng.seed(7, 7, 7);
+    const unsigned sector_counts[] = {3, 8, 16, 32, 180};
+    int compared = 0;
+    for (unsigned n : sector_counts) {
+        qnav::SonarRing ring(shapes, e.width_m, e.height_m, static_cast<uint16_t>(n), 100.0);
+        std::vector<double> dist(n);
+        for (int trial = 0; trial < 6; ++trial) {
+            qnav::Vec2 p;
+            qnav::Vec2 q;
+            bool free;
+            do {
+                p = {rng.uniform(0.3, 9.7), rng.uniform(0.3, 9.7)};
+                free = true;
+                for (const auto &s : shapes)
+                    if (qnav::nearest_point(s, p, &q) < 0.3) free = false;
+            } while (!free);
+            const double h = rng.uniform(-kPiD, kPiD);
+            ring.measure(p, h, dist.data());
+            const double w = 2 * kPiD / n;
+            for (unsigned k = 0; k < n; ++k) {
+                double best = qnav::kInf;
+                const int steps = static_cast<int>(std::ceil(w * 180 / kPiD * 50));
+                for (int i = 0; i <= steps; ++i) {
+                    const double a = h + k * w - w / 2 + w * i / steps;
+                    const qnav::Vec2 u{std::cos(a), std::sin(a)};
+                    for (const auto &s : all) best = std::min(best, qnav::ray_hit(s, p, u));
+                }
+                // The fan can only overestimate the true minimum, and by very little.
+                assert_true(dist[k] <= best + 1e-9);
+                assert_true(best - dist[k] < 0.003);
+                ++compared;
+            }
+        }
+    }
+    assert_true(compared > 1000);  // 6 poses x (3+8+16+32+180) sectors
+    qnav_sim_env_free(env);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_obstacle_at_45_deg_appears_in_sector_2_of_16_at_surface_range),
+        cmocka_unit_test(test_sector_without_perpendicular_foot_reads_its_nearest_edge_ray),
+        cmocka_unit_test(test_turned_robot_sees_the_obstacle_clockwise_of_ahead),
+        cmocka_unit_test(test_ranges_clip_to_profile_min_and_max),
+        cmocka_unit_test(test_goal_bearing_is_robot_relative_in_centidegrees),
+        cmocka_unit_test(test_one_sector_reads_the_nearest_obstacle_all_round),
+        cmocka_unit_test(test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
