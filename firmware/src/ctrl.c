@@ -16,7 +16,7 @@
  * (implementation-defined in C99; true on gcc, avr-gcc and arm-none-eabi-gcc). */
 typedef char qnav_arith_shift_check[((-8 >> 1) == -4) ? 1 : -1];
 
-static int16_t sat16(int32_t v)
+static inline int16_t sat16(int32_t v)
 {
     if (v > 32767) {
         return 32767;
@@ -53,7 +53,7 @@ static uint16_t exp_neg_q15(uint32_t u_q16)
     for (k = 8u; k >= 1u; --k) {
         t = 65536u - ((r * t) / k >> 16);
     }
-    v = (t + (1u << n)) >> (n + 1u);
+    v = (t + ((uint32_t)1 << n)) >> (n + 1u);
     return (uint16_t)v;
 }
 
@@ -92,7 +92,7 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     ctrl->full_speed_quality = cfg->full_speed_quality;
     ctrl->level_scale = ((uint32_t)(QNAV_DIST_LEVELS - 1) * 65536u + cfg->max_range_mm / 2u) /
                         cfg->max_range_mm;
-    ctrl->speed_scale = (32768u * 32768u + q_full / 2u) / q_full;
+    ctrl->speed_scale = (32768ul * 32768ul + q_full / 2u) / q_full;
     ctrl->sector_paths = (uint16_t)(QNAV_PATHS / cfg->n_sectors);
     ctrl->sector_span = (uint16_t)(ctrl->sector_paths * cfg->n_sectors);
     ctrl->first_sector_paths = (uint16_t)((QNAV_PATHS / 2u + cfg->n_sectors - 1u) / cfg->n_sectors);
@@ -188,14 +188,14 @@ qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *
  * [-16, 16); out (Q8.8) times h (Q1.15) is below 2^30; >> 8 leaves units of 2^-15, below
  * 2^22 per unit, so 32 units sum below 2^27.
  */
-static int32_t unit_share(int32_t z, int16_t out)
+static inline int32_t unit_share(int32_t z, int16_t out)
 {
     int16_t h = qnav_sigmoid_q5_11(sat16((z + 128) >> 8));
     return ((int32_t)out * h + 128) >> 8;
 }
 
 /* Output unit: acc in units of 2^-15, rounded to Q5.11 and saturated. */
-static qnav_q1_15_t net_output(int32_t acc)
+static inline qnav_q1_15_t net_output(int32_t acc)
 {
     return qnav_sigmoid_q5_11(sat16((acc + 8) >> 4));
 }
@@ -207,12 +207,12 @@ static qnav_q1_15_t prob_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t
 }
 
 /* a * b for a small unsigned b: avr-gcc then uses its 32x16 multiply, not 32x32. */
-static int32_t mul_u8(int32_t a, uint8_t b)
+static inline int32_t mul_u8(int32_t a, uint8_t b)
 {
     return a * (int32_t)b;
 }
 
-static int32_t unit_base(const qnav_ctrl_unit_t *u, uint8_t level)
+static inline int32_t unit_base(const qnav_ctrl_unit_t *u, uint8_t level)
 {
     return u->bias_z + mul_u8(u->per_level, level);
 }
@@ -267,10 +267,16 @@ qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_q1_15_t *table
     return QNAV_OK;
 }
 
-/* Level of a range already known to be at most max_range_mm. */
+/* Level of a range already known to be at most max_range_mm. For ranges of 32 mm and
+ * more the scale fits 16 bits and a 16x16 multiply does (much cheaper on AVR). */
 static uint8_t level_of(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm)
 {
-    uint32_t level = ((uint32_t)range_mm * ctrl->level_scale + 32768u) >> 16;
+    uint32_t level;
+    if (ctrl->level_scale <= 0xFFFFu) {
+        level = ((uint32_t)range_mm * (uint16_t)ctrl->level_scale + 32768u) >> 16;
+    } else {
+        level = ((uint32_t)range_mm * ctrl->level_scale + 32768u) >> 16;
+    }
     return (uint8_t)(level > QNAV_DIST_LEVELS - 1u ? QNAV_DIST_LEVELS - 1u : level);
 }
 
@@ -292,13 +298,24 @@ uint16_t qnav_ctrl_sector_of_path(uint16_t n_sectors, uint16_t path_deg)
     return (uint16_t)(s % n_sectors);
 }
 
-/* Destination bearing in centidegrees to the nearest whole degree in 0..359. */
+/* Destination bearing in centidegrees to the nearest whole degree (halves away from
+ * zero) in 0..359. 16-bit arithmetic: one division, no 32-bit ones (costly on AVR). */
 static uint16_t bearing_deg(qnav_cdeg_t cdeg)
 {
-    int32_t c = cdeg;
-    int32_t d = (c >= 0) ? (c + 50) / 100 : -((-c + 50) / 100);
-    d %= QNAV_PATHS;
-    return (uint16_t)(d < 0 ? d + QNAV_PATHS : d);
+    int16_t d = (int16_t)(cdeg / 100);
+    int16_t rest = (int16_t)(cdeg - d * 100);
+    if (rest >= 50) {
+        ++d;
+    } else if (rest <= -50) {
+        --d;
+    }
+    while (d < 0) {
+        d = (int16_t)(d + QNAV_PATHS);
+    }
+    while (d >= (int16_t)QNAV_PATHS) {
+        d = (int16_t)(d - QNAV_PATHS);
+    }
+    return (uint16_t)d;
 }
 
 /*
@@ -462,6 +479,87 @@ static void eval_table_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best
              (uint8_t)(r->dir > 0 ? r->dtheta0 + top_k : r->dtheta0 - top_k));
 }
 
+/*
+ * Table mode without qualities, the MCU's fast path: one pass over the sectors in path
+ * order with everything in locals; each stretch of a sector along which dtheta moves one
+ * way is scanned with a pointer into its level's row, and only its winner is considered
+ * (ties inside a stretch go to the smaller dtheta: the first path when dtheta rises, the
+ * last when it falls). Same answer as eval_table_run over the runs.
+ */
+static uint8_t table_best(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges, uint16_t goal,
+                          best_t *best)
+{
+    uint16_t path = 0;
+    uint16_t sector = 0;
+    uint16_t phase = QNAV_PATHS / 2u;
+    uint16_t count = ctrl->first_sector_paths;
+    uint16_t offset = goal == 0u ? 0u : (uint16_t)(QNAV_PATHS - goal);
+    uint8_t flags = 0;
+    for (;;) {
+        qnav_mm_t range = ranges[sector];
+        const qnav_q1_15_t *row;
+        uint16_t left = count;
+        if (range > ctrl->max_range_mm) {
+            range = ctrl->max_range_mm;
+            flags |= QNAV_FLAG_RANGE_CLIPPED;
+        }
+        row = &ctrl->table[(uint16_t)level_of(ctrl, range) * QNAV_TABLE_STRIDE];
+        if (left > QNAV_PATHS - path) {
+            left = (uint16_t)(QNAV_PATHS - path);
+        }
+        while (left != 0u) {
+            uint8_t n;
+            uint8_t i;
+            uint8_t k = 0;
+            uint8_t d;
+            qnav_q1_15_t top;
+            const qnav_q1_15_t *p;
+            if (offset < QNAV_DTHETA_MAX) {
+                d = (uint8_t)offset;
+                n = (uint8_t)(left < QNAV_DTHETA_MAX - offset ? left : QNAV_DTHETA_MAX - offset);
+                p = row + d;
+                top = QNAV_FLASH_READ_I16(p);
+                for (i = 1; i < n; ++i) {
+                    qnav_q1_15_t q = QNAV_FLASH_READ_I16(++p);
+                    if (q > top) {
+                        top = q;
+                        k = i;
+                    }
+                }
+                d = (uint8_t)(d + k);
+            } else {
+                d = (uint8_t)(QNAV_PATHS - offset);
+                n = (uint8_t)(left < QNAV_PATHS - offset ? left : QNAV_PATHS - offset);
+                p = row + d;
+                top = QNAV_FLASH_READ_I16(p);
+                for (i = 1; i < n; ++i) {
+                    qnav_q1_15_t q = QNAV_FLASH_READ_I16(--p);
+                    if (q >= top) {
+                        top = q;
+                        k = i;
+                    }
+                }
+                d = (uint8_t)(d - k);
+            }
+            if (top >= best->q) {
+                consider(best, top, (uint16_t)(path + k), d);
+            }
+            path = (uint16_t)(path + n);
+            left = (uint16_t)(left - n);
+            offset = (uint16_t)(offset + n);
+            if (offset >= QNAV_PATHS) {
+                offset = (uint16_t)(offset - QNAV_PATHS);
+            }
+        }
+        if (path >= QNAV_PATHS) {
+            return flags;
+        }
+        phase = (uint16_t)(phase + count * ctrl->n_sectors - QNAV_PATHS);
+        count = (uint16_t)(ctrl->sector_paths + (phase + ctrl->sector_span < QNAV_PATHS ? 1u : 0u));
+        sector = (uint16_t)(sector + 1u == ctrl->n_sectors ? 0u : sector + 1u);
+    }
+}
+
 static void eval_prob_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best,
                           qnav_q1_15_t *qualities)
 {
@@ -514,56 +612,96 @@ static void eval_net_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best,
  * unit per run (the level term). Runs beyond cap are evaluated at once (same answer).
  * Returns the number of runs kept in runs[].
  */
+/* What bound_runs carries per hidden unit from run to run. */
+typedef struct {
+    int32_t c;    /* per_deg * dtheta at the end of the previous run */
+    int32_t span; /* per_deg * (sector_paths - 1) */
+} unit_walk_t;
+
+/* How the dtheta term moves in the current run (see bound_runs). */
+typedef struct {
+    uint8_t level;
+    uint8_t span;     /* paths in the run - 1 */
+    uint8_t q1;       /* sector_paths - 1 */
+    uint8_t up;       /* dtheta rises along the run */
+    uint8_t step_up;  /* the run's first dtheta is above the previous run's last */
+    uint8_t first;    /* first run of the step: c starts from dtheta0 */
+    uint8_t dtheta0;
+} run_walk_t;
+
+/* One unit's largest share over a run; advances its dtheta term to the run's end. Kept
+ * out of line on purpose: inlined, its 32-bit temporaries make avr-gcc spill the loop. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static int32_t bound_unit(const qnav_ctrl_unit_t *u, unit_walk_t *w, const run_walk_t *rw)
+{
+    int32_t base = unit_base(u, rw->level);
+    int32_t c = rw->first ? mul_u8(u->per_deg, rw->dtheta0)
+                          : (rw->step_up ? w->c + u->per_deg : w->c - u->per_deg);
+    int32_t dz;
+    int32_t z0 = base + c;
+    int32_t z1;
+    if (rw->span == rw->q1) {
+        dz = w->span;
+    } else if (rw->span == rw->q1 + 1u) {
+        dz = w->span + u->per_deg;
+    } else {
+        dz = mul_u8(u->per_deg, rw->span);
+    }
+    c = rw->up ? c + dz : c - dz;
+    w->c = c;
+    z1 = base + c;
+    return unit_share(((u->out >= 0) == (z1 > z0)) ? z1 : z0, u->out);
+}
+
+/*
+ * Network, first pass: bound every run. Along a run each hidden unit's pre-activation is
+ * linear in dtheta, and rounding, saturation, the interpolated sigmoid and the output
+ * weight all keep order, so a unit's share is largest at one end, the end where
+ * out * z is larger: one sigmoid per unit bounds the whole run. The dtheta term
+ * c = per_deg * dtheta is carried from run to run (neighbouring paths differ by one
+ * degree) and across a run by precomputed multiples, so the pass multiplies once per
+ * unit per run (the level term). Runs whose bound is below the best so far are dropped;
+ * runs beyond cap are evaluated at once (same answer). Returns the runs kept in runs[].
+ */
 static uint16_t bound_runs(const qnav_ctrl_t *ctrl, run_iter_t *it, pending_t *runs,
                            uint16_t cap, best_t *best)
 {
-    int32_t c[QNAV_MAX_HIDDEN];     /* per_deg * dtheta at the end of the previous run */
-    int32_t span_q[QNAV_MAX_HIDDEN]; /* per_deg * (sector_paths - 1) */
-    uint8_t q1 = (uint8_t)(ctrl->sector_paths > 180u ? 179u : ctrl->sector_paths - 1u);
+    unit_walk_t walk[QNAV_MAX_HIDDEN];
+    run_walk_t rw;
     uint8_t prev_end = 0;
     uint16_t n = 0;
-    uint8_t first = 1;
     uint8_t j;
     run_t r;
+    rw.q1 = (uint8_t)(ctrl->sector_paths > 180u ? 179u : ctrl->sector_paths - 1u);
+    rw.first = 1;
     for (j = 0; j < ctrl->hidden; ++j) {
-        span_q[j] = mul_u8(ctrl->p.unit[j].per_deg, q1);
+        walk[j].span = mul_u8(ctrl->p.unit[j].per_deg, rw.q1);
     }
     while (run_iter_next(it, &r)) {
-        uint8_t span = (uint8_t)(r.count - 1u);
-        uint8_t end = (uint8_t)(r.dir > 0 ? r.dtheta0 + span : r.dtheta0 - span);
         int32_t acc = ctrl->out_bias_z;
+        qnav_q1_15_t bound;
+        rw.level = r.level;
+        rw.span = (uint8_t)(r.count - 1u);
+        rw.up = (uint8_t)(r.dir > 0);
+        rw.step_up = (uint8_t)(r.dtheta0 > prev_end);
+        rw.dtheta0 = r.dtheta0;
         for (j = 0; j < ctrl->hidden; ++j) {
-            const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
-            int32_t base = unit_base(u, r.level);
-            int32_t dz;
-            int32_t z0;
-            int32_t z1;
-            if (first) {
-                c[j] = mul_u8(u->per_deg, r.dtheta0);
-            } else {
-                c[j] = (r.dtheta0 > prev_end) ? c[j] + u->per_deg : c[j] - u->per_deg;
-            }
-            if (span == q1) {
-                dz = span_q[j];
-            } else if (span == q1 + 1u) {
-                dz = span_q[j] + u->per_deg;
-            } else {
-                dz = mul_u8(u->per_deg, span);
-            }
-            z0 = base + c[j];
-            c[j] = (r.dir > 0) ? c[j] + dz : c[j] - dz;
-            z1 = base + c[j];
-            acc += unit_share(((u->out >= 0) == (z1 > z0)) ? z1 : z0, u->out);
+            acc += bound_unit(&ctrl->p.unit[j], &walk[j], &rw);
         }
-        first = 0;
-        prev_end = end;
+        rw.first = 0;
+        prev_end = (uint8_t)(rw.up ? r.dtheta0 + rw.span : r.dtheta0 - rw.span);
+        bound = net_output(acc);
         if (r.count == 1u) {
-            consider(best, net_output(acc), r.first, r.dtheta0); /* the bound is exact */
+            consider(best, bound, r.first, r.dtheta0); /* the bound is exact */
+        } else if (bound < best->q) {
+            /* cannot win: the best only rises */
         } else if (n < cap) {
             runs[n].first = r.first;
             runs[n].count = r.count;
             runs[n].level = r.level;
-            runs[n].bound = net_output(acc);
+            runs[n].bound = bound;
             ++n;
         } else {
             eval_net_run(ctrl, &r, best, 0);
@@ -620,14 +758,50 @@ static void stop_output(qnav_ctrl_output_t *out, uint8_t flags, qnav_q1_15_t *qu
     }
 }
 
-void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
-                    qnav_ctrl_output_t *out, qnav_q1_15_t *qualities)
+/* Network without qualities: bound every run, then search the runs best first. */
+static uint8_t net_best(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges, uint16_t goal,
+                        best_t *best)
 {
     pending_t runs[QNAV_MAX_RUNS];
     run_iter_t it;
+    uint16_t n;
+    qnav_mm_t range = ranges[qnav_ctrl_sector_of_path(ctrl->n_sectors, goal)];
+    /* the path straight at the goal first: a good best prunes runs before they are kept */
+    consider(best, net_quality(ctrl, level_of(ctrl, range > ctrl->max_range_mm ?
+                                                        ctrl->max_range_mm : range), 0),
+             goal, 0);
+    run_iter_start(&it, ctrl, ranges, goal);
+    n = bound_runs(ctrl, &it, runs, QNAV_MAX_RUNS, best);
+    search_runs(ctrl, runs, n, goal, best);
+    return it.flags;
+}
+
+/* Every path through its run: all qualities, or the probabilistic policy's run ends. */
+static uint8_t runs_best(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges, uint16_t goal,
+                         best_t *best, qnav_q1_15_t *qualities)
+{
+    run_iter_t it;
     run_t r;
+    run_iter_start(&it, ctrl, ranges, goal);
+    while (run_iter_next(&it, &r)) {
+        if (ctrl->kind == QNAV_KIND_TABLE) {
+            eval_table_run(ctrl, &r, best, qualities);
+        } else if (ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
+            eval_net_run(ctrl, &r, best, qualities);
+        } else if (qualities != 0) {
+            eval_prob_run(ctrl, &r, best, qualities);
+        } else {
+            prob_run(ctrl, &r, best);
+        }
+    }
+    return it.flags;
+}
+
+void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
+                    qnav_ctrl_output_t *out, qnav_q1_15_t *qualities)
+{
     best_t best;
-    uint16_t n = 0;
+    uint16_t goal;
     uint8_t flags;
     uint32_t speed;
 
@@ -641,26 +815,14 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     best.q = -1;
     best.dtheta = 0;
     best.heading = 0;
-    run_iter_start(&it, ctrl, in->ranges_mm, bearing_deg(in->goal_bearing_cdeg));
-    if (ctrl->kind == (uint8_t)QNAV_POLICY_NET && qualities == 0) {
-        n = bound_runs(ctrl, &it, runs, QNAV_MAX_RUNS, &best);
-        search_runs(ctrl, runs, n, it.goal, &best);
+    goal = bearing_deg(in->goal_bearing_cdeg);
+    if (qualities == 0 && ctrl->kind == QNAV_KIND_TABLE) {
+        flags = table_best(ctrl, in->ranges_mm, goal, &best);
+    } else if (qualities == 0 && ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
+        flags = net_best(ctrl, in->ranges_mm, goal, &best);
     } else {
-        while (run_iter_next(&it, &r)) {
-            if (ctrl->kind == QNAV_KIND_TABLE) {
-                eval_table_run(ctrl, &r, &best, qualities);
-            } else if (qualities != 0) {
-                if (ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
-                    eval_net_run(ctrl, &r, &best, qualities);
-                } else {
-                    eval_prob_run(ctrl, &r, &best, qualities);
-                }
-            } else {
-                prob_run(ctrl, &r, &best);
-            }
-        }
+        flags = runs_best(ctrl, in->ranges_mm, goal, &best, qualities);
     }
-    flags = it.flags;
 
     if (best.q <= 0) {
         out->heading_deg = 0;

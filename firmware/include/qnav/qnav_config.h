@@ -36,11 +36,12 @@
 #define QNAV_MAX_SECTORS 360
 
 /* Network mode keeps up to this many runs of paths (docs/architecture.md) on the stack,
- * 6 bytes each, to search them best first; a scan with more runs (more sectors) evaluates
- * the rest at once, with the same result. A scan of N sectors has at most N + 3 runs. */
+ * 6 bytes each, to search them best first; runs whose bound is already below the best
+ * path are dropped, and a run that finds no room is evaluated at once, with the same
+ * result. A scan of N sectors has at most N + 3 runs. */
 #ifndef QNAV_MAX_RUNS
 #if defined(__AVR__)
-#define QNAV_MAX_RUNS 36
+#define QNAV_MAX_RUNS 24
 #else
 #define QNAV_MAX_RUNS (QNAV_MAX_SECTORS + 3)
 #endif
