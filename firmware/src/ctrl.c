@@ -92,7 +92,7 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     ctrl->full_speed_quality = cfg->full_speed_quality;
     ctrl->level_scale = ((uint32_t)(QNAV_DIST_LEVELS - 1) * 65536u + cfg->max_range_mm / 2u) /
                         cfg->max_range_mm;
-    ctrl->speed_scale = (32768ul * 32768ul + q_full / 2u) / q_full;
+    ctrl->speed_scale = ((uint32_t)32768u * 32768u + q_full / 2u) / q_full;
     ctrl->sector_paths = (uint16_t)(QNAV_PATHS / cfg->n_sectors);
     ctrl->sector_span = (uint16_t)(ctrl->sector_paths * cfg->n_sectors);
     ctrl->first_sector_paths = (uint16_t)((QNAV_PATHS / 2u + cfg->n_sectors - 1u) / cfg->n_sectors);
@@ -629,12 +629,8 @@ typedef struct {
     uint8_t dtheta0;
 } run_walk_t;
 
-/* One unit's largest share over a run; advances its dtheta term to the run's end. Kept
- * out of line on purpose: inlined, its 32-bit temporaries make avr-gcc spill the loop. */
-#if defined(__GNUC__)
-__attribute__((noinline))
-#endif
-static int32_t bound_unit(const qnav_ctrl_unit_t *u, unit_walk_t *w, const run_walk_t *rw)
+/* One unit's largest share over a run; advances its dtheta term to the run's end. */
+static inline int32_t bound_unit(const qnav_ctrl_unit_t *u, unit_walk_t *w, const run_walk_t *rw)
 {
     int32_t base = unit_base(u, rw->level);
     int32_t c = rw->first ? mul_u8(u->per_deg, rw->dtheta0)
