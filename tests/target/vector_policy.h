@@ -12,6 +12,8 @@
 
 /* Seed of the H = 12 network whose quality table is committed in vector_table.h. */
 #define QNAV_VECTORS_NET12_SEED 0x5EED0012ul
+/* Seed of the H = 16 network (hidden weights over the whole Q8.8 range: saturation). */
+#define QNAV_VECTORS_NET16_SEED 0x5EED0016ul
 /* Seed of the H = 32 network (hidden weights over the whole Q8.8 range: saturation). */
 #define QNAV_VECTORS_NET32_SEED 0x5EED0032ul
 
