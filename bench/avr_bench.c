@@ -126,7 +126,8 @@ static void naive_load(void)
 
 /* The straightforward float controller: for every path, its sector's range, the angular
  * distance to the goal, two sigmoid layers with expf; keep the best. Returns the heading. */
-static int16_t naive_float_step(const qnav_mm_t *r, uint16_t n, float goal_deg, float max_mm)
+__attribute__((noinline)) static int16_t naive_float_step(const qnav_mm_t *r, uint16_t n,
+                                                         float goal_deg, float max_mm)
 {
     float best_q = -1.0f;
     int16_t best = 0;
