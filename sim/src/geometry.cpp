@@ -15,10 +15,13 @@ Shape make_circle(double x, double y, double r) {
 
 Shape make_box(double x, double y, double w, double h, double angle_deg) {
     Shape s;
-    s.kind = Shape::kPolygon;
+    s.kind = Shape::kBox;
     s.c = {x, y};
     s.n = 4;
     const double a = angle_deg * kPi / 180.0, ca = std::cos(a), sa = std::sin(a);
+    s.ax = {ca, sa};
+    s.hx = w / 2;
+    s.hy = h / 2;
     const double hx[4] = {-w / 2, w / 2, w / 2, -w / 2};
     const double hy[4] = {-h / 2, -h / 2, h / 2, h / 2};
     for (int i = 0; i < 4; ++i) s.v[i] = {x + ca * hx[i] - sa * hy[i], y + sa * hx[i] + ca * hy[i]};
@@ -45,6 +48,12 @@ static Vec2 nearest_on_segment(Vec2 a, Vec2 b, Vec2 p) {
     return a + t * ab;
 }
 
+// p in the box frame: (along ax, along ax turned +90 deg).
+static inline Vec2 box_local(const Shape &s, Vec2 p) {
+    const Vec2 d = p - s.c;
+    return {dot(d, s.ax), cross(s.ax, d)};
+}
+
 static bool inside_polygon(const Shape &s, Vec2 p) {
     if (s.n < 3) return false;
     for (int i = 0; i < s.n; ++i) {
@@ -64,6 +73,17 @@ double nearest_point(const Shape &s, Vec2 p, Vec2 *out) {
         }
         *out = s.c + (s.r / dist) * d;
         return dist - s.r;
+    }
+    if (s.kind == Shape::kBox) {
+        const Vec2 l = box_local(s, p);
+        const double qx = std::clamp(l.x, -s.hx, s.hx), qy = std::clamp(l.y, -s.hy, s.hy);
+        const double dx = l.x - qx, dy = l.y - qy;
+        if (dx == 0.0 && dy == 0.0) {
+            *out = p;
+            return 0.0;
+        }
+        *out = {s.c.x + qx * s.ax.x - qy * s.ax.y, s.c.y + qx * s.ax.y + qy * s.ax.x};
+        return std::sqrt(dx * dx + dy * dy);
     }
     if (inside_polygon(s, p)) {
         *out = p;
@@ -92,6 +112,25 @@ double ray_hit(const Shape &s, Vec2 p, Vec2 u) {
         const double disc = b * b - c2;
         if (disc < 0) return kInf;
         return b - std::sqrt(disc);
+    }
+    if (s.kind == Shape::kBox) {
+        // Slabs in the box frame.
+        const Vec2 o = box_local(s, p);
+        const double ux = dot(u, s.ax), uy = cross(s.ax, u);
+        double t0 = 0.0, t1 = kInf;
+        const double oo[2] = {o.x, o.y}, uu[2] = {ux, uy}, hh[2] = {s.hx, s.hy};
+        for (int k = 0; k < 2; ++k) {
+            if (uu[k] == 0.0) {
+                if (oo[k] < -hh[k] || oo[k] > hh[k]) return kInf;
+                continue;
+            }
+            double ta = (-hh[k] - oo[k]) / uu[k], tb = (hh[k] - oo[k]) / uu[k];
+            if (ta > tb) std::swap(ta, tb);
+            t0 = std::max(t0, ta);
+            t1 = std::min(t1, tb);
+            if (t0 > t1) return kInf;
+        }
+        return t0;
     }
     double best = kInf;
     const int edges = s.n == 2 ? 1 : s.n;
@@ -139,6 +178,7 @@ bool angular_span(const Shape &s, Vec2 p, double *lo, double *hi) {
 }
 
 double shape_distance(const Shape &a, const Shape &b) {
+    // (Boxes take the polygon path here through their vertices.)
     if (a.kind == Shape::kCircle && b.kind == Shape::kCircle)
         return std::max(0.0, norm(a.c - b.c) - a.r - b.r);
     if (a.kind == Shape::kCircle) {

@@ -45,11 +45,15 @@ inline double fast_atan2(double y, double x) {
 }
 
 struct Shape {
-    enum Kind { kCircle, kPolygon } kind = kCircle;
+    // A box is also a 4-vertex polygon; its own kind lets nearest-point and ray tests
+    // work in the box frame (clamp and slabs) instead of edge by edge.
+    enum Kind { kCircle, kPolygon, kBox } kind = kCircle;
     Vec2 c;            // circle centre, or polygon centroid, m
     double r = 0;      // circle radius, or polygon bounding radius about c, m
     int n = 0;         // polygon vertex count (2 = segment, 4 = box), counter-clockwise
     Vec2 v[4];
+    Vec2 ax{1, 0};     // box: unit vector of its local x axis
+    double hx = 0, hy = 0;  // box: half width and half height, m
 };
 
 Shape make_circle(double x, double y, double r);

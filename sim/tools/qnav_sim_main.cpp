@@ -216,7 +216,21 @@ struct BenchOpts {
     std::string mode = "table";
     std::uint64_t seed = 1;
     double ps = 0, pa = 0;
+    bool fresh = false;
 };
+
+// A seeded random network of `hidden` units, weights uniform in [-4, 4] (Q8.8), like a
+// member of an early evolving population.
+qnav_policy_t random_network(int hidden, std::uint64_t seed, std::uint64_t which) {
+    qnav_policy_t pol;
+    qnav_policy_net_zero(&pol, static_cast<std::uint8_t>(hidden));
+    qnav::Rng rng;
+    rng.seed(seed, 0xbe7c, which);
+    for (std::uint16_t k = 0; k < QNAV_NET_WEIGHTS(pol.u.net.hidden); ++k)
+        *qnav_net_weight(&pol.u.net, k) =
+            static_cast<qnav_q8_8_t>(std::lround(rng.uniform(-4.0, 4.0) * 256.0));
+    return pol;
+}
 
 int cmd_bench(const BenchOpts &o) {
     Loaded l;
@@ -224,19 +238,22 @@ int cmd_bench(const BenchOpts &o) {
     make_sim(l, o.sectors, o.ps, o.pa, o.seed);
     qnav::Simulation &sim = *l.sim->sim;
     qnav_policy_t pol;
-    if (!o.policy.empty()) {
+    std::string what;
+    if (o.policy == "prob") {
+        qnav_policy_prob_default(&pol);
+        what = "probabilistic (default)";
+    } else if (!o.policy.empty()) {
         pol = read_policy(o.policy);
+        what = o.policy;
     } else {
-        // A seeded random network, like a member of an early evolving population.
-        qnav_policy_net_zero(&pol, static_cast<std::uint8_t>(o.hidden));
-        qnav::Rng rng;
-        rng.seed(o.seed, 0xbe7c, 0);
-        for (std::uint16_t k = 0; k < QNAV_NET_WEIGHTS(pol.u.net.hidden); ++k)
-            *qnav_net_weight(&pol.u.net, k) = static_cast<qnav_q8_8_t>(std::lround(rng.uniform(-4.0, 4.0) * 256.0));
+        pol = random_network(o.hidden, o.seed, 0);
+        what = o.fresh ? "a new random network per episode, " + std::to_string(o.hidden) + " hidden"
+                       : "random network, " + std::to_string(o.hidden) + " hidden";
     }
     std::vector<qnav_q1_15_t> tbuf;
     qnav_ctrl_t ctrl;
     init_ctrl(l.sim, pol, o.mode == "table", tbuf, &ctrl);
+    double build_s = 0;
     using Clock = std::chrono::steady_clock;
     auto pass = [&](bool profiling, std::uint64_t *ticks, double *sum_r) {
         sim.set_profiling(profiling);
@@ -245,6 +262,17 @@ int cmd_bench(const BenchOpts &o) {
         *sum_r = 0;
         const auto t0 = Clock::now();
         for (unsigned e = 0; e < o.episodes; ++e) {
+            if (o.fresh) {
+                // As in evolution: every episode scores a new network, compiled to a
+                // table first in table mode (counted as controller time).
+                const auto b0 = Clock::now();
+                init_ctrl(l.sim, random_network(o.hidden, o.seed, e + 1), o.mode == "table", tbuf, &ctrl);
+                const double b = std::chrono::duration<double>(Clock::now() - b0).count();
+                if (profiling) {
+                    sim.profile().controller_s += b;
+                    build_s += b;
+                }
+            }
             const qnav_sim_result_t r = sim.run_episode(&ctrl, e, nullptr, nullptr);
             *ticks += r.ticks;
             *sum_r += r.R;
@@ -262,7 +290,7 @@ int cmd_bench(const BenchOpts &o) {
     std::printf("bench: robot %s  env %s  sectors %d  policy %s  controller %s mode  episodes %u  "
                 "noise %.3f/%.3f\n",
                 o.robot.c_str(), sim.env().name.c_str(), o.sectors,
-                o.policy.empty() ? ("random network, " + std::to_string(o.hidden) + " hidden").c_str() : o.policy.c_str(),
+                what.c_str(),
                 o.mode.c_str(), o.episodes, o.ps, o.pa);
     std::printf("episodes/s per core: %.1f   (%.0f ticks/s, %.1f ticks/episode, %.2f us/tick, mean R %.3f)\n",
                 o.episodes / wall, ticks / wall, static_cast<double>(ticks) / o.episodes,
@@ -274,6 +302,9 @@ int cmd_bench(const BenchOpts &o) {
     std::printf("per tick: physics %.2f us  sonar %.2f us  controller %.2f us\n",
                 1e6 * p.physics_s / static_cast<double>(ticks2), 1e6 * p.sonar_s / static_cast<double>(ticks2),
                 1e6 * p.controller_s / static_cast<double>(ticks2));
+    if (o.fresh)
+        std::printf("controller includes building each network (and its table): %.1f us/episode\n",
+                    1e6 * build_s / o.episodes);
     if (ticks != ticks2 || sum_r != sum_r2) {
         std::fprintf(stderr, "bench: profiled and plain passes differ (determinism broken)\n");
         return 1;
@@ -324,7 +355,9 @@ int main(int argc, char **argv) {
     bench->add_option("--env", bo.env, "environment")->capture_default_str();
     bench->add_option("--sectors", bo.sectors, "sonar sectors")->check(CLI::Range(1, 360))->capture_default_str();
     bench->add_option("--hidden", bo.hidden, "hidden units of the random network")->check(CLI::Range(1, QNAV_MAX_HIDDEN))->capture_default_str();
-    bench->add_option("--policy", bo.policy, "use this policy file instead of a random network")->check(CLI::ExistingFile);
+    bench->add_option("--policy", bo.policy, "policy file, or 'prob' for the hand-tuned policy (default: a random network)")
+        ->check(CLI::ExistingFile | CLI::IsMember({"prob"}));
+    bench->add_flag("--fresh-network", bo.fresh, "a new random network for every episode, as in evolution");
     bench->add_option("--episodes", bo.episodes, "episodes per pass")->check(CLI::Range(1u, 10000000u))->capture_default_str();
     bench->add_option("--mode", bo.mode, "controller mode")->check(CLI::IsMember({"table", "network"}))->capture_default_str();
     bench->add_option("--seed", bo.seed, "context and network seed")->capture_default_str();

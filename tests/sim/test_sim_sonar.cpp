@@ -113,6 +113,26 @@ static void test_one_sector_reads_the_nearest_obstacle_all_round(void **state) {
     assert_int_equal(s.ranges_mm[0], 1440);
 }
 
+static void test_box_ray_hits_and_nearest_points_match_hand_geometry(void **state) {
+    (void)state;
+    const qnav::Shape b = qnav::make_box(5.0, 5.0, 2.0, 1.0, 0.0);
+    assert_true(std::fabs(qnav::ray_hit(b, {0.0, 5.0}, {1.0, 0.0}) - 4.0) < 1e-12);  // left face x = 4
+    assert_true(std::fabs(qnav::ray_hit(b, {5.0, 0.0}, {0.0, 1.0}) - 4.5) < 1e-12);
+    assert_true(qnav::ray_hit(b, {0.0, 5.0}, {-1.0, 0.0}) == qnav::kInf);
+    assert_true(qnav::ray_hit(b, {0.0, 6.0}, {1.0, 0.0}) == qnav::kInf);  // passes above
+    const qnav::Shape r = qnav::make_box(5.0, 5.0, 2.0, 1.0, 90.0);
+    assert_true(std::fabs(qnav::ray_hit(r, {0.0, 5.0}, {1.0, 0.0}) - 4.5) < 1e-12);
+    const double h = std::sqrt(0.5);
+    const qnav::Shape d = qnav::make_box(0.0, 0.0, 1.0, 1.0, 45.0);  // a diamond
+    assert_true(std::fabs(qnav::ray_hit(d, {3.0, 0.0}, {-1.0, 0.0}) - (3.0 - h)) < 1e-12);
+    qnav::Vec2 q;
+    assert_true(std::fabs(qnav::nearest_point(b, {5.0, 8.0}, &q) - 2.5) < 1e-12);
+    assert_true(std::fabs(q.x - 5.0) < 1e-12 && std::fabs(q.y - 5.5) < 1e-12);
+    assert_true(std::fabs(qnav::nearest_point(b, {7.0, 7.5}, &q) - std::sqrt(5.0)) < 1e-12);  // corner
+    assert_true(std::fabs(qnav::nearest_point(d, {3.0, 0.0}, &q) - (3.0 - h)) < 1e-12);
+    assert_true(qnav::nearest_point(b, {5.5, 5.2}, &q) == 0.0);  // inside
+}
+
 // Brute force: nearest hit over a fan of rays 0.01 deg apart inside each sector.
 static void test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment(void **state) {
     (void)state;
@@ -184,6 +204,7 @@ int main(void) {
         cmocka_unit_test(test_ranges_clip_to_profile_min_and_max),
         cmocka_unit_test(test_goal_bearing_is_robot_relative_in_centidegrees),
         cmocka_unit_test(test_one_sector_reads_the_nearest_obstacle_all_round),
+        cmocka_unit_test(test_box_ray_hits_and_nearest_points_match_hand_geometry),
         cmocka_unit_test(test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
