@@ -14,7 +14,9 @@
 #include "vector_policy.h"
 #include "vector_table.h"
 
-#define QNAV_BENCH_SECTORS 32u
+#ifndef QNAV_BENCH_SECTORS
+#define QNAV_BENCH_SECTORS 32u /* the benchmark; -D to study other N */
+#endif
 #define QNAV_BENCH_MAX_RANGE_MM 5000u
 #define QNAV_BENCH_SCANS 8u
 
