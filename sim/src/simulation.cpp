@@ -185,7 +185,10 @@ void Simulation::compute_scan() {
     using Clock = std::chrono::steady_clock;
     Clock::time_point t0;
     if (profiling_) t0 = Clock::now();
-    sonar_.measure(pos_, heading_, true_dist_.data());
+    if (reference_)
+        reference_scan();
+    else
+        sonar_.measure(pos_, heading_, true_dist_.data());
     const double ps = cfg_.sensor_noise;
     const double r = robot_.radius_m, rmin = robot_.range_min_m, rmax = robot_.range_max_m;
     for (std::uint16_t k = 0; k < cfg_.n_sectors; ++k) {
@@ -203,6 +206,39 @@ void Simulation::compute_scan() {
     const double bearing = std::atan2(env_.dest_y_m - pos_.y, env_.dest_x_m - pos_.x) - hd;
     scan_.goal_bearing_cdeg = to_cdeg(bearing);
     if (profiling_) prof_.sonar_s += std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+namespace {
+// Closest hit along a ray, ignoring the robot's own fixture.
+class ClosestHit : public b2RayCastCallback {
+public:
+    explicit ClosestHit(const b2Body *self) : self_(self) {}
+    float ReportFixture(b2Fixture *fixture, const b2Vec2 &, const b2Vec2 &, float fraction) override {
+        if (fixture->GetBody() == self_) return -1.0f;
+        if (fraction < best) best = fraction;
+        return fraction;
+    }
+    float best = 2.0f;
+
+private:
+    const b2Body *self_;
+};
+}  // namespace
+
+void Simulation::reference_scan() {
+    std::fill(true_dist_.begin(), true_dist_.end(), kInf);
+    const double len = robot_.range_max_m + robot_.radius_m;
+    const b2Vec2 p1(static_cast<float>(pos_.x), static_cast<float>(pos_.y));
+    for (int deg = 0; deg < 360; ++deg) {
+        const double a = heading_ + deg * kPi / 180.0;
+        const b2Vec2 p2(static_cast<float>(pos_.x + len * std::cos(a)),
+                        static_cast<float>(pos_.y + len * std::sin(a)));
+        ClosestHit hit(body_);
+        world_->RayCast(&hit, p1, p2);
+        if (hit.best > 1.0f) continue;
+        const std::uint16_t k = sonar_.sector_of(deg * kPi / 180.0);
+        true_dist_[k] = std::min(true_dist_[k], static_cast<double>(hit.best) * len);
+    }
 }
 
 bool Simulation::touching(Vec2 *contact) {
@@ -286,7 +322,7 @@ void Simulation::drive_substep(double dt) {
     // position += dt * velocity, angle += dt * turn rate). Box2D's step costs about a
     // microsecond, most of it in its internal timers.
     const double reach = robot_.radius_m + (robot_.v_max_mps + std::fabs(v_lat)) * dt * 1.5 + 0.05;
-    if (clearance_m_ > reach) {
+    if (clearance_m_ > reach && !reference_) {
         pos_ = pos_ + dt * vel_;
         heading_ = wrap_pi(heading_ + dt * omega_a);
         body_stale_ = true;

@@ -68,6 +68,9 @@ public:
                                   qnav_sim_trace_fn trace, void *user);
 
     void set_profiling(bool on) { profiling_ = on; }
+    // Benchmark reference only: the straightforward way (a Box2D ray cast per degree for
+    // the sonar, a Box2D step every tick). Same noise and clipping; not bit-identical.
+    void set_reference_mode(bool on) { reference_ = on; }
     SimProfile &profile() { return prof_; }
 
     const RobotProfile &robot() const { return robot_; }
@@ -112,6 +115,8 @@ private:
     qnav_sim_scan_t scan_{};
     std::vector<CollisionMark> marks_;
 
+    void reference_scan();
+    bool reference_ = false;
     bool profiling_ = false;
     SimProfile prof_;
 };

@@ -17,9 +17,10 @@ SonarRing::SonarRing(std::vector<Shape> shapes, double width_m, double height_m,
 }
 
 std::uint16_t SonarRing::sector_of(double a) const {
-    double u = std::floor((a + 0.5 * width_) / width_);
-    long k = static_cast<long>(u) % static_cast<long>(n_);
-    if (k < 0) k += n_;
+    long k = static_cast<long>(std::floor((a + 0.5 * width_) / width_));
+    // a is a difference of two wrapped angles, so k is within a few turns of 0..n-1.
+    while (k < 0) k += n_;
+    while (k >= static_cast<long>(n_)) k -= n_;
     return static_cast<std::uint16_t>(k);
 }
 
@@ -74,9 +75,10 @@ void SonarRing::measure(Vec2 pos, double heading, double *dist) const {
         const double span = hi - lo;
         const long j0 = static_cast<long>(std::ceil(lo_r / width_ + 0.5));
         const long j1 = static_cast<long>(std::floor((lo_r + span) / width_ + 0.5));
-        for (long j = j0; j <= j1; ++j) {
-            long jj = j % static_cast<long>(n_);
-            if (jj < 0) jj += n_;
+        long jj = j0;
+        while (jj < 0) jj += n_;
+        while (jj >= static_cast<long>(n_)) jj -= n_;
+        for (long j = j0; j <= j1; ++j, jj = jj + 1 == static_cast<long>(n_) ? 0 : jj + 1) {
             const Vec2 b = boundary_[static_cast<std::size_t>(jj)];
             const Vec2 u{ch * b.x - sh * b.y, sh * b.x + ch * b.y};
             const double t = ray_hit(s, pos, u);

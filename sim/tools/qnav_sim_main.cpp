@@ -100,7 +100,7 @@ void print_result(unsigned long long episode, const qnav_sim_result_t &r) {
 }
 
 struct RunOpts {
-    std::string robot = "pioneer3dx", env = "dense", policy, svg;
+    std::string robot = "pioneer3dx", env = "dense", policy, svg, trace;
     int sectors = 0;
     double ps = -1, pa = -1;
     std::uint64_t seed = 1, episode = 0;
@@ -134,6 +134,8 @@ int cmd_run(const RunOpts &o) {
         const std::uint64_t es = o.episode + e;
         qnav::EpisodePicture pic;
         bool want_pic = e == 0 && !o.svg.empty();
+        const bool want_trace = e == 0 && !o.trace.empty();
+        std::string csv = "tick,x_m,y_m,heading_rad,speed_mps,cmd_heading_deg,cmd_speed,recovering,collided\n";
         // Step the episode here (same loop as qnav_sim_run_episode) to catch the sonar at
         // the chosen tick for the picture.
         sim.reset(es);
@@ -141,6 +143,14 @@ int cmd_run(const RunOpts &o) {
         qnav_ctrl_output_t out;
         in.ranges_mm = sim.scan().ranges_mm;
         auto grab = [&](std::uint32_t tick) {
+            if (want_trace) {
+                const qnav_sim_sample_t smp = sim.sample();
+                char line[256];
+                std::snprintf(line, sizeof line, "%u,%.6f,%.6f,%.6f,%.4f,%d,%.4f,%d,%d\n", smp.tick,
+                              smp.x_m, smp.y_m, smp.heading_rad, smp.speed_mps, smp.cmd_heading_deg,
+                              smp.cmd_speed, smp.recovering ? 1 : 0, smp.collided ? 1 : 0);
+                csv += line;
+            }
             if (!want_pic) return;
             const qnav_sim_state_t st = sim.state();
             pic.path.push_back({st.x_m, st.y_m});
@@ -165,6 +175,10 @@ int cmd_run(const RunOpts &o) {
         print_result(static_cast<unsigned long long>(es), r);
         sum_r += r.R;
         reached += r.reached;
+        if (want_trace) {
+            qnav::write_file_atomic(o.trace, csv);
+            std::printf("trajectory: %s\n", o.trace.c_str());
+        }
         if (want_pic) {
             pic.collisions = sim.collision_marks();
             pic.reached = r.reached;
@@ -217,6 +231,7 @@ struct BenchOpts {
     std::uint64_t seed = 1;
     double ps = 0, pa = 0;
     bool fresh = false;
+    bool reference = false;
 };
 
 // A seeded random network of `hidden` units, weights uniform in [-4, 4] (Q8.8), like a
@@ -254,6 +269,7 @@ int cmd_bench(const BenchOpts &o) {
     qnav_ctrl_t ctrl;
     init_ctrl(l.sim, pol, o.mode == "table", tbuf, &ctrl);
     double build_s = 0;
+    sim.set_reference_mode(o.reference);
     using Clock = std::chrono::steady_clock;
     auto pass = [&](bool profiling, std::uint64_t *ticks, double *sum_r) {
         sim.set_profiling(profiling);
@@ -287,8 +303,8 @@ int cmd_bench(const BenchOpts &o) {
     const double wall_p = pass(true, &ticks2, &sum_r2);
     const qnav::SimProfile p = sim.profile();
     const double other = wall_p - p.physics_s - p.sonar_s - p.controller_s;
-    std::printf("bench: robot %s  env %s  sectors %d  policy %s  controller %s mode  episodes %u  "
-                "noise %.3f/%.3f\n",
+    std::printf("bench%s: robot %s  env %s  sectors %d  policy %s  controller %s mode  episodes %u  "
+                "noise %.3f/%.3f\n", o.reference ? " (reference: Box2D ray per degree, Box2D every tick)" : "",
                 o.robot.c_str(), sim.env().name.c_str(), o.sectors,
                 what.c_str(),
                 o.mode.c_str(), o.episodes, o.ps, o.pa);
@@ -331,6 +347,7 @@ int main(int argc, char **argv) {
     run->add_option("--episodes", ro.episodes, "number of episodes")->check(CLI::Range(1u, 1000000u))->capture_default_str();
     run->add_flag("--table", ro.table, "run the controller in table mode");
     run->add_option("--svg", ro.svg, "write the first episode's picture here");
+    run->add_option("--trace", ro.trace, "write the first episode's trajectory here (CSV, one row per tick)");
     run->add_option("--svg-tick", ro.svg_tick, "tick whose sonar sectors are drawn (default 0)")->check(CLI::NonNegativeNumber);
 
     std::string de_env = "dense", de_robot = "pioneer3dx", de_out;
@@ -358,6 +375,7 @@ int main(int argc, char **argv) {
     bench->add_option("--policy", bo.policy, "policy file, or 'prob' for the hand-tuned policy (default: a random network)")
         ->check(CLI::ExistingFile | CLI::IsMember({"prob"}));
     bench->add_flag("--fresh-network", bo.fresh, "a new random network for every episode, as in evolution");
+    bench->add_flag("--reference", bo.reference, "the straightforward way for comparison: a Box2D ray per degree, Box2D every tick");
     bench->add_option("--episodes", bo.episodes, "episodes per pass")->check(CLI::Range(1u, 10000000u))->capture_default_str();
     bench->add_option("--mode", bo.mode, "controller mode")->check(CLI::IsMember({"table", "network"}))->capture_default_str();
     bench->add_option("--seed", bo.seed, "context and network seed")->capture_default_str();
