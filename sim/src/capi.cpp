@@ -224,22 +224,31 @@ qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
                                        uint64_t episode_seed, qnav_sim_result_t *res,
                                        qnav_sim_trace_fn trace, void *user) {
     if (!sim || !ctrl || !res) return QNAV_SIM_E_NULL;
-    return guarded(nullptr, 0, [&] { *res = sim->sim->run_episode(ctrl, episode_seed, trace, user); });
+    sim->last_error[0] = '\0';
+    return guarded(sim->last_error, sizeof sim->last_error,
+                   [&] { *res = sim->sim->run_episode(ctrl, episode_seed, trace, user); });
 }
 
 qnav_sim_status_t qnav_sim_reset(qnav_sim_t *sim, uint64_t episode_seed) {
     if (!sim) return QNAV_SIM_E_NULL;
-    return guarded(nullptr, 0, [&] { sim->sim->reset(episode_seed); });
+    sim->last_error[0] = '\0';
+    return guarded(sim->last_error, sizeof sim->last_error, [&] { sim->sim->reset(episode_seed); });
 }
 
 qnav_sim_status_t qnav_sim_place(qnav_sim_t *sim, double x_m, double y_m, double heading_rad) {
     if (!sim) return QNAV_SIM_E_NULL;
-    if (!std::isfinite(x_m) || !std::isfinite(y_m) || !std::isfinite(heading_rad))
-        return QNAV_SIM_E_PARAM;
     const qnav::Environment &e = sim->sim->env();
-    if (x_m < 0 || y_m < 0 || x_m > e.width_m || y_m > e.height_m) return QNAV_SIM_E_PARAM;
-    return guarded(nullptr, 0, [&] { sim->sim->place(x_m, y_m, heading_rad); });
+    if (!std::isfinite(x_m) || !std::isfinite(y_m) || !std::isfinite(heading_rad) || x_m < 0 ||
+        y_m < 0 || x_m > e.width_m || y_m > e.height_m) {
+        put_err(sim->last_error, sizeof sim->last_error, "place: pose outside the arena");
+        return QNAV_SIM_E_PARAM;
+    }
+    sim->last_error[0] = '\0';
+    return guarded(sim->last_error, sizeof sim->last_error,
+                   [&] { sim->sim->place(x_m, y_m, heading_rad); });
 }
+
+const char *qnav_sim_last_error(const qnav_sim_t *sim) { return sim ? sim->last_error : ""; }
 
 qnav_sim_status_t qnav_sim_scan(const qnav_sim_t *sim, qnav_sim_scan_t *scan) {
     if (!sim || !scan) return QNAV_SIM_E_NULL;
@@ -268,8 +277,8 @@ qnav_sim_status_t qnav_sim_command_raw(qnav_sim_t *sim, double heading_deg, doub
 
 qnav_sim_status_t qnav_sim_advance(qnav_sim_t *sim) {
     if (!sim) return QNAV_SIM_E_NULL;
-    if (!sim->sim->started()) return QNAV_SIM_E_STATE;
-    return guarded(nullptr, 0, [&] { sim->sim->advance(); });
+    sim->last_error[0] = '\0';
+    return guarded(sim->last_error, sizeof sim->last_error, [&] { sim->sim->advance(); });
 }
 
 qnav_sim_status_t qnav_sim_state(const qnav_sim_t *sim, qnav_sim_state_t *state) {

@@ -17,6 +17,7 @@ struct qnav_sim_env {
 };
 struct qnav_sim {
     std::unique_ptr<qnav::Simulation> sim;
+    char last_error[QNAV_SIM_ERRLEN] = "";
 };
 
 namespace qnav {

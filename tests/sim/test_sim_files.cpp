@@ -12,6 +12,7 @@
 #include <unistd.h>
 #include <sys/wait.h>
 
+#include "env.hpp"
 #include "qnav/ctrl.h"
 #include "qnav/policy.h"
 
@@ -185,6 +186,30 @@ static void test_mismatched_controller_is_refused(void **state) {
     assert_int_equal(qnav_ctrl_init(&ctrl, &cc, &pol), QNAV_OK);
     qnav_sim_result_t r;
     assert_int_equal(qnav_sim_run_episode(t.sim, &ctrl, 0, &r, NULL, NULL), QNAV_SIM_E_PARAM);
+    assert_string_equal(qnav_sim_last_error(t.sim),
+                        "controller: n_sectors 8 does not match the simulation's 16");
+    assert_int_equal(qnav_sim_place(t.sim, 11.0, 5.0, 0.0), QNAV_SIM_E_PARAM);
+    assert_string_equal(qnav_sim_last_error(t.sim), "place: pose outside the arena");
+}
+
+static void test_generator_is_seeded_connected_and_writes_what_it_reads(void **state) {
+    (void)state;
+    const qnav::Environment a = qnav::generate_environment(0.2, 5, 0.26);
+    const qnav::Environment b = qnav::generate_environment(0.2, 5, 0.26);
+    const qnav::Environment c = qnav::generate_environment(0.2, 6, 0.26);
+    const std::string ta = qnav::environment_to_toml(a);
+    assert_true(ta == qnav::environment_to_toml(b));
+    assert_true(ta != qnav::environment_to_toml(c));
+    assert_true(a.circles.size() + a.boxes.size() >= 5);
+    assert_true(qnav::environment_connected(a, 0.26));
+    const qnav::Environment back = qnav::parse_environment(ta, "gen.toml");
+    assert_int_equal(back.circles.size(), a.circles.size());
+    assert_int_equal(back.boxes.size(), a.boxes.size());
+    // A wall of boxes across the arena is not connected.
+    qnav::Environment blocked = a;
+    blocked.circles.clear();
+    blocked.boxes = {{5.0, 5.0, 10.0, 0.5, 0.0}};
+    assert_false(qnav::environment_connected(blocked, 0.26));
 }
 
 // Run qnav-sim with args; returns its exit status and its stderr+stdout.
@@ -257,6 +282,7 @@ int main(void) {
         cmocka_unit_test(test_missing_file_is_an_io_error_naming_it),
         cmocka_unit_test(test_impossible_parameters_are_refused_by_field),
         cmocka_unit_test(test_mismatched_controller_is_refused),
+        cmocka_unit_test(test_generator_is_seeded_connected_and_writes_what_it_reads),
         cmocka_unit_test(test_cli_prints_one_line_and_fails_on_bad_input),
         cmocka_unit_test(test_cli_runs_an_episode_and_writes_a_complete_picture),
     };

@@ -187,6 +187,10 @@ qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
                                        uint64_t episode_seed, qnav_sim_result_t *res,
                                        qnav_sim_trace_fn trace, void *user);
 
+/* The one-line message of the last failing call on this context (run_episode, reset,
+ * advance, place), or "" when none failed. Valid until the next call on the context. */
+const char *qnav_sim_last_error(const qnav_sim_t *sim);
+
 /* ---- Step-wise API (software in the loop) ---------------------------------------- */
 
 /* One tick's sensing, exactly what the controller takes. */
