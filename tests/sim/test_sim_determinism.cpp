@@ -12,6 +12,7 @@
 #include "sim_test_util.hpp"
 
 #include <cinttypes>
+#include <thread>
 #include <cmath>
 #include <cstdlib>
 #include <vector>
@@ -107,6 +108,17 @@ static void test_batch_of_episodes_hashes_to_the_committed_value(void **state) {
     assert_true(h == batch_hash());  // and again in the same process
 }
 
+static void test_contexts_in_parallel_threads_give_the_committed_hash(void **state) {
+    (void)state;
+    uint64_t h[2] = {0, 0};
+    std::thread a([&] { h[0] = batch_hash(); });
+    std::thread b([&] { h[1] = batch_hash(); });
+    a.join();
+    b.join();
+    assert_true(h[0] == kCommittedHash);
+    assert_true(h[1] == kCommittedHash);
+}
+
 static void test_episode_does_not_depend_on_earlier_episodes(void **state) {
     (void)state;
     TestSim a, b;
@@ -165,6 +177,7 @@ int main(int argc, char **argv) {
     if (argc > 1 && std::strcmp(argv[1], "--print-hash") == 0) g_print = true;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_batch_of_episodes_hashes_to_the_committed_value),
+        cmocka_unit_test(test_contexts_in_parallel_threads_give_the_committed_hash),
         cmocka_unit_test(test_episode_does_not_depend_on_earlier_episodes),
         cmocka_unit_test(test_whole_episodes_with_libqnav_repeat_exactly_in_table_and_network_mode),
     };
