@@ -4,9 +4,9 @@
 Usage: plot_learning.py EXPERIMENT_DIR [OUT.png]
 
 Reads EXPERIMENT_DIR/curves.csv and summary.json (written by `simevo run`) and draws, per
-condition, the mean over runs of the episode fitness R (binned) with its 95% confidence
-band; the probabilistic policy is a horizontal reference band (its held-out mean and 95%
-CI). Writes EXPERIMENT_DIR/learning.png unless OUT.png is given. Needs matplotlib only.
+condition, the mean over runs with its 95% confidence band of (left) the population's best
+fitness and (right) the episode R of the candidates (binned); the probabilistic policy is a
+horizontal reference band (its held-out mean and 95% CI). Writes EXPERIMENT_DIR/learning.png unless OUT.png is given. Needs matplotlib only.
 """
 import csv
 import json
@@ -25,48 +25,54 @@ def main(argv):
         return 2
     exp = argv[1]
     out = argv[2] if len(argv) == 3 else os.path.join(exp, "learning.png")
+    keys = ("mean", "ci_low", "ci_high", "best_mean", "best_ci_low", "best_ci_high")
     try:
         with open(os.path.join(exp, "summary.json")) as f:
             summary = json.load(f)
         curves = {}
         with open(os.path.join(exp, "curves.csv")) as f:
             for row in csv.DictReader(f):
-                c = curves.setdefault(row["condition"], ([], [], [], []))
-                c[0].append(int(row["episode"]))
-                for i, key in enumerate(("mean", "ci_low", "ci_high"), start=1):
-                    c[i].append(float(row[key]) if row[key] != "null" else float("nan"))
+                c = curves.setdefault(row["condition"], {k: [] for k in ("episode",) + keys})
+                c["episode"].append(int(row["episode"]))
+                for k in keys:
+                    c[k].append(float(row[k]) if row[k] != "null" else float("nan"))
     except (OSError, ValueError, KeyError) as e:
         print(f"plot_learning.py: {exp}: {e}", file=sys.stderr)
         return 1
 
-    fig, ax = plt.subplots(figsize=(7.5, 4.6), dpi=120)
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.6), dpi=110, layout="constrained")
     colors = {"direct": "tab:red", "probabilistic": "tab:gray"}
     palette = ["tab:blue", "tab:green", "tab:purple", "tab:orange"]
     conds = {c["label"]: c for c in summary["conditions"]}
     transfer = [k for k in curves if k.startswith("transfer-")]
     for i, k in enumerate(transfer):
         colors[k] = palette[i % len(palette)]
-    for k in transfer + ["direct"]:
-        if k not in curves:
-            continue
-        x, m, lo, hi = curves[k]
-        label = k.replace("transfer-", "transfer from ") if k != "direct" else "direct (random population)"
-        ax.plot(x, m, color=colors[k], lw=1.8, label=label)
-        ax.fill_between(x, lo, hi, color=colors[k], alpha=0.2, lw=0)
-    p = conds.get("probabilistic")
-    if p and p["final_mean"] is not None:
-        mean = p["final_mean"]
-        ci = p["final_ci95"] or 0.0
-        ax.axhline(mean, color=colors["probabilistic"], ls="--", lw=1.5, label="probabilistic (held out)")
-        ax.axhspan(mean - ci, mean + ci, color=colors["probabilistic"], alpha=0.15, lw=0)
-    ax.set_xlabel("episode in the target situation")
-    ax.set_ylabel(f"R (mean of {summary['curve_bin']}-episode bins over runs)")
+    panels = (
+        (axes[0], "best", "population's best fitness R (mean over runs)"),
+        (axes[1], "", f"candidates' episode R ({summary['curve_bin']}-episode bins, mean over runs)"),
+    )
+    for ax, prefix, ylabel in panels:
+        m_key, lo_key, hi_key = (prefix + "_mean", prefix + "_ci_low", prefix + "_ci_high") if prefix else keys[:3]
+        for k in transfer + ["direct"]:
+            if k not in curves:
+                continue
+            c = curves[k]
+            label = k.replace("transfer-", "transfer from ") if k != "direct" else "direct (random population)"
+            ax.plot(c["episode"], c[m_key], color=colors[k], lw=1.8, label=label)
+            ax.fill_between(c["episode"], c[lo_key], c[hi_key], color=colors[k], alpha=0.2, lw=0)
+        p = conds.get("probabilistic")
+        if p and p["final_mean"] is not None:
+            mean = p["final_mean"]
+            ci = p["final_ci95"] or 0.0
+            ax.axhline(mean, color=colors["probabilistic"], ls="--", lw=1.5, label="probabilistic (held out)")
+            ax.axhspan(mean - ci, mean + ci, color=colors["probabilistic"], alpha=0.15, lw=0)
+        ax.set_xlabel("episode in the target situation")
+        ax.set_ylabel(ylabel, fontsize=9)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8, loc="lower right")
     fig_ref = f" ({summary['figure']})" if summary.get("figure") else ""
-    ax.set_title(f"{summary['title'] or summary['name']}{fig_ref}\n"
-                 f"{summary['runs']} runs, preset {summary['preset']}; bands: 95% CI", fontsize=9)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="lower right")
-    fig.tight_layout()
+    fig.suptitle(f"{summary['title'] or summary['name']}{fig_ref}: "
+                 f"{summary['runs']} runs, preset {summary['preset']}; bands: 95% CI", fontsize=10)
     tmp = out + ".tmp.png"
     fig.savefig(tmp)
     os.replace(tmp, out)

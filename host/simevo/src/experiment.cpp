@@ -371,7 +371,7 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
     for (const std::string &label : labels) {
         ConditionSummary c;
         c.label = label;
-        std::vector<std::vector<double>> bins(nbins);
+        std::vector<std::vector<double>> bins(nbins), best_bins(nbins);
         double best_final = -std::numeric_limits<double>::infinity();
         uint64_t reached = 0, evals = 0;
         for (const TaskDef &t : tasks) {
@@ -396,11 +396,13 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
                 throw UserError(join_path(t.dir, "episodes.csv") + ": has " + std::to_string(R.size()) +
                                 " episodes, expected " + std::to_string(spec.target_episodes));
             }
+            const auto B = read_journal_best(join_path(t.dir, "episodes.csv"));
             for (uint64_t b = 0; b < nbins; ++b) {
                 const uint64_t lo = b * spec.curve_bin;
                 const uint64_t hi = std::min<uint64_t>(lo + spec.curve_bin, R.size());
                 std::vector<double> part(R.begin() + static_cast<long>(lo), R.begin() + static_cast<long>(hi));
                 bins[b].push_back(mean_of(part));
+                best_bins[b].push_back(B[hi - 1]);
             }
         }
         c.final_mean = mean_of(c.final_per_run);
@@ -411,9 +413,14 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
             c.curve_mean.push_back(mean_of(b));
             c.curve_ci.push_back(ci95_half_width(b));
         }
+        for (auto &b : best_bins) {
+            c.best_mean.push_back(mean_of(b));
+            c.best_ci.push_back(ci95_half_width(b));
+        }
         if (!c.curve_mean.empty()) {
             c.start = c.curve_mean.front();
             c.end = c.curve_mean.back();
+            c.best_end = c.best_mean.back();
             if (c.end > c.start) {
                 const double goal = c.start + 0.9 * (c.end - c.start);
                 for (uint64_t b = 0; b < nbins; ++b) {
@@ -484,12 +491,14 @@ namespace {
 std::string curves_csv(const ExperimentSummary &S)
 {
     std::ostringstream o;
-    o << "condition,episode,mean,ci_low,ci_high\n";
+    o << "condition,episode,mean,ci_low,ci_high,best_mean,best_ci_low,best_ci_high\n";
     for (const ConditionSummary &c : S.conditions) {
         for (std::size_t b = 0; b < c.curve_mean.size(); ++b) {
             const uint64_t ep = std::min<uint64_t>((b + 1) * S.curve_bin, S.episodes);
             o << c.label << "," << ep << "," << json_num(c.curve_mean[b]) << ","
-              << json_num(c.curve_mean[b] - c.curve_ci[b]) << "," << json_num(c.curve_mean[b] + c.curve_ci[b]) << "\n";
+              << json_num(c.curve_mean[b] - c.curve_ci[b]) << "," << json_num(c.curve_mean[b] + c.curve_ci[b]) << ","
+              << json_num(c.best_mean[b]) << "," << json_num(c.best_mean[b] - c.best_ci[b]) << ","
+              << json_num(c.best_mean[b] + c.best_ci[b]) << "\n";
         }
     }
     return o.str();
@@ -555,7 +564,7 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
         o << "    {\"label\": " << json_str(c.label) << ", \"final_mean\": " << json_num(c.final_mean)
           << ", \"final_ci95\": " << json_num(c.final_ci) << ", \"final_sd\": " << json_num(c.final_sd)
           << ", \"n\": " << c.final_per_run.size() << ", \"start\": " << json_num(c.start)
-          << ", \"end\": " << json_num(c.end) << ", \"episodes_to_90\": "
+          << ", \"end\": " << json_num(c.end) << ", \"best_end\": " << json_num(c.best_end) << ", \"episodes_to_90\": "
           << (c.episodes_to_90 > 0 ? json_num(c.episodes_to_90) : "null")
           << ", \"reached_rate\": " << json_num(c.reached_rate) << ", \"best_run\": " << (c.best_run + 1) << "}"
           << (i + 1 < S.conditions.size() ? "," : "") << "\n";
@@ -594,15 +603,15 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
                                     : "policy file " + s.policy_file)
           << "\n\n";
     }
-    o << "| condition | final R (mean ± 95% CI) | sd | first " << S.curve_bin
-      << " episodes | last " << S.curve_bin << " episodes | episodes to 90% | goal reached |\n"
-      << "|---|---|---|---|---|---|---|\n";
+    o << "| condition | final R held out (mean ± 95% CI) | sd | candidates' R, first " << S.curve_bin
+      << " episodes | last " << S.curve_bin << " | episodes to 90% | best fitness at the end | goal reached (held out) |\n"
+      << "|---|---|---|---|---|---|---|---|\n";
     for (const ConditionSummary &c : S.conditions) {
         const bool prob = c.label == "probabilistic";
         o << "| " << c.label << " | " << fmt(c.final_mean) << " ± " << fmt(c.final_ci) << " | " << fmt(c.final_sd)
           << " | " << (prob ? "-" : fmt(c.start)) << " | " << (prob ? "-" : fmt(c.end)) << " | "
           << (prob ? "-" : (c.episodes_to_90 > 0 ? fmt(c.episodes_to_90, 0) : "n/a")) << " | "
-          << fmt(100.0 * c.reached_rate, 0) << "% |\n";
+          << (prob ? "-" : fmt(c.best_end)) << " | " << fmt(100.0 * c.reached_rate, 0) << "% |\n";
     }
     o << "\n| comparison | difference in R | improvement | faster to 90% | test | p | Mann-Whitney p |\n|---|---|---|---|---|---|---|\n";
     for (const Comparison &c : S.comparisons) {
@@ -612,8 +621,10 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
           << (c.test == "welch" ? "Welch t" : "one-sample t") << " | " << fmt_p(c.t) << " | "
           << (c.b == "probabilistic" ? "-" : fmt_p(c.mann_whitney)) << " |\n";
     }
-    o << "\nImprovement = (mean_a − mean_b) / |mean_b| (n/a when |mean_b| < 1). Episodes to 90% = first learning-curve point at "
-         "which the mean curve has covered 90% of its rise from its first to its last point. "
+    o << "\nCandidates' R = episode R of the networks evaluated (mutants), binned, mean over runs. "
+         "Best fitness = the population's best member's fitness (mean R of its episodes; biased upwards by selection), mean over runs. "
+         "Improvement = (mean_a − mean_b) / |mean_b| (n/a when |mean_b| < 1). Episodes to 90% = first bin at "
+         "which the candidates' mean curve has covered 90% of its rise from its first to its last bin. "
          "The probabilistic policy's p-value is a one-sample t-test of the runs against its held-out mean.\n\n";
     if (plots) {
         o << "![learning curves](learning.png)\n\n![policy quality](policy.png)\n\n";

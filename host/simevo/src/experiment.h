@@ -42,10 +42,14 @@ struct ConditionSummary {
     std::string label;               /* "transfer-open", "direct", "probabilistic" */
     std::vector<double> final_per_run; /* held-out mean R per run (probabilistic: per episode) */
     double final_mean = 0, final_ci = 0, final_sd = 0;
-    std::vector<double> curve_mean, curve_ci; /* per bin, over runs */
-    double start = 0;                /* first bin of the mean curve */
-    double end = 0;                  /* last bin of the mean curve */
-    double episodes_to_90 = -1;      /* first bin end reaching start + 0.9 (end - start); -1 n/a */
+    std::vector<double> curve_mean, curve_ci; /* candidates' R: per bin, mean over runs */
+    std::vector<double> best_mean, best_ci;   /* population best's fitness at each bin's
+                                                 end: mean over runs (the learned policy) */
+    double start = 0;                /* first bin of the candidates' curve */
+    double end = 0;                  /* last bin of the candidates' curve */
+    double best_end = 0;             /* last point of the best-fitness curve */
+    double episodes_to_90 = -1;      /* first bin end where the candidates' curve reaches
+                                        start + 0.9 (end - start); -1 n/a */
     int best_run = -1;               /* run whose best policy scored highest held out */
     double reached_rate = 0;         /* fraction of held-out episodes that reached the goal */
 };

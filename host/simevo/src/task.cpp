@@ -270,7 +270,8 @@ uint64_t task_total_episodes(const TaskDef &t)
     return (t.kind == TaskKind::Evolve ? t.episodes : 0) + t.eval_episodes;
 }
 
-std::vector<double> read_journal_R(const std::string &csv_path)
+namespace {
+std::vector<double> read_journal_column(const std::string &csv_path, std::size_t col)
 {
     std::string text;
     if (!read_file(csv_path, text)) {
@@ -280,17 +281,21 @@ std::vector<double> read_journal_R(const std::string &csv_path)
     if (L.lines.empty() || L.lines[0] + "\n" != kJournalHeader) {
         throw UserError(csv_path + ":1: not a simevo episode journal");
     }
-    std::vector<double> R;
+    std::vector<double> v;
     for (std::size_t i = 1; i < L.lines.size(); ++i) {
         const auto f = split_csv(L.lines[i]);
         double r = 0.0;
-        if (f.size() != 11 || !parse_double(f[1], r)) {
+        if (f.size() != 11 || !parse_double(f[col], r)) {
             throw UserError(csv_path + ":" + std::to_string(i + 1) + ": malformed row");
         }
-        R.push_back(r);
+        v.push_back(r);
     }
-    return R;
+    return v;
 }
+} // namespace
+
+std::vector<double> read_journal_R(const std::string &csv_path) { return read_journal_column(csv_path, 1); }
+std::vector<double> read_journal_best(const std::string &csv_path) { return read_journal_column(csv_path, 10); }
 
 std::vector<EpisodeOutcome> read_eval(const std::string &csv_path)
 {

@@ -70,6 +70,8 @@ uint64_t task_total_episodes(const TaskDef &t);
 
 /* Reading finished task outputs. Throw UserError on malformed files. */
 std::vector<double> read_journal_R(const std::string &csv_path);
+/* The best_fitness column (population best after each candidate). */
+std::vector<double> read_journal_best(const std::string &csv_path);
 std::vector<EpisodeOutcome> read_eval(const std::string &csv_path);
 
 /* The canonical settings text written to task.txt. */
