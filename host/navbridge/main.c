@@ -216,10 +216,10 @@ int main(int argc, char **argv)
             return 2;
         }
         printf("replay: %llu scans, %llu commands compared: %llu identical, %llu differ "
-               "(%llu stops not compared)\n",
+               "(not compared: %llu stops, %llu from another policy)\n",
                (unsigned long long)res.scans, (unsigned long long)res.compared,
                (unsigned long long)res.identical, (unsigned long long)res.differ,
-               (unsigned long long)res.stops);
+               (unsigned long long)res.stops, (unsigned long long)res.other_policy);
         if (res.compared == 0) {
             fprintf(stderr, "navbridge: %s: no commands answering scans in this log\n",
                     replay_path);

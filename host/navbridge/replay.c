@@ -58,6 +58,14 @@ int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg,
                 res->bad_events++;
             } else if (c.stop_reason != QNAV_STOP_NONE || c.scan_seq < 0) {
                 res->stops++;
+            } else if (c.policy_crc != 0 && (uint16_t)c.policy_crc != bc.policy_crc) {
+                res->other_policy++;
+                if (!crc_noted && out != NULL) {
+                    fprintf(out, "note: some logged commands came from policy crc 0x%04x, "
+                                 "replaying with 0x%04x: those are not compared\n",
+                            (unsigned)(uint16_t)c.policy_crc, (unsigned)bc.policy_crc);
+                    crc_noted = 1;
+                }
             } else {
                 /* newest pending scan with that sequence number */
                 unsigned k;
@@ -81,13 +89,6 @@ int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg,
                                     c.flags, p->cmd.heading_deg, p->cmd.speed_q15,
                                     p->cmd.quality_q15, p->cmd.flags);
                         }
-                    }
-                    if (!crc_noted && c.policy_crc != 0 &&
-                        (uint16_t)c.policy_crc != bc.policy_crc && out != NULL) {
-                        fprintf(out, "note: the log's commands came from policy crc 0x%04x, "
-                                     "replaying with 0x%04x\n",
-                                (unsigned)(uint16_t)c.policy_crc, (unsigned)bc.policy_crc);
-                        crc_noted = 1;
                     }
                     p->used = 0;
                     break;

@@ -24,6 +24,9 @@
 #include "qnav/ctrl.h"
 #include "qnav/link.h"
 #include "qnav/policy_io.h"
+#include "qnav_command_t.h"
+
+#include <lcm/eventlog.h>
 
 static char g_dir[256];
 static char g_policy[300];
@@ -127,9 +130,42 @@ static int wait_stop(fakeboard_t *fb, int timeout_ms)
     return -1;
 }
 
+/* Copy a log, changing the speed of the n-th non-stop command by one LSB. */
+static void tamper_log(const char *in, const char *out, int nth)
+{
+    lcm_eventlog_t *r = lcm_eventlog_create(in, "r");
+    lcm_eventlog_t *w = lcm_eventlog_create(out, "w");
+    lcm_eventlog_event_t *ev;
+    int seen = 0;
+    assert_non_null(r);
+    assert_non_null(w);
+    while ((ev = lcm_eventlog_read_next_event(r)) != NULL) {
+        qnav_command_t c;
+        uint8_t buf[256];
+        if (strcmp(ev->channel, "QNAV_COMMAND") == 0 &&
+            qnav_command_t_decode(ev->data, 0, ev->datalen, &c) > 0 && c.stop_reason == 0 &&
+            seen++ == nth) {
+            void *orig = ev->data;
+            int32_t orig_len = ev->datalen;
+            c.speed_q15 = (int16_t)(c.speed_q15 ^ 1);
+            ev->datalen = qnav_command_t_encode(buf, 0, (int)sizeof buf, &c);
+            ev->data = buf;
+            assert_int_equal(lcm_eventlog_write_event(w, ev), 0);
+            ev->data = orig; /* buf is ours: give the event back its own data */
+            ev->datalen = orig_len;
+            lcm_eventlog_free_event(ev);
+            continue;
+        }
+        assert_int_equal(lcm_eventlog_write_event(w, ev), 0);
+        lcm_eventlog_free_event(ev);
+    }
+    lcm_eventlog_destroy(r);
+    lcm_eventlog_destroy(w);
+}
+
 static void test_offboard_commands_equal_libqnav_and_replay_identically(void **state)
 {
-    char log[320], out[320], err[320], text[4096];
+    char log[320], bad_log[320], out[320], err[320], text[4096];
     const char *args[] = {"--lcm-url", "memq://", "--policy", g_policy, "--log", log, NULL};
     fakeboard_t fb;
     qnav_policy_t policy;
@@ -137,6 +173,7 @@ static void test_offboard_commands_equal_libqnav_and_replay_identically(void **s
     int i;
     (void)state;
     snprintf(log, sizeof log, "%s/trial.lcmlog", g_dir);
+    snprintf(bad_log, sizeof bad_log, "%s/tampered.lcmlog", g_dir);
     snprintf(out, sizeof out, "%s/replay.out", g_dir);
     snprintf(err, sizeof err, "%s/replay.err", g_dir);
     assert_int_equal(qnav_policy_read(g_policy, &policy, perr, sizeof perr), 0);
@@ -166,13 +203,20 @@ static void test_offboard_commands_equal_libqnav_and_replay_identically(void **s
 
     {
         const char *replay[] = {EXE, "--replay", log, "--policy", g_policy, NULL};
-        const char *wrong[] = {EXE, "--replay", log, NULL}; /* default policy: must differ */
+        const char *wrong[] = {EXE, "--replay", log, NULL}; /* default policy */
+        const char *tampered[] = {EXE, "--replay", bad_log, "--policy", g_policy, NULL};
         assert_int_equal(run_program(replay, out, err), 0);
         assert_true(read_text(out, text, sizeof text) > 0);
         assert_non_null(strstr(text, "40 commands compared: 40 identical, 0 differ"));
+        /* another policy: nothing comparable, refused */
         assert_int_equal(run_program(wrong, out, err), 1);
         assert_true(read_text(out, text, sizeof text) > 0);
-        assert_null(strstr(text, " 0 differ"));
+        assert_non_null(strstr(text, "40 from another policy"));
+        /* one command changed by one LSB: caught */
+        tamper_log(log, bad_log, 17);
+        assert_int_equal(run_program(tampered, out, err), 1);
+        assert_true(read_text(out, text, sizeof text) > 0);
+        assert_non_null(strstr(text, "39 identical, 1 differ"));
     }
 }
 
