@@ -37,13 +37,14 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
     p.slip_lateral_s = r.number(slip, "lateral_s", 0.0, 1.0);
 
     const toml::table &sonar = r.table(root, "sonar");
-    r.only_keys(sonar, {"range_min_m", "range_max_m", "default_sectors"});
+    r.only_keys(sonar, {"range_min_m", "range_max_m", "default_sectors", "cone_deg"});
     p.range_min_m = r.number(sonar, "range_min_m", 0.0, 10.0);
     p.range_max_m = r.number(sonar, "range_max_m", 0.05, 65.0);
     if (p.range_min_m >= p.range_max_m)
         r.fail(*sonar.get("range_min_m"), "'range_min_m' must be below 'range_max_m'");
     p.default_sectors =
         static_cast<std::uint16_t>(r.integer(sonar, "default_sectors", 1, 360));
+    p.cone_deg = r.number(sonar, "cone_deg", 0.0, 180.0, true, 0.0);
 
     if (root.get("noise")) {
         const toml::table &noise = r.table(root, "noise");

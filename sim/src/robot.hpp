@@ -28,6 +28,8 @@ struct RobotProfile {
     double range_min_m = 0.05;      // closer obstacles read this, m
     double range_max_m = 3.0;       // farther obstacles are not seen (read max), m
     std::uint16_t default_sectors = 16;
+    double cone_deg = 0.0;          // physical cone of one reading, deg; 0 = 360/N (see
+                                    // docs/sim.md); wider cones overlap, at most 180
     // typical noise levels (used by the CLI when none are given)
     double noise_sensor = 0.0;      // p_s
     double noise_actuation = 0.0;   // p_a

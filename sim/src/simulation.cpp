@@ -65,7 +65,7 @@ Simulation::Simulation(const RobotProfile &robot, const Environment &env, const 
       env_(env),
       cfg_(cfg),
       sonar_(env.obstacle_shapes(), env.width_m, env.height_m, cfg.n_sectors,
-             robot.range_max_m + robot.radius_m) {
+             robot.range_max_m + robot.radius_m, robot.cone_deg * kPi / 180.0) {
     max_range_mm_ = static_cast<std::uint16_t>(
         std::min(65535.0, std::round(robot_.range_max_m * 1000.0)));
     const double limit_s = cfg_.episode_limit_s > 0 ? cfg_.episode_limit_s : env_.episode_limit_s;
@@ -236,8 +236,11 @@ void Simulation::reference_scan() {
         ClosestHit hit(body_);
         world_->RayCast(&hit, p1, p2);
         if (hit.best > 1.0f) continue;
-        const std::uint16_t k = sonar_.sector_of(deg * kPi / 180.0);
-        true_dist_[k] = std::min(true_dist_[k], static_cast<double>(hit.best) * len);
+        const double d = static_cast<double>(hit.best) * len;
+        const double w = 2.0 * kPi / cfg_.n_sectors, half = sonar_.cone() / 2;
+        for (std::uint16_t k = 0; k < cfg_.n_sectors; ++k)
+            if (std::fabs(wrap_pi(deg * kPi / 180.0 - k * w)) <= half + 1e-12)
+                true_dist_[k] = std::min(true_dist_[k], d);
     }
 }
 

@@ -77,6 +77,7 @@ public:
     const Environment &env() const { return env_; }
     const SimConfig &config() const { return cfg_; }
     std::uint16_t max_range_mm() const { return max_range_mm_; }
+    double sonar_cone_rad() const { return sonar_.cone(); }
 
 private:
     void build_world();

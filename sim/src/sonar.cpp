@@ -7,12 +7,92 @@
 namespace qnav {
 
 SonarRing::SonarRing(std::vector<Shape> shapes, double width_m, double height_m,
-                     std::uint16_t n_sectors, double reach_m)
-    : shapes_(std::move(shapes)), width_m_(width_m), height_m_(height_m), n_(n_sectors), width_(2.0 * kPi / n_sectors), reach_(reach_m) {
+                     std::uint16_t n_sectors, double reach_m, double cone_rad)
+    : shapes_(std::move(shapes)),
+      width_m_(width_m),
+      height_m_(height_m),
+      n_(n_sectors),
+      width_(2.0 * kPi / n_sectors),
+      reach_(reach_m) {
     boundary_.resize(n_);
     for (std::uint16_t j = 0; j < n_; ++j) {
         const double a = (j - 0.5) * width_;
         boundary_[j] = {std::cos(a), std::sin(a)};
+    }
+    cone_ = cone_rad > width_ ? std::min(cone_rad, kPi) : width_;
+    if (cone_ > width_) {
+        right_.resize(n_);
+        left_.resize(n_);
+        for (std::uint16_t k = 0; k < n_; ++k) {
+            right_[k] = {std::cos(k * width_ - cone_ / 2), std::sin(k * width_ - cone_ / 2)};
+            left_[k] = {std::cos(k * width_ + cone_ / 2), std::sin(k * width_ + cone_ / 2)};
+        }
+    }
+}
+
+template <typename F>
+void SonarRing::for_sectors_in(double lo, double span, double offset, F &&f) const {
+    const long k0 = static_cast<long>(std::ceil((lo - offset) / width_));
+    const long k1 = static_cast<long>(std::floor((lo + span - offset) / width_));
+    long kk = k0;
+    while (kk < 0) kk += n_;
+    while (kk >= static_cast<long>(n_)) kk -= n_;
+    for (long k = k0; k <= k1 && k < k0 + static_cast<long>(n_); ++k) {
+        f(static_cast<std::uint16_t>(kk));
+        kk = kk + 1 == static_cast<long>(n_) ? 0 : kk + 1;
+    }
+}
+
+// Exit distance of the unit ray u from inside the arena, wall_d = distances to the walls
+// at +x, +y, -x, -y.
+static inline double exit_distance(Vec2 u, const double wall_d[4]) {
+    double t = kInf;
+    if (u.x > 0) t = wall_d[0] / u.x;
+    else if (u.x < 0) t = -wall_d[2] / u.x;
+    if (u.y > 0) t = std::min(t, wall_d[1] / u.y);
+    else if (u.y < 0) t = std::min(t, -wall_d[3] / u.y);
+    return std::max(0.0, t);
+}
+
+void SonarRing::measure_wide(Vec2 pos, double heading, double *dist) const {
+    std::fill(dist, dist + n_, kInf);
+    const double ch = std::cos(heading), sh = std::sin(heading);
+    const double half = cone_ / 2;
+    auto rot = [&](Vec2 b) { return Vec2{ch * b.x - sh * b.y, sh * b.x + ch * b.y}; };
+    const double wall_d[4] = {width_m_ - pos.x, height_m_ - pos.y, pos.x, pos.y};
+    for (int w = 0; w < 4; ++w) {
+        const double d = std::max(0.0, wall_d[w]);
+        const double a = wrap_pi(w * 0.5 * kPi - heading);
+        for_sectors_in(a - half, cone_, 0.0, [&](std::uint16_t k) { dist[k] = std::min(dist[k], d); });
+    }
+    for (std::uint16_t k = 0; k < n_; ++k) {
+        dist[k] = std::min(dist[k], exit_distance(rot(right_[k]), wall_d));
+        dist[k] = std::min(dist[k], exit_distance(rot(left_[k]), wall_d));
+    }
+    for (const Shape &s : shapes_) {
+        const Vec2 dc = s.c - pos;
+        const double bound = s.r + reach_;
+        if (dot(dc, dc) > bound * bound) continue;
+        Vec2 q;
+        const double dn = nearest_point(s, pos, &q);
+        if (dn > reach_) continue;
+        if (dn <= 0.0) {
+            const double a = wrap_pi(fast_atan2(dc.y, dc.x) - heading);
+            for_sectors_in(a - half, cone_, 0.0, [&](std::uint16_t k) { dist[k] = 0.0; });
+            continue;
+        }
+        const Vec2 dq = q - pos;
+        const double aq = wrap_pi(fast_atan2(dq.y, dq.x) - heading);
+        for_sectors_in(aq - half, cone_, 0.0, [&](std::uint16_t k) { dist[k] = std::min(dist[k], dn); });
+        double lo, hi;
+        if (!angular_span(s, pos, &lo, &hi)) continue;
+        const double lo_r = wrap_pi(lo - heading), span = hi - lo;
+        for_sectors_in(lo_r, span, -half, [&](std::uint16_t k) {
+            dist[k] = std::min(dist[k], ray_hit(s, pos, rot(right_[k])));
+        });
+        for_sectors_in(lo_r, span, half, [&](std::uint16_t k) {
+            dist[k] = std::min(dist[k], ray_hit(s, pos, rot(left_[k])));
+        });
     }
 }
 
@@ -25,6 +105,10 @@ std::uint16_t SonarRing::sector_of(double a) const {
 }
 
 void SonarRing::measure(Vec2 pos, double heading, double *dist) const {
+    if (cone_ > width_) {
+        measure_wide(pos, heading, dist);
+        return;
+    }
     std::fill(dist, dist + n_, kInf);
     const double ch = std::cos(heading), sh = std::sin(heading);
     // Arena walls: perpendicular feet (walls at angles 0, pi/2, pi, -pi/2 from the robot)...

@@ -83,11 +83,12 @@ std::string render_svg(const Environment &env, double robot_r, const EpisodePict
         if (!ep->sonar_ranges_m.empty()) {
             // Each sector as a wedge out to its reported range (from the body surface).
             const std::size_t n = ep->sonar_ranges_m.size();
-            const double w = 2 * kPi / static_cast<double>(n);
+            const double step = 2 * kPi / static_cast<double>(n);
+            const double w = ep->cone_rad > step ? ep->cone_rad : step;
             o << "<g fill=\"#3fa9f5\" fill-opacity=\"0.25\" stroke=\"#1f6fb2\" stroke-width=\"0.8\">\n";
             for (std::size_t k = 0; k < n; ++k) {
                 const double rr = robot_r + ep->sonar_ranges_m[k];
-                const double a0 = ep->sonar_heading + (static_cast<double>(k) - 0.5) * w;
+                const double a0 = ep->sonar_heading + static_cast<double>(k) * step - 0.5 * w;
                 const double a1 = a0 + w;
                 const Vec2 c = ep->sonar_pos;
                 if (n == 1) {

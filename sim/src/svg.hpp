@@ -22,6 +22,7 @@ struct EpisodePicture {
     double sonar_heading = 0;             // rad, world frame
     std::vector<double> sonar_ranges_m;   // reported ranges (from the body surface), m
     double range_max_m = 0;
+    double cone_rad = 0;                  // each sector's wedge, rad (0: 2*pi/N)
     std::string caption;
 };
 

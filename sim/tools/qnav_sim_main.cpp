@@ -181,6 +181,7 @@ int cmd_run(const RunOpts &o) {
         }
         if (want_pic) {
             pic.collisions = sim.collision_marks();
+            pic.cone_rad = sim.sonar_cone_rad();
             pic.reached = r.reached;
             char cap[256];
             std::snprintf(cap, sizeof cap, "%s, %s, %u sectors, episode %llu: R %.2f, %s, sonar at tick %u",

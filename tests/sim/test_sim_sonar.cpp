@@ -113,6 +113,44 @@ static void test_one_sector_reads_the_nearest_obstacle_all_round(void **state) {
     assert_int_equal(s.ranges_mm[0], 1440);
 }
 
+static void test_wide_cone_sees_the_obstacle_from_every_overlapping_sector(void **state) {
+    (void)state;
+    char err[QNAV_SIM_ERRLEN] = "";
+    std::string text;
+    {
+        std::FILE *f = std::fopen(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml", "rb");
+        assert_non_null(f);
+        char buf[4096];
+        size_t n;
+        while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+        std::fclose(f);
+    }
+    text.replace(text.find("default_sectors = 16"), 20, "default_sectors = 32\ncone_deg = 30");
+    qnav_sim_robot_t *robot = nullptr;
+    qnav_sim_env_t *env = nullptr;
+    qnav_sim_t *sim = nullptr;
+    assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "cone.toml", &robot, err, sizeof err), QNAV_SIM_OK);
+    const std::string et = env_with_circle_at_45();
+    assert_int_equal(qnav_sim_env_parse(et.data(), et.size(), "e.toml", &env, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_config_t cfg;
+    qnav_sim_config_default(&cfg);  // 0 sectors: the profile's 32
+    assert_int_equal(qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_reset(sim, 1);
+    qnav_sim_place(sim, 5.0, 5.0, 0.0);
+    qnav_sim_scan_t s;
+    qnav_sim_scan(sim, &s);
+    assert_int_equal(s.n_sectors, 32);
+    // The circle spans 36.4..53.6 deg; 30 deg cones centred every 11.25 deg reach it from
+    // sectors 2 (22.5) to 6 (67.5); sector 4 (45) holds its nearest point.
+    assert_int_equal(s.ranges_mm[4], 1440);
+    for (int k = 2; k <= 6; ++k) assert_true(s.ranges_mm[k] >= 1440 && s.ranges_mm[k] < 2000);
+    assert_true(s.ranges_mm[1] > 4000);
+    assert_true(s.ranges_mm[7] > 4000);
+    qnav_sim_destroy(sim);
+    qnav_sim_env_free(env);
+    qnav_sim_robot_free(robot);
+}
+
 static void test_box_ray_hits_and_nearest_points_match_hand_geometry(void **state) {
     (void)state;
     const qnav::Shape b = qnav::make_box(5.0, 5.0, 2.0, 1.0, 0.0);
@@ -159,12 +197,17 @@ static void test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment(
     for (const auto &w : e.wall_shapes()) all.push_back(w);
     qnav::Rng rng;
     rng.seed(7, 7, 7);
-    const unsigned sector_counts[] = {3, 8, 16, 32, 180};
+    // (sectors, cone deg): cone 0 = 360/N; wider cones overlap.
+    const struct { unsigned n; double cone_deg; } cases[] = {
+        {3, 0}, {8, 0}, {16, 0}, {32, 0}, {180, 0}, {8, 60}, {32, 30}, {180, 15}};
     int compared = 0;
-    for (unsigned n : sector_counts) {
-        qnav::SonarRing ring(shapes, e.width_m, e.height_m, static_cast<uint16_t>(n), 100.0);
+    for (const auto &cs : cases) {
+        const unsigned n = cs.n;
+        qnav::SonarRing ring(shapes, e.width_m, e.height_m, static_cast<uint16_t>(n), 100.0,
+                             cs.cone_deg * kPiD / 180.0);
+        const double cone = ring.cone();
         std::vector<double> dist(n);
-        for (int trial = 0; trial < 6; ++trial) {
+        for (int trial = 0; trial < 4; ++trial) {
             qnav::Vec2 p;
             qnav::Vec2 q;
             bool free;
@@ -179,20 +222,23 @@ static void test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment(
             const double w = 2 * kPiD / n;
             for (unsigned k = 0; k < n; ++k) {
                 double best = qnav::kInf;
-                const int steps = static_cast<int>(std::ceil(w * 180 / kPiD * 50));
+                const int steps = static_cast<int>(std::ceil(cone * 180 / kPiD * 30));
                 for (int i = 0; i <= steps; ++i) {
-                    const double a = h + k * w - w / 2 + w * i / steps;
+                    const double a = h + k * w - cone / 2 + cone * i / steps;
                     const qnav::Vec2 u{std::cos(a), std::sin(a)};
                     for (const auto &s : all) best = std::min(best, qnav::ray_hit(s, p, u));
                 }
                 // The fan can only overestimate the true minimum, and by very little.
                 assert_true(dist[k] <= best + 1e-9);
+                if (best - dist[k] >= 0.003)
+                    print_error("n %u cone %g sector %u: analytic %.4f m, fan %.4f m\n", n,
+                                cs.cone_deg, k, dist[k], best);
                 assert_true(best - dist[k] < 0.003);
                 ++compared;
             }
         }
     }
-    assert_true(compared > 1000);  // 6 poses x (3+8+16+32+180) sectors
+    assert_true(compared > 1500);  // 4 poses x (3+8+16+32+180+8+32+180) sectors
     qnav_sim_env_free(env);
 }
 
@@ -204,6 +250,7 @@ int main(void) {
         cmocka_unit_test(test_ranges_clip_to_profile_min_and_max),
         cmocka_unit_test(test_goal_bearing_is_robot_relative_in_centidegrees),
         cmocka_unit_test(test_one_sector_reads_the_nearest_obstacle_all_round),
+        cmocka_unit_test(test_wide_cone_sees_the_obstacle_from_every_overlapping_sector),
         cmocka_unit_test(test_box_ray_hits_and_nearest_points_match_hand_geometry),
         cmocka_unit_test(test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment),
     };
