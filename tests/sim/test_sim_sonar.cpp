@@ -125,7 +125,8 @@ static void test_wide_cone_sees_the_obstacle_from_every_overlapping_sector(void 
         while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
         std::fclose(f);
     }
-    text.replace(text.find("default_sectors = 16"), 20, "default_sectors = 32\ncone_deg = 30");
+    text.replace(text.find("default_sectors = 16"), 20, "default_sectors = 32");
+    text.replace(text.find("cone_deg = 0"), 12, "cone_deg = 30");
     qnav_sim_robot_t *robot = nullptr;
     qnav_sim_env_t *env = nullptr;
     qnav_sim_t *sim = nullptr;
