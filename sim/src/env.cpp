@@ -263,6 +263,9 @@ Environment generate_environment(double density, std::uint64_t seed, double clea
         bool bad = false;
         for (const auto &z : env.start_zones)
             if (shape_distance(zone_shape(z), s) < 2 * clearance_m) bad = true;
+        // Obstacles do not overlap: spread out, they make more distinct gaps.
+        for (const Shape &o : env.obstacle_shapes())
+            if (!bad && shape_distance(o, s) < 0.1) bad = true;
         if (bad || !environment_connected(trial, clearance_m, 0.1)) continue;
         env = std::move(trial);
         covered += area;
