@@ -114,9 +114,9 @@ void qnav_sim_env_info(const qnav_sim_env_t *env, qnav_sim_env_info_t *info);
 /* Context settings. Obtain with qnav_sim_config_default(), then edit. */
 typedef struct {
     uint16_t n_sectors;        /* sonar sectors N, 1..360; 0 = the profile's default */
-    double sensor_noise;       /* p_s >= 0 (0.05 = 5 %): range*(1+p_s*n), bearing
+    double sensor_noise;       /* p_s in [0, 1] (0.05 = 5 %): range*(1+p_s*n), bearing
                                   + p_s*pi*n rad, n ~ N(0,1) fresh per reading */
-    double actuation_noise;    /* p_a >= 0: commanded speed*(1+p_a*n), commanded heading
+    double actuation_noise;    /* p_a in [0, 1]: commanded speed*(1+p_a*n), commanded heading
                                   + p_a*pi*n rad, fresh per tick */
     uint64_t seed;             /* context seed; an episode's randomness depends only on
                                   (seed, episode_seed), never on earlier episodes */
@@ -127,9 +127,11 @@ typedef struct {
 void qnav_sim_config_default(qnav_sim_config_t *cfg);
 
 /*
- * Create a context for (robot, env, cfg). robot and env must outlive it. Returns
- * QNAV_SIM_OK and *out, or QNAV_SIM_E_NULL / _PARAM (n_sectors > 360, negative or
- * non-finite noise, limit < 0) / _NOMEM with a "FIELD: problem" line in err.
+ * Create a context for (robot, env, cfg); the context keeps its own copies, so robot and
+ * env may be freed afterwards. Returns QNAV_SIM_OK and *out, or QNAV_SIM_E_NULL,
+ * QNAV_SIM_E_PARAM (n_sectors > 360, noise outside [0, 1] or not finite, limit outside
+ * [0, 36000] s) with a "FIELD: problem" line in err, QNAV_SIM_E_WORLD (a start zone closer
+ * than the robot's radius to an obstacle or wall: "FILE:LINE: ...") or QNAV_SIM_E_NOMEM.
  */
 qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_env_t *env,
                                   const qnav_sim_config_t *cfg, qnav_sim_t **out, char *err,
