@@ -3,7 +3,7 @@
  * resumed (with a half-written journal line) ends with the same bytes as an uninterrupted
  * one; a journal from other settings is refused; the simevo program killed by its pid in
  * the middle of a run and started again ends with files identical to an uninterrupted
- * run; and bad input (unknown experiment, malformed spec, missing or incompatible policy
+ * run; table mode and network mode give byte-identical results; and bad input (unknown experiment, malformed spec, missing or incompatible policy
  * file) gives one line and a non-zero exit without a summary.
  */
 #include <setjmp.h>
@@ -264,6 +264,25 @@ static void test_program_killed_by_pid_resumes_to_identical_results(void **state
     assert_true(fa["tiny/STATUS"] == "complete\n");
 }
 
+static void test_table_mode_and_network_mode_give_identical_results(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::vector<std::string> base = {"run", SIMEVO_TEST_DIR "/tiny.toml", "--no-plot", "--no-progress",
+                                           "--runs", "1", "-j", "2"};
+    auto args = base;
+    args.insert(args.end(), {"--out", join_path(root, "table")});
+    assert_int_equal(wait_exit(spawn(args, join_path(root, "t.err"))), 0);
+    args = base;
+    args.insert(args.end(), {"--out", join_path(root, "network"), "--network-mode"});
+    assert_int_equal(wait_exit(spawn(args, join_path(root, "n.err"))), 0);
+    std::map<std::string, std::string> ft, fn;
+    collect(join_path(root, "table"), "", ft);
+    collect(join_path(root, "network"), "", fn);
+    assert_true(ft.size() > 10);
+    assert_true(ft == fn);
+}
+
 static std::string run_for_error(const std::vector<std::string> &args, int &status)
 {
     const std::string root = make_tmp_dir();
@@ -326,6 +345,7 @@ int main(void)
         cmocka_unit_test(test_transfer_task_resumes_from_source_file_and_refuses_other_settings),
         cmocka_unit_test(test_program_rejects_bad_input_with_one_line),
         cmocka_unit_test(test_program_killed_by_pid_resumes_to_identical_results),
+        cmocka_unit_test(test_table_mode_and_network_mode_give_identical_results),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
