@@ -176,7 +176,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: qnav-sil-robot [--robot NAME|FILE] [--env NAME|FILE] [--sectors N]\n"
             "                      [--seed N] [--episode N] [--noise P] [--link PATH]\n"
-            "                      [--lockstep] [--reply-ms N] [--wait-s N]\n"
+            "                      [--lockstep | --tick-ms N] [--reply-ms N] [--wait-s N]\n"
             "                      [--lcm-url URL | --pose]\n"
             "  --robot, --env   simulator robot profile and environment (tekbot, open)\n"
             "  --sectors N      sonar sectors (0 = the profile's default)\n"
@@ -184,6 +184,8 @@ static void usage(FILE *f)
             "  --noise P        sensor and actuation noise level p (0)\n"
             "  --link PATH      also make PATH a symlink to the pty (for navbridge --device)\n"
             "  --lockstep       wait for each reply instead of the 0.1 s wall clock\n"
+            "  --tick-ms N      wall-clock period of a 0.1 s simulated tick (100; smaller\n"
+            "                   runs faster than real time)\n"
             "  --reply-ms N     longest wait for the bridge's command each tick (300)\n"
             "  --wait-s N       how long to wait for navbridge to appear (30)\n"
             "  --pose           publish QNAV_POSE on LCM's default bus; --lcm-url on URL\n");
@@ -213,9 +215,11 @@ int main(int argc, char **argv)
         {"link", required_argument, NULL, 'l'},    {"lockstep", no_argument, NULL, 'L'},
         {"reply-ms", required_argument, NULL, 'R'}, {"wait-s", required_argument, NULL, 'w'},
         {"lcm-url", required_argument, NULL, 'u'}, {"pose", no_argument, NULL, 'P'},
+        {"tick-ms", required_argument, NULL, 'T'},
         {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0}};
     const char *robot_spec = "tekbot", *env_spec = "open", *link_path = NULL, *lcm_url = NULL;
     double sectors = 0, seed = 1, episode = 1, noise = 0, reply_ms = 300, wait_s = 30;
+    double tick_ms = 100;
     int lockstep = 0, pose = 0, c, rc = 0;
     char err[QNAV_SIM_ERRLEN];
     qnav_sim_robot_t *robot = NULL;
@@ -249,6 +253,7 @@ int main(int argc, char **argv)
         case 'p': if (parse_num("noise", optarg, 0, 1, &noise)) return 2; break;
         case 'R': if (parse_num("reply-ms", optarg, 1, 60000, &reply_ms)) return 2; break;
         case 'w': if (parse_num("wait-s", optarg, 0, 3600, &wait_s)) return 2; break;
+        case 'T': if (parse_num("tick-ms", optarg, 1, 10000, &tick_ms)) return 2; break;
         case 'h': usage(stdout); return 0;
         default:
             fprintf(stderr, "qnav-sil-robot: %s: unknown option or missing value (see --help)\n",
@@ -361,6 +366,15 @@ int main(int argc, char **argv)
         memcpy(ls.ranges_mm, scan.ranges_mm, scan.n_sectors * sizeof scan.ranges_mm[0]);
         seq = r.tx.next_seq;
         send_frame(&r, QNAV_LINK_MSG_SCAN, p, qnav_link_scan_pack(&ls, p, sizeof p));
+        /* heartbeat before any decision, so the bridge labels it with the current policy */
+        hb.uptime_ms = (uint32_t)(mono_ms() - t_start);
+        hb.mode = r.mode;
+        hb.state = (uint8_t)(QNAV_LINK_STATE_LINK_OK | QNAV_LINK_STATE_POLICY |
+                             (r.stop_held ? QNAV_LINK_STATE_STOPPED : QNAV_LINK_STATE_MOVING));
+        hb.rx_ok = (uint16_t)r.rx.stats.frames_ok;
+        hb.rx_dropped = (uint16_t)qnav_link_rx_dropped_total(&r.rx);
+        hb.policy_crc = r.policy_crc;
+        send_frame(&r, QNAV_LINK_MSG_HEARTBEAT, p, qnav_link_heartbeat_pack(&hb, p, sizeof p));
 
         memset(&out, 0, sizeof out);
         if (r.mode == QNAV_LINK_MODE_ONBOARD) {
@@ -409,14 +423,6 @@ int main(int argc, char **argv)
         qnav_sim_advance(sim);
         ticks++;
 
-        hb.uptime_ms = (uint32_t)(mono_ms() - t_start);
-        hb.mode = r.mode;
-        hb.state = (uint8_t)(QNAV_LINK_STATE_LINK_OK | QNAV_LINK_STATE_POLICY |
-                             (moving ? QNAV_LINK_STATE_MOVING : QNAV_LINK_STATE_STOPPED));
-        hb.rx_ok = (uint16_t)r.rx.stats.frames_ok;
-        hb.rx_dropped = (uint16_t)qnav_link_rx_dropped_total(&r.rx);
-        hb.policy_crc = r.policy_crc;
-        send_frame(&r, QNAV_LINK_MSG_HEARTBEAT, p, qnav_link_heartbeat_pack(&hb, p, sizeof p));
 
         if (lcm != NULL) {
             qnav_pose_t ps;
@@ -435,10 +441,10 @@ int main(int argc, char **argv)
             qnav_pose_t_publish(lcm, "QNAV_POSE", &ps);
         }
         if (!lockstep) {
-            int64_t left = tick_start + 100 - mono_ms();
+            int64_t left = tick_start + (int64_t)tick_ms - mono_ms();
             while (left > 0 && !g_quit) {
                 pump(&r, (int)left);
-                left = tick_start + 100 - mono_ms();
+                left = tick_start + (int64_t)tick_ms - mono_ms();
             }
         }
     }

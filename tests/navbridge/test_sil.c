@@ -167,11 +167,12 @@ static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(vo
     count_channels(log, &scan, &cmd, &qual, &status, &pose);
     print_message("lcm-logger recorded %d scans, %d commands, %d qualities, %d link status, "
                   "%d poses\n", scan, cmd, qual, status, pose);
-    assert_true(scan > 20);
-    assert_true(cmd >= scan);
-    assert_int_equal(qual, scan);
+    /* UDP may lose a datagram on a loaded machine: near-complete, not exact, counts */
+    assert_true(scan > 100);
+    assert_true(cmd > 100);
+    assert_true(qual > 100);
     assert_true(status > 0);
-    assert_true(pose > 20);
+    assert_true(pose > 100);
     replay_is_identical(log);
 }
 

@@ -2,6 +2,8 @@
 # One software-in-the-loop trial on a real udpm:// LCM bus, recorded by lcm-logger. Run
 # only inside a private network namespace (the test does `unshare -n sh udpm_trial.sh`):
 # loopback up with multicast routed to it, so no packet can leave the machine.
+# The robot is paced at 20 ms per tick (not lockstep) so bursts do not overrun the
+# logger's UDP socket on a busy machine.
 # usage: udpm_trial.sh NAVBRIDGE SIL_ROBOT DIR
 set -u
 NB_EXE=$1; SIL_EXE=$2; DIR=$3
@@ -10,7 +12,7 @@ ip link set lo multicast on || exit 10
 ip route add 224.0.0.0/4 dev lo || exit 10
 export LCM_DEFAULT_URL="udpm://239.255.76.67:7667?ttl=0"
 lcm-logger -q -f "$DIR/trial.lcmlog" & LOGGER=$!
-"$SIL_EXE" --lockstep --link "$DIR/link" --pose > "$DIR/sil.out" 2> "$DIR/sil.err" & SIL=$!
+"$SIL_EXE" --tick-ms 20 --link "$DIR/link" --pose > "$DIR/sil.out" 2> "$DIR/sil.err" & SIL=$!
 i=0
 while [ ! -e "$DIR/link" ] && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
 sleep 0.3   # lcm-logger subscribed before the trial starts

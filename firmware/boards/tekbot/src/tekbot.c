@@ -330,7 +330,7 @@ void qnav_tekbot_tick(qnav_tekbot_t *bot)
         bot->stats.stopped_ticks++;
     }
 
-    /* report: scan, onboard decision, heartbeat */
+    /* report: scan, heartbeat, onboard decision */
     {
         /* pack the scan straight from the ranges buffer (no second copy on the MCU) */
         uint16_t len = (uint16_t)(QNAV_LINK_SCAN_HEADER_BYTES + 2u * bot->cfg.n_sectors);
@@ -354,15 +354,7 @@ void qnav_tekbot_tick(qnav_tekbot_t *bot)
         scan_seq = bot->tx.next_seq;
         send(bot, QNAV_LINK_MSG_SCAN, p, (int32_t)len);
     }
-    if (bot->mode == QNAV_LINK_MODE_ONBOARD) {
-        tel.scan_seq = scan_seq;
-        tel.heading_deg = out.heading_deg;
-        tel.speed = out.speed;
-        tel.quality = out.quality;
-        tel.flags = (uint8_t)(out.flags | (moving ? 0u : QNAV_LINK_CMD_STOP));
-        tel.reserved = 0;
-        send(bot, QNAV_LINK_MSG_COMMAND, p, qnav_link_command_pack(&tel, p, sizeof p));
-    }
+    /* heartbeat before the decision, so the bridge labels it with the current policy */
     hb.uptime_ms = now;
     hb.mode = bot->mode;
     hb.state = (uint8_t)((bot->link_ok ? QNAV_LINK_STATE_LINK_OK : 0u) |
@@ -373,4 +365,13 @@ void qnav_tekbot_tick(qnav_tekbot_t *bot)
     hb.rx_dropped = (uint16_t)qnav_link_rx_dropped_total(&bot->rx);
     hb.policy_crc = bot->policy_crc;
     send(bot, QNAV_LINK_MSG_HEARTBEAT, p, qnav_link_heartbeat_pack(&hb, p, sizeof p));
+    if (bot->mode == QNAV_LINK_MODE_ONBOARD) {
+        tel.scan_seq = scan_seq;
+        tel.heading_deg = out.heading_deg;
+        tel.speed = out.speed;
+        tel.quality = out.quality;
+        tel.flags = (uint8_t)(out.flags | (moving ? 0u : QNAV_LINK_CMD_STOP));
+        tel.reserved = 0;
+        send(bot, QNAV_LINK_MSG_COMMAND, p, qnav_link_command_pack(&tel, p, sizeof p));
+    }
 }
