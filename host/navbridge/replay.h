@@ -18,14 +18,15 @@ typedef struct {
     uint64_t identical;   /* of those, equal in heading, speed, quality and flags */
     uint64_t differ;      /* of those, different */
     uint64_t stops;       /* logged stop commands (not compared) */
-    uint64_t other_policy; /* logged commands made with another policy (CRC differs) */
+    uint64_t other_policy; /* logged commands of another policy (CRC differs) */
     uint64_t bad_events;  /* events on qnav channels that did not decode */
 } qnav_replay_result_t;
 
 /*
  * Replay the log at path with policy and ctrl config cfg (n_sectors and max range are
  * taken from each scan). Commands whose policy CRC is set and differs from policy's (a
- * trial with an upload part-way) are counted in other_policy, not compared. Differences are listed on out (may be NULL), at most 10.
+ * trial with an upload part-way) are counted in other_policy, not compared. Differences
+ * are listed on out (may be NULL), at most 10.
  * Returns 0, or -1 with "PATH: problem" in err when the log cannot be read.
  */
 int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg,

@@ -68,7 +68,8 @@ static void test_scan_round_trips_over_memq(void **state)
     for (k = 0; k < 360; ++k) {
         m.ranges_mm[k] = 65535 - k;
     }
-    qnav_scan_t_subscription_t *sub = qnav_scan_t_subscribe(lcm, "QNAV_SCAN", on_qnav_scan_t, NULL);
+    qnav_scan_t_subscription_t *sub =
+        qnav_scan_t_subscribe(lcm, "QNAV_SCAN", on_qnav_scan_t, NULL);
     assert_int_equal(qnav_scan_t_publish(lcm, "QNAV_SCAN", &m), 0);
     deliver(lcm);
     assert_int_equal(n_qnav_scan_t, 1);
@@ -82,7 +83,8 @@ static void test_goal_round_trips_over_memq(void **state)
     lcm_t *lcm = bus();
     qnav_goal_t m = {123, 65535, 9000, 2000000};
     (void)state;
-    qnav_goal_t_subscription_t *sub = qnav_goal_t_subscribe(lcm, "QNAV_GOAL", on_qnav_goal_t, NULL);
+    qnav_goal_t_subscription_t *sub =
+        qnav_goal_t_subscribe(lcm, "QNAV_GOAL", on_qnav_goal_t, NULL);
     assert_int_equal(qnav_goal_t_publish(lcm, "QNAV_GOAL", &m), 0);
     deliver(lcm);
     assert_int_equal(n_qnav_goal_t, 1);
@@ -110,7 +112,8 @@ static void test_command_round_trips_over_memq(void **state)
     m.stop_reason = 1;
     m.source = 2;
     m.policy_crc = 0xBEEF;
-    qnav_command_t_subscription_t *sub = qnav_command_t_subscribe(lcm, "QNAV_COMMAND", on_qnav_command_t, NULL);
+    qnav_command_t_subscription_t *sub =
+        qnav_command_t_subscribe(lcm, "QNAV_COMMAND", on_qnav_command_t, NULL);
     assert_int_equal(qnav_command_t_publish(lcm, "QNAV_COMMAND", &m), 0);
     deliver(lcm);
     assert_int_equal(n_qnav_command_t, 1);
@@ -139,7 +142,8 @@ static void test_path_qualities_round_trip_all_360_over_memq(void **state)
         m.quality_q15[k] = (int16_t)(k * 91);
         m.quality[k] = (float)k / 360.0f;
     }
-    qnav_path_qualities_t_subscription_t *sub = qnav_path_qualities_t_subscribe(lcm, "QNAV_QUALITIES", on_qnav_path_qualities_t, NULL);
+    qnav_path_qualities_t_subscription_t *sub =
+        qnav_path_qualities_t_subscribe(lcm, "QNAV_QUALITIES", on_qnav_path_qualities_t, NULL);
     assert_int_equal(qnav_path_qualities_t_publish(lcm, "QNAV_QUALITIES", &m), 0);
     deliver(lcm);
     assert_int_equal(n_qnav_path_qualities_t, 1);
@@ -164,7 +168,8 @@ static void test_pose_round_trips_over_memq(void **state)
     m.recovering = 1;
     m.collisions = 3;
     m.reached = 0;
-    qnav_pose_t_subscription_t *sub = qnav_pose_t_subscribe(lcm, "QNAV_POSE", on_qnav_pose_t, NULL);
+    qnav_pose_t_subscription_t *sub =
+        qnav_pose_t_subscribe(lcm, "QNAV_POSE", on_qnav_pose_t, NULL);
     assert_int_equal(qnav_pose_t_publish(lcm, "QNAV_POSE", &m), 0);
     deliver(lcm);
     assert_int_equal(n_qnav_pose_t, 1);
@@ -200,7 +205,8 @@ static void test_link_status_round_trips_over_memq(void **state)
     m.board_state = 5;
     m.board_policy_crc = 0x1234;
     m.last_upload_status = -2;
-    qnav_link_status_t_subscription_t *sub = qnav_link_status_t_subscribe(lcm, "QNAV_LINK_STATUS", on_qnav_link_status_t, NULL);
+    qnav_link_status_t_subscription_t *sub =
+        qnav_link_status_t_subscribe(lcm, "QNAV_LINK_STATUS", on_qnav_link_status_t, NULL);
     assert_int_equal(qnav_link_status_t_publish(lcm, "QNAV_LINK_STATUS", &m), 0);
     deliver(lcm);
     assert_int_equal(n_qnav_link_status_t, 1);

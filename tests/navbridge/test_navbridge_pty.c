@@ -70,7 +70,8 @@ static uint16_t scan_payload(int i, uint16_t n, uint8_t *out, qnav_link_scan_t *
     s->max_range_mm = 5000;
     s->n_sectors = n;
     for (k = 0; k < n; ++k) {
-        s->ranges_mm[k] = (qnav_mm_t)(k == (uint16_t)(i % n) ? 300 : 200 + (k * 613 + i * 97) % 5200);
+        s->ranges_mm[k] =
+            (qnav_mm_t)(k == (uint16_t)(i % n) ? 300 : 200 + (k * 613 + i * 97) % 5200);
     }
     return (uint16_t)qnav_link_scan_pack(s, out, QNAV_LINK_MAX_PAYLOAD);
 }

@@ -297,10 +297,11 @@ void qnav_tekbot_tick(qnav_tekbot_t *bot)
         bot->ranges[k] = bot->cfg.max_range_mm; /* a missing sonar reads as clear */
     }
     in.ranges_mm = bot->ranges;
-    in.goal_bearing_cdeg =
-        bot->have_goal
-            ? wrap_cdeg((int32_t)bot->goal.bearing_cdeg - (int32_t)bot->hal.heading_cdeg(bot->hal.ctx))
-            : 0;
+    in.goal_bearing_cdeg = 0;
+    if (bot->have_goal) {
+        in.goal_bearing_cdeg = wrap_cdeg((int32_t)bot->goal.bearing_cdeg -
+                                         (int32_t)bot->hal.heading_cdeg(bot->hal.ctx));
+    }
 
     /* decide */
     out.heading_deg = 0;
