@@ -1,0 +1,114 @@
+/*
+ * The drive model: acceleration and deceleration limits of the Pioneer profile (0.3 and
+ * 0.6 m/s^2, 1 m/s), the heading controller turning to a commanded heading, and slip
+ * (a slipping robot turns less at speed and skids outwards).
+ */
+#include "sim_test_util.hpp"
+
+#include <cmath>
+
+static const double kPiD = 3.14159265358979323846;
+
+static qnav_sim_state_t drive(qnav_sim_t *sim, double heading_deg, double speed, int ticks) {
+    qnav_sim_command_raw(sim, heading_deg, speed);
+    for (int i = 0; i < ticks; ++i) qnav_sim_advance(sim);
+    qnav_sim_state_t st;
+    qnav_sim_state(sim, &st);
+    return st;
+}
+
+static void test_pioneer_speeds_up_at_0_3_and_slows_at_0_6_mps2_to_1_mps(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
+    qnav_sim_reset(t.sim, 1);
+    qnav_sim_place(t.sim, 0.8, 5.0, 0.0);
+    qnav_sim_state_t st = drive(t.sim, 0.0, 1.0, 10);
+    assert_true(std::fabs(st.speed_mps - 0.3) < 1e-3);  // 1 s at 0.3 m/s^2
+    st = drive(t.sim, 0.0, 1.0, 30);
+    assert_true(std::fabs(st.speed_mps - 1.0) < 1e-3);  // capped at v_max
+    st = drive(t.sim, 0.0, 0.0, 10);
+    assert_true(std::fabs(st.speed_mps - 0.4) < 1e-3);  // 1 s at 0.6 m/s^2
+    st = drive(t.sim, 0.0, 0.0, 10);
+    assert_true(std::fabs(st.speed_mps) < 1e-9);
+    assert_true(std::fabs(st.y_m - 5.0) < 1e-6);  // straight line
+}
+
+static void test_heading_controller_turns_to_the_commanded_heading_and_stays(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "tekbot", test_env_text(""), nullptr, 8, 0, 0);
+    qnav_sim_reset(t.sim, 1);
+    qnav_sim_place(t.sim, 5.0, 5.0, 0.0);
+    // Command a world heading of 90 deg, relative to the current heading every tick.
+    qnav_sim_state_t st;
+    qnav_sim_state(t.sim, &st);
+    for (int i = 0; i < 30; ++i) {
+        const double rel = std::remainder(kPiD / 2 - st.heading_rad, 2 * kPiD) * 180.0 / kPiD;
+        st = drive(t.sim, rel, 0.0, 1);
+    }
+    assert_true(std::fabs(st.heading_rad - kPiD / 2) < 0.02);
+    assert_true(std::hypot(st.x_m - 5.0, st.y_m - 5.0) < 1e-6);  // turned on the spot
+}
+
+// Heading change after driving 20 ticks at full speed while commanding 30 deg left.
+static double turn_at_speed(const char *slip_turn, const char *slip_lateral, double *lateral) {
+    std::string text;
+    {
+        std::FILE *f = std::fopen(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml", "rb");
+        char buf[4096];
+        size_t n;
+        while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+        std::fclose(f);
+    }
+    text.replace(text.find("turn = 0.15"), 11, std::string("turn = ") + slip_turn);
+    text.replace(text.find("lateral_s = 0.04"), 16, std::string("lateral_s = ") + slip_lateral);
+    char err[QNAV_SIM_ERRLEN];
+    qnav_sim_robot_t *robot = nullptr;
+    qnav_sim_env_t *env = nullptr;
+    qnav_sim_t *sim = nullptr;
+    const std::string et = test_env_text("");
+    assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "r.toml", &robot, err, sizeof err), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_env_parse(et.data(), et.size(), "e.toml", &env, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_config_t cfg;
+    qnav_sim_config_default(&cfg);
+    assert_int_equal(qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_reset(sim, 1);
+    qnav_sim_place(sim, 2.0, 2.0, 0.0);
+    drive(sim, 0.0, 1.0, 40);  // up to 1 m/s first
+    qnav_sim_state_t a, b;
+    qnav_sim_state(sim, &a);
+    qnav_sim_command_raw(sim, 30.0, 1.0);
+    qnav_sim_advance(sim);
+    qnav_sim_state(sim, &b);
+    // Sideways displacement in the frame of the heading at the start of the tick.
+    const double dx = b.x_m - a.x_m, dy = b.y_m - a.y_m;
+    *lateral = -std::sin(a.heading_rad) * dx + std::cos(a.heading_rad) * dy;
+    const double turned = b.heading_rad - a.heading_rad;
+    qnav_sim_destroy(sim);
+    qnav_sim_env_free(env);
+    qnav_sim_robot_free(robot);
+    return turned;
+}
+
+static void test_slipping_robot_turns_less_at_speed_and_skids_outwards(void **state) {
+    (void)state;
+    double lat_grip, lat_slip;
+    const double grip = turn_at_speed("0.0", "0.0", &lat_grip);
+    const double slip = turn_at_speed("0.15", "0.04", &lat_slip);
+    assert_true(grip > 0.0);
+    // The first tick of the turn: wheels near full speed, so the rate loss is close to 15 %.
+    assert_true(slip < grip * 0.9);
+    assert_true(slip > grip * 0.8);
+    // Turning left: a gripping robot's chord goes left, a skidding one's less so.
+    assert_true(lat_slip < lat_grip);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_pioneer_speeds_up_at_0_3_and_slows_at_0_6_mps2_to_1_mps),
+        cmocka_unit_test(test_heading_controller_turns_to_the_commanded_heading_and_stays),
+        cmocka_unit_test(test_slipping_robot_turns_less_at_speed_and_skids_outwards),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
