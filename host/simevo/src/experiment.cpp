@@ -397,6 +397,7 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
                                 " episodes, expected " + std::to_string(spec.target_episodes));
             }
             const auto B = read_journal_best(join_path(t.dir, "episodes.csv"));
+            c.online_per_run.push_back(mean_of(R));
             for (uint64_t b = 0; b < nbins; ++b) {
                 const uint64_t lo = b * spec.curve_bin;
                 const uint64_t hi = std::min<uint64_t>(lo + spec.curve_bin, R.size());
@@ -409,6 +410,7 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
         c.final_sd = sd_of(c.final_per_run);
         c.final_ci = ci95_half_width(c.final_per_run);
         c.reached_rate = evals ? static_cast<double>(reached) / static_cast<double>(evals) : 0.0;
+        c.online_mean = mean_of(c.online_per_run);
         for (auto &b : bins) {
             c.curve_mean.push_back(mean_of(b));
             c.curve_ci.push_back(ci95_half_width(b));
@@ -467,6 +469,8 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
         cmp.test = "welch";
         cmp.t = welch_t_test(c.final_per_run, direct.final_per_run);
         cmp.mann_whitney = mann_whitney(c.final_per_run, direct.final_per_run);
+        cmp.online_difference = c.online_mean - direct.online_mean;
+        cmp.online = welch_t_test(c.online_per_run, direct.online_per_run);
         S.comparisons.push_back(cmp);
     }
     for (std::size_t i = 0; i < labels.size(); ++i) {
@@ -566,7 +570,8 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
           << ", \"n\": " << c.final_per_run.size() << ", \"start\": " << json_num(c.start)
           << ", \"end\": " << json_num(c.end) << ", \"best_end\": " << json_num(c.best_end) << ", \"episodes_to_90\": "
           << (c.episodes_to_90 > 0 ? json_num(c.episodes_to_90) : "null")
-          << ", \"reached_rate\": " << json_num(c.reached_rate) << ", \"best_run\": " << (c.best_run + 1) << "}"
+          << ", \"reached_rate\": " << json_num(c.reached_rate)
+          << ", \"online_mean\": " << json_num(c.label == "probabilistic" ? std::nan("") : c.online_mean) << ", \"best_run\": " << (c.best_run + 1) << "}"
           << (i + 1 < S.conditions.size() ? "," : "") << "\n";
     }
     o << "  ],\n  \"comparisons\": [\n";
@@ -579,7 +584,9 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
           << ", \"t\": " << json_num(c.t.valid ? c.t.statistic : std::nan(""))
           << ", \"df\": " << json_num(c.t.valid ? c.t.df : std::nan(""))
           << ", \"p\": " << json_num(c.t.valid ? c.t.p : std::nan(""))
-          << ", \"mann_whitney_p\": " << json_num(c.mann_whitney.valid ? c.mann_whitney.p : std::nan("")) << "}"
+          << ", \"mann_whitney_p\": " << json_num(c.mann_whitney.valid ? c.mann_whitney.p : std::nan(""))
+          << ", \"online_difference\": " << json_num(c.b == "direct" ? c.online_difference : std::nan(""))
+          << ", \"online_p\": " << json_num(c.online.valid ? c.online.p : std::nan("")) << "}"
           << (i + 1 < S.comparisons.size() ? "," : "") << "\n";
     }
     o << "  ]\n}\n";
@@ -613,16 +620,18 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
           << (prob ? "-" : (c.episodes_to_90 > 0 ? fmt(c.episodes_to_90, 0) : "n/a")) << " | "
           << (prob ? "-" : fmt(c.best_end)) << " | " << fmt(100.0 * c.reached_rate, 0) << "% |\n";
     }
-    o << "\n| comparison | difference in R | improvement | faster to 90% | test | p | Mann-Whitney p |\n|---|---|---|---|---|---|---|\n";
+    o << "\n| comparison | difference in final R | improvement | faster to 90% | test | p | Mann-Whitney p | difference in online R (Welch p) |\n|---|---|---|---|---|---|---|---|\n";
     for (const Comparison &c : S.comparisons) {
         o << "| " << c.a << " vs " << c.b << " | " << fmt(c.difference) << " | "
           << (std::isfinite(c.improvement_pct) ? fmt(c.improvement_pct, 1) + "%" : "n/a") << " | "
           << (std::isfinite(c.speedup_pct) ? fmt(c.speedup_pct, 0) + "%" : "-") << " | "
           << (c.test == "welch" ? "Welch t" : "one-sample t") << " | " << fmt_p(c.t) << " | "
-          << (c.b == "probabilistic" ? "-" : fmt_p(c.mann_whitney)) << " |\n";
+          << (c.b == "probabilistic" ? "-" : fmt_p(c.mann_whitney)) << " | "
+          << (c.b == "probabilistic" ? "-" : fmt(c.online_difference) + " (" + fmt_p(c.online) + ")") << " |\n";
     }
     o << "\nCandidates' R = episode R of the networks evaluated (mutants), binned, mean over runs. "
          "Best fitness = the population's best member's fitness (mean R of its episodes; biased upwards by selection), mean over runs. "
+         "Online R = mean episode R of all candidates of a run (the area under its learning curve; higher = learns faster and better). "
          "Improvement = (mean_a − mean_b) / |mean_b| (n/a when |mean_b| < 1). Episodes to 90% = first bin at "
          "which the candidates' mean curve has covered 90% of its rise from its first to its last bin. "
          "The probabilistic policy's p-value is a one-sample t-test of the runs against its held-out mean.\n\n";

@@ -50,6 +50,9 @@ struct ConditionSummary {
     double best_end = 0;             /* last point of the best-fitness curve */
     double episodes_to_90 = -1;      /* first bin end where the candidates' curve reaches
                                         start + 0.9 (end - start); -1 n/a */
+    std::vector<double> online_per_run; /* mean episode R of all candidates of a run: the
+                                           area under its learning curve */
+    double online_mean = 0;
     int best_run = -1;               /* run whose best policy scored highest held out */
     double reached_rate = 0;         /* fraction of held-out episodes that reached the goal */
 };
@@ -64,6 +67,8 @@ struct Comparison {
                                     probabilistic policy's held-out mean) */
     TestResult t;                /* the t test named above */
     TestResult mann_whitney;     /* runs vs runs only */
+    double online_difference = 0; /* online_mean_a - online_mean_b (runs vs runs only) */
+    TestResult online;            /* Welch t on the runs' online means */
 };
 
 struct ExperimentSummary {
