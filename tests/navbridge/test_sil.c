@@ -23,6 +23,7 @@
 #include <lcm/eventlog.h>
 
 #include "fakeboard.h"
+#include "qnav/policy_io.h"
 
 static char g_dir[256];
 
@@ -136,6 +137,60 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     replay_is_identical(log);
 }
 
+static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(void **state)
+{
+    char link[300], log[300], pol[300], sil_out[300], sil_err[300], nb_out[300], nb_err[300];
+    char text[4096], perr[QNAV_POLICY_IO_ERRLEN];
+    const char *sil[] = {SIL_EXE, "--tick-ms", "20", "--link", link, NULL};
+    const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--mode",
+                        "onboard", "--policy", pol, "--upload", "--log", log, NULL};
+    const char *replay[] = {NAVBRIDGE_EXE, "--replay", log, "--policy", pol, NULL};
+    qnav_policy_t p;
+    pid_t ps, pn;
+    int i;
+    unsigned scans = 0, compared = 0;
+    struct stat sb;
+    (void)state;
+    snprintf(link, sizeof link, "%s/link-onboard", g_dir);
+    snprintf(log, sizeof log, "%s/onboard.lcmlog", g_dir);
+    snprintf(pol, sizeof pol, "%s/sharp.policy", g_dir);
+    snprintf(sil_out, sizeof sil_out, "%s/sil-on.out", g_dir);
+    snprintf(sil_err, sizeof sil_err, "%s/sil-on.err", g_dir);
+    snprintf(nb_out, sizeof nb_out, "%s/nb-on.out", g_dir);
+    snprintf(nb_err, sizeof nb_err, "%s/nb-on.err", g_dir);
+    qnav_policy_prob_default(&p);
+    p.u.prob.k_goal = 3 * 256; /* not the board's default: the upload must take */
+    assert_int_equal(qnav_policy_write(pol, &p, "sil onboard test", perr, sizeof perr), 0);
+    ps = spawn(sil, sil_out, sil_err);
+    assert_true(ps > 0);
+    for (i = 0; i < 200 && lstat(link, &sb) != 0; ++i) {
+        usleep(20000);
+    }
+    assert_int_equal(lstat(link, &sb), 0);
+    pn = spawn(nb, nb_out, nb_err);
+    assert_true(pn > 0);
+    assert_int_equal(wait_exit(ps), 0);
+    kill(pn, SIGTERM);
+    assert_int_equal(wait_exit(pn), 0);
+    assert_true(read_text(sil_err, text, sizeof text) > 0);
+    assert_non_null(strstr(text, "policy uploaded"));
+    assert_true(read_text(nb_err, text, sizeof text) > 0);
+    assert_non_null(strstr(text, "policy upload: ok"));
+    assert_true(read_text(sil_out, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, "reached yes"));
+    snprintf(sil_out, sizeof sil_out, "%s/rp-on.out", g_dir);
+    snprintf(sil_err, sizeof sil_err, "%s/rp-on.err", g_dir);
+    i = run_program(replay, sil_out, sil_err);
+    assert_true(read_text(sil_out, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_int_equal(i, 0);
+    assert_non_null(strstr(text, "identical, 0 differ"));
+    assert_int_equal(sscanf(strstr(text, "replay: "), "replay: %u scans, %u commands compared",
+                            &scans, &compared), 2);
+    assert_true(compared + 20u >= scans); /* all but the ticks before the upload landed */
+}
+
 static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(void **state)
 {
     char log[300], rc_path[300], text[2048], out[300], err[300], sil_out[300];
@@ -180,6 +235,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sil_robot_reaches_destination_through_navbridge_over_memq),
+        cmocka_unit_test(test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically),
         cmocka_unit_test(test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
