@@ -20,6 +20,12 @@ public:
     EpisodeOutcome run(const qnav_policy_t &policy, uint64_t episode_seed) override
     {
         ++calls;
+        if (policy.kind != QNAV_POLICY_NET) { // the probabilistic policy: a fixed score
+            Rng r(episode_seed);
+            EpisodeOutcome o;
+            o.R = -20.0 + (r.uniform01() - 0.5);
+            return o;
+        }
         qnav_net_t net = policy.u.net;
         double d2 = 0.0;
         for (uint16_t k = 0; k < QNAV_NET_WEIGHTS(net.hidden); ++k) {

@@ -3,7 +3,8 @@
  * resumed (with a half-written journal line) ends with the same bytes as an uninterrupted
  * one; a journal from other settings is refused; the simevo program killed by its pid in
  * the middle of a run and started again ends with files identical to an uninterrupted
- * run; table mode and network mode give byte-identical results; and bad input (unknown experiment, malformed spec, missing or incompatible policy
+ * run; an experiment on 1 and 3 threads gives the same files and its summary matches
+ * them; table mode and network mode give byte-identical results; and bad input (unknown experiment, malformed spec, missing or incompatible policy
  * file) gives one line and a non-zero exit without a summary.
  */
 #include <setjmp.h>
@@ -16,6 +17,7 @@ extern "C" {
 }
 
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -32,6 +34,9 @@ extern "C" {
 #include "fake_runner.h"
 #include "files.h"
 #include "qnav/policy_io.h"
+#include "experiment.h"
+#include "spec.h"
+#include "stats.h"
 #include "task.h"
 
 using namespace qnav;
@@ -168,6 +173,61 @@ static void test_transfer_task_resumes_from_source_file_and_refuses_other_settin
         assert_non_null(std::strstr(e.what(), "incompatible policy"));
     }
     assert_true(journal == slurp(join_path(a.dir, "episodes.csv")));
+}
+
+static void test_experiment_results_do_not_depend_on_thread_count_and_summary_reads_them(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    ExperimentSpec spec = parse_experiment(R"(name = "fake"
+runs = 3
+curve_bin = 20
+[evolution]
+population = 6
+hidden = 3
+[target]
+episodes = 100
+[[source]]
+label = "a"
+episodes = 60
+[[source]]
+label = "b"
+episodes = 80
+[evaluation]
+episodes = 7
+)", "fake.toml");
+    const auto t1 = plan_tasks(spec, join_path(root, "one"));
+    const auto t3 = plan_tasks(spec, join_path(root, "three"));
+    // 3 runs x (2 sources + 2 transfers + direct) + probabilistic
+    assert_int_equal(t1.size(), 16);
+    for (const TaskDef &t : t1) {
+        if (t.label.rfind("transfer-", 0) == 0) {
+            assert_true(t.source_task >= 0);
+            assert_true(t1[static_cast<size_t>(t.source_task)].label == "source-" + t.label.substr(9));
+        }
+    }
+    run_tasks(t1, fake_factory(), 1, false, "one");
+    run_tasks(t3, fake_factory(), 3, false, "three");
+    std::map<std::string, std::string> f1, f3;
+    collect(join_path(root, "one"), "", f1);
+    collect(join_path(root, "three"), "", f3);
+    assert_true(f1 == f3);
+
+    const ExperimentSummary S = summarize(spec, t1);
+    assert_int_equal(S.conditions.size(), 4); // transfer-a, transfer-b, direct, probabilistic
+    assert_int_equal(S.comparisons.size(), 5);
+    const ConditionSummary &direct = S.conditions[2];
+    assert_string_equal(direct.label.c_str(), "direct");
+    assert_int_equal(direct.final_per_run.size(), 3);
+    assert_int_equal(direct.curve_mean.size(), 5);
+    std::vector<double> r;
+    for (const auto &o : read_eval(join_path(root, "one/run-002/direct/eval.csv"))) {
+        r.push_back(o.R);
+    }
+    assert_true(std::fabs(direct.final_per_run[1] - mean_of(r)) < 1e-12);
+    assert_int_equal(S.conditions[3].final_per_run.size(), 7); // probabilistic: per episode
+    assert_true(S.comparisons[0].a == "transfer-a" && S.comparisons[0].b == "direct");
+    assert_true(std::fabs(S.comparisons[0].difference - (S.conditions[0].final_mean - direct.final_mean)) < 1e-12);
 }
 
 /* Run simevo with args; returns exit status; stderr captured to err_path. */
@@ -343,6 +403,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_task_stopped_and_resumed_matches_uninterrupted_bytes),
         cmocka_unit_test(test_transfer_task_resumes_from_source_file_and_refuses_other_settings),
+        cmocka_unit_test(test_experiment_results_do_not_depend_on_thread_count_and_summary_reads_them),
         cmocka_unit_test(test_program_rejects_bad_input_with_one_line),
         cmocka_unit_test(test_program_killed_by_pid_resumes_to_identical_results),
         cmocka_unit_test(test_table_mode_and_network_mode_give_identical_results),
