@@ -4,8 +4,9 @@
  * one; a journal from other settings is refused; the simevo program killed by its pid in
  * the middle of a run and started again ends with files identical to an uninterrupted
  * run; an experiment on 1 and 3 threads gives the same files and its summary matches
- * them; table mode and network mode give byte-identical results; and bad input (unknown experiment, malformed spec, missing or incompatible policy
- * file) gives one line and a non-zero exit without a summary.
+ * them; table mode and network mode give byte-identical results; and bad input (unknown
+ * experiment, malformed spec, missing or incompatible policy file, a folder made with other
+ * settings) gives one line and a non-zero exit without a summary.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -322,6 +323,16 @@ static void test_program_killed_by_pid_resumes_to_identical_results(void **state
     }
     assert_true(fa.count("tiny/summary.md") == 1);
     assert_true(fa["tiny/STATUS"] == "complete\n");
+
+    // The same folder with other settings is refused and left as it was.
+    auto other = with_out(a);
+    other.insert(other.end(), {"--runs", "3"});
+    const std::string err_path = join_path(root, "c.err");
+    assert_int_equal(wait_exit(spawn(other, err_path)), 1);
+    const std::string err = slurp(err_path);
+    assert_non_null(std::strstr(err.c_str(), "settings.txt: this output folder holds tiny with other settings"));
+    assert_true(err.find('\n') == err.size() - 1);
+    assert_true(slurp(join_path(a, "tiny/STATUS")) == "complete\n");
 }
 
 static void test_table_mode_and_network_mode_give_identical_results(void **state)

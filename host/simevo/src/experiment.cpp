@@ -673,10 +673,25 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
 {
     const std::string exp_dir = join_path(opt.out_dir, spec.name);
     make_dirs(exp_dir);
+    const std::vector<TaskDef> tasks = plan_tasks(spec, exp_dir);
+    // Refuse a folder made with other settings before touching anything in it.
+    std::string settings = "# simevo experiment " + spec.name + ": the settings of every task\n";
+    for (const TaskDef &t : tasks) {
+        settings += "\n[" + t.dir.substr(exp_dir.size() + 1) + "]\n" + task_settings_text(t, t.source_policy_file);
+    }
+    const std::string settings_path = join_path(exp_dir, "settings.txt");
+    std::string existing;
+    if (read_file(settings_path, existing)) {
+        if (existing != settings) {
+            throw UserError(settings_path + ": this output folder holds " + spec.name +
+                            " with other settings (preset, runs, episodes or seeds); use another --out");
+        }
+    } else {
+        write_file_atomic(settings_path, settings);
+    }
     const std::string status_path = join_path(exp_dir, "STATUS");
     write_file_atomic(status_path, "incomplete: running or interrupted; rerun the same command to resume\n");
 
-    const std::vector<TaskDef> tasks = plan_tasks(spec, exp_dir);
     SimWorlds worlds;
     // Load every robot and environment up front so a bad name fails before any work.
     std::unique_ptr<SimRunner> target_runner;
