@@ -154,7 +154,8 @@ int cmd_run(const RunOpts &o) {
             if (!want_pic) return;
             const qnav_sim_state_t st = sim.state();
             pic.path.push_back({st.x_m, st.y_m});
-            if (static_cast<long>(tick) == o.svg_tick || (o.svg_tick < 0 && tick == 0)) {
+            // The chosen tick, or the last one before the episode ended.
+            if (static_cast<long>(tick) <= std::max(0L, o.svg_tick)) {
                 pic.sonar_tick = tick;
                 pic.sonar_pos = {st.x_m, st.y_m};
                 pic.sonar_heading = st.heading_rad;
@@ -349,7 +350,7 @@ int main(int argc, char **argv) {
     run->add_flag("--table", ro.table, "run the controller in table mode");
     run->add_option("--svg", ro.svg, "write the first episode's picture here");
     run->add_option("--trace", ro.trace, "write the first episode's trajectory here (CSV, one row per tick)");
-    run->add_option("--svg-tick", ro.svg_tick, "tick whose sonar sectors are drawn (default 0)")->check(CLI::NonNegativeNumber);
+    run->add_option("--svg-tick", ro.svg_tick, "tick whose sonar sectors are drawn (default 0; past the end: the last tick)")->check(CLI::NonNegativeNumber);
 
     std::string de_env = "dense", de_robot = "pioneer3dx", de_out;
     CLI::App *draw = app.add_subcommand("draw-env", "draw an environment (like the paper's Fig. 6) to SVG");
