@@ -302,6 +302,35 @@ static void test_watchdog_stops_robot_within_its_timeout(void **state)
     fakeboard_close(&fb);
 }
 
+static void test_onboard_watchdog_stops_robot_when_heartbeats_stop(void **state)
+{
+    const char *args[] = {"--lcm-url", "memq://", "--mode", "onboard", "--timeout-ms", "300",
+                          NULL};
+    uint8_t p[QNAV_LINK_HEARTBEAT_BYTES];
+    fakeboard_t fb;
+    qnav_link_heartbeat_t hb = {0, QNAV_LINK_MODE_ONBOARD, QNAV_LINK_STATE_POLICY, 0, 0, 0};
+    int64_t t_last, elapsed, end;
+    (void)state;
+    assert_int_equal(fakeboard_start(&fb, EXE, g_dir, args), 0);
+    wait_bridge_up(&fb);
+    qnav_link_heartbeat_pack(&hb, p, sizeof p);
+    /* heartbeats every 50 ms for 0.6 s: no stop may come meanwhile */
+    end = fakeboard_ms() + 600;
+    t_last = 0;
+    while (fakeboard_ms() < end) {
+        assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_HEARTBEAT, p, sizeof p), 0);
+        t_last = fakeboard_ms(); /* the watchdog runs from the last heartbeat */
+        assert_int_not_equal(wait_stop(&fb, 50), 0);
+    }
+    assert_int_equal(wait_stop(&fb, 3000), 0);
+    elapsed = fakeboard_ms() - t_last;
+    print_message("onboard watchdog stop after %lld ms (timeout 300 ms)\n", (long long)elapsed);
+    assert_true(elapsed >= 250);
+    assert_true(elapsed <= 1300);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, 3000), 0);
+    fakeboard_close(&fb);
+}
+
 static void test_sigint_stops_robot_before_exit(void **state)
 {
     const char *args[] = {"--lcm-url", "memq://", "--timeout-ms", "5000", NULL};
@@ -466,6 +495,7 @@ int main(void)
         cmocka_unit_test(test_offboard_commands_equal_libqnav_and_replay_identically),
         cmocka_unit_test(test_corrupted_and_replayed_scans_are_not_answered),
         cmocka_unit_test(test_watchdog_stops_robot_within_its_timeout),
+        cmocka_unit_test(test_onboard_watchdog_stops_robot_when_heartbeats_stop),
         cmocka_unit_test(test_sigint_stops_robot_before_exit),
         cmocka_unit_test(test_onboard_upload_delivers_the_policy_file_to_the_board),
         cmocka_unit_test(test_start_goal_is_relayed_to_the_board),
