@@ -528,24 +528,7 @@ std::string quality_csv(const ExperimentSpec &spec, const ExperimentSummary &S, 
         policies.emplace_back(c.label + " (run " + std::to_string(c.best_run + 1) + ")", p);
     }
     (void)spec;
-    std::ostringstream o;
-    o << "policy,level,distance_m,dtheta_deg,quality\n";
-    for (auto &pp : policies) {
-        qnav_ctrl_t ctrl;
-        if (qnav_ctrl_init(&ctrl, &ccfg, &pp.second) != QNAV_OK) {
-            throw UserError("quality map: controller refused policy " + pp.first);
-        }
-        for (uint32_t level = 0; level < QNAV_DIST_LEVELS; ++level) {
-            const double dist = static_cast<double>(level) / (QNAV_DIST_LEVELS - 1) * ccfg.max_range_mm / 1000.0;
-            for (uint32_t dt = 0; dt <= QNAV_DTHETA_MAX; ++dt) {
-                const qnav_q1_15_t q = qnav_ctrl_quality(&ctrl, static_cast<uint8_t>(level), static_cast<uint8_t>(dt));
-                char b[200];
-                std::snprintf(b, sizeof b, "%s,%u,%.4f,%u,%.6f\n", pp.first.c_str(), level, dist, dt, q / 32768.0);
-                o << b;
-            }
-        }
-    }
-    return o.str();
+    return quality_table_csv(policies, ccfg);
 }
 
 std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt)
@@ -643,7 +626,7 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
     return o.str();
 }
 
-void run_plot(const RunOptions &opt, const std::string &script, const std::string &exp_dir)
+void run_plot_impl(const RunOptions &opt, const std::string &script, const std::string &exp_dir)
 {
     const std::string path = join_path(opt.tools_dir, script);
     if (!file_exists(path)) {
@@ -668,6 +651,34 @@ void run_plot(const RunOptions &opt, const std::string &script, const std::strin
 }
 
 } // namespace
+
+std::string quality_table_csv(const std::vector<std::pair<std::string, qnav_policy_t>> &policies,
+                              const qnav_ctrl_config_t &ccfg)
+{
+    std::ostringstream o;
+    o << "policy,level,distance_m,dtheta_deg,quality\n";
+    for (auto &pp : policies) {
+        qnav_ctrl_t ctrl;
+        if (qnav_ctrl_init(&ctrl, &ccfg, &pp.second) != QNAV_OK) {
+            throw UserError("quality map: the controller refused policy " + pp.first);
+        }
+        for (uint32_t level = 0; level < QNAV_DIST_LEVELS; ++level) {
+            const double dist = static_cast<double>(level) / (QNAV_DIST_LEVELS - 1) * ccfg.max_range_mm / 1000.0;
+            for (uint32_t dt = 0; dt <= QNAV_DTHETA_MAX; ++dt) {
+                const qnav_q1_15_t q = qnav_ctrl_quality(&ctrl, static_cast<uint8_t>(level), static_cast<uint8_t>(dt));
+                char b[200];
+                std::snprintf(b, sizeof b, "%s,%u,%.4f,%u,%.6f\n", pp.first.c_str(), level, dist, dt, q / 32768.0);
+                o << b;
+            }
+        }
+    }
+    return o.str();
+}
+
+void run_plot(const RunOptions &opt, const std::string &script, const std::string &dir)
+{
+    run_plot_impl(opt, script, dir);
+}
 
 std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
 {
@@ -731,8 +742,8 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
     write_file_atomic(join_path(exp_dir, "summary.json"), summary_json(spec, S, opt));
     if (opt.plots) {
         write_file_atomic(status_path, "incomplete: runs finished, plots missing\n");
-        run_plot(opt, "plot_learning.py", exp_dir);
-        run_plot(opt, "plot_policy.py", exp_dir);
+        run_plot_impl(opt, "plot_learning.py", exp_dir);
+        run_plot_impl(opt, "plot_policy.py", exp_dir);
     }
     write_file_atomic(join_path(exp_dir, "summary.md"), summary_md(spec, S, opt, exp_dir, opt.plots));
     write_file_atomic(status_path, "complete\n");

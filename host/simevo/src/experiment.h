@@ -10,7 +10,10 @@
 #define QNAV_SIMEVO_EXPERIMENT_H
 
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "qnav/ctrl.h"
 
 #include "spec.h"
 #include "stats.h"
@@ -79,6 +82,13 @@ struct ExperimentSummary {
 };
 
 ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks);
+
+/* Path quality over (distance level, dtheta) of each named policy, as libqnav computes it
+ * (qnav_ctrl_quality): the quality.csv that tools/plot_policy.py draws. Throws UserError. */
+std::string quality_table_csv(const std::vector<std::pair<std::string, qnav_policy_t>> &policies,
+                              const qnav_ctrl_config_t &ccfg);
+/* Run tools/<script> DIR with opt.python. Throws UserError when it fails. */
+void run_plot(const RunOptions &opt, const std::string &script, const std::string &dir);
 
 /* Run a spec end to end (resuming what is there). Returns the experiment folder. Throws
  * UserError. */

@@ -157,6 +157,17 @@ int main(int argc, char **argv)
     eval->add_option("--episodes", e_episodes, "episodes")->capture_default_str();
     eval->add_option("--seed", e_seed, "seed")->capture_default_str();
 
+    // quality: Figs. 2-3 for any policy files
+    auto *quality = app.add_subcommand("quality", "plot path quality over (dtheta, distance) of policy files (paper Figs. 2-3)");
+    std::vector<std::string> q_policies;
+    std::string q_out = "runs/quality";
+    uint32_t q_range = 5000;
+    quality->add_option("policy", q_policies, "policy files, or 'prob'")->required();
+    quality->add_option("--out", q_out, "folder for quality.csv and policy.png")->capture_default_str();
+    quality->add_option("--range-mm", q_range, "sonar maximum range for the distance axis, mm")
+        ->capture_default_str()->check(CLI::Range(1, 65535));
+    quality->add_option("--tools-dir", opt.tools_dir, "folder with plot_policy.py")->capture_default_str();
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp &e) {
@@ -238,6 +249,48 @@ int main(int argc, char **argv)
             run_tasks({t}, make, 1, ::isatty(2) != 0, "evolve");
             std::printf("best policy %s/best.policy; episodes %s/episodes.csv; held-out %s/eval.csv\n",
                         out_dir.c_str(), out_dir.c_str(), out_dir.c_str());
+            return 0;
+        }
+        if (*quality) {
+            std::vector<std::pair<std::string, qnav_policy_t>> policies;
+            for (const auto &arg : q_policies) {
+                qnav_policy_t p;
+                if (arg == "prob") {
+                    qnav_policy_prob_default(&p);
+                } else {
+                    char err[QNAV_POLICY_IO_ERRLEN] = {0};
+                    if (!file_exists(arg)) {
+                        throw UserError(arg + ": policy file not found");
+                    }
+                    if (qnav_policy_read(arg.c_str(), &p, err, sizeof err) != 0) {
+                        throw UserError(err);
+                    }
+                }
+                // Label: the last two path components (run folders all hold "best.policy"),
+                // made unique with a number when needed.
+                std::string label = "probabilistic";
+                if (arg != "prob") {
+                    const std::size_t last = arg.find_last_of('/');
+                    const std::size_t prev = last == std::string::npos || last == 0 ? std::string::npos
+                                                                                    : arg.find_last_of('/', last - 1);
+                    label = prev == std::string::npos ? arg : arg.substr(prev + 1);
+                }
+                for (const auto &q : policies) {
+                    if (q.first == label) {
+                        label += " #" + std::to_string(policies.size() + 1);
+                        break;
+                    }
+                }
+                std::replace(label.begin(), label.end(), ',', ' ');
+                policies.emplace_back(label, p);
+            }
+            qnav_ctrl_config_t ccfg;
+            qnav_ctrl_config_default(&ccfg);
+            ccfg.max_range_mm = static_cast<qnav_mm_t>(q_range);
+            make_dirs(q_out);
+            write_file_atomic(join_path(q_out, "quality.csv"), quality_table_csv(policies, ccfg));
+            run_plot(opt, "plot_policy.py", q_out);
+            std::printf("plot %s/policy.png\n", q_out.c_str());
             return 0;
         }
         if (*eval) {
