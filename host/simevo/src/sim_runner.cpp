@@ -89,8 +89,8 @@ EpisodeOutcome SimRunner::run(const qnav_policy_t &policy, uint64_t episode_seed
     char msg[64];
     const qnav_sim_status_t s = qnav_sim_run_episode(sim_, &ctrl, episode_seed, &res, nullptr, nullptr);
     if (s != QNAV_SIM_OK) {
-        std::snprintf(msg, sizeof msg, "simulator: episode failed (status %d)", static_cast<int>(s));
-        throw UserError(msg);
+        std::snprintf(msg, sizeof msg, "simulator: episode failed (status %d): ", static_cast<int>(s));
+        throw UserError(msg + std::string(qnav_sim_last_error(sim_)));
     }
     EpisodeOutcome out;
     out.R = res.R;

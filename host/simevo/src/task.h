@@ -54,11 +54,6 @@ struct TaskObserver {
     std::function<void(const std::string &label, double best_R)> best;
 };
 
-/* Held-out evaluation result per episode. */
-struct EvalRow {
-    EpisodeOutcome out;
-};
-
 /* Run (or resume, or skip if done) a task. source_policy_path is the file that seeds a
  * transfer ("" for none). stop is polled between episodes. Throws UserError. Returns
  * true when complete, false when stopped. */
