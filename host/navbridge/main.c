@@ -3,7 +3,8 @@
  * pseudo-terminal). Offboard mode runs libqnav here on the board's scans and streams
  * commands back; onboard mode relays goals and telemetry and can upload a policy file to
  * the board. Everything is published on LCM. When the board goes quiet for --timeout-ms
- * it commands a stop; SIGINT/SIGTERM stop the robot before exiting. --replay re-runs a
+ * it commands a stop; SIGINT/SIGTERM stop the robot before exiting (status 0); a port that
+ * hangs up ends it with status 3. --replay re-runs a
  * recorded trial's scans through the controller and checks the commands are identical.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -117,7 +118,7 @@ int main(int argc, char **argv)
     lcm_eventlog_t *log = NULL;
     goal_ctx_t gctx;
     qnav_goal_t_subscription_t *sub;
-    int fd, c, exit_code = 0;
+    int fd, c, exit_code = 0, hung_up = 0;
     struct sigaction sa;
 
     qnav_bridge_config_default(&cfg);
@@ -289,20 +290,20 @@ int main(int argc, char **argv)
             exit_code = 1;
             break;
         }
-        if (n > 0 && (p[0].revents & POLLIN)) {
+        if (n > 0 && (p[0].revents & (POLLIN | POLLHUP | POLLERR))) {
             uint8_t buf[512];
             ssize_t r = read(fd, buf, sizeof buf);
             if (r > 0) {
                 qnav_bridge_on_bytes(&bridge, buf, (size_t)r, mono_ms());
-            } else if (r < 0 && errno != EAGAIN && errno != EINTR) {
-                fprintf(stderr, "navbridge: %s: %s: link lost\n", device, strerror(errno));
+            } else if (r == 0 || (errno != EAGAIN && errno != EINTR)) {
+                /* end of file on a serial port: unplugged adapter, or the SIL robot or
+                 * simavr board (pty master) has gone */
+                fprintf(stderr, "navbridge: %s: %s: link lost\n", device,
+                        r == 0 ? "device hung up" : strerror(errno));
                 exit_code = 3;
+                hung_up = 1;
                 break;
             }
-        } else if (n > 0 && (p[0].revents & (POLLHUP | POLLERR))) {
-            fprintf(stderr, "navbridge: %s: device hung up: link lost\n", device);
-            exit_code = 3;
-            break;
         }
         if (n > 0 && (p[1].revents & POLLIN)) {
             lcm_handle_timeout(lcm, 0);
@@ -311,7 +312,9 @@ int main(int argc, char **argv)
     }
     /* stop the robot before leaving, whatever made us leave */
     qnav_bridge_shutdown(&bridge, mono_ms());
-    tcdrain(fd);
+    if (!hung_up) {
+        tcdrain(fd);
+    }
     if (g_stop_signal) {
         fprintf(stderr, "navbridge: %s: robot stopped, exiting\n",
                 g_stop_signal == SIGINT ? "SIGINT" : "SIGTERM");

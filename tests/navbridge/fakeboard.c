@@ -176,6 +176,21 @@ void fakeboard_close(fakeboard_t *fb)
     fb->slave_keep = -1;
 }
 
+int wait_exit_within(pid_t pid, int timeout_ms)
+{
+    int64_t end = fakeboard_ms() + timeout_ms;
+    int status = 0;
+    while (fakeboard_ms() < end) {
+        if (waitpid(pid, &status, WNOHANG) == pid) {
+            return WIFEXITED(status) ? WEXITSTATUS(status) : 256 + WTERMSIG(status);
+        }
+        usleep(5000);
+    }
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+    return -1;
+}
+
 int run_program(const char *const *argv, const char *out_path, const char *err_path)
 {
     int status = 0;

@@ -48,6 +48,10 @@ void fakeboard_close(fakeboard_t *fb);
 /* Monotonic milliseconds. */
 int64_t fakeboard_ms(void);
 
+/* Wait up to timeout_ms for pid to exit; its status (0..255, 256 + signal), or -1 after
+ * killing it when it did not exit in time. */
+int wait_exit_within(pid_t pid, int timeout_ms);
+
 /* Run a program to completion, stdout and stderr into files; returns exit status or -1. */
 int run_program(const char *const *argv, const char *out_path, const char *err_path);
 

@@ -3,7 +3,8 @@
  * on a pty) and navbridge drive the simulated robot to its destination; the trial, logged,
  * replays to identical commands. Once on memq:// with navbridge --log, once on a real
  * udpm:// bus recorded by lcm-logger inside a private network namespace (skipped when
- * `unshare -n` is not permitted). No packet leaves the machine.
+ * `unshare -n` is not permitted). No packet leaves the machine. When the robot's episode
+ * ends its pty closes and navbridge exits with status 3 (link lost).
  */
 #define _XOPEN_SOURCE 700
 #define _DEFAULT_SOURCE
@@ -123,8 +124,10 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     pn = spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(wait_exit(ps), 0); /* 0: destination reached */
-    kill(pn, SIGTERM);
-    assert_int_equal(wait_exit(pn), 0);
+    /* the robot's end closes the pty: navbridge sees the hang-up and leaves with 3 */
+    assert_int_equal(wait_exit_within(pn, 3000), 3);
+    assert_true(read_text(nb_err, text, sizeof text) > 0);
+    assert_non_null(strstr(text, "device hung up: link lost"));
     assert_true(read_text(sil_out, text, sizeof text) > 0);
     print_message("%s", text);
     assert_non_null(strstr(text, "reached yes"));
@@ -170,8 +173,7 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     pn = spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(wait_exit(ps), 0);
-    kill(pn, SIGTERM);
-    assert_int_equal(wait_exit(pn), 0);
+    assert_int_equal(wait_exit_within(pn, 3000), 3);
     assert_true(read_text(sil_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "policy uploaded"));
     assert_true(read_text(nb_err, text, sizeof text) > 0);
@@ -216,7 +218,7 @@ static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(vo
     }
     assert_true(read_text(rc_path, text, sizeof text) > 0);
     print_message("%s", text);
-    assert_non_null(strstr(text, "sil=0 navbridge=0"));
+    assert_non_null(strstr(text, "sil=0 navbridge=3"));
     assert_true(read_text(sil_out, text, sizeof text) > 0);
     assert_non_null(strstr(text, "reached yes"));
     count_channels(log, &scan, &cmd, &qual, &status, &pose);
