@@ -28,6 +28,7 @@ extern "C" {
 #include <functional>
 #include <map>
 #include <string>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -323,6 +324,13 @@ static void test_program_killed_by_pid_resumes_to_identical_results(void **state
     }
     assert_true(fa.count("tiny/summary.md") == 1);
     assert_true(fa["tiny/STATUS"] == "complete\n");
+
+    // While another process holds the folder's lock, simevo refuses to touch it.
+    const int lfd = open(join_path(a, "tiny/.lock").c_str(), O_RDWR);
+    assert_true(lfd >= 0 && flock(lfd, LOCK_EX | LOCK_NB) == 0);
+    assert_int_equal(wait_exit(spawn(with_out(a), join_path(root, "lock.err"))), 1);
+    assert_non_null(std::strstr(slurp(join_path(root, "lock.err")).c_str(), "another simevo is running in this folder"));
+    close(lfd);
 
     // The same folder with other settings is refused and left as it was.
     auto other = with_out(a);

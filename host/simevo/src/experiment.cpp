@@ -16,6 +16,8 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -684,6 +686,19 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
 {
     const std::string exp_dir = join_path(opt.out_dir, spec.name);
     make_dirs(exp_dir);
+    // One simevo per experiment folder: two writers would interleave their journals.
+    const std::string lock_path = join_path(exp_dir, ".lock");
+    const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (lock_fd < 0 || ::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
+        if (lock_fd >= 0) {
+            ::close(lock_fd);
+        }
+        throw UserError(exp_dir + ": another simevo is running in this folder (or it cannot be locked)");
+    }
+    struct LockGuard {
+        int fd;
+        ~LockGuard() { ::close(fd); }
+    } lock_guard{lock_fd};
     const std::vector<TaskDef> tasks = plan_tasks(spec, exp_dir);
     // Refuse a folder made with other settings before touching anything in it.
     std::string settings = "# simevo experiment " + spec.name + ": the settings of every task\n";
