@@ -381,7 +381,8 @@ int main(int argc, char **argv)
             qnav_ctrl_input_t in = {scan.ranges_mm, scan.goal_bearing_cdeg};
             qnav_link_command_t tel;
             qnav_ctrl_step(&r.ctrl, &in, &out, NULL);
-            moving = !r.stop_held;
+            /* like the board: hold still while stopped or when the bridge went quiet */
+            moving = !r.stop_held && mono_ms() - r.last_rx_ms <= 300;
             tel.scan_seq = seq;
             tel.heading_deg = out.heading_deg;
             tel.speed = moving ? out.speed : 0;
