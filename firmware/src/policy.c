@@ -10,8 +10,8 @@ void qnav_policy_prob_default(qnav_policy_t *policy)
         return;
     }
     policy->kind = (uint8_t)QNAV_POLICY_PROB;
-    policy->u.prob.k_goal = QNAV_Q8_8(2.0);
-    policy->u.prob.k_safe = QNAV_Q8_8(6.0);
+    policy->u.prob.k_goal = QNAV_Q8_8(1.0);
+    policy->u.prob.k_safe = QNAV_Q8_8(4.0);
 }
 
 void qnav_policy_net_zero(qnav_policy_t *policy, uint8_t hidden)

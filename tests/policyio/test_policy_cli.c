@@ -159,8 +159,12 @@ static void test_cli_new_writes_files_that_check_accepts(void **state)
     assert_int_equal(run_tool("new", "--kind", "probabilistic", tmp_path("p.policy"), NULL), 0);
     assert_int_equal(qnav_policy_read(tmp_path("p.policy"), &p, err, sizeof err), 0);
     assert_int_equal(p.kind, QNAV_POLICY_PROB);
-    assert_int_equal(p.u.prob.k_goal, 512);
-    assert_int_equal(p.u.prob.k_safe, 1536);
+    {
+        qnav_policy_t d;
+        qnav_policy_prob_default(&d);
+        assert_int_equal(p.u.prob.k_goal, d.u.prob.k_goal);
+        assert_int_equal(p.u.prob.k_safe, d.u.prob.k_safe);
+    }
     assert_int_equal(run_tool("new", "--kind", "network", "--hidden", "5", "--seed", "9",
                               tmp_path("n.policy"), NULL),
                      0);

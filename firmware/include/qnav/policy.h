@@ -56,7 +56,7 @@ typedef struct {
 /* Number of Q8.8 weights of a network with H hidden units: 4H + 1. */
 #define QNAV_NET_WEIGHTS(h) (4u * (h) + 1u)
 
-/* The hand-tuned probabilistic policy: k_goal = 2.0, k_safe = 6.0 (docs/architecture.md). */
+/* The hand-tuned probabilistic policy: k_goal = 1.0, k_safe = 4.0 (docs/architecture.md). */
 void qnav_policy_prob_default(qnav_policy_t *policy);
 
 /* A network of H hidden units with every weight zero (its quality is 0.5 everywhere).
