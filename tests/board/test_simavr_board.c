@@ -21,6 +21,7 @@
 #include <cmocka.h>
 
 #include "fakeboard.h"
+#include "test_proc.h"
 #include "qnav/policy_io.h"
 
 static char g_dir[256];
@@ -28,39 +29,13 @@ static char g_dir[256];
 static int setup(void **state)
 {
     (void)state;
-    snprintf(g_dir, sizeof g_dir, "/tmp/qnav_simavr_test.XXXXXX");
-    return mkdtemp(g_dir) == NULL ? -1 : 0;
+    return qnav_test_tmpdir_make(g_dir, sizeof g_dir, "qnav_simavr_test");
 }
 
 static int teardown(void **state)
 {
-    char cmd[300];
     (void)state;
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
-    return system(cmd) == 0 ? 0 : -1;
-}
-
-static pid_t spawn(const char *const *argv, const char *out, const char *err)
-{
-    pid_t pid = fork();
-    if (pid == 0) {
-        FILE *o = freopen(out, "w", stdout);
-        FILE *e = freopen(err, "w", stderr);
-        (void)o;
-        (void)e;
-        execv(argv[0], (char *const *)argv);
-        _exit(127);
-    }
-    return pid;
-}
-
-static int wait_exit(pid_t pid)
-{
-    int st = 0;
-    if (waitpid(pid, &st, 0) != pid) {
-        return -1;
-    }
-    return WIFEXITED(st) ? WEXITSTATUS(st) : 256 + WTERMSIG(st);
+    return qnav_test_tmpdir_remove(g_dir);
 }
 
 static void test_firmware_in_simavr_runs_uploaded_network_bit_identical_to_host(void **state)
@@ -95,15 +70,15 @@ static void test_firmware_in_simavr_runs_uploaded_network_bit_identical_to_host(
     }
     assert_int_equal(qnav_policy_write(policy, &p, "simavr test", perr, sizeof perr), 0);
 
-    pb = spawn(board, sa_out, sa_err);
+    pb = qnav_test_spawn(board, sa_out, sa_err);
     assert_true(pb > 0);
     for (i = 0; i < 200 && lstat(link, &sb) != 0; ++i) {
         usleep(20000);
     }
     assert_int_equal(lstat(link, &sb), 0);
-    pn = spawn(bridge, nb_out, nb_err);
+    pn = qnav_test_spawn(bridge, nb_out, nb_err);
     assert_true(pn > 0);
-    assert_int_equal(wait_exit(pb), 0);
+    assert_int_equal(qnav_test_wait_exit(pb), 0);
     assert_int_equal(wait_exit_within(pn, 3000), 3); /* simavr's pty closed: link lost */
     assert_true(read_text(sa_out, text, sizeof text) > 0);
     assert_non_null(strstr(text, "stopped after 4.00 simulated s (done)"));

@@ -24,6 +24,7 @@
 #include <lcm/eventlog.h>
 
 #include "fakeboard.h"
+#include "test_proc.h"
 #include "qnav/policy_io.h"
 
 static char g_dir[256];
@@ -31,40 +32,14 @@ static char g_dir[256];
 static int setup(void **state)
 {
     (void)state;
-    snprintf(g_dir, sizeof g_dir, "/tmp/qnav_sil_test.XXXXXX");
     setenv("QNAV_DATA_DIR", QNAV_DATA_DIR, 1);
-    return mkdtemp(g_dir) == NULL ? -1 : 0;
+    return qnav_test_tmpdir_make(g_dir, sizeof g_dir, "qnav_sil_test");
 }
 
 static int teardown(void **state)
 {
-    char cmd[300];
     (void)state;
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
-    return system(cmd) == 0 ? 0 : -1;
-}
-
-static pid_t spawn(const char *const *argv, const char *out, const char *err)
-{
-    pid_t pid = fork();
-    if (pid == 0) {
-        FILE *o = freopen(out, "w", stdout);
-        FILE *e = freopen(err, "w", stderr);
-        (void)o;
-        (void)e;
-        execv(argv[0], (char *const *)argv);
-        _exit(127);
-    }
-    return pid;
-}
-
-static int wait_exit(pid_t pid)
-{
-    int st = 0;
-    if (waitpid(pid, &st, 0) != pid) {
-        return -1;
-    }
-    return WIFEXITED(st) ? WEXITSTATUS(st) : 256 + WTERMSIG(st);
+    return qnav_test_tmpdir_remove(g_dir);
 }
 
 /* Count events per channel of interest in an LCM log. */
@@ -115,15 +90,15 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     snprintf(sil_err, sizeof sil_err, "%s/sil.err", g_dir);
     snprintf(nb_out, sizeof nb_out, "%s/nb.out", g_dir);
     snprintf(nb_err, sizeof nb_err, "%s/nb.err", g_dir);
-    ps = spawn(sil, sil_out, sil_err);
+    ps = qnav_test_spawn(sil, sil_out, sil_err);
     assert_true(ps > 0);
     for (i = 0; i < 200 && lstat(link, &sb) != 0; ++i) {
         usleep(20000);
     }
     assert_int_equal(lstat(link, &sb), 0);
-    pn = spawn(nb, nb_out, nb_err);
+    pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
-    assert_int_equal(wait_exit(ps), 0); /* 0: destination reached */
+    assert_int_equal(qnav_test_wait_exit(ps), 0); /* 0: destination reached */
     /* the robot's end closes the pty: navbridge sees the hang-up and leaves with 3 */
     assert_int_equal(wait_exit_within(pn, 3000), 3);
     assert_true(read_text(nb_err, text, sizeof text) > 0);
@@ -164,15 +139,15 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     qnav_policy_prob_default(&p);
     p.u.prob.k_goal = 3 * 256; /* not the board's default: the upload must take */
     assert_int_equal(qnav_policy_write(pol, &p, "sil onboard test", perr, sizeof perr), 0);
-    ps = spawn(sil, sil_out, sil_err);
+    ps = qnav_test_spawn(sil, sil_out, sil_err);
     assert_true(ps > 0);
     for (i = 0; i < 200 && lstat(link, &sb) != 0; ++i) {
         usleep(20000);
     }
     assert_int_equal(lstat(link, &sb), 0);
-    pn = spawn(nb, nb_out, nb_err);
+    pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
-    assert_int_equal(wait_exit(ps), 0);
+    assert_int_equal(qnav_test_wait_exit(ps), 0);
     assert_int_equal(wait_exit_within(pn, 3000), 3);
     assert_true(read_text(sil_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "policy uploaded"));

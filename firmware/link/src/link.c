@@ -271,7 +271,7 @@ void qnav_link_tx_init(qnav_link_tx_t *tx)
 typedef struct {
     uint8_t *out;
     uint16_t cap;
-    uint16_t pos;      /* next free byte */
+    uint16_t pos;      /* next unused byte */
     uint16_t code_at;  /* where the current block's code byte goes */
     uint8_t code;      /* current block code (1 + data bytes in block) */
     uint8_t full;      /* 1 when out of space */

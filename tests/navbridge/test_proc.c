@@ -1,0 +1,52 @@
+/*
+ * Child processes and scratch folders for the process-level tests (test_proc.h).
+ */
+#define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE
+#include "test_proc.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+pid_t qnav_test_spawn(const char *const *argv, const char *out, const char *err)
+{
+    pid_t pid = fork();
+    if (pid == 0) {
+        if (freopen(out, "w", stdout) == NULL || freopen(err, "w", stderr) == NULL) {
+            _exit(126);
+        }
+        execv(argv[0], (char *const *)argv);
+        _exit(127);
+    }
+    return pid;
+}
+
+int qnav_test_wait_exit(pid_t pid)
+{
+    int st = 0;
+    if (waitpid(pid, &st, 0) != pid) {
+        return -1;
+    }
+    return WIFEXITED(st) ? WEXITSTATUS(st) : 256 + WTERMSIG(st);
+}
+
+int qnav_test_tmpdir_make(char *dir, size_t len, const char *prefix)
+{
+    int n = snprintf(dir, len, "/tmp/%s.XXXXXX", prefix);
+    if (n < 0 || (size_t)n >= len) {
+        return -1;
+    }
+    return mkdtemp(dir) == NULL ? -1 : 0;
+}
+
+int qnav_test_tmpdir_remove(const char *dir)
+{
+    char cmd[600];
+    int n = snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (n < 0 || (size_t)n >= sizeof cmd) {
+        return -1;
+    }
+    return system(cmd) == 0 ? 0 : -1;
+}

@@ -1,0 +1,25 @@
+/*
+ * Child processes and scratch folders for the tests that run qnav programs against each
+ * other (navbridge, the SIL robot, the simavr board): start one with its output in files,
+ * wait for its exit status, make and remove a private folder under /tmp.
+ */
+#ifndef QNAV_TEST_PROC_H
+#define QNAV_TEST_PROC_H
+
+#include <stddef.h>
+#include <sys/types.h>
+
+/* Run argv (argv[0] a path, null-terminated) with stdout and stderr sent to the files
+ * out and err. Returns the child's pid, or -1. */
+pid_t qnav_test_spawn(const char *const *argv, const char *out, const char *err);
+
+/* Wait for pid: its exit status, 256 + signal number if a signal ended it, -1 on error. */
+int qnav_test_wait_exit(pid_t pid);
+
+/* Make a fresh folder /tmp/<prefix>.XXXXXX into dir (len bytes). 0 or -1. */
+int qnav_test_tmpdir_make(char *dir, size_t len, const char *prefix);
+
+/* Remove the folder and everything in it. 0 or -1. */
+int qnav_test_tmpdir_remove(const char *dir);
+
+#endif
