@@ -121,6 +121,32 @@ void write_all(int fd, const std::string &s, const std::string &path)
     }
 }
 
+// Closes a file descriptor when it goes out of scope.
+struct FdGuard {
+    int fd;
+    ~FdGuard() { ::close(fd); }
+};
+
+// Open a journal for appending after its first `keep` bytes (the complete lines that
+// survived an interrupted run), writing the header when nothing survived.
+int open_journal_at(const std::string &path, std::size_t keep, const char *header)
+{
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        throw UserError(path + ": cannot open (" + std::strerror(errno) + ")");
+    }
+    FdGuard guard{fd};
+    if (::ftruncate(fd, static_cast<off_t>(keep)) != 0 ||
+        ::lseek(fd, static_cast<off_t>(keep), SEEK_SET) < 0) {
+        throw UserError(path + ": cannot truncate (" + std::strerror(errno) + ")");
+    }
+    if (keep == 0) {
+        write_all(fd, header, path);
+    }
+    guard.fd = -1; // handed to the caller
+    return fd;
+}
+
 qnav_policy_t load_source_policy(const std::string &path)
 {
     qnav_policy_t p;
@@ -179,21 +205,8 @@ bool run_eval(EpisodeRunner &runner, const qnav_policy_t &policy, const TaskDef 
     if (obs.episodes_done && have > 0) {
         obs.episodes_done(have, true);
     }
-    const int fd = ::open(partial.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        throw UserError(partial + ": cannot open (" + std::strerror(errno) + ")");
-    }
-    struct FdGuard {
-        int fd;
-        ~FdGuard() { ::close(fd); }
-    } guard{fd};
-    if (::ftruncate(fd, static_cast<off_t>(keep)) != 0 ||
-        ::lseek(fd, static_cast<off_t>(keep), SEEK_SET) < 0) {
-        throw UserError(partial + ": cannot truncate (" + std::strerror(errno) + ")");
-    }
-    if (keep == 0) {
-        write_all(fd, kEvalHeader, partial);
-    }
+    const int fd = open_journal_at(partial, keep, kEvalHeader);
+    FdGuard guard{fd};
     for (uint32_t i = have; i < t.eval_episodes; ++i) {
         if (stop.load()) {
             return false;
@@ -411,21 +424,8 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
             }
         }
     }
-    const int fd = ::open(journal_path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        throw UserError(journal_path + ": cannot open (" + std::strerror(errno) + ")");
-    }
-    struct FdGuard {
-        int fd;
-        ~FdGuard() { ::close(fd); }
-    } guard{fd};
-    if (::ftruncate(fd, static_cast<off_t>(keep)) != 0 ||
-        ::lseek(fd, static_cast<off_t>(keep), SEEK_SET) < 0) {
-        throw UserError(journal_path + ": cannot truncate (" + std::strerror(errno) + ")");
-    }
-    if (keep == 0) {
-        write_all(fd, kJournalHeader, journal_path);
-    }
+    const int fd = open_journal_at(journal_path, keep, kJournalHeader);
+    FdGuard guard{fd};
     if (obs.best && evo.episodes_done() > 0) {
         obs.best(t.label, evo.best_so_far());
     }
