@@ -149,6 +149,14 @@ void qnav_sim_robot_info(const qnav_sim_robot_t *robot, qnav_sim_robot_info_t *i
     info->actuation_noise = p.noise_actuation;
 }
 
+void qnav_sim_robot_prob_policy(const qnav_sim_robot_t *robot, qnav_policy_t *policy) {
+    if (!policy) return;
+    qnav_policy_prob_default(policy);
+    if (!robot || robot->profile.prob_k_goal <= 0.0) return;
+    policy->u.prob.k_goal = static_cast<qnav_q8_8_t>(std::lround(robot->profile.prob_k_goal * 256.0));
+    policy->u.prob.k_safe = static_cast<qnav_q8_8_t>(std::lround(robot->profile.prob_k_safe * 256.0));
+}
+
 void qnav_sim_env_info(const qnav_sim_env_t *env, qnav_sim_env_info_t *info) {
     if (!env || !info) return;
     const qnav::Environment &e = env->env;

@@ -9,7 +9,7 @@ namespace qnav {
 RobotProfile parse_robot_profile(std::string_view text, const std::string &name) {
     TomlReader r(text, name);
     const toml::table &root = r.root();
-    r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery"});
+    r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery", "probabilistic"});
     RobotProfile p;
     p.name = r.string(root, "name");
     if (p.name.empty()) r.fail(root, "'name' must not be empty");
@@ -51,6 +51,13 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
         r.only_keys(noise, {"sensor", "actuation"});
         p.noise_sensor = r.number(noise, "sensor", 0.0, 1.0, true, 0.0);
         p.noise_actuation = r.number(noise, "actuation", 0.0, 1.0, true, 0.0);
+    }
+
+    if (root.get("probabilistic")) {
+        const toml::table &prob = r.table(root, "probabilistic");
+        r.only_keys(prob, {"k_goal", "k_safe"});
+        p.prob_k_goal = r.number(prob, "k_goal", 1.0 / 256.0, 64.0);
+        p.prob_k_safe = r.number(prob, "k_safe", 1.0 / 256.0, 64.0);
     }
 
     const toml::table &rec = r.table(root, "recovery");

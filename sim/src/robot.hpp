@@ -38,6 +38,9 @@ struct RobotProfile {
     std::uint32_t recovery_back_ticks = 5;  // of which backing up, ticks
     double recovery_back_speed_mps = 0.2;   // backing-up speed, m/s
     double recovery_turn_deg = 60;          // turn away from the obstacle after, deg
+    // the probabilistic policy hand-tuned for this robot (paper §3.2); 0 = libqnav default
+    double prob_k_goal = 0.0;               // P_goal steepness, (0, 64]
+    double prob_k_safe = 0.0;               // P_safe steepness, (0, 64]
 };
 
 // Parse a profile (TOML text); name is used in error messages. Throws SimError.

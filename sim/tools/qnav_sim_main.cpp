@@ -59,10 +59,11 @@ void make_sim(Loaded &l, int sectors, double ps, double pa, std::uint64_t seed) 
     check(qnav_sim_create(l.robot, l.env, &cfg, &l.sim, err, sizeof err), err);
 }
 
-qnav_policy_t read_policy(const std::string &path) {
+// The policy file at path, or (empty path) the probabilistic policy tuned for the robot.
+qnav_policy_t read_policy(const std::string &path, const qnav_sim_robot_t *robot) {
     qnav_policy_t pol;
     if (path.empty()) {
-        qnav_policy_prob_default(&pol);
+        qnav_sim_robot_prob_policy(robot, &pol);
         return pol;
     }
 #ifdef QNAV_SIM_HAVE_POLICYIO
@@ -118,7 +119,7 @@ int cmd_run(const RunOpts &o) {
     const double pa = o.pa >= 0 ? o.pa : ri.actuation_noise;
     make_sim(l, o.sectors, ps, pa, o.seed);
     qnav::Simulation &sim = *l.sim->sim;
-    const qnav_policy_t pol = read_policy(o.policy);
+    const qnav_policy_t pol = read_policy(o.policy, l.robot);
     std::vector<qnav_q1_15_t> tbuf;
     qnav_ctrl_t ctrl;
     init_ctrl(l.sim, pol, o.table, tbuf, &ctrl);
@@ -257,10 +258,10 @@ int cmd_bench(const BenchOpts &o) {
     qnav_policy_t pol;
     std::string what;
     if (o.policy == "prob") {
-        qnav_policy_prob_default(&pol);
-        what = "probabilistic (default)";
+        qnav_sim_robot_prob_policy(l.robot, &pol);
+        what = "probabilistic (tuned for the robot)";
     } else if (!o.policy.empty()) {
-        pol = read_policy(o.policy);
+        pol = read_policy(o.policy, l.robot);
         what = o.policy;
     } else {
         pol = random_network(o.hidden, o.seed, 0);
@@ -338,7 +339,7 @@ int main(int argc, char **argv) {
 
     RunOpts ro;
     CLI::App *run = app.add_subcommand("run", "simulate a policy and print the episode's figures");
-    run->add_option("--policy", ro.policy, "policy file (default: the hand-tuned probabilistic policy)")->check(CLI::ExistingFile);
+    run->add_option("--policy", ro.policy, "policy file (default: the probabilistic policy tuned for the robot)")->check(CLI::ExistingFile);
     run->add_option("--robot", ro.robot, "robot profile name or file")->capture_default_str();
     run->add_option("--env", ro.env, "environment name or file")->capture_default_str();
     run->add_option("--sectors", ro.sectors, "sonar sectors 1..360 (default: the profile's)")->check(CLI::Range(1, 360));

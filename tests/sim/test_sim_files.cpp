@@ -131,6 +131,29 @@ static void test_bad_robot_profiles_are_refused(void **state) {
     assert_int_equal(parse_robot(t4, &msg), QNAV_SIM_E_PARSE);
     assert_true(starts_with(msg, "bad.toml:"));
     assert_true(one_line(msg));
+    std::string t5 = good;
+    t5.replace(t5.find("k_safe = 4.0"), 12, "k_safe = 0.0");
+    assert_int_equal(parse_robot(t5, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("k_safe") != std::string::npos);
+    assert_true(one_line(msg));
+}
+
+static void test_profile_carries_its_tuned_probabilistic_policy(void **state) {
+    (void)state;
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_robot_t *robot = nullptr;
+    qnav_policy_t p;
+    assert_int_equal(qnav_sim_robot_load("tekbot", &robot, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_robot_prob_policy(robot, &p);
+    assert_int_equal(p.kind, QNAV_POLICY_PROB);
+    assert_int_equal(p.u.prob.k_goal, 256);
+    assert_int_equal(p.u.prob.k_safe, 512);
+    qnav_sim_robot_free(robot);
+    /* no robot: libqnav's defaults */
+    qnav_policy_t d;
+    qnav_policy_prob_default(&d);
+    qnav_sim_robot_prob_policy(nullptr, &p);
+    assert_int_equal(p.u.prob.k_safe, d.u.prob.k_safe);
 }
 
 static void test_missing_file_is_an_io_error_naming_it(void **state) {
@@ -279,6 +302,7 @@ int main(void) {
         cmocka_unit_test(test_missing_table_and_bad_values_name_their_line),
         cmocka_unit_test(test_start_zone_inside_an_obstacle_is_refused_with_its_line),
         cmocka_unit_test(test_bad_robot_profiles_are_refused),
+        cmocka_unit_test(test_profile_carries_its_tuned_probabilistic_policy),
         cmocka_unit_test(test_missing_file_is_an_io_error_naming_it),
         cmocka_unit_test(test_impossible_parameters_are_refused_by_field),
         cmocka_unit_test(test_mismatched_controller_is_refused),

@@ -33,6 +33,14 @@ class EpisodeRunner {
 public:
     virtual ~EpisodeRunner() = default;
     virtual EpisodeOutcome run(const qnav_policy_t &policy, uint64_t episode_seed) = 0;
+    /* The probabilistic policy to compare against: the one tuned for the runner's robot
+     * (libqnav's defaults unless a runner knows better). */
+    virtual qnav_policy_t probabilistic_policy() const
+    {
+        qnav_policy_t p;
+        qnav_policy_prob_default(&p);
+        return p;
+    }
 };
 
 /* How the initial random population is drawn. */

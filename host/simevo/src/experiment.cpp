@@ -511,11 +511,9 @@ std::string curves_csv(const ExperimentSummary &S)
 }
 
 std::string quality_csv(const ExperimentSpec &spec, const ExperimentSummary &S, const std::string &exp_dir,
-                        const qnav_ctrl_config_t &ccfg)
+                        const qnav_ctrl_config_t &ccfg, const qnav_policy_t &prob)
 {
     std::vector<std::pair<std::string, qnav_policy_t>> policies;
-    qnav_policy_t prob;
-    qnav_policy_prob_default(&prob);
     policies.emplace_back("probabilistic", prob);
     for (const ConditionSummary &c : S.conditions) {
         if (c.label == "probabilistic" || c.best_run < 0) {
@@ -753,7 +751,8 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
 
     const ExperimentSummary S = summarize(spec, tasks);
     write_file_atomic(join_path(exp_dir, "curves.csv"), curves_csv(S));
-    write_file_atomic(join_path(exp_dir, "quality.csv"), quality_csv(spec, S, exp_dir, target_runner->ctrl_config()));
+    write_file_atomic(join_path(exp_dir, "quality.csv"), quality_csv(spec, S, exp_dir, target_runner->ctrl_config(),
+                                                                         target_runner->probabilistic_policy()));
     write_file_atomic(join_path(exp_dir, "summary.json"), summary_json(spec, S, opt));
     if (opt.plots) {
         write_file_atomic(status_path, "incomplete: runs finished, plots missing\n");

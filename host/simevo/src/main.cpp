@@ -294,9 +294,11 @@ int main(int argc, char **argv)
             return 0;
         }
         if (*eval) {
+            SimWorlds worlds;
+            SimRunner runner(worlds, scenario_from(e_env, e_robot, e_sectors, e_noise, -1, -1), e_seed, true);
             qnav_policy_t p;
             if (policy_arg == "prob") {
-                qnav_policy_prob_default(&p);
+                p = runner.probabilistic_policy();
             } else {
                 char err[QNAV_POLICY_IO_ERRLEN] = {0};
                 if (!file_exists(policy_arg)) {
@@ -306,8 +308,6 @@ int main(int argc, char **argv)
                     throw UserError(err);
                 }
             }
-            SimWorlds worlds;
-            SimRunner runner(worlds, scenario_from(e_env, e_robot, e_sectors, e_noise, -1, -1), e_seed, true);
             std::vector<double> R;
             uint32_t reached = 0, tau = 0;
             for (uint32_t i = 0; i < e_episodes; ++i) {

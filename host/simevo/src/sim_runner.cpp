@@ -67,6 +67,7 @@ SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t conte
         throw UserError(std::string("simulator (") + scenario.describe() + "): " + err);
     }
     qnav_sim_ctrl_config(sim_, &ctrl_cfg_);
+    qnav_sim_robot_prob_policy(robot, &prob_);
 }
 
 SimRunner::~SimRunner() { qnav_sim_destroy(sim_); }

@@ -49,12 +49,15 @@ public:
     SimRunner &operator=(const SimRunner &) = delete;
 
     EpisodeOutcome run(const qnav_policy_t &policy, uint64_t episode_seed) override;
+    /* The robot profile's hand-tuned probabilistic policy (qnav_sim_robot_prob_policy). */
+    qnav_policy_t probabilistic_policy() const override { return prob_; }
     /* The controller configuration of this context (sectors, max range). */
     const qnav_ctrl_config_t &ctrl_config() const { return ctrl_cfg_; }
 
 private:
     qnav_sim_t *sim_ = nullptr;
     qnav_ctrl_config_t ctrl_cfg_{};
+    qnav_policy_t prob_{};
     bool use_table_;
     std::vector<qnav_q1_15_t> table_;
 };

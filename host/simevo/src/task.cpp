@@ -371,8 +371,7 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
     std::unique_ptr<EpisodeRunner> runner = make(t.scenario, t.context_seed);
 
     if (t.kind == TaskKind::EvalProbabilistic) {
-        qnav_policy_t prob;
-        qnav_policy_prob_default(&prob);
+        const qnav_policy_t prob = runner->probabilistic_policy();
         if (!run_eval(*runner, prob, t, obs, stop)) {
             return false;
         }
