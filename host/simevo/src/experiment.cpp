@@ -701,7 +701,11 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
     // Refuse a folder made with other settings before touching anything in it.
     std::string settings = "# simevo experiment " + spec.name + ": the settings of every task\n";
     for (const TaskDef &t : tasks) {
-        settings += "\n[" + t.dir.substr(exp_dir.size() + 1) + "]\n" + task_settings_text(t, t.source_policy_file);
+        // a transfer's source policy does not exist yet: name the task that will make it
+        const std::string source = t.source_task >= 0
+                                       ? "best policy of " + tasks[static_cast<std::size_t>(t.source_task)].dir.substr(exp_dir.size() + 1)
+                                       : t.source_policy_file;
+        settings += "\n[" + t.dir.substr(exp_dir.size() + 1) + "]\n" + task_settings_text(t, source);
     }
     const std::string settings_path = join_path(exp_dir, "settings.txt");
     std::string existing;

@@ -162,7 +162,9 @@ int main(int argc, char **argv)
     std::vector<std::string> q_policies;
     std::string q_out = "runs/quality";
     uint32_t q_range = 5000;
-    quality->add_option("policy", q_policies, "policy files, or 'prob'")->required();
+    std::string q_robot = "tekbot";
+    quality->add_option("policy", q_policies, "policy files, or 'prob' (the robot's tuned probabilistic policy)")->required();
+    quality->add_option("--robot", q_robot, "robot profile whose probabilistic policy 'prob' means")->capture_default_str();
     quality->add_option("--out", q_out, "folder for quality.csv and policy.png")->capture_default_str();
     quality->add_option("--range-mm", q_range, "sonar maximum range for the distance axis, mm")
         ->capture_default_str()->check(CLI::Range(1, 65535));
@@ -256,7 +258,8 @@ int main(int argc, char **argv)
             for (const auto &arg : q_policies) {
                 qnav_policy_t p;
                 if (arg == "prob") {
-                    qnav_policy_prob_default(&p);
+                    SimWorlds worlds;
+                    qnav_sim_robot_prob_policy(worlds.robot(q_robot), &p);
                 } else {
                     char err[QNAV_POLICY_IO_ERRLEN] = {0};
                     if (!file_exists(arg)) {
