@@ -248,24 +248,6 @@ qnav_q1_15_t qnav_ctrl_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t d
     return QNAV_FLASH_READ_I16(&ctrl->table[(uint16_t)level * QNAV_TABLE_STRIDE + dtheta_deg]);
 }
 
-qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_q1_15_t *table)
-{
-    uint16_t level;
-    uint16_t dtheta;
-    if (ctrl == 0 || table == 0) {
-        return QNAV_E_NULL;
-    }
-    if (ctrl->magic != QNAV_CTRL_MAGIC || ctrl->kind == QNAV_KIND_TABLE) {
-        return QNAV_E_POLICY_KIND;
-    }
-    for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
-        for (dtheta = 0; dtheta <= QNAV_DTHETA_MAX; ++dtheta) {
-            table[level * QNAV_TABLE_STRIDE + dtheta] =
-                qnav_ctrl_quality(ctrl, (uint8_t)level, (uint8_t)dtheta);
-        }
-    }
-    return QNAV_OK;
-}
 
 /* Level of a range already known to be at most max_range_mm. For ranges of 32 mm and
  * more the scale fits 16 bits and a 16x16 multiply does (much cheaper on AVR). */
@@ -600,6 +582,40 @@ static void eval_net_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best,
         }
         consider(best, q, (uint16_t)(r->first + k), dtheta);
     }
+}
+
+qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_q1_15_t *table)
+{
+    uint16_t level;
+    uint16_t dtheta;
+    if (ctrl == 0 || table == 0) {
+        return QNAV_E_NULL;
+    }
+    if (ctrl->magic != QNAV_CTRL_MAGIC || ctrl->kind == QNAV_KIND_TABLE) {
+        return QNAV_E_POLICY_KIND;
+    }
+    for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
+        qnav_q1_15_t *row = &table[level * QNAV_TABLE_STRIDE];
+        if (ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
+            /* a row is a run of dtheta 0..180: the same integers, by addition */
+            run_t r;
+            best_t ignore;
+            r.first = 0;
+            r.count = QNAV_DTHETA_MAX + 1;
+            r.level = (uint8_t)level;
+            r.dtheta0 = 0;
+            r.dir = 1;
+            ignore.q = -1;
+            ignore.dtheta = 0;
+            ignore.heading = 0;
+            eval_net_run(ctrl, &r, &ignore, row);
+        } else {
+            for (dtheta = 0; dtheta <= QNAV_DTHETA_MAX; ++dtheta) {
+                row[dtheta] = prob_quality(ctrl, (uint8_t)level, (uint8_t)dtheta);
+            }
+        }
+    }
+    return QNAV_OK;
 }
 
 /*
