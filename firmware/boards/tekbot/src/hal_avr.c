@@ -19,6 +19,10 @@
 #ifndef QNAV_TEKBOT_BAUD
 #define QNAV_TEKBOT_BAUD 57600UL
 #endif
+/* avr-libc rounds the divider to the nearest rate, picks U2X when it is closer, and warns
+ * (an error with -Werror) when the rate is more than 2 % off. */
+#define BAUD QNAV_TEKBOT_BAUD
+#include <util/setbaud.h>
 /* mm of range per ADC count (x10): LV-EZ at 5 V: 9.8 mV/in, 4.88 mV/count -> 12.7 mm */
 #ifndef QNAV_TEKBOT_MM_PER_COUNT_X10
 #define QNAV_TEKBOT_MM_PER_COUNT_X10 127UL
@@ -162,17 +166,15 @@ static void avr_uart_write(void *ctx, const uint8_t *bytes, uint16_t n)
 
 void qnav_tekbot_hal_avr_init(qnav_board_hal_t *hal)
 {
-    const uint16_t ubrr = (uint16_t)((F_CPU / (8UL * QNAV_TEKBOT_BAUD)) - 1UL + 0UL);
-
     /* Timer0: CTC, clk/64, 250 counts = 1 ms at 16 MHz */
     TCCR0 = (uint8_t)(_BV(WGM01) | _BV(CS02));
     OCR0 = (uint8_t)((F_CPU / 64UL / 1000UL) - 1UL);
     TIMSK |= _BV(OCIE0);
 
-    /* USART0: U2X, 8N1, receive interrupt */
-    UBRR0H = (uint8_t)(ubrr >> 8);
-    UBRR0L = (uint8_t)(ubrr & 0xFFu);
-    UCSR0A = _BV(U2X0);
+    /* USART0: 8N1, receive interrupt */
+    UBRR0H = UBRRH_VALUE;
+    UBRR0L = UBRRL_VALUE;
+    UCSR0A = USE_2X ? _BV(U2X0) : 0u;
     UCSR0C = (uint8_t)(_BV(UCSZ01) | _BV(UCSZ00));
     UCSR0B = (uint8_t)(_BV(RXEN0) | _BV(TXEN0) | _BV(RXCIE0));
 
