@@ -1,8 +1,8 @@
 /*
  * The serial link codec (qnav/link.h): CRC-16, streaming COBS encoder, byte-at-a-time
  * decoder with drop counters, little-endian message packing and chunked policy upload.
- * Shared unchanged by the board firmware and navbridge. No heap, no float, no file-scope
- * writable state; every buffer belongs to the caller.
+ * Shared unchanged by the board firmware and navbridge. No heap, integers only, no
+ * file-scope writable state; every buffer belongs to the caller.
  */
 #include "qnav/link.h"
 

@@ -2,8 +2,8 @@
  * The hardware a qnav board application needs, as a small table of functions the board
  * support code fills in: a millisecond tick, the sonar sectors, the heading, the two drive
  * motors and a byte-wise UART. The ATmega128 TekBot fills it from registers
- * (firmware/boards/tekbot/hal_avr.c); host tests fill it with a simulated robot. No int,
- * long or float: int is 16 bits on AVR.
+ * (firmware/boards/tekbot/src/hal_avr.c); host tests fill it with a simulated robot.
+ * Fixed-width integers only (no int or long): int is 16 bits on AVR.
  */
 #ifndef QNAV_BOARD_HAL_H
 #define QNAV_BOARD_HAL_H

@@ -1,7 +1,7 @@
 /*
  * The TekBot board application (qnav/tekbot.h): link frames in, a 10 Hz control tick,
- * scans, telemetry and heartbeats out, motors through the HAL. No heap, no float, no
- * file-scope state: everything lives in the caller's qnav_tekbot_t.
+ * scans, telemetry and heartbeats out, motors through the HAL. No heap, integers only,
+ * no file-scope state: everything lives in the caller's qnav_tekbot_t.
  */
 #include "qnav/tekbot.h"
 

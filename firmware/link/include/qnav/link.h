@@ -1,6 +1,6 @@
 /*
  * The serial link between a robot board and navbridge (DESIGN.md §5). One codec, C99, no
- * heap, no float, no file-scope state: the board and the bridge link the same code. A
+ * heap, integers only, no file-scope state: the board and the bridge link the same code. A
  * frame is [msg id u8][sequence u16][payload][CRC-16/CCITT-FALSE u16], all little endian,
  * COBS-encoded and delimited by 0x00 bytes. The decoder is fed one byte at a time and
  * hands out only frames whose CRC, message id, payload length and sequence number are all
