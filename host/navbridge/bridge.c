@@ -100,7 +100,6 @@ void qnav_bridge_config_default(qnav_bridge_config_t *cfg)
     cfg->status_ms = 500;
     qnav_ctrl_config_default(&cfg->ctrl);
     qnav_policy_prob_default(&cfg->policy);
-    cfg->have_policy = 1;
 }
 
 void qnav_bridge_publish(qnav_bridge_t *b, const char *channel, const void *data, int len)
@@ -173,10 +172,10 @@ static void send_heartbeat(qnav_bridge_t *b)
                               ? QNAV_LINK_STATE_LINK_OK
                               : 0u) |
                          (b->watchdog_stop || b->shutting_down ? QNAV_LINK_STATE_STOPPED : 0u) |
-                         (b->cfg.have_policy ? QNAV_LINK_STATE_POLICY : 0u));
+                         QNAV_LINK_STATE_POLICY);
     hb.rx_ok = (uint16_t)b->rx.stats.frames_ok;
     hb.rx_dropped = (uint16_t)qnav_link_rx_dropped_total(&b->rx);
-    hb.policy_crc = b->cfg.have_policy ? b->bc.policy_crc : 0u;
+    hb.policy_crc = b->bc.policy_crc;
     send_frame(b, QNAV_LINK_MSG_HEARTBEAT, p, qnav_link_heartbeat_pack(&hb, p, sizeof p));
 }
 
@@ -250,7 +249,7 @@ void qnav_bridge_init(qnav_bridge_t *b, const qnav_bridge_config_t *cfg, lcm_t *
     b->last_rx_ms = -1;
     b->next_heartbeat_ms = now_ms;
     b->next_status_ms = now_ms + cfg->status_ms;
-    b->upload_state = (cfg->upload && cfg->have_policy) ? 1 : 0;
+    b->upload_state = cfg->upload ? QNAV_BRIDGE_UPLOAD_WAITING : QNAV_BRIDGE_UPLOAD_IDLE;
     b->last_upload_status = 1;
 }
 
@@ -281,9 +280,6 @@ static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
 
     if (b->goal.goal_id != 0u && ls.goal_id != b->goal.goal_id) {
         send_goal(b); /* the board has not got the current goal yet */
-    }
-    if (b->cfg.mode == QNAV_LINK_MODE_ONBOARD && !b->cfg.have_policy) {
-        return; /* nothing to compute qualities with */
     }
     memset(&q, 0, sizeof q);
     qnav_bridge_ctrl_step(&b->bc, &s, &c, q.quality_q15);
@@ -333,11 +329,11 @@ static void on_ack(qnav_bridge_t *b, const qnav_link_frame_t *f)
 {
     qnav_link_policy_ack_t a;
     if (qnav_link_policy_ack_unpack(f->payload, f->len, &a) != QNAV_LINK_OK ||
-        b->upload_state != 2) {
+        b->upload_state != QNAV_BRIDGE_UPLOAD_SENT) {
         return;
     }
     b->last_upload_status = a.status;
-    b->upload_state = 3;
+    b->upload_state = QNAV_BRIDGE_UPLOAD_DONE;
     if (b->diag != NULL) {
         if (a.status == QNAV_LINK_ACK_OK) {
             fprintf(b->diag, "navbridge: policy upload: ok (crc 0x%04x)\n", a.crc);
@@ -357,7 +353,7 @@ static void send_upload(qnav_bridge_t *b)
     int32_t n = qnav_link_policy_to_blob(&b->cfg.policy, blob, sizeof blob);
     uint16_t off = 0;
     if (n <= 0) {
-        b->upload_state = 3;
+        b->upload_state = QNAV_BRIDGE_UPLOAD_DONE;
         b->last_upload_status = QNAV_LINK_ACK_BAD_POLICY;
         return;
     }
@@ -378,7 +374,7 @@ static void send_upload(qnav_bridge_t *b)
     cm.crc = qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n);
     send_frame(b, QNAV_LINK_MSG_POLICY_COMMIT, p,
                qnav_link_policy_commit_pack(&cm, p, sizeof p));
-    b->upload_state = 2;
+    b->upload_state = QNAV_BRIDGE_UPLOAD_SENT;
     b->upload_tries++;
     b->upload_sent_ms = b->now_ms;
 }
@@ -465,13 +461,14 @@ void qnav_bridge_poll(qnav_bridge_t *b, int64_t now_ms)
             b->next_stop_repeat_ms = now_ms + b->cfg.heartbeat_ms;
         }
     }
-    if (b->upload_state == 1 && b->last_heartbeat_ms >= 0) {
+    if (b->upload_state == QNAV_BRIDGE_UPLOAD_WAITING && b->last_heartbeat_ms >= 0) {
         send_upload(b);
-    } else if (b->upload_state == 2 && now_ms - b->upload_sent_ms > 1000) {
+    } else if (b->upload_state == QNAV_BRIDGE_UPLOAD_SENT &&
+               now_ms - b->upload_sent_ms > 1000) {
         if (b->upload_tries < 3) {
             send_upload(b);
         } else {
-            b->upload_state = 3;
+            b->upload_state = QNAV_BRIDGE_UPLOAD_DONE;
             b->last_upload_status = QNAV_LINK_ACK_BAD_LENGTH;
             if (b->diag != NULL) {
                 fprintf(b->diag, "navbridge: policy upload: no answer from the board\n");

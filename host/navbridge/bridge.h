@@ -53,7 +53,6 @@ typedef struct {
     uint32_t heartbeat_ms;        /* bridge heartbeat period, ms (100) */
     uint32_t status_ms;           /* link status publish period, ms (500) */
     qnav_ctrl_config_t ctrl;      /* n_sectors is taken from each scan */
-    int have_policy;              /* 1 when policy is set */
     qnav_policy_t policy;         /* offboard: drives the robot; onboard: qualities shown */
     int upload;                   /* onboard: upload policy to the board */
 } qnav_bridge_config_t;
@@ -76,6 +75,14 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
                            qnav_command_t *cmd, int16_t *qualities);
 /* CRC-16 of a policy's link blob (0 if it cannot be serialised). */
 uint16_t qnav_bridge_policy_crc(const qnav_policy_t *policy);
+
+/* Where an onboard policy upload stands. */
+typedef enum {
+    QNAV_BRIDGE_UPLOAD_IDLE = 0,  /* no upload asked for */
+    QNAV_BRIDGE_UPLOAD_WAITING,   /* asked for: sent once the board's first heartbeat is in */
+    QNAV_BRIDGE_UPLOAD_SENT,      /* chunks and commit sent, waiting for the board's ack */
+    QNAV_BRIDGE_UPLOAD_DONE       /* acked, refused, or given up (last_upload_status) */
+} qnav_bridge_upload_state_t;
 
 typedef struct {
     qnav_bridge_config_t cfg;
@@ -103,7 +110,7 @@ typedef struct {
     qnav_link_goal_t goal;            /* last goal relayed (goal_id 0 none) */
 
     /* policy upload (onboard) */
-    int upload_state;             /* 0 idle, 1 waiting for the board, 2 sent, 3 done */
+    qnav_bridge_upload_state_t upload_state;
     int upload_tries;
     int64_t upload_sent_ms;
     int8_t last_upload_status;    /* QNAV_LINK_ACK_*, or 1 none yet */
