@@ -160,6 +160,15 @@ static void send_command(qnav_bridge_t *b, const qnav_command_t *c, int stop)
     }
 }
 
+/* A bare stop on the wire, repeated because a single frame may be lost. */
+static void send_stop(qnav_bridge_t *b)
+{
+    qnav_command_t c;
+    memset(&c, 0, sizeof c);
+    c.scan_seq = -1;
+    send_command(b, &c, 1);
+}
+
 static void send_heartbeat(qnav_bridge_t *b)
 {
     qnav_link_heartbeat_t hb;
@@ -454,10 +463,7 @@ void qnav_bridge_poll(qnav_bridge_t *b, int64_t now_ms)
             }
         } else if (now_ms >= b->next_stop_repeat_ms) {
             /* repeat on the wire (a stop may be lost) without flooding LCM */
-            qnav_command_t c;
-            memset(&c, 0, sizeof c);
-            c.scan_seq = -1;
-            send_command(b, &c, 1);
+            send_stop(b);
             b->next_stop_repeat_ms = now_ms + b->cfg.heartbeat_ms;
         }
     }
@@ -488,10 +494,7 @@ void qnav_bridge_shutdown(qnav_bridge_t *b, int64_t now_ms)
     b->shutting_down = 1;
     command_stop(b, QNAV_STOP_SHUTDOWN);
     for (i = 0; i < 2; ++i) {
-        qnav_command_t c;
-        memset(&c, 0, sizeof c);
-        c.scan_seq = -1;
-        send_command(b, &c, 1);
+        send_stop(b);
     }
     send_heartbeat(b);
     publish_status(b);

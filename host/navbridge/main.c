@@ -78,17 +78,12 @@ static int parse_long(const char *s, long lo, long hi, long *out)
     return 0;
 }
 
-typedef struct {
-    qnav_bridge_t *bridge;
-} goal_ctx_t;
-
 static void on_goal(const lcm_recv_buf_t *rbuf, const char *channel, const qnav_goal_t *msg,
                     void *user)
 {
-    goal_ctx_t *g = (goal_ctx_t *)user;
     (void)rbuf;
     (void)channel;
-    qnav_bridge_on_goal(g->bridge, msg, mono_ms());
+    qnav_bridge_on_goal((qnav_bridge_t *)user, msg, mono_ms());
 }
 
 static int write_serial(void *user, const uint8_t *bytes, size_t n)
@@ -116,7 +111,6 @@ int main(int argc, char **argv)
     static qnav_bridge_t bridge;
     lcm_t *lcm;
     lcm_eventlog_t *log = NULL;
-    goal_ctx_t gctx;
     qnav_goal_t_subscription_t *sub;
     int fd, c, exit_code = 0, hung_up = 0;
     struct sigaction sa;
@@ -264,8 +258,7 @@ int main(int argc, char **argv)
 
     qnav_bridge_init(&bridge, &cfg, lcm, log, write_serial, &fd, mono_ms());
     bridge.diag = stderr;
-    gctx.bridge = &bridge;
-    sub = qnav_goal_t_subscribe(lcm, QNAV_CH_GOAL, on_goal, &gctx);
+    sub = qnav_goal_t_subscribe(lcm, QNAV_CH_GOAL, on_goal, &bridge);
     if (have_goal) {
         start_goal.utime = qnav_bridge_utime();
         qnav_bridge_on_goal(&bridge, &start_goal, mono_ms());

@@ -235,7 +235,7 @@ int main(int argc, char **argv)
     char *slave;
     struct termios tio;
     struct sigaction sa;
-    uint32_t missed = 0, ticks = 0;
+    uint32_t missed = 0;
     int64_t t_start;
 
     opterr = 0;
@@ -422,8 +422,6 @@ int main(int argc, char **argv)
         }
         qnav_sim_command(sim, &out);
         qnav_sim_advance(sim);
-        ticks++;
-
 
         if (lcm != NULL) {
             qnav_pose_t ps;
@@ -458,7 +456,6 @@ int main(int argc, char **argv)
            (unsigned long)qnav_link_rx_dropped_total(&r.rx));
     fflush(stdout);
     rc = g_quit ? 4 : (res.reached ? 0 : 1);
-    (void)ticks;
 out:
     if (link_path != NULL) {
         unlink(link_path);
