@@ -14,7 +14,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -49,7 +48,6 @@ static void test_firmware_in_simavr_runs_uploaded_network_bit_identical_to_host(
                             "20", "--log", log, NULL};
     const char *replay[] = {NAVBRIDGE_EXE, "--replay", log, "--policy", policy, NULL};
     qnav_policy_t p;
-    struct stat sb;
     unsigned scans = 0, compared = 0;
     uint16_t k;
     pid_t pb, pn;
@@ -72,10 +70,7 @@ static void test_firmware_in_simavr_runs_uploaded_network_bit_identical_to_host(
 
     pb = qnav_test_spawn(board, sa_out, sa_err);
     assert_true(pb > 0);
-    for (i = 0; i < 200 && lstat(link, &sb) != 0; ++i) {
-        usleep(20000);
-    }
-    assert_int_equal(lstat(link, &sb), 0);
+    assert_int_equal(qnav_test_wait_path(link, 4000), 0);
     pn = qnav_test_spawn(bridge, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(pb), 0);

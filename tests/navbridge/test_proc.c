@@ -7,6 +7,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -30,6 +31,19 @@ int qnav_test_wait_exit(pid_t pid)
         return -1;
     }
     return WIFEXITED(st) ? WEXITSTATUS(st) : 256 + WTERMSIG(st);
+}
+
+int qnav_test_wait_path(const char *path, int timeout_ms)
+{
+    struct stat sb;
+    int waited;
+    for (waited = 0; lstat(path, &sb) != 0; waited += 20) {
+        if (waited >= timeout_ms) {
+            return -1;
+        }
+        usleep(20000);
+    }
+    return 0;
 }
 
 int qnav_test_tmpdir_make(char *dir, size_t len, const char *prefix)

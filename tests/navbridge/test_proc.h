@@ -16,6 +16,10 @@ pid_t qnav_test_spawn(const char *const *argv, const char *out, const char *err)
 /* Wait for pid: its exit status, 256 + signal number if a signal ended it, -1 on error. */
 int qnav_test_wait_exit(pid_t pid);
 
+/* Wait up to timeout_ms for path to exist (the pty link a child makes once it is up),
+ * checking every 20 ms. 0, or -1 when it did not appear. */
+int qnav_test_wait_path(const char *path, int timeout_ms);
+
 /* Make a fresh folder /tmp/<prefix>.XXXXXX into dir (len bytes). 0 or -1. */
 int qnav_test_tmpdir_make(char *dir, size_t len, const char *prefix);
 

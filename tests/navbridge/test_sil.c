@@ -16,7 +16,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -81,8 +80,7 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--log", log,
                         NULL};
     pid_t ps, pn;
-    int i, scan, cmd, qual, status, pose;
-    struct stat sb;
+    int scan, cmd, qual, status, pose;
     (void)state;
     snprintf(link, sizeof link, "%s/link", g_dir);
     snprintf(log, sizeof log, "%s/memq.lcmlog", g_dir);
@@ -92,10 +90,7 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     snprintf(nb_err, sizeof nb_err, "%s/nb.err", g_dir);
     ps = qnav_test_spawn(sil, sil_out, sil_err);
     assert_true(ps > 0);
-    for (i = 0; i < 200 && lstat(link, &sb) != 0; ++i) {
-        usleep(20000);
-    }
-    assert_int_equal(lstat(link, &sb), 0);
+    assert_int_equal(qnav_test_wait_path(link, 4000), 0);
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0); /* 0: destination reached */
@@ -127,7 +122,6 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     pid_t ps, pn;
     int i;
     unsigned scans = 0, compared = 0;
-    struct stat sb;
     (void)state;
     snprintf(link, sizeof link, "%s/link-onboard", g_dir);
     snprintf(log, sizeof log, "%s/onboard.lcmlog", g_dir);
@@ -141,10 +135,7 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     assert_int_equal(qnav_policy_write(pol, &p, "sil onboard test", perr, sizeof perr), 0);
     ps = qnav_test_spawn(sil, sil_out, sil_err);
     assert_true(ps > 0);
-    for (i = 0; i < 200 && lstat(link, &sb) != 0; ++i) {
-        usleep(20000);
-    }
-    assert_int_equal(lstat(link, &sb), 0);
+    assert_int_equal(qnav_test_wait_path(link, 4000), 0);
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0);
