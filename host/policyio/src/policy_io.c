@@ -293,7 +293,8 @@ static int tok_is(const token_t *t, const char *s)
     return t->n == n && memcmp(t->p, s, n) == 0;
 }
 
-/* Decimal integer with optional sign. 0 ok, -1 not an integer, -2 too large for int32. */
+/* Decimal integer with optional sign. 0 ok, -1 not an integer. Magnitudes past 10^9
+ * saturate there (out of every range this format checks), so long never overflows. */
 static int parse_int(const token_t *t, long *out)
 {
     size_t i = 0;
