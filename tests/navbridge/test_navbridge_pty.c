@@ -25,6 +25,7 @@
 #include "qnav/link.h"
 #include "qnav/policy_io.h"
 #include "qnav_command_t.h"
+#include "test_proc.h"
 
 #include <lcm/eventlog.h>
 
@@ -39,8 +40,7 @@ static int setup_dir(void **state)
     char err[QNAV_POLICY_IO_ERRLEN];
     uint16_t k;
     (void)state;
-    snprintf(g_dir, sizeof g_dir, "/tmp/qnav_navbridge_test.XXXXXX");
-    if (mkdtemp(g_dir) == NULL) {
+    if (qnav_test_tmpdir_make(g_dir, sizeof g_dir, "qnav_navbridge_test") != 0) {
         return -1;
     }
     /* a network policy with spread weights: its commands differ from the default's */
@@ -54,10 +54,8 @@ static int setup_dir(void **state)
 
 static int teardown_dir(void **state)
 {
-    char cmd[300];
     (void)state;
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return qnav_test_tmpdir_remove(g_dir);
 }
 
 /* A scan with an obstacle that moves with i, and a bearing that sweeps. */
