@@ -4,6 +4,7 @@
 #define _XOPEN_SOURCE 700
 #define _DEFAULT_SOURCE
 #include "fakeboard.h"
+#include "test_proc.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -193,27 +194,8 @@ int wait_exit_within(pid_t pid, int timeout_ms)
 
 int run_program(const char *const *argv, const char *out_path, const char *err_path)
 {
-    int status = 0;
-    pid_t pid = fork();
-    if (pid < 0) {
-        return -1;
-    }
-    if (pid == 0) {
-        int o = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        int e = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (o >= 0) {
-            dup2(o, 1);
-        }
-        if (e >= 0) {
-            dup2(e, 2);
-        }
-        execv(argv[0], (char *const *)argv);
-        _exit(127);
-    }
-    if (waitpid(pid, &status, 0) != pid) {
-        return -1;
-    }
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 256 + WTERMSIG(status);
+    pid_t pid = qnav_test_spawn(argv, out_path, err_path);
+    return pid < 0 ? -1 : qnav_test_wait_exit(pid);
 }
 
 int read_text(const char *path, char *buf, int cap)
