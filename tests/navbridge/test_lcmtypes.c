@@ -32,6 +32,8 @@ static void deliver(lcm_t *lcm)
     assert_int_equal(lcm_handle_timeout(lcm, 1000), 1);
 }
 
+/* For type T: got_T and n_T hold what the subscriber received, and round_trip_T(m, ch)
+ * publishes m on ch of a fresh memq:// bus and delivers it to that subscriber once. */
 #define DEFINE_CATCHER(T)                                                                   \
     static T got_##T;                                                                       \
     static int n_##T;                                                                       \
@@ -42,6 +44,16 @@ static void deliver(lcm_t *lcm)
         (void)u;                                                                            \
         got_##T = *msg;                                                                     \
         n_##T++;                                                                            \
+    }                                                                                       \
+    static void round_trip_##T(const T *m, const char *ch)                                  \
+    {                                                                                       \
+        lcm_t *lcm = bus();                                                                 \
+        T##_subscription_t *sub = T##_subscribe(lcm, ch, on_##T, NULL);                     \
+        assert_int_equal(T##_publish(lcm, ch, m), 0);                                       \
+        deliver(lcm);                                                                       \
+        assert_int_equal(n_##T, 1);                                                         \
+        T##_unsubscribe(lcm, sub);                                                          \
+        lcm_destroy(lcm);                                                                   \
     }
 
 DEFINE_CATCHER(qnav_scan_t)
@@ -53,7 +65,6 @@ DEFINE_CATCHER(qnav_link_status_t)
 
 static void test_scan_round_trips_over_memq(void **state)
 {
-    lcm_t *lcm = bus();
     qnav_scan_t m;
     int k;
     (void)state;
@@ -68,36 +79,22 @@ static void test_scan_round_trips_over_memq(void **state)
     for (k = 0; k < 360; ++k) {
         m.ranges_mm[k] = 65535 - k;
     }
-    qnav_scan_t_subscription_t *sub =
-        qnav_scan_t_subscribe(lcm, "QNAV_SCAN", on_qnav_scan_t, NULL);
-    assert_int_equal(qnav_scan_t_publish(lcm, "QNAV_SCAN", &m), 0);
-    deliver(lcm);
-    assert_int_equal(n_qnav_scan_t, 1);
+    round_trip_qnav_scan_t(&m, "QNAV_SCAN");
     assert_memory_equal(&got_qnav_scan_t, &m, sizeof m);
-    qnav_scan_t_unsubscribe(lcm, sub);
-    lcm_destroy(lcm);
 }
 
 static void test_goal_round_trips_over_memq(void **state)
 {
-    lcm_t *lcm = bus();
     qnav_goal_t m = {123, 65535, 9000, 2000000};
     (void)state;
-    qnav_goal_t_subscription_t *sub =
-        qnav_goal_t_subscribe(lcm, "QNAV_GOAL", on_qnav_goal_t, NULL);
-    assert_int_equal(qnav_goal_t_publish(lcm, "QNAV_GOAL", &m), 0);
-    deliver(lcm);
-    assert_int_equal(n_qnav_goal_t, 1);
+    round_trip_qnav_goal_t(&m, "QNAV_GOAL");
     assert_int_equal(got_qnav_goal_t.goal_id, 65535);
     assert_int_equal(got_qnav_goal_t.bearing_cdeg, 9000);
     assert_int_equal(got_qnav_goal_t.distance_mm, 2000000);
-    qnav_goal_t_unsubscribe(lcm, sub);
-    lcm_destroy(lcm);
 }
 
 static void test_command_round_trips_over_memq(void **state)
 {
-    lcm_t *lcm = bus();
     qnav_command_t m;
     (void)state;
     memset(&m, 0, sizeof m);
@@ -112,11 +109,7 @@ static void test_command_round_trips_over_memq(void **state)
     m.stop_reason = 1;
     m.source = 2;
     m.policy_crc = 0xBEEF;
-    qnav_command_t_subscription_t *sub =
-        qnav_command_t_subscribe(lcm, "QNAV_COMMAND", on_qnav_command_t, NULL);
-    assert_int_equal(qnav_command_t_publish(lcm, "QNAV_COMMAND", &m), 0);
-    deliver(lcm);
-    assert_int_equal(n_qnav_command_t, 1);
+    round_trip_qnav_command_t(&m, "QNAV_COMMAND");
     assert_int_equal(got_qnav_command_t.heading_deg, -179);
     assert_int_equal(got_qnav_command_t.speed_q15, 32767);
     assert_int_equal(got_qnav_command_t.quality_q15, 16384);
@@ -125,13 +118,10 @@ static void test_command_round_trips_over_memq(void **state)
     assert_int_equal(got_qnav_command_t.stop_reason, 1);
     assert_int_equal(got_qnav_command_t.source, 2);
     assert_int_equal(got_qnav_command_t.policy_crc, 0xBEEF);
-    qnav_command_t_unsubscribe(lcm, sub);
-    lcm_destroy(lcm);
 }
 
 static void test_path_qualities_round_trip_all_360_over_memq(void **state)
 {
-    lcm_t *lcm = bus();
     static qnav_path_qualities_t m;
     int k;
     (void)state;
@@ -142,19 +132,12 @@ static void test_path_qualities_round_trip_all_360_over_memq(void **state)
         m.quality_q15[k] = (int16_t)(k * 91);
         m.quality[k] = (float)k / 360.0f;
     }
-    qnav_path_qualities_t_subscription_t *sub =
-        qnav_path_qualities_t_subscribe(lcm, "QNAV_QUALITIES", on_qnav_path_qualities_t, NULL);
-    assert_int_equal(qnav_path_qualities_t_publish(lcm, "QNAV_QUALITIES", &m), 0);
-    deliver(lcm);
-    assert_int_equal(n_qnav_path_qualities_t, 1);
+    round_trip_qnav_path_qualities_t(&m, "QNAV_QUALITIES");
     assert_memory_equal(&got_qnav_path_qualities_t, &m, sizeof m);
-    qnav_path_qualities_t_unsubscribe(lcm, sub);
-    lcm_destroy(lcm);
 }
 
 static void test_pose_round_trips_over_memq(void **state)
 {
-    lcm_t *lcm = bus();
     qnav_pose_t m;
     (void)state;
     memset(&m, 0, sizeof m);
@@ -168,19 +151,12 @@ static void test_pose_round_trips_over_memq(void **state)
     m.recovering = 1;
     m.collisions = 3;
     m.reached = 0;
-    qnav_pose_t_subscription_t *sub =
-        qnav_pose_t_subscribe(lcm, "QNAV_POSE", on_qnav_pose_t, NULL);
-    assert_int_equal(qnav_pose_t_publish(lcm, "QNAV_POSE", &m), 0);
-    deliver(lcm);
-    assert_int_equal(n_qnav_pose_t, 1);
+    round_trip_qnav_pose_t(&m, "QNAV_POSE");
     assert_memory_equal(&got_qnav_pose_t, &m, sizeof m);
-    qnav_pose_t_unsubscribe(lcm, sub);
-    lcm_destroy(lcm);
 }
 
 static void test_link_status_round_trips_over_memq(void **state)
 {
-    lcm_t *lcm = bus();
     qnav_link_status_t m;
     (void)state;
     memset(&m, 0, sizeof m);
@@ -205,14 +181,8 @@ static void test_link_status_round_trips_over_memq(void **state)
     m.board_state = 5;
     m.board_policy_crc = 0x1234;
     m.last_upload_status = -2;
-    qnav_link_status_t_subscription_t *sub =
-        qnav_link_status_t_subscribe(lcm, "QNAV_LINK_STATUS", on_qnav_link_status_t, NULL);
-    assert_int_equal(qnav_link_status_t_publish(lcm, "QNAV_LINK_STATUS", &m), 0);
-    deliver(lcm);
-    assert_int_equal(n_qnav_link_status_t, 1);
+    round_trip_qnav_link_status_t(&m, "QNAV_LINK_STATUS");
     assert_memory_equal(&got_qnav_link_status_t, &m, sizeof m);
-    qnav_link_status_t_unsubscribe(lcm, sub);
-    lcm_destroy(lcm);
 }
 
 static void test_decoder_refuses_truncated_buffer(void **state)
