@@ -6,6 +6,7 @@
 #include "qnav/tekbot.h"
 
 #include <stddef.h>
+#include <string.h>
 
 /* Most UART bytes handled per poll, so one poll never starves the tick. */
 #define UART_BURST 128u
@@ -78,38 +79,16 @@ qnav_tekbot_status_t qnav_tekbot_init(qnav_tekbot_t *bot, const qnav_tekbot_conf
         cfg->spin_deg < 1 || cfg->spin_deg > 180) {
         return QNAV_TEKBOT_E_CONFIG;
     }
+    /* everything starts at zero (no mode, no goal, link not heard, counters 0) but for
+     * the two fields below */
+    memset(bot, 0, sizeof *bot);
     bot->cfg = *cfg;
     bot->hal = *hal;
     qnav_link_rx_init(&bot->rx);
     qnav_link_tx_init(&bot->tx);
     qnav_link_upload_init(&bot->upload);
-    bot->mode = 0;
-    bot->hold_stop = 0;
-    bot->link_ok = 0;
-    bot->have_goal = 0;
-    bot->goal.goal_id = 0;
-    bot->goal.bearing_cdeg = 0;
-    bot->goal.distance_mm = 0;
-    bot->cmd.speed = 0;
-    bot->cmd.heading_deg = 0;
-    bot->cmd.quality = 0;
     bot->cmd.flags = QNAV_LINK_CMD_STOP;
-    bot->cmd.scan_seq = 0;
-    bot->cmd.reserved = 0;
-    bot->cmd_ms = 0;
-    bot->last_rx_ms = 0;
-    bot->heard = 0;
-    bot->left = 0;
-    bot->right = 0;
-    bot->last_out.heading_deg = 0;
-    bot->last_out.speed = 0;
-    bot->last_out.quality = 0;
     bot->last_out.flags = QNAV_FLAG_NOT_READY;
-    bot->stats.ticks = 0;
-    bot->stats.stopped_ticks = 0;
-    bot->stats.link_lost = 0;
-    bot->stats.uploads_ok = 0;
-    bot->stats.uploads_refused = 0;
 
     qnav_policy_prob_default(&bot->policy);
     qnav_ctrl_config_default(&cc);
