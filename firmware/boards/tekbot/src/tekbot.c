@@ -79,8 +79,7 @@ qnav_tekbot_status_t qnav_tekbot_init(qnav_tekbot_t *bot, const qnav_tekbot_conf
         cfg->spin_deg < 1 || cfg->spin_deg > 180) {
         return QNAV_TEKBOT_E_CONFIG;
     }
-    /* everything starts at zero (no mode, no goal, link not heard, counters 0) but for
-     * the two fields below */
+    /* everything starts at zero (no mode, no goal, link not heard, counters 0) */
     memset(bot, 0, sizeof *bot);
     bot->cfg = *cfg;
     bot->hal = *hal;
@@ -88,7 +87,6 @@ qnav_tekbot_status_t qnav_tekbot_init(qnav_tekbot_t *bot, const qnav_tekbot_conf
     qnav_link_tx_init(&bot->tx);
     qnav_link_upload_init(&bot->upload);
     bot->cmd.flags = QNAV_LINK_CMD_STOP;
-    bot->last_out.flags = QNAV_FLAG_NOT_READY;
 
     qnav_policy_prob_default(&bot->policy);
     qnav_ctrl_config_default(&cc);
@@ -256,6 +254,8 @@ void qnav_tekbot_tick(qnav_tekbot_t *bot)
     uint16_t scan_seq;
     uint8_t was_ok;
     uint8_t moving;
+    qnav_q1_15_t left;
+    qnav_q1_15_t right;
 
     if (bot == NULL) {
         return;
@@ -303,9 +303,8 @@ void qnav_tekbot_tick(qnav_tekbot_t *bot)
     }
 
     /* act: the motors are set every tick, to 0 whenever anything is wrong */
-    qnav_tekbot_mix(out.heading_deg, out.speed, bot->cfg.spin_deg, &bot->left, &bot->right);
-    bot->hal.motors_set(bot->hal.ctx, bot->left, bot->right);
-    bot->last_out = out;
+    qnav_tekbot_mix(out.heading_deg, out.speed, bot->cfg.spin_deg, &left, &right);
+    bot->hal.motors_set(bot->hal.ctx, left, right);
     if (!moving) {
         bot->stats.stopped_ticks++;
     }

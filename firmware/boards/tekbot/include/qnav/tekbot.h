@@ -69,8 +69,6 @@ typedef struct {
     uint32_t last_rx_ms;         /* last good frame */
     uint8_t heard;               /* any good frame since start */
     uint32_t next_tick_ms;
-    qnav_q1_15_t left, right;    /* last motor outputs */
-    qnav_ctrl_output_t last_out; /* last decision applied (speed 0 when stopped) */
     qnav_mm_t ranges[QNAV_LINK_MAX_SECTORS];
     uint8_t wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
     qnav_tekbot_stats_t stats;
