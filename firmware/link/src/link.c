@@ -579,7 +579,7 @@ int32_t qnav_link_policy_ack_unpack(const uint8_t *p, uint16_t len,
     if (len != QNAV_LINK_POLICY_ACK_BYTES) {
         return QNAV_LINK_E_LENGTH;
     }
-    m->status = (int8_t)as_i16((uint16_t)((p[0] & 0x80u) ? (0xFF00u | p[0]) : p[0]));
+    m->status = (int8_t)((p[0] & 0x80u) ? (int16_t)p[0] - 256 : (int16_t)p[0]);
     m->reserved = p[1];
     m->crc = get_u16(&p[2]);
     return QNAV_LINK_OK;
