@@ -346,6 +346,19 @@ void Simulation::drive_substep(double dt) {
     vel_ = {bv.x, bv.y};
 }
 
+void Simulation::start_recovery(Vec2 contact) {
+    // Stop the wheels; the fixed manoeuvre starts next tick, backing away from the contact
+    // and turning away from its side.
+    ++collisions_;
+    recovery_left_ = robot_.recovery_ticks;
+    wheel_l_ = wheel_r_ = 0;
+    const Vec2 d = contact - pos_;
+    const double rel = wrap_pi(std::atan2(d.y, d.x) - heading_);
+    recovery_back_sign_ = std::cos(rel) >= 0 ? -1.0 : 1.0;
+    recovery_turn_sign_ = rel > 0 ? -1 : 1;
+    marks_.push_back({tick_, pos_, contact});
+}
+
 void Simulation::advance() {
     if (!started_) throw SimError(QNAV_SIM_E_STATE, "advance: no episode (call reset first)");
     if (done_) return;
@@ -377,30 +390,9 @@ void Simulation::advance() {
     }
     l_m_ += norm(pos_ - before);
     ++tick_;
-    collided_this_tick_ = false;
-    if (touched && recovery_left_ == 0 && !recovering) {
-        // A new collision: stop the wheels and start the fixed manoeuvre next tick.
-        collided_this_tick_ = true;
-        ++collisions_;
-        recovery_left_ = robot_.recovery_ticks;
-        wheel_l_ = wheel_r_ = 0;
-        const Vec2 d = contact - pos_;
-        const double rel = wrap_pi(std::atan2(d.y, d.x) - heading_);
-        recovery_back_sign_ = std::cos(rel) >= 0 ? -1.0 : 1.0;
-        recovery_turn_sign_ = rel > 0 ? -1 : 1;
-        marks_.push_back({tick_, pos_, contact});
-    } else if (recovering && recovery_left_ == 0 && touching(&contact)) {
-        // Still touching after the manoeuvre: start another one.
-        collided_this_tick_ = true;
-        ++collisions_;
-        recovery_left_ = robot_.recovery_ticks;
-        wheel_l_ = wheel_r_ = 0;
-        const Vec2 d = contact - pos_;
-        const double rel = wrap_pi(std::atan2(d.y, d.x) - heading_);
-        recovery_back_sign_ = std::cos(rel) >= 0 ? -1.0 : 1.0;
-        recovery_turn_sign_ = rel > 0 ? -1 : 1;
-        marks_.push_back({tick_, pos_, contact});
-    }
+    // A new collision, or still touching when the manoeuvre ends: start (another) one.
+    collided_this_tick_ = recovering ? recovery_left_ == 0 && touching(&contact) : touched;
+    if (collided_this_tick_) start_recovery(contact);
     if (profiling_) prof_.physics_s += std::chrono::duration<double>(Clock::now() - t0).count();
     ++prof_.ticks;
     const double dx = env_.dest_x_m - pos_.x, dy = env_.dest_y_m - pos_.y;

@@ -84,6 +84,7 @@ private:
     void compute_scan();
     void drive_substep(double dt);
     bool touching(Vec2 *contact);
+    void start_recovery(Vec2 contact);
 
     RobotProfile robot_;
     Environment env_;
