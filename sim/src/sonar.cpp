@@ -123,12 +123,7 @@ void SonarRing::measure(Vec2 pos, double heading, double *dist) const {
         for (std::uint16_t j = 0; j < n_; ++j) {
             const Vec2 b = boundary_[j];
             const Vec2 u{ch * b.x - sh * b.y, sh * b.x + ch * b.y};
-            double t = kInf;
-            if (u.x > 0) t = wall_d[0] / u.x;
-            else if (u.x < 0) t = -wall_d[2] / u.x;
-            if (u.y > 0) t = std::min(t, wall_d[1] / u.y);
-            else if (u.y < 0) t = std::min(t, -wall_d[3] / u.y);
-            t = std::max(0.0, t);
+            const double t = exit_distance(u, wall_d);
             const std::uint16_t left = j == 0 ? static_cast<std::uint16_t>(n_ - 1) : static_cast<std::uint16_t>(j - 1);
             if (t < dist[j]) dist[j] = t;
             if (t < dist[left]) dist[left] = t;
