@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <new>
 #include <string>
 
@@ -64,14 +65,9 @@ qnav_sim_status_t qnav_sim_robot_parse(const char *text, size_t len, const char 
         return QNAV_SIM_E_NULL;
     }
     return guarded(err, errlen, [&] {
-        auto *r = new qnav_sim_robot;
-        try {
-            r->profile = qnav::parse_robot_profile(std::string_view(text, len), name);
-        } catch (...) {
-            delete r;
-            throw;
-        }
-        *out = r;
+        auto r = std::make_unique<qnav_sim_robot>();
+        r->profile = qnav::parse_robot_profile(std::string_view(text, len), name);
+        *out = r.release();
     });
 }
 
@@ -103,14 +99,9 @@ qnav_sim_status_t qnav_sim_env_parse(const char *text, size_t len, const char *n
         return QNAV_SIM_E_NULL;
     }
     return guarded(err, errlen, [&] {
-        auto *e = new qnav_sim_env;
-        try {
-            e->env = qnav::parse_environment(std::string_view(text, len), name);
-        } catch (...) {
-            delete e;
-            throw;
-        }
-        *out = e;
+        auto e = std::make_unique<qnav_sim_env>();
+        e->env = qnav::parse_environment(std::string_view(text, len), name);
+        *out = e.release();
     });
 }
 
@@ -208,14 +199,9 @@ qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_
         sc.actuation_noise = cfg->actuation_noise;
         sc.seed = cfg->seed;
         sc.episode_limit_s = cfg->episode_limit_s;
-        auto *s = new qnav_sim;
-        try {
-            s->sim = std::make_unique<qnav::Simulation>(robot->profile, env->env, sc);
-        } catch (...) {
-            delete s;
-            throw;
-        }
-        *out = s;
+        auto s = std::make_unique<qnav_sim>();
+        s->sim = std::make_unique<qnav::Simulation>(robot->profile, env->env, sc);
+        *out = s.release();
     });
 }
 
