@@ -259,7 +259,7 @@ void qnav_bridge_init(qnav_bridge_t *b, const qnav_bridge_config_t *cfg, lcm_t *
     b->next_heartbeat_ms = now_ms;
     b->next_status_ms = now_ms + cfg->status_ms;
     b->upload_state = cfg->upload ? QNAV_BRIDGE_UPLOAD_WAITING : QNAV_BRIDGE_UPLOAD_IDLE;
-    b->last_upload_status = 1;
+    b->last_upload_status = QNAV_BRIDGE_UPLOAD_NONE_YET;
 }
 
 static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
@@ -475,7 +475,7 @@ void qnav_bridge_poll(qnav_bridge_t *b, int64_t now_ms)
             send_upload(b);
         } else {
             b->upload_state = QNAV_BRIDGE_UPLOAD_DONE;
-            b->last_upload_status = QNAV_LINK_ACK_BAD_LENGTH;
+            b->last_upload_status = QNAV_BRIDGE_UPLOAD_NO_ANSWER;
             if (b->diag != NULL) {
                 fprintf(b->diag, "navbridge: policy upload: no answer from the board\n");
             }

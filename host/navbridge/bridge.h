@@ -43,6 +43,10 @@ extern "C" {
 #define QNAV_SOURCE_BRIDGE 1
 #define QNAV_SOURCE_BOARD 2
 
+/* link_status_t.last_upload_status besides the board's QNAV_LINK_ACK_* answers. */
+#define QNAV_BRIDGE_UPLOAD_NONE_YET 1
+#define QNAV_BRIDGE_UPLOAD_NO_ANSWER (-5) /* three tries, one second apart, never acked */
+
 /* Writes bytes to the serial port; returns 0 or -1. */
 typedef int (*qnav_bridge_write_fn)(void *user, const uint8_t *bytes, size_t n);
 
@@ -113,7 +117,7 @@ typedef struct {
     qnav_bridge_upload_state_t upload_state;
     int upload_tries;
     int64_t upload_sent_ms;
-    int8_t last_upload_status;    /* QNAV_LINK_ACK_*, or 1 none yet */
+    int8_t last_upload_status;    /* QNAV_LINK_ACK_* or QNAV_BRIDGE_UPLOAD_NONE_YET/_NO_ANSWER */
 
     uint64_t rx_bytes;
     uint64_t commands_sent;

@@ -391,6 +391,45 @@ static void test_board_and_bridge_drive_together_in_both_modes(void **state)
     lcm_destroy(lcm);
 }
 
+static int discard_write(void *user, const uint8_t *bytes, size_t n)
+{
+    (void)user;
+    (void)bytes;
+    (void)n;
+    return 0;
+}
+
+static void test_bridge_reports_no_answer_when_the_board_never_acks_an_upload(void **state)
+{
+    static qnav_bridge_t b;
+    qnav_bridge_config_t cfg;
+    qnav_link_tx_t board_tx;
+    qnav_link_heartbeat_t hb = {0, QNAV_LINK_MODE_ONBOARD, QNAV_LINK_STATE_POLICY, 0, 0, 0};
+    uint8_t p[QNAV_LINK_HEARTBEAT_BYTES];
+    uint8_t wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_HEARTBEAT_BYTES)];
+    int32_t n;
+    int64_t t;
+    (void)state;
+    qnav_bridge_config_default(&cfg);
+    cfg.mode = QNAV_LINK_MODE_ONBOARD;
+    cfg.upload = 1;
+    qnav_bridge_init(&b, &cfg, NULL, NULL, discard_write, NULL, 0);
+    assert_int_equal(b.last_upload_status, QNAV_BRIDGE_UPLOAD_NONE_YET);
+    /* the board's first heartbeat starts the upload; no ack ever comes back */
+    qnav_link_tx_init(&board_tx);
+    n = qnav_link_encode(&board_tx, QNAV_LINK_MSG_HEARTBEAT, p,
+                         (uint16_t)qnav_link_heartbeat_pack(&hb, p, sizeof p), wire,
+                         (uint16_t)sizeof wire);
+    assert_true(n > 0);
+    qnav_bridge_on_bytes(&b, wire, (size_t)n, 10);
+    for (t = 10; t <= 5000; t += 10) {
+        qnav_bridge_poll(&b, t);
+    }
+    assert_int_equal(b.upload_tries, 3);
+    assert_int_equal(b.upload_state, QNAV_BRIDGE_UPLOAD_DONE);
+    assert_int_equal(b.last_upload_status, QNAV_BRIDGE_UPLOAD_NO_ANSWER);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -404,6 +443,7 @@ int main(void)
         cmocka_unit_test(test_corrupted_goal_is_not_acted_on),
         cmocka_unit_test(test_uploaded_policy_is_used_and_a_bad_one_is_refused),
         cmocka_unit_test(test_board_and_bridge_drive_together_in_both_modes),
+        cmocka_unit_test(test_bridge_reports_no_answer_when_the_board_never_acks_an_upload),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
