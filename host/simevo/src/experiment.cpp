@@ -510,8 +510,8 @@ std::string curves_csv(const ExperimentSummary &S)
     return o.str();
 }
 
-std::string quality_csv(const ExperimentSpec &spec, const ExperimentSummary &S, const std::string &exp_dir,
-                        const qnav_ctrl_config_t &ccfg, const qnav_policy_t &prob)
+std::string quality_csv(const ExperimentSummary &S, const std::string &exp_dir, const qnav_ctrl_config_t &ccfg,
+                        const qnav_policy_t &prob)
 {
     std::vector<std::pair<std::string, qnav_policy_t>> policies;
     policies.emplace_back("probabilistic", prob);
@@ -527,7 +527,6 @@ std::string quality_csv(const ExperimentSpec &spec, const ExperimentSummary &S, 
         }
         policies.emplace_back(c.label + " (run " + std::to_string(c.best_run + 1) + ")", p);
     }
-    (void)spec;
     return quality_table_csv(policies, ccfg);
 }
 
@@ -576,8 +575,7 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
     return o.str();
 }
 
-std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt,
-                       const std::string &exp_dir, bool plots)
+std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt, bool plots)
 {
     std::ostringstream o;
     o << "# " << spec.name << (spec.figure.empty() ? "" : " (paper " + spec.figure + ")") << "\n\n"
@@ -622,11 +620,12 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
         o << "![learning curves](learning.png)\n\n![policy quality](policy.png)\n\n";
     }
     o << "Regenerate: `simevo run " << spec.name << " --preset " << opt.preset << "` (with the same `--out`)\n";
-    (void)exp_dir;
     return o.str();
 }
 
-void run_plot_impl(const RunOptions &opt, const std::string &script, const std::string &exp_dir)
+} // namespace
+
+void run_plot(const RunOptions &opt, const std::string &script, const std::string &exp_dir)
 {
     const std::string path = join_path(opt.tools_dir, script);
     if (!file_exists(path)) {
@@ -650,8 +649,6 @@ void run_plot_impl(const RunOptions &opt, const std::string &script, const std::
     }
 }
 
-} // namespace
-
 std::string quality_table_csv(const std::vector<std::pair<std::string, qnav_policy_t>> &policies,
                               const qnav_ctrl_config_t &ccfg)
 {
@@ -673,11 +670,6 @@ std::string quality_table_csv(const std::vector<std::pair<std::string, qnav_poli
         }
     }
     return o.str();
-}
-
-void run_plot(const RunOptions &opt, const std::string &script, const std::string &dir)
-{
-    run_plot_impl(opt, script, dir);
 }
 
 std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
@@ -722,14 +714,13 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
 
     SimWorlds worlds;
     // Load every robot and environment up front so a bad name fails before any work.
-    std::unique_ptr<SimRunner> target_runner;
     std::set<std::string> probed;
     for (const TaskDef &t : tasks) {
         if (probed.insert(t.scenario.describe()).second) {
             SimRunner probe(worlds, t.scenario, t.context_seed, opt.use_table);
         }
     }
-    target_runner = std::make_unique<SimRunner>(worlds, spec.target, spec.seed, opt.use_table);
+    const SimRunner target_runner(worlds, spec.target, spec.seed, opt.use_table);
     for (const SourceSpec &s : spec.sources) {
         if (!s.policy_file.empty()) {
             qnav_policy_t p;
@@ -755,15 +746,15 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
 
     const ExperimentSummary S = summarize(spec, tasks);
     write_file_atomic(join_path(exp_dir, "curves.csv"), curves_csv(S));
-    write_file_atomic(join_path(exp_dir, "quality.csv"), quality_csv(spec, S, exp_dir, target_runner->ctrl_config(),
-                                                                         target_runner->probabilistic_policy()));
+    write_file_atomic(join_path(exp_dir, "quality.csv"), quality_csv(S, exp_dir, target_runner.ctrl_config(),
+                                                                   target_runner.probabilistic_policy()));
     write_file_atomic(join_path(exp_dir, "summary.json"), summary_json(spec, S, opt));
     if (opt.plots) {
         write_file_atomic(status_path, "incomplete: runs finished, plots missing\n");
-        run_plot_impl(opt, "plot_learning.py", exp_dir);
-        run_plot_impl(opt, "plot_policy.py", exp_dir);
+        run_plot(opt, "plot_learning.py", exp_dir);
+        run_plot(opt, "plot_policy.py", exp_dir);
     }
-    write_file_atomic(join_path(exp_dir, "summary.md"), summary_md(spec, S, opt, exp_dir, opt.plots));
+    write_file_atomic(join_path(exp_dir, "summary.md"), summary_md(spec, S, opt, opt.plots));
     write_file_atomic(status_path, "complete\n");
     return exp_dir;
 }
