@@ -127,8 +127,8 @@ int main(int argc, char **argv)
         case 'U': cfg.upload = 1; break;
         case 'b':
             if (parse_long(optarg, 1, LONG_MAX, &baud) != 0 || !qnav_serial_baud_ok(baud)) {
-                fprintf(stderr, "navbridge: --baud %s: unsupported rate (9600, 19200, 38400, "
-                                "57600, 115200, 230400, 460800, 500000, 1000000)\n", optarg);
+                fprintf(stderr, "navbridge: --baud %s: unsupported rate (" QNAV_SERIAL_RATES ")\n",
+                        optarg);
                 return 2;
             }
             break;

@@ -41,8 +41,7 @@ int qnav_serial_open(const char *device, long baud, char *err, size_t errlen)
     int fd;
 
     if (sp == (speed_t)0) {
-        snprintf(err, errlen, "--baud %ld: unsupported rate (9600, 19200, 38400, 57600, "
-                              "115200, 230400, 460800, 500000, 1000000)", baud);
+        snprintf(err, errlen, "--baud %ld: unsupported rate (" QNAV_SERIAL_RATES ")", baud);
         return -1;
     }
     fd = open(device, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);

@@ -7,6 +7,9 @@
 
 #include <stddef.h>
 
+/* The rates qnav_serial_baud_ok() accepts, for messages. */
+#define QNAV_SERIAL_RATES "9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 1000000"
+
 /* 1 if baud is a rate the bridge supports (termios has a constant for it). */
 int qnav_serial_baud_ok(long baud);
 
