@@ -133,7 +133,7 @@ static void test_task_stopped_and_resumed_matches_uninterrupted_bytes(void **sta
     for (const char *name : {"episodes.csv", "best.policy", "eval.csv", "task.txt", "done"}) {
         assert_true(slurp(join_path(a.dir, name)) == slurp(join_path(b.dir, name)));
     }
-    assert_int_equal(read_journal_R(join_path(b.dir, "episodes.csv")).size(), 300);
+    assert_int_equal(read_journal(join_path(b.dir, "episodes.csv")).R.size(), 300);
     assert_int_equal(read_eval(join_path(b.dir, "eval.csv")).size(), 12);
 }
 

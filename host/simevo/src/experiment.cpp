@@ -393,12 +393,13 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
                 best_final = m;
                 c.best_run = static_cast<int>(t.run);
             }
-            const auto R = read_journal_R(join_path(t.dir, "episodes.csv"));
+            const std::string journal = join_path(t.dir, "episodes.csv");
+            const JournalColumns J = read_journal(journal);
+            const std::vector<double> &R = J.R, &B = J.best_fitness;
             if (R.size() != spec.target_episodes) {
-                throw UserError(join_path(t.dir, "episodes.csv") + ": has " + std::to_string(R.size()) +
-                                " episodes, expected " + std::to_string(spec.target_episodes));
+                throw UserError(journal + ": has " + std::to_string(R.size()) + " episodes, expected " +
+                                std::to_string(spec.target_episodes));
             }
-            const auto B = read_journal_best(join_path(t.dir, "episodes.csv"));
             c.online_per_run.push_back(mean_of(R));
             for (uint64_t b = 0; b < nbins; ++b) {
                 const uint64_t lo = b * spec.curve_bin;

@@ -283,8 +283,7 @@ uint64_t task_total_episodes(const TaskDef &t)
     return (t.kind == TaskKind::Evolve ? t.episodes : 0) + t.eval_episodes;
 }
 
-namespace {
-std::vector<double> read_journal_column(const std::string &csv_path, std::size_t col)
+JournalColumns read_journal(const std::string &csv_path)
 {
     std::string text;
     if (!read_file(csv_path, text)) {
@@ -294,21 +293,18 @@ std::vector<double> read_journal_column(const std::string &csv_path, std::size_t
     if (L.lines.empty() || L.lines[0] + "\n" != kJournalHeader) {
         throw UserError(csv_path + ":1: not a simevo episode journal");
     }
-    std::vector<double> v;
+    JournalColumns c;
     for (std::size_t i = 1; i < L.lines.size(); ++i) {
         const auto f = split_csv(L.lines[i]);
-        double r = 0.0;
-        if (f.size() != 11 || !parse_double(f[col], r)) {
+        double r = 0.0, best = 0.0;
+        if (f.size() != 11 || !parse_double(f[1], r) || !parse_double(f[10], best)) {
             throw UserError(csv_path + ":" + std::to_string(i + 1) + ": malformed row");
         }
-        v.push_back(r);
+        c.R.push_back(r);
+        c.best_fitness.push_back(best);
     }
-    return v;
+    return c;
 }
-} // namespace
-
-std::vector<double> read_journal_R(const std::string &csv_path) { return read_journal_column(csv_path, 1); }
-std::vector<double> read_journal_best(const std::string &csv_path) { return read_journal_column(csv_path, 10); }
 
 std::vector<EpisodeOutcome> read_eval(const std::string &csv_path)
 {

@@ -60,13 +60,16 @@ struct TaskObserver {
 bool run_task(const TaskDef &t, const std::string &source_policy_path, const RunnerFactory &make,
               const TaskObserver &obs, const std::atomic<bool> &stop);
 
-/* Episodes a task still has to simulate (for progress totals) and has in total. */
+/* Episodes a task runs in all (evolution plus held-out evaluation), for progress totals. */
 uint64_t task_total_episodes(const TaskDef &t);
 
 /* Reading finished task outputs. Throw UserError on malformed files. */
-std::vector<double> read_journal_R(const std::string &csv_path);
-/* The best_fitness column (population best after each candidate). */
-std::vector<double> read_journal_best(const std::string &csv_path);
+/* An episode journal's R column and its best_fitness column (population best after
+ * each candidate), one entry per episode. */
+struct JournalColumns {
+    std::vector<double> R, best_fitness;
+};
+JournalColumns read_journal(const std::string &csv_path);
 std::vector<EpisodeOutcome> read_eval(const std::string &csv_path);
 
 /* The canonical settings text written to task.txt. */
