@@ -153,11 +153,6 @@ static void send_command(qnav_bridge_t *b, const qnav_command_t *c, int stop)
     lc.quality = c->quality_q15;
     lc.flags = (uint8_t)((uint8_t)c->flags | (stop ? QNAV_LINK_CMD_STOP : 0u));
     send_frame(b, QNAV_LINK_MSG_COMMAND, p, qnav_link_command_pack(&lc, p, sizeof p));
-    if (stop) {
-        b->stops_sent++;
-    } else {
-        b->commands_sent++;
-    }
 }
 
 /* A bare stop on the wire, repeated because a single frame may be lost. */

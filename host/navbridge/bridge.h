@@ -120,8 +120,6 @@ typedef struct {
     int8_t last_upload_status;    /* QNAV_LINK_ACK_* or QNAV_BRIDGE_UPLOAD_NONE_YET/_NO_ANSWER */
 
     uint64_t rx_bytes;
-    uint64_t commands_sent;
-    uint64_t stops_sent;
     FILE *diag;                   /* one-line notices (upload result, link lost), or NULL */
 } qnav_bridge_t;
 
