@@ -30,14 +30,18 @@ PROB = (
 )
 
 
-def net_line(n, text):
-    """NET with line n (1-based) replaced by text (None deletes it)."""
-    lines = NET.splitlines(keepends=True)
+def replace_line(base, n, text):
+    """base with line n (1-based) replaced by text (None deletes it)."""
+    lines = base.splitlines(keepends=True)
     if text is None:
         del lines[n - 1]
     else:
         lines[n - 1] = text
     return "".join(lines)
+
+
+def net_line(n, text):
+    return replace_line(NET, n, text)
 
 
 def net_insert(n, text):
@@ -48,12 +52,7 @@ def net_insert(n, text):
 
 
 def prob_line(n, text):
-    lines = PROB.splitlines(keepends=True)
-    if text is None:
-        del lines[n - 1]
-    else:
-        lines[n - 1] = text
-    return "".join(lines)
+    return replace_line(PROB, n, text)
 
 
 CASES = [
