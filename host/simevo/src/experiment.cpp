@@ -83,7 +83,7 @@ public:
     void best(const std::string &label, double r)
     {
         std::lock_guard<std::mutex> l(mu_);
-        // Strip the run-independent part: best over all runs of a condition.
+        // A label names a condition, not a run: keep the best over all its runs.
         auto it = best_.find(label);
         if (it == best_.end() || r > it->second) {
             best_[label] = r;
@@ -202,51 +202,40 @@ std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &e
     for (uint32_t r = 0; r < spec.runs; ++r) {
         const uint64_t run_seed = mix_seed(spec.seed, r + 1);
         const std::string rdir = run_dir(exp_dir, r);
+        // An evolution task of this run; its evolution seed follows from its label.
+        auto evolve = [&](const std::string &label, const Scenario &scenario, uint64_t episodes,
+                          uint64_t episode_seed_base) {
+            TaskDef t;
+            t.label = label;
+            t.dir = join_path(rdir, label);
+            t.run = r;
+            t.scenario = scenario;
+            t.context_seed = spec.seed;
+            t.episodes = episodes;
+            t.evolution = spec.evolution;
+            t.evolution_seed = mix_seed(run_seed, label_hash("evolution:" + label));
+            t.episode_seed_base = episode_seed_base;
+            return t;
+        };
         // Transfer and direct runs of one run face the same episode sequence (common
         // random numbers): the comparison is paired by construction.
         const uint64_t target_episodes_base = mix_seed(run_seed, label_hash("episodes:target"));
         for (const SourceSpec &s : spec.sources) {
             int src_index = -1;
             if (s.policy_file.empty()) {
-                TaskDef src;
-                src.label = "source-" + s.label;
-                src.dir = join_path(rdir, src.label);
-                src.run = r;
-                src.scenario = s.scenario;
-                src.context_seed = spec.seed;
-                src.episodes = s.episodes;
-                src.evolution = spec.evolution;
-                src.evolution_seed = mix_seed(run_seed, label_hash("evolution:" + src.label));
-                src.episode_seed_base = mix_seed(run_seed, label_hash("episodes:" + src.label));
-                tasks.push_back(src);
+                const std::string label = "source-" + s.label;
+                tasks.push_back(evolve(label, s.scenario, s.episodes,
+                                       mix_seed(run_seed, label_hash("episodes:" + label))));
                 src_index = static_cast<int>(tasks.size() - 1);
             }
-            TaskDef tr;
-            tr.label = "transfer-" + s.label;
-            tr.dir = join_path(rdir, tr.label);
-            tr.run = r;
-            tr.scenario = spec.target;
-            tr.context_seed = spec.seed;
-            tr.episodes = spec.target_episodes;
-            tr.evolution = spec.evolution;
-            tr.evolution_seed = mix_seed(run_seed, label_hash("evolution:" + tr.label));
-            tr.episode_seed_base = target_episodes_base;
+            TaskDef tr = evolve("transfer-" + s.label, spec.target, spec.target_episodes, target_episodes_base);
             tr.source_task = src_index;
             tr.source_policy_file = s.policy_file;
             tr.eval_episodes = spec.eval_episodes;
             tr.eval_seed_base = eval_base;
             tasks.push_back(tr);
         }
-        TaskDef d;
-        d.label = "direct";
-        d.dir = join_path(rdir, d.label);
-        d.run = r;
-        d.scenario = spec.target;
-        d.context_seed = spec.seed;
-        d.episodes = spec.target_episodes;
-        d.evolution = spec.evolution;
-        d.evolution_seed = mix_seed(run_seed, label_hash("evolution:direct"));
-        d.episode_seed_base = target_episodes_base;
+        TaskDef d = evolve("direct", spec.target, spec.target_episodes, target_episodes_base);
         d.eval_episodes = spec.eval_episodes;
         d.eval_seed_base = eval_base;
         tasks.push_back(d);
