@@ -28,6 +28,7 @@
 #include "qnav/link.h"
 #include "qnav/sim.h"
 #include "qnav_pose_t.h"
+#include "serial.h"
 
 static volatile sig_atomic_t g_quit = 0;
 
@@ -71,23 +72,14 @@ typedef struct {
 static void send_frame(robot_t *r, uint8_t id, const uint8_t *p, int32_t len)
 {
     uint8_t wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
-    int32_t n, done = 0;
+    int32_t n;
     if (len < 0) {
         return;
     }
     n = qnav_link_encode(&r->tx, id, p, (uint16_t)len, wire, sizeof wire);
-    while (n > 0 && done < n) {
-        ssize_t w = write(r->fd, wire + done, (size_t)(n - done));
-        if (w > 0) {
-            done += (int32_t)w;
-        } else if (w < 0 && errno != EAGAIN && errno != EINTR) {
-            return;
-        } else {
-            struct pollfd p2 = {r->fd, POLLOUT, 0};
-            if (poll(&p2, 1, 100) <= 0) {
-                return; /* nobody reads the pty: drop, like a UART with no listener */
-            }
-        }
+    if (n > 0) {
+        /* a port nobody reads drops the frame, like a UART with no listener */
+        (void)qnav_serial_write_all(r->fd, wire, (size_t)n);
     }
 }
 
