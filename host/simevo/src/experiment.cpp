@@ -713,16 +713,10 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
     const SimRunner target_runner(worlds, spec.target, spec.seed, opt.use_table);
     for (const SourceSpec &s : spec.sources) {
         if (!s.policy_file.empty()) {
-            qnav_policy_t p;
-            char err[QNAV_POLICY_IO_ERRLEN] = {0};
-            if (!file_exists(s.policy_file)) {
-                throw UserError(s.policy_file + ": policy file not found (source '" + s.label + "' of " + spec.file + ")");
-            }
-            if (qnav_policy_read(s.policy_file.c_str(), &p, err, sizeof err) != 0) {
-                throw UserError(err);
-            }
-            if (p.kind != QNAV_POLICY_NET) {
-                throw UserError(s.policy_file + ": incompatible policy: kind is not 'net' (a transfer seeds a population of networks)");
+            try {
+                load_source_policy(s.policy_file);
+            } catch (const UserError &e) {
+                throw UserError(std::string(e.what()) + " (source '" + s.label + "' of " + spec.file + ")");
             }
         }
     }

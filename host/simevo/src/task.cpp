@@ -147,26 +147,6 @@ int open_journal_at(const std::string &path, std::size_t keep, const char *heade
     return fd;
 }
 
-qnav_policy_t load_source_policy(const std::string &path)
-{
-    qnav_policy_t p;
-    char err[QNAV_POLICY_IO_ERRLEN] = {0};
-    if (!file_exists(path)) {
-        throw UserError(path + ": policy file not found");
-    }
-    if (qnav_policy_read(path.c_str(), &p, err, sizeof err) != 0) {
-        throw UserError(err);
-    }
-    if (p.kind != QNAV_POLICY_NET) {
-        throw UserError(path + ": incompatible policy: kind is not 'net' (a transfer seeds a "
-                               "population of networks)");
-    }
-    if (p.u.net.hidden < 1 || p.u.net.hidden > QNAV_MAX_HIDDEN) {
-        throw UserError(path + ": incompatible policy: hidden units outside 1..32");
-    }
-    return p;
-}
-
 /* Held-out evaluation, journaled like the evolution (eval.partial, one line per episode)
  * and renamed to eval.csv when complete. Returns false when stopped. */
 bool run_eval(EpisodeRunner &runner, const qnav_policy_t &policy, const TaskDef &t,
@@ -250,6 +230,26 @@ EpisodeOutcome run_k(EpisodeRunner &runner, const qnav_policy_t &policy, uint64_
 uint64_t parent_base(const TaskDef &t) { return mix_seed(t.episode_seed_base, 0x706172656e74ull); }
 
 } // namespace
+
+qnav_policy_t load_source_policy(const std::string &path)
+{
+    qnav_policy_t p;
+    char err[QNAV_POLICY_IO_ERRLEN] = {0};
+    if (!file_exists(path)) {
+        throw UserError(path + ": policy file not found");
+    }
+    if (qnav_policy_read(path.c_str(), &p, err, sizeof err) != 0) {
+        throw UserError(err);
+    }
+    if (p.kind != QNAV_POLICY_NET) {
+        throw UserError(path + ": incompatible policy: kind is not 'net' (a transfer seeds a "
+                               "population of networks)");
+    }
+    if (p.u.net.hidden < 1 || p.u.net.hidden > QNAV_MAX_HIDDEN) {
+        throw UserError(path + ": incompatible policy: hidden units outside 1..32");
+    }
+    return p;
+}
 
 std::string task_settings_text(const TaskDef &t, const std::string &source_fingerprint)
 {

@@ -54,6 +54,10 @@ struct TaskObserver {
     std::function<void(const std::string &label, double best_R)> best;
 };
 
+/* A policy file that can seed a transfer (a network with 1..QNAV_MAX_HIDDEN hidden
+ * units). Throws UserError naming the file. */
+qnav_policy_t load_source_policy(const std::string &path);
+
 /* Run (or resume, or skip if done) a task. source_policy_path is the file that seeds a
  * transfer ("" for none). stop is polled between episodes. Throws UserError. Returns
  * true when complete, false when stopped. */
