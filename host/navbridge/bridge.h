@@ -133,8 +133,8 @@ void qnav_bridge_init(qnav_bridge_t *b, const qnav_bridge_config_t *cfg, lcm_t *
 /* Bytes read from the serial port at now_ms. */
 void qnav_bridge_on_bytes(qnav_bridge_t *b, const uint8_t *bytes, size_t n, int64_t now_ms);
 
-/* A goal from LCM: relayed to the board and remembered (resent with each heartbeat
- * period until the board's scans report it). */
+/* A goal from LCM: relayed to the board and remembered (sent again after every board scan
+ * that still reports another goal id). */
 void qnav_bridge_on_goal(qnav_bridge_t *b, const qnav_goal_t *goal, int64_t now_ms);
 
 /* Periodic work (call at least every 20 ms): heartbeats, watchdog, status, upload. */
