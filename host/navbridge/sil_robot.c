@@ -58,7 +58,6 @@ typedef struct {
     qnav_link_upload_t upload;
     uint8_t mode;                 /* bridge's requested mode (0 until heard) */
     int stop_held;                /* bridge holds a stop */
-    int heard;
     int64_t last_rx_ms;
     int have_cmd;
     qnav_link_command_t cmd;      /* newest command from the bridge */
@@ -66,7 +65,6 @@ typedef struct {
     qnav_ctrl_config_t ccfg;
     qnav_policy_t policy;
     uint16_t policy_crc;
-    uint32_t uploads;
 } robot_t;
 
 static void send_frame(robot_t *r, uint8_t id, const uint8_t *p, int32_t len)
@@ -92,7 +90,6 @@ static uint16_t blob_crc(const qnav_policy_t *p)
 
 static void on_frame(robot_t *r, const qnav_link_frame_t *f)
 {
-    r->heard = 1;
     r->last_rx_ms = mono_ms();
     if (f->msg_id == QNAV_LINK_MSG_HEARTBEAT) {
         qnav_link_heartbeat_t hb;
@@ -131,7 +128,6 @@ static void on_frame(robot_t *r, const qnav_link_frame_t *f)
             if (qnav_ctrl_init(&r->ctrl, &r->ccfg, &fresh) == QNAV_OK) {
                 r->policy = fresh;
                 r->policy_crc = cm.crc;
-                r->uploads++;
                 fprintf(stderr, "qnav-sil-robot: policy uploaded (crc 0x%04x)\n", cm.crc);
             } else {
                 (void)qnav_ctrl_init(&r->ctrl, &r->ccfg, &r->policy);
