@@ -510,12 +510,7 @@ std::string quality_csv(const ExperimentSummary &S, const std::string &exp_dir, 
             continue;
         }
         const std::string path = join_path(join_path(run_dir(exp_dir, static_cast<uint32_t>(c.best_run)), c.label), "best.policy");
-        qnav_policy_t p;
-        char err[QNAV_POLICY_IO_ERRLEN] = {0};
-        if (qnav_policy_read(path.c_str(), &p, err, sizeof err) != 0) {
-            throw UserError(err);
-        }
-        policies.emplace_back(c.label + " (run " + std::to_string(c.best_run + 1) + ")", p);
+        policies.emplace_back(c.label + " (run " + std::to_string(c.best_run + 1) + ")", read_policy_file(path));
     }
     return quality_table_csv(policies, ccfg);
 }

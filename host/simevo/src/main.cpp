@@ -261,13 +261,7 @@ int main(int argc, char **argv)
                     SimWorlds worlds;
                     qnav_sim_robot_prob_policy(worlds.robot(q_robot), &p);
                 } else {
-                    char err[QNAV_POLICY_IO_ERRLEN] = {0};
-                    if (!file_exists(arg)) {
-                        throw UserError(arg + ": policy file not found");
-                    }
-                    if (qnav_policy_read(arg.c_str(), &p, err, sizeof err) != 0) {
-                        throw UserError(err);
-                    }
+                    p = read_policy_file(arg);
                 }
                 // Label: the last two path components (run folders all hold "best.policy"),
                 // made unique with a number when needed.
@@ -303,13 +297,7 @@ int main(int argc, char **argv)
             if (policy_arg == "prob") {
                 p = runner.probabilistic_policy();
             } else {
-                char err[QNAV_POLICY_IO_ERRLEN] = {0};
-                if (!file_exists(policy_arg)) {
-                    throw UserError(policy_arg + ": policy file not found");
-                }
-                if (qnav_policy_read(policy_arg.c_str(), &p, err, sizeof err) != 0) {
-                    throw UserError(err);
-                }
+                p = read_policy_file(policy_arg);
             }
             std::vector<double> R;
             uint32_t reached = 0, tau = 0;

@@ -231,16 +231,22 @@ uint64_t parent_base(const TaskDef &t) { return mix_seed(t.episode_seed_base, 0x
 
 } // namespace
 
-qnav_policy_t load_source_policy(const std::string &path)
+qnav_policy_t read_policy_file(const std::string &path)
 {
-    qnav_policy_t p;
-    char err[QNAV_POLICY_IO_ERRLEN] = {0};
     if (!file_exists(path)) {
         throw UserError(path + ": policy file not found");
     }
+    qnav_policy_t p;
+    char err[QNAV_POLICY_IO_ERRLEN] = {0};
     if (qnav_policy_read(path.c_str(), &p, err, sizeof err) != 0) {
         throw UserError(err);
     }
+    return p;
+}
+
+qnav_policy_t load_source_policy(const std::string &path)
+{
+    const qnav_policy_t p = read_policy_file(path);
     if (p.kind != QNAV_POLICY_NET) {
         throw UserError(path + ": incompatible policy: kind is not 'net' (a transfer seeds a "
                                "population of networks)");

@@ -54,6 +54,8 @@ struct TaskObserver {
     std::function<void(const std::string &label, double best_R)> best;
 };
 
+/* A policy file (qnav_policy_read). Throws UserError naming the file. */
+qnav_policy_t read_policy_file(const std::string &path);
 /* A policy file that can seed a transfer (a network with 1..QNAV_MAX_HIDDEN hidden
  * units). Throws UserError naming the file. */
 qnav_policy_t load_source_policy(const std::string &path);
