@@ -1,7 +1,7 @@
 /*
  * simevo: evolve navigation policies in the simulator with the paper's ε-greedy
  * neuro-evolution, transfer them between situations, and run the paper's five transfer
- * experiments with summaries and plots. Subcommands: run, list, evolve, eval.
+ * experiments with summaries and plots. Subcommands: run, list, evolve, eval, quality.
  * Every bad input ends in one line on stderr and exit status 1 (2 for usage errors).
  */
 #include <CLI/CLI.hpp>
@@ -121,14 +121,12 @@ int main(int argc, char **argv)
     uint64_t ev_episodes = 1000, ev_seed = 1;
     uint32_t ev_eval = 50;
     EvolutionParams ep;
-    for (auto *sc : {evolve}) {
-        sc->add_option("--env", env, "environment name or file")->capture_default_str();
-        sc->add_option("--robot", robot, "robot profile name or file")->capture_default_str();
-        sc->add_option("--sectors", sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
-        sc->add_option("--noise", noise, "sensor and actuation noise level p (0.05 = 5%)")->check(CLI::Range(0.0, 10.0));
-        sc->add_option("--sensor-noise", sensor_noise, "sensor noise only")->check(CLI::Range(0.0, 10.0));
-        sc->add_option("--actuation-noise", actuation_noise, "actuation noise only")->check(CLI::Range(0.0, 10.0));
-    }
+    evolve->add_option("--env", env, "environment name or file")->capture_default_str();
+    evolve->add_option("--robot", robot, "robot profile name or file")->capture_default_str();
+    evolve->add_option("--sectors", sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
+    evolve->add_option("--noise", noise, "sensor and actuation noise level p (0.05 = 5%)")->check(CLI::Range(0.0, 10.0));
+    evolve->add_option("--sensor-noise", sensor_noise, "sensor noise only")->check(CLI::Range(0.0, 10.0));
+    evolve->add_option("--actuation-noise", actuation_noise, "actuation noise only")->check(CLI::Range(0.0, 10.0));
     evolve->add_option("--from", from, "policy file to seed the population from (transfer)");
     evolve->add_option("--episodes", ev_episodes, "episodes")->capture_default_str()->check(CLI::Range(uint64_t(1), uint64_t(100000000)));
     evolve->add_option("--eval-episodes", ev_eval, "held-out evaluation episodes of the best")->capture_default_str();
