@@ -6,7 +6,6 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
-#include <fcntl.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -15,12 +14,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmocka.h>
 
 #include "qnav/policy_io.h"
+#include "test_proc.h"
 
 #ifndef QNAV_POLICY_TOOL
 #error "QNAV_POLICY_TOOL must name the qnav-policy binary"
@@ -52,7 +51,7 @@ static int run_tool(const char *arg0, ...)
     char outp[128];
     char errp[128];
     pid_t pid;
-    int status = 0;
+    int status;
     argv[argc++] = QNAV_POLICY_TOOL;
     va_start(ap, arg0);
     for (a = arg0; a != NULL && argc < 15; a = va_arg(ap, const char *)) {
@@ -62,22 +61,13 @@ static int run_tool(const char *arg0, ...)
     argv[argc] = NULL;
     (void)snprintf(outp, sizeof outp, "%s/stdout", tmpdir);
     (void)snprintf(errp, sizeof errp, "%s/stderr", tmpdir);
-    pid = fork();
-    assert_true(pid >= 0);
-    if (pid == 0) {
-        int fo = open(outp, O_WRONLY | O_CREAT | O_TRUNC, 0600);
-        int fe = open(errp, O_WRONLY | O_CREAT | O_TRUNC, 0600);
-        if (fo < 0 || fe < 0 || dup2(fo, 1) < 0 || dup2(fe, 2) < 0) {
-            _exit(127);
-        }
-        execv(QNAV_POLICY_TOOL, (char *const *)argv);
-        _exit(127);
-    }
-    assert_int_equal(waitpid(pid, &status, 0), pid);
-    assert_true(WIFEXITED(status));
+    pid = qnav_test_spawn(argv, outp, errp);
+    assert_true(pid > 0);
+    status = qnav_test_wait_exit(pid);
+    assert_true(status >= 0 && status < 256); /* exited, not killed by a signal */
     read_all(outp, out_text, sizeof out_text);
     read_all(errp, err_text, sizeof err_text);
-    return WEXITSTATUS(status);
+    return status;
 }
 
 static const char *tmp_path(const char *name)
@@ -103,20 +93,13 @@ static void assert_one_line_error(const char *prefix, const char *fragment)
 static int setup(void **state)
 {
     (void)state;
-    (void)snprintf(tmpdir, sizeof tmpdir, "/tmp/qnav_cli_XXXXXX");
-    return mkdtemp(tmpdir) == NULL ? -1 : 0;
+    return qnav_test_tmpdir_make(tmpdir, sizeof tmpdir, "qnav_cli");
 }
 
 static int teardown(void **state)
 {
-    static const char *const names[] = {"stdout", "stderr", "p.policy", "n.policy",
-                                        "n2.policy", "h.h", "t.h", "x.h"};
-    size_t i;
     (void)state;
-    for (i = 0; i < sizeof names / sizeof names[0]; ++i) {
-        (void)unlink(tmp_path(names[i]));
-    }
-    return rmdir(tmpdir);
+    return qnav_test_tmpdir_remove(tmpdir);
 }
 
 static void test_cli_check_accepts_good_file_silently(void **state)
