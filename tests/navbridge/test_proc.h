@@ -1,7 +1,7 @@
 /*
- * Child processes and scratch folders for the tests that run qnav programs against each
- * other (navbridge, the SIL robot, the simavr board): start one with its output in files,
- * wait for its exit status, make and remove a private folder under /tmp.
+ * Child processes and scratch folders for the tests that run qnav programs (navbridge, the
+ * SIL robot, the simavr board, qnav-policy): start one with its output in files, wait for
+ * its exit status or for the pty link it makes, make and remove a private folder under /tmp.
  */
 #ifndef QNAV_TEST_PROC_H
 #define QNAV_TEST_PROC_H
