@@ -134,18 +134,13 @@ int cmd_run(const RunOpts &o) {
     for (unsigned e = 0; e < o.episodes; ++e) {
         const std::uint64_t es = o.episode + e;
         qnav::EpisodePicture pic;
-        bool want_pic = e == 0 && !o.svg.empty();
+        const bool want_pic = e == 0 && !o.svg.empty();
         const bool want_trace = e == 0 && !o.trace.empty();
         std::string csv = "tick,x_m,y_m,heading_rad,speed_mps,cmd_heading_deg,cmd_speed,recovering,collided\n";
-        // Step the episode here (same loop as qnav_sim_run_episode) to catch the sonar at
-        // the chosen tick for the picture.
-        sim.reset(es);
-        qnav_ctrl_input_t in;
-        qnav_ctrl_output_t out;
-        in.ranges_mm = sim.scan().ranges_mm;
-        auto grab = [&](std::uint32_t tick) {
+        // Every sample of the episode: the trajectory row, the path, and the sonar at the
+        // chosen tick (or the last one before the episode ended).
+        auto grab = [&](const qnav_sim_sample_t &smp) {
             if (want_trace) {
-                const qnav_sim_sample_t smp = sim.sample();
                 char line[256];
                 std::snprintf(line, sizeof line, "%u,%.6f,%.6f,%.6f,%.4f,%d,%.4f,%d,%d\n", smp.tick,
                               smp.x_m, smp.y_m, smp.heading_rad, smp.speed_mps, smp.cmd_heading_deg,
@@ -153,27 +148,18 @@ int cmd_run(const RunOpts &o) {
                 csv += line;
             }
             if (!want_pic) return;
-            const qnav_sim_state_t st = sim.state();
-            pic.path.push_back({st.x_m, st.y_m});
-            // The chosen tick, or the last one before the episode ended.
-            if (static_cast<long>(tick) <= std::max(0L, o.svg_tick)) {
-                pic.sonar_tick = tick;
-                pic.sonar_pos = {st.x_m, st.y_m};
-                pic.sonar_heading = st.heading_rad;
+            pic.path.push_back({smp.x_m, smp.y_m});
+            if (static_cast<long>(smp.tick) <= std::max(0L, o.svg_tick)) {
+                pic.sonar_tick = smp.tick;
+                pic.sonar_pos = {smp.x_m, smp.y_m};
+                pic.sonar_heading = smp.heading_rad;
                 pic.sonar_ranges_m.clear();
                 for (unsigned k = 0; k < sim.config().n_sectors; ++k)
                     pic.sonar_ranges_m.push_back(sim.scan().ranges_mm[k] / 1000.0);
             }
         };
-        grab(0);
-        while (!sim.done()) {
-            in.goal_bearing_cdeg = sim.scan().goal_bearing_cdeg;
-            qnav_ctrl_step(&ctrl, &in, &out, nullptr);
-            sim.command(out.heading_deg, out.speed / 32768.0);
-            sim.advance();
-            grab(sim.state().tick);
-        }
-        const qnav_sim_result_t r = sim.result();
+        auto trace = [](void *user, const qnav_sim_sample_t *smp) { (*static_cast<decltype(grab) *>(user))(*smp); };
+        const qnav_sim_result_t r = sim.run_episode(&ctrl, es, want_trace || want_pic ? +trace : nullptr, &grab);
         print_result(static_cast<unsigned long long>(es), r);
         sum_r += r.R;
         reached += r.reached;
