@@ -3,7 +3,6 @@
  */
 #include "sim_runner.h"
 
-#include <cstdio>
 
 namespace qnav {
 
@@ -17,36 +16,36 @@ SimWorlds::~SimWorlds()
     }
 }
 
-const qnav_sim_robot_t *SimWorlds::robot(const std::string &spec)
+namespace {
+/* The cached handle for spec, loading it on first use. */
+template <typename T>
+const T *load_once(std::map<std::string, T *> &cache, const std::string &spec, const char *what,
+                   qnav_sim_status_t (*load)(const char *, T **, char *, size_t))
 {
-    std::lock_guard<std::mutex> lock(mu_);
-    auto it = robots_.find(spec);
-    if (it != robots_.end()) {
+    auto it = cache.find(spec);
+    if (it != cache.end()) {
         return it->second;
     }
     char err[QNAV_SIM_ERRLEN] = {0};
-    qnav_sim_robot_t *r = nullptr;
-    if (qnav_sim_robot_load(spec.c_str(), &r, err, sizeof err) != QNAV_SIM_OK) {
-        throw UserError(std::string("robot '") + spec + "': " + err);
+    T *h = nullptr;
+    if (load(spec.c_str(), &h, err, sizeof err) != QNAV_SIM_OK) {
+        throw UserError(std::string(what) + " '" + spec + "': " + err);
     }
-    robots_[spec] = r;
-    return r;
+    cache[spec] = h;
+    return h;
+}
+} // namespace
+
+const qnav_sim_robot_t *SimWorlds::robot(const std::string &spec)
+{
+    std::lock_guard<std::mutex> lock(mu_);
+    return load_once(robots_, spec, "robot", qnav_sim_robot_load);
 }
 
 const qnav_sim_env_t *SimWorlds::env(const std::string &spec)
 {
     std::lock_guard<std::mutex> lock(mu_);
-    auto it = envs_.find(spec);
-    if (it != envs_.end()) {
-        return it->second;
-    }
-    char err[QNAV_SIM_ERRLEN] = {0};
-    qnav_sim_env_t *e = nullptr;
-    if (qnav_sim_env_load(spec.c_str(), &e, err, sizeof err) != QNAV_SIM_OK) {
-        throw UserError(std::string("environment '") + spec + "': " + err);
-    }
-    envs_[spec] = e;
-    return e;
+    return load_once(envs_, spec, "environment", qnav_sim_env_load);
 }
 
 SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t context_seed,
@@ -87,11 +86,10 @@ EpisodeOutcome SimRunner::run(const qnav_policy_t &policy, uint64_t episode_seed
         }
     }
     qnav_sim_result_t res;
-    char msg[64];
     const qnav_sim_status_t s = qnav_sim_run_episode(sim_, &ctrl, episode_seed, &res, nullptr, nullptr);
     if (s != QNAV_SIM_OK) {
-        std::snprintf(msg, sizeof msg, "simulator: episode failed (status %d): ", static_cast<int>(s));
-        throw UserError(msg + std::string(qnav_sim_last_error(sim_)));
+        throw UserError("simulator: episode failed (status " + std::to_string(static_cast<int>(s)) +
+                        "): " + qnav_sim_last_error(sim_));
     }
     EpisodeOutcome out;
     out.R = res.R;
