@@ -26,6 +26,21 @@ std::string join_path(const std::string &a, const std::string &b)
     return a.back() == '/' ? a + b : a + "/" + b;
 }
 
+void write_all(int fd, const std::string &s, const std::string &path)
+{
+    std::size_t off = 0;
+    while (off < s.size()) {
+        const ssize_t n = ::write(fd, s.data() + off, s.size() - off);
+        if (n < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            throw UserError(path + ": write failed (" + errno_text() + ")");
+        }
+        off += static_cast<std::size_t>(n);
+    }
+}
+
 void write_file_atomic(const std::string &path, const std::string &content)
 {
     const std::string tmp = path + ".tmp" + std::to_string(::getpid()) + "-" +
@@ -34,19 +49,12 @@ void write_file_atomic(const std::string &path, const std::string &content)
     if (fd < 0) {
         throw UserError(path + ": cannot write (" + errno_text() + ")");
     }
-    std::size_t off = 0;
-    while (off < content.size()) {
-        const ssize_t n = ::write(fd, content.data() + off, content.size() - off);
-        if (n < 0) {
-            if (errno == EINTR) {
-                continue;
-            }
-            const std::string e = errno_text();
-            ::close(fd);
-            ::unlink(tmp.c_str());
-            throw UserError(path + ": write failed (" + e + ")");
-        }
-        off += static_cast<std::size_t>(n);
+    try {
+        write_all(fd, content, path);
+    } catch (...) {
+        ::close(fd);
+        ::unlink(tmp.c_str());
+        throw;
     }
     if (::close(fd) != 0 || ::rename(tmp.c_str(), path.c_str()) != 0) {
         const std::string e = errno_text();

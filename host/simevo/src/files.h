@@ -11,6 +11,8 @@
 namespace qnav {
 
 void write_file_atomic(const std::string &path, const std::string &content);
+/* Write all of s to fd (retrying short writes); path names the file in the error. */
+void write_all(int fd, const std::string &s, const std::string &path);
 /* Returns false if the file does not exist; throws on other read errors. */
 bool read_file(const std::string &path, std::string &out);
 bool file_exists(const std::string &path);

@@ -106,21 +106,6 @@ Lines split_lines(const std::string &text)
     return L;
 }
 
-void write_all(int fd, const std::string &s, const std::string &path)
-{
-    std::size_t off = 0;
-    while (off < s.size()) {
-        const ssize_t n = ::write(fd, s.data() + off, s.size() - off);
-        if (n < 0) {
-            if (errno == EINTR) {
-                continue;
-            }
-            throw UserError(path + ": write failed (" + std::strerror(errno) + ")");
-        }
-        off += static_cast<std::size_t>(n);
-    }
-}
-
 // Closes a file descriptor when it goes out of scope.
 struct FdGuard {
     int fd;
