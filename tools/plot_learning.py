@@ -26,18 +26,34 @@ def main(argv):
     exp = argv[1]
     out = argv[2] if len(argv) == 3 else os.path.join(exp, "learning.png")
     keys = ("mean", "ci_low", "ci_high", "best_mean", "best_ci_low", "best_ci_high")
+    summary_path = os.path.join(exp, "summary.json")
     try:
-        with open(os.path.join(exp, "summary.json")) as f:
+        with open(summary_path) as f:
             summary = json.load(f)
-        curves = {}
-        with open(os.path.join(exp, "curves.csv")) as f:
-            for row in csv.DictReader(f):
+    except OSError as e:
+        print(f"plot_learning.py: {summary_path}: {e.strerror}", file=sys.stderr)
+        return 1
+    except json.JSONDecodeError as e:
+        print(f"plot_learning.py: {summary_path}:{e.lineno}: {e.msg}", file=sys.stderr)
+        return 1
+    path = os.path.join(exp, "curves.csv")
+    curves = {}
+    try:
+        with open(path) as f:
+            reader = csv.DictReader(f)
+            for row in reader:
                 c = curves.setdefault(row["condition"], {k: [] for k in ("episode",) + keys})
                 c["episode"].append(int(row["episode"]))
                 for k in keys:
                     c[k].append(float(row[k]) if row[k] != "null" else float("nan"))
-    except (OSError, ValueError, KeyError) as e:
-        print(f"plot_learning.py: {exp}: {e}", file=sys.stderr)
+    except OSError as e:
+        print(f"plot_learning.py: {path}: {e.strerror}", file=sys.stderr)
+        return 1
+    except KeyError as e:
+        print(f"plot_learning.py: {path}:1: missing column {e}", file=sys.stderr)
+        return 1
+    except (ValueError, TypeError) as e:
+        print(f"plot_learning.py: {path}:{reader.line_num}: {e}", file=sys.stderr)
         return 1
 
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.6), dpi=110, layout="constrained")

@@ -26,17 +26,25 @@ def main(argv):
         return 2
     exp = argv[1]
     out = argv[2] if len(argv) == 3 else os.path.join(exp, "policy.png")
+    path = os.path.join(exp, "quality.csv")
     data = {}
     try:
-        with open(os.path.join(exp, "quality.csv")) as f:
-            for row in csv.DictReader(f):
+        with open(path) as f:
+            reader = csv.DictReader(f)
+            for row in reader:
                 data.setdefault(row["policy"], []).append(
                     (int(row["level"]), float(row["distance_m"]), int(row["dtheta_deg"]), float(row["quality"])))
-    except (OSError, ValueError, KeyError) as e:
-        print(f"plot_policy.py: {exp}: {e}", file=sys.stderr)
+    except OSError as e:
+        print(f"plot_policy.py: {path}: {e.strerror}", file=sys.stderr)
+        return 1
+    except KeyError as e:
+        print(f"plot_policy.py: {path}:1: missing column {e}", file=sys.stderr)
+        return 1
+    except (ValueError, TypeError) as e:
+        print(f"plot_policy.py: {path}:{reader.line_num}: {e}", file=sys.stderr)
         return 1
     if not data:
-        print(f"plot_policy.py: {exp}/quality.csv: no rows", file=sys.stderr)
+        print(f"plot_policy.py: {path}: no rows", file=sys.stderr)
         return 1
     n = len(data)
     fig, axes = plt.subplots(1, n, figsize=(2.9 * n + 1.0, 3.2), dpi=120, squeeze=False,
