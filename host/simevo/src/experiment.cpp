@@ -618,7 +618,7 @@ void run_plot(const RunOptions &opt, const std::string &script, const std::strin
     }
     const pid_t pid = ::fork();
     if (pid < 0) {
-        throw UserError("cannot start " + opt.python);
+        throw UserError(opt.python + ": cannot start (" + std::strerror(errno) + ")");
     }
     if (pid == 0) {
         ::execl(opt.python.c_str(), opt.python.c_str(), path.c_str(), exp_dir.c_str(), static_cast<char *>(nullptr));
@@ -629,8 +629,7 @@ void run_plot(const RunOptions &opt, const std::string &script, const std::strin
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-        throw UserError(path + ": plotting failed for " + exp_dir +
-                        " (results are complete except plots; STATUS says so)");
+        throw UserError(path + ": plotting failed for " + exp_dir);
     }
 }
 
@@ -730,8 +729,12 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
     write_file_atomic(join_path(exp_dir, "summary.json"), summary_json(spec, S, opt));
     if (opt.plots) {
         write_file_atomic(status_path, "incomplete: runs finished, plots missing\n");
-        run_plot(opt, "plot_learning.py", exp_dir);
-        run_plot(opt, "plot_policy.py", exp_dir);
+        try {
+            run_plot(opt, "plot_learning.py", exp_dir);
+            run_plot(opt, "plot_policy.py", exp_dir);
+        } catch (const UserError &e) {
+            throw UserError(std::string(e.what()) + " (results are complete except plots; STATUS says so)");
+        }
     }
     write_file_atomic(join_path(exp_dir, "summary.md"), summary_md(spec, S, opt, opt.plots));
     write_file_atomic(status_path, "complete\n");
