@@ -3,7 +3,7 @@
  * pseudo-terminal). Offboard mode runs libqnav here on the board's scans and streams
  * commands back; onboard mode relays goals and telemetry and can upload a policy file to
  * the board. Everything is published on LCM. When the board goes quiet for --timeout-ms
- * it commands a stop; SIGINT/SIGTERM stop the robot before exiting (status 0); a port that
+ * it commands a stop; SIGINT/SIGTERM/SIGHUP stop the robot before exiting (status 0); a port that
  * hangs up ends it with status 3. --replay re-runs a
  * recorded trial's scans through the controller and checks the commands are identical.
  */
@@ -254,6 +254,7 @@ int main(int argc, char **argv)
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGHUP, &sa, NULL); /* a dropped ssh session: stop the robot too */
     signal(SIGPIPE, SIG_IGN);
 
     qnav_bridge_init(&bridge, &cfg, lcm, log, write_serial, &fd, mono_ms());
@@ -310,7 +311,7 @@ int main(int argc, char **argv)
     }
     if (g_stop_signal) {
         fprintf(stderr, "navbridge: %s: robot stopped, exiting\n",
-                g_stop_signal == SIGINT ? "SIGINT" : "SIGTERM");
+                g_stop_signal == SIGINT ? "SIGINT" : g_stop_signal == SIGHUP ? "SIGHUP" : "SIGTERM");
     }
     qnav_goal_t_unsubscribe(lcm, sub);
     if (log != NULL) {

@@ -329,7 +329,8 @@ static void test_onboard_watchdog_stops_robot_when_heartbeats_stop(void **state)
     fakeboard_close(&fb);
 }
 
-static void test_sigint_stops_robot_before_exit(void **state)
+/* A terminating signal: a stop reaches the board, then a clean exit naming the signal. */
+static void check_signal_stops_robot_before_exit(int sig, const char *said)
 {
     const char *args[] = {"--lcm-url", "memq://", "--timeout-ms", "5000", NULL};
     uint8_t p[QNAV_LINK_MAX_PAYLOAD];
@@ -338,19 +339,30 @@ static void test_sigint_stops_robot_before_exit(void **state)
     qnav_link_command_t c;
     uint16_t seq, n;
     char text[1024];
-    (void)state;
     assert_int_equal(fakeboard_start(&fb, EXE, g_dir, args), 0);
     wait_bridge_up(&fb);
     seq = fb.tx.next_seq;
     n = scan_payload(3, 8, p, &s);
     assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_SCAN, p, n), 0);
     assert_int_equal(wait_command_for(&fb, seq, &c), 0);
-    kill(fb.pid, SIGINT);
+    kill(fb.pid, sig);
     assert_int_equal(wait_stop(&fb, 2000), 0);
     assert_int_equal(fakeboard_signal_and_wait(&fb, 0, 3000), 0);
     assert_true(read_text(fb.stderr_path, text, sizeof text) > 0);
-    assert_non_null(strstr(text, "SIGINT: robot stopped"));
+    assert_non_null(strstr(text, said));
     fakeboard_close(&fb);
+}
+
+static void test_sigint_stops_robot_before_exit(void **state)
+{
+    (void)state;
+    check_signal_stops_robot_before_exit(SIGINT, "SIGINT: robot stopped");
+}
+
+static void test_sighup_stops_robot_before_exit(void **state)
+{
+    (void)state;
+    check_signal_stops_robot_before_exit(SIGHUP, "SIGHUP: robot stopped");
 }
 
 static void test_onboard_upload_delivers_the_policy_file_to_the_board(void **state)
@@ -495,6 +507,7 @@ int main(void)
         cmocka_unit_test(test_watchdog_stops_robot_within_its_timeout),
         cmocka_unit_test(test_onboard_watchdog_stops_robot_when_heartbeats_stop),
         cmocka_unit_test(test_sigint_stops_robot_before_exit),
+        cmocka_unit_test(test_sighup_stops_robot_before_exit),
         cmocka_unit_test(test_onboard_upload_delivers_the_policy_file_to_the_board),
         cmocka_unit_test(test_start_goal_is_relayed_to_the_board),
         cmocka_unit_test(test_bad_options_and_files_fail_with_one_line),
