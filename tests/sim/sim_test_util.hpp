@@ -25,6 +25,18 @@ inline std::string test_env_text(const std::string &extra) {
            "[[start_zone]]\nx_m = 0.5\ny_m = 0.5\nw_m = 0.5\nh_m = 0.5\n" + extra;
 }
 
+// The whole file at path; fails the test when it cannot be opened.
+inline std::string read_text_file(const std::string &path) {
+    std::FILE *f = std::fopen(path.c_str(), "rb");
+    assert_non_null(f);
+    std::string text;
+    char buf[4096];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+    std::fclose(f);
+    return text;
+}
+
 struct TestSim {
     qnav_sim_robot_t *robot = nullptr;
     qnav_sim_env_t *env = nullptr;

@@ -27,15 +27,7 @@ static qnav_sim_status_t parse_env(const std::string &text, std::string *msg) {
 }
 
 static std::string read_data(const char *rel) {
-    const std::string path = std::string(QNAV_TEST_DATA_DIR) + "/" + rel;
-    std::FILE *f = std::fopen(path.c_str(), "rb");
-    assert_non_null(f);
-    std::string text;
-    char buf[4096];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-    std::fclose(f);
-    return text;
+    return read_text_file(std::string(QNAV_TEST_DATA_DIR) + "/" + rel);
 }
 
 static qnav_sim_status_t parse_robot(const std::string &text, std::string *msg) {
@@ -271,13 +263,7 @@ static void test_cli_runs_an_episode_and_writes_a_complete_picture(void **state)
     assert_int_equal(run_tool("run " + data + " --sectors 16 --sensor-noise 0 --actuation-noise 0 --svg " + svg + " --svg-tick 5", &out), 0);
     assert_true(out.find("episode 0:") != std::string::npos);
     assert_true(out.find(" R ") != std::string::npos);
-    std::FILE *f = std::fopen(svg.c_str(), "rb");
-    assert_non_null(f);
-    std::string text;
-    char buf[4096];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-    std::fclose(f);
+    const std::string text = read_text_file(svg);
     assert_true(starts_with(text, "<?xml"));
     assert_true(text.find("</svg>") != std::string::npos);
     assert_true(text.find("<polyline") != std::string::npos);  // the path

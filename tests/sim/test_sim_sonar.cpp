@@ -181,18 +181,8 @@ static void test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment(
     assert_int_equal(qnav_sim_env_load(path.c_str(), &env, err, sizeof err), QNAV_SIM_OK);
     qnav_sim_env_info_t info;
     qnav_sim_env_info(env, &info);
-    qnav::Environment e;
-    {
-        // Re-read through the C++ loader to get the shapes.
-        std::FILE *f = std::fopen(path.c_str(), "rb");
-        assert_non_null(f);
-        std::string text;
-        char buf[4096];
-        size_t n;
-        while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-        std::fclose(f);
-        e = qnav::parse_environment(text, path);
-    }
+    // Re-read through the C++ loader to get the shapes.
+    const qnav::Environment e = qnav::parse_environment(read_text_file(path), path);
     std::vector<qnav::Shape> shapes = e.obstacle_shapes();
     std::vector<qnav::Shape> all = shapes;
     for (const auto &w : e.wall_shapes()) all.push_back(w);
