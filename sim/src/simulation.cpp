@@ -167,7 +167,6 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     target_speed_ = 0;
     marks_.clear();
     vel_ = {0, 0};
-    omega_ = 0;
     body_stale_ = false;
     Vec2 unused;
     touching(&unused);  // sets clearance_m_
@@ -319,7 +318,6 @@ void Simulation::drive_substep(double dt) {
     const double v_lat = -robot_.slip_lateral_s * v * omega_a;
     const double ch = std::cos(heading_), sh = std::sin(heading_);
     vel_ = {v * ch - v_lat * sh, v * sh + v_lat * ch};
-    omega_ = omega_a;
     // Box2D only where a contact is possible this step: far from every obstacle the disc
     // moves freely and its motion is integrated here exactly as Box2D would (no forces:
     // position += dt * velocity, angle += dt * turn rate). Box2D's step costs about a
@@ -394,7 +392,6 @@ void Simulation::advance() {
     collided_this_tick_ = recovering ? recovery_left_ == 0 && touching(&contact) : touched;
     if (collided_this_tick_) start_recovery(contact);
     if (profiling_) prof_.physics_s += std::chrono::duration<double>(Clock::now() - t0).count();
-    ++prof_.ticks;
     const double dx = env_.dest_x_m - pos_.x, dy = env_.dest_y_m - pos_.y;
     if (dx * dx + dy * dy <= env_.dest_radius_m * env_.dest_radius_m) {
         reached_ = true;

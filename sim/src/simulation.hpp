@@ -31,7 +31,6 @@ struct SimConfig {
 // Where time went (only counted when profiling is on), seconds.
 struct SimProfile {
     double physics_s = 0, sonar_s = 0, controller_s = 0;
-    std::uint64_t ticks = 0;
 };
 
 struct CollisionMark {
@@ -108,7 +107,6 @@ private:
     double start_heading_ = 0, heading_ = 0;
     double wheel_l_ = 0, wheel_r_ = 0;  // wheel surface speeds, m/s
     Vec2 vel_{};                        // body velocity, world frame, m/s
-    double omega_ = 0;                  // body turn rate, rad/s
     double clearance_m_ = 0;            // centre to nearest surface after the last step, m
     bool body_stale_ = false;           // Box2D body not moved since free steps
     double cmd_heading_deg_ = 0, cmd_speed_ = 0;  // last command, as given
