@@ -55,8 +55,6 @@ public:
     bool done() const { return done_; }
 
     const qnav_sim_scan_t &scan() const { return scan_; }
-    // True centre distances of the last scan before noise (m, kInf = nothing in reach).
-    const std::vector<double> &true_distances() const { return true_dist_; }
     qnav_sim_state_t state() const;
     qnav_sim_result_t result() const;
     qnav_sim_sample_t sample() const;
@@ -72,7 +70,6 @@ public:
     void set_reference_mode(bool on) { reference_ = on; }
     SimProfile &profile() { return prof_; }
 
-    const RobotProfile &robot() const { return robot_; }
     const Environment &env() const { return env_; }
     const SimConfig &config() const { return cfg_; }
     std::uint16_t max_range_mm() const { return max_range_mm_; }
@@ -111,7 +108,7 @@ private:
     bool body_stale_ = false;           // Box2D body not moved since free steps
     double cmd_heading_deg_ = 0, cmd_speed_ = 0;  // last command, as given
     double target_heading_ = 0, target_speed_ = 0;  // this tick, with actuation noise
-    std::vector<double> true_dist_;
+    std::vector<double> true_dist_;  // centre distances of the last scan before noise, m
     qnav_sim_scan_t scan_{};
     std::vector<CollisionMark> marks_;
 
