@@ -232,7 +232,7 @@ Environment generate_environment(double density, std::uint64_t seed, double clea
     env.episode_limit_s = 40;
     env.start_zones = {{0.6, 0.6, 2.0, 1.0}, {4.0, 0.6, 2.0, 1.0}, {7.4, 0.6, 2.0, 1.0}};
     env.zone_lines = {0, 0, 0};
-    Rng rng;
+    SimRng rng;
     rng.seed(seed, 0x67656e, 0);
     // Obstacles live in the band y in [2.2, 8.2]; keep the destination area free.
     const double band_lo = 2.2, band_hi = 8.2;

@@ -18,9 +18,11 @@ inline std::uint64_t splitmix64(std::uint64_t &state) {
     return z ^ (z >> 31);
 }
 
-class Rng {
+// Named apart from simevo's qnav::Rng (host/simevo/src/rng.h): both end up in one binary,
+// and two classes of one name there would be one class to the linker.
+class SimRng {
 public:
-    Rng() { seed(0, 0, 0); }
+    SimRng() { seed(0, 0, 0); }
     // Seed from the context seed, the episode seed and a stream number.
     void seed(std::uint64_t context, std::uint64_t episode, std::uint64_t stream) {
         std::uint64_t sm = context;

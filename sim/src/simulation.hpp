@@ -92,7 +92,7 @@ private:
     std::unique_ptr<b2World> world_;
     b2Body *body_ = nullptr;
 
-    Rng rng_start_, rng_sensor_, rng_act_;
+    SimRng rng_start_, rng_sensor_, rng_act_;
     bool started_ = false, done_ = false, reached_ = false;
     std::uint32_t tick_ = 0, tau_c_ = 0, collisions_ = 0;
     std::uint32_t recovery_left_ = 0;

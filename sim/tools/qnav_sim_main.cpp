@@ -228,7 +228,7 @@ struct BenchOpts {
 qnav_policy_t random_network(int hidden, std::uint64_t seed, std::uint64_t which) {
     qnav_policy_t pol;
     qnav_policy_net_zero(&pol, static_cast<std::uint8_t>(hidden));
-    qnav::Rng rng;
+    qnav::SimRng rng;
     rng.seed(seed, 0xbe7c, which);
     for (std::uint16_t k = 0; k < QNAV_NET_WEIGHTS(pol.u.net.hidden); ++k)
         *qnav_net_weight(&pol.u.net, k) =

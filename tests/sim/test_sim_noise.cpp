@@ -15,7 +15,7 @@ static const double kPiD = 3.14159265358979323846;
 
 static void test_normal_draws_have_unit_variance_and_gaussian_tails(void **state) {
     (void)state;
-    qnav::Rng rng;
+    qnav::SimRng rng;
     rng.seed(42, 0, 0);
     const int n = 200000;
     double sum = 0, sum2 = 0;
@@ -36,7 +36,7 @@ static void test_normal_draws_have_unit_variance_and_gaussian_tails(void **state
 
 static void test_uniform_draws_fill_the_unit_interval_evenly(void **state) {
     (void)state;
-    qnav::Rng rng;
+    qnav::SimRng rng;
     rng.seed(1, 2, 3);
     int bins[10] = {0};
     for (int i = 0; i < 100000; ++i) {
@@ -49,7 +49,7 @@ static void test_uniform_draws_fill_the_unit_interval_evenly(void **state) {
 
 static void test_same_seeds_give_the_same_stream_and_different_streams_differ(void **state) {
     (void)state;
-    qnav::Rng a, b, c;
+    qnav::SimRng a, b, c;
     a.seed(5, 9, 1);
     b.seed(5, 9, 1);
     c.seed(5, 9, 2);

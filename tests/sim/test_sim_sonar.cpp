@@ -186,7 +186,7 @@ static void test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment(
     std::vector<qnav::Shape> shapes = e.obstacle_shapes();
     std::vector<qnav::Shape> all = shapes;
     for (const auto &w : e.wall_shapes()) all.push_back(w);
-    qnav::Rng rng;
+    qnav::SimRng rng;
     rng.seed(7, 7, 7);
     // (sectors, cone deg): cone 0 = 360/N; wider cones overlap.
     const struct { unsigned n; double cone_deg; } cases[] = {
