@@ -3,10 +3,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
-#include <unistd.h>
 
 #include "error.hpp"
 
@@ -131,24 +129,6 @@ std::string render_svg(const Environment &env, double robot_r, const EpisodePict
     }
     o << "</svg>\n";
     return o.str();
-}
-
-void write_file_atomic(const std::string &path, const std::string &text) {
-    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw SimError(QNAV_SIM_E_IO, path + ":0: cannot write file");
-        out << text;
-        out.flush();
-        if (!out) {
-            std::remove(tmp.c_str());
-            throw SimError(QNAV_SIM_E_IO, path + ":0: cannot write file");
-        }
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        throw SimError(QNAV_SIM_E_IO, path + ":0: cannot rename into place");
-    }
 }
 
 }  // namespace qnav

@@ -31,7 +31,4 @@ struct EpisodePicture {
 std::string render_svg(const Environment &env, double robot_radius_m,
                        const EpisodePicture *episode);
 
-// Write text to path through a temporary file renamed into place. Throws SimError (IO).
-void write_file_atomic(const std::string &path, const std::string &text);
-
 }  // namespace qnav

@@ -4,12 +4,16 @@
 // `draw-env` draws an environment like the paper's Fig. 6; `gen-env` writes a random
 // environment of a given density; `bench` measures episodes per second per core with the
 // time split into physics, sonar and controller. Bad input: one line, non-zero exit.
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
@@ -37,6 +41,26 @@ struct Loaded {
         qnav_sim_robot_free(robot);
     }
 };
+
+// Write text to path through a temporary file renamed into place. Throws SimError (IO).
+void write_output(const std::string &path, const std::string &text) {
+    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out) throw SimError(QNAV_SIM_E_IO, path + ": cannot write (" + std::strerror(errno) + ")");
+        out << text;
+        out.flush();
+        if (!out) {
+            std::remove(tmp.c_str());
+            throw SimError(QNAV_SIM_E_IO, path + ": cannot write");
+        }
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        const std::string why = std::strerror(errno);
+        std::remove(tmp.c_str());
+        throw SimError(QNAV_SIM_E_IO, path + ": cannot rename into place (" + why + ")");
+    }
+}
 
 void check(qnav_sim_status_t st, const char *err) {
     if (st != QNAV_SIM_OK) throw SimError(st, err);
@@ -164,7 +188,7 @@ int cmd_run(const RunOpts &o) {
         sum_r += r.R;
         reached += r.reached;
         if (want_trace) {
-            qnav::write_file_atomic(o.trace, csv);
+            write_output(o.trace, csv);
             std::printf("trajectory: %s\n", o.trace.c_str());
         }
         if (want_pic) {
@@ -177,7 +201,7 @@ int cmd_run(const RunOpts &o) {
                           static_cast<unsigned long long>(es), r.R, r.reached ? "reached" : "not reached",
                           pic.sonar_tick);
             pic.caption = cap;
-            qnav::write_file_atomic(o.svg, qnav::render_svg(sim.env(), ri.radius_m, &pic));
+            write_output(o.svg, qnav::render_svg(sim.env(), ri.radius_m, &pic));
             std::printf("picture: %s\n", o.svg.c_str());
         }
     }
@@ -191,7 +215,7 @@ int cmd_draw_env(const std::string &env, const std::string &robot, const std::st
     load(l, robot, env);
     qnav_sim_robot_info_t ri;
     qnav_sim_robot_info(l.robot, &ri);
-    qnav::write_file_atomic(outp, qnav::render_svg(l.env->env, ri.radius_m, nullptr));
+    write_output(outp, qnav::render_svg(l.env->env, ri.radius_m, nullptr));
     std::printf("picture: %s\n", outp.c_str());
     return 0;
 }
@@ -206,7 +230,7 @@ int cmd_gen_env(double density, std::uint64_t seed, const std::string &robot,
     const std::string text = qnav::environment_to_toml(env);
     // Check that what we write reads back.
     qnav::parse_environment(text, outp);
-    qnav::write_file_atomic(outp, text);
+    write_output(outp, text);
     std::printf("environment %s: %zu circles, %zu boxes -> %s\n", env.name.c_str(),
                 env.circles.size(), env.boxes.size(), outp.c_str());
     return 0;
