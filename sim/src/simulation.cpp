@@ -227,6 +227,7 @@ private:
 void Simulation::reference_scan() {
     std::fill(true_dist_.begin(), true_dist_.end(), kInf);
     const double len = robot_.range_max_m + robot_.radius_m;
+    const double w = 2.0 * kPi / cfg_.n_sectors, half = sonar_.cone() / 2;
     const b2Vec2 p1(static_cast<float>(pos_.x), static_cast<float>(pos_.y));
     for (int deg = 0; deg < 360; ++deg) {
         const double a = heading_ + deg * kPi / 180.0;
@@ -236,7 +237,6 @@ void Simulation::reference_scan() {
         world_->RayCast(&hit, p1, p2);
         if (hit.best > 1.0f) continue;
         const double d = static_cast<double>(hit.best) * len;
-        const double w = 2.0 * kPi / cfg_.n_sectors, half = sonar_.cone() / 2;
         for (std::uint16_t k = 0; k < cfg_.n_sectors; ++k)
             if (std::fabs(wrap_pi(deg * kPi / 180.0 - k * w)) <= half + 1e-12)
                 true_dist_[k] = std::min(true_dist_[k], d);
