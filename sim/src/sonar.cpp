@@ -58,7 +58,7 @@ void SonarRing::measure_wide(Vec2 pos, double heading, double *dist) const {
     std::fill(dist, dist + n_, kInf);
     const double ch = std::cos(heading), sh = std::sin(heading);
     const double half = cone_ / 2;
-    auto rot = [&](Vec2 b) { return Vec2{ch * b.x - sh * b.y, sh * b.x + ch * b.y}; };
+    auto rot = [&](Vec2 b) { return rotate(b, ch, sh); };
     const double wall_d[4] = {width_m_ - pos.x, height_m_ - pos.y, pos.x, pos.y};
     for (int w = 0; w < 4; ++w) {
         const double d = std::max(0.0, wall_d[w]);
@@ -121,8 +121,7 @@ void SonarRing::measure(Vec2 pos, double heading, double *dist) const {
     // ... and every boundary ray's exit distance from the rectangle.
     if (n_ > 1) {
         for (std::uint16_t j = 0; j < n_; ++j) {
-            const Vec2 b = boundary_[j];
-            const Vec2 u{ch * b.x - sh * b.y, sh * b.x + ch * b.y};
+            const Vec2 u = rotate(boundary_[j], ch, sh);
             const double t = exit_distance(u, wall_d);
             const std::uint16_t left = j == 0 ? static_cast<std::uint16_t>(n_ - 1) : static_cast<std::uint16_t>(j - 1);
             if (t < dist[j]) dist[j] = t;
@@ -158,8 +157,7 @@ void SonarRing::measure(Vec2 pos, double heading, double *dist) const {
         while (jj < 0) jj += n_;
         while (jj >= static_cast<long>(n_)) jj -= n_;
         for (long j = j0; j <= j1; ++j, jj = jj + 1 == static_cast<long>(n_) ? 0 : jj + 1) {
-            const Vec2 b = boundary_[static_cast<std::size_t>(jj)];
-            const Vec2 u{ch * b.x - sh * b.y, sh * b.x + ch * b.y};
+            const Vec2 u = rotate(boundary_[static_cast<std::size_t>(jj)], ch, sh);
             const double t = ray_hit(s, pos, u);
             if (t == kInf) continue;
             const std::size_t right = static_cast<std::size_t>(jj);
