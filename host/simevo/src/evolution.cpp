@@ -6,6 +6,10 @@
 #include <cmath>
 #include <limits>
 
+/* The value of a macro as a string literal (QNAV_MAX_HIDDEN can be set with -D). */
+#define QNAV_SIMEVO_STR_(x) #x
+#define QNAV_SIMEVO_STR(x) QNAV_SIMEVO_STR_(x)
+
 namespace qnav {
 
 const char *evolution_params_problem(const EvolutionParams &p)
@@ -17,7 +21,7 @@ const char *evolution_params_problem(const EvolutionParams &p)
         return "epsilon: must be in [0, 1]";
     }
     if (p.hidden < 1 || p.hidden > QNAV_MAX_HIDDEN) {
-        return "hidden: must be 1..32 (QNAV_MAX_HIDDEN)";
+        return "hidden: must be 1.." QNAV_SIMEVO_STR(QNAV_MAX_HIDDEN) " (QNAV_MAX_HIDDEN)";
     }
     if (!(p.mutation_scale > 0.0 && p.mutation_scale <= 128.0)) {
         return "mutation_scale: must be in (0, 128]";

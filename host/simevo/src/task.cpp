@@ -237,7 +237,7 @@ qnav_policy_t load_source_policy(const std::string &path)
                                "population of networks)");
     }
     if (p.u.net.hidden < 1 || p.u.net.hidden > QNAV_MAX_HIDDEN) {
-        throw UserError(path + ": incompatible policy: hidden units outside 1..32");
+        throw UserError(path + ": incompatible policy: hidden units outside 1.." + std::to_string(QNAV_MAX_HIDDEN));
     }
     return p;
 }
