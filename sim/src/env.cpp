@@ -238,6 +238,7 @@ Environment generate_environment(double density, std::uint64_t seed, double clea
     const double band_lo = 2.2, band_hi = 8.2;
     const double band_area = env.width_m * (band_hi - band_lo);
     double covered = 0;
+    std::vector<Shape> placed;  // env's obstacles so far
     const double target = std::clamp(density, 0.0, 0.5) * band_area;
     for (int attempt = 0; attempt < 4000 && covered < target; ++attempt) {
         const bool circle = rng.uniform() < 0.5;
@@ -245,18 +246,19 @@ Environment generate_environment(double density, std::uint64_t seed, double clea
         const double y = rng.uniform(band_lo, band_hi);
         Environment trial = env;
         double area;
+        Shape s;
         if (circle) {
             const double r = rng.uniform(0.2, 0.7);
             trial.circles.push_back({x, y, r});
+            s = make_circle(x, y, r);
             area = kPi * r * r;
         } else {
             const double w = rng.uniform(0.3, 1.8), h = rng.uniform(0.3, 1.8);
             const double a = std::floor(rng.uniform(0.0, 4.0)) * 15.0;  // 0, 15, 30, 45
             trial.boxes.push_back({x, y, w, h, a});
+            s = make_box(x, y, w, h, a);
             area = w * h;
         }
-        const Shape s = circle ? trial.obstacle_shapes()[trial.circles.size() - 1]
-                               : trial.obstacle_shapes().back();
         Vec2 q;
         if (nearest_point(s, {env.dest_x_m, env.dest_y_m}, &q) < env.dest_radius_m + 2 * clearance_m)
             continue;
@@ -264,10 +266,11 @@ Environment generate_environment(double density, std::uint64_t seed, double clea
         for (const auto &z : env.start_zones)
             if (shape_distance(zone_shape(z), s) < 2 * clearance_m) bad = true;
         // Obstacles do not overlap: spread out, they make more distinct gaps.
-        for (const Shape &o : env.obstacle_shapes())
+        for (const Shape &o : placed)
             if (!bad && shape_distance(o, s) < 0.1) bad = true;
         if (bad || !environment_connected(trial, clearance_m, 0.1)) continue;
         env = std::move(trial);
+        placed.push_back(s);
         covered += area;
     }
     return env;
