@@ -3,6 +3,8 @@
  */
 #include "sim_runner.h"
 
+#include <cstring>
+
 
 namespace qnav {
 
@@ -50,7 +52,7 @@ const qnav_sim_env_t *SimWorlds::env(const std::string &spec)
 
 SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t context_seed,
                      bool use_table)
-    : use_table_(use_table), table_(QNAV_QTABLE_ENTRIES)
+    : use_table_(use_table)
 {
     const qnav_sim_robot_t *robot = worlds.robot(scenario.robot);
     const qnav_sim_env_t *env = worlds.env(scenario.environment);
@@ -71,6 +73,26 @@ SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t conte
 
 SimRunner::~SimRunner() { qnav_sim_destroy(sim_); }
 
+const qnav_q1_15_t *SimRunner::table_for(const qnav_ctrl_t &ctrl, const qnav_policy_t &policy)
+{
+    for (unsigned i = 0; i < 2; ++i) {
+        if (tables_[i].valid && std::memcmp(&tables_[i].policy, &policy, sizeof policy) == 0) {
+            least_recent_ = 1 - i;
+            return tables_[i].table.data();
+        }
+    }
+    CompiledTable &t = tables_[least_recent_];
+    least_recent_ = 1 - least_recent_;
+    t.valid = false;
+    t.table.resize(QNAV_QTABLE_ENTRIES);
+    if (qnav_ctrl_build_table(&ctrl, t.table.data()) != QNAV_OK) {
+        return nullptr;
+    }
+    t.policy = policy;
+    t.valid = true;
+    return t.table.data();
+}
+
 EpisodeOutcome SimRunner::run(const qnav_policy_t &policy, uint64_t episode_seed)
 {
     qnav_ctrl_t ctrl;
@@ -80,8 +102,8 @@ EpisodeOutcome SimRunner::run(const qnav_policy_t &policy, uint64_t episode_seed
                         std::to_string(static_cast<int>(st)) + ")");
     }
     if (use_table_ && policy.kind == QNAV_POLICY_NET) {
-        if (qnav_ctrl_build_table(&ctrl, table_.data()) != QNAV_OK ||
-            qnav_ctrl_init_table(&ctrl, &ctrl_cfg_, table_.data()) != QNAV_OK) {
+        const qnav_q1_15_t *table = table_for(ctrl, policy);
+        if (!table || qnav_ctrl_init_table(&ctrl, &ctrl_cfg_, table) != QNAV_OK) {
             throw UserError("controller: could not compile the policy into a quality table");
         }
     }

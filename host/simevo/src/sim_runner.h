@@ -55,11 +55,22 @@ public:
     const qnav_ctrl_config_t &ctrl_config() const { return ctrl_cfg_; }
 
 private:
+    /* policy's quality table, compiled by ctrl (initialised with policy), or null when it
+     * cannot be. The last two are kept: an evolution step runs a new candidate and then,
+     * mostly, the same best member as its parent, whose table need not be built again. */
+    const qnav_q1_15_t *table_for(const qnav_ctrl_t &ctrl, const qnav_policy_t &policy);
+
+    struct CompiledTable {
+        qnav_policy_t policy{};
+        std::vector<qnav_q1_15_t> table;
+        bool valid = false;
+    };
     qnav_sim_t *sim_ = nullptr;
     qnav_ctrl_config_t ctrl_cfg_{};
     qnav_policy_t prob_{};
     bool use_table_;
-    std::vector<qnav_q1_15_t> table_;
+    CompiledTable tables_[2];
+    unsigned least_recent_ = 0; /* index into tables_ to overwrite next */
 };
 
 } // namespace qnav
