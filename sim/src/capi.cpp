@@ -40,6 +40,28 @@ qnav_sim_status_t guarded(char *err, std::size_t errlen, F &&f) {
     }
 }
 
+// A *_load: resolve spec in the data folder kind, read the file and hand its text to
+// parse (the matching *_parse); what names the argument in messages.
+template <typename T>
+qnav_sim_status_t load_spec(const char *spec, const char *kind, const char *what,
+                            qnav_sim_status_t (*parse)(const char *, size_t, const char *, T **,
+                                                       char *, size_t),
+                            T **out, char *err, std::size_t errlen) {
+    if (!out) return QNAV_SIM_E_NULL;
+    *out = nullptr;
+    if (!spec) {
+        put_err(err, errlen, std::string(what) + ": null path");
+        return QNAV_SIM_E_NULL;
+    }
+    std::string text, path;
+    const qnav_sim_status_t st = guarded(err, errlen, [&] {
+        path = qnav::resolve_data_spec(spec, kind);
+        text = qnav::TomlReader::read_file(path);
+    });
+    if (st != QNAV_SIM_OK) return st;
+    return parse(text.data(), text.size(), path.c_str(), out, err, errlen);
+}
+
 }  // namespace
 
 namespace qnav {
@@ -73,19 +95,7 @@ qnav_sim_status_t qnav_sim_robot_parse(const char *text, size_t len, const char 
 
 qnav_sim_status_t qnav_sim_robot_load(const char *spec, qnav_sim_robot_t **out, char *err,
                                       size_t errlen) {
-    if (!out) return QNAV_SIM_E_NULL;
-    *out = nullptr;
-    if (!spec) {
-        put_err(err, errlen, "robot: null path");
-        return QNAV_SIM_E_NULL;
-    }
-    std::string text, path;
-    const qnav_sim_status_t st = guarded(err, errlen, [&] {
-        path = qnav::resolve_data_spec(spec, "robots");
-        text = qnav::TomlReader::read_file(path);
-    });
-    if (st != QNAV_SIM_OK) return st;
-    return qnav_sim_robot_parse(text.data(), text.size(), path.c_str(), out, err, errlen);
+    return load_spec(spec, "robots", "robot", qnav_sim_robot_parse, out, err, errlen);
 }
 
 void qnav_sim_robot_free(qnav_sim_robot_t *robot) { delete robot; }
@@ -107,19 +117,7 @@ qnav_sim_status_t qnav_sim_env_parse(const char *text, size_t len, const char *n
 
 qnav_sim_status_t qnav_sim_env_load(const char *spec, qnav_sim_env_t **out, char *err,
                                     size_t errlen) {
-    if (!out) return QNAV_SIM_E_NULL;
-    *out = nullptr;
-    if (!spec) {
-        put_err(err, errlen, "env: null path");
-        return QNAV_SIM_E_NULL;
-    }
-    std::string text, path;
-    const qnav_sim_status_t st = guarded(err, errlen, [&] {
-        path = qnav::resolve_data_spec(spec, "envs");
-        text = qnav::TomlReader::read_file(path);
-    });
-    if (st != QNAV_SIM_OK) return st;
-    return qnav_sim_env_parse(text.data(), text.size(), path.c_str(), out, err, errlen);
+    return load_spec(spec, "envs", "env", qnav_sim_env_parse, out, err, errlen);
 }
 
 void qnav_sim_env_free(qnav_sim_env_t *env) { delete env; }
