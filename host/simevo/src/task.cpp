@@ -274,16 +274,26 @@ uint64_t task_total_episodes(const TaskDef &t)
     return (t.kind == TaskKind::Evolve ? t.episodes : 0) + t.eval_episodes;
 }
 
-JournalColumns read_journal(const std::string &csv_path)
+namespace {
+/* The complete lines of a finished output file, its header checked; kind names the file
+ * in the message. */
+Lines read_with_header(const std::string &csv_path, const char *header, const char *kind)
 {
     std::string text;
     if (!read_file(csv_path, text)) {
         throw UserError(csv_path + ": missing");
     }
-    const Lines L = split_lines(text);
-    if (L.lines.empty() || L.lines[0] + "\n" != kJournalHeader) {
-        throw UserError(csv_path + ":1: not a simevo episode journal");
+    Lines L = split_lines(text);
+    if (L.lines.empty() || L.lines[0] + "\n" != header) {
+        throw UserError(csv_path + ":1: not a simevo " + kind);
     }
+    return L;
+}
+} // namespace
+
+JournalColumns read_journal(const std::string &csv_path)
+{
+    const Lines L = read_with_header(csv_path, kJournalHeader, "episode journal");
     JournalColumns c;
     for (std::size_t i = 1; i < L.lines.size(); ++i) {
         const auto f = split_csv(L.lines[i]);
@@ -299,14 +309,7 @@ JournalColumns read_journal(const std::string &csv_path)
 
 std::vector<EpisodeOutcome> read_eval(const std::string &csv_path)
 {
-    std::string text;
-    if (!read_file(csv_path, text)) {
-        throw UserError(csv_path + ": missing");
-    }
-    const Lines L = split_lines(text);
-    if (L.lines.empty() || L.lines[0] + "\n" != kEvalHeader) {
-        throw UserError(csv_path + ":1: not a simevo evaluation file");
-    }
+    const Lines L = read_with_header(csv_path, kEvalHeader, "evaluation file");
     std::vector<EpisodeOutcome> v;
     for (std::size_t i = 1; i < L.lines.size(); ++i) {
         const auto f = split_csv(L.lines[i]);
