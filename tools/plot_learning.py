@@ -8,7 +8,6 @@ condition, the mean over runs with its 95% confidence band of (left) the populat
 fitness and (right) the episode R of the candidates (binned); the probabilistic policy is a
 horizontal reference band (its held-out mean and 95% CI). Writes EXPERIMENT_DIR/learning.png unless OUT.png is given. Needs matplotlib only.
 """
-import csv
 import json
 import os
 import sys
@@ -18,43 +17,32 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from plotcommon import PlotError, parse_args, read_csv, run, save  # noqa: E402
+
 
 def main(argv):
-    if len(argv) not in (2, 3):
-        print("usage: plot_learning.py EXPERIMENT_DIR [OUT.png]", file=sys.stderr)
+    args = parse_args(argv, "plot_learning.py", "learning.png")
+    if args is None:
         return 2
-    exp = argv[1]
-    out = argv[2] if len(argv) == 3 else os.path.join(exp, "learning.png")
+    exp, out = args
     keys = ("mean", "ci_low", "ci_high", "best_mean", "best_ci_low", "best_ci_high")
     summary_path = os.path.join(exp, "summary.json")
     try:
         with open(summary_path) as f:
             summary = json.load(f)
     except OSError as e:
-        print(f"plot_learning.py: {summary_path}: {e.strerror}", file=sys.stderr)
-        return 1
+        raise PlotError(f"{summary_path}: {e.strerror}") from e
     except json.JSONDecodeError as e:
-        print(f"plot_learning.py: {summary_path}:{e.lineno}: {e.msg}", file=sys.stderr)
-        return 1
-    path = os.path.join(exp, "curves.csv")
+        raise PlotError(f"{summary_path}:{e.lineno}: {e.msg}") from e
     curves = {}
-    try:
-        with open(path) as f:
-            reader = csv.DictReader(f)
-            for row in reader:
-                c = curves.setdefault(row["condition"], {k: [] for k in ("episode",) + keys})
-                c["episode"].append(int(row["episode"]))
-                for k in keys:
-                    c[k].append(float(row[k]) if row[k] != "null" else float("nan"))
-    except OSError as e:
-        print(f"plot_learning.py: {path}: {e.strerror}", file=sys.stderr)
-        return 1
-    except KeyError as e:
-        print(f"plot_learning.py: {path}:1: missing column {e}", file=sys.stderr)
-        return 1
-    except (ValueError, TypeError) as e:
-        print(f"plot_learning.py: {path}:{reader.line_num}: {e}", file=sys.stderr)
-        return 1
+
+    def add(row):
+        c = curves.setdefault(row["condition"], {k: [] for k in ("episode",) + keys})
+        c["episode"].append(int(row["episode"]))
+        for k in keys:
+            c[k].append(float(row[k]) if row[k] != "null" else float("nan"))
+
+    read_csv(os.path.join(exp, "curves.csv"), add)
 
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.6), dpi=110, layout="constrained")
     colors = {"direct": "tab:red", "probabilistic": "tab:gray"}
@@ -89,11 +77,9 @@ def main(argv):
     fig_ref = f" ({summary['figure']})" if summary.get("figure") else ""
     fig.suptitle(f"{summary['title'] or summary['name']}{fig_ref}: "
                  f"{summary['runs']} runs, preset {summary['preset']}; bands: 95% CI", fontsize=10)
-    tmp = out + ".tmp.png"
-    fig.savefig(tmp)
-    os.replace(tmp, out)
+    save(fig, out)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    sys.exit(run(main, sys.argv, "plot_learning.py"))

@@ -9,7 +9,6 @@ libqnav computes, qnav_ctrl_quality, for every distance level and every degree o
 dtheta) and draws one panel per policy: x = dtheta (deg), y = distance (m), colour =
 quality. Writes EXPERIMENT_DIR/policy.png unless OUT.png is given.
 """
-import csv
 import os
 import sys
 
@@ -19,33 +18,20 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from plotcommon import PlotError, parse_args, read_csv, run, save  # noqa: E402
+
 
 def main(argv):
-    if len(argv) not in (2, 3):
-        print("usage: plot_policy.py EXPERIMENT_DIR [OUT.png]", file=sys.stderr)
+    args = parse_args(argv, "plot_policy.py", "policy.png")
+    if args is None:
         return 2
-    exp = argv[1]
-    out = argv[2] if len(argv) == 3 else os.path.join(exp, "policy.png")
+    exp, out = args
     path = os.path.join(exp, "quality.csv")
     data = {}
-    try:
-        with open(path) as f:
-            reader = csv.DictReader(f)
-            for row in reader:
-                data.setdefault(row["policy"], []).append(
-                    (int(row["level"]), float(row["distance_m"]), int(row["dtheta_deg"]), float(row["quality"])))
-    except OSError as e:
-        print(f"plot_policy.py: {path}: {e.strerror}", file=sys.stderr)
-        return 1
-    except KeyError as e:
-        print(f"plot_policy.py: {path}:1: missing column {e}", file=sys.stderr)
-        return 1
-    except (ValueError, TypeError) as e:
-        print(f"plot_policy.py: {path}:{reader.line_num}: {e}", file=sys.stderr)
-        return 1
+    read_csv(path, lambda row: data.setdefault(row["policy"], []).append(
+        (int(row["level"]), float(row["distance_m"]), int(row["dtheta_deg"]), float(row["quality"]))))
     if not data:
-        print(f"plot_policy.py: {path}: no rows", file=sys.stderr)
-        return 1
+        raise PlotError(f"{path}: no rows")
     n = len(data)
     fig, axes = plt.subplots(1, n, figsize=(2.9 * n + 1.0, 3.2), dpi=120, squeeze=False,
                              sharey=True, layout="constrained")
@@ -61,11 +47,9 @@ def main(argv):
         ax.set_xlabel("Δθ to destination (deg)")
     axes[0][0].set_ylabel("distance to obstacle (m)")
     fig.colorbar(im, ax=axes[0].tolist(), shrink=0.95, label="path quality X")
-    tmp = out + ".tmp.png"
-    fig.savefig(tmp)
-    os.replace(tmp, out)
+    save(fig, out)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    sys.exit(run(main, sys.argv, "plot_policy.py"))
