@@ -55,7 +55,7 @@ static inline qnav_status_t qnav_bench_init(qnav_ctrl_t *ctrl, uint8_t mode)
         qnav_policy_prob_default(&policy);
         return qnav_ctrl_init(ctrl, &cfg, &policy);
     }
-    return qnav_ctrl_init_table(ctrl, &cfg, qnav_vectors_net12_table);
+    return qnav_ctrl_init_table(ctrl, &cfg, qnav_vectors_net12_table, QNAV_VECTORS_NET12_TABLE_RANK);
 }
 
 #endif /* QNAV_BENCH_COMMON_H */

@@ -68,7 +68,7 @@ int main(void)
         }
     }
 #else
-    if (qnav_ctrl_init_table(&ctrl, &cfg, qnav_vectors_net12_table) != QNAV_OK) {
+    if (qnav_ctrl_init_table(&ctrl, &cfg, qnav_vectors_net12_table, QNAV_VECTORS_NET12_TABLE_RANK) != QNAV_OK) {
         return 1;
     }
 #endif

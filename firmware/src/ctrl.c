@@ -1,10 +1,12 @@
 /*
- * The navigation controller: quantizes a scan and the destination bearing, gives each of
- * the 360 paths a quality through one policy function (network, probabilistic or compiled
- * table), picks the best path and maps its quality to a speed. Integer arithmetic only;
+ * The navigation controller: quantizes a scan into per-path distance levels (clearance.c),
+ * gives each of the 360 paths a rank key through one policy function (network,
+ * probabilistic or compiled table), picks the best path and maps its quality to a speed
+ * under the speed guard. Integer arithmetic only;
  * every format and bound is in docs/qformats.md.
  */
 #include "qnav/ctrl.h"
+#include "clearance.h"
 #include "qnav/flash.h"
 #include "sigmoid_lut.h"
 
@@ -65,6 +67,11 @@ void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg)
     cfg->n_sectors = 16u;
     cfg->max_range_mm = 5000u;
     cfg->full_speed_quality = QNAV_Q1_15(0.9);
+    cfg->body_radius_mm = 120u;
+    cfg->safety_mm = 50u;
+    cfg->v_max_mm_s = 500u;
+    cfg->decel_mm_s2 = 2000u;
+    cfg->rank = (uint8_t)QNAV_RANK_PREACT;
 }
 
 static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg)
@@ -86,6 +93,9 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     if (cfg->full_speed_quality <= 0) {
         return QNAV_E_SPEED;
     }
+    if (cfg->rank != (uint8_t)QNAV_RANK_QUALITY && cfg->rank != (uint8_t)QNAV_RANK_PREACT) {
+        return QNAV_E_RANK;
+    }
     q_full = (uint32_t)cfg->full_speed_quality;
     ctrl->n_sectors = cfg->n_sectors;
     ctrl->max_range_mm = cfg->max_range_mm;
@@ -99,6 +109,8 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     ctrl->table = 0;
     ctrl->hidden = 0u;
     ctrl->out_bias_z = 0;
+    ctrl->rank = cfg->rank;
+    qnav_clearance_init(ctrl, cfg);
     return QNAV_OK;
 }
 
@@ -152,6 +164,7 @@ qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
         return QNAV_E_NULL;
     }
     if (policy->kind == (uint8_t)QNAV_POLICY_PROB) {
+        ctrl->rank = (uint8_t)QNAV_RANK_QUALITY; /* a product of probabilities: no saturation */
         st = init_prob(ctrl, &policy->u.prob);
     } else if (policy->kind == (uint8_t)QNAV_POLICY_NET) {
         st = init_net(ctrl, &policy->u.net);
@@ -166,7 +179,7 @@ qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
 }
 
 qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
-                                   const qnav_q1_15_t *table)
+                                   const qnav_qkey_t *table, qnav_rank_t rank)
 {
     qnav_status_t st = init_common(ctrl, cfg);
     if (st != QNAV_OK) {
@@ -175,7 +188,11 @@ qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *
     if (table == 0) {
         return QNAV_E_NULL;
     }
+    if (rank != QNAV_RANK_QUALITY && rank != QNAV_RANK_PREACT) {
+        return QNAV_E_RANK;
+    }
     ctrl->table = table;
+    ctrl->rank = (uint8_t)rank;
     ctrl->kind = QNAV_KIND_TABLE;
     ctrl->magic = QNAV_CTRL_MAGIC;
     return QNAV_OK;
@@ -194,10 +211,55 @@ static inline int32_t unit_share(int32_t z, int16_t out)
     return ((int32_t)out * h + 128) >> 8;
 }
 
+/* Knee of the companded key: |z| below 8 keeps Q5.11 resolution. */
+#define QNAV_KEY_KNEE 16384
+#define QNAV_KEY_NONE (-32767 - 1)
+
 /* Output unit: acc in units of 2^-15, rounded to Q5.11 and saturated. */
 static inline qnav_q1_15_t net_output(int32_t acc)
 {
     return qnav_sigmoid_q5_11(sat16((acc + 8) >> 4));
+}
+
+/*
+ * The companded pre-activation key of acc (units of 2^-15).
+ * @par Scaling and overflow: a = round(acc / 16) is Q5.11; |a| < 16384 (|z| < 8) is kept,
+ * beyond the knee every 16 Q5.11 steps are one key step (1/128 in z), saturated to
+ * +-32767, so the key is monotone in acc and -32768 stays free. |acc| < 2^27.
+ */
+static inline qnav_qkey_t preact_key(int32_t acc)
+{
+    int32_t a = (acc + 8) >> 4;
+    if (a >= QNAV_KEY_KNEE) {
+        a = QNAV_KEY_KNEE + ((a - QNAV_KEY_KNEE) >> 4);
+        return (qnav_qkey_t)(a > 32767 ? 32767 : a);
+    }
+    if (a < -QNAV_KEY_KNEE) {
+        a = -QNAV_KEY_KNEE + ((a + QNAV_KEY_KNEE) >> 4);
+        return (qnav_qkey_t)(a < -32767 ? -32767 : a);
+    }
+    return (qnav_qkey_t)a;
+}
+
+/* The network's key for an output accumulator, under the controller's rank. */
+static inline qnav_qkey_t net_key_of(const qnav_ctrl_t *ctrl, int32_t acc)
+{
+    return ctrl->rank == (uint8_t)QNAV_RANK_PREACT ? preact_key(acc) : net_output(acc);
+}
+
+/* A key back to the quality: expand to Q5.11 (saturating at +-16) and take the sigmoid. */
+static qnav_q1_15_t key_quality(const qnav_ctrl_t *ctrl, qnav_qkey_t key)
+{
+    int32_t z = key;
+    if (ctrl->rank != (uint8_t)QNAV_RANK_PREACT) {
+        return (qnav_q1_15_t)(key < 0 ? 0 : key);
+    }
+    if (z >= QNAV_KEY_KNEE) {
+        z = QNAV_KEY_KNEE + (z - QNAV_KEY_KNEE) * 16;
+    } else if (z < -QNAV_KEY_KNEE) {
+        z = -QNAV_KEY_KNEE + (z + QNAV_KEY_KNEE) * 16;
+    }
+    return qnav_sigmoid_q5_11(sat16(z));
 }
 
 static qnav_q1_15_t prob_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
@@ -206,7 +268,7 @@ static qnav_q1_15_t prob_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t
     return (qnav_q1_15_t)((q + 16384u) >> 15);
 }
 
-/* a * b for a small unsigned b: avr-gcc then uses its 32x16 multiply, not 32x32. */
+/* a * b for a small unsigned b. */
 static inline int32_t mul_u8(int32_t a, uint8_t b)
 {
     return a * (int32_t)b;
@@ -217,7 +279,7 @@ static inline int32_t unit_base(const qnav_ctrl_unit_t *u, uint8_t level)
     return u->bias_z + mul_u8(u->per_level, level);
 }
 
-static qnav_q1_15_t net_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
+static qnav_qkey_t net_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
 {
     int32_t acc = ctrl->out_bias_z;
     uint8_t j;
@@ -225,13 +287,24 @@ static qnav_q1_15_t net_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t 
         const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
         acc += unit_share(unit_base(u, level) + mul_u8(u->per_deg, dtheta), u->out);
     }
-    return net_output(acc);
+    return net_key_of(ctrl, acc);
 }
 
-qnav_q1_15_t qnav_ctrl_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta_deg)
+static qnav_qkey_t key_at(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
+{
+    if (ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
+        return net_key(ctrl, level, dtheta);
+    }
+    if (ctrl->kind == (uint8_t)QNAV_POLICY_PROB) {
+        return prob_quality(ctrl, level, dtheta);
+    }
+    return QNAV_FLASH_READ_I16(&ctrl->table[(uint16_t)level * QNAV_TABLE_STRIDE + dtheta]);
+}
+
+qnav_qkey_t qnav_ctrl_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta_deg)
 {
     if (ctrl == 0 || ctrl->magic != QNAV_CTRL_MAGIC) {
-        return 0;
+        return -32767;
     }
     if (level >= QNAV_DIST_LEVELS) {
         level = QNAV_DIST_LEVELS - 1u;
@@ -239,27 +312,31 @@ qnav_q1_15_t qnav_ctrl_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t d
     if (dtheta_deg > QNAV_DTHETA_MAX) {
         dtheta_deg = QNAV_DTHETA_MAX;
     }
-    if (ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
-        return net_quality(ctrl, level, dtheta_deg);
-    }
-    if (ctrl->kind == (uint8_t)QNAV_POLICY_PROB) {
-        return prob_quality(ctrl, level, dtheta_deg);
-    }
-    return QNAV_FLASH_READ_I16(&ctrl->table[(uint16_t)level * QNAV_TABLE_STRIDE + dtheta_deg]);
+    return key_at(ctrl, level, dtheta_deg);
 }
 
-
-/* Level of a range already known to be at most max_range_mm. For ranges of 32 mm and
- * more the scale fits 16 bits and a 16x16 multiply does (much cheaper on AVR). */
-static uint8_t level_of(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm)
+qnav_q1_15_t qnav_ctrl_key_quality(const qnav_ctrl_t *ctrl, qnav_qkey_t key)
 {
-    uint32_t level;
-    if (ctrl->level_scale <= 0xFFFFu) {
-        level = ((uint32_t)range_mm * (uint16_t)ctrl->level_scale + 32768u) >> 16;
-    } else {
-        level = ((uint32_t)range_mm * ctrl->level_scale + 32768u) >> 16;
+    if (ctrl == 0 || ctrl->magic != QNAV_CTRL_MAGIC) {
+        return 0;
     }
-    return (uint8_t)(level > QNAV_DIST_LEVELS - 1u ? QNAV_DIST_LEVELS - 1u : level);
+    return key_quality(ctrl, key);
+}
+
+qnav_q1_15_t qnav_ctrl_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta_deg)
+{
+    if (ctrl == 0 || ctrl->magic != QNAV_CTRL_MAGIC) {
+        return 0;
+    }
+    return key_quality(ctrl, qnav_ctrl_key(ctrl, level, dtheta_deg));
+}
+
+qnav_rank_t qnav_ctrl_rank(const qnav_ctrl_t *ctrl)
+{
+    if (ctrl == 0 || ctrl->magic != QNAV_CTRL_MAGIC || ctrl->rank != (uint8_t)QNAV_RANK_PREACT) {
+        return QNAV_RANK_QUALITY;
+    }
+    return QNAV_RANK_PREACT;
 }
 
 uint8_t qnav_ctrl_level(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm)
@@ -267,7 +344,7 @@ uint8_t qnav_ctrl_level(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm)
     if (ctrl == 0 || ctrl->magic != QNAV_CTRL_MAGIC) {
         return 0;
     }
-    return level_of(ctrl, range_mm > ctrl->max_range_mm ? ctrl->max_range_mm : range_mm);
+    return qnav_clearance_level_of(ctrl, range_mm > ctrl->max_range_mm ? ctrl->max_range_mm : range_mm);
 }
 
 uint16_t qnav_ctrl_sector_of_path(uint16_t n_sectors, uint16_t path_deg)
@@ -300,15 +377,16 @@ static uint16_t bearing_deg(qnav_cdeg_t cdeg)
     return (uint16_t)d;
 }
 
+
 /*
- * A run: consecutive paths in one sector along which dtheta moves one way. Within a run
- * the distance level is fixed and each hidden unit's pre-activation is monotone, which is
- * what lets the network step bound a whole run from its two ends (docs/architecture.md).
+ * A run: consecutive paths of one distance level along which dtheta moves one way. Within
+ * a run each hidden unit's pre-activation is monotone, which is what lets the network step
+ * bound a whole run from its two ends (docs/architecture.md).
  */
 typedef struct {
     uint16_t first;      /* first path, degrees */
     uint8_t count;       /* paths in the run, 1..180 */
-    uint8_t level;       /* distance level of the run's sector */
+    uint8_t level;       /* distance level of every path of the run */
     uint8_t dtheta0;     /* dtheta of the first path */
     int8_t dir;          /* +1 or -1: change of dtheta from one path to the next */
 } run_t;
@@ -318,27 +396,27 @@ typedef struct {
     uint16_t first;
     uint8_t count;
     uint8_t level;
-    qnav_q1_15_t bound;  /* no path of the run exceeds it; -1 once evaluated */
+    qnav_qkey_t bound;   /* no path of the run exceeds it; QNAV_KEY_NONE once evaluated */
 } pending_t;
 
-/* The best path so far under the controller's total order (quality, then smaller
- * dtheta, then smaller turn, then counter-clockwise). */
+/* The best path so far under the controller's total order (key, then smaller dtheta,
+ * then smaller turn, then counter-clockwise). */
 typedef struct {
-    qnav_q1_15_t q;
+    qnav_qkey_t key;
     uint8_t dtheta;
     qnav_deg_t heading;
 } best_t;
 
-static void consider(best_t *best, qnav_q1_15_t q, uint16_t path, uint8_t dtheta)
+static void consider(best_t *best, qnav_qkey_t key, uint16_t path, uint8_t dtheta)
 {
     qnav_deg_t heading;
     int16_t turn;
     int16_t best_turn;
-    if (q < best->q) {
+    if (key < best->key) {
         return;
     }
     heading = (qnav_deg_t)(path <= 180u ? (int16_t)path : (int16_t)path - 360);
-    if (q == best->q) {
+    if (key == best->key) {
         if (dtheta != best->dtheta) {
             if (dtheta > best->dtheta) {
                 return;
@@ -351,49 +429,17 @@ static void consider(best_t *best, qnav_q1_15_t q, uint16_t path, uint8_t dtheta
             }
         }
     }
-    best->q = q;
+    best->key = key;
     best->dtheta = dtheta;
     best->heading = heading;
 }
 
-/* Walks the 360 paths once and hands out their runs in path order, a run at a time. */
+/* Walks the 360 paths once and hands out their runs in path order. */
 typedef struct {
-    const qnav_ctrl_t *ctrl;
-    const qnav_mm_t *ranges;
+    const uint8_t *lvl;   /* distance level of every path */
     uint16_t goal;        /* destination, whole degrees 0..359 */
     uint16_t path;        /* next path to hand out */
-    uint16_t sector;      /* its sector */
-    uint16_t left;        /* paths of that sector still to hand out */
-    uint16_t phase;       /* first path of the sector * N + 180, modulo 360 */
-    uint16_t count;       /* paths in the sector */
-    uint8_t level;        /* distance level of the sector */
-    uint8_t flags;        /* QNAV_FLAG_RANGE_CLIPPED once a clipped range was seen */
 } run_iter_t;
-
-static void run_iter_enter_sector(run_iter_t *it)
-{
-    qnav_mm_t r = it->ranges[it->sector];
-    if (r > it->ctrl->max_range_mm) {
-        r = it->ctrl->max_range_mm;
-        it->flags |= QNAV_FLAG_RANGE_CLIPPED;
-    }
-    it->level = level_of(it->ctrl, r);
-    it->left = it->count;
-}
-
-static void run_iter_start(run_iter_t *it, const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges,
-                           uint16_t goal)
-{
-    it->ctrl = ctrl;
-    it->ranges = ranges;
-    it->goal = goal;
-    it->path = 0;
-    it->sector = 0;
-    it->phase = QNAV_PATHS / 2u;
-    it->count = ctrl->first_sector_paths;
-    it->flags = 0;
-    run_iter_enter_sector(it);
-}
 
 /* dtheta of a run's first path and its direction, from the path and the goal. */
 static void run_shape(run_t *r, uint16_t goal)
@@ -404,22 +450,15 @@ static void run_shape(run_t *r, uint16_t goal)
 }
 
 /* The next run into *r; 0 when all 360 paths have been handed out. A run ends where the
- * sector ends, where dtheta turns (at the goal and opposite it) and after path 359.
- * Sector lengths follow from path * N + 180 wrapping past 360: a sector whose first path
- * has phase p holds q = 360 / N paths, or q + 1 when p + q * N is still below 360. */
+ * level changes, where dtheta turns (at the goal and opposite it) and after path 359. */
 static uint8_t run_iter_next(run_iter_t *it, run_t *r)
 {
-    uint16_t n;
+    uint16_t end;
     uint16_t to_turn;
+    uint16_t p;
+    uint8_t level;
     if (it->path >= QNAV_PATHS) {
         return 0;
-    }
-    if (it->left == 0u) {
-        const qnav_ctrl_t *c = it->ctrl;
-        it->phase = (uint16_t)(it->phase + it->count * c->n_sectors - QNAV_PATHS);
-        it->count = (uint16_t)(c->sector_paths + (it->phase + c->sector_span < QNAV_PATHS ? 1u : 0u));
-        it->sector = (uint16_t)(it->sector + 1u == c->n_sectors ? 0u : it->sector + 1u);
-        run_iter_enter_sector(it);
     }
     r->first = it->path;
     run_shape(r, it->goal);
@@ -427,30 +466,34 @@ static uint8_t run_iter_next(run_iter_t *it, run_t *r)
     if (to_turn == 0u) {
         to_turn = QNAV_DTHETA_MAX; /* starts at the goal, or opposite it going down */
     }
-    n = it->left < to_turn ? it->left : to_turn;
-    if (n > QNAV_PATHS - it->path) {
-        n = (uint16_t)(QNAV_PATHS - it->path);
+    end = (uint16_t)(it->path + to_turn);
+    if (end > QNAV_PATHS) {
+        end = QNAV_PATHS;
     }
-    r->count = (uint8_t)n;
-    r->level = it->level;
-    it->path = (uint16_t)(it->path + n);
-    it->left = (uint16_t)(it->left - n);
+    level = it->lvl[it->path];
+    p = (uint16_t)(it->path + 1u);
+    while (p < end && it->lvl[p] == level) {
+        ++p;
+    }
+    r->count = (uint8_t)(p - it->path);
+    r->level = level;
+    it->path = p;
     return 1;
 }
 
 /* Table mode: read a run's row. Along the run the tie order prefers earlier paths when
  * dtheta rises and later ones when it falls, so only the run's winner is considered. */
 static void eval_table_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best,
-                           qnav_q1_15_t *qualities)
+                           qnav_qkey_t *keys)
 {
-    const qnav_q1_15_t *p = &ctrl->table[(uint16_t)r->level * QNAV_TABLE_STRIDE + r->dtheta0];
-    qnav_q1_15_t top = -1;
+    const qnav_qkey_t *p = &ctrl->table[(uint16_t)r->level * QNAV_TABLE_STRIDE + r->dtheta0];
+    qnav_qkey_t top = QNAV_KEY_NONE;
     uint8_t top_k = 0;
     uint8_t k;
     for (k = 0; k < r->count; ++k, p += r->dir) {
-        qnav_q1_15_t q = QNAV_FLASH_READ_I16(p);
-        if (qualities != 0) {
-            qualities[r->first + k] = q;
+        qnav_qkey_t q = QNAV_FLASH_READ_I16(p);
+        if (keys != 0) {
+            keys[r->first + k] = q;
         }
         if (q > top || (q == top && r->dir < 0)) {
             top = q;
@@ -461,96 +504,15 @@ static void eval_table_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best
              (uint8_t)(r->dir > 0 ? r->dtheta0 + top_k : r->dtheta0 - top_k));
 }
 
-/*
- * Table mode without qualities, the MCU's fast path: one pass over the sectors in path
- * order with everything in locals; each stretch of a sector along which dtheta moves one
- * way is scanned with a pointer into its level's row, and only its winner is considered
- * (ties inside a stretch go to the smaller dtheta: the first path when dtheta rises, the
- * last when it falls). Same answer as eval_table_run over the runs.
- */
-static uint8_t table_best(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges, uint16_t goal,
-                          best_t *best)
-{
-    uint16_t path = 0;
-    uint16_t sector = 0;
-    uint16_t phase = QNAV_PATHS / 2u;
-    uint16_t count = ctrl->first_sector_paths;
-    uint16_t offset = goal == 0u ? 0u : (uint16_t)(QNAV_PATHS - goal);
-    uint8_t flags = 0;
-    for (;;) {
-        qnav_mm_t range = ranges[sector];
-        const qnav_q1_15_t *row;
-        uint16_t left = count;
-        if (range > ctrl->max_range_mm) {
-            range = ctrl->max_range_mm;
-            flags |= QNAV_FLAG_RANGE_CLIPPED;
-        }
-        row = &ctrl->table[(uint16_t)level_of(ctrl, range) * QNAV_TABLE_STRIDE];
-        if (left > QNAV_PATHS - path) {
-            left = (uint16_t)(QNAV_PATHS - path);
-        }
-        while (left != 0u) {
-            uint8_t n;
-            uint8_t i;
-            uint8_t k = 0;
-            uint8_t d;
-            qnav_q1_15_t top;
-            const qnav_q1_15_t *p;
-            if (offset < QNAV_DTHETA_MAX) {
-                d = (uint8_t)offset;
-                n = (uint8_t)(left < QNAV_DTHETA_MAX - offset ? left : QNAV_DTHETA_MAX - offset);
-                p = row + d;
-                top = QNAV_FLASH_READ_I16(p);
-                for (i = 1; i < n; ++i) {
-                    qnav_q1_15_t q = QNAV_FLASH_READ_I16(++p);
-                    if (q > top) {
-                        top = q;
-                        k = i;
-                    }
-                }
-                d = (uint8_t)(d + k);
-            } else {
-                d = (uint8_t)(QNAV_PATHS - offset);
-                n = (uint8_t)(left < QNAV_PATHS - offset ? left : QNAV_PATHS - offset);
-                p = row + d;
-                top = QNAV_FLASH_READ_I16(p);
-                for (i = 1; i < n; ++i) {
-                    qnav_q1_15_t q = QNAV_FLASH_READ_I16(--p);
-                    if (q >= top) {
-                        top = q;
-                        k = i;
-                    }
-                }
-                d = (uint8_t)(d - k);
-            }
-            if (top >= best->q) {
-                consider(best, top, (uint16_t)(path + k), d);
-            }
-            path = (uint16_t)(path + n);
-            left = (uint16_t)(left - n);
-            offset = (uint16_t)(offset + n);
-            if (offset >= QNAV_PATHS) {
-                offset = (uint16_t)(offset - QNAV_PATHS);
-            }
-        }
-        if (path >= QNAV_PATHS) {
-            return flags;
-        }
-        phase = (uint16_t)(phase + count * ctrl->n_sectors - QNAV_PATHS);
-        count = (uint16_t)(ctrl->sector_paths + (phase + ctrl->sector_span < QNAV_PATHS ? 1u : 0u));
-        sector = (uint16_t)(sector + 1u == ctrl->n_sectors ? 0u : sector + 1u);
-    }
-}
-
 static void eval_prob_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best,
-                          qnav_q1_15_t *qualities)
+                          qnav_qkey_t *keys)
 {
     uint8_t k;
     uint8_t dtheta = r->dtheta0;
     for (k = 0; k < r->count; ++k, dtheta = (uint8_t)(dtheta + r->dir)) {
         qnav_q1_15_t q = prob_quality(ctrl, r->level, dtheta);
-        if (qualities != 0) {
-            qualities[r->first + k] = q;
+        if (keys != 0) {
+            keys[r->first + k] = q;
         }
         consider(best, q, (uint16_t)(r->first + k), dtheta);
     }
@@ -558,7 +520,7 @@ static void eval_prob_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best,
 
 /* Network: every path of a run; pre-activations walk by one degree's weight per path. */
 static void eval_net_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best,
-                         qnav_q1_15_t *qualities)
+                         qnav_qkey_t *keys)
 {
     int32_t z[QNAV_MAX_HIDDEN];
     uint8_t k;
@@ -570,21 +532,21 @@ static void eval_net_run(const qnav_ctrl_t *ctrl, const run_t *r, best_t *best,
     }
     for (k = 0; k < r->count; ++k, dtheta = (uint8_t)(dtheta + r->dir)) {
         int32_t acc = ctrl->out_bias_z;
-        qnav_q1_15_t q;
+        qnav_qkey_t q;
         for (j = 0; j < ctrl->hidden; ++j) {
             const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
             acc += unit_share(z[j], u->out);
             z[j] = (r->dir > 0) ? z[j] + u->per_deg : z[j] - u->per_deg;
         }
-        q = net_output(acc);
-        if (qualities != 0) {
-            qualities[r->first + k] = q;
+        q = net_key_of(ctrl, acc);
+        if (keys != 0) {
+            keys[r->first + k] = q;
         }
         consider(best, q, (uint16_t)(r->first + k), dtheta);
     }
 }
 
-qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_q1_15_t *table)
+qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_qkey_t *table)
 {
     uint16_t level;
     uint16_t dtheta;
@@ -595,7 +557,7 @@ qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_q1_15_t *table
         return QNAV_E_POLICY_KIND;
     }
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
-        qnav_q1_15_t *row = &table[level * QNAV_TABLE_STRIDE];
+        qnav_qkey_t *row = &table[level * QNAV_TABLE_STRIDE];
         if (ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
             /* a row is a run of dtheta 0..180: the same integers, by addition */
             run_t r;
@@ -605,7 +567,7 @@ qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_q1_15_t *table
             r.level = (uint8_t)level;
             r.dtheta0 = 0;
             r.dir = 1;
-            ignore.q = -1;
+            ignore.key = QNAV_KEY_NONE;
             ignore.dtheta = 0;
             ignore.heading = 0;
             eval_net_run(ctrl, &r, &ignore, row);
@@ -618,51 +580,28 @@ qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_q1_15_t *table
     return QNAV_OK;
 }
 
-/*
- * Network, first pass: bound every run. Along a run each hidden unit's pre-activation is
- * linear in dtheta, and rounding, saturation, the interpolated sigmoid and the output
- * weight all keep order, so a unit's share is largest at one end, the end where
- * out * z is larger: one sigmoid per unit bounds the whole run. The dtheta term
- * c = per_deg * dtheta is carried from run to run (neighbouring paths differ by one
- * degree) and across a run by precomputed multiples, so the pass multiplies once per
- * unit per run (the level term). Runs beyond cap are evaluated at once (same answer).
- * Returns the number of runs kept in runs[].
- */
-/* What bound_runs carries per hidden unit from run to run. */
-typedef struct {
-    int32_t c;    /* per_deg * dtheta at the end of the previous run */
-    int32_t span; /* per_deg * (sector_paths - 1) */
-} unit_walk_t;
-
 /* How the dtheta term moves in the current run (see bound_runs). */
 typedef struct {
     uint8_t level;
     uint8_t span;     /* paths in the run - 1 */
-    uint8_t q1;       /* sector_paths - 1 */
     uint8_t up;       /* dtheta rises along the run */
     uint8_t step_up;  /* the run's first dtheta is above the previous run's last */
     uint8_t first;    /* first run of the step: c starts from dtheta0 */
     uint8_t dtheta0;
 } run_walk_t;
 
-/* One unit's largest share over a run; advances its dtheta term to the run's end. */
-static inline int32_t bound_unit(const qnav_ctrl_unit_t *u, unit_walk_t *w, const run_walk_t *rw)
+/* One unit's largest share over a run; advances its dtheta term c (per_deg * dtheta at
+ * the end of the previous run) to the run's end. */
+static inline int32_t bound_unit(const qnav_ctrl_unit_t *u, int32_t *c_io, const run_walk_t *rw)
 {
     int32_t base = unit_base(u, rw->level);
     int32_t c = rw->first ? mul_u8(u->per_deg, rw->dtheta0)
-                          : (rw->step_up ? w->c + u->per_deg : w->c - u->per_deg);
-    int32_t dz;
+                          : (rw->step_up ? *c_io + u->per_deg : *c_io - u->per_deg);
+    int32_t dz = mul_u8(u->per_deg, rw->span);
     int32_t z0 = base + c;
     int32_t z1;
-    if (rw->span == rw->q1) {
-        dz = w->span;
-    } else if (rw->span == rw->q1 + 1u) {
-        dz = w->span + u->per_deg;
-    } else {
-        dz = mul_u8(u->per_deg, rw->span);
-    }
     c = rw->up ? c + dz : c - dz;
-    w->c = c;
+    *c_io = c;
     z1 = base + c;
     return unit_share(((u->out >= 0) == (z1 > z0)) ? z1 : z0, u->out);
 }
@@ -671,43 +610,38 @@ static inline int32_t bound_unit(const qnav_ctrl_unit_t *u, unit_walk_t *w, cons
  * Network, first pass: bound every run. Along a run each hidden unit's pre-activation is
  * linear in dtheta, and rounding, saturation, the interpolated sigmoid and the output
  * weight all keep order, so a unit's share is largest at one end, the end where
- * out * z is larger: one sigmoid per unit bounds the whole run. The dtheta term
- * c = per_deg * dtheta is carried from run to run (neighbouring paths differ by one
- * degree) and across a run by precomputed multiples, so the pass multiplies once per
- * unit per run (the level term). Runs whose bound is below the best so far are dropped;
+ * out * z is larger: one sigmoid per unit bounds the whole run, and the key is monotone
+ * in the output's accumulator. The dtheta term is carried from run to run (neighbouring
+ * paths differ by one degree). Runs whose bound is below the best so far are dropped;
  * runs beyond cap are evaluated at once (same answer). Returns the runs kept in runs[].
  */
 static uint16_t bound_runs(const qnav_ctrl_t *ctrl, run_iter_t *it, pending_t *runs,
                            uint16_t cap, best_t *best)
 {
-    unit_walk_t walk[QNAV_MAX_HIDDEN];
+    int32_t c[QNAV_MAX_HIDDEN];
     run_walk_t rw;
     uint8_t prev_end = 0;
     uint16_t n = 0;
     uint8_t j;
     run_t r;
-    rw.q1 = (uint8_t)(ctrl->sector_paths > 180u ? 179u : ctrl->sector_paths - 1u);
     rw.first = 1;
-    for (j = 0; j < ctrl->hidden; ++j) {
-        walk[j].span = mul_u8(ctrl->p.unit[j].per_deg, rw.q1);
-    }
     while (run_iter_next(it, &r)) {
         int32_t acc = ctrl->out_bias_z;
-        qnav_q1_15_t bound;
+        qnav_qkey_t bound;
         rw.level = r.level;
         rw.span = (uint8_t)(r.count - 1u);
         rw.up = (uint8_t)(r.dir > 0);
         rw.step_up = (uint8_t)(r.dtheta0 > prev_end);
         rw.dtheta0 = r.dtheta0;
         for (j = 0; j < ctrl->hidden; ++j) {
-            acc += bound_unit(&ctrl->p.unit[j], &walk[j], &rw);
+            acc += bound_unit(&ctrl->p.unit[j], &c[j], &rw);
         }
         rw.first = 0;
         prev_end = (uint8_t)(rw.up ? r.dtheta0 + rw.span : r.dtheta0 - rw.span);
-        bound = net_output(acc);
+        bound = net_key_of(ctrl, acc);
         if (r.count == 1u) {
             consider(best, bound, r.first, r.dtheta0); /* the bound is exact */
-        } else if (bound < best->q) {
+        } else if (bound < best->key) {
             /* cannot win: the best only rises */
         } else if (n < cap) {
             runs[n].first = r.first;
@@ -731,11 +665,11 @@ static void search_runs(const qnav_ctrl_t *ctrl, pending_t *runs, uint16_t n, ui
         pending_t *top = 0;
         run_t r;
         for (i = 0; i < n; ++i) {
-            if (runs[i].bound >= 0 && (top == 0 || runs[i].bound > top->bound)) {
+            if (runs[i].bound != QNAV_KEY_NONE && (top == 0 || runs[i].bound > top->bound)) {
                 top = &runs[i];
             }
         }
-        if (top == 0 || top->bound < best->q) {
+        if (top == 0 || top->bound < best->key) {
             return;
         }
         r.first = top->first;
@@ -743,7 +677,7 @@ static void search_runs(const qnav_ctrl_t *ctrl, pending_t *runs, uint16_t n, ui
         r.level = top->level;
         run_shape(&r, goal);
         eval_net_run(ctrl, &r, best, 0);
-        top->bound = -1;
+        top->bound = QNAV_KEY_NONE;
     }
 }
 
@@ -771,51 +705,52 @@ static void stop_output(qnav_ctrl_output_t *out, uint8_t flags, qnav_q1_15_t *qu
 }
 
 /* Network without qualities: bound every run, then search the runs best first. */
-static uint8_t net_best(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges, uint16_t goal,
-                        best_t *best)
+static void net_best(const qnav_ctrl_t *ctrl, run_iter_t *it, best_t *best)
 {
     pending_t runs[QNAV_MAX_RUNS];
-    run_iter_t it;
     uint16_t n;
-    qnav_mm_t range = ranges[qnav_ctrl_sector_of_path(ctrl->n_sectors, goal)];
     /* the path straight at the goal first: a good best prunes runs before they are kept */
-    consider(best, net_quality(ctrl, level_of(ctrl, range > ctrl->max_range_mm ?
-                                                        ctrl->max_range_mm : range), 0),
-             goal, 0);
-    run_iter_start(&it, ctrl, ranges, goal);
-    n = bound_runs(ctrl, &it, runs, QNAV_MAX_RUNS, best);
-    search_runs(ctrl, runs, n, goal, best);
-    return it.flags;
+    consider(best, net_key(ctrl, it->lvl[it->goal], 0), it->goal, 0);
+    n = bound_runs(ctrl, it, runs, QNAV_MAX_RUNS, best);
+    search_runs(ctrl, runs, n, it->goal, best);
 }
 
-/* Every path through its run: all qualities, or the probabilistic policy's run ends. */
-static uint8_t runs_best(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges, uint16_t goal,
-                         best_t *best, qnav_q1_15_t *qualities)
+/* Every path through its run: all keys, or the table's and probabilistic run winners. */
+static void runs_best(const qnav_ctrl_t *ctrl, run_iter_t *it, best_t *best, qnav_qkey_t *keys)
 {
-    run_iter_t it;
     run_t r;
-    run_iter_start(&it, ctrl, ranges, goal);
-    while (run_iter_next(&it, &r)) {
+    while (run_iter_next(it, &r)) {
         if (ctrl->kind == QNAV_KIND_TABLE) {
-            eval_table_run(ctrl, &r, best, qualities);
+            eval_table_run(ctrl, &r, best, keys);
         } else if (ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
-            eval_net_run(ctrl, &r, best, qualities);
-        } else if (qualities != 0) {
-            eval_prob_run(ctrl, &r, best, qualities);
+            eval_net_run(ctrl, &r, best, keys);
+        } else if (keys != 0) {
+            eval_prob_run(ctrl, &r, best, keys);
         } else {
             prob_run(ctrl, &r, best);
         }
     }
-    return it.flags;
+}
+
+uint8_t qnav_ctrl_path_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges_mm, uint8_t *lvl)
+{
+    if (ctrl == 0 || ctrl->magic != QNAV_CTRL_MAGIC || ranges_mm == 0 || lvl == 0) {
+        return QNAV_FLAG_NOT_READY;
+    }
+    return qnav_clearance_levels(ctrl, ranges_mm, lvl);
 }
 
 void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
                     qnav_ctrl_output_t *out, qnav_q1_15_t *qualities)
 {
+    uint8_t lvl[QNAV_PATHS];
+    run_iter_t it;
     best_t best;
-    uint16_t goal;
     uint8_t flags;
+    uint16_t path;
     uint32_t speed;
+    qnav_q1_15_t quality;
+    qnav_q1_15_t cap;
 
     if (out == 0) {
         return;
@@ -824,32 +759,46 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
         stop_output(out, QNAV_FLAG_NOT_READY, qualities);
         return;
     }
-    best.q = -1;
+    best.key = QNAV_KEY_NONE;
     best.dtheta = 0;
     best.heading = 0;
-    goal = bearing_deg(in->goal_bearing_cdeg);
-    if (qualities == 0 && ctrl->kind == QNAV_KIND_TABLE) {
-        flags = table_best(ctrl, in->ranges_mm, goal, &best);
-    } else if (qualities == 0 && ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
-        flags = net_best(ctrl, in->ranges_mm, goal, &best);
+    flags = qnav_clearance_levels(ctrl, in->ranges_mm, lvl);
+    it.lvl = lvl;
+    it.goal = bearing_deg(in->goal_bearing_cdeg);
+    it.path = 0;
+    if (qualities == 0 && ctrl->kind == (uint8_t)QNAV_POLICY_NET) {
+        net_best(ctrl, &it, &best);
     } else {
-        flags = runs_best(ctrl, in->ranges_mm, goal, &best, qualities);
+        /* the keys land in qualities[] and are turned into qualities below */
+        runs_best(ctrl, &it, &best, qualities);
+    }
+    if (qualities != 0) {
+        for (path = 0; path < QNAV_PATHS; ++path) {
+            qualities[path] = key_quality(ctrl, qualities[path]);
+        }
     }
 
-    if (best.q <= 0) {
+    quality = key_quality(ctrl, best.key);
+    if (quality <= 0) {
         out->heading_deg = 0;
         out->speed = 0;
         out->quality = 0;
         out->flags = (uint8_t)(flags | QNAV_FLAG_NO_PATH);
         return;
     }
-    speed = ((uint32_t)best.q * ctrl->speed_scale) >> 15;
-    if (best.q >= ctrl->full_speed_quality || speed > QNAV_Q1_15_MAX) {
+    speed = ((uint32_t)quality * ctrl->speed_scale) >> 15;
+    if (quality >= ctrl->full_speed_quality || speed > QNAV_Q1_15_MAX) {
         speed = QNAV_Q1_15_MAX;
         flags |= QNAV_FLAG_FULL_SPEED;
     }
+    path = (uint16_t)(best.heading < 0 ? best.heading + QNAV_PATHS : best.heading);
+    cap = ctrl->speed_cap[lvl[path]];
+    if (speed > (uint32_t)cap) {
+        speed = (uint32_t)cap;
+        flags |= QNAV_FLAG_SPEED_GUARD;
+    }
     out->heading_deg = best.heading;
     out->speed = (qnav_q1_15_t)speed;
-    out->quality = best.q;
+    out->quality = quality;
     out->flags = flags;
 }

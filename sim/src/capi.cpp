@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
 #include <cstring>
 #include <memory>
 #include <new>
@@ -252,6 +253,14 @@ void qnav_sim_ctrl_config(const qnav_sim_t *sim, qnav_ctrl_config_t *cfg) {
     qnav_ctrl_config_default(cfg);
     cfg->n_sectors = sim->sim->config().n_sectors;
     cfg->max_range_mm = sim->sim->max_range_mm();
+    const qnav::RobotProfile &r = sim->sim->robot();
+    auto mm = [](double m) {
+        return static_cast<std::uint16_t>(std::min(65535.0, std::round(m * 1000.0)));
+    };
+    cfg->body_radius_mm = mm(r.radius_m);
+    cfg->safety_mm = mm(r.safety_m);
+    cfg->v_max_mm_s = mm(r.v_max_mps);
+    cfg->decel_mm_s2 = r.speed_guard ? mm(r.decel_mps2) : 0;
 }
 
 qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,

@@ -9,7 +9,8 @@ namespace qnav {
 RobotProfile parse_robot_profile(std::string_view text, const std::string &name) {
     TomlReader r(text, name);
     const toml::table &root = r.root();
-    r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery", "probabilistic"});
+    r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery", "probabilistic",
+                      "clearance"});
     RobotProfile p;
     p.name = r.string(root, "name");
     if (p.name.empty()) r.fail(root, "'name' must not be empty");
@@ -58,6 +59,16 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
         r.only_keys(prob, {"k_goal", "k_safe"});
         p.prob_k_goal = r.number(prob, "k_goal", 1.0 / 256.0, 64.0);
         p.prob_k_safe = r.number(prob, "k_safe", 1.0 / 256.0, 64.0);
+    }
+
+    if (root.get("clearance")) {
+        const toml::table &cl = r.table(root, "clearance");
+        r.only_keys(cl, {"safety_m", "speed_guard"});
+        p.safety_m = r.number(cl, "safety_m", 0.0, 10.0, true, p.safety_m);
+        if (const toml::node *g = cl.get("speed_guard")) {
+            if (!g->is_boolean()) r.fail(*g, "'speed_guard' must be true or false");
+            p.speed_guard = g->value_or(true);
+        }
     }
 
     const toml::table &rec = r.table(root, "recovery");

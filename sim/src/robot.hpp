@@ -30,6 +30,10 @@ struct RobotProfile {
     std::uint16_t default_sectors = 16;
     double cone_deg = 0.0;          // physical cone of one reading, deg; 0 = 360/N (see
                                     // docs/sim.md); wider cones overlap, at most 180
+    // what libqnav's clearance uses (qnav_sim_ctrl_config): obstacle enlargement by
+    // radius_m + safety_m, and the speed guard with decel_mps2
+    double safety_m = 0.05;         // safety distance d_s, m (assumed; docs/sim.md)
+    bool speed_guard = true;        // cap the speed at what the path's clearance stops in
     // typical noise levels (used by the CLI when none are given)
     double noise_sensor = 0.0;      // p_s
     double noise_actuation = 0.0;   // p_a

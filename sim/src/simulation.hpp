@@ -72,6 +72,7 @@ public:
     SimProfile &profile() { return prof_; }
 
     const Environment &env() const { return env_; }
+    const RobotProfile &robot() const { return robot_; }
     const SimConfig &config() const { return cfg_; }
     std::uint16_t max_range_mm() const { return max_range_mm_; }
     double sonar_cone_rad() const { return sonar_.cone(); }

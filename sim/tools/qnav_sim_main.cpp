@@ -104,7 +104,7 @@ qnav_policy_t read_policy(const std::string &path, const qnav_sim_robot_t *robot
 
 // Initialise ctrl for sim from a policy, in network/probabilistic or table mode.
 void init_ctrl(const qnav_sim_t *sim, const qnav_policy_t &pol, bool table,
-               std::vector<qnav_q1_15_t> &table_buf, qnav_ctrl_t *ctrl) {
+               std::vector<qnav_qkey_t> &table_buf, qnav_ctrl_t *ctrl) {
     qnav_ctrl_config_t cc;
     qnav_sim_ctrl_config(sim, &cc);
     qnav_status_t st = qnav_ctrl_init(ctrl, &cc, &pol);
@@ -113,7 +113,7 @@ void init_ctrl(const qnav_sim_t *sim, const qnav_policy_t &pol, bool table,
     if (table) {
         table_buf.assign(QNAV_QTABLE_ENTRIES, 0);
         st = qnav_ctrl_build_table(ctrl, table_buf.data());
-        if (st == QNAV_OK) st = qnav_ctrl_init_table(ctrl, &cc, table_buf.data());
+        if (st == QNAV_OK) st = qnav_ctrl_init_table(ctrl, &cc, table_buf.data(), qnav_ctrl_rank(ctrl));
         if (st != QNAV_OK)
             throw SimError(QNAV_SIM_E_PARAM, "policy: table mode failed (status " + std::to_string(st) + ")");
     }
@@ -150,7 +150,7 @@ int cmd_run(const RunOpts &o) {
     make_sim(l, o.sectors, ps, pa, o.seed, rule);
     qnav::Simulation &sim = *l.sim->sim;
     const qnav_policy_t pol = read_policy(o.policy, l.robot);
-    std::vector<qnav_q1_15_t> tbuf;
+    std::vector<qnav_qkey_t> tbuf;
     qnav_ctrl_t ctrl;
     init_ctrl(l.sim, pol, o.table, tbuf, &ctrl);
     std::printf("robot %s  env %s  sectors %u  sensor noise %.3f  actuation noise %.3f  seed %llu  "
@@ -285,7 +285,7 @@ int cmd_bench(const BenchOpts &o) {
         what = o.fresh ? "a new random network per episode, " + std::to_string(o.hidden) + " hidden"
                        : "random network, " + std::to_string(o.hidden) + " hidden";
     }
-    std::vector<qnav_q1_15_t> tbuf;
+    std::vector<qnav_qkey_t> tbuf;
     qnav_ctrl_t ctrl;
     init_ctrl(l.sim, pol, o.mode == "table", tbuf, &ctrl);
     double build_s = 0;

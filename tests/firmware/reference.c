@@ -7,6 +7,32 @@
 
 static double sigmoid(double z) { return 1.0 / (1.0 + exp(-z)); }
 
+double ref_preact(const qnav_policy_t *policy, unsigned level, unsigned dtheta)
+{
+    double xt = dtheta / 180.0;
+    double xd = level / (double)(QNAV_DIST_LEVELS - 1);
+    const qnav_net_t *n = &policy->u.net;
+    double y = n->b_out / 256.0;
+    for (unsigned j = 0; j < n->hidden; ++j) {
+        double z = n->w_theta[j] / 256.0 * xt + n->w_dist[j] / 256.0 * xd + n->b_hidden[j] / 256.0;
+        y += n->w_out[j] / 256.0 * sigmoid(z);
+    }
+    return y;
+}
+
+double ref_preact_bound(const qnav_policy_t *policy)
+{
+    const qnav_net_t *n = &policy->u.net;
+    double sum_out = 0.0;
+    for (unsigned j = 0; j < n->hidden; ++j) {
+        sum_out += fabs(n->w_out[j] / 256.0);
+    }
+    /* as ref_quality_bound, before the output sigmoid; keys beyond |y| = 8 step by 1/128 */
+    const double e_z = 1.0 / 4096 + 211.0 / 1048576.0;
+    const double e_hidden = 0.25 * e_z + 1.0 / 32768 + 1e-6;
+    return sum_out * e_hidden + n->hidden / 65536.0 + 1.0 / 4096;
+}
+
 double ref_quality(const qnav_policy_t *policy, unsigned level, unsigned dtheta)
 {
     double xt = dtheta / 180.0;
@@ -62,9 +88,11 @@ void ref_path_qualities(const qnav_ctrl_t *ctrl, const qnav_policy_t *policy,
                         const qnav_ctrl_input_t *in, double out[QNAV_PATHS])
 {
     unsigned goal = ref_goal_deg(in->goal_bearing_cdeg);
+    uint8_t lvl[QNAV_PATHS];
+    (void)qnav_ctrl_path_levels(ctrl, in->ranges_mm, lvl);
     for (unsigned i = 0; i < QNAV_PATHS; ++i) {
-        uint16_t s = qnav_ctrl_sector_of_path(ctrl->n_sectors, (uint16_t)i);
-        unsigned level = qnav_ctrl_level(ctrl, in->ranges_mm[s]);
-        out[i] = ref_quality(policy, level, ref_dtheta(i, goal));
+        out[i] = policy->kind == QNAV_POLICY_NET && qnav_ctrl_rank(ctrl) == QNAV_RANK_PREACT
+                     ? ref_preact(policy, lvl[i], ref_dtheta(i, goal))
+                     : ref_quality(policy, lvl[i], ref_dtheta(i, goal));
     }
 }

@@ -14,8 +14,14 @@ double ref_quality(const qnav_policy_t *policy, unsigned level, unsigned dtheta)
  * (docs/qformats.md, "error bound"). */
 double ref_quality_bound(const qnav_policy_t *policy);
 
-/* Reference qualities of all 360 paths for a scan, using the controller's own input
- * quantization (qnav_ctrl_level, qnav_ctrl_sector_of_path). */
+/* Output pre-activation y (X = sigmoid(y)) of a network policy in real arithmetic, and
+ * the bound on |fixed-point y - reference| (docs/qformats.md, "error bound"). */
+double ref_preact(const qnav_policy_t *policy, unsigned level, unsigned dtheta);
+double ref_preact_bound(const qnav_policy_t *policy);
+
+/* Reference rank values of all 360 paths for a scan, using the controller's own input
+ * quantization (qnav_ctrl_path_levels): the pre-activation for a network ranked by it,
+ * else the quality. */
 void ref_path_qualities(const qnav_ctrl_t *ctrl, const qnav_policy_t *policy,
                         const qnav_ctrl_input_t *in, double out[QNAV_PATHS]);
 

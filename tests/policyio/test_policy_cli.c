@@ -246,7 +246,7 @@ static void test_cli_header_writes_commented_header(void **state)
     read_all(tmp_path("t.h"), h, sizeof h);
     assert_non_null(strstr(h, "#if QNAV_DIST_LEVELS != 32"));
     assert_non_null(
-        strstr(h, "static QNAV_FLASH const qnav_q1_15_t my_table[QNAV_QTABLE_ENTRIES] = {"));
+        strstr(h, "static QNAV_FLASH const qnav_qkey_t my_table[QNAV_QTABLE_ENTRIES] = {"));
 }
 
 static void test_cli_header_refuses_bad_requests_without_writing(void **state)

@@ -43,9 +43,9 @@ static void assert_header_policy_matches_file(const qnav_policy_t *from_header,
     assert_true(qnav_policy_equal(from_header, &from_file));
 }
 
-static void assert_table_matches_library(const qnav_policy_t *policy, const qnav_q1_15_t *table)
+static void assert_table_matches_library(const qnav_policy_t *policy, const qnav_qkey_t *table)
 {
-    static qnav_q1_15_t built[QNAV_QTABLE_ENTRIES];
+    static qnav_qkey_t built[QNAV_QTABLE_ENTRIES];
     qnav_ctrl_t ctrl;
     qnav_ctrl_config_t cfg;
     qnav_ctrl_config_default(&cfg);
@@ -58,7 +58,7 @@ static void assert_table_matches_library(const qnav_policy_t *policy, const qnav
  * output field and every path quality must agree. Returns how many distinct headings the
  * scans produced, so the caller can check the scans were not all alike. */
 static int assert_table_mode_equals_policy_mode(const qnav_policy_t *policy,
-                                                const qnav_q1_15_t *table)
+                                                const qnav_qkey_t *table)
 {
     static const uint16_t sector_counts[] = {8, 16, 32, 180};
     int headings_seen[360] = {0};
@@ -73,7 +73,7 @@ static int assert_table_mode_equals_policy_mode(const qnav_policy_t *policy,
         cfg.n_sectors = sector_counts[s];
         cfg.max_range_mm = 4000;
         assert_int_equal(qnav_ctrl_init(&by_policy, &cfg, policy), QNAV_OK);
-        assert_int_equal(qnav_ctrl_init_table(&by_table, &cfg, table), QNAV_OK);
+        assert_int_equal(qnav_ctrl_init_table(&by_table, &cfg, table, qnav_ctrl_rank(&by_policy)), QNAV_OK);
         for (scan = 0; scan < 25; ++scan) {
             qnav_mm_t ranges[QNAV_MAX_SECTORS];
             qnav_q1_15_t qa[QNAV_PATHS];

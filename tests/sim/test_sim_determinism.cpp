@@ -161,9 +161,9 @@ static void test_whole_episodes_with_libqnav_repeat_exactly_in_table_and_network
     qnav_sim_ctrl_config(t.sim, &cc);
     qnav_ctrl_t net, tab;
     assert_int_equal(qnav_ctrl_init(&net, &cc, &pol), QNAV_OK);
-    std::vector<qnav_q1_15_t> table(QNAV_QTABLE_ENTRIES);
+    std::vector<qnav_qkey_t> table(QNAV_QTABLE_ENTRIES);
     assert_int_equal(qnav_ctrl_build_table(&net, table.data()), QNAV_OK);
-    assert_int_equal(qnav_ctrl_init_table(&tab, &cc, table.data()), QNAV_OK);
+    assert_int_equal(qnav_ctrl_init_table(&tab, &cc, table.data(), qnav_ctrl_rank(&net)), QNAV_OK);
     for (uint64_t e = 0; e < 3; ++e) {
         Fnv f1, f2;
         qnav_sim_result_t r1, r2;

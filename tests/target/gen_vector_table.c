@@ -1,5 +1,5 @@
 /*
- * Host program that writes tests/target/vector_table.h: the quality table of the shared
+ * Host program that writes tests/target/vector_table.h: the rank-key table of the shared
  * vectors' H = 12 network (vector_policy.h), compiled by qnav_ctrl_build_table() and
  * declared with QNAV_FLASH so an ATmega128 reads it from program memory. The CTest
  * vector_table_header_matches_its_generator reruns this and compares with the committed
@@ -11,7 +11,7 @@
 #include "qnav/ctrl.h"
 #include "vector_policy.h"
 
-static qnav_q1_15_t table[QNAV_QTABLE_ENTRIES];
+static qnav_qkey_t table[QNAV_QTABLE_ENTRIES];
 
 int main(void)
 {
@@ -34,9 +34,10 @@ int main(void)
         return 1;
     }
     printf("/*\n"
-           " * Quality table of the shared vectors' H = 12 network (seed 0x%08lX, see\n"
-           " * vector_policy.h): %d distance levels x %d dtheta values, Q1.15, row-major by\n"
-           " * level. Generated, do not edit. Made by:\n"
+           " * Rank-key table of the shared vectors' H = 12 network (seed 0x%08lX, see\n"
+           " * vector_policy.h): %d distance levels x %d dtheta values, row-major by level;\n"
+           " * keys of QNAV_RANK_PREACT (companded output pre-activation). Generated, do not\n"
+           " * edit. Made by:\n"
            " *   build/<preset>/tests/target/gen_vector_table > tests/target/vector_table.h\n"
            " * The CTest vector_table_header_matches_its_generator fails when it is stale.\n"
            " */\n",
@@ -47,7 +48,12 @@ int main(void)
            QNAV_DTHETA_MAX);
     printf("#error \"vector_table.h was generated for other QNAV_DIST_LEVELS/QNAV_DTHETA_MAX\"\n");
     printf("#endif\n\n");
-    printf("static const qnav_q1_15_t qnav_vectors_net12_table[QNAV_QTABLE_ENTRIES] QNAV_FLASH = {\n");
+    if (qnav_ctrl_rank(&ctrl) != QNAV_RANK_PREACT) {
+        fprintf(stderr, "gen_vector_table: the default configuration no longer ranks by pre-activation\n");
+        return 1;
+    }
+    printf("#define QNAV_VECTORS_NET12_TABLE_RANK QNAV_RANK_PREACT\n\n");
+    printf("static const qnav_qkey_t qnav_vectors_net12_table[QNAV_QTABLE_ENTRIES] QNAV_FLASH = {\n");
     for (i = 0; i < QNAV_QTABLE_ENTRIES; ++i) {
         printf("%s%6d%s", (i % 10u == 0u) ? "   " : "", (int)table[i],
                (i + 1u == QNAV_QTABLE_ENTRIES) ? "\n" : ((i % 10u == 9u) ? ",\n" : ","));

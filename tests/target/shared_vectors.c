@@ -64,6 +64,7 @@ static const char *const policy_names[N_POLICIES] = {"prob ", "net12", "net16", 
 /* Large buffers live here, not on the stack: the ATmega128 has 4 KB of RAM. */
 static qnav_mm_t ranges[QNAV_MAX_SECTORS];
 static qnav_q1_15_t qualities[QNAV_PATHS];
+static uint8_t path_levels[QNAV_PATHS];
 static qnav_policy_t policy;
 static qnav_ctrl_t ctrl;
 
@@ -138,7 +139,7 @@ static qnav_status_t init_policy(uint8_t which, const qnav_ctrl_config_t *cfg)
         qnav_vectors_net_policy(&policy, 32u, QNAV_VECTORS_NET32_SEED, 1u);
         return qnav_ctrl_init(&ctrl, cfg, &policy);
     default:
-        return qnav_ctrl_init_table(&ctrl, cfg, qnav_vectors_net12_table);
+        return qnav_ctrl_init_table(&ctrl, cfg, qnav_vectors_net12_table, QNAV_VECTORS_NET12_TABLE_RANK);
     }
 }
 
@@ -158,8 +159,9 @@ static void put_result(const qnav_ctrl_output_t *out, uint32_t hash)
 }
 
 /* Paths whose quality from the step differs from qnav_ctrl_quality() of the path's own
- * (distance level, dtheta), plus 1 if the chosen quality is not the maximum: the step's
- * fast paths (run bounds, table rows) must give exactly what the policy function gives. */
+ * (distance level after enlargement, dtheta), plus 1 if the chosen path's quality is not
+ * that of the largest key: the step's fast paths (run bounds, table rows) must give
+ * exactly what the policy function gives. */
 static uint16_t step_inconsistencies(const scan_spec_t *spec, const qnav_ctrl_output_t *out)
 {
     int32_t c = spec->goal_cdeg;
@@ -167,26 +169,29 @@ static uint16_t step_inconsistencies(const scan_spec_t *spec, const qnav_ctrl_ou
     uint16_t goal;
     uint16_t i;
     uint16_t bad = 0;
-    qnav_q1_15_t max_q = 0;
+    qnav_qkey_t max_key = -32767;
     g %= 360;
     goal = (uint16_t)(g < 0 ? g + 360 : g);
+    if (qnav_ctrl_path_levels(&ctrl, ranges, path_levels) & QNAV_FLAG_NOT_READY) {
+        return 0; /* the bad-configuration case: nothing to compare */
+    }
+    (void)spec;
     for (i = 0; i < QNAV_PATHS; ++i) {
-        uint16_t sector = qnav_ctrl_sector_of_path(spec->n_sectors, i);
-        uint8_t level = qnav_ctrl_level(&ctrl, ranges[sector]);
+        uint8_t level = path_levels[i];
         uint16_t d = (uint16_t)((i + 360u - goal) % 360u);
-        qnav_q1_15_t q;
+        qnav_qkey_t k;
         if (d > 180u) {
             d = (uint16_t)(360u - d);
         }
-        q = qnav_ctrl_quality(&ctrl, level, (uint8_t)d);
-        if (q != qualities[i]) {
+        k = qnav_ctrl_key(&ctrl, level, (uint8_t)d);
+        if (qnav_ctrl_key_quality(&ctrl, k) != qualities[i]) {
             ++bad;
         }
-        if (q > max_q) {
-            max_q = q;
+        if (k > max_key) {
+            max_key = k;
         }
     }
-    if (max_q != out->quality) {
+    if (qnav_ctrl_key_quality(&ctrl, max_key) != out->quality) {
         ++bad;
     }
     return bad;
@@ -207,7 +212,7 @@ static uint16_t table_mismatches(void)
         for (dtheta = 0; dtheta <= QNAV_DTHETA_MAX; ++dtheta) {
             uint16_t k = (uint16_t)(level * (QNAV_DTHETA_MAX + 1u) + dtheta);
             if (QNAV_FLASH_READ_I16(&qnav_vectors_net12_table[k]) !=
-                qnav_ctrl_quality(&ctrl, (uint8_t)level, (uint8_t)dtheta)) {
+                qnav_ctrl_key(&ctrl, (uint8_t)level, (uint8_t)dtheta)) {
                 ++bad;
             }
         }

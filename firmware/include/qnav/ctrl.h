@@ -1,8 +1,13 @@
 /*
  * The navigation controller (paper §3.1-3.3). Each control tick it takes N sonar sector
  * ranges and the destination bearing, gives each of the 360 candidate paths a quality in
- * [0, 1), turns to the best path and sets the speed linearly from its quality. Nothing is
- * remembered between ticks. Fixed point only, no heap, no float, no writable file-scope
+ * [0, 1), turns to the best path and sets the speed linearly from its quality, capped by
+ * what the path's clearance can stop in. A path is as wide as the robot: it sees the
+ * nearest reading whose arc, enlarged by the robot's radius plus a safety distance
+ * (VFH+), covers it. The best path is the one with the largest rank key: the network's
+ * output before its sigmoid (the float network's order, which Q1.15 saturation would
+ * hide), or the quality itself for the probabilistic policy. Nothing is remembered
+ * between ticks. Fixed point only, no heap, no float, no writable file-scope
  * state: a population of controllers lives side by side in one process.
  *
  * Use: qnav_ctrl_config_default() -> edit fields -> qnav_ctrl_init() (or
@@ -28,14 +33,29 @@ typedef enum {
     QNAV_E_SPEED = -4,        /* full_speed_quality outside (0, 1) */
     QNAV_E_POLICY_KIND = -5,  /* policy kind unknown */
     QNAV_E_HIDDEN = -6,       /* hidden units outside 1..QNAV_MAX_HIDDEN */
-    QNAV_E_PROB_PARAM = -7    /* a probabilistic parameter outside (0, 64] */
+    QNAV_E_PROB_PARAM = -7,   /* a probabilistic parameter outside (0, 64] */
+    QNAV_E_RANK = -8          /* rank is not a qnav_rank_t */
 } qnav_status_t;
+
+/* What the step maximises over the paths (docs/architecture.md, "Argmax"). */
+typedef enum {
+    QNAV_RANK_QUALITY = 0,  /* the Q1.15 quality (the paper read literally; saturated
+                               networks then tie on many paths) */
+    QNAV_RANK_PREACT = 1    /* network: the output unit's pre-activation (default); the
+                               probabilistic policy always ranks by its quality */
+} qnav_rank_t;
+
+/* A rank key: larger is better. QNAV_RANK_QUALITY: the quality, Q1.15. QNAV_RANK_PREACT:
+ * the output pre-activation z companded into 16 bits: Q5.11 (z * 2048) for |z| < 8, then
+ * 1/128 per step up to |z| = 136 (docs/qformats.md). -32768 is never a key. */
+typedef int16_t qnav_qkey_t;
 
 /* Output flags: the step never fails; it reports what it had to do here. */
 #define QNAV_FLAG_RANGE_CLIPPED 0x01u  /* a range exceeded max_range_mm and was clipped */
 #define QNAV_FLAG_NOT_READY 0x02u      /* controller not initialised or input null: stop */
 #define QNAV_FLAG_NO_PATH 0x04u        /* every path has quality 0: stop */
 #define QNAV_FLAG_FULL_SPEED 0x08u     /* quality at or above full_speed_quality: speed capped */
+#define QNAV_FLAG_SPEED_GUARD 0x10u    /* speed lowered to what the path's clearance stops in */
 
 /* Runtime configuration. Obtain with qnav_ctrl_config_default(), then edit. */
 typedef struct {
@@ -44,6 +64,16 @@ typedef struct {
     qnav_mm_t max_range_mm;           /* sonar maximum range, mm, 1..65535 */
     qnav_q1_15_t full_speed_quality;  /* quality giving full speed (F is linear through 0),
                                          Q1.15 in (0, 1); default 0.9 */
+    qnav_mm_t body_radius_mm;         /* robot radius r (centre to the farthest point of the
+                                         body), mm; with safety_mm the obstacle enlargement
+                                         asin((r + d_s) / D); both 0: the paper's per-sector
+                                         mapping. Default 120 (TekBot class) */
+    qnav_mm_t safety_mm;              /* safety distance d_s added to r, mm; default 50 */
+    uint16_t v_max_mm_s;              /* speed 1.0 in mm/s, for the speed guard; default 500 */
+    uint16_t decel_mm_s2;             /* braking deceleration, mm/s^2; the speed guard keeps
+                                         v T + v^2 / (2 a) within the chosen path's clearance
+                                         (T one 0.1 s tick); 0 turns the guard off. Default 2000 */
+    uint8_t rank;                     /* a qnav_rank_t; default QNAV_RANK_PREACT */
 } qnav_ctrl_config_t;
 
 /* One control tick's input. */
@@ -75,6 +105,7 @@ typedef struct {
     uint16_t magic;                   /* set by a successful init */
     uint8_t kind;                     /* QNAV_POLICY_PROB, QNAV_POLICY_NET, or 0 for table */
     uint8_t hidden;
+    uint8_t rank;                     /* qnav_rank_t of the keys (table: as given at init) */
     uint16_t n_sectors;
     qnav_mm_t max_range_mm;
     uint32_t level_scale;             /* distance level = (range * scale + 2^15) >> 16 */
@@ -83,7 +114,9 @@ typedef struct {
     uint16_t sector_span;             /* sector_paths * N */
     uint16_t first_sector_paths;      /* paths 0.. that lie in sector 0: ceil(180 / N) */
     qnav_q1_15_t full_speed_quality;
-    const qnav_q1_15_t *table;        /* table mode: [QNAV_DIST_LEVELS][181] qualities */
+    const qnav_qkey_t *table;         /* table mode: [QNAV_DIST_LEVELS][181] rank keys */
+    uint8_t enlarge_deg[QNAV_DIST_LEVELS];      /* obstacle enlargement gamma by level, deg */
+    qnav_q1_15_t speed_cap[QNAV_DIST_LEVELS];   /* speed guard by level, Q1.15 of v_max */
     int32_t out_bias_z;               /* network output bias, units of 2^-15 */
     union {
         struct {
@@ -97,12 +130,13 @@ typedef struct {
 /* Number of entries of a quality table: QNAV_DIST_LEVELS * 181, row-major by level. */
 #define QNAV_QTABLE_ENTRIES ((uint16_t)(QNAV_DIST_LEVELS * (QNAV_DTHETA_MAX + 1)))
 
-/* Defaults: 16 sectors, 5000 mm, full speed at quality 0.9. */
+/* Defaults: 16 sectors, 5000 mm, full speed at quality 0.9, a TekBot-class body (radius
+ * 120 mm, safety 50 mm, 500 mm/s, braking 2000 mm/s^2), rank by pre-activation. */
 void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg);
 
 /*
  * Check cfg and policy and derive the step's parameters into ctrl.
- * Returns QNAV_OK, or QNAV_E_NULL, QNAV_E_SECTORS, QNAV_E_RANGE, QNAV_E_SPEED,
+ * Returns QNAV_OK, or QNAV_E_NULL, QNAV_E_SECTORS, QNAV_E_RANGE, QNAV_E_SPEED, QNAV_E_RANK,
  * QNAV_E_POLICY_KIND, QNAV_E_HIDDEN, QNAV_E_PROB_PARAM; on error ctrl is left not ready
  * (a step then commands a stop). The policy is not referenced after init returns.
  */
@@ -110,43 +144,66 @@ qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
                              const qnav_policy_t *policy);
 
 /*
- * Table mode: like qnav_ctrl_init() but the step reads qualities from a compiled table of
+ * Table mode: like qnav_ctrl_init() but the step reads rank keys from a compiled table of
  * QNAV_QTABLE_ENTRIES entries (made by qnav_ctrl_build_table() or the policy-to-header
- * tool) and does no multiplies per path. With QNAV_TABLES_IN_FLASH the table must be in
- * program memory. The table must outlive ctrl. Same statuses as qnav_ctrl_init().
+ * tool) and does no multiplies per path. rank says what the keys are (qnav_ctrl_rank() of
+ * the controller that built it); cfg->rank is not used. With QNAV_TABLES_IN_FLASH the table
+ * must be in program memory. The table must outlive ctrl. Same statuses as
+ * qnav_ctrl_init().
  */
 qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
-                                   const qnav_q1_15_t *table);
+                                   const qnav_qkey_t *table, qnav_rank_t rank);
+
+/* The qnav_rank_t of an initialised controller's keys (QNAV_RANK_QUALITY when not ready). */
+qnav_rank_t qnav_ctrl_rank(const qnav_ctrl_t *ctrl);
 
 /*
  * One control tick. Never fails: a range above max_range_mm is clipped and flagged; an
  * uninitialised controller or null input gives a stop (speed 0, heading 0) and
  * QNAV_FLAG_NOT_READY. qualities, when not null, receives X(theta_i) for i = 0..359
  * (path i points i degrees counter-clockwise of straight ahead).
- * Ties go to the smaller dtheta, then the smaller turn, then counter-clockwise.
+ * The chosen path has the largest rank key; ties go to the smaller dtheta, then the smaller
+ * turn, then counter-clockwise. The speed is F(quality), then at most the speed guard's
+ * cap for the path's level (QNAV_FLAG_SPEED_GUARD when it lowered it).
  */
 void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
                     qnav_ctrl_output_t *out, qnav_q1_15_t *qualities);
 
 /*
- * The quality the policy gives one (distance level, dtheta) pair: the single function that
- * both the network/probabilistic step and every compiled table evaluate.
- * level is clamped to 0..QNAV_DIST_LEVELS-1, dtheta_deg to 0..180. 0 if not ready.
+ * The rank key the policy gives one (distance level, dtheta) pair: the single function
+ * that both the network/probabilistic step and every compiled table evaluate.
+ * level is clamped to 0..QNAV_DIST_LEVELS-1, dtheta_deg to 0..180. -32767 if not ready.
  */
+qnav_qkey_t qnav_ctrl_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta_deg);
+
+/* The quality X of one (distance level, dtheta) pair: the sigmoid of the key's
+ * pre-activation, or the key itself when it is a quality. 0 if not ready. */
 qnav_q1_15_t qnav_ctrl_quality(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta_deg);
 
+/* The quality that a key of this controller stands for (see qnav_ctrl_quality). */
+qnav_q1_15_t qnav_ctrl_key_quality(const qnav_ctrl_t *ctrl, qnav_qkey_t key);
+
 /*
- * Compile the controller's policy into a quality table of QNAV_QTABLE_ENTRIES entries
- * (caller's buffer, in RAM). Returns QNAV_OK, QNAV_E_NULL, or QNAV_E_POLICY_KIND when ctrl
- * is not initialised with a policy.
+ * Compile the controller's policy into a key table of QNAV_QTABLE_ENTRIES entries
+ * (caller's buffer, in RAM), for qnav_ctrl_init_table(..., qnav_ctrl_rank(ctrl)).
+ * Returns QNAV_OK, QNAV_E_NULL, or QNAV_E_POLICY_KIND when ctrl is not initialised with a
+ * policy.
  */
-qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_q1_15_t *table);
+qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_qkey_t *table);
 
 /* The distance level a range maps to under this controller (clipped to max range). */
 uint8_t qnav_ctrl_level(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm);
 
 /* The sector (0..n_sectors-1) that contains path i (0..359). */
 uint16_t qnav_ctrl_sector_of_path(uint16_t n_sectors, uint16_t path_deg);
+
+/*
+ * The distance level each path sees under this controller's enlargement (lvl[i] for path
+ * i, i = 0..359; caller's buffer): the nearest reading whose enlarged arc covers the path.
+ * Returns the step's QNAV_FLAG_RANGE_CLIPPED, or QNAV_FLAG_NOT_READY (lvl untouched).
+ */
+uint8_t qnav_ctrl_path_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges_mm,
+                              uint8_t *lvl);
 
 #ifdef __cplusplus
 }

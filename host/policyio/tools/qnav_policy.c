@@ -450,7 +450,7 @@ static int header_body(int argc, char **argv, const char *cmd)
     if (strcmp(mode, "table") == 0) {
         qnav_ctrl_t ctrl;
         qnav_ctrl_config_t cfg;
-        qnav_q1_15_t *table = (qnav_q1_15_t *)malloc(sizeof(qnav_q1_15_t) * QNAV_QTABLE_ENTRIES);
+        qnav_qkey_t *table = (qnav_qkey_t *)malloc(sizeof(qnav_qkey_t) * QNAV_QTABLE_ENTRIES);
         unsigned level;
         unsigned d;
         qnav_ctrl_config_default(&cfg);
@@ -467,10 +467,13 @@ static int header_body(int argc, char **argv, const char *cmd)
         put(&t, "#error \"%s was generated for QNAV_DIST_LEVELS %d: regenerate it with "
                 "qnav-policy header for this build\"\n#endif\n\n",
             name, QNAV_DIST_LEVELS);
-        put(&t, "/* Path quality (Q1.15) by distance level (rows, 0..%d) and dtheta in degrees\n"
-                " * (columns, 0..%d); use with qnav_ctrl_init_table(). */\n",
-            QNAV_DIST_LEVELS - 1, QNAV_DTHETA_MAX);
-        put(&t, "static QNAV_FLASH const qnav_q1_15_t %s[QNAV_QTABLE_ENTRIES] = {\n", name);
+        put(&t, "/* Path rank keys (qnav_qkey_t of rank %s_RANK) by distance level (rows,\n"
+                " * 0..%d) and dtheta in degrees (columns, 0..%d); use with\n"
+                " * qnav_ctrl_init_table(&ctrl, &cfg, %s, %s_RANK). */\n",
+            name, QNAV_DIST_LEVELS - 1, QNAV_DTHETA_MAX, name, name);
+        put(&t, "#define %s_RANK %s\n", name,
+            qnav_ctrl_rank(&ctrl) == QNAV_RANK_PREACT ? "QNAV_RANK_PREACT" : "QNAV_RANK_QUALITY");
+        put(&t, "static QNAV_FLASH const qnav_qkey_t %s[QNAV_QTABLE_ENTRIES] = {\n", name);
         for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
             put(&t, "    /* level %u */\n", level);
             for (d = 0; d <= QNAV_DTHETA_MAX; ++d) {

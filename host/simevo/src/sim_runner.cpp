@@ -74,7 +74,7 @@ SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t conte
 
 SimRunner::~SimRunner() { qnav_sim_destroy(sim_); }
 
-const qnav_q1_15_t *SimRunner::table_for(const qnav_ctrl_t &ctrl, const qnav_policy_t &policy)
+const qnav_qkey_t *SimRunner::table_for(const qnav_ctrl_t &ctrl, const qnav_policy_t &policy)
 {
     for (unsigned i = 0; i < 2; ++i) {
         if (tables_[i].valid && std::memcmp(&tables_[i].policy, &policy, sizeof policy) == 0) {
@@ -109,8 +109,8 @@ EpisodeOutcome SimRunner::run_traced(const qnav_policy_t &policy, uint64_t episo
                         std::to_string(static_cast<int>(st)) + ")");
     }
     if (use_table_ && policy.kind == QNAV_POLICY_NET) {
-        const qnav_q1_15_t *table = table_for(ctrl, policy);
-        if (!table || qnav_ctrl_init_table(&ctrl, &ctrl_cfg_, table) != QNAV_OK) {
+        const qnav_qkey_t *table = table_for(ctrl, policy);
+        if (!table || qnav_ctrl_init_table(&ctrl, &ctrl_cfg_, table, qnav_ctrl_rank(&ctrl)) != QNAV_OK) {
             throw UserError("controller: could not compile the policy into a quality table");
         }
     }

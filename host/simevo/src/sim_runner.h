@@ -61,11 +61,11 @@ private:
     /* policy's quality table, compiled by ctrl (initialised with policy), or null when it
      * cannot be. The last two are kept: an evolution step runs a new candidate and then,
      * mostly, the same best member as its parent, whose table need not be built again. */
-    const qnav_q1_15_t *table_for(const qnav_ctrl_t &ctrl, const qnav_policy_t &policy);
+    const qnav_qkey_t *table_for(const qnav_ctrl_t &ctrl, const qnav_policy_t &policy);
 
     struct CompiledTable {
         qnav_policy_t policy{};
-        std::vector<qnav_q1_15_t> table;
+        std::vector<qnav_qkey_t> table;
         bool valid = false;
     };
     qnav_sim_t *sim_ = nullptr;

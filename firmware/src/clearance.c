@@ -1,0 +1,180 @@
+/*
+ * Body-aware clearance: VFH+-style enlargement of the sector readings into per-path
+ * distance levels, and the speed guard (see clearance.h; docs/architecture.md,
+ * "Clearance that respects the body"). Integer arithmetic only; the per-level tables are
+ * made at init so that the step does no multiply or division here.
+ */
+#include "clearance.h"
+#include "qnav/flash.h"
+
+/* sin(g degrees) in units of 2^-15, g = 0..90 (sin 90 stored as 32767). Made by:
+ * python3 -c "import math;print([min(32767,round(math.sin(math.radians(g))*32768)) for g in range(91)])" */
+static const uint16_t sin_deg_q15[91] QNAV_FLASH = {
+    0, 572, 1144, 1715, 2286, 2856, 3425, 3993, 4560, 5126, 5690, 6252,
+    6813, 7371, 7927, 8481, 9032, 9580, 10126, 10668, 11207, 11743, 12275, 12803,
+    13328, 13848, 14365, 14876, 15384, 15886, 16384, 16877, 17364, 17847, 18324, 18795,
+    19261, 19720, 20174, 20622, 21063, 21498, 21926, 22348, 22763, 23170, 23571, 23965,
+    24351, 24730, 25102, 25466, 25822, 26170, 26510, 26842, 27166, 27482, 27789, 28088,
+    28378, 28660, 28932, 29197, 29452, 29698, 29935, 30163, 30382, 30592, 30792, 30983,
+    31164, 31336, 31499, 31651, 31795, 31928, 32052, 32166, 32270, 32365, 32449, 32524,
+    32588, 32643, 32688, 32723, 32748, 32763, 32767,
+};
+
+/* Control tick the speed guard allows for reacting, ms (DESIGN.md §4: 0.1 s). */
+#define QNAV_GUARD_REACTION_MS 100u
+
+uint8_t qnav_clearance_level_of(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm)
+{
+    uint32_t level;
+    /* For ranges of 32 mm and more the scale fits 16 bits: a 16x16 multiply (AVR) */
+    if (ctrl->level_scale <= 0xFFFFu) {
+        level = ((uint32_t)range_mm * (uint16_t)ctrl->level_scale + 32768u) >> 16;
+    } else {
+        level = ((uint32_t)range_mm * ctrl->level_scale + 32768u) >> 16;
+    }
+    return (uint8_t)(level > QNAV_DIST_LEVELS - 1u ? QNAV_DIST_LEVELS - 1u : level);
+}
+
+/* The smallest range (mm) that maps to level or above: the nearest an obstacle read at
+ * that level can be, so both tables below err on the safe side. */
+static uint32_t level_floor_mm(const qnav_ctrl_t *ctrl, uint8_t level)
+{
+    uint32_t lo = 0;
+    uint32_t hi = ctrl->max_range_mm;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2u;
+        if (qnav_clearance_level_of(ctrl, (qnav_mm_t)mid) >= level) {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    return lo;
+}
+
+/* Smallest whole degree g with sin(g) >= margin / d (90 when d <= margin). */
+static uint8_t enlarge_deg(uint32_t margin_mm, uint32_t d_mm)
+{
+    uint8_t g;
+    if (margin_mm == 0u) {
+        return 0;
+    }
+    if (d_mm <= margin_mm) {
+        return 90;
+    }
+    /* d < 2^16 and margin < d, so both products stay below 2^31 */
+    for (g = 0; g < 90u; ++g) {
+        if ((uint32_t)QNAV_FLASH_READ_U16(&sin_deg_q15[g]) * d_mm >= margin_mm * 32768u) {
+            return g;
+        }
+    }
+    return 90;
+}
+
+static uint32_t isqrt32(uint32_t x)
+{
+    uint32_t r = 0;
+    uint32_t bit = (uint32_t)1 << 30;
+    while (bit > x) {
+        bit >>= 2;
+    }
+    while (bit != 0u) {
+        if (x >= r + bit) {
+            x -= r + bit;
+            r = (r >> 1) + bit;
+        } else {
+            r >>= 1;
+        }
+        bit >>= 2;
+    }
+    return r;
+}
+
+/* Largest speed (Q1.15 of v_max) that stops within s_mm after one reaction tick:
+ * v T + v^2 / (2 a) <= s, so v = sqrt((a T)^2 + 2 a s) - a T. */
+static qnav_q1_15_t stop_speed(uint32_t s_mm, uint32_t v_max_mm_s, uint32_t decel_mm_s2)
+{
+    uint32_t at = decel_mm_s2 * QNAV_GUARD_REACTION_MS / 1000u;
+    uint32_t at2 = at * at;
+    uint32_t v;
+    /* a <= 65535 and s <= 65535: 2 a s may pass 2^32; such a cap is above any v_max */
+    if (s_mm > (0xFFFFFFFFu - at2) / (2u * decel_mm_s2)) {
+        return QNAV_Q1_15_MAX;
+    }
+    v = isqrt32(at2 + 2u * decel_mm_s2 * s_mm) - at;
+    if (v >= v_max_mm_s) {
+        return QNAV_Q1_15_MAX;
+    }
+    return (qnav_q1_15_t)((v * 32768u) / v_max_mm_s);
+}
+
+void qnav_clearance_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg)
+{
+    uint32_t margin = (uint32_t)cfg->body_radius_mm + cfg->safety_mm;
+    uint8_t level;
+    for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
+        uint32_t d = level_floor_mm(ctrl, level);
+        ctrl->enlarge_deg[level] = enlarge_deg(margin, d);
+        if (cfg->v_max_mm_s == 0u || cfg->decel_mm_s2 == 0u) {
+            ctrl->speed_cap[level] = QNAV_Q1_15_MAX;
+        } else if (level == QNAV_DIST_LEVELS - 1u) {
+            ctrl->speed_cap[level] = QNAV_Q1_15_MAX; /* nothing seen within range */
+        } else {
+            ctrl->speed_cap[level] = stop_speed(d > margin ? d - margin : 0u, cfg->v_max_mm_s,
+                                                cfg->decel_mm_s2);
+        }
+    }
+}
+
+/* Lower the level of n paths from first on, widened by gamma on both sides, to level. */
+static void paint(uint8_t *lvl, uint16_t first, uint16_t n, uint8_t gamma, uint8_t level)
+{
+    uint16_t p = (uint16_t)(first >= gamma ? first - gamma : first + QNAV_PATHS - gamma);
+    uint16_t k = (uint16_t)(n + 2u * gamma);
+    if (k > QNAV_PATHS) {
+        k = QNAV_PATHS;
+    }
+    while (k != 0u) {
+        if (lvl[p] > level) {
+            lvl[p] = level;
+        }
+        p = (uint16_t)(p + 1u == QNAV_PATHS ? 0u : p + 1u);
+        --k;
+    }
+}
+
+/* Sector lengths follow from path * N + 180 wrapping past 360: a sector whose first path
+ * has phase p holds q = 360 / N paths, or q + 1 when p + q * N is still below 360; sector 0
+ * is cut in two, paths 0.. and the last ones before 360. */
+uint8_t qnav_clearance_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges, uint8_t *lvl)
+{
+    uint16_t path = 0;
+    uint16_t sector = 0;
+    uint16_t phase = QNAV_PATHS / 2u;
+    uint16_t count = ctrl->first_sector_paths;
+    uint8_t flags = 0;
+    uint16_t i;
+    for (i = 0; i < QNAV_PATHS; ++i) {
+        lvl[i] = (uint8_t)(QNAV_DIST_LEVELS - 1u);
+    }
+    for (;;) {
+        qnav_mm_t r = ranges[sector];
+        uint16_t n = count < QNAV_PATHS - path ? count : (uint16_t)(QNAV_PATHS - path);
+        uint8_t level;
+        if (r > ctrl->max_range_mm) {
+            r = ctrl->max_range_mm;
+            flags |= QNAV_FLAG_RANGE_CLIPPED;
+        }
+        level = qnav_clearance_level_of(ctrl, r);
+        if (level != QNAV_DIST_LEVELS - 1u) {
+            paint(lvl, path, n, ctrl->enlarge_deg[level], level);
+        }
+        path = (uint16_t)(path + n);
+        if (path >= QNAV_PATHS) {
+            return flags;
+        }
+        phase = (uint16_t)(phase + count * ctrl->n_sectors - QNAV_PATHS);
+        count = (uint16_t)(ctrl->sector_paths + (phase + ctrl->sector_span < QNAV_PATHS ? 1u : 0u));
+        sector = (uint16_t)(sector + 1u == ctrl->n_sectors ? 0u : sector + 1u);
+    }
+}

@@ -1,0 +1,30 @@
+/*
+ * Body-aware clearance (private to libqnav): which distance level each of the 360 paths
+ * sees, and how fast the robot may drive along it. A sector's reading blocks its own
+ * wedge and, enlarged as in VFH+ (Ulrich & Borenstein 1998), every path within
+ * gamma = asin((r_robot + d_safe) / D) of it, D the obstacle's distance from the robot's
+ * centre; a path's level is the nearest reading whose enlarged arc covers it. With
+ * r_robot = d_safe = 0 every gamma is 0 and a path sees exactly its own sector (the
+ * paper's literal mapping). The speed guard caps the speed at what the path's clearance
+ * can stop in. Everything per level is computed at init; the step only paints bytes.
+ */
+#ifndef QNAV_CLEARANCE_H
+#define QNAV_CLEARANCE_H
+
+#include "qnav/ctrl.h"
+
+/* Fill ctrl->enlarge_deg[] and ctrl->speed_cap[] from cfg (init time; integer only). */
+void qnav_clearance_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg);
+
+/*
+ * The distance level of every path (lvl[i] for path i, i = 0..359) from the n_sectors
+ * ranges: the minimum over the sectors whose enlarged arc covers the path.
+ * Returns QNAV_FLAG_RANGE_CLIPPED when a range above max_range_mm was clipped, else 0.
+ * @par Cost: 360 byte writes plus count + 2 * gamma per sector nearer than the maximum.
+ */
+uint8_t qnav_clearance_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges, uint8_t *lvl);
+
+/* Level of a range already known to be at most max_range_mm. */
+uint8_t qnav_clearance_level_of(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm);
+
+#endif /* QNAV_CLEARANCE_H */
