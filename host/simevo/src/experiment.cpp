@@ -532,6 +532,7 @@ ConditionSummary summarize_condition(const ExperimentSpec &spec, const std::vect
     c.tau_c = t_interval(c.tau_c_per_run, 0.0, std::numeric_limits<double>::infinity());
     c.online_mean = mean_of(c.online_per_run);
     for (CheckpointSummary &cs : c.checkpoints) {
+        cs.listed = std::find(spec.checkpoints.begin(), spec.checkpoints.end(), cs.checkpoint) != spec.checkpoints.end();
         cs.R_ci = t_interval(cs.R, -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
         cs.arrival_ci = t_interval(cs.arrival, 0.0, 1.0);
         cs.tau_c_ci = t_interval(cs.tau_c, 0.0, std::numeric_limits<double>::infinity());
@@ -704,7 +705,8 @@ std::string json_checkpoints(const ConditionSummary &c)
     o << ", \"checkpoints\": [";
     for (std::size_t i = 0; i < c.checkpoints.size(); ++i) {
         const CheckpointSummary &k = c.checkpoints[i];
-        o << (i ? ", " : "") << "{\"episodes\": " << k.checkpoint << ", \"R\": " << json_interval(k.R_ci)
+        o << (i ? ", " : "") << "{\"episodes\": " << k.checkpoint
+          << ", \"listed\": " << (k.listed ? "true" : "false") << ", \"R\": " << json_interval(k.R_ci)
           << ", \"arrival\": " << json_interval(k.arrival_ci) << ", \"tau_c\": " << json_interval(k.tau_c_ci)
           << ", \"R_p_vs_direct\": " << json_p(k.R_vs_direct)
           << ", \"arrival_p_vs_direct\": " << json_p(k.arrival_vs_direct) << "}";
@@ -828,11 +830,15 @@ std::string checkpoint_tables_md(const ExperimentSummary &S)
     }
     o << "## Held out at equal target budgets\n\n"
       << "Best member of each run after the given target episodes, on the first " << S.checkpoint_episodes
-      << " held-out episodes (mean over runs, 95% CI); p: transfer vs direct over the runs.\n\n"
+      << " held-out episodes (mean over runs, 95% CI); p: transfer vs direct over the runs. summary.json also "
+         "holds the checkpoint_every grid used for the threshold below.\n\n"
       << "| condition | target episodes | R | arrival | recovery ticks per episode | p R (Welch) | p arrival (Mann-Whitney) |\n"
       << "|---|---|---|---|---|---|---|\n";
     for (const ConditionSummary &c : S.conditions) {
         for (const CheckpointSummary &k : c.checkpoints) {
+            if (!k.listed) {
+                continue;
+            }
             const bool direct = c.label == "direct";
             o << "| " << c.label << " | " << k.checkpoint << " | " << num_interval(k.R_ci) << " | "
               << pct_interval(k.arrival_ci) << " | " << num_interval(k.tau_c_ci, 1) << " | "

@@ -54,6 +54,8 @@ struct Interval {
 /* Held-out performance of a condition's best members at one checkpoint, per run. */
 struct CheckpointSummary {
     uint64_t checkpoint = 0;          /* target episodes */
+    bool listed = false;              /* one of the spec's checkpoints (else only a point of
+                                         the checkpoint_every grid, for the threshold) */
     std::vector<double> R, arrival, tau_c; /* per run: mean R, arrival fraction, recovery
                                              ticks per episode */
     Interval R_ci, arrival_ci, tau_c_ci;

@@ -373,8 +373,9 @@ std::string task_settings_text(const TaskDef &t, const std::string &source_finge
 
 uint64_t task_steps(const TaskDef &t)
 {
+    // Rounded up, so that every checkpoint within the budget is reached.
     const uint64_t k = std::max<uint32_t>(1, t.evolution.episodes_per_candidate);
-    return std::max<uint64_t>(1, t.episodes / k);
+    return std::max<uint64_t>(1, (t.episodes + k - 1) / k);
 }
 
 uint64_t task_total_episodes(const TaskDef &t)

@@ -53,7 +53,8 @@ struct TaskDef {
     uint32_t checkpoint_episodes = 0;  /* the first this many held-out episodes */
 };
 
-/* Evolution steps of a task: budget / k, at least 1. */
+/* Evolution steps of a task: budget / k rounded up (so a step may end up to k - 1
+ * episodes past the budget), at least 1. */
 uint64_t task_steps(const TaskDef &t);
 
 /* Creates the runner a task uses (the simulator, or a fake in tests). */
