@@ -14,7 +14,6 @@ body at the end. Writes EXPERIMENT_DIR/episodes.png unless OUT.png is given.
 import math
 import os
 import sys
-import tomllib
 
 import matplotlib
 
@@ -22,17 +21,7 @@ matplotlib.use("Agg")
 import matplotlib.patches as mpatches  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 
-from plotcommon import PlotError, parse_args, read_csv, read_json, run, save  # noqa: E402
-
-
-def read_env(path):
-    try:
-        with open(path, "rb") as f:
-            return tomllib.load(f)
-    except OSError as e:
-        raise PlotError(f"{path}: {e.strerror}") from e
-    except tomllib.TOMLDecodeError as e:
-        raise PlotError(f"{path}: {e}") from e
+from plotcommon import PlotError, parse_args, read_csv, read_json, read_toml, run, save  # noqa: E402
 
 
 def draw_env(ax, env):
@@ -77,7 +66,7 @@ def main(argv):
         return 2
     exp, out = args
     summary = read_json(os.path.join(exp, "summary.json"))
-    env = read_env(summary["environment_file"])
+    env = read_toml(summary["environment_file"])
     radius = summary["robot_radius_m"]
     episodes = {}  # condition -> episode -> columns
 

@@ -1,9 +1,10 @@
 """What simevo's plot scripts share: their command line, reading a CSV or JSON file with
-one-line errors (FILE:LINE: problem), and writing a PNG atomically (no half-written plot)."""
+one-line errors (FILE:LINE: problem), reading an environment's TOML file, and writing a PNG atomically (no half-written plot)."""
 import csv
 import json
 import os
 import sys
+import tomllib
 
 
 class PlotError(Exception):
@@ -35,15 +36,25 @@ def read_csv(path, on_row):
         raise PlotError(f"{path}:{reader.line_num if reader else 0}: {e}") from e
 
 
-def read_json(path):
-    """The parsed JSON file at path; raise PlotError naming the file (and line)."""
+def _read(path, mode, parse, decode_error, where):
+    """parse(file) of path opened in mode; PlotError naming the file (where(e): ':LINE')."""
     try:
-        with open(path) as f:
-            return json.load(f)
+        with open(path, mode) as f:
+            return parse(f)
     except OSError as e:
         raise PlotError(f"{path}: {e.strerror}") from e
-    except json.JSONDecodeError as e:
-        raise PlotError(f"{path}:{e.lineno}: {e.msg}") from e
+    except decode_error as e:
+        raise PlotError(f"{path}{where(e)}") from e
+
+
+def read_json(path):
+    """The parsed JSON file at path; raise PlotError naming the file and line."""
+    return _read(path, "r", json.load, json.JSONDecodeError, lambda e: f":{e.lineno}: {e.msg}")
+
+
+def read_toml(path):
+    """The parsed TOML file at path (an environment); raise PlotError naming the file."""
+    return _read(path, "rb", tomllib.load, tomllib.TOMLDecodeError, lambda e: f": {e}")
 
 
 def save(fig, out):

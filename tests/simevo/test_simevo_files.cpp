@@ -96,6 +96,19 @@ static TaskDef fake_task(const std::string &dir)
     return t;
 }
 
+/* An observer that sets stop once n episodes have been reported (seen counts them). */
+static TaskObserver stop_after(uint64_t n, uint64_t &seen, std::atomic<bool> &stop)
+{
+    TaskObserver obs;
+    obs.episodes_done = [n, &seen, &stop](uint64_t more, bool) {
+        seen += more;
+        if (seen >= n) {
+            stop = true;
+        }
+    };
+    return obs;
+}
+
 static RunnerFactory fake_factory()
 {
     return [](const Scenario &, uint64_t) -> std::unique_ptr<EpisodeRunner> { return std::make_unique<FakeRunner>(); };
@@ -112,14 +125,7 @@ static void test_task_stopped_and_resumed_matches_uninterrupted_bytes(void **sta
     TaskDef b = fake_task(join_path(root, "b"));
     std::atomic<bool> stop{false};
     uint64_t seen = 0;
-    TaskObserver obs;
-    obs.episodes_done = [&](uint64_t n, bool) {
-        seen += n;
-        if (seen >= 137) {
-            stop = true;
-        }
-    };
-    assert_false(run_task(b, "", fake_factory(), obs, stop));
+    assert_false(run_task(b, "", fake_factory(), stop_after(137, seen, stop), stop));
     assert_false(file_exists(join_path(b.dir, "done")));
     assert_false(file_exists(join_path(b.dir, "best.policy")));
     // A kill in the middle of a write leaves half a line behind.
@@ -204,14 +210,7 @@ static void test_checkpoints_resume_to_identical_bytes_even_when_a_row_is_missin
     const TaskDef b = task("b");
     std::atomic<bool> stop{false};
     uint64_t seen = 0;
-    TaskObserver obs;
-    obs.episodes_done = [&](uint64_t n, bool) {
-        seen += n;
-        if (seen >= 70) {
-            stop = true;
-        }
-    };
-    assert_false(run_task(b, "", fake_factory(), obs, stop));
+    assert_false(run_task(b, "", fake_factory(), stop_after(70, seen, stop), stop));
     // Killed after the journal line of step 25 but before checkpoint 50 was written whole.
     const std::string ck = join_path(b.dir, "checkpoints.csv");
     std::string text = slurp(ck);

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
+#include <functional>
 #include <sstream>
 #include <unistd.h>
 
@@ -139,6 +140,34 @@ int open_journal_at(const std::string &path, std::size_t keep, const char *heade
     return fd;
 }
 
+/* The rows of a resumable journal that survived an interrupted run: the header is checked
+ * ("PATH:1: not a simevo KIND"), then row(fields, where) is called for each complete line
+ * until it returns false (enough rows) or throws; where = "PATH:LINE: ". Returns the bytes
+ * to keep: the header and the rows accepted (0 for a missing or empty file). */
+std::size_t resume_rows(const std::string &path, const char *header, const char *kind,
+                        const std::function<bool(const std::vector<std::string> &, const std::string &)> &row)
+{
+    std::string text;
+    if (!read_file(path, text) || text.empty()) {
+        return 0;
+    }
+    const Lines L = split_lines(text);
+    if (L.lines.empty()) {
+        return 0; // killed while writing the header
+    }
+    if (L.lines[0] + "\n" != header) {
+        throw UserError(path + ":1: not a simevo " + kind);
+    }
+    std::size_t keep = L.ends[0];
+    for (std::size_t i = 1; i < L.lines.size(); ++i) {
+        if (!row(split_csv(L.lines[i]), path + ":" + std::to_string(i + 1) + ": ")) {
+            break;
+        }
+        keep = L.ends[i];
+    }
+    return keep;
+}
+
 /* Held-out evaluation, journaled like the evolution (eval.partial, one line per episode)
  * and renamed to eval.csv when complete. Returns false when stopped. */
 bool run_eval(EpisodeRunner &runner, const qnav_policy_t &policy, const TaskDef &t,
@@ -152,28 +181,20 @@ bool run_eval(EpisodeRunner &runner, const qnav_policy_t &policy, const TaskDef 
         }
         return true;
     }
-    std::string text;
-    std::size_t keep = 0;
     uint32_t have = 0;
-    if (read_file(partial, text) && !text.empty()) {
-        const Lines L = split_lines(text);
-        if (!L.lines.empty()) {
-            if (L.lines[0] + "\n" != kEvalHeader) {
-                throw UserError(partial + ":1: not a simevo evaluation file");
-            }
-            keep = L.ends[0];
-            for (std::size_t i = 1; i < L.lines.size() && have < t.eval_episodes; ++i) {
-                const auto f = split_csv(L.lines[i]);
-                EpisodeOutcome o;
-                uint64_t idx = 0;
-                if (f.size() != 6 || !parse_u64(f[0], idx) || idx != have || !parse_outcome(f, 1, o)) {
-                    throw UserError(partial + ":" + std::to_string(i + 1) + ": malformed row");
-                }
-                ++have;
-                keep = L.ends[i];
-            }
+    const std::size_t keep = resume_rows(partial, kEvalHeader, "evaluation file",
+                                         [&](const std::vector<std::string> &f, const std::string &where) {
+        if (have >= t.eval_episodes) {
+            return false;
         }
-    }
+        EpisodeOutcome o;
+        uint64_t idx = 0;
+        if (f.size() != 6 || !parse_u64(f[0], idx) || idx != have || !parse_outcome(f, 1, o)) {
+            throw UserError(where + "malformed row");
+        }
+        ++have;
+        return true;
+    });
     if (obs.episodes_done && have > 0) {
         obs.episodes_done(have, true);
     }
@@ -241,26 +262,18 @@ public:
         if (t.checkpoints.empty()) {
             return;
         }
-        std::string text;
-        std::size_t keep = 0;
-        if (read_file(path_, text) && !text.empty()) {
-            const Lines L = split_lines(text);
-            if (!L.lines.empty()) {
-                if (L.lines[0] + "\n" != kCheckpointHeader) {
-                    throw UserError(path_ + ":1: not a simevo checkpoint file");
-                }
-                keep = L.ends[0];
-                for (std::size_t i = 1; i < L.lines.size() && done_ < t.checkpoints.size(); ++i) {
-                    const auto f = split_csv(L.lines[i]);
-                    uint64_t c = 0;
-                    if (f.size() != 6 || !parse_u64(f[0], c) || c != t.checkpoints[done_]) {
-                        throw UserError(path_ + ":" + std::to_string(i + 1) + ": malformed row");
-                    }
-                    ++done_;
-                    keep = L.ends[i];
-                }
+        const std::size_t keep = resume_rows(path_, kCheckpointHeader, "checkpoint file",
+                                             [&](const std::vector<std::string> &f, const std::string &where) {
+            if (done_ >= t.checkpoints.size()) {
+                return false;
             }
-        }
+            uint64_t c = 0;
+            if (f.size() != 6 || !parse_u64(f[0], c) || c != t.checkpoints[done_]) {
+                throw UserError(where + "malformed row");
+            }
+            ++done_;
+            return true;
+        });
         if (obs_.episodes_done && done_ > 0) {
             obs_.episodes_done(done_ * t.checkpoint_episodes, true);
         }
@@ -423,39 +436,51 @@ JournalColumns read_journal(const std::string &csv_path)
     return c;
 }
 
-std::vector<CheckpointRow> read_checkpoints(const std::string &csv_path)
+namespace {
+/* The rows of a finished output file, each parsed by parse (false = malformed). */
+template <typename T>
+std::vector<T> read_rows(const std::string &csv_path, const char *header, const char *kind,
+                         bool (*parse)(const std::vector<std::string> &, T &))
 {
-    const Lines L = read_with_header(csv_path, kCheckpointHeader, "checkpoint file");
-    std::vector<CheckpointRow> v;
+    const Lines L = read_with_header(csv_path, header, kind);
+    std::vector<T> v;
     for (std::size_t i = 1; i < L.lines.size(); ++i) {
-        const auto f = split_csv(L.lines[i]);
-        CheckpointRow r;
-        uint64_t n = 0, arrived = 0;
-        if (f.size() != 6 || !parse_u64(f[0], r.checkpoint) || !parse_u64(f[1], r.episodes) ||
-            !parse_u64(f[2], n) || !parse_double(f[3], r.R) || !parse_u64(f[4], arrived) ||
-            !parse_u64(f[5], r.tau_c) || n == 0 || n > UINT32_MAX || arrived > n) {
+        T row;
+        if (!parse(split_csv(L.lines[i]), row)) {
             throw UserError(csv_path + ":" + std::to_string(i + 1) + ": malformed row");
         }
-        r.n = static_cast<uint32_t>(n);
-        r.arrived = static_cast<uint32_t>(arrived);
-        v.push_back(r);
+        v.push_back(row);
     }
     return v;
 }
 
+bool parse_checkpoint(const std::vector<std::string> &f, CheckpointRow &r)
+{
+    uint64_t n = 0, arrived = 0;
+    if (f.size() != 6 || !parse_u64(f[0], r.checkpoint) || !parse_u64(f[1], r.episodes) || !parse_u64(f[2], n) ||
+        !parse_double(f[3], r.R) || !parse_u64(f[4], arrived) || !parse_u64(f[5], r.tau_c) || n == 0 ||
+        n > UINT32_MAX || arrived > n) {
+        return false;
+    }
+    r.n = static_cast<uint32_t>(n);
+    r.arrived = static_cast<uint32_t>(arrived);
+    return true;
+}
+
+bool parse_eval_row(const std::vector<std::string> &f, EpisodeOutcome &o)
+{
+    return f.size() == 6 && parse_outcome(f, 1, o);
+}
+} // namespace
+
+std::vector<CheckpointRow> read_checkpoints(const std::string &csv_path)
+{
+    return read_rows(csv_path, kCheckpointHeader, "checkpoint file", parse_checkpoint);
+}
+
 std::vector<EpisodeOutcome> read_eval(const std::string &csv_path)
 {
-    const Lines L = read_with_header(csv_path, kEvalHeader, "evaluation file");
-    std::vector<EpisodeOutcome> v;
-    for (std::size_t i = 1; i < L.lines.size(); ++i) {
-        const auto f = split_csv(L.lines[i]);
-        EpisodeOutcome o;
-        if (f.size() != 6 || !parse_outcome(f, 1, o)) {
-            throw UserError(csv_path + ":" + std::to_string(i + 1) + ": malformed row");
-        }
-        v.push_back(o);
-    }
-    return v;
+    return read_rows(csv_path, kEvalHeader, "evaluation file", parse_eval_row);
 }
 
 namespace {
@@ -465,22 +490,12 @@ namespace {
 std::size_t replay_journal(const TaskDef &t, const std::string &journal_path, Evolution &evo,
                            CheckpointLog &checkpoints, const TaskObserver &obs)
 {
-    std::string text;
-    if (!read_file(journal_path, text) || text.empty()) {
-        return 0;
-    }
-    const Lines L = split_lines(text);
-    if (L.lines.empty()) {
-        return 0; // killed while writing the header
-    }
-    if (L.lines[0] + "\n" != kJournalHeader) {
-        throw UserError(journal_path + ":1: not a simevo episode journal");
-    }
     const uint32_t k = t.evolution.episodes_per_candidate;
-    std::size_t keep = L.ends[0];
-    for (std::size_t i = 1; i < L.lines.size() && evo.episodes_done() < task_steps(t); ++i) {
-        const std::string where = journal_path + ":" + std::to_string(i + 1) + ": ";
-        const auto f = split_csv(L.lines[i]);
+    return resume_rows(journal_path, kJournalHeader, "episode journal",
+                       [&](const std::vector<std::string> &f, const std::string &where) {
+        if (evo.episodes_done() >= task_steps(t)) {
+            return false;
+        }
         uint64_t step = 0;
         EpisodeOutcome o;
         if (f.size() != 11 || !parse_u64(f[0], step) || !parse_outcome(f, 1, o, k)) {
@@ -499,13 +514,12 @@ std::size_t replay_journal(const TaskDef &t, const std::string &journal_path, Ev
                                     "(step or policy differs); use another --out");
         }
         evo.accept(c, o, has_parent ? &po : nullptr);
-        keep = L.ends[i];
         if (obs.episodes_done) {
             obs.episodes_done(k, true);
         }
         checkpoints.reach(evo, evo.episodes_done() * k);
-    }
-    return keep;
+        return true;
+    });
 }
 } // namespace
 
