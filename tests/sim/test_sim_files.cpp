@@ -248,6 +248,11 @@ static void test_cli_prints_one_line_and_fails_on_bad_input(void **state) {
     assert_true(one_line(out.substr(0, out.size() - 1)));
     assert_true(out.find("--sectors") != std::string::npos);
     assert_int_not_equal(run_tool("run --sensor-noise -1", &out), 0);
+    assert_int_not_equal(run_tool(std::string("run --robot ") + QNAV_TEST_DATA_DIR + "/robots/tekbot.toml --env " +
+                                      QNAV_TEST_DATA_DIR + "/envs/open.toml --fitness survival",
+                                  &out),
+                         0);
+    assert_string_equal(out.c_str(), "--fitness: 'survival' is not one of progress, paper\n");
     assert_int_not_equal(run_tool("gen-env --density 0.9 --out /tmp/never.toml", &out), 0);
     assert_int_not_equal(access("/tmp/never.toml", F_OK), 0);
 }

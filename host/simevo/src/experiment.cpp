@@ -976,6 +976,40 @@ std::string quality_table_csv(const std::vector<std::pair<std::string, qnav_poli
     return o.str();
 }
 
+namespace {
+
+/* Everything after the runs but summary.md: curves, quality map, summary.json, episode
+ * traces and the plots (STATUS says when plots are missing). Throws UserError. */
+void write_outputs(const ExperimentSpec &spec, const ExperimentSummary &S, const std::vector<TaskDef> &tasks,
+                   const std::string &exp_dir, SimWorlds &worlds, SimRunner &target_runner, const RunOptions &opt)
+{
+    const std::string status_path = join_path(exp_dir, "STATUS");
+    write_file_atomic(join_path(exp_dir, "curves.csv"), curves_csv(S));
+    write_file_atomic(join_path(exp_dir, "quality.csv"), quality_csv(S, exp_dir, target_runner.ctrl_config(),
+                                                                   target_runner.probabilistic_policy()));
+    qnav_sim_env_info_t env_info;
+    qnav_sim_env_info(worlds.env(spec.target.environment), &env_info);
+    qnav_sim_robot_info_t robot_info;
+    qnav_sim_robot_info(worlds.robot(spec.target.robot), &robot_info);
+    write_file_atomic(join_path(exp_dir, "summary.json"),
+                      summary_json(spec, S, opt, env_info.source, robot_info.radius_m));
+    const uint64_t eval_base = tasks.back().eval_seed_base; // the probabilistic task's: the held-out set
+    write_file_atomic(join_path(exp_dir, "episodes.csv"),
+                      episodes_csv(S, exp_dir, target_runner, eval_base, spec.eval_episodes));
+    if (opt.plots) {
+        write_file_atomic(status_path, "incomplete: runs finished, plots missing\n");
+        try {
+            run_plot(opt, "plot_learning.py", exp_dir);
+            run_plot(opt, "plot_policy.py", exp_dir);
+            run_plot(opt, "plot_episodes.py", exp_dir);
+        } catch (const UserError &e) {
+            throw UserError(std::string(e.what()) + " (results are complete except plots; STATUS says so)");
+        }
+    }
+}
+
+} // namespace
+
 std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
 {
     const std::string exp_dir = join_path(opt.out_dir, spec.name);
@@ -1043,28 +1077,7 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
     run_tasks(tasks, make, opt.jobs, progress, spec.name);
 
     const ExperimentSummary S = summarize(spec, tasks);
-    write_file_atomic(join_path(exp_dir, "curves.csv"), curves_csv(S));
-    write_file_atomic(join_path(exp_dir, "quality.csv"), quality_csv(S, exp_dir, target_runner.ctrl_config(),
-                                                                   target_runner.probabilistic_policy()));
-    qnav_sim_env_info_t env_info;
-    qnav_sim_env_info(worlds.env(spec.target.environment), &env_info);
-    qnav_sim_robot_info_t robot_info;
-    qnav_sim_robot_info(worlds.robot(spec.target.robot), &robot_info);
-    write_file_atomic(join_path(exp_dir, "summary.json"),
-                      summary_json(spec, S, opt, env_info.source, robot_info.radius_m));
-    const uint64_t eval_base = tasks.back().eval_seed_base; // the probabilistic task's: the held-out set
-    write_file_atomic(join_path(exp_dir, "episodes.csv"),
-                      episodes_csv(S, exp_dir, target_runner, eval_base, spec.eval_episodes));
-    if (opt.plots) {
-        write_file_atomic(status_path, "incomplete: runs finished, plots missing\n");
-        try {
-            run_plot(opt, "plot_learning.py", exp_dir);
-            run_plot(opt, "plot_policy.py", exp_dir);
-            run_plot(opt, "plot_episodes.py", exp_dir);
-        } catch (const UserError &e) {
-            throw UserError(std::string(e.what()) + " (results are complete except plots; STATUS says so)");
-        }
-    }
+    write_outputs(spec, S, tasks, exp_dir, worlds, target_runner, opt);
     write_file_atomic(join_path(exp_dir, "summary.md"), summary_md(spec, S, opt, opt.plots));
     write_file_atomic(status_path, "complete\n");
     return exp_dir;

@@ -521,6 +521,49 @@ std::size_t replay_journal(const TaskDef &t, const std::string &journal_path, Ev
         return true;
     });
 }
+/* Resume (replay) and continue an evolution to its budget, journaling each step and
+ * evaluating the checkpoints. Returns false when stopped. */
+bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, const std::string &journal_path,
+            const TaskObserver &obs, const std::atomic<bool> &stop)
+{
+    CheckpointLog checkpoints(t, runner, obs);
+    const std::size_t keep = replay_journal(t, journal_path, evo, checkpoints, obs);
+    const int fd = open_journal_at(journal_path, keep, kJournalHeader);
+    FdGuard guard{fd};
+    if (obs.best && evo.episodes_done() > 0) {
+        obs.best(t.label, evo.best_so_far());
+    }
+    const uint32_t k = t.evolution.episodes_per_candidate;
+    while (evo.episodes_done() < task_steps(t)) {
+        if (stop.load()) {
+            return false;
+        }
+        const Candidate c = evo.propose();
+        const StepOutcome o = run_k(runner, c.policy, t.episode_seed_base, c.episode, k);
+        const bool has_parent = t.evolution.reevaluate_parent && c.parent >= 0;
+        StepOutcome po;
+        char parent_r[40] = "";
+        if (has_parent) {
+            po = run_k(runner, evo.members()[static_cast<std::size_t>(c.parent)].policy, t.episode_seed_base, c.episode, k);
+            std::snprintf(parent_r, sizeof parent_r, "%.17g", po.o.R);
+        }
+        evo.accept(c, o.o, has_parent ? &po.o : nullptr);
+        char row[360];
+        std::snprintf(row, sizeof row, "%" PRIu64 ",%s,%d,%d,%08" PRIx32 ",%s,%.17g\n", c.episode,
+                      fmt_step(o).c_str(), static_cast<int>(c.parent), c.explored ? 1 : 0,
+                      policy_fingerprint(c.policy), parent_r, evo.best_so_far());
+        write_all(fd, row, journal_path);
+        if (obs.episodes_done) {
+            obs.episodes_done(k, false);
+        }
+        if (obs.best) {
+            obs.best(t.label, evo.best_so_far());
+        }
+        checkpoints.reach(evo, evo.episodes_done() * k);
+    }
+
+    return true;
+}
 } // namespace
 
 bool run_task(const TaskDef &t, const std::string &source_policy_path, const RunnerFactory &make,
@@ -573,42 +616,9 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
     Evolution evo = source_policy_path.empty()
                         ? Evolution(t.evolution, t.evolution_seed)
                         : Evolution(t.evolution, t.evolution_seed, source);
-    CheckpointLog checkpoints(t, *runner, obs);
-    const std::size_t keep = replay_journal(t, journal_path, evo, checkpoints, obs);
-    const int fd = open_journal_at(journal_path, keep, kJournalHeader);
-    FdGuard guard{fd};
-    if (obs.best && evo.episodes_done() > 0) {
-        obs.best(t.label, evo.best_so_far());
+    if (!evolve(t, evo, *runner, journal_path, obs, stop)) {
+        return false;
     }
-    const uint32_t k = t.evolution.episodes_per_candidate;
-    while (evo.episodes_done() < task_steps(t)) {
-        if (stop.load()) {
-            return false;
-        }
-        const Candidate c = evo.propose();
-        const StepOutcome o = run_k(*runner, c.policy, t.episode_seed_base, c.episode, k);
-        const bool has_parent = t.evolution.reevaluate_parent && c.parent >= 0;
-        StepOutcome po;
-        char parent_r[40] = "";
-        if (has_parent) {
-            po = run_k(*runner, evo.members()[static_cast<std::size_t>(c.parent)].policy, t.episode_seed_base, c.episode, k);
-            std::snprintf(parent_r, sizeof parent_r, "%.17g", po.o.R);
-        }
-        evo.accept(c, o.o, has_parent ? &po.o : nullptr);
-        char row[360];
-        std::snprintf(row, sizeof row, "%" PRIu64 ",%s,%d,%d,%08" PRIx32 ",%s,%.17g\n", c.episode,
-                      fmt_step(o).c_str(), static_cast<int>(c.parent), c.explored ? 1 : 0,
-                      policy_fingerprint(c.policy), parent_r, evo.best_so_far());
-        write_all(fd, row, journal_path);
-        if (obs.episodes_done) {
-            obs.episodes_done(k, false);
-        }
-        if (obs.best) {
-            obs.best(t.label, evo.best_so_far());
-        }
-        checkpoints.reach(evo, evo.episodes_done() * k);
-    }
-
     const int32_t b = evo.best_index();
     const qnav_policy_t best = evo.members()[static_cast<std::size_t>(b)].policy;
     char comment[200];
