@@ -68,13 +68,20 @@ std::string resolve_experiment(const std::string &arg, const std::string &dir)
     return path;
 }
 
+/* The rule --fitness names ("" = the default). Throws UserError. */
+qnav_sim_fitness_rule_t fitness_option(const std::string &name)
+{
+    qnav_sim_fitness_rule_t rule = QNAV_SIM_FITNESS_PROGRESS;
+    if (!name.empty() && qnav_sim_fitness_rule_parse(name.c_str(), &rule) != QNAV_SIM_OK) {
+        throw UserError("--fitness: '" + name + "' is not one of " + qnav_sim_fitness_rule_names());
+    }
+    return rule;
+}
+
 /* --fitness NAME for every scenario of s. Throws UserError. */
 void set_fitness(ExperimentSpec &s, const std::string &name)
 {
-    qnav_sim_fitness_rule_t rule;
-    if (qnav_sim_fitness_rule_parse(name.c_str(), &rule) != QNAV_SIM_OK) {
-        throw UserError("--fitness: '" + name + "' is not one of " + qnav_sim_fitness_rule_names());
-    }
+    const qnav_sim_fitness_rule_t rule = fitness_option(name);
     s.target.fitness = rule;
     for (auto &src : s.sources) {
         src.scenario.fitness = rule;
@@ -100,9 +107,10 @@ void print_transfer_arrival(const ExperimentSpec &s, const std::string &dir)
 }
 
 Scenario scenario_from(const std::string &env, const std::string &robot, uint32_t sectors, double noise,
-                       double sensor_noise, double actuation_noise)
+                       double sensor_noise, double actuation_noise, const std::string &fitness)
 {
     Scenario s;
+    s.fitness = fitness_option(fitness);
     s.environment = env;
     s.robot = robot;
     s.sectors = sectors;
@@ -165,6 +173,7 @@ int main(int argc, char **argv)
     evolve->add_option("--episodes", ev_episodes, "episodes")->capture_default_str()->check(CLI::Range(uint64_t(1), uint64_t(100000000)));
     evolve->add_option("--eval-episodes", ev_eval, "held-out evaluation episodes of the best")->capture_default_str();
     evolve->add_option("--seed", ev_seed, "seed")->capture_default_str();
+    evolve->add_option("--fitness", fitness, "fitness rule: progress (default) or paper");
     evolve->add_option("--population", ep.population, "population size")->capture_default_str();
     evolve->add_option("--epsilon", ep.epsilon, "probability of mutating a random member")->capture_default_str();
     evolve->add_option("--hidden", ep.hidden, "hidden units of random networks")->capture_default_str();
@@ -188,6 +197,7 @@ int main(int argc, char **argv)
     eval->add_option("--noise", e_noise, "noise level p")->check(CLI::Range(0.0, 10.0));
     eval->add_option("--episodes", e_episodes, "episodes")->capture_default_str();
     eval->add_option("--seed", e_seed, "seed")->capture_default_str();
+    eval->add_option("--fitness", fitness, "fitness rule: progress (default) or paper");
 
     // quality: Figs. 2-3 for any policy files
     auto *quality = app.add_subcommand("quality", "plot path quality over (dtheta, distance) of policy files (paper Figs. 2-3)");
@@ -270,7 +280,7 @@ int main(int argc, char **argv)
             TaskDef t;
             t.label = from.empty() ? "direct" : "transfer";
             t.dir = out_dir;
-            t.scenario = scenario_from(env, robot, sectors, noise, sensor_noise, actuation_noise);
+            t.scenario = scenario_from(env, robot, sectors, noise, sensor_noise, actuation_noise, fitness);
             t.context_seed = ev_seed;
             t.episodes = ev_episodes;
             t.evolution = ep;
@@ -327,7 +337,7 @@ int main(int argc, char **argv)
         }
         if (*eval) {
             SimWorlds worlds;
-            SimRunner runner(worlds, scenario_from(e_env, e_robot, e_sectors, e_noise, -1, -1), e_seed, true);
+            SimRunner runner(worlds, scenario_from(e_env, e_robot, e_sectors, e_noise, -1, -1, fitness), e_seed, true);
             qnav_policy_t p;
             if (policy_arg == "prob") {
                 p = runner.probabilistic_policy();
