@@ -74,6 +74,17 @@ void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg)
     cfg->rank = (uint8_t)QNAV_RANK_PREACT;
 }
 
+void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg)
+{
+    if (cfg == 0) {
+        return;
+    }
+    cfg->body_radius_mm = 0u;
+    cfg->safety_mm = 0u;
+    cfg->decel_mm_s2 = 0u;
+    cfg->rank = (uint8_t)QNAV_RANK_QUALITY;
+}
+
 static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg)
 {
     uint32_t q_full;

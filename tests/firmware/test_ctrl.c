@@ -69,10 +69,9 @@ static void init_literal(qnav_ctrl_t *c, uint16_t sectors, qnav_mm_t max_mm, con
     qnav_ctrl_config_default(&cfg);
     cfg.n_sectors = sectors;
     cfg.max_range_mm = max_mm;
-    cfg.body_radius_mm = 0;
-    cfg.safety_mm = 0;
-    cfg.decel_mm_s2 = 0;
-    cfg.rank = (uint8_t)QNAV_RANK_QUALITY;
+    qnav_ctrl_config_literal(&cfg);
+    assert_int_equal(cfg.body_radius_mm, 0);
+    assert_int_equal(cfg.rank, QNAV_RANK_QUALITY);
     assert_int_equal(qnav_ctrl_init(c, &cfg, p), QNAV_OK);
 }
 

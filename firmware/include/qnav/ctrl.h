@@ -134,6 +134,11 @@ typedef struct {
  * 120 mm, safety 50 mm, 500 mm/s, braking 2000 mm/s^2), rank by pre-activation. */
 void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg);
 
+/* The paper read literally, kept as an ablation: every path sees only its own sector
+ * (zero radius and safety distance), no speed guard, rank by quality. Other fields are
+ * left as they are. */
+void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg);
+
 /*
  * Check cfg and policy and derive the step's parameters into ctrl.
  * Returns QNAV_OK, or QNAV_E_NULL, QNAV_E_SECTORS, QNAV_E_RANGE, QNAV_E_SPEED, QNAV_E_RANK,
