@@ -113,7 +113,11 @@ void qnav_clearance_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg)
     uint32_t margin = (uint32_t)cfg->body_radius_mm + cfg->safety_mm;
     uint8_t level;
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
-        uint32_t d = level_floor_mm(ctrl, level);
+        /* from the robot's centre: readings start at the transducers */
+        uint32_t d = level_floor_mm(ctrl, level) + cfg->sensor_offset_mm;
+        if (d > 65535u) {
+            d = 65535u;
+        }
         ctrl->enlarge_deg[level] = enlarge_deg(margin, d);
         if (cfg->v_max_mm_s == 0u || cfg->decel_mm_s2 == 0u) {
             ctrl->speed_cap[level] = QNAV_Q1_15_MAX;

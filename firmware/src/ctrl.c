@@ -69,6 +69,7 @@ void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg)
     cfg->full_speed_quality = QNAV_Q1_15(0.9);
     cfg->body_radius_mm = 120u;
     cfg->safety_mm = 50u;
+    cfg->sensor_offset_mm = 120u;
     cfg->v_max_mm_s = 500u;
     cfg->decel_mm_s2 = 2000u;
     cfg->rank = (uint8_t)QNAV_RANK_PREACT;
