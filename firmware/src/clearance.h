@@ -3,7 +3,7 @@
  * sees, and how fast the robot may drive along it. A sector's reading blocks its own
  * wedge and, enlarged as in VFH+ (Ulrich & Borenstein 1998), every path within
  * gamma = asin((r_robot + d_safe) / D) of it, D the obstacle's distance from the robot's
- * centre; a path's level is the nearest reading whose enlarged arc covers it. With
+ * centre (range + sensor offset); a path's level is the nearest reading whose enlarged arc covers it. With
  * r_robot = d_safe = 0 every gamma is 0 and a path sees exactly its own sector (the
  * paper's literal mapping). The speed guard caps the speed at what the path's clearance
  * can stop in. Everything per level is computed at init; the step only paints bytes.

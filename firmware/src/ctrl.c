@@ -69,9 +69,21 @@ void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg)
     cfg->full_speed_quality = QNAV_Q1_15(0.9);
     cfg->body_radius_mm = 120u;
     cfg->safety_mm = 50u;
+    cfg->sensor_offset_mm = 120u;
     cfg->v_max_mm_s = 500u;
     cfg->decel_mm_s2 = 2000u;
     cfg->rank = (uint8_t)QNAV_RANK_PREACT;
+}
+
+void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg)
+{
+    if (cfg == 0) {
+        return;
+    }
+    cfg->body_radius_mm = 0u;
+    cfg->safety_mm = 0u;
+    cfg->decel_mm_s2 = 0u;
+    cfg->rank = (uint8_t)QNAV_RANK_QUALITY;
 }
 
 static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg)

@@ -259,6 +259,7 @@ void qnav_sim_ctrl_config(const qnav_sim_t *sim, qnav_ctrl_config_t *cfg) {
     };
     cfg->body_radius_mm = mm(r.radius_m);
     cfg->safety_mm = mm(r.safety_m);
+    cfg->sensor_offset_mm = mm(r.radius_m); // ranges are measured from the body's surface
     cfg->v_max_mm_s = mm(r.v_max_mps);
     cfg->decel_mm_s2 = r.speed_guard ? mm(r.decel_mps2) : 0;
 }

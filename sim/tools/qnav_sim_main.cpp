@@ -102,11 +102,13 @@ qnav_policy_t read_policy(const std::string &path, const qnav_sim_robot_t *robot
 #endif
 }
 
-// Initialise ctrl for sim from a policy, in network/probabilistic or table mode.
+// Initialise ctrl for sim from a policy, in network/probabilistic or table mode; literal:
+// the paper's per-sector reading without enlargement, guard or pre-activation rank.
 void init_ctrl(const qnav_sim_t *sim, const qnav_policy_t &pol, bool table,
-               std::vector<qnav_qkey_t> &table_buf, qnav_ctrl_t *ctrl) {
+               std::vector<qnav_qkey_t> &table_buf, qnav_ctrl_t *ctrl, bool literal = false) {
     qnav_ctrl_config_t cc;
     qnav_sim_ctrl_config(sim, &cc);
+    if (literal) qnav_ctrl_config_literal(&cc);
     qnav_status_t st = qnav_ctrl_init(ctrl, &cc, &pol);
     if (st != QNAV_OK)
         throw SimError(QNAV_SIM_E_PARAM, "policy: rejected by qnav_ctrl_init (status " + std::to_string(st) + ")");
@@ -133,6 +135,7 @@ struct RunOpts {
     std::uint64_t seed = 1, episode = 0;
     unsigned episodes = 1;
     bool table = false;
+    std::string controller = "body";
     long svg_tick = -1;
 };
 
@@ -152,7 +155,7 @@ int cmd_run(const RunOpts &o) {
     const qnav_policy_t pol = read_policy(o.policy, l.robot);
     std::vector<qnav_qkey_t> tbuf;
     qnav_ctrl_t ctrl;
-    init_ctrl(l.sim, pol, o.table, tbuf, &ctrl);
+    init_ctrl(l.sim, pol, o.table, tbuf, &ctrl, o.controller == "literal");
     std::printf("robot %s  env %s  sectors %u  sensor noise %.3f  actuation noise %.3f  seed %llu  "
                 "fitness %s  policy %s%s\n",
                 ri.name, sim.env().name.c_str(), sim.config().n_sectors, ps, pa,
@@ -367,6 +370,10 @@ int main(int argc, char **argv) {
     run->add_option("--episode", ro.episode, "first episode seed")->capture_default_str();
     run->add_option("--episodes", ro.episodes, "number of episodes")->check(CLI::Range(1u, 1000000u))->capture_default_str();
     run->add_flag("--table", ro.table, "run the controller in table mode");
+    run->add_option("--controller", ro.controller,
+                    "body: obstacles enlarged by the robot's radius + safety distance, speed guard, "
+                    "rank by pre-activation; literal: the paper's per-sector reading (ablation)")
+        ->check(CLI::IsMember({"body", "literal"}))->capture_default_str();
     run->add_option("--svg", ro.svg, "write the first episode's picture here");
     run->add_option("--trace", ro.trace, "write the first episode's trajectory here (CSV, one row per tick)");
     run->add_option("--svg-tick", ro.svg_tick, "tick whose sonar sectors are drawn (default 0; past the end: the last tick)")->check(CLI::NonNegativeNumber);

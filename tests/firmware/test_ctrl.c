@@ -69,10 +69,9 @@ static void init_literal(qnav_ctrl_t *c, uint16_t sectors, qnav_mm_t max_mm, con
     qnav_ctrl_config_default(&cfg);
     cfg.n_sectors = sectors;
     cfg.max_range_mm = max_mm;
-    cfg.body_radius_mm = 0;
-    cfg.safety_mm = 0;
-    cfg.decel_mm_s2 = 0;
-    cfg.rank = (uint8_t)QNAV_RANK_QUALITY;
+    qnav_ctrl_config_literal(&cfg);
+    assert_int_equal(cfg.body_radius_mm, 0);
+    assert_int_equal(cfg.rank, QNAV_RANK_QUALITY);
     assert_int_equal(qnav_ctrl_init(c, &cfg, p), QNAV_OK);
 }
 
@@ -560,7 +559,8 @@ static void test_enlargement_blocks_paths_beside_a_near_obstacle(void **state)
     assert_int_equal(qnav_ctrl_path_levels(&c, ranges, lvl), 0);
     uint8_t near = qnav_ctrl_level(&c, 500);
     /* the body (0.17 m with the margin) hits it on every path within asin(0.17 / D) */
-    double gamma = asin(170.0 / level_floor(&c, near)) * 180.0 / M_PI;
+    /* D from the centre: the range plus the default sensor offset (the body's rim, 120) */
+    double gamma = asin(170.0 / (level_floor(&c, near) + 120.0)) * 180.0 / M_PI;
     for (unsigned i = 0; i < QNAV_PATHS; ++i) {
         unsigned off = i <= 180 ? i : 360 - i;
         if (off + 1e-9 < gamma) {
@@ -591,7 +591,7 @@ static void test_enlargement_matches_asin_at_every_level(void **state)
     init_body(&c, 360, 2500, 120, 50, 0, &p);
     for (unsigned level = 0; level + 1 < QNAV_DIST_LEVELS; ++level) {
         unsigned d = level_floor(&c, level);
-        double ratio = d == 0 ? 2.0 : 170.0 / d;
+        double ratio = 170.0 / (d + 120.0);
         double g = ratio >= 1.0 ? 90.0 : asin(ratio) * 180.0 / M_PI;
         unsigned blocked = 0;
         fill(ranges, 360, 2500);
@@ -626,7 +626,7 @@ static void test_enlargement_lowers_collisions_with_sector_count_not_raises(void
         ranges[qnav_ctrl_sector_of_path(n, 30)] = 250; /* 0.25 m away at 30 degrees */
         qnav_ctrl_path_levels(&c, ranges, lvl);
         assert_int_equal(lvl[30], qnav_ctrl_level(&c, 250));
-        /* gamma(0.25 m) > 30 degrees: the straight path is blocked too */
+        /* gamma(0.25 m + 0.12 m) = 27 degrees (+ the wedge): the straight path is blocked too */
         assert_int_equal(lvl[0], qnav_ctrl_level(&c, 250));
     }
 }
@@ -652,12 +652,13 @@ static void test_speed_guard_caps_speed_to_stop_within_clearance(void **state)
         assert_int_equal(of.speed, QNAV_Q1_15_MAX);
         assert_false(of.flags & QNAV_FLAG_SPEED_GUARD);
         /* v T + v^2 / (2 a) within the clearance D - r - d_s, D the level's nearest range */
-        double s_mm = (double)level_floor(&guarded, qnav_ctrl_level(&guarded, r)) - 170.0;
+        double s_mm = (double)level_floor(&guarded, qnav_ctrl_level(&guarded, r)) + 120.0 - 170.0;
         double v = s_mm <= 0 ? 0 : -200.0 + sqrt(200.0 * 200.0 + 4000.0 * s_mm);
         double cap = v / 500.0 * 32768.0;
         if (cap < 32767.0 && qnav_ctrl_level(&guarded, r) + 1 < QNAV_DIST_LEVELS) {
             assert_true(og.flags & QNAV_FLAG_SPEED_GUARD);
-            assert_in_range(og.speed, (int)floor(cap) - 2 < 0 ? 0 : (int)floor(cap) - 2, (int)cap);
+            /* the integer square root works in whole mm/s: 1 mm/s is 66 LSB of 500 mm/s */
+            assert_in_range(og.speed, (int)floor(cap) - 70 < 0 ? 0 : (int)floor(cap) - 70, (int)cap);
         } else {
             assert_int_equal(og.speed, QNAV_Q1_15_MAX);
         }

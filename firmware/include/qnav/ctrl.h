@@ -69,6 +69,9 @@ typedef struct {
                                          asin((r + d_s) / D); both 0: the paper's per-sector
                                          mapping. Default 120 (TekBot class) */
     qnav_mm_t safety_mm;              /* safety distance d_s added to r, mm; default 50 */
+    qnav_mm_t sensor_offset_mm;       /* robot centre to where ranges are measured from, mm
+                                         (transducers on the body's rim: r); D = range +
+                                         offset. Default 120 */
     uint16_t v_max_mm_s;              /* speed 1.0 in mm/s, for the speed guard; default 500 */
     uint16_t decel_mm_s2;             /* braking deceleration, mm/s^2; the speed guard keeps
                                          v T + v^2 / (2 a) within the chosen path's clearance
@@ -131,8 +134,14 @@ typedef struct {
 #define QNAV_QTABLE_ENTRIES ((uint16_t)(QNAV_DIST_LEVELS * (QNAV_DTHETA_MAX + 1)))
 
 /* Defaults: 16 sectors, 5000 mm, full speed at quality 0.9, a TekBot-class body (radius
- * 120 mm, safety 50 mm, 500 mm/s, braking 2000 mm/s^2), rank by pre-activation. */
+ * 120 mm with the sonar on its rim, safety 50 mm, 500 mm/s, braking 2000 mm/s^2), rank by
+ * pre-activation. */
 void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg);
+
+/* The paper read literally, kept as an ablation: every path sees only its own sector
+ * (zero radius and safety distance), no speed guard, rank by quality. Other fields are
+ * left as they are. */
+void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg);
 
 /*
  * Check cfg and policy and derive the step's parameters into ctrl.
