@@ -63,8 +63,16 @@ struct CheckpointSummary {
     TestResult arrival_vs_direct;     /* Mann-Whitney on the arrival fractions */
 };
 
+/* What a condition is: the summary dispatches on this, never on its label's text. */
+enum class ConditionKind {
+    Transfer,      /* "transfer-<source label>": seeded from a source's best */
+    Direct,        /* "direct": a random initial population in the target */
+    Probabilistic  /* "probabilistic": the hand-tuned policy, held out only */
+};
+
 struct ConditionSummary {
     std::string label;               /* "transfer-open", "direct", "probabilistic" */
+    ConditionKind kind = ConditionKind::Direct;
     std::vector<double> final_per_run; /* held-out mean R per run (probabilistic: per episode) */
     double final_mean = 0, final_ci = 0, final_sd = 0;
     std::vector<double> curve_mean, curve_ci; /* candidates' R: per bin, mean over runs */
@@ -98,6 +106,7 @@ struct ConditionSummary {
 
 struct Comparison {
     std::string a, b;
+    ConditionKind b_kind = ConditionKind::Direct; /* Direct (runs vs runs) or Probabilistic */
     double difference = 0;       /* mean_a - mean_b, R units */
     double improvement_pct = 0;  /* (mean_a - mean_b) / |mean_b| * 100; NaN when
                                     |mean_b| < 1 (a percentage of almost nothing) */

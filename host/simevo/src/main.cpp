@@ -93,7 +93,7 @@ void print_transfer_arrival(const ExperimentSpec &s, const std::string &dir)
 {
     const ExperimentSummary S = summarize(s, plan_tasks(s, dir));
     for (const ConditionSummary &c : S.conditions) {
-        if (c.label.rfind("transfer-", 0) != 0 || c.best_run < 0) {
+        if (c.kind != ConditionKind::Transfer || c.best_run < 0) {
             continue;
         }
         char run[16];
