@@ -245,6 +245,18 @@ static void test_evolution_improves_fitness_on_fake_task(void **state)
     assert_true(last > first_best + 1.0);
 }
 
+static void test_wilson_interval_matches_hand_values_and_stays_inside_0_1(void **state)
+{
+    (void)state;
+    double lo = -1, hi = -1;
+    wilson_ci95(10, 20, &lo, &hi);
+    assert_true(std::fabs(lo - 0.2993) < 5e-4 && std::fabs(hi - 0.7007) < 5e-4);
+    wilson_ci95(0, 20, &lo, &hi);
+    assert_true(lo == 0.0 && std::fabs(hi - 0.1611) < 5e-4);
+    wilson_ci95(20, 20, &lo, &hi);
+    assert_true(std::fabs(lo - 0.8389) < 5e-4 && std::fabs(hi - 1.0) < 1e-12);
+}
+
 static void test_t_critical_and_welch_match_tables(void **state)
 {
     (void)state;
@@ -396,6 +408,7 @@ int main(void)
         cmocka_unit_test(test_transfer_population_is_source_plus_mutants_first_episode_random),
         cmocka_unit_test(test_same_seed_gives_identical_evolution),
         cmocka_unit_test(test_evolution_improves_fitness_on_fake_task),
+        cmocka_unit_test(test_wilson_interval_matches_hand_values_and_stays_inside_0_1),
         cmocka_unit_test(test_t_critical_and_welch_match_tables),
         cmocka_unit_test(test_mann_whitney_separated_samples_are_significant),
         cmocka_unit_test(test_spec_parses_inheritance_and_presets),

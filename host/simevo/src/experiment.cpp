@@ -380,20 +380,11 @@ Interval t_interval(const std::vector<double> &x, double lo_bound, double hi_bou
     return v;
 }
 
-/* Wilson score interval of a proportion (95%): honest at 0% and 100%, unlike mean ± t. */
 Interval wilson_interval(double successes, double n)
 {
     Interval v;
-    if (n <= 0) {
-        return v;
-    }
-    const double z = 1.959963984540054, p = successes / n;
-    const double d = 1 + z * z / n;
-    const double c = (p + z * z / (2 * n)) / d;
-    const double h = z * std::sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d;
-    v.mean = p;
-    v.lo = std::max(0.0, c - h);
-    v.hi = std::min(1.0, c + h);
+    v.mean = n > 0 ? successes / n : 0.0;
+    wilson_ci95(successes, n, &v.lo, &v.hi);
     return v;
 }
 

@@ -344,17 +344,20 @@ int main(int argc, char **argv)
             } else {
                 p = read_policy_file(policy_arg);
             }
-            std::vector<double> R;
-            uint32_t reached = 0, tau = 0;
+            std::vector<double> R, tau;
+            uint32_t reached = 0;
             for (uint32_t i = 0; i < e_episodes; ++i) {
                 const EpisodeOutcome o = runner.run(p, mix_seed(e_seed, i));
                 R.push_back(o.R);
                 reached += o.reached;
-                tau += o.tau_c;
+                tau.push_back(o.tau_c);
             }
-            std::printf("episodes %u  mean R %.3f ± %.3f (95%% CI)  sd %.3f  reached %.0f%%  mean tau_c %.1f ticks\n",
-                        e_episodes, mean_of(R), ci95_half_width(R), sd_of(R),
-                        100.0 * reached / std::max(1u, e_episodes), static_cast<double>(tau) / std::max(1u, e_episodes));
+            double lo = 0, hi = 0;
+            wilson_ci95(reached, e_episodes, &lo, &hi);
+            std::printf("episodes %u  mean R %.3f ± %.3f (95%% CI)  sd %.3f  reached %.0f%% (95%% CI %.0f-%.0f%%)  "
+                        "mean tau_c %.1f ± %.1f ticks\n",
+                        e_episodes, mean_of(R), ci95_half_width(R), sd_of(R), 100.0 * reached / std::max(1u, e_episodes),
+                        100.0 * lo, 100.0 * hi, mean_of(tau), ci95_half_width(tau));
             return 0;
         }
     } catch (const UserError &e) {

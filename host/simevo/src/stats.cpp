@@ -151,6 +151,20 @@ TestResult one_sample_t_test(const std::vector<double> &a, double mu)
     return r;
 }
 
+void wilson_ci95(double successes, double n, double *lo, double *hi)
+{
+    *lo = *hi = 0.0;
+    if (n <= 0) {
+        return;
+    }
+    const double z = 1.959963984540054, p = successes / n;
+    const double d = 1 + z * z / n;
+    const double c = (p + z * z / (2 * n)) / d;
+    const double h = z * std::sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d;
+    *lo = std::max(0.0, c - h);
+    *hi = std::min(1.0, c + h);
+}
+
 TestResult mann_whitney(const std::vector<double> &a, const std::vector<double> &b)
 {
     TestResult r;

@@ -24,6 +24,10 @@ double t_critical(double df, double alpha);
 /* Half-width of the 95% confidence interval of the mean (0 for n < 2). */
 double ci95_half_width(const std::vector<double> &x);
 
+/* 95% Wilson score interval [*lo, *hi] of a proportion successes / n (honest at 0 and n,
+ * unlike mean ± t); [0, 0] for n = 0. */
+void wilson_ci95(double successes, double n, double *lo, double *hi);
+
 struct TestResult {
     double statistic = 0.0; /* t, or z for Mann-Whitney */
     double df = 0.0;        /* degrees of freedom (t tests) */
