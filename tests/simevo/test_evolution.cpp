@@ -346,6 +346,25 @@ static void test_spec_fitness_rule_reaches_every_scenario(void **state)
     assert_true(s.target.describe().find("fitness=paper") != std::string::npos);
 }
 
+static void test_spec_controller_reading_reaches_every_scenario_and_bad_names_fail(void **state)
+{
+    (void)state;
+    ExperimentSpec d = parse_experiment(kGoodSpec, "x.toml");
+    assert_true(d.target.controller == ControllerReading::Body); // the default
+    ExperimentSpec s = parse_experiment(
+        "name = \"t\"\n[evolution]\ncontroller = \"literal\"\n[target]\nepisodes = 9\n[[source]]\nlabel = \"a\"\n", "x.toml");
+    assert_true(s.target.controller == ControllerReading::Literal);
+    assert_true(s.sources[0].scenario.controller == ControllerReading::Literal);
+    assert_true(s.target.describe().find("controller=literal") != std::string::npos);
+    try {
+        (void)parse_experiment("name = \"t\"\n[evolution]\ncontroller = \"wide\"\n[target]\nepisodes = 9\n", "x.toml");
+        fail_msg("a bad controller name was accepted");
+    } catch (const UserError &e) {
+        assert_true(std::string(e.what()).find("x.toml:3: controller: 'wide' is not one of body, literal") !=
+                    std::string::npos);
+    }
+}
+
 static void test_spec_checkpoints_parse_and_presets_shrink_their_evaluation(void **state)
 {
     (void)state;
@@ -413,6 +432,7 @@ int main(void)
         cmocka_unit_test(test_mann_whitney_separated_samples_are_significant),
         cmocka_unit_test(test_spec_parses_inheritance_and_presets),
         cmocka_unit_test(test_spec_fitness_rule_reaches_every_scenario),
+        cmocka_unit_test(test_spec_controller_reading_reaches_every_scenario_and_bad_names_fail),
         cmocka_unit_test(test_spec_checkpoints_parse_and_presets_shrink_their_evaluation),
         cmocka_unit_test(test_spec_errors_name_file_line_and_problem),
     };

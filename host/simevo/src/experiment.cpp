@@ -761,6 +761,7 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
       << ",\n  \"eval_episodes\": " << spec.eval_episodes << ",\n  \"curve_bin\": " << spec.curve_bin
       << ",\n  \"episodes_per_candidate\": " << S.k << ",\n  \"fitness\": "
       << json_str(qnav_sim_fitness_rule_name(spec.target.fitness))
+      << ",\n  \"controller\": " << json_str(controller_reading_name(spec.target.controller))
       << ",\n  \"arrival_threshold\": " << json_num(S.arrival_threshold)
       << ",\n  \"checkpoint_episodes\": " << S.checkpoint_episodes
       << ",\n  \"environment_file\": " << json_str(env_file) << ",\n  \"robot_radius_m\": " << json_num(robot_radius_m)
@@ -875,7 +876,8 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
       << spec.title << "\n\n"
       << "Preset `" << opt.preset << "`: " << spec.runs << " runs, " << spec.target_episodes
       << " target episodes per run (" << S.k << " per candidate), fitness rule `"
-      << qnav_sim_fitness_rule_name(spec.target.fitness) << "`, population " << spec.evolution.population << ", epsilon "
+      << qnav_sim_fitness_rule_name(spec.target.fitness) << "`, controller `"
+      << controller_reading_name(spec.target.controller) << "`, population " << spec.evolution.population << ", epsilon "
       << fmt(spec.evolution.epsilon, 2) << ", " << spec.evolution.hidden << " hidden units; final performance = each run's best policy over "
       << spec.eval_episodes << " held-out episodes (the same set for every run and condition).\n\n"
       << "Target: " << spec.target.describe() << "\n\n";

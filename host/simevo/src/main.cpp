@@ -68,6 +68,16 @@ std::string resolve_experiment(const std::string &arg, const std::string &dir)
     return path;
 }
 
+/* set(scenario) for the target and every source of s (settings that apply to all). */
+template <typename F>
+void for_each_scenario(ExperimentSpec &s, F set)
+{
+    set(s.target);
+    for (SourceSpec &src : s.sources) {
+        set(src.scenario);
+    }
+}
+
 /* The rule --fitness names ("" = the default). Throws UserError. */
 qnav_sim_fitness_rule_t fitness_option(const std::string &name)
 {
@@ -78,14 +88,21 @@ qnav_sim_fitness_rule_t fitness_option(const std::string &name)
     return rule;
 }
 
+/* --controller NAME for every scenario of s. Throws UserError. */
+void set_controller(ExperimentSpec &s, const std::string &name)
+{
+    ControllerReading c;
+    if (!controller_reading_parse(name, &c)) {
+        throw UserError("--controller: '" + name + "' is not one of body, literal");
+    }
+    for_each_scenario(s, [c](Scenario &sc) { sc.controller = c; });
+}
+
 /* --fitness NAME for every scenario of s. Throws UserError. */
 void set_fitness(ExperimentSpec &s, const std::string &name)
 {
     const qnav_sim_fitness_rule_t rule = fitness_option(name);
-    s.target.fitness = rule;
-    for (auto &src : s.sources) {
-        src.scenario.fitness = rule;
-    }
+    for_each_scenario(s, [rule](Scenario &sc) { sc.fitness = rule; });
 }
 
 /* What a user takes to a robot: each transfer's best policy and how often it arrives. */
@@ -135,7 +152,7 @@ int main(int argc, char **argv)
     opt.tools_dir = env_or("QNAV_TOOLS_DIR", std::string(QNAV_SOURCE_DIR) + "/tools");
     std::string preset = "full";
     int64_t runs = 0, episodes = 0, source_episodes = 0, eval_episodes = 0, seed = -1, per_candidate = 0;
-    std::string fitness;
+    std::string fitness, controller;
     bool no_plot = false, no_progress = false, network_mode = false;
     run->add_option("experiment", names, "experiment name(s), a .toml path, or 'all'")->required();
     run->add_option("--preset", preset, "'full' (the file's values) or a preset the file defines, e.g. 'quick'")->capture_default_str();
@@ -148,6 +165,9 @@ int main(int argc, char **argv)
     run->add_option("--seed", seed, "override the master seed")->check(CLI::Range(int64_t(0), INT64_MAX));
     run->add_option("--per-candidate", per_candidate, "override episodes per candidate (k)")->check(CLI::Range(int64_t(1), int64_t(1000)));
     run->add_option("--fitness", fitness, "override the fitness rule: progress or paper (docs/sim.md)");
+    run->add_option("--controller", controller,
+                    "override the controller's reading: body, or literal (the paper's per-sector "
+                    "mapping, no speed guard, rank by quality; docs/architecture.md)");
     run->add_option("--tools-dir", opt.tools_dir, "folder with plot_learning.py and plot_policy.py")->capture_default_str();
     run->add_flag("--no-plot", no_plot, "skip the PNG plots");
     run->add_flag("--no-progress", no_progress, "no progress line even on a terminal");
@@ -254,6 +274,7 @@ int main(int argc, char **argv)
                 if (seed >= 0) s.seed = static_cast<uint64_t>(seed);
                 if (per_candidate > 0) s.evolution.episodes_per_candidate = static_cast<uint32_t>(per_candidate);
                 if (!fitness.empty()) set_fitness(s, fitness);
+                if (!controller.empty()) set_controller(s, controller);
                 specs.push_back(s);
             }
             opt.plots = !no_plot;

@@ -69,6 +69,9 @@ SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t conte
         throw UserError(std::string("simulator (") + scenario.describe() + "): " + err);
     }
     qnav_sim_ctrl_config(sim_, &ctrl_cfg_);
+    if (scenario.controller == ControllerReading::Literal) {
+        qnav_ctrl_config_literal(&ctrl_cfg_);
+    }
     qnav_sim_robot_prob_policy(robot, &prob_);
 }
 

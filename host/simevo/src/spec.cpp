@@ -12,6 +12,28 @@
 
 namespace qnav {
 
+const char *controller_reading_name(ControllerReading c)
+{
+    switch (c) {
+    case ControllerReading::Body:
+        return "body";
+    case ControllerReading::Literal:
+        return "literal";
+    }
+    return "body";
+}
+
+bool controller_reading_parse(const std::string &name, ControllerReading *out)
+{
+    for (ControllerReading c : {ControllerReading::Body, ControllerReading::Literal}) {
+        if (name == controller_reading_name(c)) {
+            *out = c;
+            return true;
+        }
+    }
+    return false;
+}
+
 std::string Scenario::describe() const
 {
     std::ostringstream o;
@@ -19,7 +41,8 @@ std::string Scenario::describe() const
     o << "environment=" << environment << " robot=" << robot << " sectors=" << sectors
       << " sensor_noise=" << sensor_noise << " actuation_noise=" << actuation_noise
       << " episode_limit_s=" << episode_limit_s
-      << " fitness=" << qnav_sim_fitness_rule_name(fitness);
+      << " fitness=" << qnav_sim_fitness_rule_name(fitness)
+      << " controller=" << controller_reading_name(controller);
     return o.str();
 }
 
@@ -210,7 +233,7 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
         const toml::table &t = p.table(*n, "evolution");
         p.only_keys(t, {"population", "epsilon", "hidden", "mutation_scale", "mutation_clip",
                         "episodes_per_candidate", "reevaluate_parent", "init", "init_scale",
-                        "fitness"},
+                        "fitness", "controller"},
                     "evolution");
         EvolutionParams &e = spec.evolution;
         if (auto *v = t.get("population")) {
@@ -255,6 +278,13 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
             const std::string s = p.str(*v, "fitness");
             if (qnav_sim_fitness_rule_parse(s.c_str(), &spec.target.fitness) != QNAV_SIM_OK) {
                 p.fail(*v, "fitness: '" + s + "' is not one of " + qnav_sim_fitness_rule_names());
+            }
+        }
+        if (auto *v = t.get("controller")) {
+            // Like fitness: one reading for the target and every source.
+            const std::string s = p.str(*v, "controller");
+            if (!controller_reading_parse(s, &spec.target.controller)) {
+                p.fail(*v, "controller: '" + s + "' is not one of body, literal");
             }
         }
     }

@@ -26,6 +26,16 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/* How the controller reads the paper (docs/architecture.md): Body = obstacles enlarged by
+ * the robot's radius + safety distance, speed guard, networks ranked by pre-activation;
+ * Literal = each path sees its own sector, no guard, ranked by quality (the ablation). */
+enum class ControllerReading { Body, Literal };
+
+/* "body" / "literal". */
+const char *controller_reading_name(ControllerReading c);
+/* Parses a name; false when it is not one. */
+bool controller_reading_parse(const std::string &name, ControllerReading *out);
+
 /* The situation a policy is evolved or evaluated in. */
 struct Scenario {
     std::string environment = "dense"; /* sim environment: name or file */
@@ -36,6 +46,8 @@ struct Scenario {
     double episode_limit_s = 0.0;       /* s; 0 = the environment's limit */
     qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS; /* how R is computed;
                                            set for every scenario from [evolution] fitness */
+    ControllerReading controller = ControllerReading::Body; /* set for every scenario from
+                                           [evolution] controller */
 
     /* Canonical one-line description (also part of task fingerprints). */
     std::string describe() const;
