@@ -191,21 +191,11 @@ bool valid_name(const std::string &s)
 
 } // namespace
 
-ExperimentSpec parse_experiment(const std::string &text, const std::string &name)
+namespace {
+
+/* the top-level keys: name, title, figure, runs, seed, curve_bin. Throws UserError. */
+void parse_header(const Parser &p, const toml::table &root, ExperimentSpec &spec)
 {
-    Parser p(name);
-    toml::table root;
-    try {
-        root = toml::parse(text, name);
-    } catch (const toml::parse_error &e) {
-        throw UserError(name + ":" + std::to_string(e.source().begin.line) + ": " +
-                        std::string(e.description()));
-    }
-    ExperimentSpec spec;
-    spec.file = name;
-    p.only_keys(root, {"name", "title", "figure", "runs", "seed", "curve_bin", "evolution",
-                       "target", "source", "evaluation", "preset"},
-                "");
     if (!root.contains("name")) {
         p.fail_line(1, "name: missing (the experiment's identifier)");
     }
@@ -228,7 +218,11 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
     if (auto *n = root.get("curve_bin")) {
         spec.curve_bin = static_cast<uint32_t>(p.integer(*n, "curve_bin", 1, 100000));
     }
+}
 
+/* [evolution]: the algorithm's settings, the fitness rule and the controller reading. Throws UserError. */
+void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &spec)
+{
     if (auto *n = root.get("evolution")) {
         const toml::table &t = p.table(*n, "evolution");
         p.only_keys(t, {"population", "epsilon", "hidden", "mutation_scale", "mutation_clip",
@@ -288,7 +282,11 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
             }
         }
     }
+}
 
+/* [target]: the situation transfer and direct evolution share. Throws UserError. */
+void parse_target(const Parser &p, const toml::table &root, ExperimentSpec &spec)
+{
     if (!root.contains("target")) {
         p.fail_line(1, "[target]: missing (the situation transfer and direct evolution share)");
     }
@@ -307,7 +305,11 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
             }
         }
     }
+}
 
+/* [[source]]: the situations whose best policies seed transfers (they inherit [target]). Throws UserError. */
+void parse_sources(const Parser &p, const toml::table &root, ExperimentSpec &spec)
+{
     if (auto *n = root.get("source")) {
         if (!n->is_array_of_tables()) {
             p.fail(*n, "source: expected [[source]] tables");
@@ -354,7 +356,11 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
     if (spec.sources.empty()) {
         p.fail_line(1, "[[source]]: at least one source situation is needed for a transfer");
     }
+}
 
+/* [evaluation]: the held-out set and the checkpoints. Throws UserError. */
+void parse_evaluation(const Parser &p, const toml::table &root, ExperimentSpec &spec)
+{
     if (auto *n = root.get("evaluation")) {
         const toml::table &t = p.table(*n, "evaluation");
         p.only_keys(t, {"episodes", "seed", "checkpoints", "checkpoint_every", "checkpoint_episodes",
@@ -379,7 +385,11 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
             spec.arrival_threshold = p.number(*v, "arrival_threshold", 0.0, 100.0) / 100.0;
         }
     }
+}
 
+/* [preset.NAME]: overrides selected with --preset. Throws UserError. */
+void parse_presets(const Parser &p, const toml::table &root, ExperimentSpec &spec)
+{
     if (auto *n = root.get("preset")) {
         const toml::table &all = p.table(*n, "preset");
         for (auto &&[k, v] : all) {
@@ -415,6 +425,31 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
             spec.presets[pname] = pr;
         }
     }
+}
+
+} // namespace
+
+ExperimentSpec parse_experiment(const std::string &text, const std::string &name)
+{
+    Parser p(name);
+    toml::table root;
+    try {
+        root = toml::parse(text, name);
+    } catch (const toml::parse_error &e) {
+        throw UserError(name + ":" + std::to_string(e.source().begin.line) + ": " +
+                        std::string(e.description()));
+    }
+    ExperimentSpec spec;
+    spec.file = name;
+    p.only_keys(root, {"name", "title", "figure", "runs", "seed", "curve_bin", "evolution",
+                       "target", "source", "evaluation", "preset"},
+                "");
+    parse_header(p, root, spec);
+    parse_evolution(p, root, spec);
+    parse_target(p, root, spec);
+    parse_sources(p, root, spec);
+    parse_evaluation(p, root, spec);
+    parse_presets(p, root, spec);
     return spec;
 }
 
