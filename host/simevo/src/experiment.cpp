@@ -922,7 +922,8 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
         o << "![learning curves](learning.png)\n\n![policy quality](policy.png)\n\n"
           << "![held-out episodes of the best policies](episodes.png)\n\n";
     }
-    o << "Regenerate: `simevo run " << spec.name << " --preset " << opt.preset << "` (with the same `--out`)\n";
+    o << "Regenerate: `simevo run " << spec.name << " --preset " << opt.preset << opt.overrides
+      << "` (with the same `--out`)\n";
     return o.str();
 }
 

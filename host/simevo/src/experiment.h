@@ -30,6 +30,8 @@ struct RunOptions {
     std::string python = "/usr/bin/python3";
     bool use_table = true;          /* table-mode controller (bit-identical, faster) */
     std::string preset = "full";    /* recorded in the summary's command line */
+    std::string overrides;          /* the command line's overrides (" --runs 3 ..."), also
+                                       recorded there, so the line regenerates these results */
 };
 
 /* Target episodes after which a target run's best member is evaluated held out: the

@@ -105,6 +105,28 @@ void set_fitness(ExperimentSpec &s, const std::string &name)
     for_each_scenario(s, [rule](Scenario &sc) { sc.fitness = rule; });
 }
 
+/* The overrides given to `simevo run` that change results, as flags (" --runs 3 --fitness
+ * paper"); --network-mode is not one (bit-identical to table mode by design). */
+std::string override_flags(int64_t runs, int64_t episodes, int64_t source_episodes, int64_t eval_episodes, int64_t seed,
+                           int64_t per_candidate, const std::string &fitness, const std::string &controller)
+{
+    std::string o;
+    auto add = [&o](const char *flag, int64_t v, bool given) {
+        if (given) {
+            o += std::string(" ") + flag + " " + std::to_string(v);
+        }
+    };
+    add("--runs", runs, runs > 0);
+    add("--episodes", episodes, episodes > 0);
+    add("--source-episodes", source_episodes, source_episodes > 0);
+    add("--eval-episodes", eval_episodes, eval_episodes > 0);
+    add("--seed", seed, seed >= 0);
+    add("--per-candidate", per_candidate, per_candidate > 0);
+    o += fitness.empty() ? "" : " --fitness " + fitness;
+    o += controller.empty() ? "" : " --controller " + controller;
+    return o;
+}
+
 /* What a user takes to a robot: each transfer's best policy and how often it arrives. */
 void print_transfer_arrival(const ExperimentSpec &s, const std::string &dir)
 {
@@ -281,6 +303,8 @@ int main(int argc, char **argv)
             opt.progress = no_progress ? 0 : -1;
             opt.use_table = !network_mode;
             opt.preset = preset;
+            opt.overrides = override_flags(runs, episodes, source_episodes, eval_episodes, seed, per_candidate, fitness,
+                                           controller);
             for (const auto &s : specs) {
                 const auto t0 = std::chrono::steady_clock::now();
                 const std::string dir = run_experiment(s, opt);
