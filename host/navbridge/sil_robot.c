@@ -27,6 +27,7 @@
 #include "qnav/ctrl.h"
 #include "qnav/link.h"
 #include "qnav/sim.h"
+#include "ptylink.h"
 #include "qnav_pose_t.h"
 #include "serial.h"
 
@@ -219,8 +220,8 @@ int main(int argc, char **argv)
     static qnav_sim_scan_t scan;
     static robot_t r;
     lcm_t *lcm = NULL;
-    int slave_keep;
-    char *slave;
+    int slave_keep, linked = 0;
+    char *slave = NULL;
     struct termios tio;
     struct sigaction sa;
     uint32_t missed = 0;
@@ -287,12 +288,12 @@ int main(int argc, char **argv)
     }
     fcntl(r.fd, F_SETFL, fcntl(r.fd, F_GETFL) | O_NONBLOCK);
     if (link_path != NULL) {
-        unlink(link_path);
-        if (symlink(slave, link_path) != 0) {
-            fprintf(stderr, "qnav-sil-robot: --link %s: %s\n", link_path, strerror(errno));
+        if (qnav_ptylink_make(link_path, slave, err, sizeof err) != 0) {
+            fprintf(stderr, "qnav-sil-robot: %s\n", err);
             rc = 2;
             goto out;
         }
+        linked = 1;
     }
     printf("qnav-sil-robot: link on %s%s%s\n", slave, link_path ? " = " : "",
            link_path ? link_path : "");
@@ -445,8 +446,8 @@ int main(int argc, char **argv)
     fflush(stdout);
     rc = g_quit ? 4 : (res.reached ? 0 : 1);
 out:
-    if (link_path != NULL) {
-        unlink(link_path);
+    if (linked) {
+        qnav_ptylink_remove(link_path, slave);
     }
     if (lcm != NULL) {
         lcm_destroy(lcm);

@@ -18,9 +18,12 @@
 #include <unistd.h>
 
 #include <simavr/avr_adc.h>
+#include <simavr/avr_uart.h>
 #include <simavr/parts/uart_pty.h>
 #include <simavr/sim_avr.h>
 #include <simavr/sim_elf.h>
+
+#include "ptylink.h"
 
 static volatile sig_atomic_t g_quit = 0;
 
@@ -45,6 +48,55 @@ static int64_t mono_us(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
+/* the accessors of the part's fifo (its header only declares the type) */
+DEFINE_FIFO(uint8_t, uart_pty_fifo);
+
+/* The USART's flow control, as uart_pty_connect() registers it: bytes from the pty wait in
+ * the part's fifo and go on to the MCU while the USART has room (xon), from this hook. */
+static void on_uart_xon(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    uart_pty_t *p = (uart_pty_t *)param;
+    (void)irq;
+    (void)value;
+    p->xon = 1;
+    while (p->xon && !uart_pty_fifo_isempty(&p->pty.out)) {
+        avr_raise_irq(p->irq + IRQ_UART_PTY_BYTE_OUT, uart_pty_fifo_read(&p->pty.out));
+    }
+}
+
+static void on_uart_xoff(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    (void)irq;
+    (void)value;
+    ((uart_pty_t *)param)->xon = 0;
+}
+
+/* USART0 <-> the pty, what uart_pty_connect(p, '0') does minus the fixed, shared link
+ * /tmp/simavr-uart0 that it unlinks and remakes (two boards would take each other's, and
+ * it deletes whatever file has that name). The pty's own /dev/pts/N name is unique. */
+static void connect_uart0(avr_t *avr, uart_pty_t *p)
+{
+    uint32_t flags = 0;
+    avr_irq_t *src = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT);
+    avr_irq_t *dst = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
+    avr_irq_t *xon = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XON);
+    avr_irq_t *xoff = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF);
+    /* binary frames: no copy of the UART on stdout */
+    avr_ioctl(avr, AVR_IOCTL_UART_GET_FLAGS('0'), &flags);
+    flags &= ~(uint32_t)AVR_UART_FLAG_STDIO;
+    avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
+    if (src != NULL && dst != NULL) {
+        avr_connect_irq(src, p->irq + IRQ_UART_PTY_BYTE_IN);
+        avr_connect_irq(p->irq + IRQ_UART_PTY_BYTE_OUT, dst);
+    }
+    if (xon != NULL) {
+        avr_irq_register_notify(xon, on_uart_xon, p);
+    }
+    if (xoff != NULL) {
+        avr_irq_register_notify(xoff, on_uart_xoff, p);
+    }
+}
+
 /* Sonar k's voltage for a range in mm at 5 V: 12.7 mm per ADC count of 4.883 mV. */
 static uint32_t range_to_mv(uint32_t mm)
 {
@@ -66,6 +118,7 @@ int main(int argc, char **argv)
     int64_t t0;
     uint64_t last_scene = (uint64_t)-1;
     int c, k, state = cpu_Running;
+    char err[512];
 
     opterr = 0;
     while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
@@ -123,13 +176,11 @@ int main(int argc, char **argv)
     avr->aref = 5000;
 
     uart_pty_init(avr, &pty);
-    uart_pty_connect(&pty, '0');
-    if (link_path != NULL) {
-        unlink(link_path);
-        if (symlink(pty.pty.slavename, link_path) != 0) {
-            fprintf(stderr, "qnav-simavr-board: --link %s: %s\n", link_path, strerror(errno));
-            return 2;
-        }
+    connect_uart0(avr, &pty);
+    if (link_path != NULL &&
+        qnav_ptylink_make(link_path, pty.pty.slavename, err, sizeof err) != 0) {
+        fprintf(stderr, "qnav-simavr-board: %s\n", err);
+        return 2;
     }
     printf("qnav-simavr-board: %s (%s, %u Hz) with USART0 on %s%s%s\n", elf, fw.mmcu,
            (unsigned)fw.frequency, pty.pty.slavename, link_path ? " = " : "",
@@ -170,19 +221,7 @@ int main(int argc, char **argv)
            state == cpu_Crashed ? "crashed" : (g_quit ? "signal" : "done"));
     fflush(stdout);
     /* not uart_pty_stop(): in simavr 1.6 it joins a thread that never returns. Exiting
-     * ends that thread; only the links made here (and simavr's own) are removed. */
-    if (link_path != NULL) {
-        unlink(link_path);
-    }
-    {
-        char target[128];
-        ssize_t n = readlink("/tmp/simavr-uart0", target, sizeof target - 1);
-        if (n > 0) {
-            target[n] = '\0';
-            if (strcmp(target, pty.pty.slavename) == 0) {
-                unlink("/tmp/simavr-uart0");
-            }
-        }
-    }
+     * ends that thread; only the link made here is removed, and only if still ours. */
+    qnav_ptylink_remove(link_path, pty.pty.slavename);
     return state == cpu_Crashed ? 1 : 0;
 }
