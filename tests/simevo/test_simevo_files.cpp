@@ -28,6 +28,7 @@ extern "C" {
 #include <functional>
 #include <map>
 #include <string>
+#include <thread>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -418,6 +419,167 @@ static void test_program_rejects_bad_input_with_one_line(void **state)
     assert_one_line_containing(e, "no preset 'nope'");
 }
 
+/* The temporary name write_file_atomic used before it made them with mkstemp: a planted
+ * symlink there was followed and the file it pointed to overwritten. */
+static void test_atomic_write_never_follows_a_planted_symlink(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir(), outside = make_tmp_dir();
+    const std::string victim = join_path(outside, "victim.txt"), target = join_path(root, "summary.md");
+    write_file_atomic(victim, "keep me\n");
+    const std::string old_tmp = target + ".tmp" + std::to_string(::getpid()) + "-" +
+                                std::to_string(std::hash<std::thread::id>()(std::this_thread::get_id()) % 100000);
+    assert_int_equal(symlink(victim.c_str(), old_tmp.c_str()), 0);
+    write_file_atomic(target, "new content\n");
+    assert_string_equal(slurp(victim).c_str(), "keep me\n");
+    assert_string_equal(slurp(target).c_str(), "new content\n");
+    std::map<std::string, std::string> files;
+    collect(root, "", files);
+    assert_int_equal(files.size(), 2); /* the target and the planted link: no temporary left */
+    struct stat st;
+    assert_int_equal(stat(target.c_str(), &st), 0);
+    assert_int_equal(st.st_mode & 0777, 0644);
+}
+
+static bool process_gone(pid_t pid)
+{
+    char path[64], text[512] = "";
+    std::snprintf(path, sizeof path, "/proc/%d/stat", static_cast<int>(pid));
+    FILE *f = std::fopen(path, "r");
+    if (f == nullptr) {
+        return true;
+    }
+    const size_t n = std::fread(text, 1, sizeof text - 1, f);
+    std::fclose(f);
+    text[n] = '\0';
+    const char *paren = std::strrchr(text, ')');
+    return paren != nullptr && paren[1] == ' ' && (paren[2] == 'Z' || paren[2] == 'X');
+}
+
+/* simevo killed with SIGKILL while a plot script runs: the script dies too, instead of
+ * living on to race the resumed run for the plot files. */
+static void test_plot_child_dies_when_simevo_is_killed(void **state)
+{
+    (void)state;
+    const std::string dir = make_tmp_dir();
+    write_file_atomic(join_path(dir, "slow_plot.sh"),
+                      "echo $$ > \"$1/pid.tmp\" && mv \"$1/pid.tmp\" \"$1/pid\" && exec sleep 120\n");
+    const pid_t sim = fork();
+    assert_true(sim >= 0);
+    if (sim == 0) {
+        RunOptions opt;
+        opt.python = "/bin/sh";
+        opt.tools_dir = dir;
+        try {
+            run_plot(opt, "slow_plot.sh", dir);
+        } catch (...) {
+        }
+        _exit(0);
+    }
+    std::string text;
+    for (int waited = 0; !read_file(join_path(dir, "pid"), text); waited += 20) {
+        assert_true(waited < 30000);
+        usleep(20000);
+    }
+    const pid_t plot = static_cast<pid_t>(std::atol(text.c_str()));
+    assert_true(plot > 0);
+    assert_false(process_gone(plot));
+    assert_int_equal(kill(sim, SIGKILL), 0);
+    assert_int_equal(wait_exit(sim), 128 + SIGKILL);
+    int waited = 0;
+    while (!process_gone(plot) && waited < 10000) {
+        usleep(20000);
+        waited += 20;
+    }
+    if (!process_gone(plot)) {
+        kill(plot, SIGKILL);
+        fail_msg("the plot script (pid %d) outlived simevo", static_cast<int>(plot));
+    }
+}
+
+static std::string run_for_stdout(const std::string &args, int &status)
+{
+    const std::string cmd = std::string(SIMEVO_EXE) + " " + args + " 2>/dev/null";
+    FILE *p = popen(cmd.c_str(), "r");
+    assert_non_null(p);
+    std::string out;
+    char buf[512];
+    while (fgets(buf, sizeof buf, p)) {
+        out += buf;
+    }
+    const int st = pclose(p);
+    status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    return out;
+}
+
+static void test_program_command_line_names_unknown_options_and_subcommands(void **state)
+{
+    (void)state;
+    int st = 0;
+    std::string e = run_for_error({"--bogus"}, st);
+    assert_int_equal(st, 2);
+    assert_string_equal(e.c_str(), "simevo: --bogus: unknown option (see simevo --help)\n");
+    e = run_for_error({"bogus"}, st);
+    assert_int_equal(st, 2);
+    assert_string_equal(e.c_str(),
+                        "simevo: bogus: unknown subcommand (known: run, list, evolve, eval, quality) (see simevo --help)\n");
+    e = run_for_error({"eval", "prob", "--bogus"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--bogus");
+    const std::string v = run_for_stdout("--version", st);
+    assert_int_equal(st, 0);
+    assert_string_equal(v.c_str(), "simevo (qnav) " QNAV_VERSION "\n");
+}
+
+/* Zero episodes, NaN or out-of-range noise: refused as bad usage, naming the option. */
+static void test_program_refuses_zero_episodes_and_impossible_noise(void **state)
+{
+    (void)state;
+    int st = 0;
+    std::string e = run_for_error({"eval", "prob", "--episodes", "0"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--episodes");
+    e = run_for_error({"evolve", "--eval-episodes", "0", "--out", make_tmp_dir() + "/never"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--eval-episodes");
+    e = run_for_error({"evolve", "--noise", "nan"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "expected a number in [0, 1], got 'nan'");
+    e = run_for_error({"evolve", "--sensor-noise", "5"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--sensor-noise");
+    e = run_for_error({"eval", "prob", "--noise", "nan"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--noise");
+}
+
+/* Experiment files: noise above the simulator's 1 refused at its line before any output
+ * is written; a directory named as the file; a quoted key with a newline on one line. */
+static void test_experiment_file_problems_are_found_before_any_output(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::string out = join_path(root, "out");
+    const std::string noisy = join_path(root, "noisy.toml");
+    write_file_atomic(noisy, "name = \"noisy\"\n[target]\nepisodes = 5\nnoise = 5\n");
+    int st = 0;
+    std::string e = run_for_error({"run", noisy, "--out", out, "--no-plot"}, st);
+    assert_int_equal(st, 1);
+    assert_one_line_containing(e, (noisy + ":4: noise: 5 is outside [0, 1]").c_str());
+    assert_false(file_exists(out));
+
+    e = run_for_error({"run", root, "--out", out, "--no-plot"}, st);
+    assert_int_equal(st, 1);
+    assert_one_line_containing(e, (root + ": is a directory, not a file").c_str());
+
+    const std::string nl = join_path(root, "nl.toml");
+    write_file_atomic(nl, "name = \"nl\"\n[target]\n\"a\\nb\" = 1\n");
+    e = run_for_error({"run", nl, "--out", out, "--no-plot"}, st);
+    assert_int_equal(st, 1);
+    assert_one_line_containing(e, (nl + ":3: unknown key 'a\\nb' in [target]").c_str());
+    assert_false(file_exists(out));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -427,6 +589,11 @@ int main(void)
         cmocka_unit_test(test_program_rejects_bad_input_with_one_line),
         cmocka_unit_test(test_program_killed_by_pid_resumes_to_identical_results),
         cmocka_unit_test(test_table_mode_and_network_mode_give_identical_results),
+        cmocka_unit_test(test_atomic_write_never_follows_a_planted_symlink),
+        cmocka_unit_test(test_plot_child_dies_when_simevo_is_killed),
+        cmocka_unit_test(test_program_command_line_names_unknown_options_and_subcommands),
+        cmocka_unit_test(test_program_refuses_zero_episodes_and_impossible_noise),
+        cmocka_unit_test(test_experiment_file_problems_are_found_before_any_output),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -17,7 +17,9 @@
 #include <mutex>
 #include <sstream>
 #include <fcntl.h>
+#include <csignal>
 #include <sys/file.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -616,11 +618,17 @@ void run_plot(const RunOptions &opt, const std::string &script, const std::strin
     if (!file_exists(path)) {
         throw UserError(path + ": plot script not found (set --tools-dir or QNAV_TOOLS_DIR, or use --no-plot)");
     }
+    const pid_t parent = ::getpid();
     const pid_t pid = ::fork();
     if (pid < 0) {
         throw UserError(opt.python + ": cannot start (" + std::strerror(errno) + ")");
     }
     if (pid == 0) {
+        // The plot dies with simevo (kill -9 included): a leftover plotter would race the
+        // resumed run for the same output files.
+        if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || ::getppid() != parent) {
+            ::_exit(127);
+        }
         ::execl(opt.python.c_str(), opt.python.c_str(), path.c_str(), exp_dir.c_str(), static_cast<char *>(nullptr));
         std::fprintf(stderr, "%s: cannot run (%s)\n", opt.python.c_str(), std::strerror(errno));
         ::_exit(127);
