@@ -24,6 +24,7 @@
 #include <simavr/sim_elf.h>
 
 #include "ptylink.h"
+#include "qnav/cli.h"
 
 static volatile sig_atomic_t g_quit = 0;
 
@@ -108,7 +109,7 @@ int main(int argc, char **argv)
     static const struct option opts[] = {
         {"elf", required_argument, NULL, 'e'},    {"link", required_argument, NULL, 'l'},
         {"seconds", required_argument, NULL, 's'}, {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0}};
+        {"version", no_argument, NULL, 'V'},       {NULL, 0, NULL, 0}};
     const char *elf = NULL, *link_path = NULL;
     double seconds = 0.0;
     elf_firmware_t fw;
@@ -136,8 +137,13 @@ int main(int argc, char **argv)
             break;
         }
         case 'h':
-            printf("usage: qnav-simavr-board --elf tekbot.elf [--link PATH] [--seconds S]\n");
+            printf("usage: qnav-simavr-board --elf tekbot.elf [--link PATH] [--seconds S]\n"
+                   "  --elf FILE     the TekBot firmware image (tekbot-avr.elf)\n"
+                   "  --link PATH    also make PATH a symlink to the board's pty\n"
+                   "  --seconds S    stop after S simulated seconds (0: run until a signal)\n"
+                   "  --help, --version  this text; the version\n");
             return 0;
+        case 'V': fputs(QNAV_CLI_VERSION_LINE("qnav-simavr-board"), stdout); return 0;
         default:
             fprintf(stderr, "qnav-simavr-board: %s: unknown option or missing value\n",
                     argv[optind - 1]);

@@ -382,6 +382,18 @@ static void test_cli_refuses_nan_noise_instead_of_using_the_profiles(void **stat
     assert_int_equal(run_tool("bench --sensor-noise nan", &out), 2);
 }
 
+static void test_cli_names_unknown_options_and_subcommands_and_prints_its_version(void **state) {
+    (void)state;
+    std::string out;
+    assert_int_equal(run_tool("--bogus", &out), 2);
+    assert_string_equal(out.c_str(), "qnav-sim: --bogus: unknown option (see qnav-sim --help)\n");
+    assert_int_equal(run_tool("bogus", &out), 2);
+    assert_string_equal(out.c_str(), "qnav-sim: bogus: unknown subcommand (known: run, draw-env, gen-env, bench) "
+                                     "(see qnav-sim --help)\n");
+    assert_int_equal(run_tool("--version", &out), 0);
+    assert_string_equal(out.c_str(), "qnav-sim (qnav) " QNAV_VERSION "\n");
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_committed_profiles_and_environments_load),
@@ -402,6 +414,7 @@ int main(void) {
         cmocka_unit_test(test_directory_and_unreadable_files_say_why),
         cmocka_unit_test(test_messages_quoting_newlines_stay_one_line),
         cmocka_unit_test(test_cli_refuses_nan_noise_instead_of_using_the_profiles),
+        cmocka_unit_test(test_cli_names_unknown_options_and_subcommands_and_prints_its_version),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

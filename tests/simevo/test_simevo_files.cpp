@@ -25,11 +25,15 @@ extern "C" {
 #include <cstring>
 #include <dirent.h>
 #include <fcntl.h>
+#include <algorithm>
+#include <cerrno>
 #include <functional>
 #include <map>
 #include <string>
 #include <thread>
+#include <pty.h>
 #include <sys/file.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -580,6 +584,70 @@ static void test_experiment_file_problems_are_found_before_any_output(void **sta
     assert_false(file_exists(out));
 }
 
+/* On a 40-column terminal every progress redraw fits in 39 columns (a longer line wraps,
+ * and each redraw then scrolls a line instead of replacing it). */
+static void test_progress_line_is_cut_to_the_terminal_width(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    struct winsize ws {};
+    ws.ws_col = 40;
+    ws.ws_row = 24;
+    int master = -1, slave = -1;
+    assert_int_equal(openpty(&master, &slave, nullptr, nullptr, &ws), 0);
+    const pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        dup2(slave, 2);
+        const int nul = open("/dev/null", O_WRONLY);
+        dup2(nul, 1);
+        close(master);
+        setenv("QNAV_DATA_DIR", SIMEVO_SOURCE_DIR "/data", 1);
+        unsetenv("COLUMNS");
+        const std::string out = join_path(root, "out");
+        execl(SIMEVO_EXE, SIMEVO_EXE, "run", SIMEVO_TEST_DIR "/tiny.toml", "--no-plot", "-j", "1", "--out", out.c_str(),
+              static_cast<char *>(nullptr));
+        _exit(127);
+    }
+    close(slave);
+    std::string text;
+    char buf[4096];
+    for (;;) {
+        const ssize_t n = read(master, buf, sizeof buf);
+        if (n > 0) {
+            text.append(buf, static_cast<std::size_t>(n));
+        } else if (n < 0 && errno == EINTR) {
+            continue;
+        } else {
+            break; /* EIO: simevo exited and the pty's last user is gone */
+        }
+    }
+    close(master);
+    assert_int_equal(wait_exit(pid), 0);
+    std::size_t pieces = 0, longest = 0;
+    std::size_t start = 0;
+    for (std::size_t i = 0; i <= text.size(); ++i) {
+        if (i == text.size() || text[i] == '\r' || text[i] == '\n') {
+            std::string piece = text.substr(start, i - start);
+            if (piece.rfind("\033[K", 0) == 0) {
+                piece.erase(0, 3);
+            }
+            std::size_t chars = 0;
+            for (char c : piece) {
+                chars += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+            }
+            if (chars > 0) {
+                ++pieces;
+                longest = std::max(longest, chars);
+            }
+            start = i + 1;
+        }
+    }
+    print_message("%zu progress redraws, the longest %zu columns\n", pieces, longest);
+    assert_true(pieces >= 1);
+    assert_int_equal(longest, 39); /* cut (the whole line is longer), never more */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -594,6 +662,7 @@ int main(void)
         cmocka_unit_test(test_program_command_line_names_unknown_options_and_subcommands),
         cmocka_unit_test(test_program_refuses_zero_episodes_and_impossible_noise),
         cmocka_unit_test(test_experiment_file_problems_are_found_before_any_output),
+        cmocka_unit_test(test_progress_line_is_cut_to_the_terminal_width),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

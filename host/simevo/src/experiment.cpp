@@ -25,6 +25,7 @@
 #include <unistd.h>
 
 #include "files.h"
+#include "qnav/terminal.hpp"
 #include "qnav/ctrl.h"
 #include "qnav/policy_io.h"
 #include "rng.h"
@@ -123,9 +124,13 @@ private:
                 bests += b;
             }
         }
-        std::fprintf(stderr, "\r\033[K[%s] %" PRIu64 "/%" PRIu64 " episodes %5.1f%%  %.0f ep/s  ETA %ld:%02ld:%02ld  best R:%s",
-                     title_.c_str(), done, total_, total_ ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 100.0,
-                     rate, eta / 3600, (eta / 60) % 60, eta % 60, bests.c_str());
+        char line[4096];
+        std::snprintf(line, sizeof line, "[%s] %" PRIu64 "/%" PRIu64 " episodes %5.1f%%  %.0f ep/s  ETA %ld:%02ld:%02ld  best R:%s",
+                      title_.c_str(), done, total_, total_ ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 100.0,
+                      rate, eta / 3600, (eta / 60) % 60, eta % 60, bests.c_str());
+        // cut to the terminal (asked each time: it may be resized): a wrapped line would
+        // scroll instead of being redrawn in place
+        std::fprintf(stderr, "\r\033[K%s", qnav::cli::fit_line(line, qnav::cli::terminal_columns(2)).c_str());
         std::fflush(stderr);
     }
 
