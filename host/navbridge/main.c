@@ -4,7 +4,7 @@
  * commands back; onboard mode relays goals and telemetry and can upload a policy file to
  * the board. Everything is published on LCM. When the board goes quiet for --timeout-ms
  * it commands a stop; SIGINT/SIGTERM/SIGHUP stop the robot before exiting (status 0); a port that
- * hangs up ends it with status 3. --replay re-runs a
+ * hangs up ends it with status 1 (link lost). --replay re-runs a
  * recorded trial's scans through the controller and checks the commands are identical.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -297,7 +297,7 @@ int main(int argc, char **argv)
                  * simavr board (pty master) has gone */
                 fprintf(stderr, "navbridge: %s: %s: link lost\n", device,
                         r == 0 ? "device hung up" : strerror(errno));
-                exit_code = 3;
+                exit_code = 1;
                 hung_up = 1;
                 break;
             }

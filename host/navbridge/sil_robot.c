@@ -332,7 +332,7 @@ int main(int argc, char **argv)
     if (r.mode == 0) {
         fprintf(stderr, "qnav-sil-robot: no navbridge heartbeat on %s within %g s\n", slave,
                 wait_s);
-        rc = 3;
+        rc = 1;
         goto out;
     }
     qnav_sim_reset(sim, (uint64_t)episode);
@@ -448,7 +448,7 @@ int main(int argc, char **argv)
            (unsigned)res.ticks, res.tau_l, (unsigned)res.collisions, res.R, (unsigned)missed,
            (unsigned long)qnav_link_rx_dropped_total(&r.rx));
     fflush(stdout);
-    rc = g_quit ? 4 : (res.reached ? 0 : 1);
+    rc = res.reached && !g_quit ? 0 : 1; /* docs/cli.md: 1 = the trial failed */
 out:
     if (linked) {
         qnav_ptylink_remove(link_path, slave);
