@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "qnav/cli.hpp"
+#include "qnav/paths.hpp"
 
 #include <chrono>
 #include <cinttypes>
@@ -31,12 +32,6 @@
 using namespace qnav;
 
 namespace {
-
-std::string env_or(const char *name, const std::string &fallback)
-{
-    const char *v = std::getenv(name);
-    return (v && *v) ? std::string(v) : fallback;
-}
 
 std::vector<std::string> list_experiments(const std::string &dir)
 {
@@ -91,14 +86,15 @@ int main(int argc, char **argv)
     CLI::App app{"simevo: ε-greedy neuro-evolution and policy transfer for qnav (paper §3.3, §4)"};
     app.require_subcommand(1);
     qnav::cli::add_version(app, "simevo");
-    std::string experiments_dir = env_or("QNAV_EXPERIMENTS_DIR", std::string(QNAV_SOURCE_DIR) + "/experiments");
+    std::string experiments_dir =
+        resource_dir("QNAV_EXPERIMENTS_DIR", "experiments", std::string(QNAV_SOURCE_DIR) + "/experiments");
     app.add_option("--experiments", experiments_dir, "folder of experiment files")->capture_default_str();
 
     // run
     auto *run = app.add_subcommand("run", "run named experiments (resumes an interrupted run in the same --out)");
     std::vector<std::string> names;
     RunOptions opt;
-    opt.tools_dir = env_or("QNAV_TOOLS_DIR", std::string(QNAV_SOURCE_DIR) + "/tools");
+    opt.tools_dir = resource_dir("QNAV_TOOLS_DIR", "tools", std::string(QNAV_SOURCE_DIR) + "/tools");
     std::string preset = "full";
     int64_t runs = 0, episodes = 0, source_episodes = 0, eval_episodes = 0, seed = -1;
     bool no_plot = false, no_progress = false, network_mode = false;
