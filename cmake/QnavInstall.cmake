@@ -1,14 +1,15 @@
 # install() rules and the exported CMake package (docs/install.md). Host builds only.
 #
 #   PREFIX/bin/                 simevo, qnav-sim, qnav-policy, navbridge, qnav-sil-robot,
-#                               qnav-simavr-board, qnav-spy, qnav-log
+#                               qnav-simavr-board
 #   PREFIX/include/qnav/        the public headers (libqnav, link codec, policy files, sim)
 #   PREFIX/lib/                 libqnav_ctrl.a, libqnav_link.a, libqnav_policyio.a, libqnav_sim.a
 #   PREFIX/lib/cmake/qnav/      qnavConfig.cmake: find_package(qnav CONFIG) -> qnav::ctrl,
 #                               qnav::link, qnav::policyio, qnav::sim
 #   PREFIX/lib/pkgconfig/       qnav.pc
 #   PREFIX/share/qnav/          data/ (robots, environments), experiments/, tools/ (plot
-#                               scripts), firmware/ (sources for add_subdirectory() in a
+#                               scripts, qnav_log.py), python/qnav/ (generated LCM types),
+#                               java/ (LCM types jar), firmware/ (sources for add_subdirectory() in a
 #                               firmware project), cmake/ (toolchain files), VERSION
 #
 # Programs find share/qnav from their own location (qnav/paths.hpp), so the tree can be
@@ -60,7 +61,14 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/ DESTINATION ${QNAV_SHARE_INSTALL_D
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/experiments/
         DESTINATION ${QNAV_SHARE_INSTALL_DIR}/experiments)
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/tools/plot_learning.py ${PROJECT_SOURCE_DIR}/tools/plot_policy.py
+                 ${PROJECT_SOURCE_DIR}/tools/qnav_log.py
         DESTINATION ${QNAV_SHARE_INSTALL_DIR}/tools)
+if(QNAV_LCMTYPES_PYTHON_DIR)
+  install(DIRECTORY ${QNAV_LCMTYPES_PYTHON_DIR}/qnav DESTINATION ${QNAV_SHARE_INSTALL_DIR}/python)
+endif()
+if(QNAV_LCMTYPES_JAR)
+  install(FILES ${QNAV_LCMTYPES_JAR} DESTINATION ${QNAV_SHARE_INSTALL_DIR}/java)
+endif()
 install(FILES ${PROJECT_SOURCE_DIR}/tools/plotcommon.py ${PROJECT_SOURCE_DIR}/VERSION
         DESTINATION ${QNAV_SHARE_INSTALL_DIR}/tools)
 install(FILES ${PROJECT_SOURCE_DIR}/VERSION DESTINATION ${QNAV_SHARE_INSTALL_DIR})

@@ -43,6 +43,11 @@ programs)
     v=$(cat "$p/share/qnav/VERSION")
     [ "$(/usr/bin/python3 "$p/share/qnav/tools/plot_policy.py" --version)" = "plot_policy.py (qnav) $v" ] || fail "plot script version"
     [ "$("$p/bin/qnav-policy" --version)" = "qnav-policy (qnav) $v" ] || fail "qnav-policy version"
+    # the installed log tool finds the installed Python LCM types by itself
+    "$p/bin/qnav-sil-robot" --version > /dev/null
+    /usr/bin/python3 "$p/share/qnav/tools/qnav_log.py" --help > /dev/null
+    [ -f "$p/share/qnav/python/qnav/pose_t.py" ] || fail "Python LCM types not installed"
+    [ -f "$p/share/qnav/java/qnav_lcmtypes.jar" ] || fail "Java LCM types not installed"
     ;;
 host)
     prefix=$2 work=$3 src=$4 cmake=$5
