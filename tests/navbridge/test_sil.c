@@ -159,14 +159,15 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     assert_true(compared + 20u >= scans); /* all but the ticks before the upload landed */
 }
 
-static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(void **state)
+/* One udpm:// trial by udpm_trial.sh in a private network namespace (skips the test when
+ * namespaces or loopback multicast are not permitted), watched by qnav-spy when spy is not
+ * NULL; checks the statuses the script reports (expect, e.g. "sil=0 navbridge=1 spy=-"). */
+static void run_udpm_trial(const char *spy, const char *expect)
 {
-    char log[300], rc_path[300], text[2048], out[300], err[300], sil_out[300];
+    char rc_path[300], text[512], out[300], err[300];
     const char *probe[] = {UNSHARE_EXE, "-n", "true", NULL};
     const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
-                           g_dir, NULL};
-    int scan, cmd, qual, status, pose, rc;
-    (void)state;
+                           g_dir, spy, NULL};
     snprintf(out, sizeof out, "%s/probe.out", g_dir);
     snprintf(err, sizeof err, "%s/probe.err", g_dir);
     if (run_program(probe, out, err) != 0) {
@@ -174,17 +175,24 @@ static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(vo
                       "run in a private network namespace (DESIGN.md §7)\n");
         skip();
     }
-    snprintf(log, sizeof log, "%s/trial.lcmlog", g_dir);
     snprintf(rc_path, sizeof rc_path, "%s/rc.txt", g_dir);
-    snprintf(sil_out, sizeof sil_out, "%s/sil.out", g_dir);
-    rc = run_program(trial, out, err);
-    if (rc == 10) {
+    if (run_program(trial, out, err) == 10) {
         print_message("SKIP: cannot configure loopback multicast in the namespace\n");
         skip();
     }
     assert_true(read_text(rc_path, text, sizeof text) > 0);
     print_message("%s", text);
-    assert_non_null(strstr(text, "sil=0 navbridge=1 spy=-"));
+    assert_non_null(strstr(text, expect));
+}
+
+static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(void **state)
+{
+    char log[300], text[2048], sil_out[300];
+    int scan, cmd, qual, status, pose;
+    (void)state;
+    snprintf(log, sizeof log, "%s/trial.lcmlog", g_dir);
+    snprintf(sil_out, sizeof sil_out, "%s/sil.out", g_dir);
+    run_udpm_trial(NULL, "sil=0 navbridge=1 spy=-");
     assert_true(read_text(sil_out, text, sizeof text) > 0);
     assert_non_null(strstr(text, "reached yes"));
     count_channels(log, &scan, &cmd, &qual, &status, &pose);
@@ -203,18 +211,11 @@ static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(vo
  * deleted and replaced by the link). */
 static void test_sil_robot_refuses_link_path_that_is_a_file(void **state)
 {
-    char path[300], out[300], err[300], text[512];
+    char path[300];
     const char *sil[] = {SIL_EXE, "--wait-s", "0", "--link", path, NULL};
     (void)state;
     snprintf(path, sizeof path, "%s/notes.txt", g_dir);
-    snprintf(out, sizeof out, "%s/refuse.out", g_dir);
-    snprintf(err, sizeof err, "%s/refuse.err", g_dir);
-    assert_int_equal(qnav_test_write_text(path, "the user's notes\n"), 0);
-    assert_int_equal(run_program(sil, out, err), 2);
-    assert_true(read_text(path, text, sizeof text) > 0);
-    assert_string_equal(text, "the user's notes\n");
-    assert_true(read_text(err, text, sizeof text) > 0);
-    assert_non_null(strstr(text, "refusing to replace it"));
+    assert_int_equal(qnav_test_link_refused(sil, path, g_dir), 0);
 }
 
 /* A file put where the link was while the robot runs survives the robot's exit: only the
@@ -273,34 +274,16 @@ static void test_qnav_spy_under_xvfb_decodes_every_qnav_channel(void **state)
                                            "QNAV_QUALITIES qnav.path_qualities_t ",
                                            "QNAV_POSE qnav.pose_t ",
                                            "QNAV_LINK_STATUS qnav.link_status_t "};
-    char rc_path[300], spy_out[300], spy_png[300], text[4096], out[300], err[300];
-    const char *probe[] = {UNSHARE_EXE, "-n", "true", NULL};
-    const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
-                           g_dir, SPY_EXE, NULL};
+    char spy_out[300], spy_png[300], text[4096];
     unsigned k, n;
-    int rc;
     (void)state;
-    snprintf(out, sizeof out, "%s/spy-probe.out", g_dir);
-    snprintf(err, sizeof err, "%s/spy-probe.err", g_dir);
-    if (run_program(probe, out, err) != 0) {
-        print_message("SKIP: `unshare -n` is not permitted here (DESIGN.md §7)\n");
-        skip();
-    }
     if (access(XVFB_EXE, X_OK) != 0) {
         print_message("SKIP: no Xvfb (Debian package xvfb)\n");
         skip();
     }
-    snprintf(rc_path, sizeof rc_path, "%s/rc.txt", g_dir);
     snprintf(spy_out, sizeof spy_out, "%s/spy.out", g_dir);
     snprintf(spy_png, sizeof spy_png, "%s/spy.png", g_dir);
-    rc = run_program(trial, out, err);
-    if (rc == 10) {
-        print_message("SKIP: cannot configure loopback multicast in the namespace\n");
-        skip();
-    }
-    assert_true(read_text(rc_path, text, sizeof text) > 0);
-    print_message("%s", text);
-    assert_non_null(strstr(text, "sil=0 navbridge=1 spy=0"));
+    run_udpm_trial(SPY_EXE, "sil=0 navbridge=1 spy=0");
     assert_true(read_text(spy_out, text, sizeof text) > 0);
     print_message("%s", text);
     for (k = 0; k < sizeof channels / sizeof channels[0]; ++k) {
