@@ -4,7 +4,7 @@
  * replays to identical commands. Once on memq:// with navbridge --log, once on a real
  * udpm:// bus recorded by lcm-logger inside a private network namespace (skipped when
  * `unshare -n` is not permitted). No packet leaves the machine. When the robot's episode
- * ends its pty closes and navbridge exits with status 3 (link lost).
+ * ends its pty closes and navbridge exits with status 1 (link lost).
  */
 #define _XOPEN_SOURCE 700
 #define _DEFAULT_SOURCE
@@ -94,8 +94,8 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0); /* 0: destination reached */
-    /* the robot's end closes the pty: navbridge sees the hang-up and leaves with 3 */
-    assert_int_equal(wait_exit_within(pn, 3000), 3);
+    /* the robot's end closes the pty: navbridge sees the hang-up and leaves with 1 */
+    assert_int_equal(wait_exit_within(pn, 3000), 1);
     assert_true(read_text(nb_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "device hung up: link lost"));
     assert_true(read_text(sil_out, text, sizeof text) > 0);
@@ -139,7 +139,7 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0);
-    assert_int_equal(wait_exit_within(pn, 3000), 3);
+    assert_int_equal(wait_exit_within(pn, 3000), 1);
     assert_true(read_text(sil_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "policy uploaded"));
     assert_true(read_text(nb_err, text, sizeof text) > 0);
@@ -159,14 +159,15 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     assert_true(compared + 20u >= scans); /* all but the ticks before the upload landed */
 }
 
-static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(void **state)
+/* One udpm:// trial by udpm_trial.sh in a private network namespace (skips the test when
+ * namespaces or loopback multicast are not permitted), watched by qnav-spy when spy is not
+ * NULL; checks the statuses the script reports (expect, e.g. "sil=0 navbridge=1 spy=-"). */
+static void run_udpm_trial(const char *spy, const char *expect)
 {
-    char log[300], rc_path[300], text[2048], out[300], err[300], sil_out[300];
+    char rc_path[300], text[512], out[300], err[300];
     const char *probe[] = {UNSHARE_EXE, "-n", "true", NULL};
     const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
-                           g_dir, NULL};
-    int scan, cmd, qual, status, pose, rc;
-    (void)state;
+                           g_dir, spy, NULL};
     snprintf(out, sizeof out, "%s/probe.out", g_dir);
     snprintf(err, sizeof err, "%s/probe.err", g_dir);
     if (run_program(probe, out, err) != 0) {
@@ -174,17 +175,24 @@ static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(vo
                       "run in a private network namespace (DESIGN.md §7)\n");
         skip();
     }
-    snprintf(log, sizeof log, "%s/trial.lcmlog", g_dir);
     snprintf(rc_path, sizeof rc_path, "%s/rc.txt", g_dir);
-    snprintf(sil_out, sizeof sil_out, "%s/sil.out", g_dir);
-    rc = run_program(trial, out, err);
-    if (rc == 10) {
+    if (run_program(trial, out, err) == 10) {
         print_message("SKIP: cannot configure loopback multicast in the namespace\n");
         skip();
     }
     assert_true(read_text(rc_path, text, sizeof text) > 0);
     print_message("%s", text);
-    assert_non_null(strstr(text, "sil=0 navbridge=3"));
+    assert_non_null(strstr(text, expect));
+}
+
+static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(void **state)
+{
+    char log[300], text[2048], sil_out[300];
+    int scan, cmd, qual, status, pose;
+    (void)state;
+    snprintf(log, sizeof log, "%s/trial.lcmlog", g_dir);
+    snprintf(sil_out, sizeof sil_out, "%s/sil.out", g_dir);
+    run_udpm_trial(NULL, "sil=0 navbridge=1 spy=-");
     assert_true(read_text(sil_out, text, sizeof text) > 0);
     assert_non_null(strstr(text, "reached yes"));
     count_channels(log, &scan, &cmd, &qual, &status, &pose);
@@ -199,12 +207,105 @@ static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(vo
     replay_is_identical(log);
 }
 
+/* --link onto a user's file: refused with status 2, the file untouched (it used to be
+ * deleted and replaced by the link). */
+static void test_sil_robot_refuses_link_path_that_is_a_file(void **state)
+{
+    char path[300];
+    const char *sil[] = {SIL_EXE, "--wait-s", "0", "--link", path, NULL};
+    (void)state;
+    snprintf(path, sizeof path, "%s/notes.txt", g_dir);
+    assert_int_equal(qnav_test_link_refused(sil, path, g_dir), 0);
+}
+
+/* A file put where the link was while the robot runs survives the robot's exit: only the
+ * link it made is removed. */
+static void test_sil_robot_leaves_a_file_that_replaced_its_link(void **state)
+{
+    char path[300], out[300], err[300], text[512];
+    const char *sil[] = {SIL_EXE, "--wait-s", "60", "--link", path, NULL};
+    pid_t ps;
+    (void)state;
+    snprintf(path, sizeof path, "%s/link-replaced", g_dir);
+    snprintf(out, sizeof out, "%s/replaced.out", g_dir);
+    snprintf(err, sizeof err, "%s/replaced.err", g_dir);
+    ps = qnav_test_spawn(sil, out, err);
+    assert_true(ps > 0);
+    assert_int_equal(qnav_test_wait_text(out, "link on", 10000), 0);
+    assert_int_equal(unlink(path), 0);
+    assert_int_equal(qnav_test_write_text(path, "mine now\n"), 0);
+    assert_int_equal(kill(ps, SIGTERM), 0);
+    assert_int_equal(qnav_test_wait_exit(ps), 1); /* no navbridge came */
+    assert_true(read_text(path, text, sizeof text) > 0);
+    assert_string_equal(text, "mine now\n");
+}
+
+/* The dangling pty link of a killed earlier run is replaced, and removed at exit. */
+static void test_sil_robot_replaces_stale_pty_link_and_removes_it_at_exit(void **state)
+{
+    char path[300], out[300], err[300], target[256];
+    const char *sil[] = {SIL_EXE, "--wait-s", "60", "--link", path, NULL};
+    ssize_t n;
+    pid_t ps;
+    (void)state;
+    snprintf(path, sizeof path, "%s/link-stale", g_dir);
+    snprintf(out, sizeof out, "%s/stale.out", g_dir);
+    snprintf(err, sizeof err, "%s/stale.err", g_dir);
+    assert_int_equal(symlink("/dev/pts/999999", path), 0);
+    ps = qnav_test_spawn(sil, out, err);
+    assert_true(ps > 0);
+    assert_int_equal(qnav_test_wait_text(out, "link on", 10000), 0);
+    n = readlink(path, target, sizeof target - 1);
+    assert_true(n > 9);
+    target[n] = '\0';
+    assert_string_not_equal(target, "/dev/pts/999999");
+    assert_int_equal(strncmp(target, "/dev/pts/", 9), 0);
+    assert_int_equal(kill(ps, SIGTERM), 0);
+    assert_int_equal(qnav_test_wait_exit(ps), 1);
+    assert_int_equal(access(path, F_OK), -1);
+    assert_int_equal(readlink(path, target, sizeof target), -1);
+}
+
+/* qnav-spy (lcm-spy with the qnav types on OpenJDK 17) under Xvfb, inside a private network
+ * namespace during a udpm:// trial: it runs, and decodes every channel of the trial. */
+static void test_qnav_spy_under_xvfb_decodes_every_qnav_channel(void **state)
+{
+    static const char *const channels[] = {"QNAV_SCAN qnav.scan_t ", "QNAV_COMMAND qnav.command_t ",
+                                           "QNAV_QUALITIES qnav.path_qualities_t ",
+                                           "QNAV_POSE qnav.pose_t ",
+                                           "QNAV_LINK_STATUS qnav.link_status_t "};
+    char spy_out[300], spy_png[300], text[4096];
+    unsigned k, n;
+    (void)state;
+    if (access(XVFB_EXE, X_OK) != 0) {
+        print_message("SKIP: no Xvfb (Debian package xvfb)\n");
+        skip();
+    }
+    snprintf(spy_out, sizeof spy_out, "%s/spy.out", g_dir);
+    snprintf(spy_png, sizeof spy_png, "%s/spy.png", g_dir);
+    run_udpm_trial(SPY_EXE, "sil=0 navbridge=1 spy=0");
+    assert_true(read_text(spy_out, text, sizeof text) > 0);
+    print_message("%s", text);
+    for (k = 0; k < sizeof channels / sizeof channels[0]; ++k) {
+        const char *line = strstr(text, channels[k]);
+        assert_non_null(line);
+        assert_int_equal(sscanf(line + strlen(channels[k]), "%u", &n), 1);
+        assert_true(n > 5u);
+    }
+    assert_true(read_text(spy_png, text, sizeof text) > 8);
+    assert_int_equal(memcmp(text, "\x89PNG", 4), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sil_robot_reaches_destination_through_navbridge_over_memq),
         cmocka_unit_test(test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically),
         cmocka_unit_test(test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically),
+        cmocka_unit_test(test_sil_robot_refuses_link_path_that_is_a_file),
+        cmocka_unit_test(test_sil_robot_leaves_a_file_that_replaced_its_link),
+        cmocka_unit_test(test_sil_robot_replaces_stale_pty_link_and_removes_it_at_exit),
+        cmocka_unit_test(test_qnav_spy_under_xvfb_decodes_every_qnav_channel),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -17,12 +17,15 @@
 #include <mutex>
 #include <sstream>
 #include <fcntl.h>
+#include <csignal>
 #include <sys/file.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
 
 #include "files.h"
+#include "qnav/terminal.hpp"
 #include "qnav/ctrl.h"
 #include "qnav/policy_io.h"
 #include "rng.h"
@@ -121,9 +124,13 @@ private:
                 bests += b;
             }
         }
-        std::fprintf(stderr, "\r\033[K[%s] %" PRIu64 "/%" PRIu64 " episodes %5.1f%%  %.0f ep/s  ETA %ld:%02ld:%02ld  best R:%s",
-                     title_.c_str(), done, total_, total_ ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 100.0,
-                     rate, eta / 3600, (eta / 60) % 60, eta % 60, bests.c_str());
+        char line[4096];
+        std::snprintf(line, sizeof line, "[%s] %" PRIu64 "/%" PRIu64 " episodes %5.1f%%  %.0f ep/s  ETA %ld:%02ld:%02ld  best R:%s",
+                      title_.c_str(), done, total_, total_ ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 100.0,
+                      rate, eta / 3600, (eta / 60) % 60, eta % 60, bests.c_str());
+        // cut to the terminal (asked each time: it may be resized): a wrapped line would
+        // scroll instead of being redrawn in place
+        std::fprintf(stderr, "\r\033[K%s", qnav::cli::fit_line(line, qnav::cli::terminal_columns(2)).c_str());
         std::fflush(stderr);
     }
 
@@ -935,11 +942,17 @@ void run_plot(const RunOptions &opt, const std::string &script, const std::strin
     if (!file_exists(path)) {
         throw UserError(path + ": plot script not found (set --tools-dir or QNAV_TOOLS_DIR, or use --no-plot)");
     }
+    const pid_t parent = ::getpid();
     const pid_t pid = ::fork();
     if (pid < 0) {
         throw UserError(opt.python + ": cannot start (" + std::strerror(errno) + ")");
     }
     if (pid == 0) {
+        // The plot dies with simevo (kill -9 included): a leftover plotter would race the
+        // resumed run for the same output files.
+        if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || ::getppid() != parent) {
+            ::_exit(127);
+        }
         ::execl(opt.python.c_str(), opt.python.c_str(), path.c_str(), exp_dir.c_str(), static_cast<char *>(nullptr));
         std::fprintf(stderr, "%s: cannot run (%s)\n", opt.python.c_str(), std::strerror(errno));
         ::_exit(127);
@@ -975,7 +988,30 @@ std::string quality_table_csv(const std::vector<std::pair<std::string, qnav_poli
     return o.str();
 }
 
+std::string best_policy_copy(const std::string &exp_dir, const std::string &condition)
+{
+    return join_path(exp_dir, "best-" + condition + ".policy");
+}
+
 namespace {
+
+/* Each evolved condition's best policy (the run that scored highest held out) copied to
+ * best-<condition>.policy beside summary.md: one stable name to take to a robot. */
+void write_best_policies(const ExperimentSummary &S, const std::string &exp_dir)
+{
+    for (const ConditionSummary &c : S.conditions) {
+        if (c.kind == ConditionKind::Probabilistic || c.best_run < 0) {
+            continue;
+        }
+        const std::string from =
+            join_path(join_path(run_dir(exp_dir, static_cast<uint32_t>(c.best_run)), c.label), "best.policy");
+        std::string text;
+        if (!read_file(from, text)) {
+            throw UserError(from + ": cannot read (" + std::strerror(errno) + ")");
+        }
+        write_file_atomic(best_policy_copy(exp_dir, c.label), text);
+    }
+}
 
 /* Everything after the runs but summary.md: curves, quality map, summary.json, episode
  * traces and the plots (STATUS says when plots are missing). Throws UserError. */
@@ -992,6 +1028,7 @@ void write_outputs(const ExperimentSpec &spec, const ExperimentSummary &S, const
     qnav_sim_robot_info(worlds.robot(spec.target.robot), &robot_info);
     write_file_atomic(join_path(exp_dir, "summary.json"),
                       summary_json(spec, S, opt, env_info.source, robot_info.radius_m));
+    write_best_policies(S, exp_dir);
     const uint64_t eval_base = tasks.back().eval_seed_base; // the probabilistic task's: the held-out set
     write_file_atomic(join_path(exp_dir, "episodes.csv"),
                       episodes_csv(S, exp_dir, target_runner, eval_base, spec.eval_episodes));

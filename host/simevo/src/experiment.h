@@ -141,6 +141,10 @@ std::string quality_table_csv(const std::vector<std::pair<std::string, qnav_poli
 /* Run tools/<script> DIR with opt.python. Throws UserError when it fails. */
 void run_plot(const RunOptions &opt, const std::string &script, const std::string &dir);
 
+/* Where an experiment's best policy of one condition is copied (best-<condition>.policy
+ * beside summary.md; written with the summary). */
+std::string best_policy_copy(const std::string &exp_dir, const std::string &condition);
+
 /* Run a spec end to end (resuming what is there). Returns the experiment folder. Throws
  * UserError. */
 std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt);

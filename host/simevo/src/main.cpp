@@ -2,9 +2,14 @@
  * simevo: evolve navigation policies in the simulator with the paper's ε-greedy
  * neuro-evolution, transfer them between situations, and run the paper's five transfer
  * experiments with summaries and plots. Subcommands: run, list, evolve, eval, quality.
- * Every bad input ends in one line on stderr and exit status 1 (2 for usage errors).
+ * Every problem ends in one line on stderr: exit status 2 for bad usage or bad input found
+ * before any work starts (options, experiment files, policy files, robots, environments),
+ * 1 for a failure while running (docs/cli.md).
  */
 #include <CLI/CLI.hpp>
+
+#include "qnav/cli.hpp"
+#include "qnav/paths.hpp"
 
 #include <chrono>
 #include <cinttypes>
@@ -27,12 +32,6 @@
 using namespace qnav;
 
 namespace {
-
-std::string env_or(const char *name, const std::string &fallback)
-{
-    const char *v = std::getenv(name);
-    return (v && *v) ? std::string(v) : fallback;
-}
 
 std::vector<std::string> list_experiments(const std::string &dir)
 {
@@ -135,11 +134,9 @@ void print_transfer_arrival(const ExperimentSpec &s, const std::string &dir)
         if (c.kind != ConditionKind::Transfer || c.best_run < 0) {
             continue;
         }
-        char run[16];
-        std::snprintf(run, sizeof run, "run-%03d", c.best_run + 1);
-        std::printf("%s: best transferred policy %s/%s/%s/best.policy arrives in %.0f%% of %u held-out episodes "
+        std::printf("%s: best transferred policy %s (run %d) arrives in %.0f%% of %u held-out episodes "
                     "(all runs: %.0f%%)\n",
-                    s.name.c_str(), dir.c_str(), run, c.label.c_str(),
+                    s.name.c_str(), best_policy_copy(dir, c.label).c_str(), c.best_run + 1,
                     100.0 * c.arrival_per_run[static_cast<std::size_t>(c.best_run)], s.eval_episodes,
                     100.0 * c.arrival.mean);
     }
@@ -164,14 +161,16 @@ int main(int argc, char **argv)
 {
     CLI::App app{"simevo: ε-greedy neuro-evolution and policy transfer for qnav (paper §3.3, §4)"};
     app.require_subcommand(1);
-    std::string experiments_dir = env_or("QNAV_EXPERIMENTS_DIR", std::string(QNAV_SOURCE_DIR) + "/experiments");
+    qnav::cli::add_version(app, "simevo");
+    std::string experiments_dir =
+        resource_dir("QNAV_EXPERIMENTS_DIR", "experiments", std::string(QNAV_SOURCE_DIR) + "/experiments");
     app.add_option("--experiments", experiments_dir, "folder of experiment files")->capture_default_str();
 
     // run
     auto *run = app.add_subcommand("run", "run named experiments (resumes an interrupted run in the same --out)");
     std::vector<std::string> names;
     RunOptions opt;
-    opt.tools_dir = env_or("QNAV_TOOLS_DIR", std::string(QNAV_SOURCE_DIR) + "/tools");
+    opt.tools_dir = resource_dir("QNAV_TOOLS_DIR", "tools", std::string(QNAV_SOURCE_DIR) + "/tools");
     std::string preset = "full";
     int64_t runs = 0, episodes = 0, source_episodes = 0, eval_episodes = 0, seed = -1, per_candidate = 0;
     std::string fitness, controller;
@@ -208,12 +207,12 @@ int main(int argc, char **argv)
     evolve->add_option("--env", env, "environment name or file")->capture_default_str();
     evolve->add_option("--robot", robot, "robot profile name or file")->capture_default_str();
     evolve->add_option("--sectors", sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
-    evolve->add_option("--noise", noise, "sensor and actuation noise level p (0.05 = 5%)")->check(CLI::Range(0.0, 10.0));
-    evolve->add_option("--sensor-noise", sensor_noise, "sensor noise only")->check(CLI::Range(0.0, 10.0));
-    evolve->add_option("--actuation-noise", actuation_noise, "actuation noise only")->check(CLI::Range(0.0, 10.0));
+    evolve->add_option("--noise", noise, "sensor and actuation noise level p (0.05 = 5%)")->check(qnav::cli::finite_range(0.0, 1.0));
+    evolve->add_option("--sensor-noise", sensor_noise, "sensor noise only")->check(qnav::cli::finite_range(0.0, 1.0));
+    evolve->add_option("--actuation-noise", actuation_noise, "actuation noise only")->check(qnav::cli::finite_range(0.0, 1.0));
     evolve->add_option("--from", from, "policy file to seed the population from (transfer)");
     evolve->add_option("--episodes", ev_episodes, "episodes")->capture_default_str()->check(CLI::Range(uint64_t(1), uint64_t(100000000)));
-    evolve->add_option("--eval-episodes", ev_eval, "held-out evaluation episodes of the best")->capture_default_str();
+    evolve->add_option("--eval-episodes", ev_eval, "held-out evaluation episodes of the best")->capture_default_str()->check(CLI::Range(1u, 1000000u));
     evolve->add_option("--seed", ev_seed, "seed")->capture_default_str();
     evolve->add_option("--fitness", fitness, "fitness rule: progress (default) or paper");
     evolve->add_option("--population", ep.population, "population size")->capture_default_str();
@@ -236,8 +235,8 @@ int main(int argc, char **argv)
     eval->add_option("--env", e_env, "environment")->capture_default_str();
     eval->add_option("--robot", e_robot, "robot profile")->capture_default_str();
     eval->add_option("--sectors", e_sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
-    eval->add_option("--noise", e_noise, "noise level p")->check(CLI::Range(0.0, 10.0));
-    eval->add_option("--episodes", e_episodes, "episodes")->capture_default_str();
+    eval->add_option("--noise", e_noise, "noise level p")->check(qnav::cli::finite_range(0.0, 1.0));
+    eval->add_option("--episodes", e_episodes, "episodes")->capture_default_str()->check(CLI::Range(1u, 1000000u));
     eval->add_option("--seed", e_seed, "seed")->capture_default_str();
     eval->add_option("--fitness", fitness, "fitness rule: progress (default) or paper");
 
@@ -254,17 +253,13 @@ int main(int argc, char **argv)
         ->capture_default_str()->check(CLI::Range(1, 65535));
     quality->add_option("--tools-dir", opt.tools_dir, "folder with plot_policy.py")->capture_default_str();
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp &e) {
-        return app.exit(e);
-    } catch (const CLI::CallForAllHelp &e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError &e) {
-        std::fprintf(stderr, "simevo: %s\n", e.what());
-        return 2;
+    if (const int status = qnav::cli::parse(app, argc, argv, "simevo"); status >= 0) {
+        return status;
     }
 
+    // Bad input found before any episode runs is exit 2; what goes wrong once work has
+    // started (a write, a plot, a journal from other settings) is 1.
+    bool started = false;
     try {
         if (*lst) {
             for (const auto &n : list_experiments(experiments_dir)) {
@@ -305,6 +300,18 @@ int main(int argc, char **argv)
             opt.preset = preset;
             opt.overrides = override_flags(runs, episodes, source_episodes, eval_episodes, seed, per_candidate, fitness,
                                            controller);
+            // every robot, environment and source policy file now, not after other runs
+            SimWorlds probe_worlds;
+            for (const auto &s : specs) {
+                SimRunner target(probe_worlds, s.target, s.seed, true);
+                for (const auto &src : s.sources) {
+                    SimRunner source(probe_worlds, src.scenario, s.seed, true);
+                    if (!src.policy_file.empty()) {
+                        (void)read_policy_file(src.policy_file);
+                    }
+                }
+            }
+            started = true;
             for (const auto &s : specs) {
                 const auto t0 = std::chrono::steady_clock::now();
                 const std::string dir = run_experiment(s, opt);
@@ -338,6 +345,13 @@ int main(int argc, char **argv)
             RunnerFactory make = [&worlds](const Scenario &sc, uint64_t s) -> std::unique_ptr<EpisodeRunner> {
                 return std::make_unique<SimRunner>(worlds, sc, s, true);
             };
+            if (!from.empty()) {
+                (void)read_policy_file(from); // a bad --from is bad input, found now
+            }
+            {
+                SimRunner probe(worlds, t.scenario, t.context_seed, true); // bad env/robot: now
+            }
+            started = true;
             run_tasks({t}, make, 1, ::isatty(2) != 0, "evolve");
             std::printf("best policy %s/best.policy; episodes %s/episodes.csv; held-out %s/eval.csv\n",
                         out_dir.c_str(), out_dir.c_str(), out_dir.c_str());
@@ -374,6 +388,7 @@ int main(int argc, char **argv)
             qnav_ctrl_config_t ccfg;
             qnav_ctrl_config_default(&ccfg);
             ccfg.max_range_mm = static_cast<qnav_mm_t>(q_range);
+            started = true;
             make_dirs(q_out);
             write_file_atomic(join_path(q_out, "quality.csv"), quality_table_csv(policies, ccfg));
             run_plot(opt, "plot_policy.py", q_out);
@@ -389,6 +404,7 @@ int main(int argc, char **argv)
             } else {
                 p = read_policy_file(policy_arg);
             }
+            started = true;
             std::vector<double> R, tau;
             uint32_t reached = 0;
             for (uint32_t i = 0; i < e_episodes; ++i) {
@@ -407,7 +423,7 @@ int main(int argc, char **argv)
         }
     } catch (const UserError &e) {
         std::fprintf(stderr, "simevo: %s\n", e.what());
-        return 1;
+        return started ? QNAV_EXIT_FAILURE : QNAV_EXIT_USAGE;
     } catch (const std::exception &e) {
         std::fprintf(stderr, "simevo: internal error: %s\n", e.what());
         return 1;

@@ -2,7 +2,7 @@
  * Reference hardware layer for an ATmega128 TekBot at 16 MHz (qnav/board_hal.h):
  *   tick    Timer0 compare interrupt every 1 ms
  *   UART    USART0 (PE0 RXD, PE1 TXD), 57600 baud 8N1 with U2X (-0.8 % error),
- *           interrupt-driven receive into a 64-byte ring, polled transmit
+ *           interrupt-driven receive into a 256-byte ring, polled transmit
  *   sonar   8 analog sonars (MaxBotix LV-EZ class, AN output ~ Vcc/512 per inch) on
  *           ADC0..ADC7, sector k on ADCk; AVcc reference
  *   motors  Timer1 8-bit fast PWM on OC1A (PB5, left) and OC1B (PB6, right); direction on
@@ -33,7 +33,18 @@
 #define QNAV_TEKBOT_CDEG_PER_TICK 328L
 #endif
 
-#define RX_RING 64u
+/* Receive ring: it must hold what arrives at line rate while the main loop is busy with a
+ * tick (the step, up to 100 000 cycles = 6.3 ms, and the polled transmit of scan, heartbeat
+ * and command, about 120 bytes = 21 ms at 57600 baud): about 160 bytes. 64 bytes lost the
+ * middle of a policy upload (3 chunks and a commit, about 200 bytes, sent at once) whenever
+ * it landed in that window. 256 (an 8-bit index) costs 192 bytes of the 4 KiB. */
+#ifndef QNAV_TEKBOT_RX_RING
+#define QNAV_TEKBOT_RX_RING 256u
+#endif
+#define RX_RING QNAV_TEKBOT_RX_RING
+#if RX_RING > 256u || RX_RING < 2u
+#error "QNAV_TEKBOT_RX_RING: 2..256 (the ring's index is 8 bits)"
+#endif
 
 static volatile uint32_t g_ms;
 static volatile uint8_t g_rx[RX_RING];
