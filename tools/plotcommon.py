@@ -1,22 +1,54 @@
-"""What simevo's plot scripts share: their command line, reading a CSV or JSON file with
-one-line errors (FILE:LINE: problem), and writing a PNG atomically (no half-written plot)."""
+"""What simevo's plot scripts share: their command line (argparse), reading a CSV or JSON
+file with one-line errors (FILE:LINE: problem), and writing a plot atomically in the format
+its file name asks for (.png, .pdf, .svg) through an exclusively created temporary file."""
+import argparse
 import csv
 import json
 import os
 import sys
+import tempfile
+
+FORMATS = ("png", "pdf", "svg")
 
 
 class PlotError(Exception):
     """A problem with an input file; str() is the one-line message."""
 
 
+def plot_format(path):
+    """The plot format that path's extension asks for ('png', 'pdf', 'svg'), or None."""
+    ext = os.path.splitext(path)[1].lower().lstrip(".")
+    return ext if ext in FORMATS else None
+
+
 def parse_args(argv, prog, default_png):
-    """EXPERIMENT_DIR [OUT.png] -> (exp_dir, out_png); None after printing usage."""
-    if len(argv) not in (2, 3):
-        print(f"usage: {prog} EXPERIMENT_DIR [OUT.png]", file=sys.stderr)
-        return None
-    exp = argv[1]
-    return exp, argv[2] if len(argv) == 3 else os.path.join(exp, default_png)
+    """EXPERIMENT_DIR [OUT] -> (exp_dir, out). --help prints the calling script's docstring
+    and exits 0; bad usage (an OUT whose extension is not .png, .pdf or .svg included)
+    prints one line and exits 2."""
+    main_doc = getattr(sys.modules.get("__main__"), "__doc__", None)
+    parser = argparse.ArgumentParser(prog=prog, description=main_doc,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("experiment_dir", metavar="EXPERIMENT_DIR")
+    parser.add_argument("out", metavar="OUT", nargs="?",
+                        help=f"plot file, .png, .pdf or .svg (default EXPERIMENT_DIR/{default_png})")
+    parser.add_argument("--version", action="version", version=f"{prog} (qnav) {version()}")
+    args = parser.parse_args(argv[1:])
+    out = args.out if args.out is not None else os.path.join(args.experiment_dir, default_png)
+    if plot_format(out) is None:
+        parser.error(f"{out}: unknown plot format (the name must end in .png, .pdf or .svg)")
+    return args.experiment_dir, out
+
+
+def version():
+    """qnav's version: the VERSION file beside tools/ (source tree) or share/qnav/ (installed)."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    for cand in (os.path.join(here, "..", "VERSION"), os.path.join(here, "VERSION")):
+        try:
+            with open(cand) as f:
+                return f.read().strip()
+        except OSError:
+            continue
+    return "unknown"
 
 
 def read_csv(path, on_row):
@@ -47,10 +79,25 @@ def read_json(path):
 
 
 def save(fig, out):
-    """Write fig to out through a temporary file, so out is whole or absent."""
-    tmp = out + ".tmp.png"
-    fig.savefig(tmp)
-    os.replace(tmp, out)
+    """Write fig to out in the format out's name asks for, so that out is whole or absent.
+    The temporary file is created exclusively (random name, O_EXCL) in out's folder: a
+    planted symlink is never followed and a leftover process never shares it."""
+    fmt = plot_format(out)
+    if fmt is None:
+        raise PlotError(f"{out}: unknown plot format (the name must end in .png, .pdf or .svg)")
+    folder = os.path.dirname(out) or "."
+    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(out) + ".", suffix=".tmp", dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            fig.savefig(f, format=fmt)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, out)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
 
 
 def run(main, argv, prog):

@@ -24,6 +24,7 @@
 #include <lcm/lcm.h>
 
 #include "bridge.h"
+#include "qnav/cli.h"
 #include "qnav/policy_io.h"
 #include "qnav_goal_t.h"
 #include "replay.h"
@@ -61,7 +62,8 @@ static void usage(FILE *f)
             "  --goal DEG[:M]     start with a goal: bearing in the board's heading frame,\n"
             "                     degrees CCW, optional distance in metres (QNAV_GOAL later\n"
             "                     messages replace it)\n"
-            "  --replay LOG       re-run LOG's scans, compare with its commands, exit\n");
+            "  --replay LOG       re-run LOG's scans, compare with its commands, exit\n"
+            "  --help, --version  this text; the version\n");
 }
 
 /* Parse a whole decimal number in [lo, hi]; 0 or -1. */
@@ -99,7 +101,7 @@ int main(int argc, char **argv)
         {"policy", required_argument, NULL, 'p'},  {"upload", no_argument, NULL, 'U'},
         {"timeout-ms", required_argument, NULL, 't'}, {"log", required_argument, NULL, 'l'},
         {"replay", required_argument, NULL, 'r'},  {"help", no_argument, NULL, 'h'},
-        {"goal", required_argument, NULL, 'g'},
+        {"goal", required_argument, NULL, 'g'},    {"version", no_argument, NULL, 'V'},
         {NULL, 0, NULL, 0}};
     const char *device = NULL, *lcm_url = NULL, *policy_path = NULL, *log_path = NULL;
     const char *replay_path = NULL;
@@ -172,8 +174,9 @@ int main(int argc, char **argv)
             break;
         }
         case 'h': usage(stdout); return 0;
+        case 'V': fputs(QNAV_CLI_VERSION_LINE("navbridge"), stdout); return 0;
         default:
-            if (optopt != 0) {
+            if (optopt != 0 && strncmp(argv[optind - 1], "--", 2) == 0) {
                 const struct option *o = opts;
                 while (o->name != NULL && o->val != optopt) {
                     ++o;
@@ -181,7 +184,7 @@ int main(int argc, char **argv)
                 fprintf(stderr, "navbridge: --%s: missing its value (see --help)\n",
                         o->name != NULL ? o->name : "?");
             } else {
-                fprintf(stderr, "navbridge: %s: unknown option or missing value (see --help)\n",
+                fprintf(stderr, "navbridge: %s: unknown option (see --help)\n",
                         argv[optind - 1]);
             }
             return 2;

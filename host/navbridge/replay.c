@@ -30,7 +30,7 @@ int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg,
     qnav_bridge_ctrl_t bc;
     lcm_eventlog_t *log;
     lcm_eventlog_event_t *ev;
-    unsigned next = 0;
+    unsigned next = 0, events = 0;
     int crc_noted = 0;
 
     memset(res, 0, sizeof *res);
@@ -42,6 +42,7 @@ int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg,
     }
     qnav_bridge_ctrl_init(&bc, cfg, policy);
     while ((ev = lcm_eventlog_read_next_event(log)) != NULL) {
+        events++;
         if (strcmp(ev->channel, QNAV_CH_SCAN) == 0) {
             if (qnav_scan_t_decode(ev->data, 0, ev->datalen, &scan) < 0) {
                 res->bad_events++;
@@ -98,5 +99,11 @@ int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg,
         lcm_eventlog_free_event(ev);
     }
     lcm_eventlog_destroy(log);
+    if (events == 0) {
+        /* lcm_eventlog stops at the first bad sync word: a text file, a truncated header
+         * or an empty file all read as "no events", and are not logs to replay */
+        snprintf(err, errlen, "%s: not an LCM log (no events could be read)", path);
+        return -1;
+    }
     return 0;
 }

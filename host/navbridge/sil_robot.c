@@ -27,6 +27,8 @@
 #include "qnav/ctrl.h"
 #include "qnav/link.h"
 #include "qnav/sim.h"
+#include "ptylink.h"
+#include "qnav/cli.h"
 #include "qnav_pose_t.h"
 #include "serial.h"
 
@@ -176,7 +178,8 @@ static void usage(FILE *f)
             "                   runs faster than real time)\n"
             "  --reply-ms N     longest wait for the bridge's command each tick (300)\n"
             "  --wait-s N       how long to wait for navbridge to appear (30)\n"
-            "  --pose           publish QNAV_POSE on LCM's default bus; --lcm-url on URL\n");
+            "  --pose           publish QNAV_POSE on LCM's default bus; --lcm-url on URL\n"
+            "  --help, --version  this text; the version\n");
 }
 
 static int parse_num(const char *opt, const char *s, double lo, double hi, double *out)
@@ -204,7 +207,8 @@ int main(int argc, char **argv)
         {"reply-ms", required_argument, NULL, 'R'}, {"wait-s", required_argument, NULL, 'w'},
         {"lcm-url", required_argument, NULL, 'u'}, {"pose", no_argument, NULL, 'P'},
         {"tick-ms", required_argument, NULL, 'T'},
-        {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0}};
+        {"help", no_argument, NULL, 'h'},          {"version", no_argument, NULL, 'V'},
+        {NULL, 0, NULL, 0}};
     const char *robot_spec = "tekbot", *env_spec = "open", *link_path = NULL, *lcm_url = NULL;
     double sectors = 0, seed = 1, episode = 1, noise = 0, reply_ms = 300, wait_s = 30;
     double tick_ms = 100;
@@ -219,8 +223,8 @@ int main(int argc, char **argv)
     static qnav_sim_scan_t scan;
     static robot_t r;
     lcm_t *lcm = NULL;
-    int slave_keep;
-    char *slave;
+    int slave_keep, linked = 0;
+    char *slave = NULL;
     struct termios tio;
     struct sigaction sa;
     uint32_t missed = 0;
@@ -243,6 +247,7 @@ int main(int argc, char **argv)
         case 'w': if (parse_num("wait-s", optarg, 0, 3600, &wait_s)) return 2; break;
         case 'T': if (parse_num("tick-ms", optarg, 1, 10000, &tick_ms)) return 2; break;
         case 'h': usage(stdout); return 0;
+        case 'V': fputs(QNAV_CLI_VERSION_LINE("qnav-sil-robot"), stdout); return 0;
         default:
             fprintf(stderr, "qnav-sil-robot: %s: unknown option or missing value (see --help)\n",
                     argv[optind - 1]);
@@ -287,12 +292,12 @@ int main(int argc, char **argv)
     }
     fcntl(r.fd, F_SETFL, fcntl(r.fd, F_GETFL) | O_NONBLOCK);
     if (link_path != NULL) {
-        unlink(link_path);
-        if (symlink(slave, link_path) != 0) {
-            fprintf(stderr, "qnav-sil-robot: --link %s: %s\n", link_path, strerror(errno));
+        if (qnav_ptylink_make(link_path, slave, err, sizeof err) != 0) {
+            fprintf(stderr, "qnav-sil-robot: %s\n", err);
             rc = 2;
             goto out;
         }
+        linked = 1;
     }
     printf("qnav-sil-robot: link on %s%s%s\n", slave, link_path ? " = " : "",
            link_path ? link_path : "");
@@ -445,8 +450,8 @@ int main(int argc, char **argv)
     fflush(stdout);
     rc = g_quit ? 4 : (res.reached ? 0 : 1);
 out:
-    if (link_path != NULL) {
-        unlink(link_path);
+    if (linked) {
+        qnav_ptylink_remove(link_path, slave);
     }
     if (lcm != NULL) {
         lcm_destroy(lcm);

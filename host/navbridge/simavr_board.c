@@ -1,7 +1,7 @@
 /*
  * qnav-simavr-board: the TekBot firmware image itself (tekbot.elf, built for the ATmega128)
- * running cycle by cycle in simavr, with its USART0 on a pseudo-terminal (simavr's
- * uart_pty part), so navbridge talks to the real board code without hardware. Sonar
+ * running cycle by cycle in simavr, with its USART0 on a pseudo-terminal served from the
+ * simulation loop, so navbridge talks to the real board code without hardware. Sonar
  * voltages are fed into ADC0..7 from a slowly changing scene; the encoders stay still, so
  * the heading reads 0. Simulated time is held to the wall clock so the board's 10 Hz tick
  * and link timeout mean what they say.
@@ -9,24 +9,30 @@
 #define _XOPEN_SOURCE 700
 #define _DEFAULT_SOURCE
 #include <errno.h>
+#include <fcntl.h>
 #include <getopt.h>
+#include <pty.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <simavr/avr_adc.h>
-#include <simavr/parts/uart_pty.h>
+#include <simavr/avr_uart.h>
 #include <simavr/sim_avr.h>
 #include <simavr/sim_elf.h>
 
+#include "ptylink.h"
+#include "qnav/cli.h"
+
 static volatile sig_atomic_t g_quit = 0;
 
-/* simavr keeps the firmware image and its symbol table allocated until exit, and its
- * uart_pty thread cannot be joined: in sanitizer builds, leak checking here would only
- * report simavr's own allocations (this program allocates nothing itself). */
+/* simavr keeps the firmware image and its symbol table allocated until exit: in sanitizer
+ * builds, leak checking here would only report simavr's own allocations (this program
+ * allocates nothing itself). */
 const char *__asan_default_options(void);
 const char *__asan_default_options(void)
 {
@@ -45,6 +51,105 @@ static int64_t mono_us(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
+/* USART0 on a pseudo-terminal, served from the simulation loop itself. Not simavr's
+ * uart_pty part: its thread and the MCU's thread both take bytes out of one unlocked fifo
+ * in simavr 1.6 (a race that loses or repeats link bytes under load), and its
+ * uart_pty_connect() unlinks and remakes the shared /tmp/simavr-uart0 (two boards take
+ * each other's, and a file of that name is deleted). The pty's /dev/pts/N name is unique. */
+typedef struct {
+    int master, slave;            /* slave kept open: no EIO before navbridge attaches */
+    char name[64];                /* /dev/pts/N */
+    avr_irq_t *to_mcu;            /* UART_IRQ_INPUT */
+    int xon;                      /* the USART's input fifo has room */
+    uint8_t in[512];              /* pty -> MCU */
+    size_t in_len, in_done;
+    uint8_t out[4096];            /* MCU -> pty */
+    size_t out_len;
+} board_uart_t;
+
+static void on_uart_byte(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    board_uart_t *u = (board_uart_t *)param;
+    (void)irq;
+    if (u->out_len < sizeof u->out) {
+        u->out[u->out_len++] = (uint8_t)value;
+    } /* else: nobody reads the port, dropped like a UART with no listener */
+}
+
+static void feed_mcu(board_uart_t *u)
+{
+    while (u->xon && u->in_done < u->in_len) {
+        avr_raise_irq(u->to_mcu, u->in[u->in_done++]);
+    }
+}
+
+static void on_uart_xon(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    (void)irq;
+    (void)value;
+    ((board_uart_t *)param)->xon = 1;
+    feed_mcu((board_uart_t *)param);
+}
+
+static void on_uart_xoff(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    (void)irq;
+    (void)value;
+    ((board_uart_t *)param)->xon = 0;
+}
+
+static int uart_open(avr_t *avr, board_uart_t *u)
+{
+    uint32_t flags = 0;
+    struct termios tio;
+    avr_irq_t *src = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT);
+    avr_irq_t *xon = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XON);
+    avr_irq_t *xoff = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF);
+    memset(u, 0, sizeof *u);
+    u->to_mcu = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
+    if (src == NULL || u->to_mcu == NULL ||
+        openpty(&u->master, &u->slave, u->name, NULL, NULL) != 0) {
+        return -1;
+    }
+    if (tcgetattr(u->slave, &tio) == 0) {
+        cfmakeraw(&tio);
+        tcsetattr(u->slave, TCSANOW, &tio);
+    }
+    fcntl(u->master, F_SETFL, fcntl(u->master, F_GETFL) | O_NONBLOCK);
+    /* binary frames: no copy of the UART on stdout */
+    avr_ioctl(avr, AVR_IOCTL_UART_GET_FLAGS('0'), &flags);
+    flags &= ~(uint32_t)AVR_UART_FLAG_STDIO;
+    avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
+    avr_irq_register_notify(src, on_uart_byte, u);
+    u->xon = 1; /* the USART starts empty; XOFF says when its fifo is full */
+    if (xon != NULL) {
+        avr_irq_register_notify(xon, on_uart_xon, u);
+    }
+    if (xoff != NULL) {
+        avr_irq_register_notify(xoff, on_uart_xoff, u);
+    }
+    return 0;
+}
+
+/* Move bytes both ways without blocking: what the MCU sent to the pty, what the pty holds
+ * to the MCU (as fast as the USART takes them). */
+static void uart_service(board_uart_t *u)
+{
+    if (u->out_len > 0) {
+        ssize_t n = write(u->master, u->out, u->out_len);
+        if (n > 0) {
+            memmove(u->out, u->out + n, u->out_len - (size_t)n);
+            u->out_len -= (size_t)n;
+        }
+    }
+    if (u->in_done == u->in_len) {
+        ssize_t n = read(u->master, u->in, sizeof u->in);
+        u->in_done = 0;
+        u->in_len = n > 0 ? (size_t)n : 0u;
+    }
+    feed_mcu(u);
+}
+
 /* Sonar k's voltage for a range in mm at 5 V: 12.7 mm per ADC count of 4.883 mV. */
 static uint32_t range_to_mv(uint32_t mm)
 {
@@ -56,16 +161,17 @@ int main(int argc, char **argv)
     static const struct option opts[] = {
         {"elf", required_argument, NULL, 'e'},    {"link", required_argument, NULL, 'l'},
         {"seconds", required_argument, NULL, 's'}, {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0}};
+        {"version", no_argument, NULL, 'V'},       {NULL, 0, NULL, 0}};
     const char *elf = NULL, *link_path = NULL;
     double seconds = 0.0;
     elf_firmware_t fw;
     avr_t *avr;
-    static uart_pty_t pty;
+    static board_uart_t uart;
     avr_irq_t *adc[8];
     int64_t t0;
     uint64_t last_scene = (uint64_t)-1;
     int c, k, state = cpu_Running;
+    char err[512];
 
     opterr = 0;
     while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
@@ -83,8 +189,13 @@ int main(int argc, char **argv)
             break;
         }
         case 'h':
-            printf("usage: qnav-simavr-board --elf tekbot.elf [--link PATH] [--seconds S]\n");
+            printf("usage: qnav-simavr-board --elf tekbot.elf [--link PATH] [--seconds S]\n"
+                   "  --elf FILE     the TekBot firmware image (tekbot-avr.elf)\n"
+                   "  --link PATH    also make PATH a symlink to the board's pty\n"
+                   "  --seconds S    stop after S simulated seconds (0: run until a signal)\n"
+                   "  --help, --version  this text; the version\n");
             return 0;
+        case 'V': fputs(QNAV_CLI_VERSION_LINE("qnav-simavr-board"), stdout); return 0;
         default:
             fprintf(stderr, "qnav-simavr-board: %s: unknown option or missing value\n",
                     argv[optind - 1]);
@@ -122,17 +233,18 @@ int main(int argc, char **argv)
     avr->avcc = 5000;
     avr->aref = 5000;
 
-    uart_pty_init(avr, &pty);
-    uart_pty_connect(&pty, '0');
-    if (link_path != NULL) {
-        unlink(link_path);
-        if (symlink(pty.pty.slavename, link_path) != 0) {
-            fprintf(stderr, "qnav-simavr-board: --link %s: %s\n", link_path, strerror(errno));
-            return 2;
-        }
+    if (uart_open(avr, &uart) != 0) {
+        fprintf(stderr, "qnav-simavr-board: cannot put USART0 on a pseudo-terminal: %s\n",
+                strerror(errno));
+        return 1;
+    }
+    if (link_path != NULL &&
+        qnav_ptylink_make(link_path, uart.name, err, sizeof err) != 0) {
+        fprintf(stderr, "qnav-simavr-board: %s\n", err);
+        return 2;
     }
     printf("qnav-simavr-board: %s (%s, %u Hz) with USART0 on %s%s%s\n", elf, fw.mmcu,
-           (unsigned)fw.frequency, pty.pty.slavename, link_path ? " = " : "",
+           (unsigned)fw.frequency, uart.name, link_path ? " = " : "",
            link_path ? link_path : "");
     fflush(stdout);
     for (k = 0; k < 8; ++k) {
@@ -160,6 +272,7 @@ int main(int argc, char **argv)
         for (k = 0; k < 2000 && state != cpu_Done && state != cpu_Crashed; ++k) {
             state = avr_run(avr);
         }
+        uart_service(&uart);
         ahead = (int64_t)sim_us - (mono_us() - t0);
         if (ahead > 2000) {
             usleep((useconds_t)ahead);
@@ -169,20 +282,7 @@ int main(int argc, char **argv)
            (double)avr->cycle / (double)fw.frequency,
            state == cpu_Crashed ? "crashed" : (g_quit ? "signal" : "done"));
     fflush(stdout);
-    /* not uart_pty_stop(): in simavr 1.6 it joins a thread that never returns. Exiting
-     * ends that thread; only the links made here (and simavr's own) are removed. */
-    if (link_path != NULL) {
-        unlink(link_path);
-    }
-    {
-        char target[128];
-        ssize_t n = readlink("/tmp/simavr-uart0", target, sizeof target - 1);
-        if (n > 0) {
-            target[n] = '\0';
-            if (strcmp(target, pty.pty.slavename) == 0) {
-                unlink("/tmp/simavr-uart0");
-            }
-        }
-    }
+    /* only the link made here is removed, and only if it is still ours */
+    qnav_ptylink_remove(link_path, uart.name);
     return state == cpu_Crashed ? 1 : 0;
 }

@@ -132,12 +132,17 @@ Environment parse_environment(std::string_view text, const std::string &name) {
             throw SimError(QNAV_SIM_E_WORLD, line_prefix(name, env.zone_lines[z]) +
                                                  "start zone overlaps the destination");
     }
+    // An obstacle wholly outside the walls is a typo that would silently do nothing; one
+    // that touches the destination's disc makes "reached" partly unreachable.
+    const Shape arena_shape = make_box(env.width_m / 2, env.height_m / 2, env.width_m, env.height_m, 0.0);
     for (std::size_t k = 0; k < obs.size(); ++k) {
-        Vec2 q;
-        if (nearest_point(obs[k], {env.dest_x_m, env.dest_y_m}, &q) <= 0.0)
-            throw SimError(QNAV_SIM_E_WORLD, r.where(dest) + ": destination lies inside "
-                                                 "the obstacle at line " +
-                                                 std::to_string(obs_lines[k]));
+        if (shape_distance(obs[k], arena_shape) > 0.0)
+            throw SimError(QNAV_SIM_E_WORLD, line_prefix(name, obs_lines[k]) +
+                                                 "obstacle lies wholly outside the arena");
+        if (shape_distance(obs[k], dest_shape) <= 0.0)
+            throw SimError(QNAV_SIM_E_WORLD, line_prefix(name, obs_lines[k]) +
+                                                 "obstacle overlaps the destination (" +
+                                                 r.where(dest) + ")");
     }
     return env;
 }
@@ -158,9 +163,22 @@ void check_clearance(const Environment &env, double clearance_m) {
         for (const Shape &s : walls)
             if (shape_distance(zs, s) < clearance_m) refuse("an arena wall");
     }
+    const int walled = first_walled_in_zone(env, clearance_m);
+    if (walled >= 0) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.3f", clearance_m);
+        const int line = static_cast<std::size_t>(walled) < env.zone_lines.size() ? env.zone_lines[walled] : 0;
+        throw SimError(QNAV_SIM_E_WORLD, line_prefix(env.source.empty() ? env.name : env.source, line) +
+                                             "start zone is walled in: no path to the destination for a "
+                                             "robot of radius " + buf + " m");
+    }
 }
 
 bool environment_connected(const Environment &env, double clearance_m, double cell_m) {
+    return first_walled_in_zone(env, clearance_m, cell_m) < 0;
+}
+
+int first_walled_in_zone(const Environment &env, double clearance_m, double cell_m) {
     const int nx = static_cast<int>(std::ceil(env.width_m / cell_m));
     const int ny = static_cast<int>(std::ceil(env.height_m / cell_m));
     const std::vector<Shape> obs = env.obstacle_shapes();
@@ -213,9 +231,11 @@ bool environment_connected(const Environment &env, double clearance_m, double ce
             }
         }
     }
-    for (const auto &z : env.start_zones)
-        if (!seen[cell(z.x_m + z.w_m / 2, z.y_m + z.h_m / 2)]) return false;
-    return true;
+    for (std::size_t z = 0; z < env.start_zones.size(); ++z) {
+        const StartZone &sz = env.start_zones[z];
+        if (!seen[cell(sz.x_m + sz.w_m / 2, sz.y_m + sz.h_m / 2)]) return static_cast<int>(z);
+    }
+    return -1;
 }
 
 Environment generate_environment(double density, std::uint64_t seed, double clearance_m) {

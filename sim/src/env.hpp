@@ -42,11 +42,12 @@ struct Environment {
 
 // Parse and check an environment (TOML text). Throws SimError: _PARSE for malformed
 // files, _WORLD for a start zone inside an obstacle or outside the arena, a destination
-// inside an obstacle or a start zone.
+// overlapping an obstacle or a start zone, an obstacle wholly outside the arena.
 Environment parse_environment(std::string_view text, const std::string &name);
 
 // Check that every start zone keeps clearance_m (a robot's radius) from obstacles and
-// walls; throws SimError(QNAV_SIM_E_WORLD, "NAME:LINE: ...") otherwise.
+// walls and that a robot of that radius can drive from it to the destination (not walled
+// in); throws SimError(QNAV_SIM_E_WORLD, "NAME:LINE: ...") otherwise.
 void check_clearance(const Environment &env, double clearance_m);
 
 // A random dense environment: 10 m x 10 m arena, start zones along the bottom, the
@@ -60,5 +61,9 @@ std::string environment_to_toml(const Environment &env);
 // Grid check that a disc of radius clearance_m can drive from the centre of every start
 // zone to the destination (cells of cell_m).
 bool environment_connected(const Environment &env, double clearance_m, double cell_m = 0.1);
+
+// The index of the first start zone that such a disc cannot leave for the destination,
+// or -1 when every zone is connected.
+int first_walled_in_zone(const Environment &env, double clearance_m, double cell_m = 0.1);
 
 }  // namespace qnav

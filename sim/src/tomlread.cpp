@@ -1,9 +1,13 @@
 // Checked TOML getters shared by the robot-profile and environment loaders.
 #include "tomlread.hpp"
 
+#include <cerrno>
 #include <cmath>
-#include <fstream>
+#include <cstring>
+#include <fcntl.h>
 #include <sstream>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "error.hpp"
 
@@ -20,12 +24,30 @@ TomlReader::TomlReader(std::string_view text, std::string name) : name_(std::mov
 }
 
 std::string TomlReader::read_file(const std::string &path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw SimError(QNAV_SIM_E_IO, path + ":0: cannot open file");
-    std::ostringstream os;
-    os << in.rdbuf();
-    if (in.bad()) throw SimError(QNAV_SIM_E_IO, path + ":0: cannot read file");
-    return os.str();
+    // POSIX rather than ifstream: ifstream opens a directory and reads it as empty (then
+    // "missing key 'name'"), and says nothing of why an open failed.
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw SimError(QNAV_SIM_E_IO, path + ": cannot open (" + std::strerror(errno) + ")");
+    struct stat st;
+    if (::fstat(fd, &st) == 0 && S_ISDIR(st.st_mode)) {
+        ::close(fd);
+        throw SimError(QNAV_SIM_E_IO, path + ": is a directory, not a file");
+    }
+    std::string text;
+    char buf[65536];
+    for (;;) {
+        const ssize_t n = ::read(fd, buf, sizeof buf);
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) {
+            const std::string e = std::strerror(errno);
+            ::close(fd);
+            throw SimError(QNAV_SIM_E_IO, path + ": cannot read (" + e + ")");
+        }
+        if (n == 0) break;
+        text.append(buf, static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+    return text;
 }
 
 std::string TomlReader::where(const toml::node &node) const {

@@ -17,6 +17,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "qnav/cli.hpp"
+
 #include "capi_internal.hpp"
 #include "error.hpp"
 #include "qnav/ctrl.h"
@@ -356,6 +358,7 @@ int cmd_bench(const BenchOpts &o) {
 int main(int argc, char **argv) {
     CLI::App app{"qnav-sim: Box2D simulator of TekBot-class and Pioneer 3-DX robots (docs/sim.md)"};
     app.require_subcommand(1);
+    qnav::cli::add_version(app, "qnav-sim");
 
     RunOpts ro;
     CLI::App *run = app.add_subcommand("run", "simulate a policy and print the episode's figures");
@@ -363,8 +366,8 @@ int main(int argc, char **argv) {
     run->add_option("--robot", ro.robot, "robot profile name or file")->capture_default_str();
     run->add_option("--env", ro.env, "environment name or file")->capture_default_str();
     run->add_option("--sectors", ro.sectors, "sonar sectors 1..360 (default: the profile's)")->check(CLI::Range(1, 360));
-    run->add_option("--sensor-noise", ro.ps, "p_s in [0, 1] (default: the profile's typical)")->check(CLI::Range(0.0, 1.0));
-    run->add_option("--actuation-noise", ro.pa, "p_a in [0, 1] (default: the profile's typical)")->check(CLI::Range(0.0, 1.0));
+    run->add_option("--sensor-noise", ro.ps, "p_s in [0, 1] (default: the profile's typical)")->check(qnav::cli::finite_range(0.0, 1.0));
+    run->add_option("--actuation-noise", ro.pa, "p_a in [0, 1] (default: the profile's typical)")->check(qnav::cli::finite_range(0.0, 1.0));
     run->add_option("--seed", ro.seed, "context seed")->capture_default_str();
     run->add_option("--fitness", ro.fitness, "fitness rule: progress (default) or paper (Eq. 1-3 literally; docs/sim.md)")->capture_default_str();
     run->add_option("--episode", ro.episode, "first episode seed")->capture_default_str();
@@ -388,7 +391,7 @@ int main(int argc, char **argv) {
     std::uint64_t g_seed = 1;
     std::string g_robot = "pioneer3dx", g_name, g_out;
     CLI::App *gen = app.add_subcommand("gen-env", "write a random environment file");
-    gen->add_option("--density", g_density, "fraction of the obstacle band covered, 0..0.5")->check(CLI::Range(0.0, 0.5))->capture_default_str();
+    gen->add_option("--density", g_density, "fraction of the obstacle band covered, 0..0.5")->check(qnav::cli::finite_range(0.0, 0.5))->capture_default_str();
     gen->add_option("--seed", g_seed, "generator seed")->capture_default_str();
     gen->add_option("--robot", g_robot, "robot that must fit through (clearance)")->capture_default_str();
     gen->add_option("--name", g_name, "environment name (default: generated-d<density>-s<seed>)");
@@ -407,16 +410,10 @@ int main(int argc, char **argv) {
     bench->add_option("--episodes", bo.episodes, "episodes per pass")->check(CLI::Range(1u, 10000000u))->capture_default_str();
     bench->add_option("--mode", bo.mode, "controller mode")->check(CLI::IsMember({"table", "network"}))->capture_default_str();
     bench->add_option("--seed", bo.seed, "context and network seed")->capture_default_str();
-    bench->add_option("--sensor-noise", bo.ps, "p_s")->check(CLI::Range(0.0, 1.0))->capture_default_str();
-    bench->add_option("--actuation-noise", bo.pa, "p_a")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+    bench->add_option("--sensor-noise", bo.ps, "p_s")->check(qnav::cli::finite_range(0.0, 1.0))->capture_default_str();
+    bench->add_option("--actuation-noise", bo.pa, "p_a")->check(qnav::cli::finite_range(0.0, 1.0))->capture_default_str();
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError &e) {
-        if (e.get_exit_code() == 0) return app.exit(e);
-        std::fprintf(stderr, "qnav-sim: %s\n", e.what());
-        return 2;
-    }
+    if (const int status = qnav::cli::parse(app, argc, argv, "qnav-sim"); status >= 0) return status;
     try {
         if (*run) return cmd_run(ro);
         if (*draw) return cmd_draw_env(de_env, de_robot, de_out);

@@ -499,6 +499,29 @@ static void test_bad_options_and_files_fail_with_one_line(void **state)
     expect_refusal(goal, "--goal 200");
 }
 
+/* Short unknown options are named as such (it used to say "--?: missing its value"), a
+ * long one without its value says so, a file that is not an LCM log is bad input (2), and
+ * --version prints the version line. */
+static void test_command_line_conventions(void **state)
+{
+    char notlog[320], out[320], err[320], text[256];
+    const char *short_unknown[] = {EXE, "-V", NULL};
+    const char *no_value[] = {EXE, "--device", NULL};
+    const char *replay[] = {EXE, "--replay", notlog, NULL};
+    const char *version[] = {EXE, "--version", NULL};
+    (void)state;
+    snprintf(notlog, sizeof notlog, "%s/notes.txt", g_dir);
+    assert_int_equal(qnav_test_write_text(notlog, "not a log\n"), 0);
+    expect_refusal(short_unknown, "navbridge: -V: unknown option (see --help)");
+    expect_refusal(no_value, "navbridge: --device: missing its value (see --help)");
+    expect_refusal(replay, "notes.txt: not an LCM log");
+    snprintf(out, sizeof out, "%s/version.out", g_dir);
+    snprintf(err, sizeof err, "%s/version.err", g_dir);
+    assert_int_equal(run_program(version, out, err), 0);
+    assert_true(read_text(out, text, sizeof text) > 0);
+    assert_string_equal(text, "navbridge (qnav) " QNAV_VERSION "\n");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -511,6 +534,7 @@ int main(void)
         cmocka_unit_test(test_onboard_upload_delivers_the_policy_file_to_the_board),
         cmocka_unit_test(test_start_goal_is_relayed_to_the_board),
         cmocka_unit_test(test_bad_options_and_files_fail_with_one_line),
+        cmocka_unit_test(test_command_line_conventions),
     };
     return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
 }

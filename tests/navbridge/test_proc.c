@@ -7,6 +7,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -44,6 +45,38 @@ int qnav_test_wait_path(const char *path, int timeout_ms)
         usleep(20000);
     }
     return 0;
+}
+
+int qnav_test_wait_text(const char *path, const char *needle, int timeout_ms)
+{
+    static char buf[65536];
+    int waited;
+    for (waited = 0;; waited += 20) {
+        FILE *f = fopen(path, "r");
+        if (f != NULL) {
+            size_t n = fread(buf, 1, sizeof buf - 1, f);
+            fclose(f);
+            buf[n] = '\0';
+            if (strstr(buf, needle) != NULL) {
+                return 0;
+            }
+        }
+        if (waited >= timeout_ms) {
+            return -1;
+        }
+        usleep(20000);
+    }
+}
+
+int qnav_test_write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wx");
+    int ok;
+    if (f == NULL) {
+        return -1;
+    }
+    ok = fputs(text, f) >= 0;
+    return (fclose(f) == 0 && ok) ? 0 : -1;
 }
 
 int qnav_test_tmpdir_make(char *dir, size_t len, const char *prefix)

@@ -20,6 +20,13 @@ int qnav_test_wait_exit(pid_t pid);
  * checking every 20 ms. 0, or -1 when it did not appear. */
 int qnav_test_wait_path(const char *path, int timeout_ms);
 
+/* Wait up to timeout_ms for the file at path to contain needle (a line a child prints
+ * once something happened), checking every 20 ms. 0, or -1 when it did not appear. */
+int qnav_test_wait_text(const char *path, const char *needle, int timeout_ms);
+
+/* Write text to a new file at path (a user's file that a program must not touch). 0/-1. */
+int qnav_test_write_text(const char *path, const char *text);
+
 /* Make a fresh folder /tmp/<prefix>.XXXXXX into dir (len bytes). 0 or -1. */
 int qnav_test_tmpdir_make(char *dir, size_t len, const char *prefix);
 

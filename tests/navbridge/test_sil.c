@@ -199,12 +199,81 @@ static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(vo
     replay_is_identical(log);
 }
 
+/* --link onto a user's file: refused with status 2, the file untouched (it used to be
+ * deleted and replaced by the link). */
+static void test_sil_robot_refuses_link_path_that_is_a_file(void **state)
+{
+    char path[300], out[300], err[300], text[512];
+    const char *sil[] = {SIL_EXE, "--wait-s", "0", "--link", path, NULL};
+    (void)state;
+    snprintf(path, sizeof path, "%s/notes.txt", g_dir);
+    snprintf(out, sizeof out, "%s/refuse.out", g_dir);
+    snprintf(err, sizeof err, "%s/refuse.err", g_dir);
+    assert_int_equal(qnav_test_write_text(path, "the user's notes\n"), 0);
+    assert_int_equal(run_program(sil, out, err), 2);
+    assert_true(read_text(path, text, sizeof text) > 0);
+    assert_string_equal(text, "the user's notes\n");
+    assert_true(read_text(err, text, sizeof text) > 0);
+    assert_non_null(strstr(text, "refusing to replace it"));
+}
+
+/* A file put where the link was while the robot runs survives the robot's exit: only the
+ * link it made is removed. */
+static void test_sil_robot_leaves_a_file_that_replaced_its_link(void **state)
+{
+    char path[300], out[300], err[300], text[512];
+    const char *sil[] = {SIL_EXE, "--wait-s", "60", "--link", path, NULL};
+    pid_t ps;
+    (void)state;
+    snprintf(path, sizeof path, "%s/link-replaced", g_dir);
+    snprintf(out, sizeof out, "%s/replaced.out", g_dir);
+    snprintf(err, sizeof err, "%s/replaced.err", g_dir);
+    ps = qnav_test_spawn(sil, out, err);
+    assert_true(ps > 0);
+    assert_int_equal(qnav_test_wait_text(out, "link on", 10000), 0);
+    assert_int_equal(unlink(path), 0);
+    assert_int_equal(qnav_test_write_text(path, "mine now\n"), 0);
+    assert_int_equal(kill(ps, SIGTERM), 0);
+    assert_int_equal(qnav_test_wait_exit(ps), 3); /* no navbridge came */
+    assert_true(read_text(path, text, sizeof text) > 0);
+    assert_string_equal(text, "mine now\n");
+}
+
+/* The dangling pty link of a killed earlier run is replaced, and removed at exit. */
+static void test_sil_robot_replaces_stale_pty_link_and_removes_it_at_exit(void **state)
+{
+    char path[300], out[300], err[300], target[256];
+    const char *sil[] = {SIL_EXE, "--wait-s", "60", "--link", path, NULL};
+    ssize_t n;
+    pid_t ps;
+    (void)state;
+    snprintf(path, sizeof path, "%s/link-stale", g_dir);
+    snprintf(out, sizeof out, "%s/stale.out", g_dir);
+    snprintf(err, sizeof err, "%s/stale.err", g_dir);
+    assert_int_equal(symlink("/dev/pts/999999", path), 0);
+    ps = qnav_test_spawn(sil, out, err);
+    assert_true(ps > 0);
+    assert_int_equal(qnav_test_wait_text(out, "link on", 10000), 0);
+    n = readlink(path, target, sizeof target - 1);
+    assert_true(n > 9);
+    target[n] = '\0';
+    assert_string_not_equal(target, "/dev/pts/999999");
+    assert_int_equal(strncmp(target, "/dev/pts/", 9), 0);
+    assert_int_equal(kill(ps, SIGTERM), 0);
+    assert_int_equal(qnav_test_wait_exit(ps), 3);
+    assert_int_equal(access(path, F_OK), -1);
+    assert_int_equal(readlink(path, target, sizeof target), -1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sil_robot_reaches_destination_through_navbridge_over_memq),
         cmocka_unit_test(test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically),
         cmocka_unit_test(test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically),
+        cmocka_unit_test(test_sil_robot_refuses_link_path_that_is_a_file),
+        cmocka_unit_test(test_sil_robot_leaves_a_file_that_replaced_its_link),
+        cmocka_unit_test(test_sil_robot_replaces_stale_pty_link_and_removes_it_at_exit),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -125,7 +125,11 @@ static void test_cli_rejects_unknown_command_and_wrong_arguments_as_usage(void *
 {
     (void)state;
     assert_int_equal(run_tool("frobnicate", NULL), 2);
-    assert_one_line_error("qnav-policy: ", "unknown command 'frobnicate'");
+    assert_one_line_error("qnav-policy: ", "frobnicate: unknown subcommand (known: check, show, new, header)");
+    assert_int_equal(run_tool("--frobnicate", NULL), 2);
+    assert_one_line_error("qnav-policy: ", "--frobnicate: unknown option");
+    assert_int_equal(run_tool("--version", NULL), 0);
+    assert_string_equal(out_text, "qnav-policy (qnav) " QNAV_VERSION "\n");
     assert_int_equal(run_tool("check", NULL), 2);
     assert_one_line_error("qnav-policy: ", "check: expected exactly one FILE");
     assert_int_equal(run_tool(NULL), 2);

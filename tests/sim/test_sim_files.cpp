@@ -1,6 +1,8 @@
 /*
  * Bad input: malformed robot profiles and environments, a start zone inside an obstacle
- * or outside the arena, a destination inside an obstacle, impossible parameters and a
+ * or outside the arena, a destination overlapping an obstacle, an obstacle wholly outside
+ * the arena, a walled-in start zone, a directory or unreadable file, NaN noise on the
+ * command line, impossible parameters and a
  * mismatched controller each give one "FILE:LINE: problem" (or "FIELD: problem") line and
  * an error status, never a crash; qnav-sim prints that line and exits non-zero, and its
  * good runs write complete pictures and environment files.
@@ -10,6 +12,7 @@
 #include <cmath>
 #include <string>
 #include <unistd.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include "env.hpp"
@@ -100,7 +103,7 @@ static void test_start_zone_inside_an_obstacle_is_refused_with_its_line(void **s
     assert_true(msg.find("leaves the arena") != std::string::npos);
     assert_int_equal(parse_env(test_env_text("[[box]]\nx_m = 9.0\ny_m = 9.0\nw_m = 1\nh_m = 1\n"), &msg),
                      QNAV_SIM_E_WORLD);
-    assert_true(msg.find("destination lies inside") != std::string::npos);
+    assert_true(msg.find("obstacle overlaps the destination") != std::string::npos);
 }
 
 static void test_bad_robot_profiles_are_refused(void **state) {
@@ -154,7 +157,7 @@ static void test_missing_file_is_an_io_error_naming_it(void **state) {
     qnav_sim_env_t *env = nullptr;
     assert_int_equal(qnav_sim_env_load("/nonexistent/x.toml", &env, err, sizeof err), QNAV_SIM_E_IO);
     assert_null(env);
-    assert_string_equal(err, "/nonexistent/x.toml:0: cannot open file");
+    assert_string_equal(err, "/nonexistent/x.toml: cannot open (No such file or directory)");
 }
 
 static void test_impossible_parameters_are_refused_by_field(void **state) {
@@ -243,7 +246,7 @@ static void test_cli_prints_one_line_and_fails_on_bad_input(void **state) {
     (void)state;
     std::string out;
     assert_int_not_equal(run_tool("run --env /nonexistent/env.toml", &out), 0);
-    assert_string_equal(out.c_str(), "/nonexistent/env.toml:0: cannot open file\n");
+    assert_string_equal(out.c_str(), "/nonexistent/env.toml: cannot open (No such file or directory)\n");
     assert_int_not_equal(run_tool("run --sectors 400", &out), 0);
     assert_true(one_line(out.substr(0, out.size() - 1)));
     assert_true(out.find("--sectors") != std::string::npos);
@@ -281,6 +284,116 @@ static void test_cli_runs_an_episode_and_writes_a_complete_picture(void **state)
     rmdir(dir);
 }
 
+static void test_obstacle_wholly_outside_the_arena_is_refused(void **state) {
+    (void)state;
+    std::string msg;
+    assert_int_equal(parse_env(test_env_text("[[circle]]\nx_m = 15\ny_m = 5\nr_m = 1\n"), &msg), QNAV_SIM_E_WORLD);
+    assert_string_equal(msg.c_str(), "bad.toml:15: obstacle lies wholly outside the arena");
+    assert_int_equal(parse_env(test_env_text("[[box]]\nx_m = 5\ny_m = -3\nw_m = 2\nh_m = 2\n"), &msg), QNAV_SIM_E_WORLD);
+    assert_string_equal(msg.c_str(), "bad.toml:15: obstacle lies wholly outside the arena");
+    // half in, half out is a legitimate obstacle against the wall
+    assert_int_equal(parse_env(test_env_text("[[circle]]\nx_m = 10\ny_m = 5\nr_m = 1\n"), &msg), QNAV_SIM_OK);
+}
+
+static void test_obstacle_overlapping_the_destination_is_refused(void **state) {
+    (void)state;
+    std::string msg;
+    // the destination (9, 9) is outside the circle, but its 0.3 m disc overlaps it
+    assert_int_equal(parse_env(test_env_text("[[circle]]\nx_m = 9\ny_m = 8.2\nr_m = 0.6\n"), &msg), QNAV_SIM_E_WORLD);
+    assert_string_equal(msg.c_str(), "bad.toml:15: obstacle overlaps the destination (bad.toml:6)");
+    assert_int_equal(parse_env(test_env_text("[[circle]]\nx_m = 9\ny_m = 7.9\nr_m = 0.6\n"), &msg), QNAV_SIM_OK);
+}
+
+static void test_walled_in_start_zone_is_refused_when_the_world_is_made(void **state) {
+    (void)state;
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_env_t *env = nullptr;
+    qnav_sim_robot_t *robot = nullptr;
+    qnav_sim_t *sim = nullptr;
+    qnav_sim_config_t cfg;
+    // a wall of boxes across the arena between the start zone and the destination
+    const std::string text = test_env_text("[[box]]\nx_m = 5\ny_m = 4\nw_m = 10\nh_m = 0.5\n");
+    assert_int_equal(qnav_sim_env_parse(text.data(), text.size(), "walled.toml", &env, err, sizeof err), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_robot_load((std::string(QNAV_TEST_DATA_DIR) + "/robots/tekbot.toml").c_str(), &robot, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_config_default(&cfg);
+    assert_int_equal(qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err), QNAV_SIM_E_WORLD);
+    assert_null(sim);
+    assert_string_equal(err, "walled.toml:10: start zone is walled in: no path to the destination for a robot of radius 0.120 m");
+    qnav_sim_env_free(env);
+    qnav_sim_robot_free(robot);
+}
+
+static void test_directory_and_unreadable_files_say_why(void **state) {
+    (void)state;
+    char dir[] = "/tmp/qnav_sim_dir_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_env_t *env = nullptr;
+    qnav_sim_robot_t *robot = nullptr;
+    assert_int_equal(qnav_sim_env_load(dir, &env, err, sizeof err), QNAV_SIM_E_IO);
+    assert_string_equal(err, (std::string(dir) + ": is a directory, not a file").c_str());
+    assert_int_equal(qnav_sim_robot_load(dir, &robot, err, sizeof err), QNAV_SIM_E_IO);
+    assert_string_equal(err, (std::string(dir) + ": is a directory, not a file").c_str());
+    const std::string locked = std::string(dir) + "/locked.toml";
+    FILE *f = fopen(locked.c_str(), "w");
+    assert_non_null(f);
+    fputs("name = \"x\"\n", f);
+    fclose(f);
+    chmod(locked.c_str(), 0);
+    if (access(locked.c_str(), R_OK) == 0) {
+        print_message("(running as root: the unreadable-file half cannot be shown here)\n");
+    } else {
+        assert_int_equal(qnav_sim_env_load(locked.c_str(), &env, err, sizeof err), QNAV_SIM_E_IO);
+        assert_string_equal(err, (locked + ": cannot open (Permission denied)").c_str());
+    }
+    // a reason root sees too: a symlink that points at itself
+    const std::string loop = std::string(dir) + "/loop.toml";
+    assert_int_equal(symlink(loop.c_str(), loop.c_str()), 0);
+    assert_int_equal(qnav_sim_env_load(loop.c_str(), &env, err, sizeof err), QNAV_SIM_E_IO);
+    assert_string_equal(err, (loop + ": cannot open (Too many levels of symbolic links)").c_str());
+    std::remove(loop.c_str());
+    std::remove(locked.c_str());
+    rmdir(dir);
+}
+
+static void test_messages_quoting_newlines_stay_one_line(void **state) {
+    (void)state;
+    std::string msg;
+    // a quoted key holding an escaped newline: the key is quoted back in the message
+    assert_int_equal(parse_env("name = \"x\"\n\"long\\nname\" = 3\n", &msg), QNAV_SIM_E_PARSE);
+    assert_string_equal(msg.c_str(), "bad.toml:2: unknown key 'long\\nname'");
+    // toml++'s own description of a control character in a string
+    assert_int_equal(parse_env("name = \"a\x01b\"\n", &msg), QNAV_SIM_E_PARSE);
+    assert_true(starts_with(msg, "bad.toml:1: "));
+    assert_true(one_line(msg));
+    for (char c : msg) assert_true(static_cast<unsigned char>(c) >= 0x20);
+}
+
+static void test_cli_refuses_nan_noise_instead_of_using_the_profiles(void **state) {
+    (void)state;
+    std::string out;
+    assert_int_equal(run_tool("run --sensor-noise nan", &out), 2);
+    assert_true(one_line(out.substr(0, out.size() - 1)));
+    assert_true(out.find("--sensor-noise") != std::string::npos);
+    assert_true(out.find("expected a number in [0, 1], got 'nan'") != std::string::npos);
+    assert_int_equal(run_tool("run --actuation-noise nan", &out), 2);
+    assert_true(out.find("--actuation-noise") != std::string::npos);
+    assert_int_equal(run_tool("run --actuation-noise inf", &out), 2);
+    assert_int_equal(run_tool("bench --sensor-noise nan", &out), 2);
+}
+
+static void test_cli_names_unknown_options_and_subcommands_and_prints_its_version(void **state) {
+    (void)state;
+    std::string out;
+    assert_int_equal(run_tool("--bogus", &out), 2);
+    assert_string_equal(out.c_str(), "qnav-sim: --bogus: unknown option (see qnav-sim --help)\n");
+    assert_int_equal(run_tool("bogus", &out), 2);
+    assert_string_equal(out.c_str(), "qnav-sim: bogus: unknown subcommand (known: run, draw-env, gen-env, bench) "
+                                     "(see qnav-sim --help)\n");
+    assert_int_equal(run_tool("--version", &out), 0);
+    assert_string_equal(out.c_str(), "qnav-sim (qnav) " QNAV_VERSION "\n");
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_committed_profiles_and_environments_load),
@@ -295,6 +408,13 @@ int main(void) {
         cmocka_unit_test(test_generator_is_seeded_connected_and_writes_what_it_reads),
         cmocka_unit_test(test_cli_prints_one_line_and_fails_on_bad_input),
         cmocka_unit_test(test_cli_runs_an_episode_and_writes_a_complete_picture),
+        cmocka_unit_test(test_obstacle_wholly_outside_the_arena_is_refused),
+        cmocka_unit_test(test_obstacle_overlapping_the_destination_is_refused),
+        cmocka_unit_test(test_walled_in_start_zone_is_refused_when_the_world_is_made),
+        cmocka_unit_test(test_directory_and_unreadable_files_say_why),
+        cmocka_unit_test(test_messages_quoting_newlines_stay_one_line),
+        cmocka_unit_test(test_cli_refuses_nan_noise_instead_of_using_the_profiles),
+        cmocka_unit_test(test_cli_names_unknown_options_and_subcommands_and_prints_its_version),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

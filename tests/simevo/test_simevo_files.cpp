@@ -26,10 +26,15 @@ extern "C" {
 #include <cstring>
 #include <dirent.h>
 #include <fcntl.h>
+#include <algorithm>
+#include <cerrno>
 #include <functional>
 #include <map>
 #include <string>
+#include <thread>
+#include <pty.h>
 #include <sys/file.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -529,6 +534,231 @@ static void test_program_rejects_bad_input_with_one_line(void **state)
     assert_one_line_containing(e, "no preset 'nope'");
 }
 
+/* The temporary name write_file_atomic used before it made them with mkstemp: a planted
+ * symlink there was followed and the file it pointed to overwritten. */
+static void test_atomic_write_never_follows_a_planted_symlink(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir(), outside = make_tmp_dir();
+    const std::string victim = join_path(outside, "victim.txt"), target = join_path(root, "summary.md");
+    write_file_atomic(victim, "keep me\n");
+    const std::string old_tmp = target + ".tmp" + std::to_string(::getpid()) + "-" +
+                                std::to_string(std::hash<std::thread::id>()(std::this_thread::get_id()) % 100000);
+    assert_int_equal(symlink(victim.c_str(), old_tmp.c_str()), 0);
+    write_file_atomic(target, "new content\n");
+    assert_string_equal(slurp(victim).c_str(), "keep me\n");
+    assert_string_equal(slurp(target).c_str(), "new content\n");
+    std::map<std::string, std::string> files;
+    collect(root, "", files);
+    assert_int_equal(files.size(), 2); /* the target and the planted link: no temporary left */
+    struct stat st;
+    assert_int_equal(stat(target.c_str(), &st), 0);
+    assert_int_equal(st.st_mode & 0777, 0644);
+}
+
+static bool process_gone(pid_t pid)
+{
+    char path[64], text[512] = "";
+    std::snprintf(path, sizeof path, "/proc/%d/stat", static_cast<int>(pid));
+    FILE *f = std::fopen(path, "r");
+    if (f == nullptr) {
+        return true;
+    }
+    const size_t n = std::fread(text, 1, sizeof text - 1, f);
+    std::fclose(f);
+    text[n] = '\0';
+    const char *paren = std::strrchr(text, ')');
+    return paren != nullptr && paren[1] == ' ' && (paren[2] == 'Z' || paren[2] == 'X');
+}
+
+/* simevo killed with SIGKILL while a plot script runs: the script dies too, instead of
+ * living on to race the resumed run for the plot files. */
+static void test_plot_child_dies_when_simevo_is_killed(void **state)
+{
+    (void)state;
+    const std::string dir = make_tmp_dir();
+    write_file_atomic(join_path(dir, "slow_plot.sh"),
+                      "echo $$ > \"$1/pid.tmp\" && mv \"$1/pid.tmp\" \"$1/pid\" && exec sleep 120\n");
+    const pid_t sim = fork();
+    assert_true(sim >= 0);
+    if (sim == 0) {
+        RunOptions opt;
+        opt.python = "/bin/sh";
+        opt.tools_dir = dir;
+        try {
+            run_plot(opt, "slow_plot.sh", dir);
+        } catch (...) {
+        }
+        _exit(0);
+    }
+    std::string text;
+    for (int waited = 0; !read_file(join_path(dir, "pid"), text); waited += 20) {
+        assert_true(waited < 30000);
+        usleep(20000);
+    }
+    const pid_t plot = static_cast<pid_t>(std::atol(text.c_str()));
+    assert_true(plot > 0);
+    assert_false(process_gone(plot));
+    assert_int_equal(kill(sim, SIGKILL), 0);
+    assert_int_equal(wait_exit(sim), 128 + SIGKILL);
+    int waited = 0;
+    while (!process_gone(plot) && waited < 10000) {
+        usleep(20000);
+        waited += 20;
+    }
+    if (!process_gone(plot)) {
+        kill(plot, SIGKILL);
+        fail_msg("the plot script (pid %d) outlived simevo", static_cast<int>(plot));
+    }
+}
+
+static std::string run_for_stdout(const std::string &args, int &status)
+{
+    const std::string cmd = std::string(SIMEVO_EXE) + " " + args + " 2>/dev/null";
+    FILE *p = popen(cmd.c_str(), "r");
+    assert_non_null(p);
+    std::string out;
+    char buf[512];
+    while (fgets(buf, sizeof buf, p)) {
+        out += buf;
+    }
+    const int st = pclose(p);
+    status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    return out;
+}
+
+static void test_program_command_line_names_unknown_options_and_subcommands(void **state)
+{
+    (void)state;
+    int st = 0;
+    std::string e = run_for_error({"--bogus"}, st);
+    assert_int_equal(st, 2);
+    assert_string_equal(e.c_str(), "simevo: --bogus: unknown option (see simevo --help)\n");
+    e = run_for_error({"bogus"}, st);
+    assert_int_equal(st, 2);
+    assert_string_equal(e.c_str(),
+                        "simevo: bogus: unknown subcommand (known: run, list, evolve, eval, quality) (see simevo --help)\n");
+    e = run_for_error({"eval", "prob", "--bogus"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--bogus");
+    const std::string v = run_for_stdout("--version", st);
+    assert_int_equal(st, 0);
+    assert_string_equal(v.c_str(), "simevo (qnav) " QNAV_VERSION "\n");
+}
+
+/* Zero episodes, NaN or out-of-range noise: refused as bad usage, naming the option. */
+static void test_program_refuses_zero_episodes_and_impossible_noise(void **state)
+{
+    (void)state;
+    int st = 0;
+    std::string e = run_for_error({"eval", "prob", "--episodes", "0"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--episodes");
+    e = run_for_error({"evolve", "--eval-episodes", "0", "--out", make_tmp_dir() + "/never"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--eval-episodes");
+    e = run_for_error({"evolve", "--noise", "nan"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "expected a number in [0, 1], got 'nan'");
+    e = run_for_error({"evolve", "--sensor-noise", "5"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--sensor-noise");
+    e = run_for_error({"eval", "prob", "--noise", "nan"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--noise");
+}
+
+/* Experiment files: noise above the simulator's 1 refused at its line before any output
+ * is written; a directory named as the file; a quoted key with a newline on one line. */
+static void test_experiment_file_problems_are_found_before_any_output(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::string out = join_path(root, "out");
+    const std::string noisy = join_path(root, "noisy.toml");
+    write_file_atomic(noisy, "name = \"noisy\"\n[target]\nepisodes = 5\nnoise = 5\n");
+    int st = 0;
+    std::string e = run_for_error({"run", noisy, "--out", out, "--no-plot"}, st);
+    assert_int_equal(st, 1);
+    assert_one_line_containing(e, (noisy + ":4: noise: 5 is outside [0, 1]").c_str());
+    assert_false(file_exists(out));
+
+    e = run_for_error({"run", root, "--out", out, "--no-plot"}, st);
+    assert_int_equal(st, 1);
+    assert_one_line_containing(e, (root + ": is a directory, not a file").c_str());
+
+    const std::string nl = join_path(root, "nl.toml");
+    write_file_atomic(nl, "name = \"nl\"\n[target]\n\"a\\nb\" = 1\n");
+    e = run_for_error({"run", nl, "--out", out, "--no-plot"}, st);
+    assert_int_equal(st, 1);
+    assert_one_line_containing(e, (nl + ":3: unknown key 'a\\nb' in [target]").c_str());
+    assert_false(file_exists(out));
+}
+
+/* On a 40-column terminal every progress redraw fits in 39 columns (a longer line wraps,
+ * and each redraw then scrolls a line instead of replacing it). */
+static void test_progress_line_is_cut_to_the_terminal_width(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    struct winsize ws {};
+    ws.ws_col = 40;
+    ws.ws_row = 24;
+    int master = -1, slave = -1;
+    assert_int_equal(openpty(&master, &slave, nullptr, nullptr, &ws), 0);
+    const pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        dup2(slave, 2);
+        const int nul = open("/dev/null", O_WRONLY);
+        dup2(nul, 1);
+        close(master);
+        setenv("QNAV_DATA_DIR", SIMEVO_SOURCE_DIR "/data", 1);
+        unsetenv("COLUMNS");
+        const std::string out = join_path(root, "out");
+        execl(SIMEVO_EXE, SIMEVO_EXE, "run", SIMEVO_TEST_DIR "/tiny.toml", "--no-plot", "-j", "1", "--out", out.c_str(),
+              static_cast<char *>(nullptr));
+        _exit(127);
+    }
+    close(slave);
+    std::string text;
+    char buf[4096];
+    for (;;) {
+        const ssize_t n = read(master, buf, sizeof buf);
+        if (n > 0) {
+            text.append(buf, static_cast<std::size_t>(n));
+        } else if (n < 0 && errno == EINTR) {
+            continue;
+        } else {
+            break; /* EIO: simevo exited and the pty's last user is gone */
+        }
+    }
+    close(master);
+    assert_int_equal(wait_exit(pid), 0);
+    std::size_t pieces = 0, longest = 0;
+    std::size_t start = 0;
+    for (std::size_t i = 0; i <= text.size(); ++i) {
+        if (i == text.size() || text[i] == '\r' || text[i] == '\n') {
+            std::string piece = text.substr(start, i - start);
+            if (piece.rfind("\033[K", 0) == 0) {
+                piece.erase(0, 3);
+            }
+            std::size_t chars = 0;
+            for (char c : piece) {
+                chars += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+            }
+            if (chars > 0) {
+                ++pieces;
+                longest = std::max(longest, chars);
+            }
+            start = i + 1;
+        }
+    }
+    print_message("%zu progress redraws, the longest %zu columns\n", pieces, longest);
+    assert_true(pieces >= 1);
+    assert_int_equal(longest, 39); /* cut (the whole line is longer), never more */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -540,6 +770,12 @@ int main(void)
         cmocka_unit_test(test_program_rejects_bad_input_with_one_line),
         cmocka_unit_test(test_program_killed_by_pid_resumes_to_identical_results),
         cmocka_unit_test(test_table_mode_and_network_mode_give_identical_results),
+        cmocka_unit_test(test_atomic_write_never_follows_a_planted_symlink),
+        cmocka_unit_test(test_plot_child_dies_when_simevo_is_killed),
+        cmocka_unit_test(test_program_command_line_names_unknown_options_and_subcommands),
+        cmocka_unit_test(test_program_refuses_zero_episodes_and_impossible_noise),
+        cmocka_unit_test(test_experiment_file_problems_are_found_before_any_output),
+        cmocka_unit_test(test_progress_line_is_cut_to_the_terminal_width),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "qnav/ctrl.h"
+#include "qnav/cli.h"
 #include "qnav/policy_io.h"
 
 #define EXIT_BAD_INPUT 1
@@ -534,6 +535,13 @@ int main(int argc, char **argv)
         fputs(usage_text, stdout);
         return 0;
     }
+    if (strcmp(cmd, "--version") == 0) {
+        fputs(QNAV_CLI_VERSION_LINE("qnav-policy"), stdout);
+        return 0;
+    }
+    if (cmd[0] == '-') {
+        return usage_error("%s: unknown option", cmd);
+    }
     if (strcmp(cmd, "check") == 0) {
         return cmd_check(argc - 1, argv + 1);
     }
@@ -546,5 +554,5 @@ int main(int argc, char **argv)
     if (strcmp(cmd, "header") == 0) {
         return cmd_header(argc - 1, argv + 1, argc, argv);
     }
-    return usage_error("unknown command '%s' (check, show, new, header)", cmd);
+    return usage_error("%s: unknown subcommand (known: check, show, new, header)", cmd);
 }

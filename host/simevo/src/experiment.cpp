@@ -17,12 +17,15 @@
 #include <mutex>
 #include <sstream>
 #include <fcntl.h>
+#include <csignal>
 #include <sys/file.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
 
 #include "files.h"
+#include "qnav/terminal.hpp"
 #include "qnav/ctrl.h"
 #include "qnav/policy_io.h"
 #include "rng.h"
@@ -121,9 +124,13 @@ private:
                 bests += b;
             }
         }
-        std::fprintf(stderr, "\r\033[K[%s] %" PRIu64 "/%" PRIu64 " episodes %5.1f%%  %.0f ep/s  ETA %ld:%02ld:%02ld  best R:%s",
-                     title_.c_str(), done, total_, total_ ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 100.0,
-                     rate, eta / 3600, (eta / 60) % 60, eta % 60, bests.c_str());
+        char line[4096];
+        std::snprintf(line, sizeof line, "[%s] %" PRIu64 "/%" PRIu64 " episodes %5.1f%%  %.0f ep/s  ETA %ld:%02ld:%02ld  best R:%s",
+                      title_.c_str(), done, total_, total_ ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 100.0,
+                      rate, eta / 3600, (eta / 60) % 60, eta % 60, bests.c_str());
+        // cut to the terminal (asked each time: it may be resized): a wrapped line would
+        // scroll instead of being redrawn in place
+        std::fprintf(stderr, "\r\033[K%s", qnav::cli::fit_line(line, qnav::cli::terminal_columns(2)).c_str());
         std::fflush(stderr);
     }
 
@@ -938,11 +945,17 @@ void run_plot(const RunOptions &opt, const std::string &script, const std::strin
     if (!file_exists(path)) {
         throw UserError(path + ": plot script not found (set --tools-dir or QNAV_TOOLS_DIR, or use --no-plot)");
     }
+    const pid_t parent = ::getpid();
     const pid_t pid = ::fork();
     if (pid < 0) {
         throw UserError(opt.python + ": cannot start (" + std::strerror(errno) + ")");
     }
     if (pid == 0) {
+        // The plot dies with simevo (kill -9 included): a leftover plotter would race the
+        // resumed run for the same output files.
+        if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || ::getppid() != parent) {
+            ::_exit(127);
+        }
         ::execl(opt.python.c_str(), opt.python.c_str(), path.c_str(), exp_dir.c_str(), static_cast<char *>(nullptr));
         std::fprintf(stderr, "%s: cannot run (%s)\n", opt.python.c_str(), std::strerror(errno));
         ::_exit(127);

@@ -1,5 +1,6 @@
 /*
- * File helpers (POSIX): atomic writes by rename, reads, mkdir -p.
+ * File helpers (POSIX): atomic writes by rename from an exclusively created temporary
+ * file, reads, mkdir -p.
  */
 #include "files.h"
 
@@ -7,7 +8,6 @@
 #include <cstring>
 #include <fcntl.h>
 #include <sys/stat.h>
-#include <thread>
 #include <unistd.h>
 
 #include "spec.h"
@@ -43,13 +43,20 @@ void write_all(int fd, const std::string &s, const std::string &path)
 
 void write_file_atomic(const std::string &path, const std::string &content)
 {
-    const std::string tmp = path + ".tmp" + std::to_string(::getpid()) + "-" +
-                            std::to_string(std::hash<std::thread::id>()(std::this_thread::get_id()) % 100000);
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    // The temporary file is made exclusively (mkstemp: O_CREAT | O_EXCL, a random name) in
+    // the target's folder, so a symlink planted beside the target is never followed and two
+    // writers (a resumed run and a leftover process) never share one.
+    const std::size_t slash = path.find_last_of('/');
+    std::string tmp = (slash == std::string::npos ? std::string() : path.substr(0, slash + 1)) + "." +
+                      path.substr(slash == std::string::npos ? 0 : slash + 1) + ".tmp.XXXXXX";
+    const int fd = ::mkostemp(tmp.data(), O_CLOEXEC);
     if (fd < 0) {
         throw UserError(path + ": cannot write (" + errno_text() + ")");
     }
     try {
+        if (::fchmod(fd, 0644) != 0) {
+            throw UserError(path + ": cannot write (" + errno_text() + ")");
+        }
         write_all(fd, content, path);
     } catch (...) {
         ::close(fd);
@@ -71,6 +78,11 @@ bool read_file(const std::string &path, std::string &out)
             return false;
         }
         throw UserError(path + ": cannot read (" + errno_text() + ")");
+    }
+    struct stat st;
+    if (::fstat(fd, &st) == 0 && S_ISDIR(st.st_mode)) {
+        ::close(fd);
+        throw UserError(path + ": is a directory, not a file");
     }
     out.clear();
     char buf[65536];

@@ -6,6 +6,8 @@
  */
 #include <CLI/CLI.hpp>
 
+#include "qnav/cli.hpp"
+
 #include <chrono>
 #include <cinttypes>
 #include <cstdio>
@@ -130,6 +132,7 @@ int main(int argc, char **argv)
 {
     CLI::App app{"simevo: ε-greedy neuro-evolution and policy transfer for qnav (paper §3.3, §4)"};
     app.require_subcommand(1);
+    qnav::cli::add_version(app, "simevo");
     std::string experiments_dir = env_or("QNAV_EXPERIMENTS_DIR", std::string(QNAV_SOURCE_DIR) + "/experiments");
     app.add_option("--experiments", experiments_dir, "folder of experiment files")->capture_default_str();
 
@@ -174,12 +177,12 @@ int main(int argc, char **argv)
     evolve->add_option("--env", env, "environment name or file")->capture_default_str();
     evolve->add_option("--robot", robot, "robot profile name or file")->capture_default_str();
     evolve->add_option("--sectors", sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
-    evolve->add_option("--noise", noise, "sensor and actuation noise level p (0.05 = 5%)")->check(CLI::Range(0.0, 10.0));
-    evolve->add_option("--sensor-noise", sensor_noise, "sensor noise only")->check(CLI::Range(0.0, 10.0));
-    evolve->add_option("--actuation-noise", actuation_noise, "actuation noise only")->check(CLI::Range(0.0, 10.0));
+    evolve->add_option("--noise", noise, "sensor and actuation noise level p (0.05 = 5%)")->check(qnav::cli::finite_range(0.0, 1.0));
+    evolve->add_option("--sensor-noise", sensor_noise, "sensor noise only")->check(qnav::cli::finite_range(0.0, 1.0));
+    evolve->add_option("--actuation-noise", actuation_noise, "actuation noise only")->check(qnav::cli::finite_range(0.0, 1.0));
     evolve->add_option("--from", from, "policy file to seed the population from (transfer)");
     evolve->add_option("--episodes", ev_episodes, "episodes")->capture_default_str()->check(CLI::Range(uint64_t(1), uint64_t(100000000)));
-    evolve->add_option("--eval-episodes", ev_eval, "held-out evaluation episodes of the best")->capture_default_str();
+    evolve->add_option("--eval-episodes", ev_eval, "held-out evaluation episodes of the best")->capture_default_str()->check(CLI::Range(1u, 1000000u));
     evolve->add_option("--seed", ev_seed, "seed")->capture_default_str();
     evolve->add_option("--population", ep.population, "population size")->capture_default_str();
     evolve->add_option("--epsilon", ep.epsilon, "probability of mutating a random member")->capture_default_str();
@@ -201,8 +204,8 @@ int main(int argc, char **argv)
     eval->add_option("--env", e_env, "environment")->capture_default_str();
     eval->add_option("--robot", e_robot, "robot profile")->capture_default_str();
     eval->add_option("--sectors", e_sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
-    eval->add_option("--noise", e_noise, "noise level p")->check(CLI::Range(0.0, 10.0));
-    eval->add_option("--episodes", e_episodes, "episodes")->capture_default_str();
+    eval->add_option("--noise", e_noise, "noise level p")->check(qnav::cli::finite_range(0.0, 1.0));
+    eval->add_option("--episodes", e_episodes, "episodes")->capture_default_str()->check(CLI::Range(1u, 1000000u));
     eval->add_option("--seed", e_seed, "seed")->capture_default_str();
 
     // quality: Figs. 2-3 for any policy files
@@ -218,15 +221,8 @@ int main(int argc, char **argv)
         ->capture_default_str()->check(CLI::Range(1, 65535));
     quality->add_option("--tools-dir", opt.tools_dir, "folder with plot_policy.py")->capture_default_str();
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp &e) {
-        return app.exit(e);
-    } catch (const CLI::CallForAllHelp &e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError &e) {
-        std::fprintf(stderr, "simevo: %s\n", e.what());
-        return 2;
+    if (const int status = qnav::cli::parse(app, argc, argv, "simevo"); status >= 0) {
+        return status;
     }
 
     try {

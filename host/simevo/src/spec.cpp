@@ -2,9 +2,9 @@
  * TOML experiment files -> ExperimentSpec, with strict checking of every key and value.
  */
 #include "spec.h"
+#include "files.h"
 
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -151,13 +151,13 @@ public:
         } else if (k == "sectors") {
             s.sectors = static_cast<uint32_t>(integer(v, k, 0, QNAV_MAX_SECTORS));
         } else if (k == "noise") {
-            s.sensor_noise = s.actuation_noise = number(v, k, 0.0, 10.0);
+            s.sensor_noise = s.actuation_noise = number(v, k, 0.0, 1.0);
             noise_set = true;
         } else if (k == "sensor_noise") {
-            s.sensor_noise = number(v, k, 0.0, 10.0);
+            s.sensor_noise = number(v, k, 0.0, 1.0);
             split_noise_set = true;
         } else if (k == "actuation_noise") {
-            s.actuation_noise = number(v, k, 0.0, 10.0);
+            s.actuation_noise = number(v, k, 0.0, 1.0);
             split_noise_set = true;
         } else if (k == "episode_limit_s") {
             s.episode_limit_s = number(v, k, 0.0, 1e6);
@@ -420,16 +420,11 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
 
 ExperimentSpec load_experiment(const std::string &path)
 {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        throw UserError(path + ": cannot open experiment file");
+    std::string text;
+    if (!read_file(path, text)) {
+        throw UserError(path + ": cannot open experiment file (No such file or directory)");
     }
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) {
-        throw UserError(path + ": read error");
-    }
-    return parse_experiment(ss.str(), path);
+    return parse_experiment(text, path);
 }
 
 void apply_preset(ExperimentSpec &spec, const std::string &preset)

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "evolution.h"
+#include "qnav/one_line.hpp"
 #include "qnav/sim.h"
 
 namespace qnav {
@@ -23,7 +24,8 @@ namespace qnav {
 /* One-line, user-facing error ("FILE:LINE: problem" or "OPTION: problem"). */
 class UserError : public std::runtime_error {
 public:
-    using std::runtime_error::runtime_error;
+    /* one line whatever the message quotes: control characters escaped (one_line()) */
+    explicit UserError(const std::string &message) : std::runtime_error(one_line(message)) {}
 };
 
 /* How the controller reads the paper (docs/architecture.md): Body = obstacles enlarged by

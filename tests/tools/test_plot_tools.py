@@ -1,0 +1,120 @@
+"""The plot scripts (tools/plot_policy.py, tools/plot_learning.py through tools/plotcommon.py):
+argparse command line (--help, --version, bad usage exits 2), the plot written in the format
+its file name asks for, and temporary files created exclusively so that a symlink planted
+beside the output is never followed."""
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+TOOLS = os.environ.get("QNAV_TOOLS_DIR") or os.path.join(os.path.dirname(__file__), "..", "..", "tools")
+sys.path.insert(0, TOOLS)
+
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+import plotcommon  # noqa: E402
+
+MAGIC = {"png": b"\x89PNG\r\n\x1a\n", "pdf": b"%PDF-", "svg": b"<?xml"}
+
+
+def quality_csv(folder):
+    with open(os.path.join(folder, "quality.csv"), "w") as f:
+        f.write("policy,level,distance_m,dtheta_deg,quality\n")
+        for lvl in range(3):
+            for dt in range(181):
+                f.write(f"prob,{lvl},{lvl * 0.5:.1f},{dt},{(180 - dt) / 180 * lvl / 2:.3f}\n")
+
+
+def run_script(name, *args):
+    return subprocess.run([sys.executable, os.path.join(TOOLS, name), *args],
+                          capture_output=True, text=True, timeout=100)
+
+
+class PlotFormatByName(unittest.TestCase):
+    def test_each_extension_gets_its_own_format(self):
+        with tempfile.TemporaryDirectory() as d:
+            quality_csv(d)
+            for fmt, magic in MAGIC.items():
+                out = os.path.join(d, "q." + fmt)
+                r = run_script("plot_policy.py", d, out)
+                self.assertEqual(r.returncode, 0, r.stderr)
+                with open(out, "rb") as f:
+                    self.assertTrue(f.read(16).startswith(magic), fmt)
+            self.assertEqual(sorted(n for n in os.listdir(d) if n.startswith(".")), [])
+
+    def test_unknown_extension_is_bad_usage(self):
+        with tempfile.TemporaryDirectory() as d:
+            quality_csv(d)
+            r = run_script("plot_policy.py", d, os.path.join(d, "q.jpeg"))
+            self.assertEqual(r.returncode, 2)
+            self.assertIn("unknown plot format", r.stderr)
+            self.assertEqual(len(r.stderr.strip().splitlines()), 2)  # usage line + error
+            self.assertFalse(os.path.exists(os.path.join(d, "q.jpeg")))
+
+
+class CommandLine(unittest.TestCase):
+    def test_help_exits_0_and_describes_the_plot(self):
+        for script in ("plot_policy.py", "plot_learning.py"):
+            r = run_script(script, "--help")
+            self.assertEqual(r.returncode, 0, script)
+            self.assertIn("usage: " + script, r.stdout)
+            self.assertIn("EXPERIMENT_DIR", r.stdout)
+
+    def test_version_names_qnav_version(self):
+        with open(os.path.join(TOOLS, "..", "VERSION")) as f:
+            want = f.read().strip()
+        r = run_script("plot_policy.py", "--version")
+        self.assertEqual(r.returncode, 0)
+        self.assertEqual(r.stdout.strip(), f"plot_policy.py (qnav) {want}")
+
+    def test_unknown_option_and_missing_folder_are_bad_usage(self):
+        r = run_script("plot_learning.py", "--bogus", "x")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("unrecognized arguments: --bogus", r.stderr)
+        r = run_script("plot_learning.py")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("EXPERIMENT_DIR", r.stderr)
+
+    def test_missing_input_file_is_one_line_exit_1(self):
+        with tempfile.TemporaryDirectory() as d:
+            r = run_script("plot_policy.py", d)
+            self.assertEqual(r.returncode, 1)
+            self.assertEqual(r.stderr.strip(), f"plot_policy.py: {d}/quality.csv: No such file or directory")
+
+
+class ExclusiveTemporaryFiles(unittest.TestCase):
+    def test_planted_symlink_at_the_old_temporary_name_is_not_followed(self):
+        with tempfile.TemporaryDirectory() as d, tempfile.TemporaryDirectory() as outside:
+            victim = os.path.join(outside, "victim.txt")
+            with open(victim, "w") as f:
+                f.write("keep me\n")
+            out = os.path.join(d, "learning.png")
+            # the names the scripts used to write through, whatever format was asked for
+            os.symlink(victim, out + ".tmp.png")
+            fig = plt.figure()
+            plotcommon.save(fig, out)
+            plt.close(fig)
+            with open(victim) as f:
+                self.assertEqual(f.read(), "keep me\n")
+            with open(out, "rb") as f:
+                self.assertTrue(f.read(8).startswith(MAGIC["png"]))
+            self.assertEqual(sorted(os.listdir(d)), ["learning.png", "learning.png.tmp.png"])
+
+    def test_failed_save_leaves_neither_output_nor_temporary(self):
+        with tempfile.TemporaryDirectory() as d:
+            fig = plt.figure()
+            fig.add_subplot().plot([0, 1], [0, float("nan")])
+            out = os.path.join(d, "x.pdf")
+            with self.assertRaises(plotcommon.PlotError):
+                plotcommon.save(fig, os.path.join(d, "x.bmp"))
+            plotcommon.save(fig, out)
+            plt.close(fig)
+            self.assertEqual(os.listdir(d), ["x.pdf"])
+
+
+if __name__ == "__main__":
+    unittest.main()
