@@ -1,9 +1,11 @@
 /*
- * The simulated TekBot hardware layer (sim_hal.h).
+ * The scripted robot (sim_hal.h).
  */
 #include "sim_hal.h"
 
 #include <string.h>
+
+#include "qnav/board.h"
 
 static uint32_t sim_millis(void *ctx)
 {
@@ -23,11 +25,19 @@ static qnav_cdeg_t sim_heading(void *ctx)
     return ((sim_hal_t *)ctx)->heading_cdeg;
 }
 
-static void sim_motors(void *ctx, qnav_q1_15_t left, qnav_q1_15_t right)
+static void sim_odometry(void *ctx, int32_t *left, int32_t *right)
 {
     sim_hal_t *s = (sim_hal_t *)ctx;
-    s->left = left;
-    s->right = right;
+    *left = s->left_counts;
+    *right = s->right_counts;
+}
+
+static void sim_drive(void *ctx, qnav_deg_t heading, qnav_q1_15_t speed)
+{
+    sim_hal_t *s = (sim_hal_t *)ctx;
+    s->drive_heading = heading;
+    s->drive_speed = speed;
+    qnav_board_mix(heading, speed, 60, &s->left, &s->right);
     s->motor_calls++;
 }
 
@@ -49,17 +59,49 @@ static void sim_uart_write(void *ctx, const uint8_t *b, uint16_t n)
     }
 }
 
+static uint8_t sim_nvm_read(void *ctx, uint16_t addr, uint8_t *out, uint16_t n)
+{
+    sim_hal_t *s = (sim_hal_t *)ctx;
+    if ((uint32_t)addr + n > SIM_HAL_NVM) {
+        return 0;
+    }
+    memcpy(out, &s->nvm[addr], n);
+    return 1;
+}
+
+static uint8_t sim_nvm_write(void *ctx, uint16_t addr, const uint8_t *b, uint16_t n)
+{
+    sim_hal_t *s = (sim_hal_t *)ctx;
+    uint16_t i;
+    if ((uint32_t)addr + n > SIM_HAL_NVM) {
+        return 0;
+    }
+    for (i = 0; i < n; ++i) {
+        if (s->nvm_cut_after != 0u && s->nvm_written >= s->nvm_cut_after) {
+            return 0; /* the power is gone: nothing more reaches the EEPROM */
+        }
+        s->nvm[addr + i] = b[i];
+        s->nvm_written++;
+    }
+    return 1;
+}
+
 void sim_hal_init(sim_hal_t *sim, qnav_board_hal_t *hal)
 {
     memset(sim, 0, sizeof *sim);
+    memset(sim->nvm, 0xFF, sizeof sim->nvm);
     sim->now_ms = 1000;
     hal->ctx = sim;
     hal->millis = sim_millis;
     hal->sonar_read = sim_sonar;
     hal->heading_cdeg = sim_heading;
-    hal->motors_set = sim_motors;
+    hal->odometry_read = sim_odometry;
+    hal->drive = sim_drive;
     hal->uart_read = sim_uart_read;
     hal->uart_write = sim_uart_write;
+    hal->nvm_read = sim_nvm_read;
+    hal->nvm_write = sim_nvm_write;
+    hal->nvm_bytes = SIM_HAL_NVM;
 }
 
 void sim_hal_to_board(sim_hal_t *sim, const uint8_t *bytes, uint32_t n)

@@ -21,7 +21,7 @@
 typedef struct {
     sim_hal_t sim;
     qnav_board_hal_t hal;
-    qnav_tekbot_t bot;
+    qnav_board_t bot;
     qnav_link_tx_t btx;           /* the bridge's sender */
     qnav_link_rx_t brx;           /* the bridge's receiver */
     uint32_t read_upto;           /* bytes of from_board already decoded */
@@ -36,7 +36,7 @@ static bench_t g;
 
 static void bench_start(uint16_t sectors)
 {
-    qnav_tekbot_config_t cfg;
+    qnav_board_config_t cfg;
     uint16_t k;
     memset(&g, 0, sizeof g);
     sim_hal_init(&g.sim, &g.hal);
@@ -46,7 +46,7 @@ static void bench_start(uint16_t sectors)
     }
     qnav_tekbot_config_default(&cfg);
     cfg.n_sectors = sectors;
-    assert_int_equal(qnav_tekbot_init(&g.bot, &cfg, &g.hal), QNAV_TEKBOT_OK);
+    assert_int_equal(qnav_board_init(&g.bot, &cfg, &g.hal), QNAV_BOARD_OK);
     qnav_link_tx_init(&g.btx);
     qnav_link_rx_init(&g.brx);
 }
@@ -110,7 +110,7 @@ static void run_ms(uint32_t ms)
     uint32_t t;
     for (t = 0; t < ms; t += 10) {
         g.sim.now_ms += 10;
-        qnav_tekbot_poll(&g.bot);
+        qnav_board_poll(&g.bot);
         read_board();
     }
 }
@@ -134,16 +134,16 @@ static void test_mix_turns_counter_clockwise_with_the_right_wheel(void **state)
 {
     qnav_q1_15_t l, r;
     (void)state;
-    qnav_tekbot_mix(30, 20000, 60, &l, &r);
+    qnav_board_mix(30, 20000, 60, &l, &r);
     assert_true(r > l);
-    qnav_tekbot_mix(-30, 20000, 60, &l, &r);
+    qnav_board_mix(-30, 20000, 60, &l, &r);
     assert_true(l > r);
-    qnav_tekbot_mix(0, 20000, 60, &l, &r);
+    qnav_board_mix(0, 20000, 60, &l, &r);
     assert_int_equal(l, 20000);
     assert_int_equal(r, 20000);
-    qnav_tekbot_mix(120, 20000, 60, &l, &r); /* beyond spin: turn in place */
+    qnav_board_mix(120, 20000, 60, &l, &r); /* beyond spin: turn in place */
     assert_int_equal(l, -r);
-    qnav_tekbot_mix(45, 0, 60, &l, &r); /* no speed: no motion at all */
+    qnav_board_mix(45, 0, 60, &l, &r); /* no speed: no motion at all */
     assert_int_equal(l, 0);
     assert_int_equal(r, 0);
 }
@@ -346,7 +346,7 @@ static void run_with_bridge(qnav_bridge_t *b, uint32_t ms)
     uint32_t t;
     for (t = 0; t < ms; t += 10) {
         g.sim.now_ms += 10;
-        qnav_tekbot_poll(&g.bot);
+        qnav_board_poll(&g.bot);
         if (g.read_upto < g.sim.from_board_n) {
             qnav_bridge_on_bytes(b, &g.sim.from_board[g.read_upto],
                                  g.sim.from_board_n - g.read_upto, g.sim.now_ms);
@@ -384,8 +384,8 @@ static void test_board_and_bridge_drive_together_in_both_modes(void **state)
         /* the bridge shuts down: the board stops at once (stop command) */
         qnav_bridge_shutdown(&b, g.sim.now_ms);
         g.sim.now_ms += 10;
-        qnav_tekbot_poll(&g.bot);
-        qnav_tekbot_tick(&g.bot);
+        qnav_board_poll(&g.bot);
+        qnav_board_tick(&g.bot);
         assert_false(moving());
     }
     lcm_destroy(lcm);
