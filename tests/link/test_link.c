@@ -170,7 +170,7 @@ static void test_codec_round_trips_every_small_message(void **state)
 
 static void test_codec_drops_frame_with_bad_crc(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_goal_t g = {0x0101u, 0x0202, 0x01020304u}; /* no zero bytes: no COBS codes */
@@ -189,7 +189,7 @@ static void test_codec_drops_frame_with_bad_crc(void **state)
 
 static void test_codec_drops_truncated_frame_and_takes_the_next(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_frame_t f;
@@ -209,7 +209,7 @@ static void test_codec_drops_truncated_frame_and_takes_the_next(void **state)
 
 static void test_codec_drops_replayed_frame(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_goal_t g = {1, 100, 5000};
@@ -229,7 +229,7 @@ static void test_codec_drops_replayed_frame(void **state)
 
 static void test_codec_accepts_sequence_wrap_and_counts_gaps(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_frame_t f;
@@ -252,7 +252,7 @@ static void test_codec_accepts_sequence_wrap_and_counts_gaps(void **state)
 
 static void test_codec_accepts_any_sequence_after_reset(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_goal_t g = {1, 100, 5000};
@@ -295,7 +295,7 @@ static void test_codec_drops_unknown_id_and_wrong_length(void **state)
 static void test_codec_drops_overlong_frame_and_recovers(void **state)
 {
     uint8_t noise[QNAV_LINK_MAX_FRAME + 300];
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_goal_t g = {1, 100, 5000};
@@ -332,7 +332,7 @@ static void test_codec_drops_cobs_block_running_past_delimiter(void **state)
 
 static void test_encode_refuses_small_buffer_and_keeps_sequence(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     uint8_t out[8];
     qnav_link_tx_t tx;
     (void)state;

@@ -60,6 +60,24 @@ static void count_channels(const char *path, int *scan, int *cmd, int *qual, int
     lcm_eventlog_destroy(log);
 }
 
+/* The destination the SIL robot printed, as navbridge --goal-at's value (odometry frame);
+ * the robot prints it before making its link. */
+static void destination_of(const char *sil_out, char *goal, size_t len)
+{
+    char text[2048];
+    const char *at;
+    size_t n = 0;
+    assert_true(read_text(sil_out, text, sizeof text) > 0);
+    at = strstr(text, "--goal-at ");
+    assert_non_null(at);
+    at += strlen("--goal-at ");
+    while (n + 1 < len && at[n] != ')' && at[n] != '\0') {
+        goal[n] = at[n];
+        n++;
+    }
+    goal[n] = '\0';
+}
+
 static void replay_is_identical(const char *log)
 {
     char out[320], err[320], text[2048];
@@ -75,10 +93,10 @@ static void replay_is_identical(const char *log)
 static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void **state)
 {
     char link[300], log[300], sil_out[300], sil_err[300], nb_out[300], nb_err[300];
-    char text[2048];
+    char text[2048], goal[64];
     const char *sil[] = {SIL_EXE, "--lockstep", "--link", link, NULL};
     const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--log", log,
-                        NULL};
+                        "--goal-at", goal, NULL};
     pid_t ps, pn;
     int scan, cmd, qual, status, pose;
     (void)state;
@@ -91,6 +109,7 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     ps = qnav_test_spawn(sil, sil_out, sil_err);
     assert_true(ps > 0);
     assert_int_equal(qnav_test_wait_path(link, 4000), 0);
+    destination_of(sil_out, goal, sizeof goal);
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0); /* 0: destination reached */
@@ -113,10 +132,11 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
 static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(void **state)
 {
     char link[300], log[300], pol[300], sil_out[300], sil_err[300], nb_out[300], nb_err[300];
-    char text[4096], perr[QNAV_POLICY_IO_ERRLEN];
+    char text[4096], perr[QNAV_POLICY_IO_ERRLEN], goal[64];
     const char *sil[] = {SIL_EXE, "--tick-ms", "20", "--link", link, NULL};
     const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--mode",
-                        "onboard", "--policy", pol, "--upload", "--log", log, NULL};
+                        "onboard", "--policy", pol, "--upload", "--log", log, "--goal-at",
+                        goal, NULL};
     const char *replay[] = {NAVBRIDGE_EXE, "--replay", log, "--policy", pol, NULL};
     qnav_policy_t p;
     pid_t ps, pn;
@@ -136,14 +156,16 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     ps = qnav_test_spawn(sil, sil_out, sil_err);
     assert_true(ps > 0);
     assert_int_equal(qnav_test_wait_path(link, 4000), 0);
+    destination_of(sil_out, goal, sizeof goal);
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0);
     assert_int_equal(wait_exit_within(pn, 3000), 3);
-    assert_true(read_text(sil_err, text, sizeof text) > 0);
-    assert_non_null(strstr(text, "policy uploaded"));
     assert_true(read_text(nb_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "policy upload: ok"));
+    /* the board's heartbeat says which policy runs: first its own, then the upload */
+    assert_non_null(strstr(text, "runs its built-in policy"));
+    assert_non_null(strstr(text, "runs its uploaded policy"));
     assert_true(read_text(sil_out, text, sizeof text) > 0);
     print_message("%s", text);
     assert_non_null(strstr(text, "reached yes"));

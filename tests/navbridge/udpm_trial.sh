@@ -16,7 +16,9 @@ lcm-logger -q -f "$DIR/trial.lcmlog" & LOGGER=$!
 i=0
 while [ ! -e "$DIR/link" ] && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
 sleep 0.3   # lcm-logger subscribed before the trial starts
-"$NB_EXE" --device "$DIR/link" > "$DIR/nb.out" 2> "$DIR/nb.err" & NB=$!
+# the robot prints its destination in the odometry frame before making the link
+GOAL=$(sed -n 's/.*--goal-at \([-0-9.:]*\)).*/\1/p' "$DIR/sil.out")
+"$NB_EXE" --device "$DIR/link" --goal-at "$GOAL" > "$DIR/nb.out" 2> "$DIR/nb.err" & NB=$!
 wait $SIL; SIL_RC=$?
 # the robot's pty closes with it: navbridge leaves on its own (status 3); guard 5 s
 ( sleep 5; kill -TERM $NB 2>/dev/null ) & GUARD=$!

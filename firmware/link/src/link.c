@@ -821,3 +821,28 @@ int8_t qnav_link_upload_commit(qnav_link_upload_t *up, const qnav_link_policy_co
     qnav_link_upload_init(up);
     return result;
 }
+
+int32_t qnav_link_send(qnav_link_tx_t *tx, uint8_t msg_id, const uint8_t *payload,
+                       int32_t len, uint8_t *wire, uint16_t cap, qnav_link_write_fn write,
+                       void *user)
+{
+    int32_t n;
+    if (len < 0) {
+        return len;
+    }
+    if (write == NULL) {
+        return QNAV_LINK_E_NULL;
+    }
+    n = qnav_link_encode(tx, msg_id, payload, (uint16_t)len, wire, cap);
+    if (n > 0) {
+        write(user, wire, (uint16_t)n);
+    }
+    return n;
+}
+
+uint16_t qnav_link_policy_crc(const qnav_policy_t *policy)
+{
+    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
+    int32_t n = qnav_link_policy_to_blob(policy, blob, (uint16_t)sizeof blob);
+    return n > 0 ? qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) : 0u;
+}

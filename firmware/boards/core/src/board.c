@@ -88,13 +88,6 @@ void qnav_board_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_deg_t spin_
     *right = sat_q15(fwd + turn);
 }
 
-static uint16_t blob_crc(const qnav_policy_t *p)
-{
-    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
-    int32_t n = qnav_link_policy_to_blob(p, blob, (uint16_t)sizeof blob);
-    return n > 0 ? qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) : 0u;
-}
-
 /* The stored policy when one is whole and the controller takes it, else the built-in. */
 static void load_policy(qnav_board_t *bot)
 {
@@ -121,7 +114,7 @@ static void load_policy(qnav_board_t *bot)
     qnav_policy_prob_default(&bot->policy);
     bot->policy_source = QNAV_BOARD_POLICY_BUILTIN;
     bot->ctrl_ready = (uint8_t)(qnav_ctrl_init(&bot->ctrl, &cc, &bot->policy) == QNAV_OK);
-    bot->policy_crc = blob_crc(&bot->policy);
+    bot->policy_crc = qnav_link_policy_crc(&bot->policy);
 }
 
 qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t *cfg,
@@ -158,15 +151,8 @@ qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t
 
 static void send(qnav_board_t *bot, uint8_t id, const uint8_t *payload, int32_t len)
 {
-    int32_t n;
-    if (len < 0) {
-        return;
-    }
-    n = qnav_link_encode(&bot->tx, id, payload, (uint16_t)len, bot->wire,
-                         (uint16_t)sizeof bot->wire);
-    if (n > 0) {
-        bot->hal.uart_write(bot->hal.ctx, bot->wire, (uint16_t)n);
-    }
+    (void)qnav_link_send(&bot->tx, id, payload, len, bot->wire, (uint16_t)sizeof bot->wire,
+                         bot->hal.uart_write, bot->hal.ctx);
 }
 
 /* A committed upload: switch controllers only when the new one initialises, then keep it

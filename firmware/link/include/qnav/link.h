@@ -206,6 +206,18 @@ void qnav_link_tx_init(qnav_link_tx_t *tx);
 int32_t qnav_link_encode(qnav_link_tx_t *tx, uint8_t msg_id, const uint8_t *payload,
                          uint16_t len, uint8_t *out, uint16_t cap);
 
+/* Where qnav_link_send puts a framed message: a UART, a pty, a test's queue. */
+typedef void (*qnav_link_write_fn)(void *user, const uint8_t *bytes, uint16_t n);
+
+/*
+ * Frame a payload into wire (cap bytes, QNAV_LINK_MAX_WIRE(len) suffices) and hand it to
+ * write. len < 0 (a failed _pack) sends nothing. The one send path of the board core and
+ * navbridge. Returns the bytes written, or the negative status of _pack/_encode.
+ */
+int32_t qnav_link_send(qnav_link_tx_t *tx, uint8_t msg_id, const uint8_t *payload,
+                       int32_t len, uint8_t *wire, uint16_t cap, qnav_link_write_fn write,
+                       void *user);
+
 /* CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, no reflection, no final xor);
  * "123456789" gives 0x29B1. Continue a running CRC by passing the previous value. */
 uint16_t qnav_link_crc16(uint16_t crc, const uint8_t *data, uint16_t len);
@@ -321,6 +333,10 @@ int32_t qnav_link_pose_unpack(const uint8_t *p, uint16_t len, qnav_link_pose_t *
  * QNAV_LINK_E_NULL / _VALUE (unknown kind, H out of range) / _SPACE.
  */
 int32_t qnav_link_policy_to_blob(const qnav_policy_t *policy, uint8_t *out, uint16_t cap);
+
+/* The CRC-16 of a policy's blob: what heartbeats, acks and commands call the policy's
+ * CRC (0 when it cannot be serialised). */
+uint16_t qnav_link_policy_crc(const qnav_policy_t *policy);
 
 /* Parse a blob back; QNAV_LINK_OK or QNAV_LINK_E_NULL / _LENGTH / _VALUE. */
 int32_t qnav_link_policy_from_blob(const uint8_t *blob, uint16_t len, qnav_policy_t *policy);
