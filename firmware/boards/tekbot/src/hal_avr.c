@@ -2,7 +2,7 @@
  * Reference hardware layer for an ATmega128 TekBot at 16 MHz (qnav/board_hal.h):
  *   tick    Timer0 compare interrupt every 1 ms
  *   UART    USART0 (PE0 RXD, PE1 TXD), 57600 baud 8N1 with U2X (-0.8 % error),
- *           interrupt-driven receive into a 64-byte ring, polled transmit
+ *           interrupt-driven receive into a 256-byte ring, polled transmit
  *   sonar   8 analog sonars (MaxBotix LV-EZ class, AN output ~ Vcc/512 per inch) on
  *           ADC0..ADC7, sector k on ADCk; AVcc reference
  *   motors  Timer1 8-bit fast PWM on OC1A (PB5, left) and OC1B (PB6, right); direction on
@@ -43,7 +43,11 @@
 #define QNAV_TEKBOT_SPIN_DEG 60
 #endif
 
-#define RX_RING 64u
+/* Receive ring, bytes (indices are uint8_t: at most 256). A tick sends ~95 bytes with
+ * polled transmit (scan, heartbeat, pose, decision: 16.5 ms at 57600 baud) while the
+ * same number may arrive (a policy upload's chunks come back to back): 64 bytes lost
+ * upload chunks under simavr, measured. */
+#define RX_RING 256u
 
 static volatile uint32_t g_ms;
 static volatile uint8_t g_rx[RX_RING];
