@@ -61,7 +61,7 @@ static int32_t wrap(int32_t a)
 void qnav_board_cos_sin(int32_t a_cdeg, int16_t *cos_q14, int16_t *sin_q14)
 {
     int32_t a = wrap(a_cdeg);
-    int32_t x = K_Q14 * INT32_C(4); /* 2 more bits inside, rounded off at the end */
+    int32_t x = K_Q14 * INT32_C(1024); /* 10 more bits inside, rounded off at the end */
     int32_t y = 0;
     int32_t z;
     int8_t flip = 1;
@@ -87,8 +87,8 @@ void qnav_board_cos_sin(int32_t a_cdeg, int16_t *cos_q14, int16_t *sin_q14)
             z += atan_step(i);
         }
     }
-    x = (x + (x >= 0 ? 2 : -2)) / 4;
-    y = (y + (y >= 0 ? 2 : -2)) / 4;
+    x = (x + (x >= 0 ? 512 : -512)) / 1024;
+    y = (y + (y >= 0 ? 512 : -512)) / 1024;
     x = x > INT32_C(16384) ? INT32_C(16384) : (x < -INT32_C(16384) ? -INT32_C(16384) : x);
     y = y > INT32_C(16384) ? INT32_C(16384) : (y < -INT32_C(16384) ? -INT32_C(16384) : y);
     if (cos_q14 != NULL) {
@@ -117,11 +117,12 @@ qnav_cdeg_t qnav_board_atan2(int32_t y, int32_t x, uint32_t *dist)
         y = -y;
         z = INT32_C(18000) * UNIT;
     }
-    /* 8 more bits of resolution for short vectors (2^21 * 2^8 * 1.65 < 2^31) */
-    if (x < INT32_C(4096) && y < INT32_C(4096) && y > -INT32_C(4096)) {
-        x *= INT32_C(256);
-        y *= INT32_C(256);
-        up = 1;
+    /* full resolution whatever the length: the largest of |x|, |y| into [2^20, 2^21]
+     * (2^21 * sqrt(2) * 1.65 < 2^31) */
+    while (x < INT32_C(1048576) && y < INT32_C(1048576) && y > -INT32_C(1048576)) {
+        x *= 2;
+        y *= 2;
+        up++;
     }
     for (i = 0; i < ITER; ++i) {
         int32_t dx = shr(y, i);
@@ -137,10 +138,10 @@ qnav_cdeg_t qnav_board_atan2(int32_t y, int32_t x, uint32_t *dist)
         }
     }
     if (dist != NULL) {
-        /* x = length * 1.6468: divide by the gain, x < 2^21 * 1.42 * 1.65 * 256 */
+        /* x = length * 1.6468 * 2^up: divide by the gain, m < 2^21 * 1.42 * 1.65 */
         uint32_t m = (uint32_t)x;
-        if (up) {
-            m = (m + 128u) / 256u;
+        if (up > 0u) {
+            m = (m + ((uint32_t)1 << (up - 1u))) >> up;
         }
         *dist = (m / 16u) * (uint32_t)K_Q14 / 1024u + ((m % 16u) * (uint32_t)K_Q14) / 16384u;
     }
