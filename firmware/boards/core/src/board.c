@@ -17,8 +17,8 @@
 /* Turn part at |heading| >= 90 deg: half of full wheel speed, Q1.15. */
 #define TURN_MAX ((int32_t)16384)
 
-/* Largest wheel travel integrated in one tick, um (1.31 m per 0.1 s tick): keeps
- * travel * cos in Q2.14 inside int32 (131000 * 16384 < 2^31). */
+/* Largest wheel travel integrated in one piece, um: keeps travel * cos in Q2.14 inside
+ * int32 (131000 * 16384 < 2^31). */
 #define STEP_MAX_UM INT32_C(131000)
 
 void qnav_board_config_default(qnav_board_config_t *cfg)
@@ -333,10 +333,15 @@ static void update_pose(qnav_board_t *bot)
     bot->odo_left = l;
     bot->odo_right = r;
     step = (step * (int32_t)bot->cfg.um_per_count) / 2;
-    step = step > STEP_MAX_UM ? STEP_MAX_UM : (step < -STEP_MAX_UM ? -STEP_MAX_UM : step);
     qnav_board_cos_sin((int32_t)h0 + (int32_t)wrap_cdeg((int32_t)h - (int32_t)h0) / 2, &c, &s);
-    bot->pose.x_um += (int32_t)((step * (int32_t)c) / (int32_t)16384);
-    bot->pose.y_um += (int32_t)((step * (int32_t)s) / (int32_t)16384);
+    /* in pieces that keep piece * cos inside int32 (a long stall moves far in one tick) */
+    while (step != 0) {
+        int32_t piece = step > STEP_MAX_UM ? STEP_MAX_UM
+                                           : (step < -STEP_MAX_UM ? -STEP_MAX_UM : step);
+        bot->pose.x_um += (int32_t)((piece * (int32_t)c) / (int32_t)16384);
+        bot->pose.y_um += (int32_t)((piece * (int32_t)s) / (int32_t)16384);
+        step -= piece;
+    }
     bot->pose.heading_cdeg = h;
 }
 
