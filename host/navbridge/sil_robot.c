@@ -402,14 +402,18 @@ static int report(robot_t *r)
         fflush(stdout);
         return g_quit ? 4 : 0;
     }
+    qnav_sim_state_t st;
+    double tx, ty;
     qnav_sim_result(r->sim, &res);
+    qnav_sim_state(r->sim, &st);
+    sil_hal_world_to_odometry(&r->hal, st.x_m, st.y_m, &tx, &ty);
     printf("qnav-sil-robot: %s: reached %s, %u ticks (%.1f s), %u collisions, "
            "R = %.3f, %u ticks without a command, %lu link frames dropped, odometry "
-           "%.3f:%.3f m\n",
+           "%.3f:%.3f m (true %.3f:%.3f m)\n",
            g_quit ? "interrupted" : "episode done", res.reached ? "yes" : "no",
            (unsigned)res.ticks, res.tau_l, (unsigned)res.collisions, res.R,
            (unsigned)r->missed, (unsigned long)qnav_link_rx_dropped_total(&r->bot.rx),
-           p->x_um / 1e6, p->y_um / 1e6);
+           p->x_um / 1e6, p->y_um / 1e6, tx / 1000.0, ty / 1000.0);
     fflush(stdout);
     return g_quit ? 4 : (res.reached ? 0 : 1);
 }

@@ -16,6 +16,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -25,6 +26,7 @@
 #include "fakeboard.h"
 #include "test_proc.h"
 #include "qnav/policy_io.h"
+#include "qnav_odometry_t.h"
 
 static char g_dir[256];
 
@@ -221,6 +223,75 @@ static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(vo
     replay_is_identical(log);
 }
 
+/* Odometry events of an LCM log: how many, and the highest waypoint index reached. */
+static void odometry_progress(const char *path, int *n, int *waypoint, int *waypoints)
+{
+    lcm_eventlog_t *log = lcm_eventlog_create(path, "r");
+    lcm_eventlog_event_t *ev;
+    assert_non_null(log);
+    *n = *waypoint = *waypoints = 0;
+    while ((ev = lcm_eventlog_read_next_event(log)) != NULL) {
+        qnav_odometry_t o;
+        if (strcmp(ev->channel, "QNAV_ODOMETRY") == 0 &&
+            qnav_odometry_t_decode(ev->data, 0, ev->datalen, &o) >= 0) {
+            (*n)++;
+            *waypoint = o.waypoint > *waypoint ? o.waypoint : *waypoint;
+            *waypoints = o.waypoints;
+        }
+        lcm_eventlog_free_event(ev);
+    }
+    lcm_eventlog_destroy(log);
+}
+
+/* Three waypoints through the dense environment (its three rows of obstacles), start
+ * at (5, 1.1) m facing +y, so the odometry frame is x = world y - 1.1, y = 5 - world x:
+ * the gap in row 1 (4.7, 3.0), the gap in row 2 (4.5, 5.0), the destination (5, 9). */
+static void test_sil_route_of_three_waypoints_through_dense_replays_identically(void **state)
+{
+    char dir[300], log[300], rc_path[300], text[4096], out[300], err[300], path[300];
+    const char *probe[] = {UNSHARE_EXE, "-n", "true", NULL};
+    const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
+                           dir, "--env", "dense", "--start", "5:1.1:90", "--",
+                           "--waypoints", "1.9:0.3,3.9:0.5,7.9:0", "--goal-radius", "0.4",
+                           NULL};
+    int n, waypoint, waypoints, rc;
+    (void)state;
+    snprintf(out, sizeof out, "%s/probe.out", g_dir);
+    snprintf(err, sizeof err, "%s/probe.err", g_dir);
+    if (run_program(probe, out, err) != 0) {
+        print_message("SKIP: `unshare -n` is not permitted here (DESIGN.md §7)\n");
+        skip();
+    }
+    snprintf(dir, sizeof dir, "%s/route", g_dir);
+    assert_int_equal(mkdir(dir, 0700), 0);
+    snprintf(log, sizeof log, "%s/trial.lcmlog", dir);
+    snprintf(rc_path, sizeof rc_path, "%s/rc.txt", dir);
+    rc = run_program(trial, out, err);
+    if (rc == 10) {
+        print_message("SKIP: cannot configure loopback multicast in the namespace\n");
+        skip();
+    }
+    assert_true(read_text(rc_path, text, sizeof text) > 0);
+    assert_non_null(strstr(text, "sil=0 navbridge=3"));
+    snprintf(path, sizeof path, "%s/sil.out", dir);
+    assert_true(read_text(path, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, "reached yes")); /* the third waypoint is the destination */
+    assert_non_null(strstr(text, " 0 collisions"));
+    snprintf(path, sizeof path, "%s/nb.err", dir);
+    assert_true(read_text(path, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, "waypoint 1/3 reached"));
+    assert_non_null(strstr(text, "waypoint 2/3 reached"));
+    odometry_progress(log, &n, &waypoint, &waypoints);
+    print_message("lcm-logger recorded %d odometry poses, waypoint index up to %d of %d\n", n,
+                  waypoint, waypoints);
+    assert_true(n > 50);
+    assert_int_equal(waypoints, 3);
+    assert_int_equal(waypoint, 2);
+    replay_is_identical(log);
+}
+
 /* --link onto a user's file: refused with status 2, the file untouched (it used to be
  * deleted and replaced by the link). */
 static void test_sil_robot_refuses_link_path_that_is_a_file(void **state)
@@ -293,6 +364,7 @@ int main(void)
         cmocka_unit_test(test_sil_robot_reaches_destination_through_navbridge_over_memq),
         cmocka_unit_test(test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically),
         cmocka_unit_test(test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically),
+        cmocka_unit_test(test_sil_route_of_three_waypoints_through_dense_replays_identically),
         cmocka_unit_test(test_sil_robot_refuses_link_path_that_is_a_file),
         cmocka_unit_test(test_sil_robot_leaves_a_file_that_replaced_its_link),
         cmocka_unit_test(test_sil_robot_replaces_stale_pty_link_and_removes_it_at_exit),
