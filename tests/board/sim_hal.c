@@ -111,3 +111,45 @@ void sim_hal_to_board(sim_hal_t *sim, const uint8_t *bytes, uint32_t n)
         sim->to_board[sim->to_board_head++ % SIM_HAL_QUEUE] = bytes[i];
     }
 }
+
+static int queue_frame(sim_hal_t *sim, qnav_link_tx_t *tx, uint8_t id, const uint8_t *p,
+                       int32_t n)
+{
+    uint8_t wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
+    int32_t w = n < 0 ? n : qnav_link_encode(tx, id, p, (uint16_t)n, wire, sizeof wire);
+    if (w <= 0) {
+        return -1;
+    }
+    sim_hal_to_board(sim, wire, (uint32_t)w);
+    return 0;
+}
+
+int sim_hal_upload(sim_hal_t *sim, qnav_link_tx_t *tx, const qnav_policy_t *pol,
+                   uint16_t crc_xor)
+{
+    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES], p[QNAV_LINK_CHUNK_MAX_BYTES];
+    qnav_link_policy_chunk_t c;
+    qnav_link_policy_commit_t cm;
+    int32_t n = qnav_link_policy_to_blob(pol, blob, sizeof blob);
+    uint16_t off = 0;
+    if (n <= 0) {
+        return -1;
+    }
+    while (off < (uint16_t)n) {
+        uint16_t len = (uint16_t)((uint16_t)n - off);
+        len = len > QNAV_LINK_CHUNK_BYTES ? (uint16_t)QNAV_LINK_CHUNK_BYTES : len;
+        c.offset = off;
+        c.total = (uint16_t)n;
+        c.len = (uint8_t)len;
+        memcpy(c.data, &blob[off], len);
+        if (queue_frame(sim, tx, QNAV_LINK_MSG_POLICY_CHUNK, p,
+                        qnav_link_policy_chunk_pack(&c, p, sizeof p)) != 0) {
+            return -1;
+        }
+        off = (uint16_t)(off + len);
+    }
+    cm.total = (uint16_t)n;
+    cm.crc = (uint16_t)(qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) ^ crc_xor);
+    return queue_frame(sim, tx, QNAV_LINK_MSG_POLICY_COMMIT, p,
+                       qnav_link_policy_commit_pack(&cm, p, sizeof p));
+}

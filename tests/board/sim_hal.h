@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "qnav/board_hal.h"
+#include "qnav/link.h"
 
 #define SIM_HAL_QUEUE 65536
 #define SIM_HAL_NVM 4096
@@ -39,5 +40,11 @@ void sim_hal_init(sim_hal_t *sim, qnav_board_hal_t *hal);
 
 /* Queue bytes for the board to read. */
 void sim_hal_to_board(sim_hal_t *sim, const uint8_t *bytes, uint32_t n);
+
+/* Queue a whole policy upload for the board, as navbridge sends it: chunks from tx, then
+ * the commit, whose CRC is xored with crc_xor (0: correct). 0, or -1 when pol does not
+ * serialise. */
+int sim_hal_upload(sim_hal_t *sim, qnav_link_tx_t *tx, const qnav_policy_t *pol,
+                   uint16_t crc_xor);
 
 #endif /* QNAV_TESTS_SIM_HAL_H */

@@ -278,28 +278,7 @@ static void test_corrupted_goal_is_not_acted_on(void **state)
 /* Upload a policy blob to the board in chunks, with the given CRC in the commit. */
 static void upload(const qnav_policy_t *pol, int break_crc)
 {
-    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES], p[QNAV_LINK_CHUNK_MAX_BYTES];
-    qnav_link_policy_chunk_t c;
-    qnav_link_policy_commit_t cm;
-    int32_t n = qnav_link_policy_to_blob(pol, blob, sizeof blob);
-    uint16_t off = 0;
-    assert_true(n > 0);
-    while (off < (uint16_t)n) {
-        uint16_t len = (uint16_t)((uint16_t)n - off);
-        if (len > QNAV_LINK_CHUNK_BYTES) {
-            len = QNAV_LINK_CHUNK_BYTES;
-        }
-        c.offset = off;
-        c.total = (uint16_t)n;
-        c.len = (uint8_t)len;
-        memcpy(c.data, &blob[off], len);
-        to_board(QNAV_LINK_MSG_POLICY_CHUNK, p, qnav_link_policy_chunk_pack(&c, p, sizeof p));
-        off = (uint16_t)(off + len);
-    }
-    cm.total = (uint16_t)n;
-    cm.crc = (uint16_t)(qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) ^
-                        (break_crc ? 0x0100u : 0u));
-    to_board(QNAV_LINK_MSG_POLICY_COMMIT, p, qnav_link_policy_commit_pack(&cm, p, sizeof p));
+    assert_int_equal(sim_hal_upload(&g.sim, &g.btx, pol, break_crc ? 0x0100u : 0u), 0);
 }
 
 static void test_uploaded_policy_is_used_and_a_bad_one_is_refused(void **state)

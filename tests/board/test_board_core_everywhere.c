@@ -68,6 +68,27 @@ static int teardown(void **state)
     return qnav_test_tmpdir_remove(g_dir);
 }
 
+/* A robot program (the simavr board or the SIL robot) that makes the pty link `link`,
+ * with navbridge on it; both run to their end: the robot exits 0, then navbridge, its
+ * pty gone, 3. Their outputs land in <dir>/<tag>-robot.out and <tag>-nb.err. */
+static void trial(const char *const *robot, const char *link, const char *const *bridge,
+                  const char *tag)
+{
+    char r_out[300], r_err[300], nb_out[300], nb_err[300];
+    pid_t pr, pn;
+    snprintf(r_out, sizeof r_out, "%s/%s-robot.out", g_dir, tag);
+    snprintf(r_err, sizeof r_err, "%s/%s-robot.err", g_dir, tag);
+    snprintf(nb_out, sizeof nb_out, "%s/%s-nb.out", g_dir, tag);
+    snprintf(nb_err, sizeof nb_err, "%s/%s-nb.err", g_dir, tag);
+    pr = qnav_test_spawn(robot, r_out, r_err);
+    assert_true(pr > 0);
+    assert_int_equal(qnav_test_wait_path(link, 20000), 0);
+    pn = qnav_test_spawn(bridge, nb_out, nb_err);
+    assert_true(pn > 0);
+    assert_int_equal(qnav_test_wait_exit(pr), 0);
+    assert_int_equal(wait_exit_within(pn, 40000), 3);
+}
+
 /* One power cycle of the simavr board (EEPROM file ee, optional power cut after `cut`
  * changed bytes) for `seconds` simulated seconds with navbridge onboard (uploading
  * `upload` when not NULL). navbridge's stderr lands in nb_text, the board's stdout in
@@ -75,29 +96,19 @@ static int teardown(void **state)
 static void power_cycle(const char *ee, const char *cut, const char *seconds,
                         const char *upload, char *nb_text, char *sa_text, int cap)
 {
-    char link[300], sa_out[300], sa_err[300], nb_out[300], nb_err[300];
+    char link[300], path[300];
     const char *board[] = {SIMAVR_BOARD_EXE, "--elf", TEKBOT_ELF, "--link", link, "--eeprom",
                            ee, "--seconds", seconds, cut ? "--power-cut-after" : NULL, cut,
                            NULL};
     const char *bridge[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://",
                             "--mode", "onboard", "--timeout-ms", "3000",
                             upload ? "--policy" : NULL, upload, "--upload", NULL};
-    pid_t pb, pn;
     snprintf(link, sizeof link, "%s/link", g_dir);
-    snprintf(sa_out, sizeof sa_out, "%s/cycle-sa.out", g_dir);
-    snprintf(sa_err, sizeof sa_err, "%s/cycle-sa.err", g_dir);
-    snprintf(nb_out, sizeof nb_out, "%s/cycle-nb.out", g_dir);
-    snprintf(nb_err, sizeof nb_err, "%s/cycle-nb.err", g_dir);
-    unlink(sa_out); /* the wait below must see this cycle's board, not the last one's */
-    pb = qnav_test_spawn(board, sa_out, sa_err);
-    assert_true(pb > 0);
-    assert_int_equal(qnav_test_wait_text(sa_out, "with USART0 on", 20000), 0);
-    pn = qnav_test_spawn(bridge, nb_out, nb_err);
-    assert_true(pn > 0);
-    assert_int_equal(qnav_test_wait_exit(pb), 0);
-    assert_int_equal(wait_exit_within(pn, 40000), 3); /* the board's pty closed */
-    assert_true(read_text(nb_err, nb_text, cap) > 0);
-    assert_true(read_text(sa_out, sa_text, cap) > 0);
+    trial(board, link, bridge, "cycle");
+    snprintf(path, sizeof path, "%s/cycle-nb.err", g_dir);
+    assert_true(read_text(path, nb_text, cap) > 0);
+    snprintf(path, sizeof path, "%s/cycle-robot.out", g_dir);
+    assert_true(read_text(path, sa_text, cap) > 0);
     print_message("%s", nb_text);
 }
 
@@ -232,67 +243,37 @@ static void read_stream(const char *path, stream_t *s)
     lcm_eventlog_destroy(log);
 }
 
-/* A trial with the simavr board (uploading p1, goal 20 deg) recorded into log. */
-static void record_avr_trial(const char *log)
+/* A trial recorded into log: the robot program (the simavr board or the SIL robot) with
+ * navbridge onboard uploading p1, goal 20 deg. */
+static void record(const char *const *robot, const char *link, const char *log,
+                   const char *tag)
 {
-    char link[300], sa_out[300], sa_err[300], nb_out[300], nb_err[300];
-    const char *board[] = {SIMAVR_BOARD_EXE, "--elf", TEKBOT_ELF, "--link", link,
-                           "--seconds", "5", NULL};
     const char *bridge[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://",
                             "--mode", "onboard", "--policy", g_p1, "--upload", "--goal", "20",
                             "--log", log, "--timeout-ms", "3000", NULL};
-    pid_t pb, pn;
-    snprintf(link, sizeof link, "%s/avr-link", g_dir);
-    snprintf(sa_out, sizeof sa_out, "%s/avr-sa.out", g_dir);
-    snprintf(sa_err, sizeof sa_err, "%s/avr-sa.err", g_dir);
-    snprintf(nb_out, sizeof nb_out, "%s/avr-nb.out", g_dir);
-    snprintf(nb_err, sizeof nb_err, "%s/avr-nb.err", g_dir);
-    pb = qnav_test_spawn(board, sa_out, sa_err);
-    assert_true(pb > 0);
-    assert_int_equal(qnav_test_wait_text(sa_out, "with USART0 on", 20000), 0);
-    pn = qnav_test_spawn(bridge, nb_out, nb_err);
-    assert_true(pn > 0);
-    assert_int_equal(qnav_test_wait_exit(pb), 0);
-    assert_int_equal(wait_exit_within(pn, 40000), 3);
-}
-
-/* The AVR's scans played into the SIL robot, same navbridge arguments, recorded. */
-static void record_sil_playback(const char *avr_log, const char *log)
-{
-    char link[300], s_out[300], s_err[300], nb_out[300], nb_err[300], text[2048];
-    const char *sil[] = {SIL_EXE, "--playback", avr_log, "--tick-ms", "25", "--link", link,
-                         NULL};
-    const char *bridge[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://",
-                            "--mode", "onboard", "--policy", g_p1, "--upload", "--goal", "20",
-                            "--log", log, "--timeout-ms", "3000", NULL};
-    pid_t ps, pn;
-    snprintf(link, sizeof link, "%s/sil-link", g_dir);
-    snprintf(s_out, sizeof s_out, "%s/sil.out", g_dir);
-    snprintf(s_err, sizeof s_err, "%s/sil.err", g_dir);
-    snprintf(nb_out, sizeof nb_out, "%s/sil-nb.out", g_dir);
-    snprintf(nb_err, sizeof nb_err, "%s/sil-nb.err", g_dir);
-    ps = qnav_test_spawn(sil, s_out, s_err);
-    assert_true(ps > 0);
-    assert_int_equal(qnav_test_wait_path(link, 10000), 0);
-    pn = qnav_test_spawn(bridge, nb_out, nb_err);
-    assert_true(pn > 0);
-    assert_int_equal(qnav_test_wait_exit(ps), 0);
-    assert_int_equal(wait_exit_within(pn, 40000), 3);
-    assert_true(read_text(s_out, text, sizeof text) > 0);
-    print_message("%s", text);
-    assert_non_null(strstr(text, "playback done"));
+    trial(robot, link, bridge, tag);
 }
 
 static void test_sil_robot_and_avr_image_command_alike_on_one_scan_stream(void **state)
 {
-    char avr_log[300], sil_log[300];
+    char avr_log[300], sil_log[300], link[300], path[300], text[2048];
+    const char *avr[] = {SIMAVR_BOARD_EXE, "--elf", TEKBOT_ELF, "--link", link, "--seconds", "5",
+                         NULL};
+    const char *sil[] = {SIL_EXE, "--playback", avr_log, "--tick-ms", "25", "--link", link,
+                         NULL};
     static stream_t a, s;
     int i, compared = 0, differ = 0;
     (void)state;
     snprintf(avr_log, sizeof avr_log, "%s/avr.lcmlog", g_dir);
     snprintf(sil_log, sizeof sil_log, "%s/sil.lcmlog", g_dir);
-    record_avr_trial(avr_log);
-    record_sil_playback(avr_log, sil_log);
+    snprintf(link, sizeof link, "%s/stream-link", g_dir);
+    record(avr, link, avr_log, "avr");
+    /* the AVR's scans played into the same core built for the host */
+    record(sil, link, sil_log, "sil");
+    snprintf(path, sizeof path, "%s/sil-robot.out", g_dir);
+    assert_true(read_text(path, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, "playback done"));
     read_stream(avr_log, &a);
     read_stream(sil_log, &s);
     assert_int_equal(s.n, a.n); /* one tick of the SIL robot per recorded scan */

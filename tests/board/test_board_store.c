@@ -29,36 +29,10 @@ static qnav_board_status_t boot(void)
     return qnav_board_init(&g_bot, &cfg, &g_hal);
 }
 
-static void to_board(uint8_t id, const uint8_t *p, int32_t n)
-{
-    uint8_t wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
-    int32_t w = qnav_link_encode(&g_tx, id, p, (uint16_t)n, wire, sizeof wire);
-    assert_true(w > 0);
-    sim_hal_to_board(&g_sim, wire, (uint32_t)w);
-}
-
 /* Upload and commit pol; the board acts on it at its next receive. */
 static void commit(const qnav_policy_t *pol)
 {
-    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES], p[QNAV_LINK_MAX_PAYLOAD];
-    qnav_link_policy_chunk_t c;
-    qnav_link_policy_commit_t cm;
-    int32_t n = qnav_link_policy_to_blob(pol, blob, sizeof blob);
-    uint16_t off = 0;
-    assert_true(n > 0);
-    while (off < (uint16_t)n) {
-        uint16_t len = (uint16_t)((uint16_t)n - off);
-        len = len > QNAV_LINK_CHUNK_BYTES ? QNAV_LINK_CHUNK_BYTES : len;
-        c.offset = off;
-        c.total = (uint16_t)n;
-        c.len = (uint8_t)len;
-        memcpy(c.data, &blob[off], len);
-        to_board(QNAV_LINK_MSG_POLICY_CHUNK, p, qnav_link_policy_chunk_pack(&c, p, sizeof p));
-        off = (uint16_t)(off + len);
-    }
-    cm.total = (uint16_t)n;
-    cm.crc = qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n);
-    to_board(QNAV_LINK_MSG_POLICY_COMMIT, p, qnav_link_policy_commit_pack(&cm, p, sizeof p));
+    assert_int_equal(sim_hal_upload(&g_sim, &g_tx, pol, 0), 0);
     qnav_board_receive(&g_bot);
     qnav_board_receive(&g_bot);
     qnav_board_receive(&g_bot);

@@ -183,29 +183,36 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     assert_true(compared + 20u >= scans); /* all but the ticks before the upload landed */
 }
 
-static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(void **state)
+/* Run a udpm:// trial (argv starts with unshare -n) in a private network namespace, or
+ * skip the test when namespaces or loopback multicast are not available here. */
+static void run_in_namespace_or_skip(const char *const *trial, const char *out,
+                                     const char *err)
 {
-    char log[300], rc_path[300], text[2048], out[300], err[300], sil_out[300];
     const char *probe[] = {UNSHARE_EXE, "-n", "true", NULL};
-    const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
-                           g_dir, NULL};
-    int scan, cmd, qual, status, pose, rc;
-    (void)state;
-    snprintf(out, sizeof out, "%s/probe.out", g_dir);
-    snprintf(err, sizeof err, "%s/probe.err", g_dir);
     if (run_program(probe, out, err) != 0) {
         print_message("SKIP: `unshare -n` is not permitted here, so the udpm:// trial cannot "
                       "run in a private network namespace (DESIGN.md §7)\n");
         skip();
     }
-    snprintf(log, sizeof log, "%s/trial.lcmlog", g_dir);
-    snprintf(rc_path, sizeof rc_path, "%s/rc.txt", g_dir);
-    snprintf(sil_out, sizeof sil_out, "%s/sil.out", g_dir);
-    rc = run_program(trial, out, err);
-    if (rc == 10) {
+    if (run_program(trial, out, err) == 10) {
         print_message("SKIP: cannot configure loopback multicast in the namespace\n");
         skip();
     }
+}
+
+static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(void **state)
+{
+    char log[300], rc_path[300], text[2048], out[300], err[300], sil_out[300];
+    const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
+                           g_dir, NULL};
+    int scan, cmd, qual, status, pose;
+    (void)state;
+    snprintf(out, sizeof out, "%s/trial.out", g_dir);
+    snprintf(err, sizeof err, "%s/trial.err", g_dir);
+    snprintf(log, sizeof log, "%s/trial.lcmlog", g_dir);
+    snprintf(rc_path, sizeof rc_path, "%s/rc.txt", g_dir);
+    snprintf(sil_out, sizeof sil_out, "%s/sil.out", g_dir);
+    run_in_namespace_or_skip(trial, out, err);
     assert_true(read_text(rc_path, text, sizeof text) > 0);
     print_message("%s", text);
     assert_non_null(strstr(text, "sil=0 navbridge=3"));
@@ -249,28 +256,19 @@ static void odometry_progress(const char *path, int *n, int *waypoint, int *wayp
 static void test_sil_route_of_three_waypoints_through_dense_replays_identically(void **state)
 {
     char dir[300], log[300], rc_path[300], text[4096], out[300], err[300], path[300];
-    const char *probe[] = {UNSHARE_EXE, "-n", "true", NULL};
     const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
                            dir, "--env", "dense", "--start", "5:1.1:90", "--",
                            "--waypoints", "1.9:0.3,3.9:0.5,7.9:0", "--goal-radius", "0.4",
                            NULL};
-    int n, waypoint, waypoints, rc;
+    int n, waypoint, waypoints;
     (void)state;
-    snprintf(out, sizeof out, "%s/probe.out", g_dir);
-    snprintf(err, sizeof err, "%s/probe.err", g_dir);
-    if (run_program(probe, out, err) != 0) {
-        print_message("SKIP: `unshare -n` is not permitted here (DESIGN.md §7)\n");
-        skip();
-    }
     snprintf(dir, sizeof dir, "%s/route", g_dir);
     assert_int_equal(mkdir(dir, 0700), 0);
+    snprintf(out, sizeof out, "%s/trial.out", dir);
+    snprintf(err, sizeof err, "%s/trial.err", dir);
     snprintf(log, sizeof log, "%s/trial.lcmlog", dir);
     snprintf(rc_path, sizeof rc_path, "%s/rc.txt", dir);
-    rc = run_program(trial, out, err);
-    if (rc == 10) {
-        print_message("SKIP: cannot configure loopback multicast in the namespace\n");
-        skip();
-    }
+    run_in_namespace_or_skip(trial, out, err);
     assert_true(read_text(rc_path, text, sizeof text) > 0);
     assert_non_null(strstr(text, "sil=0 navbridge=3"));
     snprintf(path, sizeof path, "%s/sil.out", dir);

@@ -301,18 +301,6 @@ void qnav_board_poll(qnav_board_t *bot)
     }
 }
 
-/* Wrap an angle in 0.01 deg into -18000..17999. */
-static qnav_cdeg_t wrap_cdeg(int32_t a)
-{
-    a %= INT32_C(36000);
-    if (a < -INT32_C(18000)) {
-        a += INT32_C(36000);
-    } else if (a >= INT32_C(18000)) {
-        a -= INT32_C(36000);
-    }
-    return (qnav_cdeg_t)a;
-}
-
 /* Dead reckoning: the mean wheel travel since the last tick along the mid-tick heading. */
 static void update_pose(qnav_board_t *bot)
 {
@@ -333,7 +321,8 @@ static void update_pose(qnav_board_t *bot)
     bot->odo_left = l;
     bot->odo_right = r;
     step = (step * (int32_t)bot->cfg.um_per_count) / 2;
-    qnav_board_cos_sin((int32_t)h0 + (int32_t)wrap_cdeg((int32_t)h - (int32_t)h0) / 2, &c, &s);
+    qnav_board_cos_sin((int32_t)h0 + (int32_t)qnav_board_wrap_cdeg((int32_t)h - (int32_t)h0) / 2,
+                       &c, &s);
     /* in pieces that keep piece * cos inside int32 (a long stall moves far in one tick) */
     while (step != 0) {
         int32_t piece = step > STEP_MAX_UM ? STEP_MAX_UM
@@ -356,9 +345,10 @@ static qnav_cdeg_t goal_bearing(qnav_board_t *bot, uint32_t *dist_mm)
         int32_t dx = bot->goal.x_mm - bot->pose.x_um / (int32_t)1000;
         int32_t dy = bot->goal.y_mm - bot->pose.y_um / (int32_t)1000;
         qnav_cdeg_t world = qnav_board_atan2(dy, dx, dist_mm);
-        return wrap_cdeg((int32_t)world - (int32_t)bot->pose.heading_cdeg);
+        return qnav_board_wrap_cdeg((int32_t)world - (int32_t)bot->pose.heading_cdeg);
     }
-    return wrap_cdeg((int32_t)bot->goal.bearing_cdeg - (int32_t)bot->pose.heading_cdeg);
+    return qnav_board_wrap_cdeg((int32_t)bot->goal.bearing_cdeg -
+                                (int32_t)bot->pose.heading_cdeg);
 }
 
 static void send_scan(qnav_board_t *bot, uint32_t now, qnav_cdeg_t bearing)

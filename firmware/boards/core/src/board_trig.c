@@ -46,8 +46,7 @@ static int32_t clamp(int32_t v)
     return v > LIMIT ? LIMIT : (v < -LIMIT ? -LIMIT : v);
 }
 
-/* Wrap 0.01 deg into -18000..17999. */
-static int32_t wrap(int32_t a)
+qnav_cdeg_t qnav_board_wrap_cdeg(int32_t a)
 {
     a %= INT32_C(36000);
     if (a < -INT32_C(18000)) {
@@ -55,12 +54,12 @@ static int32_t wrap(int32_t a)
     } else if (a >= INT32_C(18000)) {
         a -= INT32_C(36000);
     }
-    return a;
+    return (qnav_cdeg_t)a;
 }
 
 void qnav_board_cos_sin(int32_t a_cdeg, int16_t *cos_q14, int16_t *sin_q14)
 {
-    int32_t a = wrap(a_cdeg);
+    int32_t a = qnav_board_wrap_cdeg(a_cdeg);
     int32_t x = K_Q14 * INT32_C(1024); /* 10 more bits inside, rounded off at the end */
     int32_t y = 0;
     int32_t z;
@@ -146,5 +145,5 @@ qnav_cdeg_t qnav_board_atan2(int32_t y, int32_t x, uint32_t *dist)
         *dist = (m / 16u) * (uint32_t)K_Q14 / 1024u + ((m % 16u) * (uint32_t)K_Q14) / 16384u;
     }
     z = z >= 0 ? (z + UNIT / 2) / UNIT : -((-z + UNIT / 2) / UNIT);
-    return (qnav_cdeg_t)wrap(z);
+    return qnav_board_wrap_cdeg(z);
 }

@@ -162,6 +162,8 @@ void qnav_board_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_deg_t spin_
  * @par Scaling and overflow: inputs are clamped to +-2^21.
  */
 void qnav_board_cos_sin(int32_t a_cdeg, int16_t *cos_q14, int16_t *sin_q14);
+/* An angle in 0.01 deg wrapped into -18000..17999. */
+qnav_cdeg_t qnav_board_wrap_cdeg(int32_t a_cdeg);
 qnav_cdeg_t qnav_board_atan2(int32_t y, int32_t x, uint32_t *dist);
 
 #ifdef __cplusplus
