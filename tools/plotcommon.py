@@ -1,6 +1,7 @@
-"""What simevo's plot scripts share: their command line (argparse), reading a CSV or JSON
-file with one-line errors (FILE:LINE: problem), and writing a plot atomically in the format
-its file name asks for (.png, .pdf, .svg) through an exclusively created temporary file."""
+"""What qnav's Python tools share (the plot scripts, qnav_log.py): their command line
+(argparse), the version, reading a CSV or JSON file with one-line errors (FILE:LINE:
+problem), and writing a plot (in the format its file name asks for: .png, .pdf, .svg) or a
+text file atomically through an exclusively created temporary file."""
 import argparse
 import csv
 import json
@@ -78,18 +79,18 @@ def read_json(path):
         raise PlotError(f"{path}:{e.lineno}: {e.msg}") from e
 
 
-def save(fig, out):
-    """Write fig to out in the format out's name asks for, so that out is whole or absent.
-    The temporary file is created exclusively (random name, O_EXCL) in out's folder: a
-    planted symlink is never followed and a leftover process never shares it."""
-    fmt = plot_format(out)
-    if fmt is None:
-        raise PlotError(f"{out}: unknown plot format (the name must end in .png, .pdf or .svg)")
+def _replace_atomically(out, write):
+    """Call write(binary file) on a temporary file created exclusively (random name,
+    O_EXCL) in out's folder, then rename it over out: out is whole or absent, a planted
+    symlink is never followed and a leftover process never shares the temporary."""
     folder = os.path.dirname(out) or "."
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(out) + ".", suffix=".tmp", dir=folder)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(out) + ".", suffix=".tmp", dir=folder)
+    except OSError as e:
+        raise PlotError(f"{out}: cannot write ({e.strerror})") from e
     try:
         with os.fdopen(fd, "wb") as f:
-            fig.savefig(f, format=fmt)
+            write(f)
         os.chmod(tmp, 0o644)
         os.replace(tmp, out)
     except BaseException:
@@ -98,6 +99,19 @@ def save(fig, out):
         except OSError:
             pass
         raise
+
+
+def save(fig, out):
+    """Write fig to out in the format out's name asks for (.png, .pdf, .svg), atomically."""
+    fmt = plot_format(out)
+    if fmt is None:
+        raise PlotError(f"{out}: unknown plot format (the name must end in .png, .pdf or .svg)")
+    _replace_atomically(out, lambda f: fig.savefig(f, format=fmt))
+
+
+def write_text_atomic(path, text):
+    """Write text (UTF-8) to path atomically, like save()."""
+    _replace_atomically(path, lambda f: f.write(text.encode("utf-8")))
 
 
 def run(main, argv, prog):

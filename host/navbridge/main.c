@@ -4,8 +4,8 @@
  * commands back; onboard mode relays goals and telemetry and can upload a policy file to
  * the board. Everything is published on LCM. When the board goes quiet for --timeout-ms
  * it commands a stop; SIGINT/SIGTERM/SIGHUP stop the robot before exiting (status 0); a port that
- * hangs up ends it with status 3; a board of another link protocol version with status 5
- * (one line saying which). --replay re-runs a
+ * hangs up ends it with status 1 (link lost), and so does a board of another link
+ * protocol version (one line saying which). --replay re-runs a
  * recorded trial's scans through the controller and checks the commands are identical.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -359,7 +359,7 @@ int main(int argc, char **argv)
                  * simavr board (pty master) has gone */
                 fprintf(stderr, "navbridge: %s: %s: link lost\n", device,
                         r == 0 ? "device hung up" : strerror(errno));
-                exit_code = 3;
+                exit_code = 1;
                 hung_up = 1;
                 break;
             }
@@ -373,7 +373,7 @@ int main(int argc, char **argv)
                             "speaks %u: flash firmware of this release or run the navbridge of "
                             "the board's (docs/hil.md, \"Versions\")\n", device,
                     (unsigned)bridge.refused_protocol, (unsigned)QNAV_LINK_PROTOCOL_VERSION);
-            exit_code = 5;
+            exit_code = 1; /* docs/cli.md: a failure at run time */
             break;
         }
         qnav_bridge_poll(&bridge, mono_ms());

@@ -369,7 +369,8 @@ static int start(robot_t *r, const options_t *o, qnav_sim_robot_t **robot,
     return 0;
 }
 
-/* Wait for navbridge: its heartbeats tell the mode. 0, or 3 when none came. */
+/* Wait for navbridge: its heartbeats tell the mode. 0, or 1 (docs/cli.md: the trial
+ * failed) when none came or it speaks another protocol. */
 static int wait_bridge(robot_t *r, const options_t *o, const char *slave)
 {
     int64_t t0 = mono_ms();
@@ -380,13 +381,13 @@ static int wait_bridge(robot_t *r, const options_t *o, const char *slave)
                             "board %u: not following it\n", slave,
                     (unsigned)qnav_board_stats(&r->bot)->peer_protocol,
                     (unsigned)QNAV_LINK_PROTOCOL_VERSION);
-            return 3;
+            return 1;
         }
     }
     if (r->bot.mode == 0) {
         fprintf(stderr, "qnav-sil-robot: no navbridge heartbeat on %s within %g s\n", slave,
                 o->wait_s);
-        return 3;
+        return 1;
     }
     return 0;
 }
@@ -400,7 +401,7 @@ static int report(robot_t *r)
                "frames dropped\n", g_quit ? "interrupted" : "done", (unsigned)r->ticks,
                (unsigned)r->missed, (unsigned long)qnav_link_rx_dropped_total(&r->bot.rx));
         fflush(stdout);
-        return g_quit ? 4 : 0;
+        return g_quit ? 1 : 0;
     }
     qnav_sim_state_t st;
     double tx, ty;
@@ -415,7 +416,7 @@ static int report(robot_t *r)
            (unsigned)r->missed, (unsigned long)qnav_link_rx_dropped_total(&r->bot.rx),
            p->x_um / 1e6, p->y_um / 1e6, tx / 1000.0, ty / 1000.0);
     fflush(stdout);
-    return g_quit ? 4 : (res.reached ? 0 : 1);
+    return res.reached && !g_quit ? 0 : 1; /* docs/cli.md: 1 = the trial failed */
 }
 
 static int episode_over(robot_t *r)

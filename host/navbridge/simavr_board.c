@@ -65,6 +65,8 @@ typedef struct {
     char name[64];                /* /dev/pts/N */
     avr_irq_t *to_mcu;            /* UART_IRQ_INPUT */
     int xon;                      /* the USART's input fifo has room */
+    uint64_t cycles_per_byte;     /* one character (10 bits) at the link's baud rate */
+    uint64_t next_byte_cycle;     /* the MCU cycle at which the next byte may arrive */
     uint8_t in[512];              /* pty -> MCU */
     size_t in_len, in_done;
     uint8_t out[4096];            /* MCU -> pty */
@@ -80,10 +82,15 @@ static void on_uart_byte(struct avr_irq_t *irq, uint32_t value, void *param)
     } /* else: nobody reads the port, dropped like a UART with no listener */
 }
 
-static void feed_mcu(board_uart_t *u)
+/* Bytes reach the MCU no faster than the line rate, as on a real UART: a burst that
+ * queued in the pty while this process was not scheduled would otherwise arrive at once
+ * and overrun the firmware's receive buffer. */
+static void feed_mcu(board_uart_t *u, uint64_t cycle)
 {
-    while (u->xon && u->in_done < u->in_len) {
+    while (u->xon && u->in_done < u->in_len && cycle >= u->next_byte_cycle) {
         avr_raise_irq(u->to_mcu, u->in[u->in_done++]);
+        u->next_byte_cycle = (cycle > u->next_byte_cycle + u->cycles_per_byte
+                                  ? cycle : u->next_byte_cycle) + u->cycles_per_byte;
     }
 }
 
@@ -92,7 +99,6 @@ static void on_uart_xon(struct avr_irq_t *irq, uint32_t value, void *param)
     (void)irq;
     (void)value;
     ((board_uart_t *)param)->xon = 1;
-    feed_mcu((board_uart_t *)param);
 }
 
 static void on_uart_xoff(struct avr_irq_t *irq, uint32_t value, void *param)
@@ -102,7 +108,7 @@ static void on_uart_xoff(struct avr_irq_t *irq, uint32_t value, void *param)
     ((board_uart_t *)param)->xon = 0;
 }
 
-static int uart_open(avr_t *avr, board_uart_t *u)
+static int uart_open(avr_t *avr, board_uart_t *u, uint32_t f_cpu, uint32_t baud)
 {
     uint32_t flags = 0;
     struct termios tio;
@@ -126,6 +132,7 @@ static int uart_open(avr_t *avr, board_uart_t *u)
     avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
     avr_irq_register_notify(src, on_uart_byte, u);
     u->xon = 1; /* the USART starts empty; XOFF says when its fifo is full */
+    u->cycles_per_byte = (uint64_t)f_cpu * 10u / baud;
     if (xon != NULL) {
         avr_irq_register_notify(xon, on_uart_xon, u);
     }
@@ -137,7 +144,7 @@ static int uart_open(avr_t *avr, board_uart_t *u)
 
 /* Move bytes both ways without blocking: what the MCU sent to the pty, what the pty holds
  * to the MCU (as fast as the USART takes them). */
-static void uart_service(board_uart_t *u)
+static void uart_service(board_uart_t *u, uint64_t cycle)
 {
     if (u->out_len > 0) {
         ssize_t n = write(u->master, u->out, u->out_len);
@@ -151,7 +158,7 @@ static void uart_service(board_uart_t *u)
         u->in_done = 0;
         u->in_len = n > 0 ? (size_t)n : 0u;
     }
-    feed_mcu(u);
+    feed_mcu(u, cycle);
 }
 
 /* Sonar k's voltage for a range in mm at 5 V: 12.7 mm per ADC count of 4.883 mV. */
@@ -253,13 +260,14 @@ int main(int argc, char **argv)
     static const struct option opts[] = {
         {"elf", required_argument, NULL, 'e'},    {"link", required_argument, NULL, 'l'},
         {"seconds", required_argument, NULL, 's'}, {"help", no_argument, NULL, 'h'},
+        {"baud", required_argument, NULL, 'b'},
         {"version", no_argument, NULL, 'V'},       {"eeprom", required_argument, NULL, 'E'},
         {"power-cut-after", required_argument, NULL, 'C'}, {NULL, 0, NULL, 0}};
     const char *eeprom_path = NULL;
     static uint8_t ee_start[EEPROM_BYTES];
     long cut_after = 0, changed = 0;
     const char *elf = NULL, *link_path = NULL;
-    double seconds = 0.0;
+    double seconds = 0.0, baud = 57600.0;
     elf_firmware_t fw;
     avr_t *avr;
     static board_uart_t uart;
@@ -295,12 +303,23 @@ int main(int argc, char **argv)
             }
             break;
         }
+        case 'b': {
+            char *end = NULL;
+            baud = strtod(optarg, &end);
+            if (end == optarg || *end != '\0' || !(baud >= 300.0 && baud <= 2000000.0)) {
+                fprintf(stderr, "qnav-simavr-board: --baud %s: expected 300..2000000\n", optarg);
+                return 2;
+            }
+            break;
+        }
         case 'h':
             printf("usage: qnav-simavr-board --elf tekbot.elf [--link PATH] [--seconds S]\n"
-                   "                         [--eeprom FILE [--power-cut-after N]]\n"
+                   "                         [--baud N] [--eeprom FILE [--power-cut-after N]]\n"
                    "  --elf FILE     the TekBot firmware image (tekbot-avr.elf)\n"
                    "  --link PATH    also make PATH a symlink to the board's pty\n"
                    "  --seconds S    stop after S simulated seconds (0: run until a signal)\n"
+                   "  --baud N       the firmware's line rate: bytes reach USART0 no faster\n"
+                   "                 (57600, the TekBot's)\n"
                    "  --eeprom FILE  the EEPROM: loaded at start (absent: erased), saved at exit\n"
                    "  --power-cut-after N  stop dead once N EEPROM bytes have changed\n"
                    "  --help, --version  this text; the version\n");
@@ -352,7 +371,7 @@ int main(int argc, char **argv)
         }
     }
 
-    if (uart_open(avr, &uart) != 0) {
+    if (uart_open(avr, &uart, fw.frequency, (uint32_t)baud) != 0) {
         fprintf(stderr, "qnav-simavr-board: cannot put USART0 on a pseudo-terminal: %s\n",
                 strerror(errno));
         return 1;
@@ -400,7 +419,7 @@ int main(int argc, char **argv)
             printf("qnav-simavr-board: power cut after %ld changed EEPROM bytes\n", changed);
             break;
         }
-        uart_service(&uart);
+        uart_service(&uart, avr->cycle);
         ahead = (int64_t)sim_us - (mono_us() - t0);
         if (ahead > 2000) {
             usleep((useconds_t)ahead);

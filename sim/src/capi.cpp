@@ -10,6 +10,7 @@
 #include <string>
 
 #include "capi_internal.hpp"
+#include "qnav/paths.hpp"
 #include "error.hpp"
 #include "tomlread.hpp"
 
@@ -71,9 +72,7 @@ std::string resolve_data_spec(const char *spec, const char *kind) {
     const bool is_path = s.find('/') != std::string::npos ||
                          (s.size() > 5 && s.compare(s.size() - 5, 5, ".toml") == 0);
     if (is_path) return s;
-    const char *dir = std::getenv("QNAV_DATA_DIR");
-    std::string base = dir && *dir ? dir : QNAV_SIM_DATA_DIR;
-    return base + "/" + kind + "/" + s + ".toml";
+    return qnav::resource_dir("QNAV_DATA_DIR", "data", QNAV_SIM_DATA_DIR) + "/" + kind + "/" + s + ".toml";
 }
 }  // namespace qnav
 

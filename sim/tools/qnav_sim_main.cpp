@@ -13,6 +13,9 @@
 #include <string>
 #include <vector>
 
+#include <fcntl.h>
+#include <stdexcept>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -44,23 +47,36 @@ struct Loaded {
     }
 };
 
-// Write text to path through a temporary file renamed into place. Throws SimError (IO).
+// A failed write of an output file: a failure at run time (exit 1), not bad input (2).
+struct WriteError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// Write text to path through a temporary file renamed into place. The temporary is made
+// exclusively (mkstemp) beside path, so a symlink planted there is never followed.
 void write_output(const std::string &path, const std::string &text) {
-    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw SimError(QNAV_SIM_E_IO, path + ": cannot write (" + std::strerror(errno) + ")");
-        out << text;
-        out.flush();
-        if (!out) {
-            std::remove(tmp.c_str());
-            throw SimError(QNAV_SIM_E_IO, path + ": cannot write");
-        }
+    const std::size_t slash = path.find_last_of('/');
+    std::string tmp = (slash == std::string::npos ? std::string() : path.substr(0, slash + 1)) + "." +
+                      path.substr(slash == std::string::npos ? 0 : slash + 1) + ".tmp.XXXXXX";
+    const int fd = ::mkostemp(tmp.data(), O_CLOEXEC);
+    if (fd < 0) throw WriteError(path + ": cannot write (" + std::strerror(errno) + ")");
+    std::size_t off = 0;
+    bool ok = ::fchmod(fd, 0644) == 0;
+    while (ok && off < text.size()) {
+        const ssize_t n = ::write(fd, text.data() + off, text.size() - off);
+        if (n < 0 && errno == EINTR) continue;
+        ok = n > 0;
+        if (ok) off += static_cast<std::size_t>(n);
+    }
+    const std::string why = std::strerror(errno);
+    if (::close(fd) != 0 || !ok) {
+        ::unlink(tmp.c_str());
+        throw WriteError(path + ": cannot write (" + why + ")");
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        const std::string why = std::strerror(errno);
-        std::remove(tmp.c_str());
-        throw SimError(QNAV_SIM_E_IO, path + ": cannot rename into place (" + why + ")");
+        const std::string e = std::strerror(errno);
+        ::unlink(tmp.c_str());
+        throw WriteError(path + ": cannot rename into place (" + e + ")");
     }
 }
 
@@ -420,8 +436,12 @@ int main(int argc, char **argv) {
         if (*gen) return cmd_gen_env(g_density, g_seed, g_robot, g_name, g_out);
         if (*bench) return cmd_bench(bo);
     } catch (const SimError &e) {
+        // a bad robot, environment or policy file, or an impossible parameter
         std::fprintf(stderr, "%s\n", e.what());
-        return 1;
+        return QNAV_EXIT_USAGE;
+    } catch (const WriteError &e) {
+        std::fprintf(stderr, "qnav-sim: %s\n", e.what());
+        return QNAV_EXIT_FAILURE;
     } catch (const std::exception &e) {
         std::fprintf(stderr, "qnav-sim: %s\n", e.what());
         return 1;

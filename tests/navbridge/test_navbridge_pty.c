@@ -472,7 +472,7 @@ static void expect_refusal(const char *const *argv, const char *needle)
 }
 
 /* A board speaking link protocol `version` (1: its 12-byte heartbeat without the
- * version byte) makes navbridge exit with status 5 and one line naming both versions. */
+ * version byte) makes navbridge exit with status 1 and one line naming both versions. */
 static void check_refuses_board_of_protocol(uint8_t version)
 {
     const char *args[] = {"--lcm-url", "memq://", "--mode", "onboard", NULL};
@@ -492,7 +492,7 @@ static void check_refuses_board_of_protocol(uint8_t version)
         p[12] = version;
     }
     assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_HEARTBEAT, p, (uint16_t)n), 0);
-    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, 3000), 5);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, 3000), 1);
     assert_true(read_text(fb.stderr_path, text, sizeof text) > 0);
     snprintf(want, sizeof want, "the board speaks link protocol %u, this navbridge speaks %u",
              (unsigned)version, (unsigned)QNAV_LINK_PROTOCOL_VERSION);

@@ -4,7 +4,7 @@
  * replays to identical commands. Once on memq:// with navbridge --log, once on a real
  * udpm:// bus recorded by lcm-logger inside a private network namespace (skipped when
  * `unshare -n` is not permitted). No packet leaves the machine. When the robot's episode
- * ends its pty closes and navbridge exits with status 3 (link lost).
+ * ends its pty closes and navbridge exits with status 1 (link lost).
  */
 #define _XOPEN_SOURCE 700
 #define _DEFAULT_SOURCE
@@ -115,8 +115,8 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0); /* 0: destination reached */
-    /* the robot's end closes the pty: navbridge sees the hang-up and leaves with 3 */
-    assert_int_equal(wait_exit_within(pn, 3000), 3);
+    /* the robot's end closes the pty: navbridge sees the hang-up and leaves with 1 */
+    assert_int_equal(wait_exit_within(pn, 3000), 1);
     assert_true(read_text(nb_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "device hung up: link lost"));
     assert_true(read_text(sil_out, text, sizeof text) > 0);
@@ -162,7 +162,7 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0);
-    assert_int_equal(wait_exit_within(pn, 3000), 3);
+    assert_int_equal(wait_exit_within(pn, 3000), 1);
     assert_true(read_text(nb_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "policy upload: ok"));
     /* the board's heartbeat says which policy runs: first its own, then the upload */
@@ -215,7 +215,7 @@ static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(vo
     run_in_namespace_or_skip(trial, out, err);
     assert_true(read_text(rc_path, text, sizeof text) > 0);
     print_message("%s", text);
-    assert_non_null(strstr(text, "sil=0 navbridge=3"));
+    assert_non_null(strstr(text, "sil=0 navbridge=1"));
     assert_true(read_text(sil_out, text, sizeof text) > 0);
     assert_non_null(strstr(text, "reached yes"));
     count_channels(log, &scan, &cmd, &qual, &status, &pose);
@@ -270,7 +270,7 @@ static void test_sil_route_of_three_waypoints_through_dense_replays_identically(
     snprintf(rc_path, sizeof rc_path, "%s/rc.txt", dir);
     run_in_namespace_or_skip(trial, out, err);
     assert_true(read_text(rc_path, text, sizeof text) > 0);
-    assert_non_null(strstr(text, "sil=0 navbridge=3"));
+    assert_non_null(strstr(text, "sil=0 navbridge=1"));
     snprintf(path, sizeof path, "%s/sil.out", dir);
     assert_true(read_text(path, text, sizeof text) > 0);
     print_message("%s", text);
@@ -325,7 +325,7 @@ static void test_sil_robot_leaves_a_file_that_replaced_its_link(void **state)
     assert_int_equal(unlink(path), 0);
     assert_int_equal(qnav_test_write_text(path, "mine now\n"), 0);
     assert_int_equal(kill(ps, SIGTERM), 0);
-    assert_int_equal(qnav_test_wait_exit(ps), 3); /* no navbridge came */
+    assert_int_equal(qnav_test_wait_exit(ps), 1); /* no navbridge came */
     assert_true(read_text(path, text, sizeof text) > 0);
     assert_string_equal(text, "mine now\n");
 }
@@ -351,7 +351,7 @@ static void test_sil_robot_replaces_stale_pty_link_and_removes_it_at_exit(void *
     assert_string_not_equal(target, "/dev/pts/999999");
     assert_int_equal(strncmp(target, "/dev/pts/", 9), 0);
     assert_int_equal(kill(ps, SIGTERM), 0);
-    assert_int_equal(qnav_test_wait_exit(ps), 3);
+    assert_int_equal(qnav_test_wait_exit(ps), 1);
     assert_int_equal(access(path, F_OK), -1);
     assert_int_equal(readlink(path, target, sizeof target), -1);
 }

@@ -30,7 +30,7 @@ if [ $# -eq 0 ]; then
 fi
 "$NB_EXE" --device "$DIR/link" "$@" > "$DIR/nb.out" 2> "$DIR/nb.err" & NB=$!
 wait $SIL; SIL_RC=$?
-# the robot's pty closes with it: navbridge leaves on its own (status 3); guard 5 s
+# the robot's pty closes with it: navbridge leaves on its own (status 1); guard 5 s
 ( sleep 5; kill -TERM $NB 2>/dev/null ) & GUARD=$!
 wait $NB; NB_RC=$?
 kill $GUARD 2>/dev/null

@@ -114,10 +114,10 @@ static void test_cli_check_refuses_bad_file_with_file_and_line(void **state)
 {
     (void)state;
     assert_int_equal(run_tool("check", QNAV_POLICYIO_BAD_DIR "/unit_three_weights.policy", NULL),
-                     1);
+                     2);
     assert_one_line_error(QNAV_POLICYIO_BAD_DIR "/unit_three_weights.policy:6: ",
                           "expected 4 weights");
-    assert_int_equal(run_tool("check", tmp_path("missing.policy"), NULL), 1);
+    assert_int_equal(run_tool("check", tmp_path("missing.policy"), NULL), 2);
     assert_one_line_error(tmp_path("missing.policy"), ": cannot open (");
 }
 
@@ -226,7 +226,7 @@ static void test_cli_show_prints_weights_as_real_numbers(void **state)
     assert_int_equal(run_tool("show", QNAV_POLICYIO_GOOD_DIR "/prob.policy", NULL), 0);
     assert_non_null(strstr(out_text, "k_goal: 2.0 "));
     assert_non_null(strstr(out_text, "k_safe: 6.0 "));
-    assert_int_equal(run_tool("show", QNAV_POLICYIO_BAD_DIR "/hidden_zero.policy", NULL), 1);
+    assert_int_equal(run_tool("show", QNAV_POLICYIO_BAD_DIR "/hidden_zero.policy", NULL), 2);
     assert_one_line_error(QNAV_POLICYIO_BAD_DIR "/hidden_zero.policy:4: ", "hidden 0");
     assert_string_equal(out_text, "");
 }
@@ -258,17 +258,17 @@ static void test_cli_header_refuses_bad_requests_without_writing(void **state)
     (void)state;
     assert_int_equal(run_tool("header", "--mode", "probabilistic", "--name", "p",
                               QNAV_POLICYIO_GOOD_DIR "/net12.policy", tmp_path("x.h"), NULL),
-                     1);
+                     2);
     assert_one_line_error(QNAV_POLICYIO_GOOD_DIR "/net12.policy: ",
                           "kind is network but --mode probabilistic");
     assert_int_equal(run_tool("header", "--mode", "network", "--name", "p",
                               QNAV_POLICYIO_GOOD_DIR "/prob.policy", tmp_path("x.h"), NULL),
-                     1);
+                     2);
     assert_one_line_error(QNAV_POLICYIO_GOOD_DIR "/prob.policy: ",
                           "kind is probabilistic but --mode network");
     assert_int_equal(run_tool("header", "--mode", "table", "--name", "p",
                               QNAV_POLICYIO_BAD_DIR "/missing_end.policy", tmp_path("x.h"), NULL),
-                     1);
+                     2);
     assert_one_line_error(QNAV_POLICYIO_BAD_DIR "/missing_end.policy:8: ", "truncated");
     assert_int_equal(run_tool("header", "--mode", "table", "--name", "2fast",
                               QNAV_POLICYIO_GOOD_DIR "/prob.policy", tmp_path("x.h"), NULL),

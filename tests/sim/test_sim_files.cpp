@@ -245,13 +245,16 @@ static int run_tool(const std::string &args, std::string *out) {
 static void test_cli_prints_one_line_and_fails_on_bad_input(void **state) {
     (void)state;
     std::string out;
-    assert_int_not_equal(run_tool("run --env /nonexistent/env.toml", &out), 0);
+    assert_int_equal(run_tool("run --env /nonexistent/env.toml", &out), 2); /* bad input */
     assert_string_equal(out.c_str(), "/nonexistent/env.toml: cannot open (No such file or directory)\n");
     assert_int_not_equal(run_tool("run --sectors 400", &out), 0);
     assert_true(one_line(out.substr(0, out.size() - 1)));
     assert_true(out.find("--sectors") != std::string::npos);
     assert_int_not_equal(run_tool("run --sensor-noise -1", &out), 0);
     assert_int_not_equal(run_tool("gen-env --density 0.9 --out /tmp/never.toml", &out), 0);
+    /* an output that cannot be written is a failure at run time: 1 */
+    assert_int_equal(run_tool("draw-env --env " + std::string(QNAV_TEST_DATA_DIR) + "/envs/open.toml --out /nonexistent/x.svg", &out), 1);
+    assert_string_equal(out.c_str(), "qnav-sim: /nonexistent/x.svg: cannot write (No such file or directory)\n");
     assert_int_not_equal(access("/tmp/never.toml", F_OK), 0);
 }
 

@@ -2,11 +2,14 @@
  * simevo: evolve navigation policies in the simulator with the paper's ε-greedy
  * neuro-evolution, transfer them between situations, and run the paper's five transfer
  * experiments with summaries and plots. Subcommands: run, list, evolve, eval, quality.
- * Every bad input ends in one line on stderr and exit status 1 (2 for usage errors).
+ * Every problem ends in one line on stderr: exit status 2 for bad usage or bad input found
+ * before any work starts (options, experiment files, policy files, robots, environments),
+ * 1 for a failure while running (docs/cli.md).
  */
 #include <CLI/CLI.hpp>
 
 #include "qnav/cli.hpp"
+#include "qnav/paths.hpp"
 
 #include <chrono>
 #include <cinttypes>
@@ -29,12 +32,6 @@
 using namespace qnav;
 
 namespace {
-
-std::string env_or(const char *name, const std::string &fallback)
-{
-    const char *v = std::getenv(name);
-    return (v && *v) ? std::string(v) : fallback;
-}
 
 std::vector<std::string> list_experiments(const std::string &dir)
 {
@@ -133,14 +130,15 @@ int main(int argc, char **argv)
     CLI::App app{"simevo: ε-greedy neuro-evolution and policy transfer for qnav (paper §3.3, §4)"};
     app.require_subcommand(1);
     qnav::cli::add_version(app, "simevo");
-    std::string experiments_dir = env_or("QNAV_EXPERIMENTS_DIR", std::string(QNAV_SOURCE_DIR) + "/experiments");
+    std::string experiments_dir =
+        resource_dir("QNAV_EXPERIMENTS_DIR", "experiments", std::string(QNAV_SOURCE_DIR) + "/experiments");
     app.add_option("--experiments", experiments_dir, "folder of experiment files")->capture_default_str();
 
     // run
     auto *run = app.add_subcommand("run", "run named experiments (resumes an interrupted run in the same --out)");
     std::vector<std::string> names;
     RunOptions opt;
-    opt.tools_dir = env_or("QNAV_TOOLS_DIR", std::string(QNAV_SOURCE_DIR) + "/tools");
+    opt.tools_dir = resource_dir("QNAV_TOOLS_DIR", "tools", std::string(QNAV_SOURCE_DIR) + "/tools");
     std::string preset = "full";
     int64_t runs = 0, episodes = 0, source_episodes = 0, eval_episodes = 0, seed = -1, per_candidate = 0;
     std::string fitness, controller;
@@ -225,6 +223,9 @@ int main(int argc, char **argv)
         return status;
     }
 
+    // Bad input found before any episode runs is exit 2; what goes wrong once work has
+    // started (a write, a plot, a journal from other settings) is 1.
+    bool started = false;
     try {
         if (*lst) {
             for (const auto &n : list_experiments(experiments_dir)) {
@@ -263,6 +264,18 @@ int main(int argc, char **argv)
             opt.progress = no_progress ? 0 : -1;
             opt.use_table = !network_mode;
             opt.preset = preset;
+            // every robot, environment and source policy file now, not after other runs
+            SimWorlds probe_worlds;
+            for (const auto &s : specs) {
+                SimRunner target(probe_worlds, s.target, s.seed, true);
+                for (const auto &src : s.sources) {
+                    SimRunner source(probe_worlds, src.scenario, s.seed, true);
+                    if (!src.policy_file.empty()) {
+                        (void)read_policy_file(src.policy_file);
+                    }
+                }
+            }
+            started = true;
             for (const auto &s : specs) {
                 const auto t0 = std::chrono::steady_clock::now();
                 const std::string dir = run_experiment(s, opt);
@@ -296,6 +309,13 @@ int main(int argc, char **argv)
             RunnerFactory make = [&worlds](const Scenario &sc, uint64_t s) -> std::unique_ptr<EpisodeRunner> {
                 return std::make_unique<SimRunner>(worlds, sc, s, true);
             };
+            if (!from.empty()) {
+                (void)read_policy_file(from); // a bad --from is bad input, found now
+            }
+            {
+                SimRunner probe(worlds, t.scenario, t.context_seed, true); // bad env/robot: now
+            }
+            started = true;
             run_tasks({t}, make, 1, ::isatty(2) != 0, "evolve");
             std::printf("best policy %s/best.policy; episodes %s/episodes.csv; held-out %s/eval.csv\n",
                         out_dir.c_str(), out_dir.c_str(), out_dir.c_str());
@@ -332,6 +352,7 @@ int main(int argc, char **argv)
             qnav_ctrl_config_t ccfg;
             qnav_ctrl_config_default(&ccfg);
             ccfg.max_range_mm = static_cast<qnav_mm_t>(q_range);
+            started = true;
             make_dirs(q_out);
             write_file_atomic(join_path(q_out, "quality.csv"), quality_table_csv(policies, ccfg));
             run_plot(opt, "plot_policy.py", q_out);
@@ -347,6 +368,7 @@ int main(int argc, char **argv)
             } else {
                 p = read_policy_file(policy_arg);
             }
+            started = true;
             std::vector<double> R;
             uint32_t reached = 0, tau = 0;
             for (uint32_t i = 0; i < e_episodes; ++i) {
@@ -362,7 +384,7 @@ int main(int argc, char **argv)
         }
     } catch (const UserError &e) {
         std::fprintf(stderr, "simevo: %s\n", e.what());
-        return 1;
+        return started ? QNAV_EXIT_FAILURE : QNAV_EXIT_USAGE;
     } catch (const std::exception &e) {
         std::fprintf(stderr, "simevo: internal error: %s\n", e.what());
         return 1;

@@ -151,6 +151,43 @@ TestResult one_sample_t_test(const std::vector<double> &a, double mu)
     return r;
 }
 
+namespace {
+
+/* Two-sided exact p of the Mann-Whitney U for sample sizes na, nb without ties:
+ * 2 P(U >= u_max), u_max = max(U_a, U_b), capped at 1. The count of orderings with a given
+ * U follows f(i, j, u) = f(i - 1, j, u - j) + f(i, j - 1, u) over i a's and j b's. */
+double mann_whitney_exact_p(std::size_t na, std::size_t nb, double u_max)
+{
+    const std::size_t umax = na * nb;
+    // ways[j][u] for the current i, j = 0..nb
+    std::vector<std::vector<double>> prev(nb + 1, std::vector<double>(umax + 1, 0.0)), cur = prev;
+    for (std::size_t j = 0; j <= nb; ++j) {
+        prev[j][0] = 1.0; // i = 0: one ordering, U = 0
+    }
+    for (std::size_t i = 1; i <= na; ++i) {
+        for (std::size_t j = 0; j <= nb; ++j) {
+            for (std::size_t v = 0; v <= umax; ++v) {
+                double w = v >= j ? prev[j][v - j] : 0.0;
+                if (j > 0) {
+                    w += cur[j - 1][v];
+                }
+                cur[j][v] = w;
+            }
+        }
+        std::swap(prev, cur);
+    }
+    double total = 0.0, tail = 0.0;
+    for (std::size_t v = 0; v <= umax; ++v) {
+        total += prev[nb][v];
+        if (static_cast<double>(v) >= u_max - 1e-9) {
+            tail += prev[nb][v];
+        }
+    }
+    return std::min(1.0, 2.0 * tail / total);
+}
+
+} // namespace
+
 TestResult mann_whitney(const std::vector<double> &a, const std::vector<double> &b)
 {
     TestResult r;
@@ -197,6 +234,11 @@ TestResult mann_whitney(const std::vector<double> &a, const std::vector<double> 
     r.statistic = (u - mu) / std::sqrt(var);
     r.p = std::erfc(std::fabs(r.statistic) / std::sqrt(2.0));
     r.valid = true;
+    if (tie_term == 0.0 && std::min(na, nb) <= kMannWhitneyExactMax) {
+        // small samples without ties: the exact distribution of U (as scipy's 'auto')
+        r.p = mann_whitney_exact_p(na, nb, std::max(u, dna * dnb - u));
+        r.exact = true;
+    }
     return r;
 }
 

@@ -43,11 +43,18 @@
 #define QNAV_TEKBOT_SPIN_DEG 60
 #endif
 
-/* Receive ring, bytes (indices are uint8_t: at most 256). A tick sends ~95 bytes with
- * polled transmit (scan, heartbeat, pose, decision: 16.5 ms at 57600 baud) while the
- * same number may arrive (a policy upload's chunks come back to back): 64 bytes lost
- * upload chunks under simavr, measured. */
-#define RX_RING 256u
+/* Receive ring: it must hold what arrives at line rate while the main loop is busy with a
+ * tick (the step, up to 100 000 cycles = 6.3 ms, and the polled transmit of scan, heartbeat
+ * and command, about 120 bytes = 21 ms at 57600 baud): about 160 bytes. 64 bytes lost the
+ * middle of a policy upload (3 chunks and a commit, about 200 bytes, sent at once) whenever
+ * it landed in that window. 256 (an 8-bit index) costs 192 bytes of the 4 KiB. */
+#ifndef QNAV_TEKBOT_RX_RING
+#define QNAV_TEKBOT_RX_RING 256u
+#endif
+#define RX_RING QNAV_TEKBOT_RX_RING
+#if RX_RING > 256u || RX_RING < 2u
+#error "QNAV_TEKBOT_RX_RING: 2..256 (the ring's index is 8 bits)"
+#endif
 
 static volatile uint32_t g_ms;
 static volatile uint8_t g_rx[RX_RING];
