@@ -42,7 +42,7 @@ int main(void)
     qnav_ctrl_config_default(&cfg);
     cfg.n_sectors = 16;
     cfg.max_range_mm = 3000;
-    if (qnav_ctrl_init_table(&nav, &cfg, nav_table) != QNAV_OK) {
+    if (qnav_ctrl_init_table(&nav, &cfg, nav_table, nav_table_RANK) != QNAV_OK) {
         put("init failed\nEXIT 1\n");
     } else {
         in.ranges_mm = ranges;

@@ -80,7 +80,7 @@ avr)
     "$cmake" --build "$work" >/dev/null
     # add_subdirectory(firmware) builds the libraries, not qnav's own TekBot image
     if find "$work" -name 'tekbot*.elf' | grep -q .; then fail "the TekBot image was built unasked"; fi
-    grep -q 'static QNAV_FLASH const qnav_q1_15_t nav_table' "$work/nav_table.h" || fail "no table header"
+    grep -q 'static QNAV_FLASH const qnav_qkey_t nav_table' "$work/nav_table.h" || fail "no table header"
     "$prefix/share/qnav/cmake/run-simavr" "$work/nav-example.elf" > "$work/out.txt"
     cat "$work/out.txt"
     # the ATmega128 decides exactly as the host did on the same scan
