@@ -1,7 +1,7 @@
 # install() rules and the exported CMake package (docs/install.md). Host builds only.
 #
 #   PREFIX/bin/                 simevo, qnav-sim, qnav-policy, navbridge, qnav-sil-robot,
-#                               qnav-simavr-board
+#                               qnav-simavr-board, qnav-spy
 #   PREFIX/include/qnav/        the public headers (libqnav, link codec, policy files, sim)
 #   PREFIX/lib/                 libqnav_ctrl.a, libqnav_link.a, libqnav_policyio.a, libqnav_sim.a
 #   PREFIX/lib/cmake/qnav/      qnavConfig.cmake: find_package(qnav CONFIG) -> qnav::ctrl,
@@ -67,7 +67,8 @@ if(QNAV_LCMTYPES_PYTHON_DIR)
   install(DIRECTORY ${QNAV_LCMTYPES_PYTHON_DIR}/qnav DESTINATION ${QNAV_SHARE_INSTALL_DIR}/python)
 endif()
 if(QNAV_LCMTYPES_JAR)
-  install(FILES ${QNAV_LCMTYPES_JAR} DESTINATION ${QNAV_SHARE_INSTALL_DIR}/java)
+  install(FILES ${QNAV_LCMTYPES_JAR} ${QNAV_SPY_CHECK_JAR} DESTINATION ${QNAV_SHARE_INSTALL_DIR}/java)
+  install(PROGRAMS ${PROJECT_SOURCE_DIR}/tools/qnav-spy DESTINATION ${CMAKE_INSTALL_BINDIR})
 endif()
 install(FILES ${PROJECT_SOURCE_DIR}/tools/plotcommon.py ${PROJECT_SOURCE_DIR}/VERSION
         DESTINATION ${QNAV_SHARE_INSTALL_DIR}/tools)

@@ -48,6 +48,8 @@ programs)
     /usr/bin/python3 "$p/share/qnav/tools/qnav_log.py" --help > /dev/null
     [ -f "$p/share/qnav/python/qnav/pose_t.py" ] || fail "Python LCM types not installed"
     [ -f "$p/share/qnav/java/qnav_lcmtypes.jar" ] || fail "Java LCM types not installed"
+    [ "$("$p/bin/qnav-spy" --version)" = "qnav-spy (qnav) $v" ] || fail "qnav-spy version"
+    if "$p/bin/qnav-spy" --check 1 --types-jar /nonexistent.jar 2>/dev/null; then fail "qnav-spy took a missing jar"; fi
     ;;
 host)
     prefix=$2 work=$3 src=$4 cmake=$5

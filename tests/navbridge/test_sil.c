@@ -215,7 +215,7 @@ static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(vo
     run_in_namespace_or_skip(trial, out, err);
     assert_true(read_text(rc_path, text, sizeof text) > 0);
     print_message("%s", text);
-    assert_non_null(strstr(text, "sil=0 navbridge=1"));
+    assert_non_null(strstr(text, "sil=0 navbridge=1 spy=-"));
     assert_true(read_text(sil_out, text, sizeof text) > 0);
     assert_non_null(strstr(text, "reached yes"));
     count_channels(log, &scan, &cmd, &qual, &status, &pose);
@@ -257,7 +257,7 @@ static void test_sil_route_of_three_waypoints_through_dense_replays_identically(
 {
     char dir[300], log[300], rc_path[300], text[4096], out[300], err[300], path[300];
     const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
-                           dir, "--env", "dense", "--start", "5:1.1:90", "--",
+                           dir, "-", "--env", "dense", "--start", "5:1.1:90", "--",
                            "--waypoints", "1.9:0.3,3.9:0.5,7.9:0", "--goal-radius", "0.4",
                            NULL};
     int n, waypoint, waypoints;
@@ -356,6 +356,54 @@ static void test_sil_robot_replaces_stale_pty_link_and_removes_it_at_exit(void *
     assert_int_equal(readlink(path, target, sizeof target), -1);
 }
 
+/* qnav-spy (lcm-spy with the qnav types on OpenJDK 17) under Xvfb, inside a private network
+ * namespace during a udpm:// trial: it runs, and decodes every channel of the trial. */
+static void test_qnav_spy_under_xvfb_decodes_every_qnav_channel(void **state)
+{
+    static const char *const channels[] = {"QNAV_SCAN qnav.scan_t ", "QNAV_COMMAND qnav.command_t ",
+                                           "QNAV_QUALITIES qnav.path_qualities_t ",
+                                           "QNAV_POSE qnav.pose_t ",
+                                           "QNAV_LINK_STATUS qnav.link_status_t "};
+    char rc_path[300], spy_out[300], spy_png[300], text[4096], out[300], err[300];
+    const char *probe[] = {UNSHARE_EXE, "-n", "true", NULL};
+    const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
+                           g_dir, SPY_EXE, NULL};
+    unsigned k, n;
+    int rc;
+    (void)state;
+    snprintf(out, sizeof out, "%s/spy-probe.out", g_dir);
+    snprintf(err, sizeof err, "%s/spy-probe.err", g_dir);
+    if (run_program(probe, out, err) != 0) {
+        print_message("SKIP: `unshare -n` is not permitted here (DESIGN.md §7)\n");
+        skip();
+    }
+    if (access(XVFB_EXE, X_OK) != 0) {
+        print_message("SKIP: no Xvfb (Debian package xvfb)\n");
+        skip();
+    }
+    snprintf(rc_path, sizeof rc_path, "%s/rc.txt", g_dir);
+    snprintf(spy_out, sizeof spy_out, "%s/spy.out", g_dir);
+    snprintf(spy_png, sizeof spy_png, "%s/spy.png", g_dir);
+    rc = run_program(trial, out, err);
+    if (rc == 10) {
+        print_message("SKIP: cannot configure loopback multicast in the namespace\n");
+        skip();
+    }
+    assert_true(read_text(rc_path, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, "sil=0 navbridge=1 spy=0"));
+    assert_true(read_text(spy_out, text, sizeof text) > 0);
+    print_message("%s", text);
+    for (k = 0; k < sizeof channels / sizeof channels[0]; ++k) {
+        const char *line = strstr(text, channels[k]);
+        assert_non_null(line);
+        assert_int_equal(sscanf(line + strlen(channels[k]), "%u", &n), 1);
+        assert_true(n > 5u);
+    }
+    assert_true(read_text(spy_png, text, sizeof text) > 8);
+    assert_int_equal(memcmp(text, "\x89PNG", 4), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -366,6 +414,7 @@ int main(void)
         cmocka_unit_test(test_sil_robot_refuses_link_path_that_is_a_file),
         cmocka_unit_test(test_sil_robot_leaves_a_file_that_replaced_its_link),
         cmocka_unit_test(test_sil_robot_replaces_stale_pty_link_and_removes_it_at_exit),
+        cmocka_unit_test(test_qnav_spy_under_xvfb_decodes_every_qnav_channel),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -4,12 +4,18 @@
 # loopback up with multicast routed to it, so no packet can leave the machine.
 # The robot is paced at 20 ms per tick (not lockstep) so bursts do not overrun the
 # logger's UDP socket on a busy machine.
-# usage: udpm_trial.sh NAVBRIDGE SIL_ROBOT DIR [SIL_ARG... -- NAVBRIDGE_ARG...]
-# Without navbridge arguments the goal is the robot's destination (--goal-at, printed by
-# the robot in its odometry frame).
+# With QNAV_SPY, qnav-spy --check also watches the trial, on a private Xvfb display
+# (Xvfb's abstract socket is private to the namespace; -displayfd picks a free number),
+# and its report and window go to DIR/spy.out and DIR/spy.png; the robot is then paced at
+# 50 ms so that the trial outlasts the JVM's start. QNAV_SPY "-" (or none) is no spy.
+# Further arguments go to the robot, and those after "--" to navbridge; without navbridge
+# arguments its goal is the robot's destination (--goal-at, printed by the robot in its
+# odometry frame).
+# usage: udpm_trial.sh NAVBRIDGE SIL_ROBOT DIR [QNAV_SPY|- [SIL_ARG... [-- NAVBRIDGE_ARG...]]]
 set -u
-NB_EXE=$1; SIL_EXE=$2; DIR=$3
-shift 3
+NB_EXE=$1; SIL_EXE=$2; DIR=$3; SPY=${4:-}
+[ "$SPY" = "-" ] && SPY=
+[ $# -ge 4 ] && shift 4 || shift $#
 SIL_ARGS=""
 while [ $# -gt 0 ] && [ "$1" != "--" ]; do SIL_ARGS="$SIL_ARGS $1"; shift; done
 [ $# -gt 0 ] && shift
@@ -17,9 +23,19 @@ ip link set lo up || exit 10
 ip link set lo multicast on || exit 10
 ip route add 224.0.0.0/4 dev lo || exit 10
 export LCM_DEFAULT_URL="udpm://239.255.76.67:7667?ttl=0"
+TICK_MS=20
+if [ -n "$SPY" ]; then
+    TICK_MS=50
+    Xvfb -displayfd 3 -screen 0 1024x768x24 -nolisten tcp 3> "$DIR/display" 2> "$DIR/xvfb.err" & XVFB=$!
+    i=0
+    while [ ! -s "$DIR/display" ] && [ $i -lt 200 ]; do sleep 0.05; i=$((i+1)); done
+    [ -s "$DIR/display" ] || exit 11
+    DISPLAY=:$(cat "$DIR/display") "$SPY" --lcm-url "$LCM_DEFAULT_URL" --check 20 \
+        --screenshot "$DIR/spy.png" > "$DIR/spy.out" 2> "$DIR/spy.err" & SPY_PID=$!
+fi
 lcm-logger -q -f "$DIR/trial.lcmlog" & LOGGER=$!
 # shellcheck disable=SC2086 # the robot's arguments are words
-"$SIL_EXE" --tick-ms 20 --link "$DIR/link" --pose $SIL_ARGS > "$DIR/sil.out" 2> "$DIR/sil.err" & SIL=$!
+"$SIL_EXE" --tick-ms $TICK_MS --link "$DIR/link" --pose $SIL_ARGS > "$DIR/sil.out" 2> "$DIR/sil.err" & SIL=$!
 i=0
 while [ ! -e "$DIR/link" ] && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
 sleep 0.3   # lcm-logger subscribed before the trial starts
@@ -36,5 +52,10 @@ wait $NB; NB_RC=$?
 kill $GUARD 2>/dev/null
 sleep 0.3
 kill -INT $LOGGER; wait $LOGGER
-echo "sil=$SIL_RC navbridge=$NB_RC" > "$DIR/rc.txt"
+SPY_RC=-
+if [ -n "$SPY" ]; then
+    wait $SPY_PID; SPY_RC=$?
+    kill $XVFB 2>/dev/null; wait $XVFB 2>/dev/null
+fi
+echo "sil=$SIL_RC navbridge=$NB_RC spy=$SPY_RC" > "$DIR/rc.txt"
 exit $SIL_RC

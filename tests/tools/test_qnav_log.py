@@ -96,7 +96,7 @@ class RecordedTrial(unittest.TestCase):
         cls.dir.cleanup()
 
     def test_trial_csv_agrees_with_navbridge_replay(self):
-        self.assertEqual(self.rc, "sil=0 navbridge=1")
+        self.assertEqual(self.rc, "sil=0 navbridge=1 spy=-")
         out = os.path.join(self.dir.name, "csv")
         r = run_tool(self.log, "--csv", out)
         self.assertEqual(r.returncode, 0, r.stderr)
