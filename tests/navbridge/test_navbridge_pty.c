@@ -526,6 +526,9 @@ static void test_bad_options_and_files_fail_with_one_line(void **state)
     const char *pol[] = {EXE, "--device", "/dev/null", "--policy", bad_policy, NULL};
     const char *unknown[] = {EXE, "--frobnicate", NULL};
     const char *goal[] = {EXE, "--device", "/dev/null", "--goal", "200", NULL};
+    const char *route[] = {EXE, "--device", "/dev/null", "--waypoints", "1:2,3", NULL};
+    const char *at[] = {EXE, "--device", "/dev/null", "--goal-at", "1:2,3:4", NULL};
+    const char *radius[] = {EXE, "--device", "/dev/null", "--goal-radius", "0", NULL};
     (void)state;
     snprintf(bad_policy, sizeof bad_policy, "%s/bad.policy", g_dir);
     f = fopen(bad_policy, "w");
@@ -540,6 +543,9 @@ static void test_bad_options_and_files_fail_with_one_line(void **state)
     expect_refusal(pol, "bad.policy:");
     expect_refusal(unknown, "--frobnicate");
     expect_refusal(goal, "--goal 200");
+    expect_refusal(route, "--waypoints 1:2,3");
+    expect_refusal(at, "--goal-at 1:2,3:4");
+    expect_refusal(radius, "--goal-radius 0");
 }
 
 /* Short unknown options are named as such (it used to say "--?: missing its value"), a

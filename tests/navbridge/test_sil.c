@@ -25,6 +25,7 @@
 
 #include "fakeboard.h"
 #include "test_proc.h"
+#include "qnav/link.h"
 #include "qnav/policy_io.h"
 #include "qnav_odometry_t.h"
 
@@ -96,7 +97,8 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
 {
     char link[300], log[300], sil_out[300], sil_err[300], nb_out[300], nb_err[300];
     char text[2048], goal[64];
-    const char *sil[] = {SIL_EXE, "--lockstep", "--link", link, NULL};
+    /* lockstep is about repeatability: a loaded machine may take more than 300 ms to answer */
+    const char *sil[] = {SIL_EXE, "--lockstep", "--reply-ms", "3000", "--link", link, NULL};
     const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--log", log,
                         "--goal-at", goal, NULL};
     pid_t ps, pn;
@@ -290,6 +292,50 @@ static void test_sil_route_of_three_waypoints_through_dense_replays_identically(
     replay_is_identical(log);
 }
 
+/* One onboard SIL trial with --nvm; navbridge's stderr into text. */
+static void nvm_trial(const char *nvm, const char *pol, int upload, char *text, int cap)
+{
+    char link[300], s_out[300], s_err[300], nb_out[300], nb_err[300], goal[64];
+    const char *sil[] = {SIL_EXE, "--tick-ms", "10", "--nvm", nvm, "--link", link, NULL};
+    const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--mode",
+                        "onboard", "--goal-at", goal, upload ? "--policy" : NULL, pol,
+                        "--upload", NULL};
+    pid_t ps, pn;
+    snprintf(link, sizeof link, "%s/link-nvm", g_dir);
+    snprintf(s_out, sizeof s_out, "%s/sil-nvm.out", g_dir);
+    snprintf(s_err, sizeof s_err, "%s/sil-nvm.err", g_dir);
+    snprintf(nb_out, sizeof nb_out, "%s/nb-nvm.out", g_dir);
+    snprintf(nb_err, sizeof nb_err, "%s/nb-nvm.err", g_dir);
+    ps = qnav_test_spawn(sil, s_out, s_err);
+    assert_true(ps > 0);
+    assert_int_equal(qnav_test_wait_path(link, 4000), 0);
+    destination_of(s_out, goal, sizeof goal);
+    pn = qnav_test_spawn(nb, nb_out, nb_err);
+    assert_true(pn > 0);
+    assert_int_equal(qnav_test_wait_exit(ps), 0);
+    assert_int_equal(wait_exit_within(pn, 3000), 1);
+    assert_true(read_text(nb_err, text, cap) > 0);
+}
+
+static void test_sil_robot_keeps_an_uploaded_policy_in_its_nvm_file(void **state)
+{
+    char nvm[300], pol[300], text[4096], perr[QNAV_POLICY_IO_ERRLEN], want[96];
+    qnav_policy_t p;
+    (void)state;
+    snprintf(nvm, sizeof nvm, "%s/robot.nvm", g_dir);
+    snprintf(pol, sizeof pol, "%s/nvm.policy", g_dir);
+    qnav_policy_prob_default(&p);
+    p.u.prob.k_goal = 3 * 256;
+    assert_int_equal(qnav_policy_write(pol, &p, "sil nvm test", perr, sizeof perr), 0);
+    snprintf(want, sizeof want, "runs its uploaded policy (crc 0x%04x)", qnav_link_policy_crc(&p));
+    nvm_trial(nvm, pol, 1, text, sizeof text);
+    assert_non_null(strstr(text, "runs its built-in policy")); /* a new, erased store */
+    assert_non_null(strstr(text, want));
+    nvm_trial(nvm, pol, 0, text, sizeof text);    /* restarted: loaded from the file */
+    assert_non_null(strstr(text, want));
+    assert_null(strstr(text, "built-in"));
+}
+
 /* --link onto a user's file: refused with status 2, the file untouched (it used to be
  * deleted and replaced by the link). */
 static void test_sil_robot_refuses_link_path_that_is_a_file(void **state)
@@ -411,6 +457,7 @@ int main(void)
         cmocka_unit_test(test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically),
         cmocka_unit_test(test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically),
         cmocka_unit_test(test_sil_route_of_three_waypoints_through_dense_replays_identically),
+        cmocka_unit_test(test_sil_robot_keeps_an_uploaded_policy_in_its_nvm_file),
         cmocka_unit_test(test_sil_robot_refuses_link_path_that_is_a_file),
         cmocka_unit_test(test_sil_robot_leaves_a_file_that_replaced_its_link),
         cmocka_unit_test(test_sil_robot_replaces_stale_pty_link_and_removes_it_at_exit),
