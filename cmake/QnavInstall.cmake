@@ -61,6 +61,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/ DESTINATION ${QNAV_SHARE_INSTALL_D
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/experiments/
         DESTINATION ${QNAV_SHARE_INSTALL_DIR}/experiments)
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/tools/plot_learning.py ${PROJECT_SOURCE_DIR}/tools/plot_policy.py
+                 ${PROJECT_SOURCE_DIR}/tools/plot_episodes.py
                  ${PROJECT_SOURCE_DIR}/tools/qnav_log.py
         DESTINATION ${QNAV_SHARE_INSTALL_DIR}/tools)
 if(QNAV_LCMTYPES_PYTHON_DIR)

@@ -6,6 +6,7 @@
  * TekBot through the open arena with it.
  * Usage: qnav-example [SHARE_DIR]   (default: the installation's share/qnav)
  */
+#define _POSIX_C_SOURCE 200809L /* mkstemp */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

@@ -150,19 +150,12 @@ static void test_firmware_in_simavr_runs_uploaded_network_bit_identical_to_host(
  * to delete it, and simavr's own uart_pty_connect() deleted /tmp/simavr-uart0). */
 static void test_simavr_board_refuses_link_path_that_is_a_file(void **state)
 {
-    char path[300], out[300], err[300], text[512];
+    char path[300];
     const char *board[] = {SIMAVR_BOARD_EXE, "--elf", TEKBOT_ELF, "--link", path,
                            "--seconds", "0.1", NULL};
     (void)state;
     snprintf(path, sizeof path, "%s/notes.txt", g_dir);
-    snprintf(out, sizeof out, "%s/refuse.out", g_dir);
-    snprintf(err, sizeof err, "%s/refuse.err", g_dir);
-    assert_int_equal(qnav_test_write_text(path, "the user's notes\n"), 0);
-    assert_int_equal(run_program(board, out, err), 2);
-    assert_true(read_text(path, text, sizeof text) > 0);
-    assert_string_equal(text, "the user's notes\n");
-    assert_true(read_text(err, text, sizeof text) > 0);
-    assert_non_null(strstr(text, "refusing to replace it"));
+    assert_int_equal(qnav_test_link_refused(board, path, g_dir), 0);
 }
 
 /* Two boards at once: each on its own pty, neither touching the other's link. */

@@ -68,7 +68,7 @@ pkgconfig)
     export PKG_CONFIG_PATH="$prefix/lib/pkgconfig"
     [ "$(pkg-config --modversion qnav)" = "$(cat "$prefix/share/qnav/VERSION")" ] || fail "version"
     # shellcheck disable=SC2046
-    cc -std=c99 -o "$work/qnav-example" "$src/examples/host-app/main.c" \
+    cc -std=c99 -Wall -Wextra -Werror -o "$work/qnav-example" "$src/examples/host-app/main.c" \
         $(pkg-config --cflags qnav) $(pkg-config --static --libs qnav)
     "$work/qnav-example" "$prefix/share/qnav" > "$work/out.txt"
     grep -q '^episode: reached yes' "$work/out.txt" || fail "the episode did not reach"

@@ -79,6 +79,49 @@ int qnav_test_write_text(const char *path, const char *text)
     return (fclose(f) == 0 && ok) ? 0 : -1;
 }
 
+/* The whole small file at path into buf (NUL-terminated); its length, or -1. */
+static long read_small(const char *path, char *buf, size_t cap)
+{
+    FILE *f = fopen(path, "r");
+    size_t n;
+    if (f == NULL) {
+        return -1;
+    }
+    n = fread(buf, 1, cap - 1, f);
+    fclose(f);
+    buf[n] = '\0';
+    return (long)n;
+}
+
+int qnav_test_link_refused(const char *const *argv, const char *path, const char *dir)
+{
+    static const char notes[] = "the user's notes\n";
+    char out[512], err[512], text[1024];
+    int status;
+    pid_t pid;
+    snprintf(out, sizeof out, "%s/refuse.out", dir);
+    snprintf(err, sizeof err, "%s/refuse.err", dir);
+    if (qnav_test_write_text(path, notes) != 0) {
+        fprintf(stderr, "link_refused: cannot write %s\n", path);
+        return -1;
+    }
+    pid = qnav_test_spawn(argv, out, err);
+    status = pid > 0 ? qnav_test_wait_exit(pid) : -1;
+    if (status != 2) {
+        fprintf(stderr, "link_refused: %s exited %d, not 2\n", argv[0], status);
+        return -1;
+    }
+    if (read_small(path, text, sizeof text) < 0 || strcmp(text, notes) != 0) {
+        fprintf(stderr, "link_refused: %s was changed\n", path);
+        return -1;
+    }
+    if (read_small(err, text, sizeof text) < 0 || strstr(text, "refusing to replace it") == NULL) {
+        fprintf(stderr, "link_refused: no refusal on stderr\n");
+        return -1;
+    }
+    return 0;
+}
+
 int qnav_test_tmpdir_make(char *dir, size_t len, const char *prefix)
 {
     int n = snprintf(dir, len, "/tmp/%s.XXXXXX", prefix);

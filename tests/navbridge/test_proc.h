@@ -27,6 +27,12 @@ int qnav_test_wait_text(const char *path, const char *needle, int timeout_ms);
 /* Write text to a new file at path (a user's file that a program must not touch). 0/-1. */
 int qnav_test_write_text(const char *path, const char *text);
 
+/* The --link rule of the board programs on a user's file: writes a file at path, runs argv
+ * (whose --link is path; output to dir/refuse.out and dir/refuse.err) and checks that it
+ * exits 2, says "refusing to replace it" and leaves the file as it was. 0 when all hold,
+ * else -1 with the failed check on stderr. */
+int qnav_test_link_refused(const char *const *argv, const char *path, const char *dir);
+
 /* Make a fresh folder /tmp/<prefix>.XXXXXX into dir (len bytes). 0 or -1. */
 int qnav_test_tmpdir_make(char *dir, size_t len, const char *prefix);
 

@@ -185,39 +185,55 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     assert_true(compared + 20u >= scans); /* all but the ticks before the upload landed */
 }
 
-/* Run a udpm:// trial (argv starts with unshare -n) in a private network namespace, or
- * skip the test when namespaces or loopback multicast are not available here. */
-static void run_in_namespace_or_skip(const char *const *trial, const char *out,
-                                     const char *err)
+/* One udpm:// trial by udpm_trial.sh in a private network namespace, in dir (skips the
+ * test when namespaces or loopback multicast are not permitted). args: the script's
+ * arguments after DIR (qnav-spy's path or "-", then robot arguments, "--", navbridge
+ * arguments), NULL-ended. Checks the statuses the script reports (expect, e.g.
+ * "sil=0 navbridge=1 spy=-"). */
+static void run_udpm_trial_in(const char *dir, const char *const *args, const char *expect)
 {
+    char rc_path[300], text[512], out[300], err[300];
     const char *probe[] = {UNSHARE_EXE, "-n", "true", NULL};
+    const char *trial[32] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
+                             dir};
+    int k = 7;
+    while (*args != NULL && k < 31) {
+        trial[k++] = *args++;
+    }
+    trial[k] = NULL;
+    snprintf(out, sizeof out, "%s/probe.out", dir);
+    snprintf(err, sizeof err, "%s/probe.err", dir);
     if (run_program(probe, out, err) != 0) {
         print_message("SKIP: `unshare -n` is not permitted here, so the udpm:// trial cannot "
                       "run in a private network namespace (DESIGN.md §7)\n");
         skip();
     }
+    snprintf(rc_path, sizeof rc_path, "%s/rc.txt", dir);
     if (run_program(trial, out, err) == 10) {
         print_message("SKIP: cannot configure loopback multicast in the namespace\n");
         skip();
     }
+    assert_true(read_text(rc_path, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, expect));
+}
+
+/* The same in g_dir with the robot's destination as the goal, watched by qnav-spy when spy
+ * is not NULL. */
+static void run_udpm_trial(const char *spy, const char *expect)
+{
+    const char *args[] = {spy != NULL ? spy : "-", NULL};
+    run_udpm_trial_in(g_dir, args, expect);
 }
 
 static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(void **state)
 {
-    char log[300], rc_path[300], text[2048], out[300], err[300], sil_out[300];
-    const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
-                           g_dir, NULL};
+    char log[300], text[2048], sil_out[300];
     int scan, cmd, qual, status, pose;
     (void)state;
-    snprintf(out, sizeof out, "%s/trial.out", g_dir);
-    snprintf(err, sizeof err, "%s/trial.err", g_dir);
     snprintf(log, sizeof log, "%s/trial.lcmlog", g_dir);
-    snprintf(rc_path, sizeof rc_path, "%s/rc.txt", g_dir);
     snprintf(sil_out, sizeof sil_out, "%s/sil.out", g_dir);
-    run_in_namespace_or_skip(trial, out, err);
-    assert_true(read_text(rc_path, text, sizeof text) > 0);
-    print_message("%s", text);
-    assert_non_null(strstr(text, "sil=0 navbridge=1 spy=-"));
+    run_udpm_trial(NULL, "sil=0 navbridge=1 spy=-");
     assert_true(read_text(sil_out, text, sizeof text) > 0);
     assert_non_null(strstr(text, "reached yes"));
     count_channels(log, &scan, &cmd, &qual, &status, &pose);
@@ -257,22 +273,15 @@ static void odometry_progress(const char *path, int *n, int *waypoint, int *wayp
  * the gap in row 1 (4.7, 3.0), the gap in row 2 (4.5, 5.0), the destination (5, 9). */
 static void test_sil_route_of_three_waypoints_through_dense_replays_identically(void **state)
 {
-    char dir[300], log[300], rc_path[300], text[4096], out[300], err[300], path[300];
-    const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
-                           dir, "-", "--env", "dense", "--start", "5:1.1:90", "--",
-                           "--waypoints", "1.9:0.3,3.9:0.5,7.9:0", "--goal-radius", "0.4",
-                           NULL};
+    char dir[300], log[300], text[4096], path[300];
+    const char *args[] = {"-", "--env", "dense", "--start", "5:1.1:90", "--", "--waypoints",
+                          "1.9:0.3,3.9:0.5,7.9:0", "--goal-radius", "0.4", NULL};
     int n, waypoint, waypoints;
     (void)state;
     snprintf(dir, sizeof dir, "%s/route", g_dir);
     assert_int_equal(mkdir(dir, 0700), 0);
-    snprintf(out, sizeof out, "%s/trial.out", dir);
-    snprintf(err, sizeof err, "%s/trial.err", dir);
     snprintf(log, sizeof log, "%s/trial.lcmlog", dir);
-    snprintf(rc_path, sizeof rc_path, "%s/rc.txt", dir);
-    run_in_namespace_or_skip(trial, out, err);
-    assert_true(read_text(rc_path, text, sizeof text) > 0);
-    assert_non_null(strstr(text, "sil=0 navbridge=1"));
+    run_udpm_trial_in(dir, args, "sil=0 navbridge=1 spy=-");
     snprintf(path, sizeof path, "%s/sil.out", dir);
     assert_true(read_text(path, text, sizeof text) > 0);
     print_message("%s", text);
@@ -340,18 +349,11 @@ static void test_sil_robot_keeps_an_uploaded_policy_in_its_nvm_file(void **state
  * deleted and replaced by the link). */
 static void test_sil_robot_refuses_link_path_that_is_a_file(void **state)
 {
-    char path[300], out[300], err[300], text[512];
+    char path[300];
     const char *sil[] = {SIL_EXE, "--wait-s", "0", "--link", path, NULL};
     (void)state;
     snprintf(path, sizeof path, "%s/notes.txt", g_dir);
-    snprintf(out, sizeof out, "%s/refuse.out", g_dir);
-    snprintf(err, sizeof err, "%s/refuse.err", g_dir);
-    assert_int_equal(qnav_test_write_text(path, "the user's notes\n"), 0);
-    assert_int_equal(run_program(sil, out, err), 2);
-    assert_true(read_text(path, text, sizeof text) > 0);
-    assert_string_equal(text, "the user's notes\n");
-    assert_true(read_text(err, text, sizeof text) > 0);
-    assert_non_null(strstr(text, "refusing to replace it"));
+    assert_int_equal(qnav_test_link_refused(sil, path, g_dir), 0);
 }
 
 /* A file put where the link was while the robot runs survives the robot's exit: only the
@@ -410,34 +412,16 @@ static void test_qnav_spy_under_xvfb_decodes_every_qnav_channel(void **state)
                                            "QNAV_QUALITIES qnav.path_qualities_t ",
                                            "QNAV_POSE qnav.pose_t ",
                                            "QNAV_LINK_STATUS qnav.link_status_t "};
-    char rc_path[300], spy_out[300], spy_png[300], text[4096], out[300], err[300];
-    const char *probe[] = {UNSHARE_EXE, "-n", "true", NULL};
-    const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
-                           g_dir, SPY_EXE, NULL};
+    char spy_out[300], spy_png[300], text[4096];
     unsigned k, n;
-    int rc;
     (void)state;
-    snprintf(out, sizeof out, "%s/spy-probe.out", g_dir);
-    snprintf(err, sizeof err, "%s/spy-probe.err", g_dir);
-    if (run_program(probe, out, err) != 0) {
-        print_message("SKIP: `unshare -n` is not permitted here (DESIGN.md §7)\n");
-        skip();
-    }
     if (access(XVFB_EXE, X_OK) != 0) {
         print_message("SKIP: no Xvfb (Debian package xvfb)\n");
         skip();
     }
-    snprintf(rc_path, sizeof rc_path, "%s/rc.txt", g_dir);
     snprintf(spy_out, sizeof spy_out, "%s/spy.out", g_dir);
     snprintf(spy_png, sizeof spy_png, "%s/spy.png", g_dir);
-    rc = run_program(trial, out, err);
-    if (rc == 10) {
-        print_message("SKIP: cannot configure loopback multicast in the namespace\n");
-        skip();
-    }
-    assert_true(read_text(rc_path, text, sizeof text) > 0);
-    print_message("%s", text);
-    assert_non_null(strstr(text, "sil=0 navbridge=1 spy=0"));
+    run_udpm_trial(SPY_EXE, "sil=0 navbridge=1 spy=0");
     assert_true(read_text(spy_out, text, sizeof text) > 0);
     print_message("%s", text);
     for (k = 0; k < sizeof channels / sizeof channels[0]; ++k) {

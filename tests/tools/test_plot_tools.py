@@ -86,6 +86,17 @@ class CommandLine(unittest.TestCase):
             self.assertEqual(r.stderr.strip(), f"plot_policy.py: {d}/quality.csv: No such file or directory")
 
 
+class SigmoidTable(unittest.TestCase):
+    def test_generator_reproduces_the_committed_table_and_refuses_arguments(self):
+        r = run_script("gen_sigmoid_lut.py")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(TOOLS, "..", "firmware", "src", "sigmoid_lut.c")) as f:
+            self.assertEqual(r.stdout, f.read())
+        r = run_script("gen_sigmoid_lut.py", "--bogus")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("unrecognized arguments: --bogus", r.stderr)
+
+
 class ExclusiveTemporaryFiles(unittest.TestCase):
     def test_planted_symlink_at_the_old_temporary_name_is_not_followed(self):
         with tempfile.TemporaryDirectory() as d, tempfile.TemporaryDirectory() as outside:
