@@ -79,8 +79,26 @@ static qnav_cdeg_t hal_heading(void *ctx)
     return (qnav_cdeg_t)(cdeg >= 17999.5 ? -18000 : lround(cdeg));
 }
 
+/* A standard normal sample (Box-Muller over xorshift64). */
+static double gauss(uint64_t *state)
+{
+    double u1, u2;
+    uint64_t x = *state;
+    x ^= x << 13;
+    x ^= x >> 7;
+    x ^= x << 17;
+    u1 = ((double)(x >> 11) + 1.0) / 9007199254740993.0;
+    x ^= x << 13;
+    x ^= x >> 7;
+    x ^= x << 17;
+    u2 = (double)(x >> 11) / 9007199254740992.0;
+    *state = x;
+    return sqrt(-2.0 * log(u1)) * cos(2.0 * M_PI * u2);
+}
+
 /* Wheel travel since the last call from the simulated motion: the displacement along the
- * mid-step heading plus the turn times half the track on each side. */
+ * mid-step heading plus the turn times half the track on each side, each wheel's slipping
+ * by the noise level. */
 static void hal_odometry(void *ctx, int32_t *left, int32_t *right)
 {
     sil_hal_t *s = (sil_hal_t *)ctx;
@@ -89,8 +107,13 @@ static void hal_odometry(void *ctx, int32_t *left, int32_t *right)
         double dh = wrap_rad(st.heading_rad - s->last_h);
         double hm = s->last_h + dh / 2.0;
         double ds = (st.x_m - s->last_x) * cos(hm) + (st.y_m - s->last_y) * sin(hm);
-        s->left_um += (ds - dh * s->track_m / 2.0) * 1e6;
-        s->right_um += (ds + dh * s->track_m / 2.0) * 1e6;
+        double sl = 1.0, sr = 1.0;
+        if (s->odo_noise > 0.0) {
+            sl += s->odo_noise * gauss(&s->rng);
+            sr += s->odo_noise * gauss(&s->rng);
+        }
+        s->left_um += (ds - dh * s->track_m / 2.0) * sl * 1e6;
+        s->right_um += (ds + dh * s->track_m / 2.0) * sr * 1e6;
         s->last_x = st.x_m;
         s->last_y = st.y_m;
         s->last_h = st.heading_rad;

@@ -36,6 +36,9 @@ typedef struct {
     double track_m;               /* wheel separation */
     double um_per_count;
     double left_um, right_um;
+    double odo_noise;             /* wheel slip: each step's travel * (1 + p * n), n ~ N(0,1)
+                                     per wheel (the simulator's noise level p; 0 = exact) */
+    uint64_t rng;                 /* xorshift64 state of that noise (seeded, reproducible) */
     /* the drive */
     qnav_deg_t drive_heading;
     qnav_q1_15_t drive_speed;

@@ -72,7 +72,7 @@ static void usage(FILE *f)
             "  --robot, --env   simulator robot profile and environment (tekbot, open)\n"
             "  --sectors N      sonar sectors (0 = the profile's default)\n"
             "  --seed, --episode  simulator seed and episode seed (1, 1)\n"
-            "  --noise P        sensor and actuation noise level p (0)\n"
+            "  --noise P        sensor, actuation and wheel-slip (odometry) noise level p (0)\n"
             "  --link PATH      also make PATH a symlink to the pty (for navbridge --device)\n"
             "  --start X:Y:DEG  start pose in the world frame (m, m, deg CCW from +x) instead\n"
             "                   of a random one from the environment's start zones\n"
@@ -347,6 +347,8 @@ static int start(robot_t *r, const options_t *o, qnav_sim_robot_t **robot,
     }
     r->hal.sim = r->sim;
     r->hal.nvm_path = o->nvm;
+    r->hal.odo_noise = o->noise;
+    r->hal.rng = 0x9E3779B97F4A7C15ULL ^ (uint64_t)o->seed; /* never 0 for xorshift */
     r->hal.fd = open_pty(slave);
     if (r->hal.fd < 0) {
         return 2;
