@@ -9,7 +9,10 @@
 #include <string.h>
 #include <time.h>
 
+#include <math.h>
+
 #include "qnav_link_status_t.h"
+#include "qnav_odometry_t.h"
 #include "qnav_path_qualities_t.h"
 
 /* Largest encoded LCM message we publish (path qualities: 360 * 6 bytes + header). */
@@ -24,12 +27,7 @@ int64_t qnav_bridge_utime(void)
 
 uint16_t qnav_bridge_policy_crc(const qnav_policy_t *policy)
 {
-    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
-    int32_t n = qnav_link_policy_to_blob(policy, blob, sizeof blob);
-    if (n <= 0) {
-        return 0;
-    }
-    return qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n);
+    return qnav_link_policy_crc(policy);
 }
 
 void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg,
@@ -129,17 +127,18 @@ void qnav_bridge_publish(qnav_bridge_t *b, const char *channel, const void *data
         }                                                                                   \
     } while (0)
 
+static void write_wire(void *user, const uint8_t *bytes, uint16_t n)
+{
+    qnav_bridge_t *b = (qnav_bridge_t *)user;
+    if (b->write != NULL) {
+        b->write(b->write_user, bytes, n);
+    }
+}
+
 static void send_frame(qnav_bridge_t *b, uint8_t id, const uint8_t *payload, int32_t len)
 {
     uint8_t wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
-    int32_t n;
-    if (len < 0) {
-        return;
-    }
-    n = qnav_link_encode(&b->tx, id, payload, (uint16_t)len, wire, (uint16_t)sizeof wire);
-    if (n > 0 && b->write != NULL) {
-        b->write(b->write_user, wire, (size_t)n);
-    }
+    qnav_link_send(&b->tx, id, payload, len, wire, (uint16_t)sizeof wire, write_wire, b);
 }
 
 static void send_command(qnav_bridge_t *b, const qnav_command_t *c, int stop)
@@ -176,7 +175,7 @@ static void send_heartbeat(qnav_bridge_t *b)
                               ? QNAV_LINK_STATE_LINK_OK
                               : 0u) |
                          (b->watchdog_stop || b->shutting_down ? QNAV_LINK_STATE_STOPPED : 0u) |
-                         QNAV_LINK_STATE_POLICY);
+                         (b->bc.ready ? QNAV_LINK_STATE_POLICY : 0u));
     hb.rx_ok = (uint16_t)b->rx.stats.frames_ok;
     hb.rx_dropped = (uint16_t)qnav_link_rx_dropped_total(&b->rx);
     hb.policy_crc = b->bc.policy_crc;
@@ -282,8 +281,8 @@ static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
     }
     PUBLISH(b, QNAV_CH_SCAN, qnav_scan_t, &s);
 
-    if (b->goal.goal_id != 0u && ls.goal_id != b->goal.goal_id) {
-        send_goal(b); /* the board has not got the current goal yet */
+    if ((b->goal.goal_id != 0u || b->goal_cleared) && ls.goal_id != b->goal.goal_id) {
+        send_goal(b); /* the board has not got the current goal (or its clearing) yet */
     }
     memset(&q, 0, sizeof q);
     qnav_bridge_ctrl_step(&b->bc, &s, &c, q.quality_q15);
@@ -327,6 +326,87 @@ static void on_board_command(qnav_bridge_t *b, const qnav_link_frame_t *f)
     c.source = QNAV_SOURCE_BOARD;
     c.policy_crc = b->board_hb.policy_crc;
     PUBLISH(b, QNAV_CH_COMMAND, qnav_command_t, &c);
+}
+
+/* A board heartbeat: 1 when it is of our protocol version and taken. A board of another
+ * version is remembered in refused_protocol and not acted on. */
+static int on_board_heartbeat(qnav_bridge_t *b, const qnav_link_frame_t *f)
+{
+    qnav_link_heartbeat_t hb;
+    uint8_t stored;
+    if (qnav_link_heartbeat_unpack(f->payload, f->len, &hb) != QNAV_LINK_OK) {
+        return 0;
+    }
+    if (hb.protocol != QNAV_LINK_PROTOCOL_VERSION) {
+        b->refused_protocol = hb.protocol == 0u ? 0xFFu : hb.protocol;
+        return 0;
+    }
+    b->board_hb = hb;
+    stored = (uint8_t)((hb.state & QNAV_LINK_STATE_STORED) != 0u);
+    if (b->diag != NULL &&
+        (!b->heard_board || stored != b->board_stored || hb.policy_crc != b->board_crc_reported)) {
+        fprintf(b->diag, "navbridge: board speaks link protocol %u and runs its %s policy "
+                         "(crc 0x%04x)\n", (unsigned)hb.protocol,
+                stored ? "uploaded" : "built-in", hb.policy_crc);
+    }
+    b->heard_board = 1;
+    b->board_stored = stored;
+    b->board_crc_reported = hb.policy_crc;
+    return 1;
+}
+
+static void send_route_goal(qnav_bridge_t *b)
+{
+    memset(&b->goal, 0, sizeof b->goal);
+    b->goal_cleared = 0;
+    if (b->route_k < b->route_n) {
+        b->last_goal_id = (uint16_t)(b->last_goal_id == 65535u ? 1u : b->last_goal_id + 1u);
+        b->goal.goal_id = b->last_goal_id;
+        b->goal.kind = QNAV_LINK_GOAL_POSITION;
+        b->goal.x_mm = b->route_x_mm[b->route_k];
+        b->goal.y_mm = b->route_y_mm[b->route_k];
+    } else {
+        b->goal_cleared = 1; /* route done: no goal, the robot stops */
+    }
+    send_goal(b);
+}
+
+/* The board's pose: published, and the route advanced when the current waypoint is
+ * within the radius. */
+static void on_pose(qnav_bridge_t *b, const qnav_link_frame_t *f)
+{
+    qnav_link_pose_t lp;
+    qnav_odometry_t o;
+    if (qnav_link_pose_unpack(f->payload, f->len, &lp) != QNAV_LINK_OK) {
+        return;
+    }
+    if (b->route_n > 0 && b->route_k < b->route_n && lp.goal_id == b->goal.goal_id &&
+        b->goal.kind == QNAV_LINK_GOAL_POSITION) {
+        double dx = (double)b->route_x_mm[b->route_k] - (double)lp.x_mm;
+        double dy = (double)b->route_y_mm[b->route_k] - (double)lp.y_mm;
+        if (sqrt(dx * dx + dy * dy) <= (double)b->route_radius_mm) {
+            b->route_k++;
+            if (b->diag != NULL) {
+                fprintf(b->diag, "navbridge: waypoint %d/%d reached at %.3f:%.3f m%s\n",
+                        b->route_k, b->route_n, lp.x_mm / 1000.0, lp.y_mm / 1000.0,
+                        b->route_k == b->route_n ? ": route done, robot stopped" : "");
+            }
+            send_route_goal(b);
+        }
+    }
+    memset(&o, 0, sizeof o);
+    o.utime = qnav_bridge_utime();
+    o.board_ms = lp.board_ms;
+    o.x_mm = lp.x_mm;
+    o.y_mm = lp.y_mm;
+    o.heading_cdeg = lp.heading_cdeg;
+    o.goal_id = lp.goal_id;
+    o.goal_distance_mm = lp.goal_distance_mm > 0x7FFFFFFFu ? 0x7FFFFFFF
+                                                           : (int32_t)lp.goal_distance_mm;
+    o.route_id = b->route_id;
+    o.waypoint = (int16_t)b->route_k;
+    o.waypoints = (int16_t)b->route_n;
+    PUBLISH(b, QNAV_CH_ODOMETRY, qnav_odometry_t, &o);
 }
 
 static void on_ack(qnav_bridge_t *b, const qnav_link_frame_t *f)
@@ -401,8 +481,11 @@ void qnav_bridge_on_bytes(qnav_bridge_t *b, const uint8_t *bytes, size_t n, int6
         case QNAV_LINK_MSG_COMMAND:
             on_board_command(b, &f);
             break;
+        case QNAV_LINK_MSG_POSE:
+            on_pose(b, &f);
+            break;
         case QNAV_LINK_MSG_HEARTBEAT:
-            if (qnav_link_heartbeat_unpack(f.payload, f.len, &b->board_hb) == QNAV_LINK_OK) {
+            if (on_board_heartbeat(b, &f)) {
                 b->last_heartbeat_ms = now_ms;
                 if (b->cfg.mode == QNAV_LINK_MODE_ONBOARD && b->watchdog_stop) {
                     b->watchdog_stop = 0;
@@ -424,10 +507,93 @@ void qnav_bridge_on_bytes(qnav_bridge_t *b, const uint8_t *bytes, size_t n, int6
 void qnav_bridge_on_goal(qnav_bridge_t *b, const qnav_goal_t *goal, int64_t now_ms)
 {
     b->now_ms = now_ms;
+    b->route_n = b->route_k = 0; /* a bearing goal replaces any route */
+    b->route_id = 0;
+    memset(&b->goal, 0, sizeof b->goal);
+    b->goal_cleared = goal->goal_id == 0;
+    b->goal.kind = QNAV_LINK_GOAL_BEARING;
     b->goal.goal_id = (uint16_t)goal->goal_id;
+    if (goal->goal_id > 0) {
+        b->last_goal_id = (uint16_t)goal->goal_id;
+    }
     b->goal.bearing_cdeg = goal->bearing_cdeg;
     b->goal.distance_mm = goal->distance_mm < 0 ? 0u : (uint32_t)goal->distance_mm;
     send_goal(b);
+}
+
+int qnav_bridge_on_waypoints(qnav_bridge_t *b, const qnav_waypoints_t *w, int64_t now_ms,
+                             char *err, size_t errlen)
+{
+    int k;
+    if (w->n < 0 || w->n > QNAV_BRIDGE_MAX_WAYPOINTS) {
+        snprintf(err, errlen, "waypoints_t.n: %d: expected 0..%d", w->n,
+                 QNAV_BRIDGE_MAX_WAYPOINTS);
+        return -1;
+    }
+    if (w->n > 0 && !(w->radius_m > 0.0 && w->radius_m <= 1000.0)) {
+        snprintf(err, errlen, "waypoints_t.radius_m: %g: expected more than 0 and at most "
+                              "1000 m", w->radius_m);
+        return -1;
+    }
+    for (k = 0; k < w->n; ++k) {
+        if (!(fabs(w->x_m[k]) <= 2e6) || !(fabs(w->y_m[k]) <= 2e6)) {
+            snprintf(err, errlen, "waypoints_t.x_m/y_m[%d]: expected finite metres within "
+                                  "+-2000 km", k);
+            return -1;
+        }
+    }
+    b->now_ms = now_ms;
+    b->route_id = w->route_id;
+    b->route_n = w->n;
+    b->route_k = 0;
+    b->route_radius_mm = (int32_t)lround(w->radius_m * 1000.0);
+    for (k = 0; k < w->n; ++k) {
+        b->route_x_mm[k] = (int32_t)lround(w->x_m[k] * 1000.0);
+        b->route_y_mm[k] = (int32_t)lround(w->y_m[k] * 1000.0);
+    }
+    send_route_goal(b);
+    return 0;
+}
+
+static void on_lcm_goal(const lcm_recv_buf_t *rbuf, const char *channel,
+                        const qnav_goal_t *msg, void *user)
+{
+    (void)rbuf;
+    (void)channel;
+    qnav_bridge_on_goal((qnav_bridge_t *)user, msg, ((qnav_bridge_t *)user)->now_ms);
+}
+
+static void on_lcm_waypoints(const lcm_recv_buf_t *rbuf, const char *channel,
+                             const qnav_waypoints_t *msg, void *user)
+{
+    qnav_bridge_t *b = (qnav_bridge_t *)user;
+    char err[160];
+    (void)rbuf;
+    if (qnav_bridge_on_waypoints(b, msg, b->now_ms, err, sizeof err) != 0 && b->diag != NULL) {
+        fprintf(b->diag, "navbridge: %s: route refused: %s\n", channel, err);
+    } else if (b->diag != NULL) {
+        fprintf(b->diag, "navbridge: %s: route %d of %d waypoints\n", channel,
+                (int)msg->route_id, (int)msg->n);
+    }
+}
+
+void qnav_bridge_subscribe(qnav_bridge_t *b)
+{
+    if (b->lcm != NULL) {
+        b->goal_sub = qnav_goal_t_subscribe(b->lcm, QNAV_CH_GOAL, on_lcm_goal, b);
+        b->route_sub =
+            qnav_waypoints_t_subscribe(b->lcm, QNAV_CH_WAYPOINTS, on_lcm_waypoints, b);
+    }
+}
+
+void qnav_bridge_unsubscribe(qnav_bridge_t *b)
+{
+    if (b->lcm != NULL && b->goal_sub != NULL) {
+        qnav_goal_t_unsubscribe(b->lcm, b->goal_sub);
+        qnav_waypoints_t_unsubscribe(b->lcm, b->route_sub);
+    }
+    b->goal_sub = NULL;
+    b->route_sub = NULL;
 }
 
 void qnav_bridge_poll(qnav_bridge_t *b, int64_t now_ms)

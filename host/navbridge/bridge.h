@@ -22,6 +22,7 @@
 #include "qnav_command_t.h"
 #include "qnav_goal_t.h"
 #include "qnav_scan_t.h"
+#include "qnav_waypoints_t.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -34,6 +35,11 @@ extern "C" {
 #define QNAV_CH_QUALITIES "QNAV_QUALITIES"
 #define QNAV_CH_POSE "QNAV_POSE"
 #define QNAV_CH_LINK_STATUS "QNAV_LINK_STATUS"
+#define QNAV_CH_WAYPOINTS "QNAV_WAYPOINTS"
+#define QNAV_CH_ODOMETRY "QNAV_ODOMETRY"
+
+/* Most waypoints in a route (waypoints_t). */
+#define QNAV_BRIDGE_MAX_WAYPOINTS 16
 
 /* command_t.stop_reason and .source values. */
 #define QNAV_STOP_NONE 0
@@ -112,12 +118,30 @@ typedef struct {
 
     qnav_link_heartbeat_t board_hb;   /* last heartbeat from the board */
     qnav_link_goal_t goal;            /* last goal relayed (goal_id 0 none) */
+    int goal_cleared;                 /* the goal was cleared (sent again until the board
+                                         reports no goal) */
+    uint16_t last_goal_id;            /* goal ids handed out so far (route goals) */
+    uint8_t refused_protocol;         /* a board of this other protocol version was heard
+                                         (0 none): the bridge must stop (main exits) */
+    int heard_board;                  /* a heartbeat of our version came */
+    uint8_t board_stored;             /* last reported QNAV_LINK_STATE_STORED bit */
+    uint16_t board_crc_reported;
+
+    /* the route (waypoints): goal k of n in the odometry frame, mm */
+    int32_t route_id;
+    int route_n, route_k;
+    int32_t route_x_mm[QNAV_BRIDGE_MAX_WAYPOINTS];
+    int32_t route_y_mm[QNAV_BRIDGE_MAX_WAYPOINTS];
+    int32_t route_radius_mm;
 
     /* policy upload (onboard) */
     qnav_bridge_upload_state_t upload_state;
     int upload_tries;
     int64_t upload_sent_ms;
     int8_t last_upload_status;    /* QNAV_LINK_ACK_* or QNAV_BRIDGE_UPLOAD_NONE_YET/_NO_ANSWER */
+
+    qnav_goal_t_subscription_t *goal_sub;         /* qnav_bridge_subscribe's */
+    qnav_waypoints_t_subscription_t *route_sub;
 
     uint64_t rx_bytes;
     FILE *diag;                   /* one-line notices (upload result, link lost), or NULL */
@@ -136,6 +160,18 @@ void qnav_bridge_on_bytes(qnav_bridge_t *b, const uint8_t *bytes, size_t n, int6
 /* A goal from LCM: relayed to the board and remembered (sent again after every board scan
  * that still reports another goal id). */
 void qnav_bridge_on_goal(qnav_bridge_t *b, const qnav_goal_t *goal, int64_t now_ms);
+
+/* A route from LCM (or the command line): the first waypoint becomes the board's goal at
+ * once; the bridge advances when the board's pose is within radius_m. Returns 0, or -1
+ * with "FIELD: problem" in err for a route it cannot take (n out of 0..16, radius <= 0,
+ * a point that is not finite or beyond +-2000 km); n = 0 clears the goal. */
+int qnav_bridge_on_waypoints(qnav_bridge_t *b, const qnav_waypoints_t *w, int64_t now_ms,
+                             char *err, size_t errlen);
+
+/* Subscribe b to QNAV_GOAL and QNAV_WAYPOINTS on its LCM (a refused route is reported
+ * on b->diag). */
+void qnav_bridge_subscribe(qnav_bridge_t *b);
+void qnav_bridge_unsubscribe(qnav_bridge_t *b);
 
 /* Periodic work (call at least every 20 ms): heartbeats, watchdog, status, upload. */
 void qnav_bridge_poll(qnav_bridge_t *b, int64_t now_ms);

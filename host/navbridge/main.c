@@ -4,13 +4,15 @@
  * commands back; onboard mode relays goals and telemetry and can upload a policy file to
  * the board. Everything is published on LCM. When the board goes quiet for --timeout-ms
  * it commands a stop; SIGINT/SIGTERM/SIGHUP stop the robot before exiting (status 0); a port that
- * hangs up ends it with status 1 (link lost). --replay re-runs a
+ * hangs up ends it with status 1 (link lost), and so does a board of another link
+ * protocol version (one line saying which). --replay re-runs a
  * recorded trial's scans through the controller and checks the commands are identical.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
+#include <math.h>
 #include <poll.h>
 #include <signal.h>
 #include <stdio.h>
@@ -49,7 +51,8 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: navbridge --device PATH [--baud N] [--lcm-url URL] [--mode offboard|onboard]\n"
             "                 [--policy FILE] [--upload] [--timeout-ms N] [--log FILE]\n"
-            "                 [--goal DEG[:METRES]]\n"
+            "                 [--goal DEG[:METRES] | --goal-at X:Y | --waypoints X:Y,...]\n"
+            "                 [--goal-radius M]\n"
             "       navbridge --replay LOG [--policy FILE]\n"
             "  --device PATH      serial port to the board (or the SIL robot's pty)\n"
             "  --baud N           serial rate, default 57600\n"
@@ -62,6 +65,11 @@ static void usage(FILE *f)
             "  --goal DEG[:M]     start with a goal: bearing in the board's heading frame,\n"
             "                     degrees CCW, optional distance in metres (QNAV_GOAL later\n"
             "                     messages replace it)\n"
+            "  --goal-at X:Y      start with a position goal: metres in the board's odometry\n"
+            "                     frame (origin and x axis = its pose at start-up)\n"
+            "  --waypoints X:Y,.. start with a route of up to 16 such points (QNAV_WAYPOINTS\n"
+            "                     messages replace it); the next is sent when the board's\n"
+            "                     pose is within --goal-radius M (0.3) of the current one\n"
             "  --replay LOG       re-run LOG's scans, compare with its commands, exit\n"
             "  --help, --version  this text; the version\n");
 }
@@ -80,12 +88,37 @@ static int parse_long(const char *s, long lo, long hi, long *out)
     return 0;
 }
 
-static void on_goal(const lcm_recv_buf_t *rbuf, const char *channel, const qnav_goal_t *msg,
-                    void *user)
+/* --waypoints X:Y[,X:Y...] (metres) into w; 0 or -1. */
+static int parse_route(const char *s, qnav_waypoints_t *w)
 {
-    (void)rbuf;
-    (void)channel;
-    qnav_bridge_on_goal((qnav_bridge_t *)user, msg, mono_ms());
+    const char *p = s;
+    memset(w, 0, sizeof *w);
+    for (;;) {
+        char *end = NULL;
+        double x, y;
+        if (w->n >= QNAV_BRIDGE_MAX_WAYPOINTS) {
+            return -1;
+        }
+        x = strtod(p, &end);
+        if (end == p || *end != ':') {
+            return -1;
+        }
+        p = end + 1;
+        y = strtod(p, &end);
+        if (end == p || !(fabs(x) <= 2e6) || !(fabs(y) <= 2e6)) {
+            return -1;
+        }
+        w->x_m[w->n] = x;
+        w->y_m[w->n] = y;
+        w->n++;
+        if (*end == '\0') {
+            return 0;
+        }
+        if (*end != ',') {
+            return -1;
+        }
+        p = end + 1;
+    }
 }
 
 static int write_serial(void *user, const uint8_t *bytes, size_t n)
@@ -102,18 +135,21 @@ int main(int argc, char **argv)
         {"timeout-ms", required_argument, NULL, 't'}, {"log", required_argument, NULL, 'l'},
         {"replay", required_argument, NULL, 'r'},  {"help", no_argument, NULL, 'h'},
         {"goal", required_argument, NULL, 'g'},    {"version", no_argument, NULL, 'V'},
+        {"goal-at", required_argument, NULL, 'A'}, {"waypoints", required_argument, NULL, 'W'},
+        {"goal-radius", required_argument, NULL, 'G'},
         {NULL, 0, NULL, 0}};
     const char *device = NULL, *lcm_url = NULL, *policy_path = NULL, *log_path = NULL;
     const char *replay_path = NULL;
     long baud = 57600, timeout_ms = 300;
-    int have_goal = 0;
+    int have_goal = 0, have_route = 0;
+    double goal_radius = 0.3;
+    qnav_waypoints_t route;
     qnav_goal_t start_goal;
     char err[QNAV_POLICY_IO_ERRLEN];
     qnav_bridge_config_t cfg;
     static qnav_bridge_t bridge;
     lcm_t *lcm;
     lcm_eventlog_t *log = NULL;
-    qnav_goal_t_subscription_t *sub;
     int fd, c, exit_code = 0, hung_up = 0;
     struct sigaction sa;
 
@@ -171,6 +207,26 @@ int main(int argc, char **argv)
             start_goal.bearing_cdeg = (int16_t)(deg >= 180.0 ? -18000 : (int)(deg * 100.0));
             start_goal.distance_mm = (int32_t)(dist * 1000.0);
             have_goal = 1;
+            break;
+        }
+        case 'A':
+        case 'W':
+            if (parse_route(optarg, &route) != 0 || (c == 'A' && route.n != 1)) {
+                fprintf(stderr, "navbridge: --%s %s: expected %s in metres in the odometry "
+                                "frame, within +-2000 km\n", c == 'A' ? "goal-at" : "waypoints",
+                        optarg, c == 'A' ? "X:Y" : "X:Y[,X:Y...] (at most 16)");
+                return 2;
+            }
+            have_route = 1;
+            break;
+        case 'G': {
+            char *end = NULL;
+            goal_radius = strtod(optarg, &end);
+            if (end == optarg || *end != '\0' || !(goal_radius > 0.0 && goal_radius <= 1000.0)) {
+                fprintf(stderr, "navbridge: --goal-radius %s: expected metres in (0, 1000]\n",
+                        optarg);
+                return 2;
+            }
             break;
         }
         case 'h': usage(stdout); return 0;
@@ -262,10 +318,16 @@ int main(int argc, char **argv)
 
     qnav_bridge_init(&bridge, &cfg, lcm, log, write_serial, &fd, mono_ms());
     bridge.diag = stderr;
-    sub = qnav_goal_t_subscribe(lcm, QNAV_CH_GOAL, on_goal, &bridge);
+    qnav_bridge_subscribe(&bridge);
     if (have_goal) {
         start_goal.utime = qnav_bridge_utime();
         qnav_bridge_on_goal(&bridge, &start_goal, mono_ms());
+    }
+    if (have_route) {
+        route.utime = qnav_bridge_utime();
+        route.route_id = 1;
+        route.radius_m = goal_radius;
+        (void)qnav_bridge_on_waypoints(&bridge, &route, mono_ms(), err, sizeof err);
     }
     fprintf(stderr, "navbridge: %s mode on %s at %ld baud, watchdog %ld ms\n",
             cfg.mode == QNAV_LINK_MODE_OFFBOARD ? "offboard" : "onboard", device, baud,
@@ -303,7 +365,16 @@ int main(int argc, char **argv)
             }
         }
         if (n > 0 && (p[1].revents & POLLIN)) {
+            bridge.now_ms = mono_ms();
             lcm_handle_timeout(lcm, 0);
+        }
+        if (bridge.refused_protocol != 0) {
+            fprintf(stderr, "navbridge: %s: the board speaks link protocol %u, this navbridge "
+                            "speaks %u: flash firmware of this release or run the navbridge of "
+                            "the board's (docs/hil.md, \"Versions\")\n", device,
+                    (unsigned)bridge.refused_protocol, (unsigned)QNAV_LINK_PROTOCOL_VERSION);
+            exit_code = 1; /* docs/cli.md: a failure at run time */
+            break;
         }
         qnav_bridge_poll(&bridge, mono_ms());
     }
@@ -316,7 +387,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "navbridge: %s: robot stopped, exiting\n",
                 g_stop_signal == SIGINT ? "SIGINT" : g_stop_signal == SIGHUP ? "SIGHUP" : "SIGTERM");
     }
-    qnav_goal_t_unsubscribe(lcm, sub);
+    qnav_bridge_unsubscribe(&bridge);
     if (log != NULL) {
         lcm_eventlog_destroy(log);
     }

@@ -1,11 +1,13 @@
 /*
- * qnav-sil-robot: software in the loop. The Box2D simulator plays the robot board on a
- * pseudo-terminal, speaking the same serial link as the TekBot firmware, so that
- * simulator -> link -> navbridge -> LCM runs on one machine without hardware. Each 0.1 s
- * tick it sends the simulated scan (and the destination bearing), takes navbridge's
- * command for that scan (offboard) or runs libqnav itself (onboard, accepting policy
- * uploads), and advances the simulation. With --lockstep it waits for each reply instead
- * of the wall clock, so a trial runs as fast as the bridge answers and is repeatable.
+ * qnav-sil-robot: software in the loop. The board core (firmware/boards/core, the code the
+ * TekBot runs) plays the robot board on a pseudo-terminal with the Box2D simulator as its
+ * hardware (sil_hal.c), so that simulator -> board core -> link -> navbridge -> LCM runs
+ * on one machine without hardware. Each 0.1 s simulated tick the core senses, decides
+ * (onboard) or applies navbridge's last command (offboard), drives and reports, then the
+ * simulation advances. With --lockstep it waits for navbridge's answer to each scan
+ * instead of the wall clock, so a trial runs as fast as the bridge answers and is
+ * repeatable. --playback LOG replays a recorded scan stream (e.g. the simavr board's)
+ * into the same core instead of the simulator. --nvm FILE is the board's EEPROM.
  */
 #define _XOPEN_SOURCE 700
 #define _DEFAULT_SOURCE
@@ -13,7 +15,6 @@
 #include <fcntl.h>
 #include <getopt.h>
 #include <math.h>
-#include <poll.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,13 +25,13 @@
 
 #include <lcm/lcm.h>
 
-#include "qnav/ctrl.h"
-#include "qnav/link.h"
-#include "qnav/sim.h"
 #include "ptylink.h"
+#include "qnav/board.h"
 #include "qnav/cli.h"
+#include "qnav/sim.h"
+#include "qnav/tekbot.h"
 #include "qnav_pose_t.h"
-#include "serial.h"
+#include "sil_hal.h"
 
 static volatile sig_atomic_t g_quit = 0;
 
@@ -54,131 +55,38 @@ static int64_t utime_now(void)
 }
 
 typedef struct {
-    int fd;                       /* pty master */
-    qnav_link_rx_t rx;
-    qnav_link_tx_t tx;
-    qnav_link_upload_t upload;
-    uint8_t mode;                 /* bridge's requested mode (0 until heard) */
-    int stop_held;                /* bridge holds a stop */
-    int64_t last_rx_ms;
-    int have_cmd;
-    qnav_link_command_t cmd;      /* newest command from the bridge */
-    qnav_ctrl_t ctrl;             /* onboard controller */
-    qnav_ctrl_config_t ccfg;
-    qnav_policy_t policy;
-    uint16_t policy_crc;
-} robot_t;
-
-static void send_frame(robot_t *r, uint8_t id, const uint8_t *p, int32_t len)
-{
-    uint8_t wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
-    int32_t n;
-    if (len < 0) {
-        return;
-    }
-    n = qnav_link_encode(&r->tx, id, p, (uint16_t)len, wire, sizeof wire);
-    if (n > 0) {
-        /* a port nobody reads drops the frame, like a UART with no listener */
-        (void)qnav_serial_write_all(r->fd, wire, (size_t)n);
-    }
-}
-
-static uint16_t blob_crc(const qnav_policy_t *p)
-{
-    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
-    int32_t n = qnav_link_policy_to_blob(p, blob, sizeof blob);
-    return n > 0 ? qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) : 0u;
-}
-
-static void on_frame(robot_t *r, const qnav_link_frame_t *f)
-{
-    r->last_rx_ms = mono_ms();
-    if (f->msg_id == QNAV_LINK_MSG_HEARTBEAT) {
-        qnav_link_heartbeat_t hb;
-        if (qnav_link_heartbeat_unpack(f->payload, f->len, &hb) == QNAV_LINK_OK) {
-            if (hb.mode == QNAV_LINK_MODE_OFFBOARD || hb.mode == QNAV_LINK_MODE_ONBOARD) {
-                r->mode = hb.mode;
-            }
-            r->stop_held = (hb.state & QNAV_LINK_STATE_STOPPED) != 0;
-        }
-    } else if (f->msg_id == QNAV_LINK_MSG_COMMAND) {
-        qnav_link_command_t c;
-        if (qnav_link_command_unpack(f->payload, f->len, &c) == QNAV_LINK_OK) {
-            r->cmd = c;
-            r->have_cmd = 1;
-            if (c.flags & QNAV_LINK_CMD_STOP) {
-                r->stop_held = 1;
-            } else if (r->mode == QNAV_LINK_MODE_OFFBOARD) {
-                r->stop_held = 0;
-            }
-        }
-    } else if (f->msg_id == QNAV_LINK_MSG_POLICY_CHUNK) {
-        qnav_link_policy_chunk_t c;
-        if (qnav_link_policy_chunk_unpack(f->payload, f->len, &c) == QNAV_LINK_OK) {
-            (void)qnav_link_upload_chunk(&r->upload, &c);
-        }
-    } else if (f->msg_id == QNAV_LINK_MSG_POLICY_COMMIT) {
-        qnav_link_policy_commit_t cm;
-        qnav_link_policy_ack_t ack;
-        qnav_policy_t fresh;
-        uint8_t p[QNAV_LINK_POLICY_ACK_BYTES];
-        if (qnav_link_policy_commit_unpack(f->payload, f->len, &cm) != QNAV_LINK_OK) {
-            return;
-        }
-        ack.status = qnav_link_upload_commit(&r->upload, &cm, &fresh);
-        if (ack.status == QNAV_LINK_ACK_OK) {
-            if (qnav_ctrl_init(&r->ctrl, &r->ccfg, &fresh) == QNAV_OK) {
-                r->policy = fresh;
-                r->policy_crc = cm.crc;
-                fprintf(stderr, "qnav-sil-robot: policy uploaded (crc 0x%04x)\n", cm.crc);
-            } else {
-                (void)qnav_ctrl_init(&r->ctrl, &r->ccfg, &r->policy);
-                ack.status = QNAV_LINK_ACK_REJECTED;
-            }
-        }
-        ack.reserved = 0;
-        ack.crc = r->policy_crc;
-        send_frame(r, QNAV_LINK_MSG_POLICY_ACK, p, qnav_link_policy_ack_pack(&ack, p, sizeof p));
-    }
-}
-
-/* Read whatever the bridge sent, waiting up to wait_ms for the first byte. */
-static void pump(robot_t *r, int wait_ms)
-{
-    struct pollfd p = {r->fd, POLLIN, 0};
-    uint8_t buf[512];
-    ssize_t n;
-    qnav_link_frame_t f;
-    if (poll(&p, 1, wait_ms) <= 0 || !(p.revents & POLLIN)) {
-        return;
-    }
-    while ((n = read(r->fd, buf, sizeof buf)) > 0) {
-        for (ssize_t i = 0; i < n; ++i) {
-            if (qnav_link_rx_feed(&r->rx, buf[i], &f)) {
-                on_frame(r, &f);
-            }
-        }
-    }
-}
+    const char *robot, *env, *link, *lcm_url, *nvm, *playback;
+    double sectors, seed, episode, noise, reply_ms, wait_s, tick_ms;
+    int lockstep, pose, have_start;
+    double start_x, start_y, start_deg;
+} options_t;
 
 static void usage(FILE *f)
 {
     fprintf(f,
             "usage: qnav-sil-robot [--robot NAME|FILE] [--env NAME|FILE] [--sectors N]\n"
             "                      [--seed N] [--episode N] [--noise P] [--link PATH]\n"
+            "                      [--start X:Y:DEG] [--nvm FILE] [--playback LOG]\n"
             "                      [--lockstep | --tick-ms N] [--reply-ms N] [--wait-s N]\n"
             "                      [--lcm-url URL | --pose]\n"
             "  --robot, --env   simulator robot profile and environment (tekbot, open)\n"
             "  --sectors N      sonar sectors (0 = the profile's default)\n"
             "  --seed, --episode  simulator seed and episode seed (1, 1)\n"
-            "  --noise P        sensor and actuation noise level p (0)\n"
+            "  --noise P        sensor, actuation and wheel-slip (odometry) noise level p (0)\n"
             "  --link PATH      also make PATH a symlink to the pty (for navbridge --device)\n"
+            "  --start X:Y:DEG  start pose in the world frame (m, m, deg CCW from +x) instead\n"
+            "                   of a random one from the environment's start zones\n"
+            "  --nvm FILE       the board's non-volatile storage (made erased if absent);\n"
+            "                   default: RAM only\n"
+            "  --playback LOG   feed the QNAV_SCAN stream of an LCM log to the board core\n"
+            "                   (TekBot configuration) instead of the simulator\n"
             "  --lockstep       wait for each reply instead of the 0.1 s wall clock\n"
             "  --tick-ms N      wall-clock period of a 0.1 s simulated tick (100; smaller\n"
             "                   runs faster than real time)\n"
             "  --reply-ms N     longest wait for the bridge's command each tick (300)\n"
             "  --wait-s N       how long to wait for navbridge to appear (30)\n"
-            "  --pose           publish QNAV_POSE on LCM's default bus; --lcm-url on URL\n"
+            "  --pose           publish the true QNAV_POSE on LCM's default bus; --lcm-url on\n"
+            "                   URL\n"
             "  --help, --version  this text; the version\n");
 }
 
@@ -197,7 +105,21 @@ static int parse_num(const char *opt, const char *s, double lo, double hi, doubl
     return 0;
 }
 
-int main(int argc, char **argv)
+static int parse_start(const char *s, options_t *o)
+{
+    char tail;
+    if (sscanf(s, "%lf:%lf:%lf%c", &o->start_x, &o->start_y, &o->start_deg, &tail) != 3 ||
+        !isfinite(o->start_x) || !isfinite(o->start_y) || !isfinite(o->start_deg)) {
+        fprintf(stderr, "qnav-sil-robot: --start %s: expected X:Y:DEG (metres, metres, "
+                        "degrees)\n", s);
+        return -1;
+    }
+    o->have_start = 1;
+    return 0;
+}
+
+/* Options into o; 0 to run, 1 when --help/--version printed, 2 on bad usage. */
+static int parse_options(int argc, char **argv, options_t *o)
 {
     static const struct option opts[] = {
         {"robot", required_argument, NULL, 'r'},   {"env", required_argument, NULL, 'e'},
@@ -206,48 +128,39 @@ int main(int argc, char **argv)
         {"link", required_argument, NULL, 'l'},    {"lockstep", no_argument, NULL, 'L'},
         {"reply-ms", required_argument, NULL, 'R'}, {"wait-s", required_argument, NULL, 'w'},
         {"lcm-url", required_argument, NULL, 'u'}, {"pose", no_argument, NULL, 'P'},
-        {"tick-ms", required_argument, NULL, 'T'},
+        {"tick-ms", required_argument, NULL, 'T'}, {"nvm", required_argument, NULL, 'N'},
+        {"playback", required_argument, NULL, 'B'}, {"start", required_argument, NULL, 'S'},
         {"help", no_argument, NULL, 'h'},          {"version", no_argument, NULL, 'V'},
         {NULL, 0, NULL, 0}};
-    const char *robot_spec = "tekbot", *env_spec = "open", *link_path = NULL, *lcm_url = NULL;
-    double sectors = 0, seed = 1, episode = 1, noise = 0, reply_ms = 300, wait_s = 30;
-    double tick_ms = 100;
-    int lockstep = 0, pose = 0, c, rc = 0;
-    char err[QNAV_SIM_ERRLEN];
-    qnav_sim_robot_t *robot = NULL;
-    qnav_sim_env_t *env = NULL;
-    qnav_sim_t *sim = NULL;
-    qnav_sim_config_t scfg;
-    qnav_sim_state_t st;
-    qnav_sim_result_t res;
-    static qnav_sim_scan_t scan;
-    static robot_t r;
-    lcm_t *lcm = NULL;
-    int slave_keep, linked = 0;
-    char *slave = NULL;
-    struct termios tio;
-    struct sigaction sa;
-    uint32_t missed = 0;
-    int64_t t_start;
-
+    int c;
+    memset(o, 0, sizeof *o);
+    o->robot = "tekbot";
+    o->env = "open";
+    o->seed = o->episode = 1;
+    o->reply_ms = 300;
+    o->wait_s = 30;
+    o->tick_ms = 100;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
         switch (c) {
-        case 'r': robot_spec = optarg; break;
-        case 'e': env_spec = optarg; break;
-        case 'l': link_path = optarg; break;
-        case 'u': lcm_url = optarg; pose = 1; break;
-        case 'P': pose = 1; break;
-        case 'L': lockstep = 1; break;
-        case 'n': if (parse_num("sectors", optarg, 0, 360, &sectors)) return 2; break;
-        case 's': if (parse_num("seed", optarg, 0, 1e15, &seed)) return 2; break;
-        case 'E': if (parse_num("episode", optarg, 0, 1e15, &episode)) return 2; break;
-        case 'p': if (parse_num("noise", optarg, 0, 1, &noise)) return 2; break;
-        case 'R': if (parse_num("reply-ms", optarg, 1, 60000, &reply_ms)) return 2; break;
-        case 'w': if (parse_num("wait-s", optarg, 0, 3600, &wait_s)) return 2; break;
-        case 'T': if (parse_num("tick-ms", optarg, 1, 10000, &tick_ms)) return 2; break;
-        case 'h': usage(stdout); return 0;
-        case 'V': fputs(QNAV_CLI_VERSION_LINE("qnav-sil-robot"), stdout); return 0;
+        case 'r': o->robot = optarg; break;
+        case 'e': o->env = optarg; break;
+        case 'l': o->link = optarg; break;
+        case 'u': o->lcm_url = optarg; o->pose = 1; break;
+        case 'P': o->pose = 1; break;
+        case 'L': o->lockstep = 1; break;
+        case 'N': o->nvm = optarg; break;
+        case 'B': o->playback = optarg; break;
+        case 'S': if (parse_start(optarg, o)) return 2; break;
+        case 'n': if (parse_num("sectors", optarg, 0, 360, &o->sectors)) return 2; break;
+        case 's': if (parse_num("seed", optarg, 0, 1e15, &o->seed)) return 2; break;
+        case 'E': if (parse_num("episode", optarg, 0, 1e15, &o->episode)) return 2; break;
+        case 'p': if (parse_num("noise", optarg, 0, 1, &o->noise)) return 2; break;
+        case 'R': if (parse_num("reply-ms", optarg, 1, 60000, &o->reply_ms)) return 2; break;
+        case 'w': if (parse_num("wait-s", optarg, 0, 3600, &o->wait_s)) return 2; break;
+        case 'T': if (parse_num("tick-ms", optarg, 1, 10000, &o->tick_ms)) return 2; break;
+        case 'h': usage(stdout); return 1;
+        case 'V': fputs(QNAV_CLI_VERSION_LINE("qnav-sil-robot"), stdout); return 1;
         default:
             fprintf(stderr, "qnav-sil-robot: %s: unknown option or missing value (see --help)\n",
                     argv[optind - 1]);
@@ -258,205 +171,322 @@ int main(int argc, char **argv)
         fprintf(stderr, "qnav-sil-robot: %s: unexpected argument (see --help)\n", argv[optind]);
         return 2;
     }
-    if (qnav_sim_robot_load(robot_spec, &robot, err, sizeof err) != QNAV_SIM_OK ||
-        qnav_sim_env_load(env_spec, &env, err, sizeof err) != QNAV_SIM_OK) {
-        fprintf(stderr, "%s\n", err);
-        qnav_sim_robot_free(robot);
-        return 2;
-    }
-    qnav_sim_config_default(&scfg);
-    scfg.n_sectors = (uint16_t)sectors;
-    scfg.sensor_noise = noise;
-    scfg.actuation_noise = noise;
-    scfg.seed = (uint64_t)seed;
-    if (qnav_sim_create(robot, env, &scfg, &sim, err, sizeof err) != QNAV_SIM_OK) {
-        fprintf(stderr, "qnav-sil-robot: %s\n", err);
-        rc = 2;
-        goto out;
-    }
+    return 0;
+}
 
-    /* the pty: raw from the start; the slave stays open so the master never sees EIO
-     * while navbridge is not (yet) attached */
-    r.fd = posix_openpt(O_RDWR | O_NOCTTY);
-    if (r.fd < 0 || grantpt(r.fd) != 0 || unlockpt(r.fd) != 0 ||
-        (slave = ptsname(r.fd)) == NULL) {
+/* The board configuration: the TekBot's, with the simulated robot's sonar and body. */
+static void board_config(qnav_sim_t *sim, const sil_hal_t *hal, qnav_board_config_t *bc)
+{
+    qnav_ctrl_config_t cc;
+    qnav_tekbot_config_default(bc);
+    if (sim == NULL) {
+        bc->n_sectors = hal->playback[0].n_sectors;
+        bc->max_range_mm = hal->playback[0].max_range_mm;
+        return;
+    }
+    qnav_sim_ctrl_config(sim, &cc);
+    bc->n_sectors = cc.n_sectors;
+    bc->max_range_mm = cc.max_range_mm;
+    bc->body_radius_mm = cc.body_radius_mm;
+    bc->safety_mm = cc.safety_mm;
+    bc->sonar_offset_mm = cc.sensor_offset_mm;
+    bc->v_max_mm_s = cc.v_max_mm_s;
+    bc->decel_mm_s2 = cc.decel_mm_s2;
+}
+
+/* The pty, raw from the start; the slave stays open so the master never sees EIO while
+ * navbridge is not (yet) attached. Returns the master or -1; *slave its name. */
+static int open_pty(char **slave)
+{
+    struct termios tio;
+    int slave_keep;
+    int fd = posix_openpt(O_RDWR | O_NOCTTY);
+    if (fd < 0 || grantpt(fd) != 0 || unlockpt(fd) != 0 || (*slave = ptsname(fd)) == NULL) {
         fprintf(stderr, "qnav-sil-robot: cannot create a pseudo-terminal: %s\n",
                 strerror(errno));
-        rc = 2;
-        goto out;
+        return -1;
     }
-    slave_keep = open(slave, O_RDWR | O_NOCTTY);
+    slave_keep = open(*slave, O_RDWR | O_NOCTTY);
     if (slave_keep >= 0 && tcgetattr(slave_keep, &tio) == 0) {
         cfmakeraw(&tio);
         tcsetattr(slave_keep, TCSANOW, &tio);
     }
-    fcntl(r.fd, F_SETFL, fcntl(r.fd, F_GETFL) | O_NONBLOCK);
-    if (link_path != NULL) {
-        if (qnav_ptylink_make(link_path, slave, err, sizeof err) != 0) {
+    fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
+    return fd;
+}
+
+/* Receive for up to wait_ms, handing every byte to the board core. */
+static void pump(qnav_board_t *bot, sil_hal_t *hal, int wait_ms)
+{
+    int64_t until = mono_ms() + wait_ms;
+    do {
+        (void)sil_hal_wait_rx(hal, (int)(until - mono_ms()));
+        qnav_board_receive(bot);
+    } while (!g_quit && mono_ms() < until);
+}
+
+static void publish_true_pose(lcm_t *lcm, qnav_sim_t *sim)
+{
+    qnav_sim_state_t st;
+    qnav_pose_t ps;
+    qnav_sim_state(sim, &st);
+    memset(&ps, 0, sizeof ps);
+    ps.utime = utime_now();
+    ps.tick = (int32_t)st.tick;
+    ps.x_m = st.x_m;
+    ps.y_m = st.y_m;
+    ps.heading_deg = st.heading_rad * 180.0 / M_PI;
+    ps.speed_mps = st.speed_mps;
+    ps.goal_distance_m = st.goal_distance_m;
+    ps.recovering = st.recovering;
+    ps.collisions = (int32_t)st.collisions;
+    ps.reached = st.reached;
+    qnav_pose_t_publish(lcm, "QNAV_POSE", &ps);
+}
+
+typedef struct {
+    qnav_board_t bot;
+    sil_hal_t hal;
+    qnav_sim_t *sim;
+    lcm_t *lcm;
+    uint32_t missed;          /* offboard ticks whose scan got no answer within reply_ms */
+    uint32_t ticks;
+} robot_t;
+
+/* One simulated tick: the board core's tick, the wait for navbridge's answer (lockstep or
+ * paced), the simulator step with the core's drive. */
+static void run_tick(robot_t *r, const options_t *o)
+{
+    int64_t tick_start = mono_ms();
+    uint32_t cmds = qnav_board_stats(&r->bot)->commands;
+    uint16_t seq;
+    int answered = 0;
+    qnav_board_receive(&r->bot);
+    qnav_board_tick(&r->bot);
+    seq = qnav_board_stats(&r->bot)->last_scan_seq;
+    if (r->bot.mode == QNAV_LINK_MODE_OFFBOARD) {
+        /* the answer to this scan: the core drives with it from the next tick on */
+        while (!g_quit && mono_ms() - tick_start < (int64_t)o->reply_ms && !answered) {
+            pump(&r->bot, &r->hal, 5);
+            answered = qnav_board_stats(&r->bot)->commands != cmds &&
+                       qnav_board_stats(&r->bot)->last_command_seq == seq;
+        }
+        r->missed += !answered;
+    }
+    if (r->sim != NULL) {
+        qnav_ctrl_output_t out;
+        memset(&out, 0, sizeof out);
+        out.heading_deg = r->hal.drive_heading;
+        out.speed = r->hal.drive_speed;
+        qnav_sim_command(r->sim, &out);
+        qnav_sim_advance(r->sim);
+        if (r->lcm != NULL) {
+            publish_true_pose(r->lcm, r->sim);
+        }
+    } else {
+        r->hal.playback_i++;
+    }
+    r->ticks++;
+    if (!o->lockstep) {
+        int64_t left = tick_start + (int64_t)o->tick_ms - mono_ms();
+        if (left > 0) {
+            pump(&r->bot, &r->hal, (int)left);
+        }
+    }
+}
+
+/* Where the destination is for navbridge (--goal-at), in the odometry frame. */
+static void print_destination(robot_t *r, qnav_sim_env_t *env)
+{
+    qnav_sim_env_info_t ei;
+    double x, y;
+    if (r->sim == NULL) {
+        return;
+    }
+    qnav_sim_env_info(env, &ei);
+    sil_hal_world_to_odometry(&r->hal, ei.dest_x_m, ei.dest_y_m, &x, &y);
+    printf("qnav-sil-robot: destination at %.3f:%.3f m in the odometry frame (navbridge "
+           "--goal-at %.3f:%.3f)\n", x / 1000.0, y / 1000.0, x / 1000.0, y / 1000.0);
+}
+
+/* Simulator (or playback), board core and pty up; 0 or an exit status. */
+static int start(robot_t *r, const options_t *o, qnav_sim_robot_t **robot,
+                 qnav_sim_env_t **env, char **slave)
+{
+    char err[QNAV_SIM_ERRLEN];
+    qnav_sim_config_t scfg;
+    qnav_board_config_t bc;
+    qnav_board_hal_t hal;
+    if (o->playback != NULL) {
+        if (sil_hal_load_playback(&r->hal, o->playback, err, sizeof err) != 0) {
+            fprintf(stderr, "qnav-sil-robot: %s\n", err);
+            return 2;
+        }
+    } else {
+        if (qnav_sim_robot_load(o->robot, robot, err, sizeof err) != QNAV_SIM_OK ||
+            qnav_sim_env_load(o->env, env, err, sizeof err) != QNAV_SIM_OK) {
+            fprintf(stderr, "%s\n", err);
+            return 2;
+        }
+        qnav_sim_config_default(&scfg);
+        scfg.n_sectors = (uint16_t)o->sectors;
+        scfg.sensor_noise = o->noise;
+        scfg.actuation_noise = o->noise;
+        scfg.seed = (uint64_t)o->seed;
+        if (qnav_sim_create(*robot, *env, &scfg, &r->sim, err, sizeof err) != QNAV_SIM_OK ||
+            qnav_sim_reset(r->sim, (uint64_t)o->episode) != QNAV_SIM_OK ||
+            (o->have_start && qnav_sim_place(r->sim, o->start_x, o->start_y,
+                                             o->start_deg * M_PI / 180.0) != QNAV_SIM_OK)) {
+            fprintf(stderr, "qnav-sil-robot: %s\n",
+                    r->sim != NULL && o->have_start ? "--start: outside the arena" : err);
+            return 2;
+        }
+        qnav_sim_robot_info_t ri;
+        qnav_sim_robot_info(*robot, &ri);
+        r->hal.track_m = 2.0 * ri.radius_m;
+    }
+    r->hal.sim = r->sim;
+    r->hal.nvm_path = o->nvm;
+    r->hal.odo_noise = o->noise;
+    r->hal.rng = 0x9E3779B97F4A7C15ULL ^ (uint64_t)o->seed; /* never 0 for xorshift */
+    r->hal.fd = open_pty(slave);
+    if (r->hal.fd < 0) {
+        return 2;
+    }
+    board_config(r->sim, &r->hal, &bc);
+    r->hal.um_per_count = bc.um_per_count;
+    if (sil_hal_init(&r->hal, &hal, err, sizeof err) != 0) {
+        fprintf(stderr, "qnav-sil-robot: %s\n", err);
+        return 2;
+    }
+    sil_hal_start_odometry(&r->hal);
+    if (qnav_board_init(&r->bot, &bc, &hal) != QNAV_BOARD_OK) {
+        fprintf(stderr, "qnav-sil-robot: the board core refused its configuration\n");
+        return 2;
+    }
+    fprintf(stderr, "qnav-sil-robot: running the %s policy (crc 0x%04x)\n",
+            qnav_board_policy_source(&r->bot) == QNAV_BOARD_POLICY_STORED ? "stored"
+                                                                         : "built-in",
+            r->bot.policy_crc);
+    return 0;
+}
+
+/* Wait for navbridge: its heartbeats tell the mode. 0, or 1 (docs/cli.md: the trial
+ * failed) when none came or it speaks another protocol. */
+static int wait_bridge(robot_t *r, const options_t *o, const char *slave)
+{
+    int64_t t0 = mono_ms();
+    while (!g_quit && r->bot.mode == 0 && mono_ms() - t0 < (int64_t)(o->wait_s * 1000.0)) {
+        pump(&r->bot, &r->hal, 50);
+        if (qnav_board_stats(&r->bot)->peer_refused > 0u) {
+            fprintf(stderr, "qnav-sil-robot: navbridge on %s speaks link protocol %u, this "
+                            "board %u: not following it\n", slave,
+                    (unsigned)qnav_board_stats(&r->bot)->peer_protocol,
+                    (unsigned)QNAV_LINK_PROTOCOL_VERSION);
+            return 1;
+        }
+    }
+    if (r->bot.mode == 0) {
+        fprintf(stderr, "qnav-sil-robot: no navbridge heartbeat on %s within %g s\n", slave,
+                o->wait_s);
+        return 1;
+    }
+    return 0;
+}
+
+static int report(robot_t *r)
+{
+    qnav_sim_result_t res;
+    const qnav_board_pose_t *p = qnav_board_pose(&r->bot);
+    if (r->sim == NULL) {
+        printf("qnav-sil-robot: playback %s: %u scans, %u ticks without a command, %lu link "
+               "frames dropped\n", g_quit ? "interrupted" : "done", (unsigned)r->ticks,
+               (unsigned)r->missed, (unsigned long)qnav_link_rx_dropped_total(&r->bot.rx));
+        fflush(stdout);
+        return g_quit ? 1 : 0;
+    }
+    qnav_sim_state_t st;
+    double tx, ty;
+    qnav_sim_result(r->sim, &res);
+    qnav_sim_state(r->sim, &st);
+    sil_hal_world_to_odometry(&r->hal, st.x_m, st.y_m, &tx, &ty);
+    printf("qnav-sil-robot: %s: reached %s, %u ticks (%.1f s), %u collisions, "
+           "R = %.3f, %u ticks without a command, %lu link frames dropped, odometry "
+           "%.3f:%.3f m (true %.3f:%.3f m)\n",
+           g_quit ? "interrupted" : "episode done", res.reached ? "yes" : "no",
+           (unsigned)res.ticks, res.tau_l, (unsigned)res.collisions, res.R,
+           (unsigned)r->missed, (unsigned long)qnav_link_rx_dropped_total(&r->bot.rx),
+           p->x_um / 1e6, p->y_um / 1e6, tx / 1000.0, ty / 1000.0);
+    fflush(stdout);
+    return res.reached && !g_quit ? 0 : 1; /* docs/cli.md: 1 = the trial failed */
+}
+
+static int episode_over(robot_t *r)
+{
+    qnav_sim_state_t st;
+    if (r->sim == NULL) {
+        return r->hal.playback_i >= r->hal.playback_n;
+    }
+    qnav_sim_state(r->sim, &st);
+    return st.done;
+}
+
+int main(int argc, char **argv)
+{
+    options_t o;
+    static robot_t r;
+    qnav_sim_robot_t *robot = NULL;
+    qnav_sim_env_t *env = NULL;
+    char *slave = NULL;
+    char err[256];
+    struct sigaction sa;
+    int linked = 0;
+    int rc = parse_options(argc, argv, &o);
+    if (rc != 0) {
+        return rc == 1 ? 0 : rc;
+    }
+    rc = start(&r, &o, &robot, &env, &slave);
+    if (rc == 0 && o.link != NULL) {
+        if (qnav_ptylink_make(o.link, slave, err, sizeof err) != 0) {
             fprintf(stderr, "qnav-sil-robot: %s\n", err);
             rc = 2;
-            goto out;
-        }
-        linked = 1;
-    }
-    printf("qnav-sil-robot: link on %s%s%s\n", slave, link_path ? " = " : "",
-           link_path ? link_path : "");
-    fflush(stdout);
-    if (pose) {
-        lcm = lcm_create(lcm_url);
-        if (lcm == NULL) {
-            fprintf(stderr, "qnav-sil-robot: --lcm-url %s: cannot join the LCM bus\n",
-                    lcm_url ? lcm_url : "(default)");
-            rc = 2;
-            goto out;
-        }
-    }
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
-
-    qnav_link_rx_init(&r.rx);
-    qnav_link_tx_init(&r.tx);
-    qnav_link_upload_init(&r.upload);
-    qnav_sim_ctrl_config(sim, &r.ccfg);
-    qnav_policy_prob_default(&r.policy);
-    r.policy_crc = blob_crc(&r.policy);
-    (void)qnav_ctrl_init(&r.ctrl, &r.ccfg, &r.policy);
-
-    /* wait for navbridge: its heartbeats tell the mode */
-    t_start = mono_ms();
-    while (!g_quit && r.mode == 0 && mono_ms() - t_start < (int64_t)(wait_s * 1000.0)) {
-        pump(&r, 100);
-    }
-    if (r.mode == 0) {
-        fprintf(stderr, "qnav-sil-robot: no navbridge heartbeat on %s within %g s\n", slave,
-                wait_s);
-        rc = 1;
-        goto out;
-    }
-    qnav_sim_reset(sim, (uint64_t)episode);
-    for (;;) {
-        uint8_t p[QNAV_LINK_MAX_PAYLOAD];
-        qnav_link_scan_t ls;
-        qnav_link_heartbeat_t hb;
-        qnav_ctrl_output_t out;
-        int64_t tick_start = mono_ms();
-        uint16_t seq;
-        int moving;
-
-        qnav_sim_state(sim, &st);
-        if (st.done || g_quit) {
-            break;
-        }
-        qnav_sim_scan(sim, &scan);
-        memset(&ls, 0, sizeof ls);
-        ls.board_ms = (uint32_t)(st.tick * 100u);
-        ls.goal_bearing_cdeg = scan.goal_bearing_cdeg;
-        ls.max_range_mm = scan.max_range_mm;
-        ls.n_sectors = scan.n_sectors;
-        ls.goal_id = 1;
-        memcpy(ls.ranges_mm, scan.ranges_mm, scan.n_sectors * sizeof scan.ranges_mm[0]);
-        seq = r.tx.next_seq;
-        send_frame(&r, QNAV_LINK_MSG_SCAN, p, qnav_link_scan_pack(&ls, p, sizeof p));
-        /* heartbeat before any decision, so the bridge labels it with the current policy */
-        hb.uptime_ms = (uint32_t)(mono_ms() - t_start);
-        hb.mode = r.mode;
-        hb.state = (uint8_t)(QNAV_LINK_STATE_LINK_OK | QNAV_LINK_STATE_POLICY |
-                             (r.stop_held ? QNAV_LINK_STATE_STOPPED : QNAV_LINK_STATE_MOVING));
-        hb.rx_ok = (uint16_t)r.rx.stats.frames_ok;
-        hb.rx_dropped = (uint16_t)qnav_link_rx_dropped_total(&r.rx);
-        hb.policy_crc = r.policy_crc;
-        send_frame(&r, QNAV_LINK_MSG_HEARTBEAT, p, qnav_link_heartbeat_pack(&hb, p, sizeof p));
-
-        memset(&out, 0, sizeof out);
-        if (r.mode == QNAV_LINK_MODE_ONBOARD) {
-            qnav_ctrl_input_t in = {scan.ranges_mm, scan.goal_bearing_cdeg};
-            qnav_link_command_t tel;
-            qnav_ctrl_step(&r.ctrl, &in, &out, NULL);
-            /* like the board: hold still while stopped or when the bridge went quiet */
-            moving = !r.stop_held && mono_ms() - r.last_rx_ms <= 300;
-            tel.scan_seq = seq;
-            tel.heading_deg = out.heading_deg;
-            tel.speed = moving ? out.speed : 0;
-            tel.quality = out.quality;
-            tel.flags = (uint8_t)(out.flags | (moving ? 0u : QNAV_LINK_CMD_STOP));
-            tel.reserved = 0;
-            send_frame(&r, QNAV_LINK_MSG_COMMAND, p, qnav_link_command_pack(&tel, p, sizeof p));
-            pump(&r, 0);
         } else {
-            /* offboard: the command answering this scan, or a stop if it does not come */
-            int64_t until = tick_start + (int64_t)reply_ms;
-            r.have_cmd = 0;
-            while (!g_quit && !(r.have_cmd && r.cmd.scan_seq == seq &&
-                                !(r.cmd.flags & QNAV_LINK_CMD_STOP))) {
-                int64_t left = until - mono_ms();
-                if (left <= 0) {
-                    break;
-                }
-                if (r.have_cmd && (r.cmd.flags & QNAV_LINK_CMD_STOP)) {
-                    break;
-                }
-                r.have_cmd = 0;
-                pump(&r, (int)left);
-            }
-            moving = r.have_cmd && r.cmd.scan_seq == seq && !(r.cmd.flags & QNAV_LINK_CMD_STOP);
-            if (moving) {
-                out.heading_deg = r.cmd.heading_deg;
-                out.speed = r.cmd.speed;
-                out.quality = r.cmd.quality;
-            } else {
-                missed++;
-            }
-        }
-        if (!moving) {
-            out.speed = 0;
-            out.heading_deg = 0;
-        }
-        qnav_sim_command(sim, &out);
-        qnav_sim_advance(sim);
-
-        if (lcm != NULL) {
-            qnav_pose_t ps;
-            qnav_sim_state(sim, &st);
-            memset(&ps, 0, sizeof ps);
-            ps.utime = utime_now();
-            ps.tick = (int32_t)st.tick;
-            ps.x_m = st.x_m;
-            ps.y_m = st.y_m;
-            ps.heading_deg = st.heading_rad * 180.0 / M_PI;
-            ps.speed_mps = st.speed_mps;
-            ps.goal_distance_m = st.goal_distance_m;
-            ps.recovering = st.recovering;
-            ps.collisions = (int32_t)st.collisions;
-            ps.reached = st.reached;
-            qnav_pose_t_publish(lcm, "QNAV_POSE", &ps);
-        }
-        if (!lockstep) {
-            int64_t left = tick_start + (int64_t)tick_ms - mono_ms();
-            while (left > 0 && !g_quit) {
-                pump(&r, (int)left);
-                left = tick_start + (int64_t)tick_ms - mono_ms();
-            }
+            linked = 1;
         }
     }
-    qnav_sim_state(sim, &st);
-    qnav_sim_result(sim, &res);
-    printf("qnav-sil-robot: %s: reached %s, %u ticks (%.1f s), %u collisions, "
-           "R = %.3f, %u ticks without a command, %lu link frames dropped\n",
-           g_quit ? "interrupted" : "episode done", res.reached ? "yes" : "no",
-           (unsigned)res.ticks, res.tau_l, (unsigned)res.collisions, res.R, (unsigned)missed,
-           (unsigned long)qnav_link_rx_dropped_total(&r.rx));
-    fflush(stdout);
-    rc = res.reached && !g_quit ? 0 : 1; /* docs/cli.md: 1 = the trial failed */
-out:
+    if (rc == 0 && o.pose && o.playback == NULL) {
+        r.lcm = lcm_create(o.lcm_url);
+        if (r.lcm == NULL) {
+            fprintf(stderr, "qnav-sil-robot: --lcm-url %s: cannot join the LCM bus\n",
+                    o.lcm_url ? o.lcm_url : "(default)");
+            rc = 2;
+        }
+    }
+    if (rc == 0) {
+        print_destination(&r, env);
+        printf("qnav-sil-robot: link on %s%s%s\n", slave, o.link ? " = " : "",
+               o.link ? o.link : "");
+        fflush(stdout);
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = on_signal;
+        sigaction(SIGINT, &sa, NULL);
+        sigaction(SIGTERM, &sa, NULL);
+        rc = wait_bridge(&r, &o, slave);
+    }
+    if (rc == 0) {
+        while (!g_quit && !episode_over(&r)) {
+            run_tick(&r, &o);
+        }
+        rc = report(&r);
+    }
     if (linked) {
-        qnav_ptylink_remove(link_path, slave);
+        qnav_ptylink_remove(o.link, slave);
     }
-    if (lcm != NULL) {
-        lcm_destroy(lcm);
+    if (r.lcm != NULL) {
+        lcm_destroy(r.lcm);
     }
-    qnav_sim_destroy(sim);
+    sil_hal_free(&r.hal);
+    qnav_sim_destroy(r.sim);
     qnav_sim_env_free(env);
     qnav_sim_robot_free(robot);
     return rc;

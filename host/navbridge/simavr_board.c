@@ -4,7 +4,10 @@
  * simulation loop, so navbridge talks to the real board code without hardware. Sonar
  * voltages are fed into ADC0..7 from a slowly changing scene; the encoders stay still, so
  * the heading reads 0. Simulated time is held to the wall clock so the board's 10 Hz tick
- * and link timeout mean what they say.
+ * and link timeout mean what they say. --eeprom FILE is the MCU's EEPROM across runs
+ * (loaded at start, saved at exit: a run is a power cycle); --power-cut-after N stops the
+ * MCU dead once N bytes of its EEPROM have changed, as a power loss in the middle of a
+ * write would, and saves what had been written by then.
  */
 #define _XOPEN_SOURCE 700
 #define _DEFAULT_SOURCE
@@ -21,6 +24,7 @@
 #include <unistd.h>
 
 #include <simavr/avr_adc.h>
+#include <simavr/avr_eeprom.h>
 #include <simavr/avr_uart.h>
 #include <simavr/sim_avr.h>
 #include <simavr/sim_elf.h>
@@ -163,13 +167,105 @@ static uint32_t range_to_mv(uint32_t mm)
     return (uint32_t)((double)mm / 12.7 * (5000.0 / 1024.0));
 }
 
+#define EEPROM_BYTES 4096 /* ATmega128 */
+
+/* The first n bytes of the MCU's EEPROM into out. simavr 1.6's EEPROM ioctls return -1
+ * even when they succeed, so their result is not looked at: eeprom_load checks by
+ * reading back. */
+static int eeprom_read(avr_t *avr, uint8_t *out, uint32_t n)
+{
+    avr_eeprom_desc_t d;
+    d.ee = out;
+    d.offset = 0;
+    d.size = n;
+    (void)avr_ioctl(avr, AVR_IOCTL_EEPROM_GET, &d);
+    return 0;
+}
+
+/* Load FILE into the MCU's EEPROM (absent: left erased). 0, or -1 with a message. */
+static int eeprom_load(avr_t *avr, const char *path, uint8_t *image)
+{
+    avr_eeprom_desc_t d;
+    FILE *f = fopen(path, "rb");
+    size_t n;
+    memset(image, 0xFF, EEPROM_BYTES);
+    if (f == NULL) {
+        if (errno == ENOENT) {
+            f = NULL; /* a new EEPROM: erased; set below so that the check runs too */
+        } else {
+            fprintf(stderr, "qnav-simavr-board: --eeprom %s: %s\n", path, strerror(errno));
+            return -1;
+        }
+    }
+    if (f != NULL) {
+        n = fread(image, 1, EEPROM_BYTES, f);
+        if (n != EEPROM_BYTES || fgetc(f) != EOF) {
+            fclose(f);
+            fprintf(stderr, "qnav-simavr-board: --eeprom %s: not a %d-byte EEPROM image\n",
+                    path, EEPROM_BYTES);
+            return -1;
+        }
+        fclose(f);
+    }
+    d.ee = image;
+    d.offset = 0;
+    d.size = EEPROM_BYTES;
+    (void)avr_ioctl(avr, AVR_IOCTL_EEPROM_SET, &d);
+    {
+        static uint8_t back[EEPROM_BYTES];
+        memset(back, (int)(uint8_t)~image[0], sizeof back);
+        (void)eeprom_read(avr, back, EEPROM_BYTES);
+        if (memcmp(back, image, EEPROM_BYTES) != 0) {
+            fprintf(stderr, "qnav-simavr-board: --eeprom %s: simavr did not take the image\n",
+                    path);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static int eeprom_save(avr_t *avr, const char *path)
+{
+    static uint8_t ee[EEPROM_BYTES];
+    FILE *f = eeprom_read(avr, ee, EEPROM_BYTES) == 0 ? fopen(path, "wb") : NULL;
+    if (f == NULL || fwrite(ee, 1, EEPROM_BYTES, f) != EEPROM_BYTES || fclose(f) != 0) {
+        fprintf(stderr, "qnav-simavr-board: --eeprom %s: cannot save: %s\n", path,
+                strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+/* Bytes watched for a power cut: the board keeps its policy store at the start of the
+ * EEPROM (two slots of 8 + up to 132 bytes on the ATmega128). */
+#define WATCHED_BYTES 512
+
+/* Watched bytes of the EEPROM that differ from the image at start. */
+static long eeprom_changed(avr_t *avr, const uint8_t *start)
+{
+    uint8_t now[WATCHED_BYTES];
+    long n = 0;
+    int k;
+    if (eeprom_read(avr, now, WATCHED_BYTES) != 0) {
+        return 0;
+    }
+    for (k = 0; k < WATCHED_BYTES; ++k) {
+        n += now[k] != start[k];
+    }
+    return n;
+}
+
 int main(int argc, char **argv)
 {
     static const struct option opts[] = {
         {"elf", required_argument, NULL, 'e'},    {"link", required_argument, NULL, 'l'},
         {"seconds", required_argument, NULL, 's'}, {"help", no_argument, NULL, 'h'},
         {"baud", required_argument, NULL, 'b'},
-        {"version", no_argument, NULL, 'V'},       {NULL, 0, NULL, 0}};
+        {"version", no_argument, NULL, 'V'},       {"eeprom", required_argument, NULL, 'E'},
+        {"power-cut-after", required_argument, NULL, 'C'}, {NULL, 0, NULL, 0}};
+    const char *eeprom_path = NULL;
+    static uint8_t ee_start[EEPROM_BYTES];
+    long cut_after = 0, changed = 0;
     const char *elf = NULL, *link_path = NULL;
     double seconds = 0.0, baud = 57600.0;
     elf_firmware_t fw;
@@ -185,6 +281,17 @@ int main(int argc, char **argv)
     while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
         switch (c) {
         case 'e': elf = optarg; break;
+        case 'E': eeprom_path = optarg; break;
+        case 'C': {
+            char *end = NULL;
+            cut_after = strtol(optarg, &end, 10);
+            if (end == optarg || *end != '\0' || cut_after < 1 || cut_after > WATCHED_BYTES) {
+                fprintf(stderr, "qnav-simavr-board: --power-cut-after %s: expected a number "
+                                "of EEPROM bytes in 1..%d\n", optarg, WATCHED_BYTES);
+                return 2;
+            }
+            break;
+        }
         case 'l': link_path = optarg; break;
         case 's': {
             char *end = NULL;
@@ -207,12 +314,14 @@ int main(int argc, char **argv)
         }
         case 'h':
             printf("usage: qnav-simavr-board --elf tekbot.elf [--link PATH] [--seconds S]\n"
-                   "                         [--baud N]\n"
+                   "                         [--baud N] [--eeprom FILE [--power-cut-after N]]\n"
                    "  --elf FILE     the TekBot firmware image (tekbot-avr.elf)\n"
                    "  --link PATH    also make PATH a symlink to the board's pty\n"
                    "  --seconds S    stop after S simulated seconds (0: run until a signal)\n"
                    "  --baud N       the firmware's line rate: bytes reach USART0 no faster\n"
                    "                 (57600, the TekBot's)\n"
+                   "  --eeprom FILE  the EEPROM: loaded at start (absent: erased), saved at exit\n"
+                   "  --power-cut-after N  stop dead once N EEPROM bytes have changed\n"
                    "  --help, --version  this text; the version\n");
             return 0;
         case 'V': fputs(QNAV_CLI_VERSION_LINE("qnav-simavr-board"), stdout); return 0;
@@ -252,6 +361,15 @@ int main(int argc, char **argv)
     avr->vcc = 5000;
     avr->avcc = 5000;
     avr->aref = 5000;
+    if (cut_after > 0 && eeprom_path == NULL) {
+        fprintf(stderr, "qnav-simavr-board: --power-cut-after: needs --eeprom FILE\n");
+        return 2;
+    }
+    if (eeprom_path != NULL) {
+        if (eeprom_load(avr, eeprom_path, ee_start) != 0) {
+            return 2;
+        }
+    }
 
     if (uart_open(avr, &uart, fw.frequency, (uint32_t)baud) != 0) {
         fprintf(stderr, "qnav-simavr-board: cannot put USART0 on a pseudo-terminal: %s\n",
@@ -291,6 +409,15 @@ int main(int argc, char **argv)
         }
         for (k = 0; k < 2000 && state != cpu_Done && state != cpu_Crashed; ++k) {
             state = avr_run(avr);
+            /* a byte write takes tens of instructions: checking every 16 cuts within one */
+            if (cut_after > 0 && (k & 15) == 0 &&
+                (changed = eeprom_changed(avr, ee_start)) >= cut_after) {
+                break;
+            }
+        }
+        if (cut_after > 0 && changed >= cut_after) {
+            printf("qnav-simavr-board: power cut after %ld changed EEPROM bytes\n", changed);
+            break;
         }
         uart_service(&uart, avr->cycle);
         ahead = (int64_t)sim_us - (mono_us() - t0);
@@ -302,6 +429,9 @@ int main(int argc, char **argv)
            (double)avr->cycle / (double)fw.frequency,
            state == cpu_Crashed ? "crashed" : (g_quit ? "signal" : "done"));
     fflush(stdout);
+    if (eeprom_path != NULL && eeprom_save(avr, eeprom_path) != 0) {
+        state = cpu_Crashed;
+    }
     /* only the link made here is removed, and only if it is still ours */
     qnav_ptylink_remove(link_path, uart.name);
     return state == cpu_Crashed ? 1 : 0;

@@ -16,12 +16,14 @@
 #include "bridge.h"
 #include "qnav/link.h"
 #include "qnav/tekbot.h"
+#include "qnav_odometry_t.h"
+#include "qnav_waypoints_t.h"
 #include "sim_hal.h"
 
 typedef struct {
     sim_hal_t sim;
     qnav_board_hal_t hal;
-    qnav_tekbot_t bot;
+    qnav_board_t bot;
     qnav_link_tx_t btx;           /* the bridge's sender */
     qnav_link_rx_t brx;           /* the bridge's receiver */
     uint32_t read_upto;           /* bytes of from_board already decoded */
@@ -36,7 +38,7 @@ static bench_t g;
 
 static void bench_start(uint16_t sectors)
 {
-    qnav_tekbot_config_t cfg;
+    qnav_board_config_t cfg;
     uint16_t k;
     memset(&g, 0, sizeof g);
     sim_hal_init(&g.sim, &g.hal);
@@ -46,7 +48,7 @@ static void bench_start(uint16_t sectors)
     }
     qnav_tekbot_config_default(&cfg);
     cfg.n_sectors = sectors;
-    assert_int_equal(qnav_tekbot_init(&g.bot, &cfg, &g.hal), QNAV_TEKBOT_OK);
+    assert_int_equal(qnav_board_init(&g.bot, &cfg, &g.hal), QNAV_BOARD_OK);
     qnav_link_tx_init(&g.btx);
     qnav_link_rx_init(&g.brx);
 }
@@ -110,7 +112,7 @@ static void run_ms(uint32_t ms)
     uint32_t t;
     for (t = 0; t < ms; t += 10) {
         g.sim.now_ms += 10;
-        qnav_tekbot_poll(&g.bot);
+        qnav_board_poll(&g.bot);
         read_board();
     }
 }
@@ -134,16 +136,16 @@ static void test_mix_turns_counter_clockwise_with_the_right_wheel(void **state)
 {
     qnav_q1_15_t l, r;
     (void)state;
-    qnav_tekbot_mix(30, 20000, 60, &l, &r);
+    qnav_board_mix(30, 20000, 60, &l, &r);
     assert_true(r > l);
-    qnav_tekbot_mix(-30, 20000, 60, &l, &r);
+    qnav_board_mix(-30, 20000, 60, &l, &r);
     assert_true(l > r);
-    qnav_tekbot_mix(0, 20000, 60, &l, &r);
+    qnav_board_mix(0, 20000, 60, &l, &r);
     assert_int_equal(l, 20000);
     assert_int_equal(r, 20000);
-    qnav_tekbot_mix(120, 20000, 60, &l, &r); /* beyond spin: turn in place */
+    qnav_board_mix(120, 20000, 60, &l, &r); /* beyond spin: turn in place */
     assert_int_equal(l, -r);
-    qnav_tekbot_mix(45, 0, 60, &l, &r); /* no speed: no motion at all */
+    qnav_board_mix(45, 0, 60, &l, &r); /* no speed: no motion at all */
     assert_int_equal(l, 0);
     assert_int_equal(r, 0);
 }
@@ -276,28 +278,7 @@ static void test_corrupted_goal_is_not_acted_on(void **state)
 /* Upload a policy blob to the board in chunks, with the given CRC in the commit. */
 static void upload(const qnav_policy_t *pol, int break_crc)
 {
-    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES], p[QNAV_LINK_CHUNK_MAX_BYTES];
-    qnav_link_policy_chunk_t c;
-    qnav_link_policy_commit_t cm;
-    int32_t n = qnav_link_policy_to_blob(pol, blob, sizeof blob);
-    uint16_t off = 0;
-    assert_true(n > 0);
-    while (off < (uint16_t)n) {
-        uint16_t len = (uint16_t)((uint16_t)n - off);
-        if (len > QNAV_LINK_CHUNK_BYTES) {
-            len = QNAV_LINK_CHUNK_BYTES;
-        }
-        c.offset = off;
-        c.total = (uint16_t)n;
-        c.len = (uint8_t)len;
-        memcpy(c.data, &blob[off], len);
-        to_board(QNAV_LINK_MSG_POLICY_CHUNK, p, qnav_link_policy_chunk_pack(&c, p, sizeof p));
-        off = (uint16_t)(off + len);
-    }
-    cm.total = (uint16_t)n;
-    cm.crc = (uint16_t)(qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) ^
-                        (break_crc ? 0x0100u : 0u));
-    to_board(QNAV_LINK_MSG_POLICY_COMMIT, p, qnav_link_policy_commit_pack(&cm, p, sizeof p));
+    assert_int_equal(sim_hal_upload(&g.sim, &g.btx, pol, break_crc ? 0x0100u : 0u), 0);
 }
 
 static void test_uploaded_policy_is_used_and_a_bad_one_is_refused(void **state)
@@ -332,6 +313,76 @@ static void test_uploaded_policy_is_used_and_a_bad_one_is_refused(void **state)
     assert_int_equal(g.last_ack.crc, g.bot.policy_crc);
 }
 
+static void test_board_ignores_a_bridge_of_another_protocol_version(void **state)
+{
+    qnav_link_heartbeat_t hb = {0, QNAV_LINK_MODE_ONBOARD, 0, 0, 0, 0};
+    uint8_t p[QNAV_LINK_HEARTBEAT_BYTES];
+    uint32_t t;
+    (void)state;
+    bench_start(8);
+    goal(1, 0);
+    assert_int_equal(qnav_link_heartbeat_pack(&hb, p, sizeof p), QNAV_LINK_HEARTBEAT_BYTES);
+    p[12] = QNAV_LINK_PROTOCOL_VERSION + 1u;
+    for (t = 0; t < 1000; t += 100) {
+        to_board(QNAV_LINK_MSG_HEARTBEAT, p, QNAV_LINK_HEARTBEAT_BYTES);
+        run_ms(100);
+    }
+    assert_int_equal(g.bot.mode, 0);
+    assert_int_equal(g.bot.stats.peer_protocol, QNAV_LINK_PROTOCOL_VERSION + 1u);
+    assert_true(g.bot.stats.peer_refused >= 9u);
+    assert_false(moving());
+    assert_int_equal(g.telemetry, 0); /* no onboard decisions either */
+}
+
+static void test_pose_integrates_wheel_travel_along_the_heading(void **state)
+{
+    const qnav_board_pose_t *pose;
+    (void)state;
+    bench_start(8);
+    /* 1 m straight ahead (heading 0): 1000000 um / 6872 um per count = 145.5 counts */
+    g.sim.left_counts = 146;
+    g.sim.right_counts = 146;
+    qnav_board_tick(&g.bot);
+    pose = qnav_board_pose(&g.bot);
+    assert_int_equal(pose->x_um / 1000, 1003); /* 146 * 6.872 mm */
+    assert_int_equal(pose->y_um / 1000, 0);
+    /* turn to 90 deg on the spot (wheels opposite), then 1 m: along +y */
+    g.sim.left_counts -= 20;
+    g.sim.right_counts += 20;
+    g.sim.heading_cdeg = 9000;
+    qnav_board_tick(&g.bot);
+    g.sim.left_counts += 146;
+    g.sim.right_counts += 146;
+    qnav_board_tick(&g.bot);
+    assert_int_equal(pose->x_um / 1000, 1003);
+    assert_int_equal(pose->y_um / 1000, 1003);
+    assert_int_equal(pose->heading_cdeg, 9000);
+    /* backwards 0.5 m at 90 deg: y falls */
+    g.sim.left_counts -= 73;
+    g.sim.right_counts -= 73;
+    qnav_board_tick(&g.bot);
+    assert_int_equal(pose->y_um / 1000, 501);
+}
+
+static void test_position_goal_bearing_comes_from_the_pose(void **state)
+{
+    qnav_link_goal_t gl = {7, 0, 0, QNAV_LINK_GOAL_POSITION, 1000, 1000};
+    uint8_t p[QNAV_LINK_GOAL_BYTES];
+    (void)state;
+    bench_start(8);
+    to_board(QNAV_LINK_MSG_GOAL, p, qnav_link_goal_pack(&gl, p, sizeof p));
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    /* from the origin facing +x, (1 m, 1 m) is 45 deg to the left */
+    assert_int_equal(g.last_scan.goal_id, 7);
+    assert_int_equal(g.last_scan.goal_bearing_cdeg, 4500);
+    /* facing +y (90 deg) it is 45 deg to the right */
+    g.sim.heading_cdeg = 9000;
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    assert_int_equal(g.last_scan.goal_bearing_cdeg, -4500);
+}
+
 /* ---- the board against navbridge's core, in one process ---- */
 
 static int bridge_write(void *user, const uint8_t *bytes, size_t n)
@@ -346,7 +397,7 @@ static void run_with_bridge(qnav_bridge_t *b, uint32_t ms)
     uint32_t t;
     for (t = 0; t < ms; t += 10) {
         g.sim.now_ms += 10;
-        qnav_tekbot_poll(&g.bot);
+        qnav_board_poll(&g.bot);
         if (g.read_upto < g.sim.from_board_n) {
             qnav_bridge_on_bytes(b, &g.sim.from_board[g.read_upto],
                                  g.sim.from_board_n - g.read_upto, g.sim.now_ms);
@@ -384,8 +435,8 @@ static void test_board_and_bridge_drive_together_in_both_modes(void **state)
         /* the bridge shuts down: the board stops at once (stop command) */
         qnav_bridge_shutdown(&b, g.sim.now_ms);
         g.sim.now_ms += 10;
-        qnav_tekbot_poll(&g.bot);
-        qnav_tekbot_tick(&g.bot);
+        qnav_board_poll(&g.bot);
+        qnav_board_tick(&g.bot);
         assert_false(moving());
     }
     lcm_destroy(lcm);
@@ -397,6 +448,106 @@ static int discard_write(void *user, const uint8_t *bytes, size_t n)
     (void)bytes;
     (void)n;
     return 0;
+}
+
+static int g_odometry_seen, g_last_waypoint;
+
+static void on_odometry(const lcm_recv_buf_t *rbuf, const char *channel,
+                        const qnav_odometry_t *msg, void *user)
+{
+    (void)rbuf;
+    (void)channel;
+    (void)user;
+    g_odometry_seen++;
+    g_last_waypoint = msg->waypoint;
+}
+
+/* Drive the scripted robot's encoders by d counts along its heading. */
+static void roll(int32_t d)
+{
+    g.sim.left_counts += d;
+    g.sim.right_counts += d;
+}
+
+static void test_route_from_lcm_advances_within_the_radius_and_stops_at_its_end(void **state)
+{
+    static qnav_bridge_t b;
+    qnav_bridge_config_t cfg;
+    qnav_waypoints_t w;
+    qnav_odometry_t_subscription_t *sub;
+    lcm_t *lcm = lcm_create("memq://");
+    (void)state;
+    assert_non_null(lcm);
+    bench_start(8);
+    qnav_bridge_config_default(&cfg);
+    cfg.mode = QNAV_LINK_MODE_ONBOARD;
+    qnav_bridge_init(&b, &cfg, lcm, NULL, bridge_write, NULL, g.sim.now_ms);
+    qnav_bridge_subscribe(&b);
+    sub = qnav_odometry_t_subscribe(lcm, QNAV_CH_ODOMETRY, on_odometry, NULL);
+    memset(&w, 0, sizeof w);
+    w.route_id = 4;
+    w.n = 3;
+    w.x_m[0] = 1.0;
+    w.x_m[1] = 1.0;
+    w.y_m[1] = 1.0;
+    w.y_m[2] = 1.0;
+    w.radius_m = 0.2;
+    assert_int_equal(qnav_waypoints_t_publish(lcm, QNAV_CH_WAYPOINTS, &w), 0);
+    assert_true(lcm_handle_timeout(lcm, 100) > 0);
+    run_with_bridge(&b, 500);
+    assert_int_equal(g.bot.goal.kind, QNAV_LINK_GOAL_POSITION);
+    assert_int_equal(g.bot.goal.x_mm, 1000);
+    assert_int_equal(g.bot.goal.y_mm, 0);
+    assert_true(moving());
+    roll(100); /* 687 mm: not yet within 200 mm */
+    run_with_bridge(&b, 300);
+    assert_int_equal(g.bot.goal.x_mm, 1000);
+    assert_int_equal(g.bot.goal.y_mm, 0);
+    roll(46); /* 1003 mm */
+    run_with_bridge(&b, 300);
+    assert_int_equal(g.bot.goal.y_mm, 1000); /* waypoint 2: (1 m, 1 m) */
+    qnav_board_tick(&g.bot); /* this tick's scan read here, not by the bridge */
+    read_board();
+    assert_int_equal(g.last_scan.goal_bearing_cdeg, 9017); /* from (1003, 0) mm: atan2(1000, -3) */
+    g.sim.heading_cdeg = 9000; /* turn on the spot first (pose integrates mid-tick heading) */
+    run_with_bridge(&b, 100);
+    roll(146);
+    run_with_bridge(&b, 300);
+    assert_int_equal(g.bot.goal.x_mm, 0); /* waypoint 3: (0, 1 m) */
+    assert_int_equal(g.bot.goal.y_mm, 1000);
+    g.sim.heading_cdeg = 18000 - 1;
+    run_with_bridge(&b, 100);
+    roll(146);
+    run_with_bridge(&b, 300);
+    assert_int_equal(g.bot.have_goal, 0); /* route done: goal cleared */
+    assert_false(moving());
+    while (lcm_handle_timeout(lcm, 0) > 0) {
+    }
+    assert_true(g_odometry_seen >= 10);
+    assert_int_equal(g_last_waypoint, 3);
+    qnav_odometry_t_unsubscribe(lcm, sub);
+    qnav_bridge_unsubscribe(&b);
+    lcm_destroy(lcm);
+}
+
+static void test_route_with_a_bad_radius_is_refused_naming_the_field(void **state)
+{
+    static qnav_bridge_t b;
+    qnav_bridge_config_t cfg;
+    qnav_waypoints_t w;
+    char err[160];
+    (void)state;
+    qnav_bridge_config_default(&cfg);
+    qnav_bridge_init(&b, &cfg, NULL, NULL, bridge_write, NULL, 0);
+    memset(&w, 0, sizeof w);
+    w.n = 1;
+    w.radius_m = 0.0;
+    assert_int_equal(qnav_bridge_on_waypoints(&b, &w, 0, err, sizeof err), -1);
+    assert_non_null(strstr(err, "waypoints_t.radius_m"));
+    w.n = 17;
+    assert_int_equal(qnav_bridge_on_waypoints(&b, &w, 0, err, sizeof err), -1);
+    assert_non_null(strstr(err, "waypoints_t.n"));
+    assert_int_equal(b.route_n, 0);
 }
 
 static void test_bridge_reports_no_answer_when_the_board_never_acks_an_upload(void **state)
@@ -442,7 +593,12 @@ int main(void)
         cmocka_unit_test(test_stop_command_holds_until_the_bridge_clears_it),
         cmocka_unit_test(test_corrupted_goal_is_not_acted_on),
         cmocka_unit_test(test_uploaded_policy_is_used_and_a_bad_one_is_refused),
+        cmocka_unit_test(test_board_ignores_a_bridge_of_another_protocol_version),
+        cmocka_unit_test(test_pose_integrates_wheel_travel_along_the_heading),
+        cmocka_unit_test(test_position_goal_bearing_comes_from_the_pose),
         cmocka_unit_test(test_board_and_bridge_drive_together_in_both_modes),
+        cmocka_unit_test(test_route_from_lcm_advances_within_the_radius_and_stops_at_its_end),
+        cmocka_unit_test(test_route_with_a_bad_radius_is_refused_naming_the_field),
         cmocka_unit_test(test_bridge_reports_no_answer_when_the_board_never_acks_an_upload),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

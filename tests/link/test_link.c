@@ -170,7 +170,7 @@ static void test_codec_round_trips_every_small_message(void **state)
 
 static void test_codec_drops_frame_with_bad_crc(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_goal_t g = {0x0101u, 0x0202, 0x01020304u}; /* no zero bytes: no COBS codes */
@@ -189,7 +189,7 @@ static void test_codec_drops_frame_with_bad_crc(void **state)
 
 static void test_codec_drops_truncated_frame_and_takes_the_next(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_frame_t f;
@@ -209,7 +209,7 @@ static void test_codec_drops_truncated_frame_and_takes_the_next(void **state)
 
 static void test_codec_drops_replayed_frame(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_goal_t g = {1, 100, 5000};
@@ -229,7 +229,7 @@ static void test_codec_drops_replayed_frame(void **state)
 
 static void test_codec_accepts_sequence_wrap_and_counts_gaps(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_frame_t f;
@@ -252,7 +252,7 @@ static void test_codec_accepts_sequence_wrap_and_counts_gaps(void **state)
 
 static void test_codec_accepts_any_sequence_after_reset(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_goal_t g = {1, 100, 5000};
@@ -295,7 +295,7 @@ static void test_codec_drops_unknown_id_and_wrong_length(void **state)
 static void test_codec_drops_overlong_frame_and_recovers(void **state)
 {
     uint8_t noise[QNAV_LINK_MAX_FRAME + 300];
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     qnav_link_tx_t tx;
     qnav_link_rx_t rx;
     qnav_link_goal_t g = {1, 100, 5000};
@@ -332,7 +332,7 @@ static void test_codec_drops_cobs_block_running_past_delimiter(void **state)
 
 static void test_encode_refuses_small_buffer_and_keeps_sequence(void **state)
 {
-    uint8_t p[16] = {0};
+    uint8_t p[32] = {0};
     uint8_t out[8];
     qnav_link_tx_t tx;
     (void)state;
@@ -603,9 +603,103 @@ static void test_upload_with_missing_chunk_is_refused(void **state)
     assert_int_equal(qnav_link_upload_commit(&up, &cm, &b), QNAV_LINK_ACK_BAD_LENGTH);
 }
 
+static void test_heartbeat_carries_the_protocol_version_and_reads_version_1(void **state)
+{
+    qnav_link_heartbeat_t hb = {1234, QNAV_LINK_MODE_ONBOARD, 0x15, 7, 1, 0xBEEF, 0}, got;
+    uint8_t p[QNAV_LINK_HEARTBEAT_MAX_BYTES];
+    (void)state;
+    assert_int_equal(qnav_link_heartbeat_pack(&hb, p, sizeof p), QNAV_LINK_HEARTBEAT_BYTES);
+    assert_int_equal(p[12], QNAV_LINK_PROTOCOL_VERSION);
+    assert_int_equal(qnav_link_heartbeat_unpack(p, QNAV_LINK_HEARTBEAT_BYTES, &got), 0);
+    assert_int_equal(got.protocol, QNAV_LINK_PROTOCOL_VERSION);
+    assert_int_equal(got.policy_crc, 0xBEEF);
+    /* a version-1 board: 12 bytes, no version byte */
+    assert_int_equal(qnav_link_heartbeat_unpack(p, QNAV_LINK_HEARTBEAT_V1_BYTES, &got), 0);
+    assert_int_equal(got.protocol, 1);
+    assert_int_equal(got.state, 0x15);
+    /* a later version with more fields: its version read, the rest ignored */
+    p[12] = 9;
+    assert_int_equal(qnav_link_heartbeat_unpack(p, 20, &got), 0);
+    assert_int_equal(got.protocol, 9);
+    assert_int_equal(qnav_link_heartbeat_unpack(p, 11, &got), QNAV_LINK_E_LENGTH);
+}
+
+static void test_decoder_accepts_heartbeats_of_every_version_length(void **state)
+{
+    qnav_link_tx_t tx;
+    qnav_link_rx_t rx;
+    qnav_link_frame_t f;
+    uint8_t p[40] = {0};
+    wire_t w;
+    (void)state;
+    qnav_link_tx_init(&tx);
+    qnav_link_rx_init(&rx);
+    w = encode(&tx, QNAV_LINK_MSG_HEARTBEAT, p, QNAV_LINK_HEARTBEAT_V1_BYTES);
+    assert_int_equal(feed(&rx, w.wire, w.len, &f), 1);
+    w = encode(&tx, QNAV_LINK_MSG_HEARTBEAT, p, QNAV_LINK_HEARTBEAT_MAX_BYTES);
+    assert_int_equal(feed(&rx, w.wire, w.len, &f), 1);
+    w = encode(&tx, QNAV_LINK_MSG_HEARTBEAT, p, QNAV_LINK_HEARTBEAT_MAX_BYTES + 1u);
+    assert_int_equal(feed(&rx, w.wire, w.len, &f), 0);
+    assert_int_equal(rx.stats.dropped[QNAV_LINK_DROP_LENGTH], 1);
+}
+
+static void test_position_goal_and_pose_round_trip_with_negative_coordinates(void **state)
+{
+    qnav_link_goal_t g = {3, -4500, 0, QNAV_LINK_GOAL_POSITION, -1234567, 7654321}, g2;
+    qnav_link_pose_t ps = {0xFFFFFFFEu, -2000000, 1999999, -17999, 3, 4000000u}, ps2;
+    uint8_t p[QNAV_LINK_POSE_BYTES];
+    (void)state;
+    assert_int_equal(qnav_link_goal_pack(&g, p, sizeof p), QNAV_LINK_GOAL_BYTES);
+    assert_int_equal(qnav_link_goal_unpack(p, QNAV_LINK_GOAL_BYTES, &g2), 0);
+    assert_int_equal(g2.kind, QNAV_LINK_GOAL_POSITION);
+    assert_int_equal(g2.x_mm, -1234567);
+    assert_int_equal(g2.y_mm, 7654321);
+    p[8] = 2; /* no such goal kind */
+    assert_int_equal(qnav_link_goal_unpack(p, QNAV_LINK_GOAL_BYTES, &g2), QNAV_LINK_E_VALUE);
+    assert_int_equal(qnav_link_pose_pack(&ps, p, sizeof p), QNAV_LINK_POSE_BYTES);
+    assert_int_equal(qnav_link_pose_unpack(p, QNAV_LINK_POSE_BYTES, &ps2), 0);
+    assert_int_equal(ps2.board_ms, 0xFFFFFFFEu);
+    assert_int_equal(ps2.x_mm, -2000000);
+    assert_int_equal(ps2.y_mm, 1999999);
+    assert_int_equal(ps2.heading_cdeg, -17999);
+    assert_int_equal(ps2.goal_distance_mm, 4000000u);
+    assert_int_equal(qnav_link_pose_pack(&ps, p, QNAV_LINK_POSE_BYTES - 1u), QNAV_LINK_E_SPACE);
+}
+
+static uint32_t g_sent;
+
+static void count_bytes(void *user, const uint8_t *bytes, uint16_t n)
+{
+    (void)user;
+    (void)bytes;
+    g_sent += n;
+}
+
+static void test_send_frames_once_and_sends_nothing_for_a_failed_pack(void **state)
+{
+    qnav_link_tx_t tx;
+    uint8_t wire[64], p[4] = {1, 2, 3, 4};
+    (void)state;
+    qnav_link_tx_init(&tx);
+    g_sent = 0;
+    assert_true(qnav_link_send(&tx, QNAV_LINK_MSG_POLICY_COMMIT, p, 4, wire, sizeof wire,
+                               count_bytes, NULL) > 0);
+    assert_true(g_sent > 4u);
+    assert_int_equal(tx.next_seq, 1);
+    g_sent = 0;
+    assert_int_equal(qnav_link_send(&tx, QNAV_LINK_MSG_POLICY_COMMIT, p, QNAV_LINK_E_SPACE,
+                                    wire, sizeof wire, count_bytes, NULL), QNAV_LINK_E_SPACE);
+    assert_int_equal(g_sent, 0);
+    assert_int_equal(tx.next_seq, 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_heartbeat_carries_the_protocol_version_and_reads_version_1),
+        cmocka_unit_test(test_decoder_accepts_heartbeats_of_every_version_length),
+        cmocka_unit_test(test_position_goal_and_pose_round_trip_with_negative_coordinates),
+        cmocka_unit_test(test_send_frames_once_and_sends_nothing_for_a_failed_pack),
         cmocka_unit_test(test_crc16_matches_ccitt_false_check_value),
         cmocka_unit_test(test_codec_round_trips_scan_of_360_sectors),
         cmocka_unit_test(test_codec_round_trips_every_small_message),

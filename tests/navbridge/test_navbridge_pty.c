@@ -471,6 +471,49 @@ static void expect_refusal(const char *const *argv, const char *needle)
     assert_int_equal(nl[1], '\0'); /* exactly one line */
 }
 
+/* A board speaking link protocol `version` (1: its 12-byte heartbeat without the
+ * version byte) makes navbridge exit with status 1 and one line naming both versions. */
+static void check_refuses_board_of_protocol(uint8_t version)
+{
+    const char *args[] = {"--lcm-url", "memq://", "--mode", "onboard", NULL};
+    qnav_link_heartbeat_t hb = {0, QNAV_LINK_MODE_ONBOARD, QNAV_LINK_STATE_POLICY, 0, 0, 0};
+    uint8_t p[QNAV_LINK_HEARTBEAT_BYTES];
+    char text[2048], want[160];
+    const char *line;
+    fakeboard_t fb;
+    int32_t n;
+    assert_int_equal(fakeboard_start(&fb, EXE, g_dir, args), 0);
+    wait_bridge_up(&fb);
+    n = qnav_link_heartbeat_pack(&hb, p, sizeof p);
+    assert_int_equal(n, QNAV_LINK_HEARTBEAT_BYTES);
+    if (version == 1u) {
+        n = QNAV_LINK_HEARTBEAT_V1_BYTES;
+    } else {
+        p[12] = version;
+    }
+    assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_HEARTBEAT, p, (uint16_t)n), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, 3000), 1);
+    assert_true(read_text(fb.stderr_path, text, sizeof text) > 0);
+    snprintf(want, sizeof want, "the board speaks link protocol %u, this navbridge speaks %u",
+             (unsigned)version, (unsigned)QNAV_LINK_PROTOCOL_VERSION);
+    line = strstr(text, want);
+    assert_non_null(line);
+    assert_null(strchr(line, '\n') == NULL ? NULL : strstr(strchr(line, '\n') + 1, "protocol"));
+    fakeboard_close(&fb);
+}
+
+static void test_board_of_protocol_1_is_refused_with_one_line(void **state)
+{
+    (void)state;
+    check_refuses_board_of_protocol(1);
+}
+
+static void test_board_of_a_newer_protocol_is_refused_with_one_line(void **state)
+{
+    (void)state;
+    check_refuses_board_of_protocol(QNAV_LINK_PROTOCOL_VERSION + 1u);
+}
+
 static void test_bad_options_and_files_fail_with_one_line(void **state)
 {
     char bad_policy[320];
@@ -483,6 +526,9 @@ static void test_bad_options_and_files_fail_with_one_line(void **state)
     const char *pol[] = {EXE, "--device", "/dev/null", "--policy", bad_policy, NULL};
     const char *unknown[] = {EXE, "--frobnicate", NULL};
     const char *goal[] = {EXE, "--device", "/dev/null", "--goal", "200", NULL};
+    const char *route[] = {EXE, "--device", "/dev/null", "--waypoints", "1:2,3", NULL};
+    const char *at[] = {EXE, "--device", "/dev/null", "--goal-at", "1:2,3:4", NULL};
+    const char *radius[] = {EXE, "--device", "/dev/null", "--goal-radius", "0", NULL};
     (void)state;
     snprintf(bad_policy, sizeof bad_policy, "%s/bad.policy", g_dir);
     f = fopen(bad_policy, "w");
@@ -497,6 +543,9 @@ static void test_bad_options_and_files_fail_with_one_line(void **state)
     expect_refusal(pol, "bad.policy:");
     expect_refusal(unknown, "--frobnicate");
     expect_refusal(goal, "--goal 200");
+    expect_refusal(route, "--waypoints 1:2,3");
+    expect_refusal(at, "--goal-at 1:2,3:4");
+    expect_refusal(radius, "--goal-radius 0");
 }
 
 /* Short unknown options are named as such (it used to say "--?: missing its value"), a
@@ -533,6 +582,8 @@ int main(void)
         cmocka_unit_test(test_sighup_stops_robot_before_exit),
         cmocka_unit_test(test_onboard_upload_delivers_the_policy_file_to_the_board),
         cmocka_unit_test(test_start_goal_is_relayed_to_the_board),
+        cmocka_unit_test(test_board_of_protocol_1_is_refused_with_one_line),
+        cmocka_unit_test(test_board_of_a_newer_protocol_is_refused_with_one_line),
         cmocka_unit_test(test_bad_options_and_files_fail_with_one_line),
         cmocka_unit_test(test_command_line_conventions),
     };

@@ -16,6 +16,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -24,7 +25,9 @@
 
 #include "fakeboard.h"
 #include "test_proc.h"
+#include "qnav/link.h"
 #include "qnav/policy_io.h"
+#include "qnav_odometry_t.h"
 
 static char g_dir[256];
 
@@ -60,6 +63,24 @@ static void count_channels(const char *path, int *scan, int *cmd, int *qual, int
     lcm_eventlog_destroy(log);
 }
 
+/* The destination the SIL robot printed, as navbridge --goal-at's value (odometry frame);
+ * the robot prints it before making its link. */
+static void destination_of(const char *sil_out, char *goal, size_t len)
+{
+    char text[2048];
+    const char *at;
+    size_t n = 0;
+    assert_true(read_text(sil_out, text, sizeof text) > 0);
+    at = strstr(text, "--goal-at ");
+    assert_non_null(at);
+    at += strlen("--goal-at ");
+    while (n + 1 < len && at[n] != ')' && at[n] != '\0') {
+        goal[n] = at[n];
+        n++;
+    }
+    goal[n] = '\0';
+}
+
 static void replay_is_identical(const char *log)
 {
     char out[320], err[320], text[2048];
@@ -75,10 +96,11 @@ static void replay_is_identical(const char *log)
 static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void **state)
 {
     char link[300], log[300], sil_out[300], sil_err[300], nb_out[300], nb_err[300];
-    char text[2048];
-    const char *sil[] = {SIL_EXE, "--lockstep", "--link", link, NULL};
+    char text[2048], goal[64];
+    /* lockstep is about repeatability: a loaded machine may take more than 300 ms to answer */
+    const char *sil[] = {SIL_EXE, "--lockstep", "--reply-ms", "3000", "--link", link, NULL};
     const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--log", log,
-                        NULL};
+                        "--goal-at", goal, NULL};
     pid_t ps, pn;
     int scan, cmd, qual, status, pose;
     (void)state;
@@ -91,6 +113,7 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     ps = qnav_test_spawn(sil, sil_out, sil_err);
     assert_true(ps > 0);
     assert_int_equal(qnav_test_wait_path(link, 4000), 0);
+    destination_of(sil_out, goal, sizeof goal);
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0); /* 0: destination reached */
@@ -113,10 +136,11 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
 static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(void **state)
 {
     char link[300], log[300], pol[300], sil_out[300], sil_err[300], nb_out[300], nb_err[300];
-    char text[4096], perr[QNAV_POLICY_IO_ERRLEN];
+    char text[4096], perr[QNAV_POLICY_IO_ERRLEN], goal[64];
     const char *sil[] = {SIL_EXE, "--tick-ms", "20", "--link", link, NULL};
     const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--mode",
-                        "onboard", "--policy", pol, "--upload", "--log", log, NULL};
+                        "onboard", "--policy", pol, "--upload", "--log", log, "--goal-at",
+                        goal, NULL};
     const char *replay[] = {NAVBRIDGE_EXE, "--replay", log, "--policy", pol, NULL};
     qnav_policy_t p;
     pid_t ps, pn;
@@ -136,14 +160,16 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     ps = qnav_test_spawn(sil, sil_out, sil_err);
     assert_true(ps > 0);
     assert_int_equal(qnav_test_wait_path(link, 4000), 0);
+    destination_of(sil_out, goal, sizeof goal);
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0);
     assert_int_equal(wait_exit_within(pn, 3000), 1);
-    assert_true(read_text(sil_err, text, sizeof text) > 0);
-    assert_non_null(strstr(text, "policy uploaded"));
     assert_true(read_text(nb_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "policy upload: ok"));
+    /* the board's heartbeat says which policy runs: first its own, then the upload */
+    assert_non_null(strstr(text, "runs its built-in policy"));
+    assert_non_null(strstr(text, "runs its uploaded policy"));
     assert_true(read_text(sil_out, text, sizeof text) > 0);
     print_message("%s", text);
     assert_non_null(strstr(text, "reached yes"));
@@ -159,23 +185,30 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     assert_true(compared + 20u >= scans); /* all but the ticks before the upload landed */
 }
 
-/* One udpm:// trial by udpm_trial.sh in a private network namespace (skips the test when
- * namespaces or loopback multicast are not permitted), watched by qnav-spy when spy is not
- * NULL; checks the statuses the script reports (expect, e.g. "sil=0 navbridge=1 spy=-"). */
-static void run_udpm_trial(const char *spy, const char *expect)
+/* One udpm:// trial by udpm_trial.sh in a private network namespace, in dir (skips the
+ * test when namespaces or loopback multicast are not permitted). args: the script's
+ * arguments after DIR (qnav-spy's path or "-", then robot arguments, "--", navbridge
+ * arguments), NULL-ended. Checks the statuses the script reports (expect, e.g.
+ * "sil=0 navbridge=1 spy=-"). */
+static void run_udpm_trial_in(const char *dir, const char *const *args, const char *expect)
 {
     char rc_path[300], text[512], out[300], err[300];
     const char *probe[] = {UNSHARE_EXE, "-n", "true", NULL};
-    const char *trial[] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
-                           g_dir, spy, NULL};
-    snprintf(out, sizeof out, "%s/probe.out", g_dir);
-    snprintf(err, sizeof err, "%s/probe.err", g_dir);
+    const char *trial[32] = {UNSHARE_EXE, "-n", "/bin/sh", UDPM_SCRIPT, NAVBRIDGE_EXE, SIL_EXE,
+                             dir};
+    int k = 7;
+    while (*args != NULL && k < 31) {
+        trial[k++] = *args++;
+    }
+    trial[k] = NULL;
+    snprintf(out, sizeof out, "%s/probe.out", dir);
+    snprintf(err, sizeof err, "%s/probe.err", dir);
     if (run_program(probe, out, err) != 0) {
         print_message("SKIP: `unshare -n` is not permitted here, so the udpm:// trial cannot "
                       "run in a private network namespace (DESIGN.md §7)\n");
         skip();
     }
-    snprintf(rc_path, sizeof rc_path, "%s/rc.txt", g_dir);
+    snprintf(rc_path, sizeof rc_path, "%s/rc.txt", dir);
     if (run_program(trial, out, err) == 10) {
         print_message("SKIP: cannot configure loopback multicast in the namespace\n");
         skip();
@@ -183,6 +216,14 @@ static void run_udpm_trial(const char *spy, const char *expect)
     assert_true(read_text(rc_path, text, sizeof text) > 0);
     print_message("%s", text);
     assert_non_null(strstr(text, expect));
+}
+
+/* The same in g_dir with the robot's destination as the goal, watched by qnav-spy when spy
+ * is not NULL. */
+static void run_udpm_trial(const char *spy, const char *expect)
+{
+    const char *args[] = {spy != NULL ? spy : "-", NULL};
+    run_udpm_trial_in(g_dir, args, expect);
 }
 
 static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(void **state)
@@ -205,6 +246,103 @@ static void test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically(vo
     assert_true(status > 0);
     assert_true(pose > 100);
     replay_is_identical(log);
+}
+
+/* Odometry events of an LCM log: how many, and the highest waypoint index reached. */
+static void odometry_progress(const char *path, int *n, int *waypoint, int *waypoints)
+{
+    lcm_eventlog_t *log = lcm_eventlog_create(path, "r");
+    lcm_eventlog_event_t *ev;
+    assert_non_null(log);
+    *n = *waypoint = *waypoints = 0;
+    while ((ev = lcm_eventlog_read_next_event(log)) != NULL) {
+        qnav_odometry_t o;
+        if (strcmp(ev->channel, "QNAV_ODOMETRY") == 0 &&
+            qnav_odometry_t_decode(ev->data, 0, ev->datalen, &o) >= 0) {
+            (*n)++;
+            *waypoint = o.waypoint > *waypoint ? o.waypoint : *waypoint;
+            *waypoints = o.waypoints;
+        }
+        lcm_eventlog_free_event(ev);
+    }
+    lcm_eventlog_destroy(log);
+}
+
+/* Three waypoints through the dense environment (its three rows of obstacles), start
+ * at (5, 1.1) m facing +y, so the odometry frame is x = world y - 1.1, y = 5 - world x:
+ * the gap in row 1 (4.7, 3.0), the gap in row 2 (4.5, 5.0), the destination (5, 9). */
+static void test_sil_route_of_three_waypoints_through_dense_replays_identically(void **state)
+{
+    char dir[300], log[300], text[4096], path[300];
+    const char *args[] = {"-", "--env", "dense", "--start", "5:1.1:90", "--", "--waypoints",
+                          "1.9:0.3,3.9:0.5,7.9:0", "--goal-radius", "0.4", NULL};
+    int n, waypoint, waypoints;
+    (void)state;
+    snprintf(dir, sizeof dir, "%s/route", g_dir);
+    assert_int_equal(mkdir(dir, 0700), 0);
+    snprintf(log, sizeof log, "%s/trial.lcmlog", dir);
+    run_udpm_trial_in(dir, args, "sil=0 navbridge=1 spy=-");
+    snprintf(path, sizeof path, "%s/sil.out", dir);
+    assert_true(read_text(path, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, "reached yes")); /* the third waypoint is the destination */
+    assert_non_null(strstr(text, " 0 collisions"));
+    snprintf(path, sizeof path, "%s/nb.err", dir);
+    assert_true(read_text(path, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, "waypoint 1/3 reached"));
+    assert_non_null(strstr(text, "waypoint 2/3 reached"));
+    odometry_progress(log, &n, &waypoint, &waypoints);
+    print_message("lcm-logger recorded %d odometry poses, waypoint index up to %d of %d\n", n,
+                  waypoint, waypoints);
+    assert_true(n > 50);
+    assert_int_equal(waypoints, 3);
+    assert_int_equal(waypoint, 2);
+    replay_is_identical(log);
+}
+
+/* One onboard SIL trial with --nvm; navbridge's stderr into text. */
+static void nvm_trial(const char *nvm, const char *pol, int upload, char *text, int cap)
+{
+    char link[300], s_out[300], s_err[300], nb_out[300], nb_err[300], goal[64];
+    const char *sil[] = {SIL_EXE, "--tick-ms", "10", "--nvm", nvm, "--link", link, NULL};
+    const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--mode",
+                        "onboard", "--goal-at", goal, upload ? "--policy" : NULL, pol,
+                        "--upload", NULL};
+    pid_t ps, pn;
+    snprintf(link, sizeof link, "%s/link-nvm", g_dir);
+    snprintf(s_out, sizeof s_out, "%s/sil-nvm.out", g_dir);
+    snprintf(s_err, sizeof s_err, "%s/sil-nvm.err", g_dir);
+    snprintf(nb_out, sizeof nb_out, "%s/nb-nvm.out", g_dir);
+    snprintf(nb_err, sizeof nb_err, "%s/nb-nvm.err", g_dir);
+    ps = qnav_test_spawn(sil, s_out, s_err);
+    assert_true(ps > 0);
+    assert_int_equal(qnav_test_wait_path(link, 4000), 0);
+    destination_of(s_out, goal, sizeof goal);
+    pn = qnav_test_spawn(nb, nb_out, nb_err);
+    assert_true(pn > 0);
+    assert_int_equal(qnav_test_wait_exit(ps), 0);
+    assert_int_equal(wait_exit_within(pn, 3000), 1);
+    assert_true(read_text(nb_err, text, cap) > 0);
+}
+
+static void test_sil_robot_keeps_an_uploaded_policy_in_its_nvm_file(void **state)
+{
+    char nvm[300], pol[300], text[4096], perr[QNAV_POLICY_IO_ERRLEN], want[96];
+    qnav_policy_t p;
+    (void)state;
+    snprintf(nvm, sizeof nvm, "%s/robot.nvm", g_dir);
+    snprintf(pol, sizeof pol, "%s/nvm.policy", g_dir);
+    qnav_policy_prob_default(&p);
+    p.u.prob.k_goal = 3 * 256;
+    assert_int_equal(qnav_policy_write(pol, &p, "sil nvm test", perr, sizeof perr), 0);
+    snprintf(want, sizeof want, "runs its uploaded policy (crc 0x%04x)", qnav_link_policy_crc(&p));
+    nvm_trial(nvm, pol, 1, text, sizeof text);
+    assert_non_null(strstr(text, "runs its built-in policy")); /* a new, erased store */
+    assert_non_null(strstr(text, want));
+    nvm_trial(nvm, pol, 0, text, sizeof text);    /* restarted: loaded from the file */
+    assert_non_null(strstr(text, want));
+    assert_null(strstr(text, "built-in"));
 }
 
 /* --link onto a user's file: refused with status 2, the file untouched (it used to be
@@ -302,6 +440,8 @@ int main(void)
         cmocka_unit_test(test_sil_robot_reaches_destination_through_navbridge_over_memq),
         cmocka_unit_test(test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically),
         cmocka_unit_test(test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically),
+        cmocka_unit_test(test_sil_route_of_three_waypoints_through_dense_replays_identically),
+        cmocka_unit_test(test_sil_robot_keeps_an_uploaded_policy_in_its_nvm_file),
         cmocka_unit_test(test_sil_robot_refuses_link_path_that_is_a_file),
         cmocka_unit_test(test_sil_robot_leaves_a_file_that_replaced_its_link),
         cmocka_unit_test(test_sil_robot_replaces_stale_pty_link_and_removes_it_at_exit),

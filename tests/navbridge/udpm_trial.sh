@@ -7,10 +7,18 @@
 # With QNAV_SPY, qnav-spy --check also watches the trial, on a private Xvfb display
 # (Xvfb's abstract socket is private to the namespace; -displayfd picks a free number),
 # and its report and window go to DIR/spy.out and DIR/spy.png; the robot is then paced at
-# 50 ms so that the trial outlasts the JVM's start.
-# usage: udpm_trial.sh NAVBRIDGE SIL_ROBOT DIR [QNAV_SPY]
+# 50 ms so that the trial outlasts the JVM's start. QNAV_SPY "-" (or none) is no spy.
+# Further arguments go to the robot, and those after "--" to navbridge; without navbridge
+# arguments its goal is the robot's destination (--goal-at, printed by the robot in its
+# odometry frame).
+# usage: udpm_trial.sh NAVBRIDGE SIL_ROBOT DIR [QNAV_SPY|- [SIL_ARG... [-- NAVBRIDGE_ARG...]]]
 set -u
 NB_EXE=$1; SIL_EXE=$2; DIR=$3; SPY=${4:-}
+[ "$SPY" = "-" ] && SPY=
+[ $# -ge 4 ] && shift 4 || shift $#
+SIL_ARGS=""
+while [ $# -gt 0 ] && [ "$1" != "--" ]; do SIL_ARGS="$SIL_ARGS $1"; shift; done
+[ $# -gt 0 ] && shift
 ip link set lo up || exit 10
 ip link set lo multicast on || exit 10
 ip route add 224.0.0.0/4 dev lo || exit 10
@@ -26,11 +34,17 @@ if [ -n "$SPY" ]; then
         --screenshot "$DIR/spy.png" > "$DIR/spy.out" 2> "$DIR/spy.err" & SPY_PID=$!
 fi
 lcm-logger -q -f "$DIR/trial.lcmlog" & LOGGER=$!
-"$SIL_EXE" --tick-ms $TICK_MS --link "$DIR/link" --pose > "$DIR/sil.out" 2> "$DIR/sil.err" & SIL=$!
+# shellcheck disable=SC2086 # the robot's arguments are words
+"$SIL_EXE" --tick-ms $TICK_MS --link "$DIR/link" --pose $SIL_ARGS > "$DIR/sil.out" 2> "$DIR/sil.err" & SIL=$!
 i=0
 while [ ! -e "$DIR/link" ] && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
 sleep 0.3   # lcm-logger subscribed before the trial starts
-"$NB_EXE" --device "$DIR/link" > "$DIR/nb.out" 2> "$DIR/nb.err" & NB=$!
+if [ $# -eq 0 ]; then
+    # the robot prints its destination in the odometry frame before making the link
+    GOAL=$(sed -n 's/.*--goal-at \([-0-9.:]*\)).*/\1/p' "$DIR/sil.out")
+    set -- --goal-at "$GOAL"
+fi
+"$NB_EXE" --device "$DIR/link" "$@" > "$DIR/nb.out" 2> "$DIR/nb.err" & NB=$!
 wait $SIL; SIL_RC=$?
 # the robot's pty closes with it: navbridge leaves on its own (status 1); guard 5 s
 ( sleep 5; kill -TERM $NB 2>/dev/null ) & GUARD=$!

@@ -48,6 +48,11 @@ static uint16_t as_u16(int16_t v)
     return (uint16_t)v;
 }
 
+static int32_t as_i32(uint32_t v)
+{
+    return (v & 0x80000000UL) ? (int32_t)(-(int32_t)(~v) - 1) : (int32_t)v;
+}
+
 /* ---- CRC-16/CCITT-FALSE, nibble table (32 bytes: small enough for any MCU) ---- */
 
 static const uint16_t crc_nibble[16] = {
@@ -81,7 +86,8 @@ uint16_t qnav_link_min_payload(uint8_t msg_id)
     case QNAV_LINK_MSG_POLICY_CHUNK: return (uint16_t)(QNAV_LINK_POLICY_CHUNK_HEADER_BYTES + 1u);
     case QNAV_LINK_MSG_POLICY_COMMIT: return QNAV_LINK_POLICY_COMMIT_BYTES;
     case QNAV_LINK_MSG_POLICY_ACK: return QNAV_LINK_POLICY_ACK_BYTES;
-    case QNAV_LINK_MSG_HEARTBEAT: return QNAV_LINK_HEARTBEAT_BYTES;
+    case QNAV_LINK_MSG_HEARTBEAT: return QNAV_LINK_HEARTBEAT_V1_BYTES;
+    case QNAV_LINK_MSG_POSE: return QNAV_LINK_POSE_BYTES;
     default: return 0;
     }
 }
@@ -100,6 +106,10 @@ static uint8_t length_ok(uint8_t msg_id, uint16_t len)
     case QNAV_LINK_MSG_POLICY_CHUNK:
         return (uint8_t)(len > QNAV_LINK_POLICY_CHUNK_HEADER_BYTES &&
                          len <= QNAV_LINK_CHUNK_MAX_BYTES);
+    case QNAV_LINK_MSG_HEARTBEAT:
+        /* every version's, so that a peer of another version is heard and refused */
+        return (uint8_t)(len >= QNAV_LINK_HEARTBEAT_V1_BYTES &&
+                         len <= QNAV_LINK_HEARTBEAT_MAX_BYTES);
     default:
         return (uint8_t)(len == qnav_link_min_payload(msg_id) && len != 0u);
     }
@@ -424,6 +434,9 @@ int32_t qnav_link_goal_pack(const qnav_link_goal_t *m, uint8_t *out, uint16_t ca
     put_u16(&out[0], m->goal_id);
     put_u16(&out[2], as_u16(m->bearing_cdeg));
     put_u32(&out[4], m->distance_mm);
+    out[8] = m->kind;
+    put_u32(&out[9], (uint32_t)m->x_mm);
+    put_u32(&out[13], (uint32_t)m->y_mm);
     return (int32_t)QNAV_LINK_GOAL_BYTES;
 }
 
@@ -438,6 +451,12 @@ int32_t qnav_link_goal_unpack(const uint8_t *p, uint16_t len, qnav_link_goal_t *
     m->goal_id = get_u16(&p[0]);
     m->bearing_cdeg = as_i16(get_u16(&p[2]));
     m->distance_mm = get_u32(&p[4]);
+    m->kind = p[8];
+    m->x_mm = as_i32(get_u32(&p[9]));
+    m->y_mm = as_i32(get_u32(&p[13]));
+    if (m->kind != QNAV_LINK_GOAL_BEARING && m->kind != QNAV_LINK_GOAL_POSITION) {
+        return QNAV_LINK_E_VALUE;
+    }
     return QNAV_LINK_OK;
 }
 
@@ -599,6 +618,7 @@ int32_t qnav_link_heartbeat_pack(const qnav_link_heartbeat_t *m, uint8_t *out, u
     put_u16(&out[6], m->rx_ok);
     put_u16(&out[8], m->rx_dropped);
     put_u16(&out[10], m->policy_crc);
+    out[12] = (uint8_t)QNAV_LINK_PROTOCOL_VERSION;
     return (int32_t)QNAV_LINK_HEARTBEAT_BYTES;
 }
 
@@ -607,7 +627,7 @@ int32_t qnav_link_heartbeat_unpack(const uint8_t *p, uint16_t len, qnav_link_hea
     if (p == NULL || m == NULL) {
         return QNAV_LINK_E_NULL;
     }
-    if (len != QNAV_LINK_HEARTBEAT_BYTES) {
+    if (len < QNAV_LINK_HEARTBEAT_V1_BYTES || len > QNAV_LINK_HEARTBEAT_MAX_BYTES) {
         return QNAV_LINK_E_LENGTH;
     }
     m->uptime_ms = get_u32(&p[0]);
@@ -616,6 +636,41 @@ int32_t qnav_link_heartbeat_unpack(const uint8_t *p, uint16_t len, qnav_link_hea
     m->rx_ok = get_u16(&p[6]);
     m->rx_dropped = get_u16(&p[8]);
     m->policy_crc = get_u16(&p[10]);
+    m->protocol = len == QNAV_LINK_HEARTBEAT_V1_BYTES ? 1u : p[12];
+    return QNAV_LINK_OK;
+}
+
+int32_t qnav_link_pose_pack(const qnav_link_pose_t *m, uint8_t *out, uint16_t cap)
+{
+    if (m == NULL || out == NULL) {
+        return QNAV_LINK_E_NULL;
+    }
+    if (cap < QNAV_LINK_POSE_BYTES) {
+        return QNAV_LINK_E_SPACE;
+    }
+    put_u32(&out[0], m->board_ms);
+    put_u32(&out[4], (uint32_t)m->x_mm);
+    put_u32(&out[8], (uint32_t)m->y_mm);
+    put_u16(&out[12], as_u16(m->heading_cdeg));
+    put_u16(&out[14], m->goal_id);
+    put_u32(&out[16], m->goal_distance_mm);
+    return (int32_t)QNAV_LINK_POSE_BYTES;
+}
+
+int32_t qnav_link_pose_unpack(const uint8_t *p, uint16_t len, qnav_link_pose_t *m)
+{
+    if (p == NULL || m == NULL) {
+        return QNAV_LINK_E_NULL;
+    }
+    if (len != QNAV_LINK_POSE_BYTES) {
+        return QNAV_LINK_E_LENGTH;
+    }
+    m->board_ms = get_u32(&p[0]);
+    m->x_mm = as_i32(get_u32(&p[4]));
+    m->y_mm = as_i32(get_u32(&p[8]));
+    m->heading_cdeg = as_i16(get_u16(&p[12]));
+    m->goal_id = get_u16(&p[14]);
+    m->goal_distance_mm = get_u32(&p[16]);
     return QNAV_LINK_OK;
 }
 
@@ -765,4 +820,29 @@ int8_t qnav_link_upload_commit(qnav_link_upload_t *up, const qnav_link_policy_co
     }
     qnav_link_upload_init(up);
     return result;
+}
+
+int32_t qnav_link_send(qnav_link_tx_t *tx, uint8_t msg_id, const uint8_t *payload,
+                       int32_t len, uint8_t *wire, uint16_t cap, qnav_link_write_fn write,
+                       void *user)
+{
+    int32_t n;
+    if (len < 0) {
+        return len;
+    }
+    if (write == NULL) {
+        return QNAV_LINK_E_NULL;
+    }
+    n = qnav_link_encode(tx, msg_id, payload, (uint16_t)len, wire, cap);
+    if (n > 0) {
+        write(user, wire, (uint16_t)n);
+    }
+    return n;
+}
+
+uint16_t qnav_link_policy_crc(const qnav_policy_t *policy)
+{
+    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
+    int32_t n = qnav_link_policy_to_blob(policy, blob, (uint16_t)sizeof blob);
+    return n > 0 ? qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) : 0u;
 }

@@ -8,11 +8,16 @@
  *   motors  Timer1 8-bit fast PWM on OC1A (PB5, left) and OC1B (PB6, right); direction on
  *           PB0 (left) and PB1 (right), high = forward
  *   heading wheel-encoder odometry: INT0 (PD0, left) and INT1 (PD1, right), the sign of
- *           each tick taken from that wheel's direction pin
+ *           each tick taken from that wheel's direction pin; the same counts are the
+ *           odometry the core dead-reckons from
+ *   storage the 4 KiB EEPROM (avr-libc eeprom_*_block; a byte takes 8.5 ms to write)
  * Pin choices and scale factors are the knobs at the top; docs/hil.md lists the wiring.
  */
+#include <avr/eeprom.h>
 #include <avr/interrupt.h>
 #include <avr/io.h>
+
+#include "qnav/board.h"
 
 #include "hal_avr.h"
 
@@ -33,6 +38,11 @@
 #define QNAV_TEKBOT_CDEG_PER_TICK 328L
 #endif
 
+/* spin_deg of qnav_board_mix: at or beyond this |heading| the TekBot turns in place */
+#ifndef QNAV_TEKBOT_SPIN_DEG
+#define QNAV_TEKBOT_SPIN_DEG 60
+#endif
+
 /* Receive ring: it must hold what arrives at line rate while the main loop is busy with a
  * tick (the step, up to 100 000 cycles = 6.3 ms, and the polled transmit of scan, heartbeat
  * and command, about 120 bytes = 21 ms at 57600 baud): about 160 bytes. 64 bytes lost the
@@ -50,7 +60,10 @@ static volatile uint32_t g_ms;
 static volatile uint8_t g_rx[RX_RING];
 static volatile uint8_t g_rx_head;
 static volatile uint8_t g_rx_tail;
-static volatile int32_t g_odo; /* right ticks minus left ticks */
+/* Interrupt-shared hardware state: the only writable file-scope variables of the firmware
+ * (an ISR has no context pointer). */
+static volatile int32_t g_left;  /* left encoder counts, forward positive */
+static volatile int32_t g_right; /* right encoder counts */
 
 ISR(TIMER0_COMP_vect)
 {
@@ -69,12 +82,12 @@ ISR(USART0_RX_vect)
 
 ISR(INT0_vect)
 {
-    g_odo += (PORTB & _BV(PB0)) ? -1 : 1; /* left forward turns clockwise */
+    g_left += (PORTB & _BV(PB0)) ? 1 : -1;
 }
 
 ISR(INT1_vect)
 {
-    g_odo += (PORTB & _BV(PB1)) ? 1 : -1;
+    g_right += (PORTB & _BV(PB1)) ? 1 : -1;
 }
 
 static uint32_t avr_millis(void *ctx)
@@ -116,7 +129,7 @@ static qnav_cdeg_t avr_heading_cdeg(void *ctx)
     uint8_t sreg = SREG;
     (void)ctx;
     cli();
-    odo = g_odo;
+    odo = g_right - g_left; /* left forward turns clockwise */
     SREG = sreg;
     a = (odo * QNAV_TEKBOT_CDEG_PER_TICK) % 36000L;
     if (a >= 18000L) {
@@ -133,9 +146,22 @@ static uint8_t duty(qnav_q1_15_t v)
     return (uint8_t)(m >> 7); /* Q1.15 magnitude -> 0..255 */
 }
 
-static void avr_motors_set(void *ctx, qnav_q1_15_t left, qnav_q1_15_t right)
+static void avr_odometry(void *ctx, int32_t *left, int32_t *right)
 {
+    uint8_t sreg = SREG;
     (void)ctx;
+    cli();
+    *left = g_left;
+    *right = g_right;
+    SREG = sreg;
+}
+
+static void avr_drive(void *ctx, qnav_deg_t heading_deg, qnav_q1_15_t speed)
+{
+    qnav_q1_15_t left;
+    qnav_q1_15_t right;
+    (void)ctx;
+    qnav_board_mix(heading_deg, speed, QNAV_TEKBOT_SPIN_DEG, &left, &right);
     if (left >= 0) {
         PORTB |= _BV(PB0);
     } else {
@@ -175,6 +201,26 @@ static void avr_uart_write(void *ctx, const uint8_t *bytes, uint16_t n)
     }
 }
 
+static uint8_t avr_nvm_read(void *ctx, uint16_t addr, uint8_t *out, uint16_t n)
+{
+    (void)ctx;
+    if ((uint32_t)addr + n > (uint32_t)E2END + 1u) {
+        return 0;
+    }
+    eeprom_read_block(out, (const void *)(uintptr_t)addr, n);
+    return 1;
+}
+
+static uint8_t avr_nvm_write(void *ctx, uint16_t addr, const uint8_t *bytes, uint16_t n)
+{
+    (void)ctx;
+    if ((uint32_t)addr + n > (uint32_t)E2END + 1u) {
+        return 0;
+    }
+    eeprom_update_block(bytes, (void *)(uintptr_t)addr, n); /* unchanged bytes not rewritten */
+    return 1;
+}
+
 void qnav_tekbot_hal_avr_init(qnav_board_hal_t *hal)
 {
     /* Timer0: CTC, clk/64, 250 counts = 1 ms at 16 MHz */
@@ -208,7 +254,11 @@ void qnav_tekbot_hal_avr_init(qnav_board_hal_t *hal)
     hal->millis = avr_millis;
     hal->sonar_read = avr_sonar_read;
     hal->heading_cdeg = avr_heading_cdeg;
-    hal->motors_set = avr_motors_set;
+    hal->odometry_read = avr_odometry;
+    hal->drive = avr_drive;
+    hal->nvm_read = avr_nvm_read;
+    hal->nvm_write = avr_nvm_write;
+    hal->nvm_bytes = (uint16_t)(E2END + 1u);
     hal->uart_read = avr_uart_read;
     hal->uart_write = avr_uart_write;
     sei();

@@ -46,6 +46,12 @@ extern "C" {
 
 /* ---- Wire constants ------------------------------------------------------------------ */
 
+/* The link protocol this codec speaks, carried in every heartbeat (the handshake: each
+ * side refuses a peer of another version). Version 1 (before issue 10) had a 12-byte
+ * heartbeat without the version byte and bearing-only goals; version 2 adds the version
+ * byte, position goals and the board's POSE. */
+#define QNAV_LINK_PROTOCOL_VERSION 2u
+
 /* Message ids. Direction: B->H board to host (navbridge), H->B host to board. */
 typedef enum {
     QNAV_LINK_MSG_SCAN = 0x01,          /* B->H sonar ranges + goal bearing, every tick */
@@ -54,17 +60,21 @@ typedef enum {
     QNAV_LINK_MSG_POLICY_CHUNK = 0x04,  /* H->B part of a policy blob */
     QNAV_LINK_MSG_POLICY_COMMIT = 0x05, /* H->B end of upload: total length and CRC */
     QNAV_LINK_MSG_POLICY_ACK = 0x06,    /* B->H result of a commit */
-    QNAV_LINK_MSG_HEARTBEAT = 0x07      /* both ways, every tick */
+    QNAV_LINK_MSG_HEARTBEAT = 0x07,     /* both ways, every tick; carries the protocol version */
+    QNAV_LINK_MSG_POSE = 0x08           /* B->H dead-reckoned pose in the odometry frame */
 } qnav_link_msg_t;
 
 /* Payload sizes in bytes (the scan's is 12 + 2 * n_sectors). */
 #define QNAV_LINK_SCAN_HEADER_BYTES 12u
-#define QNAV_LINK_GOAL_BYTES 8u
+#define QNAV_LINK_GOAL_BYTES 17u
 #define QNAV_LINK_COMMAND_BYTES 10u
 #define QNAV_LINK_POLICY_CHUNK_HEADER_BYTES 4u
 #define QNAV_LINK_POLICY_COMMIT_BYTES 4u
 #define QNAV_LINK_POLICY_ACK_BYTES 4u
-#define QNAV_LINK_HEARTBEAT_BYTES 12u
+#define QNAV_LINK_HEARTBEAT_BYTES 13u     /* this version's; any version's is >= 12 */
+#define QNAV_LINK_HEARTBEAT_V1_BYTES 12u  /* version 1's (no version byte) */
+#define QNAV_LINK_HEARTBEAT_MAX_BYTES 32u /* longest a later version may send */
+#define QNAV_LINK_POSE_BYTES 20u
 
 /* Largest payload this build accepts: a full scan or a full chunk, whichever is larger. */
 #define QNAV_LINK_SCAN_MAX_BYTES (QNAV_LINK_SCAN_HEADER_BYTES + 2u * QNAV_LINK_MAX_SECTORS)
@@ -91,6 +101,13 @@ typedef enum {
 #define QNAV_LINK_STATE_MOVING 0x02u    /* motors commanded non-zero */
 #define QNAV_LINK_STATE_POLICY 0x04u    /* a policy is loaded and the controller is ready */
 #define QNAV_LINK_STATE_STOPPED 0x08u   /* holding a stop (STOP command or link lost) */
+#define QNAV_LINK_STATE_STORED 0x10u    /* board: the running policy is an uploaded one (from
+                                           non-volatile storage or just committed); clear:
+                                           the built-in policy runs */
+
+/* Goal kinds (GOAL.kind). */
+#define QNAV_LINK_GOAL_BEARING 0u   /* a fixed bearing in the board's heading frame */
+#define QNAV_LINK_GOAL_POSITION 1u  /* a point (x, y) in the board's odometry frame */
 
 /* Policy upload results (POLICY_ACK.status). */
 #define QNAV_LINK_ACK_OK 0
@@ -189,6 +206,18 @@ void qnav_link_tx_init(qnav_link_tx_t *tx);
 int32_t qnav_link_encode(qnav_link_tx_t *tx, uint8_t msg_id, const uint8_t *payload,
                          uint16_t len, uint8_t *out, uint16_t cap);
 
+/* Where qnav_link_send puts a framed message: a UART, a pty, a test's queue. */
+typedef void (*qnav_link_write_fn)(void *user, const uint8_t *bytes, uint16_t n);
+
+/*
+ * Frame a payload into wire (cap bytes, QNAV_LINK_MAX_WIRE(len) suffices) and hand it to
+ * write. len < 0 (a failed _pack) sends nothing. The one send path of the board core and
+ * navbridge. Returns the bytes written, or the negative status of _pack/_encode.
+ */
+int32_t qnav_link_send(qnav_link_tx_t *tx, uint8_t msg_id, const uint8_t *payload,
+                       int32_t len, uint8_t *wire, uint16_t cap, qnav_link_write_fn write,
+                       void *user);
+
 /* CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, no reflection, no final xor);
  * "123456789" gives 0x29B1. Continue a running CRC by passing the previous value. */
 uint16_t qnav_link_crc16(uint16_t crc, const uint8_t *data, uint16_t len);
@@ -211,10 +240,24 @@ typedef struct {
 
 typedef struct {
     uint16_t goal_id;                  /* increments with each new goal; 0 = no goal */
-    qnav_cdeg_t bearing_cdeg;          /* destination bearing in the board's heading frame
-                                          (0 = heading sensor zero), 0.01 deg, CCW */
+    qnav_cdeg_t bearing_cdeg;          /* BEARING: destination bearing in the board's
+                                          heading frame (0 = heading sensor zero), 0.01 deg,
+                                          CCW */
     uint32_t distance_mm;              /* distance to the destination, mm (0 = unknown) */
+    uint8_t kind;                      /* QNAV_LINK_GOAL_BEARING or _POSITION */
+    int32_t x_mm;                      /* POSITION: destination in the odometry frame, mm */
+    int32_t y_mm;
 } qnav_link_goal_t;
+
+typedef struct {
+    uint32_t board_ms;                 /* board clock at the estimate, ms (wraps) */
+    int32_t x_mm;                      /* odometry frame (origin and x axis = the pose at
+                                          start-up), mm */
+    int32_t y_mm;
+    qnav_cdeg_t heading_cdeg;          /* heading in that frame, 0.01 deg, CCW */
+    uint16_t goal_id;                  /* goal being driven to (0 none) */
+    uint32_t goal_distance_mm;         /* POSITION goal: distance to it, mm (0 otherwise) */
+} qnav_link_pose_t;
 
 typedef struct {
     uint16_t scan_seq;                 /* sequence number of the scan this answers */
@@ -250,6 +293,9 @@ typedef struct {
     uint16_t rx_ok;                    /* sender's accepted frames (wraps) */
     uint16_t rx_dropped;               /* sender's dropped frames (wraps) */
     uint16_t policy_crc;               /* CRC of the sender's policy blob (0 none) */
+    uint8_t protocol;                  /* unpack: the sender's QNAV_LINK_PROTOCOL_VERSION (1
+                                          for a 12-byte heartbeat); pack always sends this
+                                          codec's own version */
 } qnav_link_heartbeat_t;
 
 /* Pack into out (cap bytes); return bytes written or QNAV_LINK_E_NULL/_SPACE/_VALUE.
@@ -273,7 +319,11 @@ int32_t qnav_link_policy_ack_pack(const qnav_link_policy_ack_t *m, uint8_t *out,
 int32_t qnav_link_policy_ack_unpack(const uint8_t *p, uint16_t len,
                                     qnav_link_policy_ack_t *m);
 int32_t qnav_link_heartbeat_pack(const qnav_link_heartbeat_t *m, uint8_t *out, uint16_t cap);
+/* Any version's heartbeat unpacks (its fields are the first 12 bytes of every version);
+ * check m->protocol before acting on it. */
 int32_t qnav_link_heartbeat_unpack(const uint8_t *p, uint16_t len, qnav_link_heartbeat_t *m);
+int32_t qnav_link_pose_pack(const qnav_link_pose_t *m, uint8_t *out, uint16_t cap);
+int32_t qnav_link_pose_unpack(const uint8_t *p, uint16_t len, qnav_link_pose_t *m);
 
 /* ---- Policy blobs (what an upload carries) -------------------------------------------- */
 
@@ -283,6 +333,10 @@ int32_t qnav_link_heartbeat_unpack(const uint8_t *p, uint16_t len, qnav_link_hea
  * QNAV_LINK_E_NULL / _VALUE (unknown kind, H out of range) / _SPACE.
  */
 int32_t qnav_link_policy_to_blob(const qnav_policy_t *policy, uint8_t *out, uint16_t cap);
+
+/* The CRC-16 of a policy's blob: what heartbeats, acks and commands call the policy's
+ * CRC (0 when it cannot be serialised). */
+uint16_t qnav_link_policy_crc(const qnav_policy_t *policy);
 
 /* Parse a blob back; QNAV_LINK_OK or QNAV_LINK_E_NULL / _LENGTH / _VALUE. */
 int32_t qnav_link_policy_from_blob(const uint8_t *blob, uint16_t len, qnav_policy_t *policy);

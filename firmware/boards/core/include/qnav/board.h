@@ -1,0 +1,173 @@
+/*
+ * The qnav board core: the one board application that runs on every robot and in the
+ * software-in-the-loop simulator. A 10 Hz loop reads the sonar, heading and wheel
+ * encoders through qnav_board_hal_t, dead-reckons the pose, talks to navbridge over the
+ * serial link (heartbeat with the protocol version, scan, pose, goal, command, policy
+ * upload and commit) and drives. In onboard mode it runs libqnav itself (the built-in
+ * hand-tuned policy, or an uploaded one that a commit also writes to non-volatile storage
+ * and the next start-up loads); in offboard mode it sends scans and applies navbridge's
+ * commands. The drive stops whenever the link goes quiet, a stop is commanded, the peer
+ * speaks another protocol version, or there is no goal.
+ *
+ * Use: qnav_board_config_default() (or a board's own, e.g. qnav_tekbot_config_default())
+ * -> edit -> qnav_board_init() -> call qnav_board_poll() as often as possible (it drains
+ * the UART and runs a tick every tick_ms). A platform with its own clock (the SIL robot)
+ * calls qnav_board_receive() and qnav_board_tick() itself.
+ *
+ * Odometry frame: origin = the robot centre at start-up, x axis = heading 0 of the heading
+ * sensor, y axis 90 deg counter-clockwise of it, millimetres. The pose integrates the mean
+ * of the two wheels' travel along the mid-tick heading (docs/hil.md: units and drift).
+ */
+#ifndef QNAV_BOARD_H
+#define QNAV_BOARD_H
+
+#include <stdint.h>
+
+#include "qnav/board_hal.h"
+#include "qnav/ctrl.h"
+#include "qnav/link.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    QNAV_BOARD_OK = 0,
+    QNAV_BOARD_E_NULL = -1,     /* a required pointer or HAL function was null */
+    QNAV_BOARD_E_CONFIG = -2,   /* a config field is out of range */
+    QNAV_BOARD_E_CTRL = -3      /* the controller refused the built-in policy */
+} qnav_board_status_t;
+
+/* Where the running policy came from (heartbeat: QNAV_LINK_STATE_STORED when not BUILTIN). */
+typedef enum {
+    QNAV_BOARD_POLICY_BUILTIN = 0,  /* the hand-tuned probabilistic policy compiled in */
+    QNAV_BOARD_POLICY_STORED = 1,   /* loaded from non-volatile storage at start-up */
+    QNAV_BOARD_POLICY_UPLOADED = 2  /* committed over the link since start-up */
+} qnav_board_policy_source_t;
+
+typedef struct {
+    uint16_t n_sectors;          /* sonar sectors the HAL delivers, 1..QNAV_LINK_MAX_SECTORS */
+    qnav_mm_t max_range_mm;      /* sonar maximum range, mm (> 0) */
+    uint16_t tick_ms;            /* control period, ms (100 = 10 Hz) */
+    uint16_t link_timeout_ms;    /* the drive stops after this long without a good frame, ms */
+    qnav_mm_t body_radius_mm;    /* centre to the farthest point of the body, mm: the
+                                    controller's obstacle enlargement (docs/architecture.md) */
+    qnav_mm_t safety_mm;         /* safety distance added to the radius, mm */
+    qnav_mm_t sonar_offset_mm;   /* centre to the transducers, mm (ranges start there) */
+    uint16_t v_max_mm_s;         /* speed at full command, mm/s (speed guard) */
+    uint16_t decel_mm_s2;        /* braking deceleration, mm/s^2; 0: no speed guard */
+    uint16_t um_per_count;       /* wheel travel per encoder count, micrometres (> 0) */
+    uint16_t nvm_offset;         /* first byte of the policy store in the HAL's storage;
+                                    it takes QNAV_BOARD_STORE_BYTES bytes */
+} qnav_board_config_t;
+
+/* The policy store: two slots, each [magic 'Q' 'P'][format 1][sequence u8][blob length
+ * u16][CRC-16 u16 over format, sequence, length and blob][blob]. A commit writes the slot
+ * not in use (magic erased first, written last), so a power cut mid-write leaves the other
+ * slot, and the newest whole slot is loaded at start-up. */
+#define QNAV_BOARD_STORE_FORMAT 1u
+#define QNAV_BOARD_STORE_HEADER_BYTES 8u
+#define QNAV_BOARD_STORE_SLOT_BYTES (QNAV_BOARD_STORE_HEADER_BYTES + QNAV_LINK_POLICY_MAX_BYTES)
+#define QNAV_BOARD_STORE_BYTES (2u * QNAV_BOARD_STORE_SLOT_BYTES)
+
+/* Counters for tests and the debugger. */
+typedef struct {
+    uint32_t ticks;              /* control ticks run */
+    uint32_t stopped_ticks;      /* ticks with the drive held at 0 */
+    uint32_t link_lost;          /* transitions into link-quiet */
+    uint32_t uploads_ok;         /* policies accepted */
+    uint32_t uploads_refused;    /* policy commits refused */
+    uint32_t store_writes_failed;/* commits whose storage write failed (runs from RAM) */
+    uint32_t peer_refused;       /* heartbeats of another protocol version, ignored */
+    uint8_t peer_protocol;       /* version of the last heartbeat heard (0 none) */
+    uint32_t commands;           /* offboard commands received */
+    uint16_t last_command_seq;   /* scan_seq of the newest of them */
+    uint16_t last_scan_seq;      /* link sequence number of the last scan sent */
+} qnav_board_stats_t;
+
+/* Dead-reckoned pose. */
+typedef struct {
+    int32_t x_um;                /* odometry frame, micrometres (+-2147 m) */
+    int32_t y_um;
+    qnav_cdeg_t heading_cdeg;    /* the heading sensor's, 0.01 deg */
+} qnav_board_pose_t;
+
+/* The application; caller-owned (one static on the MCU). Fields are private. */
+typedef struct {
+    qnav_board_config_t cfg;
+    qnav_board_hal_t hal;
+    qnav_link_rx_t rx;
+    qnav_link_tx_t tx;
+    qnav_link_upload_t upload;
+    qnav_ctrl_t ctrl;
+    qnav_policy_t policy;        /* the policy ctrl was made from */
+    uint16_t policy_crc;
+    uint8_t policy_source;       /* qnav_board_policy_source_t */
+    uint8_t store_slot;          /* slot the running stored policy is in (0/1), 0xFF none */
+    uint8_t store_seq;           /* its sequence number */
+    uint8_t ctrl_ready;
+    uint8_t mode;                /* QNAV_LINK_MODE_* last requested by the bridge (0 none) */
+    uint8_t hold_stop;           /* a stop was commanded and not yet cleared */
+    uint8_t link_ok;             /* a good frame arrived within link_timeout_ms */
+    uint8_t have_goal;
+    qnav_link_goal_t goal;
+    qnav_link_command_t cmd;     /* last offboard command */
+    uint32_t cmd_ms;             /* when it arrived */
+    uint32_t last_rx_ms;         /* last good frame */
+    uint8_t heard;               /* any good frame since start */
+    uint32_t next_tick_ms;
+    qnav_board_pose_t pose;
+    int32_t odo_left, odo_right; /* encoder counts at the last tick */
+    qnav_mm_t ranges[QNAV_LINK_MAX_SECTORS];
+    uint8_t wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
+    qnav_board_stats_t stats;
+} qnav_board_t;
+
+/* Defaults: 8 sectors, 5000 mm, 100 ms tick, 300 ms link timeout, no
+ * body margin and no speed guard, 1000 um per count, store at byte 0. */
+void qnav_board_config_default(qnav_board_config_t *cfg);
+
+/* Check cfg and hal, start the link, load the newest whole policy from storage (the
+ * built-in policy when there is none or it is corrupt), start the controller; the drive
+ * is set to 0. Returns QNAV_BOARD_OK, _E_NULL, _E_CONFIG or _E_CTRL. */
+qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t *cfg,
+                                    const qnav_board_hal_t *hal);
+
+/* Drain the UART (qnav_board_receive) and run a control tick when tick_ms has passed. */
+void qnav_board_poll(qnav_board_t *bot);
+
+/* Read and act on at most 128 waiting UART bytes. */
+void qnav_board_receive(qnav_board_t *bot);
+
+/* One control tick now: odometry, sense, decide, drive, report (scan, heartbeat, pose,
+ * onboard decision). */
+void qnav_board_tick(qnav_board_t *bot);
+
+/* Counters and the pose (read-only views). */
+const qnav_board_stats_t *qnav_board_stats(const qnav_board_t *bot);
+const qnav_board_pose_t *qnav_board_pose(const qnav_board_t *bot);
+qnav_board_policy_source_t qnav_board_policy_source(const qnav_board_t *bot);
+
+/* Differential drive from a decision: forward part falls linearly to 0 at spin_deg, the
+ * turn part is proportional to heading and saturates at 90 deg. Outputs Q1.15, signed. */
+void qnav_board_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_deg_t spin_deg,
+                    qnav_q1_15_t *left, qnav_q1_15_t *right);
+
+/*
+ * Integer trigonometry for the pose (CORDIC, 16 iterations, no tables in RAM).
+ * qnav_board_cos_sin: cos and sin of a (0.01 deg, any value) in Q2.14 (16384 = 1),
+ * error <= 2/16384. qnav_board_atan2: direction of (x, y) in 0.01 deg, -18000..17999
+ * (0 for the origin), error <= 1 cdeg for |x|, |y| up to 2^21; *dist (may be NULL) its
+ * length, same unit as x and y, error <= 0.1 % + 2.
+ * @par Scaling and overflow: inputs are clamped to +-2^21.
+ */
+void qnav_board_cos_sin(int32_t a_cdeg, int16_t *cos_q14, int16_t *sin_q14);
+/* An angle in 0.01 deg wrapped into -18000..17999. */
+qnav_cdeg_t qnav_board_wrap_cdeg(int32_t a_cdeg);
+qnav_cdeg_t qnav_board_atan2(int32_t y, int32_t x, uint32_t *dist);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* QNAV_BOARD_H */

@@ -1,0 +1,506 @@
+/*
+ * The board core (qnav/board.h): link frames in, a 10 Hz control tick, scans, pose,
+ * telemetry and heartbeats out, the drive through the HAL, uploads kept in non-volatile
+ * storage. No heap, integers only, no file-scope state: everything lives in the caller's
+ * qnav_board_t.
+ */
+#include "qnav/board.h"
+
+#include <stddef.h>
+#include <string.h>
+
+#include "board_store.h"
+
+/* Most UART bytes handled per receive, so one poll never starves the tick. */
+#define UART_BURST 128u
+
+/* Turn part at |heading| >= 90 deg: half of full wheel speed, Q1.15. */
+#define TURN_MAX ((int32_t)16384)
+
+/* Largest wheel travel integrated in one piece, um: keeps travel * cos in Q2.14 inside
+ * int32 (131000 * 16384 < 2^31). */
+#define STEP_MAX_UM INT32_C(131000)
+
+void qnav_board_config_default(qnav_board_config_t *cfg)
+{
+    if (cfg == NULL) {
+        return;
+    }
+    cfg->n_sectors = 8;
+    cfg->max_range_mm = 5000;
+    cfg->tick_ms = 100;
+    cfg->link_timeout_ms = 300;
+    cfg->body_radius_mm = 0;
+    cfg->safety_mm = 0;
+    cfg->sonar_offset_mm = 0;
+    cfg->v_max_mm_s = 500;
+    cfg->decel_mm_s2 = 0;
+    cfg->um_per_count = 1000;
+    cfg->nvm_offset = 0;
+}
+
+/* The controller configuration this board's sonar and body give. */
+static void ctrl_config(const qnav_board_config_t *cfg, qnav_ctrl_config_t *cc)
+{
+    qnav_ctrl_config_default(cc);
+    cc->n_sectors = cfg->n_sectors;
+    cc->max_range_mm = cfg->max_range_mm;
+    cc->body_radius_mm = cfg->body_radius_mm;
+    cc->safety_mm = cfg->safety_mm;
+    cc->sensor_offset_mm = cfg->sonar_offset_mm;
+    cc->v_max_mm_s = cfg->v_max_mm_s;
+    cc->decel_mm_s2 = cfg->decel_mm_s2;
+}
+
+static qnav_q1_15_t sat_q15(int32_t v)
+{
+    if (v > INT32_C(32767)) {
+        return 32767;
+    }
+    if (v < -INT32_C(32767)) {
+        return -32767;
+    }
+    return (qnav_q1_15_t)v;
+}
+
+void qnav_board_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_deg_t spin_deg,
+                    qnav_q1_15_t *left, qnav_q1_15_t *right)
+{
+    int32_t h = heading_deg;
+    int32_t mag = h < 0 ? -h : h;
+    int32_t fwd;
+    int32_t turn;
+    if (left == NULL || right == NULL) {
+        return;
+    }
+    if (speed <= 0) {
+        *left = 0;
+        *right = 0;
+        return;
+    }
+    if (spin_deg < 1) {
+        spin_deg = 1;
+    }
+    fwd = mag >= spin_deg ? 0 : ((int32_t)speed * (spin_deg - mag)) / spin_deg;
+    turn = (mag >= 90 ? TURN_MAX : (TURN_MAX * mag) / 90) * (h < 0 ? -1 : 1);
+    /* counter-clockwise (positive) heading: the right wheel runs faster */
+    *left = sat_q15(fwd - turn);
+    *right = sat_q15(fwd + turn);
+}
+
+/* The stored policy when one is whole and the controller takes it, else the built-in. */
+static void load_policy(qnav_board_t *bot)
+{
+    qnav_ctrl_config_t cc;
+    qnav_policy_t stored;
+    uint16_t crc = 0;
+    uint8_t slot = 0xFFu;
+    uint8_t seq = 0;
+    ctrl_config(&bot->cfg, &cc);
+    bot->store_slot = 0xFFu;
+    bot->store_seq = 0;
+    if (qnav_board_store_load(&bot->hal, bot->cfg.nvm_offset, &stored, &crc, &slot, &seq)) {
+        /* the slot is remembered even if refused, so the next commit keeps it intact */
+        bot->store_slot = slot;
+        bot->store_seq = seq;
+        if (qnav_ctrl_init(&bot->ctrl, &cc, &stored) == QNAV_OK) {
+            bot->policy = stored;
+            bot->policy_crc = crc;
+            bot->policy_source = QNAV_BOARD_POLICY_STORED;
+            bot->ctrl_ready = 1;
+            return;
+        }
+    }
+    qnav_policy_prob_default(&bot->policy);
+    bot->policy_source = QNAV_BOARD_POLICY_BUILTIN;
+    bot->ctrl_ready = (uint8_t)(qnav_ctrl_init(&bot->ctrl, &cc, &bot->policy) == QNAV_OK);
+    bot->policy_crc = qnav_link_policy_crc(&bot->policy);
+}
+
+qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t *cfg,
+                                    const qnav_board_hal_t *hal)
+{
+    if (bot == NULL || cfg == NULL || hal == NULL || hal->millis == NULL ||
+        hal->sonar_read == NULL || hal->heading_cdeg == NULL || hal->drive == NULL ||
+        hal->uart_read == NULL || hal->uart_write == NULL) {
+        return QNAV_BOARD_E_NULL;
+    }
+    if (cfg->n_sectors < 1u || cfg->n_sectors > QNAV_LINK_MAX_SECTORS ||
+        cfg->max_range_mm == 0u || cfg->tick_ms == 0u || cfg->link_timeout_ms == 0u ||
+        cfg->um_per_count == 0u) {
+        return QNAV_BOARD_E_CONFIG;
+    }
+    /* everything starts at zero (no mode, no goal, link not heard, counters 0, pose at
+     * the origin) */
+    memset(bot, 0, sizeof *bot);
+    bot->cfg = *cfg;
+    bot->hal = *hal;
+    qnav_link_rx_init(&bot->rx);
+    qnav_link_tx_init(&bot->tx);
+    qnav_link_upload_init(&bot->upload);
+    bot->cmd.flags = QNAV_LINK_CMD_STOP;
+    bot->hal.drive(bot->hal.ctx, 0, 0);
+    load_policy(bot);
+    if (bot->hal.odometry_read != NULL) {
+        bot->hal.odometry_read(bot->hal.ctx, &bot->odo_left, &bot->odo_right);
+    }
+    bot->pose.heading_cdeg = bot->hal.heading_cdeg(bot->hal.ctx);
+    bot->next_tick_ms = bot->hal.millis(bot->hal.ctx);
+    return bot->ctrl_ready ? QNAV_BOARD_OK : QNAV_BOARD_E_CTRL;
+}
+
+static void send(qnav_board_t *bot, uint8_t id, const uint8_t *payload, int32_t len)
+{
+    (void)qnav_link_send(&bot->tx, id, payload, len, bot->wire, (uint16_t)sizeof bot->wire,
+                         bot->hal.uart_write, bot->hal.ctx);
+}
+
+/* A committed upload: switch controllers only when the new one initialises, then keep it
+ * in storage (the drive is stopped first: an EEPROM write blocks for milliseconds a byte). */
+static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm)
+{
+    qnav_policy_t fresh;
+    qnav_ctrl_config_t cc;
+    qnav_link_policy_ack_t ack;
+    uint8_t p[QNAV_LINK_POLICY_ACK_BYTES];
+    uint16_t crc;
+    int8_t status = qnav_link_upload_commit(&bot->upload, cm, &fresh);
+
+    if (status == QNAV_LINK_ACK_OK) {
+        ctrl_config(&bot->cfg, &cc);
+        if (qnav_ctrl_init(&bot->ctrl, &cc, &fresh) == QNAV_OK) {
+            bot->policy = fresh;
+            bot->policy_crc = cm->crc;
+            bot->policy_source = QNAV_BOARD_POLICY_UPLOADED;
+            bot->ctrl_ready = 1;
+            bot->stats.uploads_ok++;
+            bot->hal.drive(bot->hal.ctx, 0, 0);
+            if (!qnav_board_store_save(&bot->hal, bot->cfg.nvm_offset, &fresh, &crc,
+                                       &bot->store_slot, &bot->store_seq)) {
+                bot->stats.store_writes_failed++;
+            }
+        } else {
+            /* keep driving with the policy we had */
+            bot->ctrl_ready =
+                (uint8_t)(qnav_ctrl_init(&bot->ctrl, &cc, &bot->policy) == QNAV_OK);
+            status = QNAV_LINK_ACK_REJECTED;
+        }
+    }
+    if (status != QNAV_LINK_ACK_OK) {
+        bot->stats.uploads_refused++;
+    }
+    ack.status = status;
+    ack.reserved = 0;
+    ack.crc = bot->policy_crc;
+    send(bot, QNAV_LINK_MSG_POLICY_ACK, p, qnav_link_policy_ack_pack(&ack, p, sizeof p));
+}
+
+static void on_heartbeat(qnav_board_t *bot, const qnav_link_frame_t *f)
+{
+    qnav_link_heartbeat_t hb;
+    if (qnav_link_heartbeat_unpack(f->payload, f->len, &hb) != QNAV_LINK_OK) {
+        return;
+    }
+    bot->stats.peer_protocol = hb.protocol;
+    if (hb.protocol != QNAV_LINK_PROTOCOL_VERSION) {
+        /* a bridge of another version: its mode and goals are not ours to follow */
+        bot->stats.peer_refused++;
+        bot->mode = 0;
+        return;
+    }
+    if (hb.mode == QNAV_LINK_MODE_OFFBOARD || hb.mode == QNAV_LINK_MODE_ONBOARD) {
+        bot->mode = hb.mode;
+    }
+    bot->hold_stop = (uint8_t)((hb.state & QNAV_LINK_STATE_STOPPED) != 0u);
+}
+
+static void on_frame(qnav_board_t *bot, const qnav_link_frame_t *f, uint32_t now)
+{
+    bot->last_rx_ms = now;
+    bot->heard = 1;
+    switch (f->msg_id) {
+    case QNAV_LINK_MSG_GOAL: {
+        qnav_link_goal_t g;
+        if (qnav_link_goal_unpack(f->payload, f->len, &g) == QNAV_LINK_OK) {
+            bot->goal = g;
+            bot->have_goal = (uint8_t)(g.goal_id != 0u);
+        }
+        break;
+    }
+    case QNAV_LINK_MSG_COMMAND: {
+        qnav_link_command_t c;
+        if (qnav_link_command_unpack(f->payload, f->len, &c) == QNAV_LINK_OK) {
+            if (c.flags & QNAV_LINK_CMD_STOP) {
+                bot->hold_stop = 1;
+            } else if (bot->mode == QNAV_LINK_MODE_OFFBOARD) {
+                bot->hold_stop = 0;
+            }
+            bot->cmd = c;
+            bot->cmd_ms = now;
+            bot->stats.commands++;
+            bot->stats.last_command_seq = c.scan_seq;
+        }
+        break;
+    }
+    case QNAV_LINK_MSG_HEARTBEAT:
+        on_heartbeat(bot, f);
+        break;
+    case QNAV_LINK_MSG_POLICY_CHUNK: {
+        qnav_link_policy_chunk_t c;
+        if (qnav_link_policy_chunk_unpack(f->payload, f->len, &c) == QNAV_LINK_OK) {
+            (void)qnav_link_upload_chunk(&bot->upload, &c);
+        }
+        break;
+    }
+    case QNAV_LINK_MSG_POLICY_COMMIT: {
+        qnav_link_policy_commit_t cm;
+        if (qnav_link_policy_commit_unpack(f->payload, f->len, &cm) == QNAV_LINK_OK) {
+            commit_upload(bot, &cm);
+        }
+        break;
+    }
+    default:
+        break; /* scans, poses and acks only flow to the bridge */
+    }
+}
+
+void qnav_board_receive(qnav_board_t *bot)
+{
+    uint16_t k;
+    uint32_t now;
+    qnav_link_frame_t f;
+    if (bot == NULL) {
+        return;
+    }
+    now = bot->hal.millis(bot->hal.ctx);
+    for (k = 0; k < UART_BURST; ++k) {
+        int16_t b = bot->hal.uart_read(bot->hal.ctx);
+        if (b < 0) {
+            break;
+        }
+        if (qnav_link_rx_feed(&bot->rx, (uint8_t)b, &f)) {
+            on_frame(bot, &f, now);
+        }
+    }
+}
+
+void qnav_board_poll(qnav_board_t *bot)
+{
+    uint32_t now;
+    if (bot == NULL) {
+        return;
+    }
+    qnav_board_receive(bot);
+    now = bot->hal.millis(bot->hal.ctx);
+    if ((int32_t)(now - bot->next_tick_ms) >= 0) {
+        bot->next_tick_ms += bot->cfg.tick_ms;
+        if ((int32_t)(now - bot->next_tick_ms) > (int32_t)bot->cfg.tick_ms) {
+            bot->next_tick_ms = now + bot->cfg.tick_ms; /* fell behind: do not burst */
+        }
+        qnav_board_tick(bot);
+    }
+}
+
+/* Dead reckoning: the mean wheel travel since the last tick along the mid-tick heading. */
+static void update_pose(qnav_board_t *bot)
+{
+    int32_t l = bot->odo_left;
+    int32_t r = bot->odo_right;
+    int32_t step;
+    int16_t c;
+    int16_t s;
+    qnav_cdeg_t h = bot->hal.heading_cdeg(bot->hal.ctx);
+    qnav_cdeg_t h0 = bot->pose.heading_cdeg;
+    if (bot->hal.odometry_read != NULL) {
+        bot->hal.odometry_read(bot->hal.ctx, &l, &r);
+    }
+    /* counts wrap at 2^32: differences in unsigned arithmetic; a tick moves far less
+     * than 2^15 counts */
+    step = (int32_t)(int16_t)(uint16_t)((uint32_t)l - (uint32_t)bot->odo_left) +
+           (int32_t)(int16_t)(uint16_t)((uint32_t)r - (uint32_t)bot->odo_right);
+    bot->odo_left = l;
+    bot->odo_right = r;
+    step = (step * (int32_t)bot->cfg.um_per_count) / 2;
+    qnav_board_cos_sin((int32_t)h0 + (int32_t)qnav_board_wrap_cdeg((int32_t)h - (int32_t)h0) / 2,
+                       &c, &s);
+    /* in pieces that keep piece * cos inside int32 (a long stall moves far in one tick) */
+    while (step != 0) {
+        int32_t piece = step > STEP_MAX_UM ? STEP_MAX_UM
+                                           : (step < -STEP_MAX_UM ? -STEP_MAX_UM : step);
+        bot->pose.x_um += (int32_t)((piece * (int32_t)c) / (int32_t)16384);
+        bot->pose.y_um += (int32_t)((piece * (int32_t)s) / (int32_t)16384);
+        step -= piece;
+    }
+    bot->pose.heading_cdeg = h;
+}
+
+/* Robot-frame destination bearing for the current goal; *dist_mm for a position goal. */
+static qnav_cdeg_t goal_bearing(qnav_board_t *bot, uint32_t *dist_mm)
+{
+    *dist_mm = 0;
+    if (!bot->have_goal) {
+        return 0;
+    }
+    if (bot->goal.kind == QNAV_LINK_GOAL_POSITION) {
+        int32_t dx = bot->goal.x_mm - bot->pose.x_um / (int32_t)1000;
+        int32_t dy = bot->goal.y_mm - bot->pose.y_um / (int32_t)1000;
+        qnav_cdeg_t world = qnav_board_atan2(dy, dx, dist_mm);
+        return qnav_board_wrap_cdeg((int32_t)world - (int32_t)bot->pose.heading_cdeg);
+    }
+    return qnav_board_wrap_cdeg((int32_t)bot->goal.bearing_cdeg -
+                                (int32_t)bot->pose.heading_cdeg);
+}
+
+static void send_scan(qnav_board_t *bot, uint32_t now, qnav_cdeg_t bearing)
+{
+    /* packed straight from the ranges buffer (no second copy on the MCU) */
+    uint8_t p[QNAV_LINK_MAX_PAYLOAD];
+    uint16_t len = (uint16_t)(QNAV_LINK_SCAN_HEADER_BYTES + 2u * bot->cfg.n_sectors);
+    uint16_t gid = bot->have_goal ? bot->goal.goal_id : 0u;
+    uint16_t k;
+    p[0] = (uint8_t)(now & 0xFFu);
+    p[1] = (uint8_t)((now >> 8) & 0xFFu);
+    p[2] = (uint8_t)((now >> 16) & 0xFFu);
+    p[3] = (uint8_t)(now >> 24);
+    p[4] = (uint8_t)((uint16_t)bearing & 0xFFu);
+    p[5] = (uint8_t)((uint16_t)bearing >> 8);
+    p[6] = (uint8_t)(bot->cfg.max_range_mm & 0xFFu);
+    p[7] = (uint8_t)(bot->cfg.max_range_mm >> 8);
+    p[8] = (uint8_t)(bot->cfg.n_sectors & 0xFFu);
+    p[9] = (uint8_t)(bot->cfg.n_sectors >> 8);
+    p[10] = (uint8_t)(gid & 0xFFu);
+    p[11] = (uint8_t)(gid >> 8);
+    for (k = 0; k < bot->cfg.n_sectors; ++k) {
+        p[QNAV_LINK_SCAN_HEADER_BYTES + 2u * k] = (uint8_t)(bot->ranges[k] & 0xFFu);
+        p[QNAV_LINK_SCAN_HEADER_BYTES + 2u * k + 1u] = (uint8_t)(bot->ranges[k] >> 8);
+    }
+    bot->stats.last_scan_seq = bot->tx.next_seq;
+    send(bot, QNAV_LINK_MSG_SCAN, p, (int32_t)len);
+}
+
+static void send_status(qnav_board_t *bot, uint32_t now, uint8_t moving, uint32_t dist_mm)
+{
+    qnav_link_heartbeat_t hb;
+    qnav_link_pose_t ps;
+    uint8_t p[QNAV_LINK_POSE_BYTES > QNAV_LINK_HEARTBEAT_BYTES ? QNAV_LINK_POSE_BYTES
+                                                               : QNAV_LINK_HEARTBEAT_BYTES];
+    hb.uptime_ms = now;
+    hb.mode = bot->mode;
+    hb.state = (uint8_t)((bot->link_ok ? QNAV_LINK_STATE_LINK_OK : 0u) |
+                         (moving ? QNAV_LINK_STATE_MOVING : 0u) |
+                         (bot->ctrl_ready ? QNAV_LINK_STATE_POLICY : 0u) |
+                         (moving ? 0u : QNAV_LINK_STATE_STOPPED) |
+                         (bot->policy_source != QNAV_BOARD_POLICY_BUILTIN
+                              ? QNAV_LINK_STATE_STORED
+                              : 0u));
+    hb.rx_ok = (uint16_t)bot->rx.stats.frames_ok;
+    hb.rx_dropped = (uint16_t)qnav_link_rx_dropped_total(&bot->rx);
+    hb.policy_crc = bot->policy_crc;
+    hb.protocol = QNAV_LINK_PROTOCOL_VERSION;
+    send(bot, QNAV_LINK_MSG_HEARTBEAT, p, qnav_link_heartbeat_pack(&hb, p, sizeof p));
+    ps.board_ms = now;
+    ps.x_mm = bot->pose.x_um / (int32_t)1000;
+    ps.y_mm = bot->pose.y_um / (int32_t)1000;
+    ps.heading_cdeg = bot->pose.heading_cdeg;
+    ps.goal_id = bot->have_goal ? bot->goal.goal_id : 0u;
+    ps.goal_distance_mm = dist_mm;
+    send(bot, QNAV_LINK_MSG_POSE, p, qnav_link_pose_pack(&ps, p, sizeof p));
+}
+
+/* This tick's decision: the controller's (onboard) or navbridge's fresh command
+ * (offboard); zero otherwise. */
+static void decide(qnav_board_t *bot, uint32_t now, const qnav_ctrl_input_t *in,
+                   qnav_ctrl_output_t *out)
+{
+    out->heading_deg = 0;
+    out->speed = 0;
+    out->quality = 0;
+    out->flags = 0;
+    if (bot->mode == QNAV_LINK_MODE_ONBOARD) {
+        qnav_ctrl_step(&bot->ctrl, in, out, NULL);
+    } else if (bot->mode == QNAV_LINK_MODE_OFFBOARD &&
+               (now - bot->cmd_ms) <= bot->cfg.link_timeout_ms) {
+        out->heading_deg = bot->cmd.heading_deg;
+        out->speed = bot->cmd.speed;
+        out->quality = bot->cmd.quality;
+        out->flags = (uint8_t)(bot->cmd.flags & 0x7Fu);
+    }
+}
+
+void qnav_board_tick(qnav_board_t *bot)
+{
+    qnav_link_command_t tel;
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+    uint8_t p[QNAV_LINK_COMMAND_BYTES];
+    uint32_t now;
+    uint32_t dist_mm;
+    uint16_t n;
+    uint16_t k;
+    uint16_t scan_seq;
+    uint8_t was_ok;
+    uint8_t moving;
+
+    if (bot == NULL) {
+        return;
+    }
+    now = bot->hal.millis(bot->hal.ctx);
+    bot->stats.ticks++;
+    was_ok = bot->link_ok;
+    bot->link_ok = (uint8_t)(bot->heard && (now - bot->last_rx_ms) <= bot->cfg.link_timeout_ms);
+    if (was_ok && !bot->link_ok) {
+        bot->stats.link_lost++;
+        qnav_link_rx_reset_seq(&bot->rx); /* the bridge may come back restarted */
+        qnav_link_upload_init(&bot->upload);
+    }
+
+    /* sense */
+    update_pose(bot);
+    n = bot->hal.sonar_read(bot->hal.ctx, bot->ranges, bot->cfg.n_sectors);
+    for (k = n; k < bot->cfg.n_sectors; ++k) {
+        bot->ranges[k] = bot->cfg.max_range_mm; /* a missing sonar reads as clear */
+    }
+    in.ranges_mm = bot->ranges;
+    in.goal_bearing_cdeg = goal_bearing(bot, &dist_mm);
+
+    decide(bot, now, &in, &out);
+    moving = (uint8_t)(bot->link_ok && !bot->hold_stop && bot->have_goal && bot->mode != 0u &&
+                       out.speed > 0);
+    if (!moving) {
+        out.speed = 0;
+        bot->stats.stopped_ticks++;
+    }
+    /* act: the drive is set every tick, to 0 whenever anything is wrong */
+    bot->hal.drive(bot->hal.ctx, moving ? out.heading_deg : 0, out.speed);
+
+    /* report: scan, heartbeat (before the decision, so the bridge labels it with the
+     * current policy), pose, onboard decision */
+    send_scan(bot, now, in.goal_bearing_cdeg);
+    scan_seq = bot->stats.last_scan_seq;
+    send_status(bot, now, moving, dist_mm);
+    if (bot->mode == QNAV_LINK_MODE_ONBOARD) {
+        tel.scan_seq = scan_seq;
+        tel.heading_deg = out.heading_deg;
+        tel.speed = out.speed;
+        tel.quality = out.quality;
+        tel.flags = (uint8_t)(out.flags | (moving ? 0u : QNAV_LINK_CMD_STOP));
+        tel.reserved = 0;
+        send(bot, QNAV_LINK_MSG_COMMAND, p, qnav_link_command_pack(&tel, p, sizeof p));
+    }
+}
+
+const qnav_board_stats_t *qnav_board_stats(const qnav_board_t *bot)
+{
+    return bot != NULL ? &bot->stats : NULL;
+}
+
+const qnav_board_pose_t *qnav_board_pose(const qnav_board_t *bot)
+{
+    return bot != NULL ? &bot->pose : NULL;
+}
+
+qnav_board_policy_source_t qnav_board_policy_source(const qnav_board_t *bot)
+{
+    return bot != NULL ? (qnav_board_policy_source_t)bot->policy_source
+                       : QNAV_BOARD_POLICY_BUILTIN;
+}
