@@ -83,8 +83,8 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
     cmd->heading_deg = out.heading_deg;
     cmd->speed_q15 = out.speed;
     cmd->quality_q15 = out.quality;
-    cmd->speed = out.speed / 32768.0;
-    cmd->quality = out.quality / 32768.0;
+    cmd->speed = QNAV_Q1_15_TO_REAL(out.speed);
+    cmd->quality = QNAV_Q1_15_TO_REAL(out.quality);
     cmd->flags = (int8_t)out.flags;
     cmd->stop_reason = QNAV_STOP_NONE;
     cmd->source = QNAV_SOURCE_BRIDGE;
@@ -299,7 +299,7 @@ static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
     q.scan_seq = s.seq;
     q.best_deg = c.heading_deg;
     for (k = 0; k < QNAV_PATHS; ++k) {
-        q.quality[k] = (float)q.quality_q15[k] / 32768.0f;
+        q.quality[k] = (float)QNAV_Q1_15_TO_REAL(q.quality_q15[k]);
     }
     PUBLISH(b, QNAV_CH_QUALITIES, qnav_path_qualities_t, &q);
 }
@@ -320,8 +320,8 @@ static void on_board_command(qnav_bridge_t *b, const qnav_link_frame_t *f)
     c.heading_deg = lc.heading_deg;
     c.speed_q15 = lc.speed;
     c.quality_q15 = lc.quality;
-    c.speed = lc.speed / 32768.0;
-    c.quality = lc.quality / 32768.0;
+    c.speed = QNAV_Q1_15_TO_REAL(lc.speed);
+    c.quality = QNAV_Q1_15_TO_REAL(lc.quality);
     c.flags = (int8_t)(lc.flags & 0x7Fu);
     c.stop_reason = (lc.flags & QNAV_LINK_CMD_STOP) ? QNAV_STOP_BOARD : QNAV_STOP_NONE;
     c.source = QNAV_SOURCE_BOARD;

@@ -130,7 +130,10 @@ static void on_frame(robot_t *r, const qnav_link_frame_t *f)
                 r->policy_crc = cm.crc;
                 fprintf(stderr, "qnav-sil-robot: policy uploaded (crc 0x%04x)\n", cm.crc);
             } else {
-                (void)qnav_ctrl_init(&r->ctrl, &r->ccfg, &r->policy);
+                /* keep driving with the policy that was running (it passed init before) */
+                if (qnav_ctrl_init(&r->ctrl, &r->ccfg, &r->policy) != QNAV_OK) {
+                    fprintf(stderr, "qnav-sil-robot: the running policy no longer initialises\n");
+                }
                 ack.status = QNAV_LINK_ACK_REJECTED;
             }
         }
@@ -317,7 +320,15 @@ int main(int argc, char **argv)
     qnav_sim_ctrl_config(sim, &r.ccfg);
     qnav_policy_prob_default(&r.policy);
     r.policy_crc = blob_crc(&r.policy);
-    (void)qnav_ctrl_init(&r.ctrl, &r.ccfg, &r.policy);
+    {
+        qnav_status_t cst = qnav_ctrl_init(&r.ctrl, &r.ccfg, &r.policy);
+        if (cst != QNAV_OK) {
+            fprintf(stderr, "qnav-sil-robot: the default policy does not initialise: %s\n",
+                    qnav_status_str(cst));
+            rc = 2;
+            goto out;
+        }
+    }
 
     /* wait for navbridge: its heartbeats tell the mode */
     t_start = mono_ms();
@@ -366,7 +377,8 @@ int main(int argc, char **argv)
 
         memset(&out, 0, sizeof out);
         if (r.mode == QNAV_LINK_MODE_ONBOARD) {
-            qnav_ctrl_input_t in = {scan.ranges_mm, scan.goal_bearing_cdeg};
+            qnav_ctrl_input_t in = {scan.ranges_mm, scan.goal_bearing_cdeg,
+                                    scan.prev_heading_cdeg};
             qnav_link_command_t tel;
             qnav_ctrl_step(&r.ctrl, &in, &out, NULL);
             /* like the board: hold still while stopped or when the bridge went quiet */

@@ -266,7 +266,7 @@ qnav_sim_status_t qnav_sim_scan(const qnav_sim_t *sim, qnav_sim_scan_t *scan) {
 qnav_sim_status_t qnav_sim_command(qnav_sim_t *sim, const qnav_ctrl_output_t *out) {
     if (!sim || !out) return QNAV_SIM_E_NULL;
     if (!sim->sim->started()) return QNAV_SIM_E_STATE;
-    sim->sim->command(out->heading_deg, out->speed / 32768.0);
+    sim->sim->command(out->heading_deg, QNAV_Q1_15_TO_REAL(out->speed));
     return QNAV_SIM_OK;
 }
 

@@ -163,6 +163,7 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     l_m_ = 0;
     wheel_l_ = wheel_r_ = 0;
     cmd_heading_deg_ = cmd_speed_ = 0;
+    have_prev_ = false;
     target_heading_ = heading_;
     target_speed_ = 0;
     marks_.clear();
@@ -178,6 +179,9 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
 void Simulation::command(double heading_deg, double speed) {
     cmd_heading_deg_ = std::isfinite(heading_deg) ? heading_deg : 0.0;
     cmd_speed_ = std::isfinite(speed) ? std::clamp(speed, 0.0, 1.0) : 0.0;
+    // The decision in the world, from the heading the robot sensed when it made it.
+    prev_world_rad_ = sensed_heading_ + cmd_heading_deg_ * kPi / 180.0;
+    have_prev_ = true;
 }
 
 void Simulation::compute_scan() {
@@ -204,6 +208,8 @@ void Simulation::compute_scan() {
     if (ps > 0) hd += ps * kPi * rng_sensor_.normal();
     const double bearing = std::atan2(env_.dest_y_m - pos_.y, env_.dest_x_m - pos_.x) - hd;
     scan_.goal_bearing_cdeg = to_cdeg(bearing);
+    sensed_heading_ = hd;
+    scan_.prev_heading_cdeg = have_prev_ ? to_cdeg(prev_world_rad_ - hd) : 0;
     if (profiling_) prof_.sonar_s += std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
@@ -470,13 +476,14 @@ qnav_sim_result_t Simulation::run_episode(const qnav_ctrl_t *ctrl, std::uint64_t
     qnav_ctrl_output_t out;
     while (!done_) {
         in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
+        in.prev_heading_cdeg = scan_.prev_heading_cdeg;
         Clock::time_point t0;
         if (profiling_) t0 = Clock::now();
         qnav_ctrl_step(ctrl, &in, &out, nullptr);
         if (profiling_) prof_.controller_s += std::chrono::duration<double>(Clock::now() - t0).count();
         if (out.flags & QNAV_FLAG_NOT_READY)
             throw SimError(QNAV_SIM_E_PARAM, "controller: not initialised (qnav_ctrl_init failed or was not called)");
-        command(out.heading_deg, out.speed / 32768.0);
+        command(out.heading_deg, QNAV_Q1_15_TO_REAL(out.speed));
         advance();
         if (trace) {
             const qnav_sim_sample_t s = sample();

@@ -108,6 +108,9 @@ private:
     double clearance_m_ = 0;            // centre to nearest surface after the last step, m
     bool body_stale_ = false;           // Box2D body not moved since free steps
     double cmd_heading_deg_ = 0, cmd_speed_ = 0;  // last command, as given
+    double sensed_heading_ = 0;   // heading (with sensor noise) of the current scan, rad
+    double prev_world_rad_ = 0;   // last command's heading in the world, rad
+    bool have_prev_ = false;      // a command was given since reset
     double target_heading_ = 0, target_speed_ = 0;  // this tick, with actuation noise
     std::vector<double> true_dist_;  // centre distances of the last scan before noise, m
     qnav_sim_scan_t scan_{};

@@ -209,6 +209,10 @@ typedef struct {
                                               noisy, clipped to [min, max] range, mm */
     qnav_cdeg_t goal_bearing_cdeg;         /* destination bearing, robot frame, 0.01 deg,
                                               -18000..17999, from the noisy heading */
+    qnav_cdeg_t prev_heading_cdeg;         /* the last command's heading (qnav_sim_command)
+                                              in this tick's robot frame, from the same
+                                              sensed heading, 0.01 deg; 0 before the first
+                                              command: qnav_ctrl_input_t.prev_heading_cdeg */
 } qnav_sim_scan_t;
 
 /* The robot's true state. */
