@@ -42,6 +42,7 @@ void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg)
 static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg)
 {
     uint32_t q_full;
+    qnav_status_t st;
     if (ctrl == 0) {
         return QNAV_E_NULL;
     }
@@ -49,11 +50,9 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     if (cfg == 0) {
         return QNAV_E_NULL;
     }
-    if (cfg->n_sectors < 1u || cfg->n_sectors > QNAV_MAX_SECTORS) {
-        return QNAV_E_SECTORS;
-    }
-    if (cfg->max_range_mm == 0u) {
-        return QNAV_E_RANGE;
+    st = qnav_clearance_setup(&ctrl->clr, cfg);
+    if (st != QNAV_OK) {
+        return st;
     }
     if (cfg->full_speed_quality <= 0) {
         return QNAV_E_SPEED;
@@ -62,22 +61,14 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
         return QNAV_E_RANK;
     }
     q_full = (uint32_t)cfg->full_speed_quality;
-    ctrl->n_sectors = cfg->n_sectors;
-    ctrl->max_range_mm = cfg->max_range_mm;
     ctrl->full_speed_quality = cfg->full_speed_quality;
-    ctrl->level_scale = ((uint32_t)(QNAV_DIST_LEVELS - 1) * 65536u + cfg->max_range_mm / 2u) /
-                        cfg->max_range_mm;
     ctrl->speed_scale = ((uint32_t)32768u * 32768u + q_full / 2u) / q_full;
-    ctrl->sector_paths = (uint16_t)(QNAV_PATHS / cfg->n_sectors);
-    ctrl->sector_span = (uint16_t)(ctrl->sector_paths * cfg->n_sectors);
-    ctrl->first_sector_paths = (uint16_t)((QNAV_PATHS / 2u + cfg->n_sectors - 1u) / cfg->n_sectors);
     ctrl->table = 0;
     ctrl->kind = 0u;
     ctrl->hidden = 0u;
     ctrl->inputs = 0u;
     ctrl->out_bias_z = 0;
     ctrl->rank = cfg->rank;
-    qnav_clearance_init(ctrl, cfg);
     return QNAV_OK;
 }
 
@@ -212,7 +203,8 @@ uint8_t qnav_ctrl_level(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm)
     if (ctrl == 0 || ctrl->magic != QNAV_CTRL_MAGIC) {
         return 0;
     }
-    return qnav_clearance_level_of(ctrl, range_mm > ctrl->max_range_mm ? ctrl->max_range_mm : range_mm);
+    return qnav_clearance_level_of(&ctrl->clr, range_mm > ctrl->clr.max_range_mm
+                                                   ? ctrl->clr.max_range_mm : range_mm);
 }
 
 uint16_t qnav_ctrl_sector_of_path(uint16_t n_sectors, uint16_t path_deg)
@@ -378,7 +370,7 @@ uint8_t qnav_ctrl_path_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges_m
     if (ctrl == 0 || ctrl->magic != QNAV_CTRL_MAGIC || ranges_mm == 0 || lvl == 0) {
         return QNAV_FLAG_NOT_READY;
     }
-    return qnav_clearance_levels(ctrl, ranges_mm, lvl);
+    return qnav_clearance_levels(&ctrl->clr, ranges_mm, lvl);
 }
 
 void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
@@ -403,7 +395,7 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     best.key = QNAV_KEY_NONE;
     best.dtheta = 0;
     best.heading = 0;
-    flags = qnav_clearance_levels(ctrl, in->ranges_mm, lvl);
+    flags = qnav_clearance_levels(&ctrl->clr, in->ranges_mm, lvl);
     it.lvl = lvl;
     it.goal = bearing_deg(in->goal_bearing_cdeg);
     it.prev = bearing_deg(in->prev_heading_cdeg);
@@ -430,7 +422,7 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
         flags |= QNAV_FLAG_FULL_SPEED;
     }
     path = (uint16_t)(best.heading < 0 ? best.heading + QNAV_PATHS : best.heading);
-    cap = ctrl->speed_cap[lvl[path]];
+    cap = ctrl->clr.speed_cap[lvl[path]];
     if (speed > (uint32_t)cap) {
         speed = (uint32_t)cap;
         flags |= QNAV_FLAG_SPEED_GUARD;
@@ -466,6 +458,10 @@ const char *qnav_status_str(qnav_status_t status)
         return "network inputs neither 2 nor 3";
     case QNAV_E_NO_TABLE:
         return "a 3-input network has no 2-D quality table";
+    case QNAV_E_VFH_PARAM:
+        return "a VFH+ parameter out of range";
+    case QNAV_E_NAME:
+        return "no controller of that name";
     }
     return "unknown status";
 }

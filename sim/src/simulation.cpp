@@ -455,14 +455,41 @@ qnav_sim_sample_t Simulation::sample() const {
     return s;
 }
 
+namespace {
+void step_ctrl(void *self, const qnav_ctrl_input_t *in, qnav_ctrl_output_t *out) {
+    qnav_ctrl_step(static_cast<const qnav_ctrl_t *>(self), in, out, nullptr);
+}
+void step_nav(void *self, const qnav_ctrl_input_t *in, qnav_ctrl_output_t *out) {
+    qnav_nav_step(static_cast<qnav_nav_t *>(self), in, out);
+}
+}  // namespace
+
 qnav_sim_result_t Simulation::run_episode(const qnav_ctrl_t *ctrl, std::uint64_t episode_seed,
                                           qnav_sim_trace_fn trace, void *user) {
-    if (ctrl->n_sectors != cfg_.n_sectors)
-        throw SimError(QNAV_SIM_E_PARAM, "controller: n_sectors " + std::to_string(ctrl->n_sectors) +
+    return run_episode_with(step_ctrl, const_cast<qnav_ctrl_t *>(ctrl), ctrl->clr.n_sectors,
+                            ctrl->clr.max_range_mm, episode_seed, trace, user);
+}
+
+qnav_sim_result_t Simulation::run_episode(qnav_nav_t *nav, std::uint64_t episode_seed,
+                                          qnav_sim_trace_fn trace, void *user) {
+    std::uint16_t n = 0;
+    qnav_mm_t range = 0;
+    qnav_nav_sensors(nav, &n, &range);
+    if (qnav_nav_method(nav) == nullptr)
+        throw SimError(QNAV_SIM_E_PARAM, "controller: not initialised (qnav_nav_init failed or was not called)");
+    qnav_nav_reset(nav);
+    return run_episode_with(step_nav, nav, n, range, episode_seed, trace, user);
+}
+
+qnav_sim_result_t Simulation::run_episode_with(StepFn step, void *self, std::uint16_t n_sectors,
+                                               qnav_mm_t max_range_mm, std::uint64_t episode_seed,
+                                               qnav_sim_trace_fn trace, void *user) {
+    if (n_sectors != cfg_.n_sectors)
+        throw SimError(QNAV_SIM_E_PARAM, "controller: n_sectors " + std::to_string(n_sectors) +
                                              " does not match the simulation's " +
                                              std::to_string(cfg_.n_sectors));
-    if (ctrl->max_range_mm != max_range_mm_)
-        throw SimError(QNAV_SIM_E_PARAM, "controller: max_range_mm " + std::to_string(ctrl->max_range_mm) +
+    if (max_range_mm != max_range_mm_)
+        throw SimError(QNAV_SIM_E_PARAM, "controller: max_range_mm " + std::to_string(max_range_mm) +
                                              " does not match the robot's " +
                                              std::to_string(max_range_mm_));
     using Clock = std::chrono::steady_clock;
@@ -479,7 +506,7 @@ qnav_sim_result_t Simulation::run_episode(const qnav_ctrl_t *ctrl, std::uint64_t
         in.prev_heading_cdeg = scan_.prev_heading_cdeg;
         Clock::time_point t0;
         if (profiling_) t0 = Clock::now();
-        qnav_ctrl_step(ctrl, &in, &out, nullptr);
+        step(self, &in, &out);
         if (profiling_) prof_.controller_s += std::chrono::duration<double>(Clock::now() - t0).count();
         if (out.flags & QNAV_FLAG_NOT_READY)
             throw SimError(QNAV_SIM_E_PARAM, "controller: not initialised (qnav_ctrl_init failed or was not called)");

@@ -37,7 +37,9 @@ typedef enum {
     QNAV_E_PROB_PARAM = -7,   /* a probabilistic parameter outside (0, 64] */
     QNAV_E_RANK = -8,         /* rank is not a qnav_rank_t */
     QNAV_E_INPUTS = -9,       /* network inputs neither 2 nor 3 */
-    QNAV_E_NO_TABLE = -10     /* this policy cannot be compiled into a 2-D table (3 inputs) */
+    QNAV_E_NO_TABLE = -10,    /* this policy cannot be compiled into a 2-D table (3 inputs) */
+    QNAV_E_VFH_PARAM = -11,   /* a VFH+ parameter out of range (qnav/vfh.h) */
+    QNAV_E_NAME = -12         /* no controller of that name (qnav/nav.h) */
 } qnav_status_t;
 
 /* One line of text for a status ("ok", "n_sectors outside 1..360", ...); never null. */
@@ -114,6 +116,20 @@ typedef struct {
     int16_t out;       /* output weight, Q8.8 */
 } qnav_ctrl_unit_t;
 
+/* What clearance.c derives from a configuration: how ranges become per-path distance
+ * levels, the enlargement and the speed guard. Shared by every controller that looks at
+ * paths (the path-quality controller, VFH+). Private: reach it through functions. */
+typedef struct {
+    uint16_t n_sectors;
+    qnav_mm_t max_range_mm;
+    uint32_t level_scale;             /* distance level = (range * scale + 2^15) >> 16 */
+    uint16_t sector_paths;            /* 360 / N: paths in a sector, or one more */
+    uint16_t sector_span;             /* sector_paths * N */
+    uint16_t first_sector_paths;      /* paths 0.. that lie in sector 0: ceil(180 / N) */
+    uint8_t enlarge_deg[QNAV_DIST_LEVELS];      /* obstacle enlargement gamma by level, deg */
+    qnav_q1_15_t speed_cap[QNAV_DIST_LEVELS];   /* speed guard by level, Q1.15 of v_max */
+} qnav_clearance_t;
+
 /* The controller. Caller-owned (a static on an MCU, a vector element on a host); fields
  * are private: reach them through the functions below. */
 typedef struct {
@@ -123,17 +139,10 @@ typedef struct {
     uint8_t hidden;
     uint8_t inputs;                   /* network inputs, 2 or 3 */
     uint8_t rank;                     /* qnav_rank_t of the keys (table: as given at init) */
-    uint16_t n_sectors;
-    qnav_mm_t max_range_mm;
-    uint32_t level_scale;             /* distance level = (range * scale + 2^15) >> 16 */
+    qnav_clearance_t clr;             /* levels, enlargement, speed guard */
     uint32_t speed_scale;             /* speed = min(MAX, (quality * scale) >> 15) */
-    uint16_t sector_paths;            /* 360 / N: paths in a sector, or one more */
-    uint16_t sector_span;             /* sector_paths * N */
-    uint16_t first_sector_paths;      /* paths 0.. that lie in sector 0: ceil(180 / N) */
     qnav_q1_15_t full_speed_quality;
     const qnav_qkey_t *table;         /* table mode: [QNAV_DIST_LEVELS][181] rank keys */
-    uint8_t enlarge_deg[QNAV_DIST_LEVELS];      /* obstacle enlargement gamma by level, deg */
-    qnav_q1_15_t speed_cap[QNAV_DIST_LEVELS];   /* speed guard by level, Q1.15 of v_max */
     int32_t out_bias_z;               /* network output bias, units of 2^-15 */
     union {
         struct {

@@ -25,6 +25,7 @@
 #include <stdint.h>
 
 #include "qnav/ctrl.h"
+#include "qnav/nav.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -193,6 +194,15 @@ typedef void (*qnav_sim_trace_fn)(void *user, const qnav_sim_sample_t *sample);
 qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
                                        uint64_t episode_seed, qnav_sim_result_t *res,
                                        qnav_sim_trace_fn trace, void *user);
+
+/*
+ * The same with any controller of the table in qnav/nav.h (path-quality "body" or
+ * "literal", "vfh", ...): qnav_nav_reset() first, then every tick qnav_nav_step(). nav must
+ * be initialised for this context's sensors. Same statuses.
+ */
+qnav_sim_status_t qnav_sim_run_episode_nav(qnav_sim_t *sim, qnav_nav_t *nav, uint64_t episode_seed,
+                                           qnav_sim_result_t *res, qnav_sim_trace_fn trace,
+                                           void *user);
 
 /* The one-line message of the last failing call on this context (run_episode, reset,
  * advance, place), or "" when none failed. Valid until the next call on the context. */
