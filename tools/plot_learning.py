@@ -5,10 +5,11 @@ Usage: plot_learning.py EXPERIMENT_DIR [OUT.png]
 
 Reads EXPERIMENT_DIR/curves.csv and summary.json (written by `simevo run`) and draws, per
 condition, the mean over runs with its 95% confidence band of (left) the population's best
-fitness and (right) the episode R of the candidates (binned); the probabilistic policy is a
-horizontal reference band (its held-out mean and 95% CI). Writes EXPERIMENT_DIR/learning.png unless OUT.png is given. Needs matplotlib only.
+fitness, (middle) the R of the candidates (binned) and (right) the fraction of the
+candidates' episodes that reached the destination (binned); the probabilistic policy is a
+horizontal reference band (its held-out mean and 95% CI). Writes EXPERIMENT_DIR/learning.png
+unless OUT.png is given. Needs matplotlib only.
 """
-import json
 import os
 import sys
 
@@ -17,7 +18,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from plotcommon import PlotError, parse_args, read_csv, run, save  # noqa: E402
+from plotcommon import parse_args, read_csv, read_json, run, save  # noqa: E402
 
 
 def main(argv):
@@ -25,15 +26,9 @@ def main(argv):
     if args is None:
         return 2
     exp, out = args
-    keys = ("mean", "ci_low", "ci_high", "best_mean", "best_ci_low", "best_ci_high")
-    summary_path = os.path.join(exp, "summary.json")
-    try:
-        with open(summary_path) as f:
-            summary = json.load(f)
-    except OSError as e:
-        raise PlotError(f"{summary_path}: {e.strerror}") from e
-    except json.JSONDecodeError as e:
-        raise PlotError(f"{summary_path}:{e.lineno}: {e.msg}") from e
+    keys = ("mean", "ci_low", "ci_high", "best_mean", "best_ci_low", "best_ci_high",
+            "arrival_mean", "arrival_ci_low", "arrival_ci_high")
+    summary = read_json(os.path.join(exp, "summary.json"))
     curves = {}
 
     def add(row):
@@ -44,35 +39,44 @@ def main(argv):
 
     read_csv(os.path.join(exp, "curves.csv"), add)
 
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.6), dpi=110, layout="constrained")
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.6), dpi=110, layout="constrained")
     colors = {"direct": "tab:red", "probabilistic": "tab:gray"}
     palette = ["tab:blue", "tab:green", "tab:purple", "tab:orange"]
     conds = {c["label"]: c for c in summary["conditions"]}
     transfer = [k for k in curves if k.startswith("transfer-")]
     for i, k in enumerate(transfer):
         colors[k] = palette[i % len(palette)]
+    per_candidate = summary.get("episodes_per_candidate", 1)
     panels = (
-        (axes[0], "best", "population's best fitness R (mean over runs)"),
-        (axes[1], "", f"candidates' episode R ({summary['curve_bin']}-episode bins, mean over runs)"),
+        (axes[0], "best", "population's best fitness R (mean over runs)", "final_mean", 1.0),
+        (axes[1], "", f"candidates' R ({summary['curve_bin']}-episode bins, k = {per_candidate}, mean over runs)",
+         "final_mean", 1.0),
+        (axes[2], "arrival", "candidates' episodes that arrived (%, binned, mean over runs)", "arrival", 100.0),
     )
-    for ax, prefix, ylabel in panels:
+    for ax, prefix, ylabel, ref, scale in panels:
         m_key, lo_key, hi_key = (prefix + "_mean", prefix + "_ci_low", prefix + "_ci_high") if prefix else keys[:3]
         for k in transfer + ["direct"]:
             if k not in curves:
                 continue
             c = curves[k]
             label = k.replace("transfer-", "transfer from ") if k != "direct" else "direct (random population)"
-            ax.plot(c["episode"], c[m_key], color=colors[k], lw=1.8, label=label)
-            ax.fill_between(c["episode"], c[lo_key], c[hi_key], color=colors[k], alpha=0.2, lw=0)
+            ax.plot(c["episode"], [v * scale for v in c[m_key]], color=colors[k], lw=1.8, label=label)
+            ax.fill_between(c["episode"], [v * scale for v in c[lo_key]], [v * scale for v in c[hi_key]],
+                            color=colors[k], alpha=0.2, lw=0)
         p = conds.get("probabilistic")
-        if p and p["final_mean"] is not None:
+        if p and ref == "final_mean" and p["final_mean"] is not None:
             mean = p["final_mean"]
             ci = p["final_ci95"] or 0.0
             ax.axhline(mean, color=colors["probabilistic"], ls="--", lw=1.5, label="probabilistic (held out)")
             ax.axhspan(mean - ci, mean + ci, color=colors["probabilistic"], alpha=0.15, lw=0)
+        elif p and ref == "arrival" and p.get("arrival"):
+            a = p["arrival"]
+            ax.axhline(100 * a["mean"], color=colors["probabilistic"], ls="--", lw=1.5, label="probabilistic (held out)")
+            ax.axhspan(100 * a["ci95_low"], 100 * a["ci95_high"], color=colors["probabilistic"], alpha=0.15, lw=0)
         ax.set_xlabel("episode in the target situation")
         ax.set_ylabel(ylabel, fontsize=9)
         ax.grid(alpha=0.3)
+    axes[2].set_ylim(-2, 102)
     axes[0].legend(fontsize=8, loc="lower right")
     fig_ref = f" ({summary['figure']})" if summary.get("figure") else ""
     fig.suptitle(f"{summary['title'] or summary['name']}{fig_ref}: "

@@ -1,6 +1,7 @@
-"""What simevo's plot scripts share: their command line, reading a CSV with one-line
-errors (FILE:LINE: problem), and writing a PNG atomically (no half-written plot)."""
+"""What simevo's plot scripts share: their command line, reading a CSV or JSON file with
+one-line errors (FILE:LINE: problem), and writing a PNG atomically (no half-written plot)."""
 import csv
+import json
 import os
 import sys
 
@@ -32,6 +33,17 @@ def read_csv(path, on_row):
         raise PlotError(f"{path}:1: missing column {e}") from e
     except (ValueError, TypeError) as e:
         raise PlotError(f"{path}:{reader.line_num if reader else 0}: {e}") from e
+
+
+def read_json(path):
+    """The parsed JSON file at path; raise PlotError naming the file (and line)."""
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except OSError as e:
+        raise PlotError(f"{path}: {e.strerror}") from e
+    except json.JSONDecodeError as e:
+        raise PlotError(f"{path}:{e.lineno}: {e.msg}") from e
 
 
 def save(fig, out):

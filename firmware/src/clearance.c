@@ -5,6 +5,9 @@
  * made at init so that the step does no multiply or division here.
  */
 #include "clearance.h"
+
+#include <string.h>
+
 #include "qnav/flash.h"
 
 /* sin(g degrees) in units of 2^-15, g = 0..90 (sin 90 stored as 32767). Made by:
@@ -149,6 +152,17 @@ qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t
     return QNAV_OK;
 }
 
+/* Lower lvl[p..p+k-1] to at most level (no wrap; a branch-free min the compiler can
+ * vectorise on hosts). */
+static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
+{
+    uint8_t *q = lvl + p;
+    uint8_t *end = q + k;
+    for (; q != end; ++q) {
+        *q = *q < level ? *q : level;
+    }
+}
+
 /* Lower the level of n paths from first on, widened by gamma on both sides, to level. */
 static void paint(uint8_t *lvl, uint16_t first, uint16_t n, uint8_t gamma, uint8_t level)
 {
@@ -157,12 +171,11 @@ static void paint(uint8_t *lvl, uint16_t first, uint16_t n, uint8_t gamma, uint8
     if (k > QNAV_PATHS) {
         k = QNAV_PATHS;
     }
-    while (k != 0u) {
-        if (lvl[p] > level) {
-            lvl[p] = level;
-        }
-        p = (uint16_t)(p + 1u == QNAV_PATHS ? 0u : p + 1u);
-        --k;
+    if (p + k <= QNAV_PATHS) {
+        lower(lvl, p, k, level);
+    } else {
+        lower(lvl, p, (uint16_t)(QNAV_PATHS - p), level);
+        lower(lvl, 0u, (uint16_t)(p + k - QNAV_PATHS), level);
     }
 }
 
@@ -176,10 +189,7 @@ uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges
     uint16_t phase = QNAV_PATHS / 2u;
     uint16_t count = c->first_sector_paths;
     uint8_t flags = 0;
-    uint16_t i;
-    for (i = 0; i < QNAV_PATHS; ++i) {
-        lvl[i] = (uint8_t)(QNAV_DIST_LEVELS - 1u);
-    }
+    memset(lvl, QNAV_DIST_LEVELS - 1, QNAV_PATHS);
     for (;;) {
         qnav_mm_t r = ranges[sector];
         uint16_t n = count < QNAV_PATHS - path ? count : (uint16_t)(QNAV_PATHS - path);

@@ -159,6 +159,45 @@ void qnav_sim_env_info(const qnav_sim_env_t *env, qnav_sim_env_info_t *info) {
     info->episode_limit_s = e.episode_limit_s;
     info->n_obstacles = static_cast<uint32_t>(e.circles.size() + e.boxes.size());
     info->n_start_zones = static_cast<uint32_t>(e.start_zones.size());
+    info->source = e.source.c_str();
+}
+
+namespace {
+// The fitness rules by name: the one list that parsing, naming and messages read.
+struct FitnessRuleName {
+    qnav_sim_fitness_rule_t rule;
+    const char *name;
+};
+constexpr FitnessRuleName kFitnessRules[] = {
+    {QNAV_SIM_FITNESS_PROGRESS, "progress"},
+    {QNAV_SIM_FITNESS_PAPER, "paper"},
+};
+}  // namespace
+
+const char *qnav_sim_fitness_rule_name(qnav_sim_fitness_rule_t rule) {
+    for (const FitnessRuleName &f : kFitnessRules)
+        if (f.rule == rule) return f.name;
+    return nullptr;
+}
+
+qnav_sim_status_t qnav_sim_fitness_rule_parse(const char *name, qnav_sim_fitness_rule_t *rule) {
+    if (!name || !rule) return QNAV_SIM_E_NULL;
+    for (const FitnessRuleName &f : kFitnessRules) {
+        if (std::strcmp(f.name, name) == 0) {
+            *rule = f.rule;
+            return QNAV_SIM_OK;
+        }
+    }
+    return QNAV_SIM_E_PARAM;
+}
+
+const char *qnav_sim_fitness_rule_names(void) {
+    static const std::string names = [] {
+        std::string s;
+        for (const FitnessRuleName &f : kFitnessRules) s += (s.empty() ? "" : ", ") + std::string(f.name);
+        return s;
+    }();
+    return names.c_str();
 }
 
 void qnav_sim_config_default(qnav_sim_config_t *cfg) {
@@ -168,6 +207,7 @@ void qnav_sim_config_default(qnav_sim_config_t *cfg) {
     cfg->actuation_noise = 0.0;
     cfg->seed = 1;
     cfg->episode_limit_s = 0.0;
+    cfg->fitness = QNAV_SIM_FITNESS_PROGRESS;
 }
 
 qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_env_t *env,
@@ -190,6 +230,7 @@ qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_
         return bad("actuation_noise: must be in [0, 1]");
     if (!std::isfinite(cfg->episode_limit_s) || cfg->episode_limit_s < 0 || cfg->episode_limit_s > 36000)
         return bad("episode_limit_s: must be in [0, 36000] (0 = environment's)");
+    if (!qnav_sim_fitness_rule_name(cfg->fitness)) return bad("fitness: not a qnav_sim_fitness_rule_t");
     return guarded(err, errlen, [&] {
         qnav::check_clearance(env->env, robot->profile.radius_m);
         qnav::SimConfig sc;
@@ -198,6 +239,7 @@ qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_
         sc.actuation_noise = cfg->actuation_noise;
         sc.seed = cfg->seed;
         sc.episode_limit_s = cfg->episode_limit_s;
+        sc.fitness = cfg->fitness;
         auto s = std::make_unique<qnav_sim>();
         s->sim = std::make_unique<qnav::Simulation>(robot->profile, env->env, sc);
         *out = s.release();
@@ -306,8 +348,9 @@ qnav_sim_status_t qnav_sim_result(const qnav_sim_t *sim, qnav_sim_result_t *res)
     return QNAV_SIM_OK;
 }
 
-void qnav_sim_fitness(qnav_sim_result_t *res) {
-    if (res) qnav::compute_fitness(res);
+void qnav_sim_fitness(qnav_sim_result_t *res, qnav_sim_fitness_rule_t rule) {
+    if (!res) return;
+    qnav::compute_fitness(res, qnav_sim_fitness_rule_name(rule) ? rule : QNAV_SIM_FITNESS_PROGRESS);
 }
 
 }  // extern "C"

@@ -46,16 +46,27 @@ double shortest_time(double d_m, double v, double a) {
     return v / a + (d_m - d_acc) / v;
 }
 
-void compute_fitness(qnav_sim_result_t *res) {
-    if (res->beta_l > 0)
-        res->f1 = res->l <= res->beta_l ? res->l / res->beta_l : res->beta_l / res->l;
-    else
-        res->f1 = 1.0;
-    if (res->beta_tau > 0)
-        res->f2 = res->tau_l <= res->beta_tau ? res->tau_l / res->beta_tau
-                                               : res->beta_tau / res->tau_l;
-    else
-        res->f2 = 1.0;
+namespace {
+// Eq. 2 and 3: the ratio of actual to best, inverted past the best; 1 when the best is 0.
+double ratio_feature(double actual, double best) {
+    if (best <= 0) return 1.0;
+    return actual <= best ? actual / best : best / actual;
+}
+}  // namespace
+
+void compute_fitness(qnav_sim_result_t *res, qnav_sim_fitness_rule_t rule) {
+    res->fitness = rule;
+    if (rule == QNAV_SIM_FITNESS_PAPER || res->reached) {
+        res->f1 = ratio_feature(res->l, res->beta_l);
+        res->f2 = ratio_feature(res->tau_l, res->beta_tau);
+    } else {
+        // Not arrived: no reward for time (it would pay circling until the limit), and f1
+        // only for the part of the way covered.
+        res->f1 = res->d_start_m > 0
+                      ? std::clamp((res->d_start_m - res->d_end_m) / res->d_start_m, 0.0, 1.0)
+                      : 1.0;
+        res->f2 = 0.0;
+    }
     res->R = kEta1 * res->f1 + kEta2 * res->f2 - static_cast<double>(res->tau_c);
 }
 
@@ -430,6 +441,9 @@ qnav_sim_result_t Simulation::result() const {
     r.beta_l = std::max(0.0, norm(Vec2{env_.dest_x_m, env_.dest_y_m} - start_) - env_.dest_radius_m);
     r.tau_l = tick_ * QNAV_SIM_TICK_S;
     r.beta_tau = shortest_time(r.beta_l, robot_.v_max_mps, robot_.accel_mps2);
+    r.d_start_m = r.beta_l;
+    r.d_end_m = reached_ ? 0.0
+                         : std::max(0.0, norm(Vec2{env_.dest_x_m, env_.dest_y_m} - pos_) - env_.dest_radius_m);
     r.tau_c = tau_c_;
     r.reached = reached_;
     r.ticks = tick_;
@@ -437,7 +451,7 @@ qnav_sim_result_t Simulation::result() const {
     r.start_x_m = start_.x;
     r.start_y_m = start_.y;
     r.start_heading_rad = start_heading_;
-    compute_fitness(&r);
+    compute_fitness(&r, cfg_.fitness);
     return r;
 }
 

@@ -27,6 +27,7 @@ struct SimConfig {
     double actuation_noise = 0;     // p_a
     std::uint64_t seed = 1;
     double episode_limit_s = 0;     // 0 = environment's
+    qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS;
 };
 
 // Where time went (only counted when profiling is on), seconds.
@@ -131,8 +132,10 @@ private:
     SimProfile prof_;
 };
 
-// Eq. 1-3 on res's l, beta_l, tau_l, beta_tau, tau_c.
-void compute_fitness(qnav_sim_result_t *res);
+// f1, f2 and R of res under rule (qnav_sim_fitness_rule_t): Eq. 1-3 on l, beta_l, tau_l,
+// beta_tau, tau_c; for the progress rule and an episode not reached, f1 from d_start_m and
+// d_end_m and f2 = 0.
+void compute_fitness(qnav_sim_result_t *res, qnav_sim_fitness_rule_t rule);
 // Shortest time to drive d metres from rest with acceleration a and top speed v, s.
 double shortest_time(double d_m, double v_max_mps, double accel_mps2);
 

@@ -73,10 +73,12 @@ void load(Loaded &l, const std::string &robot, const std::string &env) {
     check(qnav_sim_env_load(env.c_str(), &l.env, err, sizeof err), err);
 }
 
-void make_sim(Loaded &l, int sectors, double ps, double pa, std::uint64_t seed) {
+void make_sim(Loaded &l, int sectors, double ps, double pa, std::uint64_t seed,
+              qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS) {
     char err[QNAV_SIM_ERRLEN] = "";
     qnav_sim_config_t cfg;
     qnav_sim_config_default(&cfg);
+    cfg.fitness = fitness;
     cfg.n_sectors = static_cast<std::uint16_t>(sectors);
     cfg.sensor_noise = ps;
     cfg.actuation_noise = pa;
@@ -101,13 +103,11 @@ qnav_policy_t read_policy(const std::string &path, const qnav_sim_robot_t *robot
 #endif
 }
 
-// Initialise ctrl for sim from a policy, in network/probabilistic or table mode; literal:
-// the paper's per-sector reading without enlargement, guard or pre-activation rank.
+// Initialise ctrl for sim from a policy, in network/probabilistic or table mode (bench).
 void init_ctrl(const qnav_sim_t *sim, const qnav_policy_t &pol, bool table,
-               std::vector<qnav_qkey_t> &table_buf, qnav_ctrl_t *ctrl, bool literal = false) {
+               std::vector<qnav_qkey_t> &table_buf, qnav_ctrl_t *ctrl) {
     qnav_ctrl_config_t cc;
     qnav_sim_ctrl_config(sim, &cc);
-    if (literal) qnav_ctrl_config_literal(&cc);
     qnav_status_t st = qnav_ctrl_init(ctrl, &cc, &pol);
     if (st != QNAV_OK)
         throw SimError(QNAV_SIM_E_PARAM, "policy: rejected by qnav_ctrl_init (status " + std::to_string(st) + ")");
@@ -157,7 +157,7 @@ void print_result(unsigned long long episode, const qnav_sim_result_t &r) {
 }
 
 struct RunOpts {
-    std::string robot = "pioneer3dx", env = "dense", policy, svg, trace;
+    std::string robot = "pioneer3dx", env = "dense", policy, svg, trace, fitness = "progress";
     int sectors = 0;
     double ps = -1, pa = -1;
     std::uint64_t seed = 1, episode = 0;
@@ -174,7 +174,11 @@ int cmd_run(const RunOpts &o) {
     qnav_sim_robot_info(l.robot, &ri);
     const double ps = o.ps >= 0 ? o.ps : ri.sensor_noise;
     const double pa = o.pa >= 0 ? o.pa : ri.actuation_noise;
-    make_sim(l, o.sectors, ps, pa, o.seed);
+    qnav_sim_fitness_rule_t rule;
+    if (qnav_sim_fitness_rule_parse(o.fitness.c_str(), &rule) != QNAV_SIM_OK)
+        throw SimError(QNAV_SIM_E_PARAM, "--fitness: '" + o.fitness + "' is not one of " +
+                                             qnav_sim_fitness_rule_names());
+    make_sim(l, o.sectors, ps, pa, o.seed, rule);
     qnav::Simulation &sim = *l.sim->sim;
     const qnav_policy_t pol = read_policy(o.policy, l.robot);
     std::vector<qnav_qkey_t> tbuf;
@@ -184,9 +188,10 @@ int cmd_run(const RunOpts &o) {
     if (!uses_policy && !o.policy.empty())
         throw SimError(QNAV_SIM_E_PARAM, "--policy: controller " + o.controller + " takes no policy");
     std::printf("robot %s  env %s  sectors %u  sensor noise %.3f  actuation noise %.3f  seed %llu  "
-                "controller %s  policy %s%s\n",
+                "controller %s  fitness %s  policy %s%s\n",
                 ri.name, sim.env().name.c_str(), sim.config().n_sectors, ps, pa,
                 static_cast<unsigned long long>(o.seed), o.controller.c_str(),
+                qnav_sim_fitness_rule_name(rule),
                 !uses_policy ? "none" : o.policy.empty() ? "probabilistic (default)" : o.policy.c_str(),
                 o.table ? " (table mode)" : "");
     double sum_r = 0;
@@ -251,11 +256,11 @@ int cmd_run(const RunOpts &o) {
         }
     }
     if (o.episodes > 1) {
-        std::printf("mean R %.3f over %u episodes, %u reached\n", sum_r / o.episodes, o.episodes, reached);
-        std::printf("arrival %.1f%%  recovery ticks %.2f per episode  path %.2f m per episode  "
-                    "heading change %.1f deg/m\n",
-                    100.0 * reached / o.episodes, static_cast<double>(tau_c) / o.episodes,
-                    path_m / o.episodes, path_m > 0 ? turn_deg / path_m : 0.0);
+        std::printf("mean R %.3f over %u episodes, %u reached (%.1f%%)\n", sum_r / o.episodes, o.episodes,
+                    reached, 100.0 * reached / o.episodes);
+        std::printf("recovery ticks %.2f per episode  path %.2f m per episode  heading change %.1f deg/m\n",
+                    static_cast<double>(tau_c) / o.episodes, path_m / o.episodes,
+                    path_m > 0 ? turn_deg / path_m : 0.0);
     }
     return 0;
 }
@@ -406,6 +411,7 @@ int main(int argc, char **argv) {
     run->add_option("--sensor-noise", ro.ps, "p_s in [0, 1] (default: the profile's typical)")->check(CLI::Range(0.0, 1.0));
     run->add_option("--actuation-noise", ro.pa, "p_a in [0, 1] (default: the profile's typical)")->check(CLI::Range(0.0, 1.0));
     run->add_option("--seed", ro.seed, "context seed")->capture_default_str();
+    run->add_option("--fitness", ro.fitness, "fitness rule: progress (default) or paper (Eq. 1-3 literally; docs/sim.md)")->capture_default_str();
     run->add_option("--episode", ro.episode, "first episode seed")->capture_default_str();
     run->add_option("--episodes", ro.episodes, "number of episodes")->check(CLI::Range(1u, 1000000u))->capture_default_str();
     run->add_flag("--table", ro.table, "run the controller in table mode");

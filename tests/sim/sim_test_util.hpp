@@ -56,7 +56,8 @@ inline void fail_with(const char *what, const char *err) {
 // robot: a profile name in data/robots; env_text: TOML, or empty to use env_name.
 inline void make_test_sim(TestSim &t, const char *robot, const std::string &env_text,
                           const char *env_name, uint16_t sectors, double ps, double pa,
-                          uint64_t seed = 1) {
+                          uint64_t seed = 1,
+                          qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS) {
     char err[QNAV_SIM_ERRLEN] = "";
     const std::string rpath = std::string(QNAV_TEST_DATA_DIR) + "/robots/" + robot + ".toml";
     if (qnav_sim_robot_load(rpath.c_str(), &t.robot, err, sizeof err) != QNAV_SIM_OK)
@@ -76,6 +77,7 @@ inline void make_test_sim(TestSim &t, const char *robot, const std::string &env_
     cfg.sensor_noise = ps;
     cfg.actuation_noise = pa;
     cfg.seed = seed;
+    cfg.fitness = fitness;
     if (qnav_sim_create(t.robot, t.env, &cfg, &t.sim, err, sizeof err) != QNAV_SIM_OK)
         fail_with("create", err);
 }

@@ -322,6 +322,52 @@ static void test_spec_parses_inheritance_and_presets(void **state)
     assert_int_equal(s.target_episodes, 10);
 }
 
+static void test_spec_fitness_rule_reaches_every_scenario(void **state)
+{
+    (void)state;
+    ExperimentSpec d = parse_experiment(kGoodSpec, "x.toml");
+    assert_int_equal(d.target.fitness, QNAV_SIM_FITNESS_PROGRESS); // the default
+    ExperimentSpec s = parse_experiment(
+        "name = \"t\"\n[evolution]\nfitness = \"paper\"\n[target]\nepisodes = 9\n[[source]]\nlabel = \"a\"\n", "x.toml");
+    assert_int_equal(s.target.fitness, QNAV_SIM_FITNESS_PAPER);
+    assert_int_equal(s.sources[0].scenario.fitness, QNAV_SIM_FITNESS_PAPER);
+    assert_true(s.target.describe().find("fitness=paper") != std::string::npos);
+}
+
+static void test_spec_controller_reading_reaches_every_scenario_and_bad_names_fail(void **state)
+{
+    (void)state;
+    ExperimentSpec d = parse_experiment(kGoodSpec, "x.toml");
+    assert_true(d.target.controller == ControllerReading::Body); // the default
+    ExperimentSpec s = parse_experiment(
+        "name = \"t\"\n[evolution]\ncontroller = \"literal\"\n[target]\nepisodes = 9\n[[source]]\nlabel = \"a\"\n", "x.toml");
+    assert_true(s.target.controller == ControllerReading::Literal);
+    assert_true(s.sources[0].scenario.controller == ControllerReading::Literal);
+    assert_true(s.target.describe().find("controller=literal") != std::string::npos);
+    try {
+        (void)parse_experiment("name = \"t\"\n[evolution]\ncontroller = \"wide\"\n[target]\nepisodes = 9\n", "x.toml");
+        fail_msg("a bad controller name was accepted");
+    } catch (const UserError &e) {
+        assert_true(std::string(e.what()).find("x.toml:3: controller: 'wide' is not one of body, literal") !=
+                    std::string::npos);
+    }
+}
+
+static void test_spec_checkpoints_parse_and_presets_shrink_their_evaluation(void **state)
+{
+    (void)state;
+    ExperimentSpec s = parse_experiment(std::string(kGoodSpec) + "checkpoint_episodes = 5\n[evaluation]\n"
+                                        "checkpoints = [10, 40]\ncheckpoint_every = 0\narrival_threshold = 90\n",
+                                        "x.toml");
+    assert_int_equal(s.checkpoints.size(), 2);
+    assert_int_equal(s.checkpoints[1], 40);
+    assert_int_equal(s.checkpoint_every, 0);
+    assert_true(std::fabs(s.arrival_threshold - 0.9) < 1e-12);
+    assert_int_equal(s.checkpoint_episodes, 20);
+    apply_preset(s, "quick");
+    assert_int_equal(s.checkpoint_episodes, 5);
+}
+
 static void test_spec_errors_name_file_line_and_problem(void **state)
 {
     (void)state;
@@ -337,6 +383,16 @@ static void test_spec_errors_name_file_line_and_problem(void **state)
     assert_true(parse_error("name = \"t\"\n[target\n").rfind("x.toml:2: ", 0) == 0);
     assert_string_equal(parse_error("name = \"t\"\n[evolution]\nepsilon = 1.5\n").c_str(),
                         "x.toml:3: epsilon: 1.5 is outside [0, 1]");
+    assert_string_equal(parse_error("name = \"t\"\n[evolution]\nfitness = \"survival\"\n").c_str(),
+                        "x.toml:3: fitness: 'survival' is not one of progress, paper");
+    assert_string_equal(parse_error("name = \"t\"\n[evolution]\nfitness = 1\n").c_str(),
+                        "x.toml:3: fitness: expected a string");
+    assert_string_equal(parse_error("name = \"t\"\n[target]\n[[source]]\nlabel = \"a\"\n[evaluation]\ncheckpoints = [100, 50]\n").c_str(),
+                        "x.toml:6: checkpoints: must be increasing (50 after 100)");
+    assert_string_equal(parse_error("name = \"t\"\n[target]\n[[source]]\nlabel = \"a\"\n[evaluation]\ncheckpoints = 100\n").c_str(),
+                        "x.toml:6: checkpoints: expected an array of episode counts, e.g. [100, 250, 500]");
+    assert_string_equal(parse_error("name = \"t\"\n[target]\n[[source]]\nlabel = \"a\"\n[evaluation]\narrival_threshold = 120\n").c_str(),
+                        "x.toml:6: arrival_threshold: 120 is outside [0, 100]");
     ExperimentSpec s = parse_experiment(kGoodSpec, "x.toml");
     try {
         apply_preset(s, "slow");
@@ -362,6 +418,9 @@ int main(void)
         cmocka_unit_test(test_t_critical_and_welch_match_tables),
         cmocka_unit_test(test_mann_whitney_separated_samples_are_significant),
         cmocka_unit_test(test_spec_parses_inheritance_and_presets),
+        cmocka_unit_test(test_spec_fitness_rule_reaches_every_scenario),
+        cmocka_unit_test(test_spec_controller_reading_reaches_every_scenario_and_bad_names_fail),
+        cmocka_unit_test(test_spec_checkpoints_parse_and_presets_shrink_their_evaluation),
         cmocka_unit_test(test_spec_errors_name_file_line_and_problem),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -17,6 +17,7 @@ extern "C" {
 #include <cmocka.h>
 }
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -37,6 +38,7 @@ extern "C" {
 #include "files.h"
 #include "qnav/policy_io.h"
 #include "experiment.h"
+#include "rng.h"
 #include "spec.h"
 #include "stats.h"
 #include "task.h"
@@ -137,6 +139,91 @@ static void test_task_stopped_and_resumed_matches_uninterrupted_bytes(void **sta
     assert_int_equal(read_eval(join_path(b.dir, "eval.csv")).size(), 12);
 }
 
+/* A FakeRunner that logs the seed of every episode it runs into a shared list. */
+class SeedLoggingRunner : public FakeRunner {
+public:
+    explicit SeedLoggingRunner(std::vector<uint64_t> *log) : log_(log) {}
+    EpisodeOutcome run(const qnav_policy_t &policy, uint64_t episode_seed) override
+    {
+        log_->push_back(episode_seed);
+        return FakeRunner::run(policy, episode_seed);
+    }
+
+private:
+    std::vector<uint64_t> *log_;
+};
+
+static void test_candidate_and_parent_face_the_same_k_episodes_and_the_budget_counts_episodes(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::atomic<bool> never{false};
+    TaskDef t = fake_task(join_path(root, "k3"));
+    t.episodes = 60; // 20 steps of 3 episodes
+    t.evolution.episodes_per_candidate = 3;
+    t.eval_episodes = 0;
+    std::vector<uint64_t> seeds;
+    RunnerFactory make = [&seeds](const Scenario &, uint64_t) -> std::unique_ptr<EpisodeRunner> {
+        return std::make_unique<SeedLoggingRunner>(&seeds);
+    };
+    assert_true(run_task(t, "", make, TaskObserver{}, never));
+    assert_int_equal(read_journal(join_path(t.dir, "episodes.csv")).R.size(), 20);
+    // 8 initial members on 3 episodes each, then 12 steps of candidate + parent.
+    assert_int_equal(seeds.size(), 8 * 3 + 12 * 6);
+    for (uint64_t step = 8; step < 20; ++step) {
+        const std::size_t at = 8 * 3 + (step - 8) * 6;
+        for (uint64_t j = 0; j < 3; ++j) {
+            assert_true(seeds[at + j] == mix_seed(t.episode_seed_base, step * 3 + j)); // candidate
+            assert_true(seeds[at + 3 + j] == seeds[at + j]);                          // parent: same
+        }
+    }
+    assert_true(seeds[24] != seeds[30]); // the next step has new start points
+}
+
+static void test_checkpoints_resume_to_identical_bytes_even_when_a_row_is_missing(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::atomic<bool> never{false};
+    auto task = [&](const std::string &name) {
+        TaskDef t = fake_task(join_path(root, name));
+        t.episodes = 120;
+        t.evolution.episodes_per_candidate = 2;
+        t.checkpoints = {20, 50, 100};
+        t.checkpoint_episodes = 4;
+        return t;
+    };
+    const TaskDef a = task("a");
+    assert_true(run_task(a, "", fake_factory(), TaskObserver{}, never));
+    const auto rows = read_checkpoints(join_path(a.dir, "checkpoints.csv"));
+    assert_int_equal(rows.size(), 3);
+    assert_int_equal(rows[1].checkpoint, 50);
+    assert_int_equal(rows[1].episodes, 50);
+    assert_int_equal(rows[1].n, 4);
+
+    const TaskDef b = task("b");
+    std::atomic<bool> stop{false};
+    uint64_t seen = 0;
+    TaskObserver obs;
+    obs.episodes_done = [&](uint64_t n, bool) {
+        seen += n;
+        if (seen >= 70) {
+            stop = true;
+        }
+    };
+    assert_false(run_task(b, "", fake_factory(), obs, stop));
+    // Killed after the journal line of step 25 but before checkpoint 50 was written whole.
+    const std::string ck = join_path(b.dir, "checkpoints.csv");
+    std::string text = slurp(ck);
+    assert_int_equal(std::count(text.begin(), text.end(), '\n'), 3); // header, 20, 50
+    text = text.substr(0, text.rfind('\n', text.size() - 2) + 1) + "50,50,4,-1.2";
+    write_file_atomic(ck, text);
+    assert_true(run_task(b, "", fake_factory(), TaskObserver{}, never));
+    for (const char *name : {"episodes.csv", "checkpoints.csv", "best.policy", "eval.csv", "task.txt"}) {
+        assert_true(slurp(join_path(a.dir, name)) == slurp(join_path(b.dir, name)));
+    }
+}
+
 static void test_transfer_task_resumes_from_source_file_and_refuses_other_settings(void **state)
 {
     (void)state;
@@ -197,6 +284,10 @@ label = "b"
 episodes = 80
 [evaluation]
 episodes = 7
+checkpoints = [20, 50, 500]
+checkpoint_every = 0
+checkpoint_episodes = 3
+arrival_threshold = 50
 )", "fake.toml");
     const auto t1 = plan_tasks(spec, join_path(root, "one"));
     const auto t3 = plan_tasks(spec, join_path(root, "three"));
@@ -228,6 +319,26 @@ episodes = 7
     }
     assert_true(std::fabs(direct.final_per_run[1] - mean_of(r)) < 1e-12);
     assert_int_equal(S.conditions[3].final_per_run.size(), 7); // probabilistic: per episode
+    // What the robots do: arrival and recovery ticks per run, held out and at checkpoints.
+    double arrived = 0, tau = 0;
+    for (const auto &o : read_eval(join_path(root, "one/run-002/direct/eval.csv"))) {
+        arrived += o.reached ? 1 : 0;
+        tau += o.tau_c;
+    }
+    assert_true(std::fabs(direct.arrival_per_run[1] - arrived / 7) < 1e-12);
+    assert_true(std::fabs(direct.tau_c_per_run[1] - tau / 7) < 1e-12);
+    assert_true(direct.arrival.lo <= direct.arrival.mean && direct.arrival.mean <= direct.arrival.hi);
+    assert_int_equal(direct.checkpoints.size(), 2); // 500 is beyond the budget: dropped
+    const auto rows = read_checkpoints(join_path(root, "one/run-003/direct/checkpoints.csv"));
+    assert_true(std::fabs(direct.checkpoints[1].arrival[2] - rows[1].arrived / 3.0) < 1e-12);
+    assert_int_equal(direct.to_threshold.size(), 3);
+    uint32_t not_reached = 0;
+    for (double x : direct.to_threshold) {
+        not_reached += std::isnan(x) ? 1 : 0;
+        assert_true(std::isnan(x) || x == 20 || x == 50);
+    }
+    assert_int_equal(direct.threshold_not_reached, not_reached);
+    assert_int_equal(S.conditions[0].checkpoints[0].R.size(), 3); // transfer-a: one value per run
     assert_true(S.comparisons[0].a == "transfer-a" && S.comparisons[0].b == "direct");
     assert_true(std::fabs(S.comparisons[0].difference - (S.conditions[0].final_mean - direct.final_mean)) < 1e-12);
 }
@@ -422,6 +533,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_task_stopped_and_resumed_matches_uninterrupted_bytes),
+        cmocka_unit_test(test_candidate_and_parent_face_the_same_k_episodes_and_the_budget_counts_episodes),
+        cmocka_unit_test(test_checkpoints_resume_to_identical_bytes_even_when_a_row_is_missing),
         cmocka_unit_test(test_transfer_task_resumes_from_source_file_and_refuses_other_settings),
         cmocka_unit_test(test_experiment_results_do_not_depend_on_thread_count_and_summary_reads_them),
         cmocka_unit_test(test_program_rejects_bad_input_with_one_line),

@@ -195,10 +195,33 @@ std::string json_str(const std::string &s)
 
 /* ---- plan ------------------------------------------------------------------------ */
 
+std::vector<uint64_t> checkpoint_grid(const ExperimentSpec &spec)
+{
+    std::set<uint64_t> g;
+    for (uint64_t c : spec.checkpoints) {
+        if (c <= spec.target_episodes) {
+            g.insert(c);
+        }
+    }
+    for (uint64_t c = spec.checkpoint_every; spec.checkpoint_every > 0 && c <= spec.target_episodes;
+         c += spec.checkpoint_every) {
+        g.insert(c);
+    }
+    return std::vector<uint64_t>(g.begin(), g.end());
+}
+
 std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &exp_dir)
 {
     std::vector<TaskDef> tasks;
     const uint64_t eval_base = mix_seed(spec.eval_seed, label_hash("held-out evaluation"));
+    const std::vector<uint64_t> grid = checkpoint_grid(spec);
+    // A target task's held-out evaluations: at the end, and at the checkpoints.
+    auto held_out = [&](TaskDef &t) {
+        t.eval_episodes = spec.eval_episodes;
+        t.eval_seed_base = eval_base;
+        t.checkpoints = grid;
+        t.checkpoint_episodes = grid.empty() ? 0 : spec.checkpoint_episodes;
+    };
     for (uint32_t r = 0; r < spec.runs; ++r) {
         const uint64_t run_seed = mix_seed(spec.seed, r + 1);
         const std::string rdir = run_dir(exp_dir, r);
@@ -231,13 +254,11 @@ std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &e
             TaskDef tr = evolve("transfer-" + s.label, spec.target, spec.target_episodes, target_episodes_base);
             tr.source_task = src_index;
             tr.source_policy_file = s.policy_file;
-            tr.eval_episodes = spec.eval_episodes;
-            tr.eval_seed_base = eval_base;
+            held_out(tr);
             tasks.push_back(tr);
         }
         TaskDef d = evolve("direct", spec.target, spec.target_episodes, target_episodes_base);
-        d.eval_episodes = spec.eval_episodes;
-        d.eval_seed_base = eval_base;
+        held_out(d);
         tasks.push_back(d);
     }
     TaskDef p;
@@ -347,109 +368,258 @@ void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, uns
 
 /* ---- summary --------------------------------------------------------------------- */
 
+namespace {
+
+Interval t_interval(const std::vector<double> &x, double lo_bound, double hi_bound)
+{
+    Interval v;
+    v.mean = mean_of(x);
+    const double h = ci95_half_width(x);
+    v.lo = std::max(lo_bound, v.mean - h);
+    v.hi = std::min(hi_bound, v.mean + h);
+    return v;
+}
+
+/* Wilson score interval of a proportion (95%): honest at 0% and 100%, unlike mean ± t. */
+Interval wilson_interval(double successes, double n)
+{
+    Interval v;
+    if (n <= 0) {
+        return v;
+    }
+    const double z = 1.959963984540054, p = successes / n;
+    const double d = 1 + z * z / n;
+    const double c = (p + z * z / (2 * n)) / d;
+    const double h = z * std::sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d;
+    v.mean = p;
+    v.lo = std::max(0.0, c - h);
+    v.hi = std::min(1.0, c + h);
+    return v;
+}
+
+/* One target run's held-out figures: R, arrival fraction, recovery ticks per episode. */
+void add_eval(ConditionSummary &c, const std::vector<EpisodeOutcome> &ev, uint64_t &reached, uint64_t &evals)
+{
+    std::vector<double> r;
+    double arrived = 0, tau = 0;
+    for (const auto &o : ev) {
+        r.push_back(o.R);
+        arrived += o.reached ? 1 : 0;
+        tau += o.tau_c;
+    }
+    reached += static_cast<uint64_t>(arrived);
+    evals += ev.size();
+    c.final_per_run.push_back(mean_of(r));
+    const double n = ev.empty() ? 1.0 : static_cast<double>(ev.size());
+    c.arrival_per_run.push_back(arrived / n);
+    c.tau_c_per_run.push_back(tau / n);
+}
+
+/* A run's checkpoints into c (one entry per checkpoint, runs appended), and the episodes
+ * until its arrival first reached the threshold. */
+void add_checkpoints(ConditionSummary &c, const std::string &path, const std::vector<uint64_t> &grid,
+                     double threshold)
+{
+    const std::vector<CheckpointRow> rows = read_checkpoints(path);
+    if (rows.size() != grid.size()) {
+        throw UserError(path + ": has " + std::to_string(rows.size()) + " checkpoints, expected " +
+                        std::to_string(grid.size()));
+    }
+    if (c.checkpoints.empty()) {
+        for (uint64_t g : grid) {
+            CheckpointSummary cs;
+            cs.checkpoint = g;
+            c.checkpoints.push_back(cs);
+        }
+    }
+    double first = std::nan("");
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        const double arrival = static_cast<double>(rows[i].arrived) / rows[i].n;
+        c.checkpoints[i].R.push_back(rows[i].R);
+        c.checkpoints[i].arrival.push_back(arrival);
+        c.checkpoints[i].tau_c.push_back(static_cast<double>(rows[i].tau_c) / rows[i].n);
+        if (std::isnan(first) && arrival >= threshold) {
+            first = static_cast<double>(rows[i].checkpoint);
+        }
+    }
+    c.to_threshold.push_back(first);
+    c.threshold_not_reached += std::isnan(first) ? 1 : 0;
+}
+
+/* One run's learning curves, binned: candidates' R, the population best, arrivals. */
+void add_curves(const JournalColumns &J, uint64_t steps_per_bin, uint32_t k, std::vector<std::vector<double>> &bins,
+                std::vector<std::vector<double>> &best_bins, std::vector<std::vector<double>> &arrival_bins)
+{
+    for (std::size_t b = 0; b < bins.size(); ++b) {
+        const std::size_t lo = b * steps_per_bin;
+        const std::size_t hi = std::min<std::size_t>(lo + steps_per_bin, J.R.size());
+        std::vector<double> part(J.R.begin() + static_cast<long>(lo), J.R.begin() + static_cast<long>(hi));
+        double arrived = 0;
+        for (std::size_t i = lo; i < hi; ++i) {
+            arrived += J.arrived[i];
+        }
+        bins[b].push_back(mean_of(part));
+        best_bins[b].push_back(J.best_fitness[hi - 1]);
+        arrival_bins[b].push_back(arrived / (static_cast<double>(hi - lo) * k));
+    }
+}
+
+void finish_curves(ConditionSummary &c, const ExperimentSummary &S, const std::vector<std::vector<double>> &bins,
+                   const std::vector<std::vector<double>> &best_bins,
+                   const std::vector<std::vector<double>> &arrival_bins)
+{
+    for (std::size_t b = 0; b < bins.size(); ++b) {
+        c.curve_mean.push_back(mean_of(bins[b]));
+        c.curve_ci.push_back(ci95_half_width(bins[b]));
+        c.best_mean.push_back(mean_of(best_bins[b]));
+        c.best_ci.push_back(ci95_half_width(best_bins[b]));
+        c.arrival_curve_mean.push_back(mean_of(arrival_bins[b]));
+        c.arrival_curve_ci.push_back(ci95_half_width(arrival_bins[b]));
+    }
+    if (c.curve_mean.empty()) {
+        return;
+    }
+    c.start = c.curve_mean.front();
+    c.end = c.curve_mean.back();
+    c.best_end = c.best_mean.back();
+    if (c.end > c.start) {
+        const double goal = c.start + 0.9 * (c.end - c.start);
+        for (std::size_t b = 0; b < c.curve_mean.size(); ++b) {
+            if (c.curve_mean[b] >= goal) {
+                c.episodes_to_90 = static_cast<double>(S.bin_end[b]);
+                break;
+            }
+        }
+    }
+}
+
+ConditionSummary summarize_condition(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks,
+                                     const std::string &label, const ExperimentSummary &S, uint64_t steps,
+                                     uint64_t steps_per_bin)
+{
+    ConditionSummary c;
+    c.label = label;
+    const std::size_t nbins = S.bin_end.size();
+    std::vector<std::vector<double>> bins(nbins), best_bins(nbins), arrival_bins(nbins);
+    double best_final = -std::numeric_limits<double>::infinity();
+    uint64_t reached = 0, evals = 0;
+    for (const TaskDef &t : tasks) {
+        if (t.label != label) {
+            continue;
+        }
+        add_eval(c, read_eval(join_path(t.dir, "eval.csv")), reached, evals);
+        if (c.final_per_run.back() > best_final) {
+            best_final = c.final_per_run.back();
+            c.best_run = static_cast<int>(t.run);
+        }
+        if (!t.checkpoints.empty()) {
+            add_checkpoints(c, join_path(t.dir, "checkpoints.csv"), t.checkpoints, spec.arrival_threshold);
+        }
+        const std::string journal = join_path(t.dir, "episodes.csv");
+        const JournalColumns J = read_journal(journal);
+        if (J.R.size() != steps) {
+            throw UserError(journal + ": has " + std::to_string(J.R.size()) + " steps, expected " +
+                            std::to_string(steps));
+        }
+        c.online_per_run.push_back(mean_of(J.R));
+        add_curves(J, steps_per_bin, S.k, bins, best_bins, arrival_bins);
+    }
+    c.final_mean = mean_of(c.final_per_run);
+    c.final_sd = sd_of(c.final_per_run);
+    c.final_ci = ci95_half_width(c.final_per_run);
+    c.reached_rate = evals ? static_cast<double>(reached) / static_cast<double>(evals) : 0.0;
+    c.arrival = t_interval(c.arrival_per_run, 0.0, 1.0);
+    c.tau_c = t_interval(c.tau_c_per_run, 0.0, std::numeric_limits<double>::infinity());
+    c.online_mean = mean_of(c.online_per_run);
+    for (CheckpointSummary &cs : c.checkpoints) {
+        cs.listed = std::find(spec.checkpoints.begin(), spec.checkpoints.end(), cs.checkpoint) != spec.checkpoints.end();
+        cs.R_ci = t_interval(cs.R, -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+        cs.arrival_ci = t_interval(cs.arrival, 0.0, 1.0);
+        cs.tau_c_ci = t_interval(cs.tau_c, 0.0, std::numeric_limits<double>::infinity());
+    }
+    finish_curves(c, S, bins, best_bins, arrival_bins);
+    return c;
+}
+
+ConditionSummary summarize_probabilistic(const std::vector<TaskDef> &tasks)
+{
+    ConditionSummary prob;
+    prob.label = "probabilistic";
+    for (const TaskDef &t : tasks) {
+        if (t.kind != TaskKind::EvalProbabilistic) {
+            continue;
+        }
+        double reached = 0;
+        const auto ev = read_eval(join_path(t.dir, "eval.csv"));
+        for (const auto &o : ev) {
+            prob.final_per_run.push_back(o.R);
+            prob.arrival_per_run.push_back(o.reached ? 1.0 : 0.0);
+            prob.tau_c_per_run.push_back(o.tau_c);
+            reached += o.reached ? 1 : 0;
+        }
+        prob.reached_rate = ev.empty() ? 0.0 : reached / static_cast<double>(ev.size());
+        prob.arrival = wilson_interval(reached, static_cast<double>(ev.size()));
+    }
+    prob.tau_c = t_interval(prob.tau_c_per_run, 0.0, std::numeric_limits<double>::infinity());
+    prob.final_mean = mean_of(prob.final_per_run);
+    prob.final_sd = sd_of(prob.final_per_run);
+    prob.final_ci = ci95_half_width(prob.final_per_run);
+    prob.start = prob.end = prob.final_mean;
+    return prob;
+}
+
+/* Transfer vs direct at every checkpoint and in episodes to the threshold. */
+void compare_checkpoints(ConditionSummary &c, const ConditionSummary &direct, uint64_t budget)
+{
+    for (std::size_t i = 0; i < c.checkpoints.size() && i < direct.checkpoints.size(); ++i) {
+        c.checkpoints[i].R_vs_direct = welch_t_test(c.checkpoints[i].R, direct.checkpoints[i].R);
+        c.checkpoints[i].arrival_vs_direct = mann_whitney(c.checkpoints[i].arrival, direct.checkpoints[i].arrival);
+    }
+    auto ranked = [budget](const std::vector<double> &v) {
+        std::vector<double> r;
+        for (double x : v) {
+            r.push_back(std::isnan(x) ? static_cast<double>(budget + 1) : x);
+        }
+        return r;
+    };
+    c.threshold_vs_direct = mann_whitney(ranked(c.to_threshold), ranked(direct.to_threshold));
+}
+
+} // namespace
+
 ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks)
 {
     ExperimentSummary S;
     S.curve_bin = spec.curve_bin;
     S.episodes = spec.target_episodes;
+    S.k = spec.evolution.episodes_per_candidate;
+    S.arrival_threshold = spec.arrival_threshold;
+    S.checkpoint_episodes = spec.checkpoint_episodes;
     std::vector<std::string> labels;
     for (const SourceSpec &s : spec.sources) {
         labels.push_back("transfer-" + s.label);
     }
     labels.push_back("direct");
-    const uint64_t nbins = (spec.target_episodes + spec.curve_bin - 1) / spec.curve_bin;
-
+    TaskDef probe;
+    probe.episodes = spec.target_episodes;
+    probe.evolution = spec.evolution;
+    const uint64_t steps = task_steps(probe);
+    // Bins hold whole steps: curve_bin episodes rounded to a multiple of k.
+    const uint64_t steps_per_bin = std::max<uint64_t>(1, (spec.curve_bin + S.k / 2) / S.k);
+    for (uint64_t lo = 0; lo < steps; lo += steps_per_bin) {
+        S.bin_end.push_back(std::min(lo + steps_per_bin, steps) * S.k);
+    }
     for (const std::string &label : labels) {
-        ConditionSummary c;
-        c.label = label;
-        std::vector<std::vector<double>> bins(nbins), best_bins(nbins);
-        double best_final = -std::numeric_limits<double>::infinity();
-        uint64_t reached = 0, evals = 0;
-        for (const TaskDef &t : tasks) {
-            if (t.label != label) {
-                continue;
-            }
-            const auto ev = read_eval(join_path(t.dir, "eval.csv"));
-            std::vector<double> r;
-            for (const auto &o : ev) {
-                r.push_back(o.R);
-                reached += o.reached ? 1 : 0;
-                ++evals;
-            }
-            const double m = mean_of(r);
-            c.final_per_run.push_back(m);
-            if (m > best_final) {
-                best_final = m;
-                c.best_run = static_cast<int>(t.run);
-            }
-            const std::string journal = join_path(t.dir, "episodes.csv");
-            const JournalColumns J = read_journal(journal);
-            const std::vector<double> &R = J.R, &B = J.best_fitness;
-            if (R.size() != spec.target_episodes) {
-                throw UserError(journal + ": has " + std::to_string(R.size()) + " episodes, expected " +
-                                std::to_string(spec.target_episodes));
-            }
-            c.online_per_run.push_back(mean_of(R));
-            for (uint64_t b = 0; b < nbins; ++b) {
-                const uint64_t lo = b * spec.curve_bin;
-                const uint64_t hi = std::min<uint64_t>(lo + spec.curve_bin, R.size());
-                std::vector<double> part(R.begin() + static_cast<long>(lo), R.begin() + static_cast<long>(hi));
-                bins[b].push_back(mean_of(part));
-                best_bins[b].push_back(B[hi - 1]);
-            }
-        }
-        c.final_mean = mean_of(c.final_per_run);
-        c.final_sd = sd_of(c.final_per_run);
-        c.final_ci = ci95_half_width(c.final_per_run);
-        c.reached_rate = evals ? static_cast<double>(reached) / static_cast<double>(evals) : 0.0;
-        c.online_mean = mean_of(c.online_per_run);
-        for (auto &b : bins) {
-            c.curve_mean.push_back(mean_of(b));
-            c.curve_ci.push_back(ci95_half_width(b));
-        }
-        for (auto &b : best_bins) {
-            c.best_mean.push_back(mean_of(b));
-            c.best_ci.push_back(ci95_half_width(b));
-        }
-        if (!c.curve_mean.empty()) {
-            c.start = c.curve_mean.front();
-            c.end = c.curve_mean.back();
-            c.best_end = c.best_mean.back();
-            if (c.end > c.start) {
-                const double goal = c.start + 0.9 * (c.end - c.start);
-                for (uint64_t b = 0; b < nbins; ++b) {
-                    if (c.curve_mean[b] >= goal) {
-                        c.episodes_to_90 = static_cast<double>(std::min<uint64_t>((b + 1) * spec.curve_bin, spec.target_episodes));
-                        break;
-                    }
-                }
-            }
-        }
-        S.conditions.push_back(c);
+        S.conditions.push_back(summarize_condition(spec, tasks, label, S, steps, steps_per_bin));
     }
-    ConditionSummary prob;
-    prob.label = "probabilistic";
-    for (const TaskDef &t : tasks) {
-        if (t.kind == TaskKind::EvalProbabilistic) {
-            uint64_t reached = 0;
-            const auto ev = read_eval(join_path(t.dir, "eval.csv"));
-            for (const auto &o : ev) {
-                prob.final_per_run.push_back(o.R);
-                reached += o.reached ? 1 : 0;
-            }
-            prob.reached_rate = ev.empty() ? 0.0 : static_cast<double>(reached) / static_cast<double>(ev.size());
-        }
-    }
-    prob.final_mean = mean_of(prob.final_per_run);
-    prob.final_sd = sd_of(prob.final_per_run);
-    prob.final_ci = ci95_half_width(prob.final_per_run);
-    prob.start = prob.end = prob.final_mean;
-    S.conditions.push_back(prob);
+    S.conditions.push_back(summarize_probabilistic(tasks));
+    const ConditionSummary &prob = S.conditions.back();
 
     const ConditionSummary &direct = S.conditions[labels.size() - 1];
     auto pct = [](double a, double b) { return std::fabs(b) >= 1.0 ? (a - b) / std::fabs(b) * 100.0 : std::nan(""); };
     for (std::size_t i = 0; i + 1 < labels.size(); ++i) {
-        const ConditionSummary &c = S.conditions[i];
+        ConditionSummary &c = S.conditions[i];
+        compare_checkpoints(c, direct, spec.target_episodes);
         Comparison cmp;
         cmp.a = c.label;
         cmp.b = "direct";
@@ -487,14 +657,16 @@ namespace {
 std::string curves_csv(const ExperimentSummary &S)
 {
     std::ostringstream o;
-    o << "condition,episode,mean,ci_low,ci_high,best_mean,best_ci_low,best_ci_high\n";
+    o << "condition,episode,mean,ci_low,ci_high,best_mean,best_ci_low,best_ci_high,arrival_mean,arrival_ci_low,"
+         "arrival_ci_high\n";
     for (const ConditionSummary &c : S.conditions) {
         for (std::size_t b = 0; b < c.curve_mean.size(); ++b) {
-            const uint64_t ep = std::min<uint64_t>((b + 1) * S.curve_bin, S.episodes);
-            o << c.label << "," << ep << "," << json_num(c.curve_mean[b]) << ","
+            const double a = c.arrival_curve_mean[b], ah = c.arrival_curve_ci[b];
+            o << c.label << "," << S.bin_end[b] << "," << json_num(c.curve_mean[b]) << ","
               << json_num(c.curve_mean[b] - c.curve_ci[b]) << "," << json_num(c.curve_mean[b] + c.curve_ci[b]) << ","
               << json_num(c.best_mean[b]) << "," << json_num(c.best_mean[b] - c.best_ci[b]) << ","
-              << json_num(c.best_mean[b] + c.best_ci[b]) << "\n";
+              << json_num(c.best_mean[b] + c.best_ci[b]) << "," << json_num(a) << ","
+              << json_num(std::max(0.0, a - ah)) << "," << json_num(std::min(1.0, a + ah)) << "\n";
         }
     }
     return o.str();
@@ -515,13 +687,88 @@ std::string quality_csv(const ExperimentSummary &S, const std::string &exp_dir, 
     return quality_table_csv(policies, ccfg);
 }
 
-std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt)
+std::string json_interval(const Interval &v)
+{
+    return "{\"mean\": " + json_num(v.mean) + ", \"ci95_low\": " + json_num(v.lo) + ", \"ci95_high\": " +
+           json_num(v.hi) + "}";
+}
+
+std::string json_p(const TestResult &t) { return json_num(t.valid ? t.p : std::nan("")); }
+
+/* A condition's checkpoints and episodes-to-threshold as JSON members (", ..."). */
+std::string json_checkpoints(const ConditionSummary &c)
+{
+    if (c.checkpoints.empty()) {
+        return "";
+    }
+    std::ostringstream o;
+    o << ", \"checkpoints\": [";
+    for (std::size_t i = 0; i < c.checkpoints.size(); ++i) {
+        const CheckpointSummary &k = c.checkpoints[i];
+        o << (i ? ", " : "") << "{\"episodes\": " << k.checkpoint
+          << ", \"listed\": " << (k.listed ? "true" : "false") << ", \"R\": " << json_interval(k.R_ci)
+          << ", \"arrival\": " << json_interval(k.arrival_ci) << ", \"tau_c\": " << json_interval(k.tau_c_ci)
+          << ", \"R_p_vs_direct\": " << json_p(k.R_vs_direct)
+          << ", \"arrival_p_vs_direct\": " << json_p(k.arrival_vs_direct) << "}";
+    }
+    o << "], \"episodes_to_threshold\": [";
+    for (std::size_t i = 0; i < c.to_threshold.size(); ++i) {
+        o << (i ? ", " : "") << json_num(c.to_threshold[i]);
+    }
+    o << "], \"threshold_not_reached\": " << c.threshold_not_reached
+      << ", \"threshold_p_vs_direct\": " << json_p(c.threshold_vs_direct);
+    return o.str();
+}
+
+/* Held-out episodes whose trajectories are drawn per condition (episodes.png). */
+constexpr uint32_t kPictureEpisodes = 3;
+
+/* Trajectories of the best policy of every condition (and the probabilistic policy) on
+ * the first held-out episodes: the episodes.csv that tools/plot_episodes.py draws. */
+std::string episodes_csv(const ExperimentSummary &S, const std::string &exp_dir, SimRunner &runner,
+                         uint64_t eval_base, uint32_t eval_episodes)
+{
+    std::ostringstream o;
+    o << "condition,episode,tick,x_m,y_m,recovering,collided,R,reached,tau_c\n";
+    for (const ConditionSummary &c : S.conditions) {
+        qnav_policy_t policy = runner.probabilistic_policy();
+        std::string name = c.label;
+        if (c.label != "probabilistic") {
+            if (c.best_run < 0) {
+                continue;
+            }
+            const uint32_t run = static_cast<uint32_t>(c.best_run);
+            policy = read_policy_file(join_path(join_path(run_dir(exp_dir, run), c.label), "best.policy"));
+            name += " (run " + std::to_string(run + 1) + ")";
+        }
+        for (uint32_t i = 0; i < std::min(kPictureEpisodes, eval_episodes); ++i) {
+            std::vector<qnav_sim_sample_t> trace;
+            const EpisodeOutcome out = runner.run_traced(policy, mix_seed(eval_base, i), &trace);
+            for (const qnav_sim_sample_t &smp : trace) {
+                char b[256];
+                std::snprintf(b, sizeof b, ",%u,%u,%.4f,%.4f,%d,%d,%.4f,%d,%u\n", i, smp.tick, smp.x_m, smp.y_m,
+                              smp.recovering ? 1 : 0, smp.collided ? 1 : 0, out.R, out.reached ? 1 : 0, out.tau_c);
+                o << name << b;
+            }
+        }
+    }
+    return o.str();
+}
+
+std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt,
+                         const std::string &env_file, double robot_radius_m)
 {
     std::ostringstream o;
     o << "{\n  \"name\": " << json_str(spec.name) << ",\n  \"title\": " << json_str(spec.title)
       << ",\n  \"figure\": " << json_str(spec.figure) << ",\n  \"preset\": " << json_str(opt.preset)
       << ",\n  \"runs\": " << spec.runs << ",\n  \"episodes\": " << spec.target_episodes
       << ",\n  \"eval_episodes\": " << spec.eval_episodes << ",\n  \"curve_bin\": " << spec.curve_bin
+      << ",\n  \"episodes_per_candidate\": " << S.k << ",\n  \"fitness\": "
+      << json_str(qnav_sim_fitness_rule_name(spec.target.fitness))
+      << ",\n  \"controller\": " << json_str(controller_reading_name(spec.target.controller))
+      << ",\n  \"arrival_threshold\": " << json_num(S.arrival_threshold)
+      << ",\n  \"checkpoint_episodes\": " << S.checkpoint_episodes
+      << ",\n  \"environment_file\": " << json_str(env_file) << ",\n  \"robot_radius_m\": " << json_num(robot_radius_m)
       << ",\n  \"target\": " << json_str(spec.target.describe()) << ",\n  \"sources\": [";
     for (std::size_t i = 0; i < spec.sources.size(); ++i) {
         const SourceSpec &s = spec.sources[i];
@@ -537,7 +784,8 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
           << ", \"n\": " << c.final_per_run.size() << ", \"start\": " << json_num(c.start)
           << ", \"end\": " << json_num(c.end) << ", \"best_end\": " << json_num(c.best_end) << ", \"episodes_to_90\": "
           << (c.episodes_to_90 > 0 ? json_num(c.episodes_to_90) : "null")
-          << ", \"reached_rate\": " << json_num(c.reached_rate)
+          << ", \"reached_rate\": " << json_num(c.reached_rate) << ", \"arrival\": " << json_interval(c.arrival)
+          << ", \"tau_c\": " << json_interval(c.tau_c) << json_checkpoints(c)
           << ", \"online_mean\": " << json_num(c.label == "probabilistic" ? std::nan("") : c.online_mean) << ", \"best_run\": " << (c.best_run + 1) << "}"
           << (i + 1 < S.conditions.size() ? "," : "") << "\n";
     }
@@ -560,14 +808,81 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
     return o.str();
 }
 
+std::string pct_interval(const Interval &v)
+{
+    return fmt(100.0 * v.mean, 0) + "% (" + fmt(100.0 * v.lo, 0) + "–" + fmt(100.0 * v.hi, 0) + ")";
+}
+
+std::string num_interval(const Interval &v, int prec = 2)
+{
+    return fmt(v.mean, prec) + " (" + fmt(v.lo, prec) + "–" + fmt(v.hi, prec) + ")";
+}
+
+/* The equal-budget table and the episodes-to-threshold table (transfer and direct). */
+std::string checkpoint_tables_md(const ExperimentSummary &S)
+{
+    std::ostringstream o;
+    bool any = false;
+    for (const ConditionSummary &c : S.conditions) {
+        any = any || !c.checkpoints.empty();
+    }
+    if (!any) {
+        return "";
+    }
+    o << "## Held out at equal target budgets\n\n"
+      << "Best member of each run after the given target episodes, on the first " << S.checkpoint_episodes
+      << " held-out episodes (mean over runs, 95% CI); p: transfer vs direct over the runs. summary.json also "
+         "holds the checkpoint_every grid used for the threshold below.\n\n"
+      << "| condition | target episodes | R | arrival | recovery ticks per episode | p R (Welch) | p arrival (Mann-Whitney) |\n"
+      << "|---|---|---|---|---|---|---|\n";
+    for (const ConditionSummary &c : S.conditions) {
+        for (const CheckpointSummary &k : c.checkpoints) {
+            if (!k.listed) {
+                continue;
+            }
+            const bool direct = c.label == "direct";
+            o << "| " << c.label << " | " << k.checkpoint << " | " << num_interval(k.R_ci) << " | "
+              << pct_interval(k.arrival_ci) << " | " << num_interval(k.tau_c_ci, 1) << " | "
+              << (direct ? "-" : fmt_p(k.R_vs_direct)) << " | " << (direct ? "-" : fmt_p(k.arrival_vs_direct))
+              << " |\n";
+        }
+    }
+    o << "\n| condition | target episodes until held-out arrival ≥ " << fmt(100.0 * S.arrival_threshold, 0)
+      << "% (median of the runs that reached it) | runs that reached it | not reached | p vs direct (Mann-Whitney) |\n"
+      << "|---|---|---|---|---|\n";
+    for (const ConditionSummary &c : S.conditions) {
+        if (c.checkpoints.empty()) {
+            continue;
+        }
+        std::vector<double> reached;
+        for (double x : c.to_threshold) {
+            if (!std::isnan(x)) {
+                reached.push_back(x);
+            }
+        }
+        std::sort(reached.begin(), reached.end());
+        const double median = reached.empty() ? std::nan("")
+                              : reached.size() % 2 ? reached[reached.size() / 2]
+                                                   : 0.5 * (reached[reached.size() / 2 - 1] + reached[reached.size() / 2]);
+        o << "| " << c.label << " | " << fmt(median, 0) << " | " << reached.size() << " | " << c.threshold_not_reached
+          << " | " << (c.label == "direct" ? "-" : fmt_p(c.threshold_vs_direct)) << " |\n";
+    }
+    o << "\nCheckpoints are checked at the end of the first step that reaches them (k = " << S.k
+      << " episodes per step); a run that does not reach the threshold within the budget is ranked after every run "
+         "that does.\n\n";
+    return o.str();
+}
+
 std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt, bool plots)
 {
     std::ostringstream o;
     o << "# " << spec.name << (spec.figure.empty() ? "" : " (paper " + spec.figure + ")") << "\n\n"
       << spec.title << "\n\n"
       << "Preset `" << opt.preset << "`: " << spec.runs << " runs, " << spec.target_episodes
-      << " target episodes per run, population " << spec.evolution.population << ", epsilon "
-      << fmt(spec.evolution.epsilon, 2) << ", " << spec.evolution.hidden << " hidden units; final performance = mean R of each run's best policy over "
+      << " target episodes per run (" << S.k << " per candidate), fitness rule `"
+      << qnav_sim_fitness_rule_name(spec.target.fitness) << "`, controller `"
+      << controller_reading_name(spec.target.controller) << "`, population " << spec.evolution.population << ", epsilon "
+      << fmt(spec.evolution.epsilon, 2) << ", " << spec.evolution.hidden << " hidden units; final performance = each run's best policy over "
       << spec.eval_episodes << " held-out episodes (the same set for every run and condition).\n\n"
       << "Target: " << spec.target.describe() << "\n\n";
     for (const SourceSpec &s : spec.sources) {
@@ -576,15 +891,16 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
                                     : "policy file " + s.policy_file)
           << "\n\n";
     }
-    o << "| condition | final R held out (mean ± 95% CI) | sd | candidates' R, first " << S.curve_bin
-      << " episodes | last " << S.curve_bin << " | episodes to 90% | best fitness at the end | goal reached (held out) |\n"
-      << "|---|---|---|---|---|---|---|---|\n";
+    o << "| condition | final R held out (mean ± 95% CI) | arrival held out (95% CI) | recovery ticks per episode (95% CI) | sd of R | candidates' R, first "
+      << S.bin_end.front() << " episodes | last bin | episodes to 90% | best fitness at the end |\n"
+      << "|---|---|---|---|---|---|---|---|---|\n";
     for (const ConditionSummary &c : S.conditions) {
         const bool prob = c.label == "probabilistic";
-        o << "| " << c.label << " | " << fmt(c.final_mean) << " ± " << fmt(c.final_ci) << " | " << fmt(c.final_sd)
+        o << "| " << c.label << " | " << fmt(c.final_mean) << " ± " << fmt(c.final_ci) << " | " << pct_interval(c.arrival)
+          << " | " << num_interval(c.tau_c, 1) << " | " << fmt(c.final_sd)
           << " | " << (prob ? "-" : fmt(c.start)) << " | " << (prob ? "-" : fmt(c.end)) << " | "
           << (prob ? "-" : (c.episodes_to_90 > 0 ? fmt(c.episodes_to_90, 0) : "n/a")) << " | "
-          << (prob ? "-" : fmt(c.best_end)) << " | " << fmt(100.0 * c.reached_rate, 0) << "% |\n";
+          << (prob ? "-" : fmt(c.best_end)) << " |\n";
     }
     o << "\n| comparison | difference in final R | improvement | faster to 90% | test | p | Mann-Whitney p | difference in online R (Welch p) |\n|---|---|---|---|---|---|---|---|\n";
     for (const Comparison &c : S.comparisons) {
@@ -595,14 +911,20 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
           << (c.b == "probabilistic" ? "-" : fmt_p(c.mann_whitney)) << " | "
           << (c.b == "probabilistic" ? "-" : fmt(c.online_difference) + " (" + fmt_p(c.online) + ")") << " |\n";
     }
-    o << "\nCandidates' R = episode R of the networks evaluated (mutants), binned, mean over runs. "
+    o << "\nArrival and recovery ticks: per run the fraction of its best policy's held-out episodes that reached the "
+         "destination and its mean recovery ticks (tau_c) per episode, 95% CI over runs (Student t, clipped to the "
+         "possible range); the probabilistic policy is one policy, so its CIs are over episodes (arrival: Wilson score "
+         "interval). "
+         "Candidates' R = mean R of the networks evaluated (mutants, each on k episodes), binned by target episodes, mean over runs. "
          "Best fitness = the population's best member's fitness (mean R of its episodes; biased upwards by selection), mean over runs. "
-         "Online R = mean episode R of all candidates of a run (the area under its learning curve; higher = learns faster and better). "
+         "Online R = mean R of all candidates of a run (the area under its learning curve; higher = learns faster and better). "
          "Improvement = (mean_a − mean_b) / |mean_b| (n/a when |mean_b| < 1). Episodes to 90% = first bin at "
          "which the candidates' mean curve has covered 90% of its rise from its first to its last bin. "
          "The probabilistic policy's p-value is a one-sample t-test of the runs against its held-out mean.\n\n";
+    o << checkpoint_tables_md(S);
     if (plots) {
-        o << "![learning curves](learning.png)\n\n![policy quality](policy.png)\n\n";
+        o << "![learning curves](learning.png)\n\n![policy quality](policy.png)\n\n"
+          << "![held-out episodes of the best policies](episodes.png)\n\n";
     }
     o << "Regenerate: `simevo run " << spec.name << " --preset " << opt.preset << "` (with the same `--out`)\n";
     return o.str();
@@ -704,7 +1026,7 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
             SimRunner probe(worlds, t.scenario, t.context_seed, opt.use_table);
         }
     }
-    const SimRunner target_runner(worlds, spec.target, spec.seed, opt.use_table);
+    SimRunner target_runner(worlds, spec.target, spec.seed, opt.use_table);
     for (const SourceSpec &s : spec.sources) {
         if (!s.policy_file.empty()) {
             try {
@@ -726,12 +1048,21 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
     write_file_atomic(join_path(exp_dir, "curves.csv"), curves_csv(S));
     write_file_atomic(join_path(exp_dir, "quality.csv"), quality_csv(S, exp_dir, target_runner.ctrl_config(),
                                                                    target_runner.probabilistic_policy()));
-    write_file_atomic(join_path(exp_dir, "summary.json"), summary_json(spec, S, opt));
+    qnav_sim_env_info_t env_info;
+    qnav_sim_env_info(worlds.env(spec.target.environment), &env_info);
+    qnav_sim_robot_info_t robot_info;
+    qnav_sim_robot_info(worlds.robot(spec.target.robot), &robot_info);
+    write_file_atomic(join_path(exp_dir, "summary.json"),
+                      summary_json(spec, S, opt, env_info.source, robot_info.radius_m));
+    const uint64_t eval_base = tasks.back().eval_seed_base; // the probabilistic task's: the held-out set
+    write_file_atomic(join_path(exp_dir, "episodes.csv"),
+                      episodes_csv(S, exp_dir, target_runner, eval_base, spec.eval_episodes));
     if (opt.plots) {
         write_file_atomic(status_path, "incomplete: runs finished, plots missing\n");
         try {
             run_plot(opt, "plot_learning.py", exp_dir);
             run_plot(opt, "plot_policy.py", exp_dir);
+            run_plot(opt, "plot_episodes.py", exp_dir);
         } catch (const UserError &e) {
             throw UserError(std::string(e.what()) + " (results are complete except plots; STATUS says so)");
         }

@@ -32,6 +32,10 @@ struct RunOptions {
     std::string preset = "full";    /* recorded in the summary's command line */
 };
 
+/* Target episodes after which a target run's best member is evaluated held out: the
+ * spec's checkpoints within the budget and every checkpoint_every episodes, increasing. */
+std::vector<uint64_t> checkpoint_grid(const ExperimentSpec &spec);
+
 /* Tasks of an experiment, in an order where every source precedes its transfers. */
 std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &exp_dir);
 
@@ -41,6 +45,24 @@ void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, uns
                bool progress, const std::string &title);
 
 /* Summary statistics of a finished experiment, from its task folders only. */
+
+/* A mean with its 95% confidence interval (lo, hi). */
+struct Interval {
+    double mean = 0, lo = 0, hi = 0;
+};
+
+/* Held-out performance of a condition's best members at one checkpoint, per run. */
+struct CheckpointSummary {
+    uint64_t checkpoint = 0;          /* target episodes */
+    bool listed = false;              /* one of the spec's checkpoints (else only a point of
+                                         the checkpoint_every grid, for the threshold) */
+    std::vector<double> R, arrival, tau_c; /* per run: mean R, arrival fraction, recovery
+                                             ticks per episode */
+    Interval R_ci, arrival_ci, tau_c_ci;
+    TestResult R_vs_direct;           /* Welch t on R, transfer vs direct */
+    TestResult arrival_vs_direct;     /* Mann-Whitney on the arrival fractions */
+};
+
 struct ConditionSummary {
     std::string label;               /* "transfer-open", "direct", "probabilistic" */
     std::vector<double> final_per_run; /* held-out mean R per run (probabilistic: per episode) */
@@ -58,6 +80,20 @@ struct ConditionSummary {
     double online_mean = 0;
     int best_run = -1;               /* run whose best policy scored highest held out */
     double reached_rate = 0;         /* fraction of held-out episodes that reached the goal */
+    /* What the robots do, held out: arrival fraction and recovery ticks per episode, per
+     * run (probabilistic: per episode), with 95% CIs (runs: Student t over runs, clamped
+     * to [0, 1]; probabilistic arrival: Wilson score interval). */
+    std::vector<double> arrival_per_run, tau_c_per_run;
+    Interval arrival, tau_c;
+    std::vector<double> arrival_curve_mean, arrival_curve_ci; /* candidates' episodes that
+                                                 arrived: per bin, mean over runs */
+    std::vector<CheckpointSummary> checkpoints; /* target conditions only */
+    /* Target episodes until the best member's held-out arrival first reached the
+     * threshold, per run; NaN = not reached within the budget. */
+    std::vector<double> to_threshold;
+    uint32_t threshold_not_reached = 0;
+    TestResult threshold_vs_direct;  /* Mann-Whitney, a run not reaching it ranked after
+                                        every run that did */
 };
 
 struct Comparison {
@@ -79,6 +115,10 @@ struct ExperimentSummary {
     std::vector<Comparison> comparisons;      /* each transfer vs direct, vs probabilistic */
     uint32_t curve_bin = 0;
     uint64_t episodes = 0;
+    std::vector<uint64_t> bin_end;  /* target episodes at the end of each curve bin */
+    uint32_t k = 1;                 /* episodes per candidate */
+    double arrival_threshold = 0.8;
+    uint32_t checkpoint_episodes = 0;
 };
 
 ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks);

@@ -68,6 +68,50 @@ std::string resolve_experiment(const std::string &arg, const std::string &dir)
     return path;
 }
 
+/* --controller NAME for every scenario of s. Throws UserError. */
+void set_controller(ExperimentSpec &s, const std::string &name)
+{
+    ControllerReading c;
+    if (!controller_reading_parse(name, &c)) {
+        throw UserError("--controller: '" + name + "' is not one of body, literal");
+    }
+    s.target.controller = c;
+    for (SourceSpec &src : s.sources) {
+        src.scenario.controller = c;
+    }
+}
+
+/* --fitness NAME for every scenario of s. Throws UserError. */
+void set_fitness(ExperimentSpec &s, const std::string &name)
+{
+    qnav_sim_fitness_rule_t rule;
+    if (qnav_sim_fitness_rule_parse(name.c_str(), &rule) != QNAV_SIM_OK) {
+        throw UserError("--fitness: '" + name + "' is not one of " + qnav_sim_fitness_rule_names());
+    }
+    s.target.fitness = rule;
+    for (auto &src : s.sources) {
+        src.scenario.fitness = rule;
+    }
+}
+
+/* What a user takes to a robot: each transfer's best policy and how often it arrives. */
+void print_transfer_arrival(const ExperimentSpec &s, const std::string &dir)
+{
+    const ExperimentSummary S = summarize(s, plan_tasks(s, dir));
+    for (const ConditionSummary &c : S.conditions) {
+        if (c.label.rfind("transfer-", 0) != 0 || c.best_run < 0) {
+            continue;
+        }
+        char run[16];
+        std::snprintf(run, sizeof run, "run-%03d", c.best_run + 1);
+        std::printf("%s: best transferred policy %s/%s/%s/best.policy arrives in %.0f%% of %u held-out episodes "
+                    "(all runs: %.0f%%)\n",
+                    s.name.c_str(), dir.c_str(), run, c.label.c_str(),
+                    100.0 * c.arrival_per_run[static_cast<std::size_t>(c.best_run)], s.eval_episodes,
+                    100.0 * c.arrival.mean);
+    }
+}
+
 Scenario scenario_from(const std::string &env, const std::string &robot, uint32_t sectors, double noise,
                        double sensor_noise, double actuation_noise)
 {
@@ -95,7 +139,8 @@ int main(int argc, char **argv)
     RunOptions opt;
     opt.tools_dir = env_or("QNAV_TOOLS_DIR", std::string(QNAV_SOURCE_DIR) + "/tools");
     std::string preset = "full";
-    int64_t runs = 0, episodes = 0, source_episodes = 0, eval_episodes = 0, seed = -1;
+    int64_t runs = 0, episodes = 0, source_episodes = 0, eval_episodes = 0, seed = -1, per_candidate = 0;
+    std::string fitness, controller;
     bool no_plot = false, no_progress = false, network_mode = false;
     run->add_option("experiment", names, "experiment name(s), a .toml path, or 'all'")->required();
     run->add_option("--preset", preset, "'full' (the file's values) or a preset the file defines, e.g. 'quick'")->capture_default_str();
@@ -106,6 +151,11 @@ int main(int argc, char **argv)
     run->add_option("--source-episodes", source_episodes, "override source episodes")->check(CLI::Range(int64_t(1), int64_t(100000000)));
     run->add_option("--eval-episodes", eval_episodes, "override held-out evaluation episodes")->check(CLI::Range(int64_t(1), int64_t(1000000)));
     run->add_option("--seed", seed, "override the master seed")->check(CLI::Range(int64_t(0), INT64_MAX));
+    run->add_option("--per-candidate", per_candidate, "override episodes per candidate (k)")->check(CLI::Range(int64_t(1), int64_t(1000)));
+    run->add_option("--fitness", fitness, "override the fitness rule: progress or paper (docs/sim.md)");
+    run->add_option("--controller", controller,
+                    "override the controller's reading: body, or literal (the paper's per-sector "
+                    "mapping, no speed guard, rank by quality; docs/architecture.md)");
     run->add_option("--tools-dir", opt.tools_dir, "folder with plot_learning.py and plot_policy.py")->capture_default_str();
     run->add_flag("--no-plot", no_plot, "skip the PNG plots");
     run->add_flag("--no-progress", no_progress, "no progress line even on a terminal");
@@ -208,6 +258,9 @@ int main(int argc, char **argv)
                 if (source_episodes > 0) for (auto &src : s.sources) src.episodes = static_cast<uint64_t>(source_episodes);
                 if (eval_episodes > 0) s.eval_episodes = static_cast<uint32_t>(eval_episodes);
                 if (seed >= 0) s.seed = static_cast<uint64_t>(seed);
+                if (per_candidate > 0) s.evolution.episodes_per_candidate = static_cast<uint32_t>(per_candidate);
+                if (!fitness.empty()) set_fitness(s, fitness);
+                if (!controller.empty()) set_controller(s, controller);
                 specs.push_back(s);
             }
             opt.plots = !no_plot;
@@ -222,6 +275,7 @@ int main(int argc, char **argv)
                 if (opt.plots) {
                     std::printf("%s: plot %s/learning.png\n", s.name.c_str(), dir.c_str());
                 }
+                print_transfer_arrival(s, dir);
                 std::fflush(stdout);
             }
             return 0;

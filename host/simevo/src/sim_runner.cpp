@@ -63,11 +63,15 @@ SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t conte
     cfg.actuation_noise = scenario.actuation_noise;
     cfg.seed = context_seed;
     cfg.episode_limit_s = scenario.episode_limit_s;
+    cfg.fitness = scenario.fitness;
     char err[QNAV_SIM_ERRLEN] = {0};
     if (qnav_sim_create(robot, env, &cfg, &sim_, err, sizeof err) != QNAV_SIM_OK) {
         throw UserError(std::string("simulator (") + scenario.describe() + "): " + err);
     }
     qnav_sim_ctrl_config(sim_, &ctrl_cfg_);
+    if (scenario.controller == ControllerReading::Literal) {
+        qnav_ctrl_config_literal(&ctrl_cfg_);
+    }
     qnav_sim_robot_prob_policy(robot, &prob_);
 }
 
@@ -95,6 +99,12 @@ const qnav_qkey_t *SimRunner::table_for(const qnav_ctrl_t &ctrl, const qnav_poli
 
 EpisodeOutcome SimRunner::run(const qnav_policy_t &policy, uint64_t episode_seed)
 {
+    return run_traced(policy, episode_seed, nullptr);
+}
+
+EpisodeOutcome SimRunner::run_traced(const qnav_policy_t &policy, uint64_t episode_seed,
+                                     std::vector<qnav_sim_sample_t> *trace)
+{
     qnav_ctrl_t ctrl;
     qnav_status_t st = qnav_ctrl_init(&ctrl, &ctrl_cfg_, &policy);
     if (st != QNAV_OK) {
@@ -108,7 +118,11 @@ EpisodeOutcome SimRunner::run(const qnav_policy_t &policy, uint64_t episode_seed
         }
     }
     qnav_sim_result_t res;
-    const qnav_sim_status_t s = qnav_sim_run_episode(sim_, &ctrl, episode_seed, &res, nullptr, nullptr);
+    auto append = [](void *user, const qnav_sim_sample_t *smp) {
+        static_cast<std::vector<qnav_sim_sample_t> *>(user)->push_back(*smp);
+    };
+    const qnav_sim_status_t s = qnav_sim_run_episode(sim_, &ctrl, episode_seed, &res,
+                                                     trace ? +append : nullptr, trace);
     if (s != QNAV_SIM_OK) {
         throw UserError("simulator: episode failed (status " + std::to_string(static_cast<int>(s)) +
                         "): " + qnav_sim_last_error(sim_));

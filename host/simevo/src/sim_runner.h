@@ -49,6 +49,9 @@ public:
     SimRunner &operator=(const SimRunner &) = delete;
 
     EpisodeOutcome run(const qnav_policy_t &policy, uint64_t episode_seed) override;
+    /* The same episode, with every trajectory sample appended to *trace (for pictures). */
+    EpisodeOutcome run_traced(const qnav_policy_t &policy, uint64_t episode_seed,
+                              std::vector<qnav_sim_sample_t> *trace);
     /* The robot profile's hand-tuned probabilistic policy (qnav_sim_robot_prob_policy). */
     qnav_policy_t probabilistic_policy() const override { return prob_; }
     /* The controller configuration of this context (sectors, max range). */

@@ -12,13 +12,37 @@
 
 namespace qnav {
 
+const char *controller_reading_name(ControllerReading c)
+{
+    switch (c) {
+    case ControllerReading::Body:
+        return "body";
+    case ControllerReading::Literal:
+        return "literal";
+    }
+    return "body";
+}
+
+bool controller_reading_parse(const std::string &name, ControllerReading *out)
+{
+    for (ControllerReading c : {ControllerReading::Body, ControllerReading::Literal}) {
+        if (name == controller_reading_name(c)) {
+            *out = c;
+            return true;
+        }
+    }
+    return false;
+}
+
 std::string Scenario::describe() const
 {
     std::ostringstream o;
     o.precision(17);
     o << "environment=" << environment << " robot=" << robot << " sectors=" << sectors
       << " sensor_noise=" << sensor_noise << " actuation_noise=" << actuation_noise
-      << " episode_limit_s=" << episode_limit_s;
+      << " episode_limit_s=" << episode_limit_s
+      << " fitness=" << qnav_sim_fitness_rule_name(fitness)
+      << " controller=" << controller_reading_name(controller);
     return o.str();
 }
 
@@ -90,6 +114,24 @@ public:
             fail(n, key + ": expected a table");
         }
         return *n.as_table();
+    }
+
+    /* A strictly increasing array of target-episode counts (>= 1). */
+    std::vector<uint64_t> checkpoint_list(const toml::node &n) const
+    {
+        if (!n.is_array()) {
+            fail(n, "checkpoints: expected an array of episode counts, e.g. [100, 250, 500]");
+        }
+        std::vector<uint64_t> v;
+        for (auto &&el : *n.as_array()) {
+            const uint64_t c = static_cast<uint64_t>(integer(el, "checkpoints", 1, 100000000));
+            if (!v.empty() && c <= v.back()) {
+                fail(el, "checkpoints: must be increasing (" + std::to_string(c) + " after " +
+                             std::to_string(v.back()) + ")");
+            }
+            v.push_back(c);
+        }
+        return v;
     }
 
     /* Scenario keys shared by [target] and [[source]]. Returns true if key was one. */
@@ -190,7 +232,8 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
     if (auto *n = root.get("evolution")) {
         const toml::table &t = p.table(*n, "evolution");
         p.only_keys(t, {"population", "epsilon", "hidden", "mutation_scale", "mutation_clip",
-                        "episodes_per_candidate", "reevaluate_parent", "init", "init_scale"},
+                        "episodes_per_candidate", "reevaluate_parent", "init", "init_scale",
+                        "fitness", "controller"},
                     "evolution");
         EvolutionParams &e = spec.evolution;
         if (auto *v = t.get("population")) {
@@ -229,6 +272,20 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
         }
         if (auto *v = t.get("init_scale")) {
             e.init_scale = p.number(*v, "init_scale", 1e-6, 128.0);
+        }
+        if (auto *v = t.get("fitness")) {
+            // Every scenario (target, and the sources that inherit from it) uses this rule.
+            const std::string s = p.str(*v, "fitness");
+            if (qnav_sim_fitness_rule_parse(s.c_str(), &spec.target.fitness) != QNAV_SIM_OK) {
+                p.fail(*v, "fitness: '" + s + "' is not one of " + qnav_sim_fitness_rule_names());
+            }
+        }
+        if (auto *v = t.get("controller")) {
+            // Like fitness: one reading for the target and every source.
+            const std::string s = p.str(*v, "controller");
+            if (!controller_reading_parse(s, &spec.target.controller)) {
+                p.fail(*v, "controller: '" + s + "' is not one of body, literal");
+            }
         }
     }
 
@@ -300,12 +357,26 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
 
     if (auto *n = root.get("evaluation")) {
         const toml::table &t = p.table(*n, "evaluation");
-        p.only_keys(t, {"episodes", "seed"}, "evaluation");
+        p.only_keys(t, {"episodes", "seed", "checkpoints", "checkpoint_every", "checkpoint_episodes",
+                        "arrival_threshold"},
+                    "evaluation");
         if (auto *v = t.get("episodes")) {
             spec.eval_episodes = static_cast<uint32_t>(p.integer(*v, "episodes", 1, 1000000));
         }
         if (auto *v = t.get("seed")) {
             spec.eval_seed = static_cast<uint64_t>(p.integer(*v, "seed", 0, INT64_MAX));
+        }
+        if (auto *v = t.get("checkpoints")) {
+            spec.checkpoints = p.checkpoint_list(*v);
+        }
+        if (auto *v = t.get("checkpoint_every")) {
+            spec.checkpoint_every = static_cast<uint64_t>(p.integer(*v, "checkpoint_every", 0, 100000000));
+        }
+        if (auto *v = t.get("checkpoint_episodes")) {
+            spec.checkpoint_episodes = static_cast<uint32_t>(p.integer(*v, "checkpoint_episodes", 1, 1000000));
+        }
+        if (auto *v = t.get("arrival_threshold")) {
+            spec.arrival_threshold = p.number(*v, "arrival_threshold", 0.0, 100.0) / 100.0;
         }
     }
 
@@ -317,7 +388,8 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
                 p.fail(v, "preset.full: reserved (it means the file's own values)");
             }
             const toml::table &t = p.table(v, "preset." + pname);
-            p.only_keys(t, {"runs", "episodes", "source_episodes", "eval_episodes", "curve_bin"},
+            p.only_keys(t, {"runs", "episodes", "source_episodes", "eval_episodes", "curve_bin",
+                            "checkpoint_episodes"},
                         "preset." + pname);
             Preset pr;
             if (auto *x = t.get("runs")) {
@@ -335,6 +407,10 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
             }
             if (auto *x = t.get("curve_bin")) {
                 pr.curve_bin = static_cast<uint32_t>(p.integer(*x, "curve_bin", 1, 100000));
+            }
+            if (auto *x = t.get("checkpoint_episodes")) {
+                pr.checkpoint_episodes =
+                    static_cast<uint32_t>(p.integer(*x, "checkpoint_episodes", 1, 1000000));
             }
             spec.presets[pname] = pr;
         }
@@ -386,6 +462,9 @@ void apply_preset(ExperimentSpec &spec, const std::string &preset)
     }
     if (p.curve_bin) {
         spec.curve_bin = *p.curve_bin;
+    }
+    if (p.checkpoint_episodes) {
+        spec.checkpoint_episodes = *p.checkpoint_episodes;
     }
 }
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "evolution.h"
+#include "qnav/sim.h"
 
 namespace qnav {
 
@@ -25,6 +26,16 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/* How the controller reads the paper (docs/architecture.md): Body = obstacles enlarged by
+ * the robot's radius + safety distance, speed guard, networks ranked by pre-activation;
+ * Literal = each path sees its own sector, no guard, ranked by quality (the ablation). */
+enum class ControllerReading { Body, Literal };
+
+/* "body" / "literal". */
+const char *controller_reading_name(ControllerReading c);
+/* Parses a name; false when it is not one. */
+bool controller_reading_parse(const std::string &name, ControllerReading *out);
+
 /* The situation a policy is evolved or evaluated in. */
 struct Scenario {
     std::string environment = "dense"; /* sim environment: name or file */
@@ -33,6 +44,10 @@ struct Scenario {
     double sensor_noise = 0.0;          /* p_s, fraction (0.05 = 5 %) */
     double actuation_noise = 0.0;       /* p_a, fraction */
     double episode_limit_s = 0.0;       /* s; 0 = the environment's limit */
+    qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS; /* how R is computed;
+                                           set for every scenario from [evolution] fitness */
+    ControllerReading controller = ControllerReading::Body; /* set for every scenario from
+                                           [evolution] controller */
 
     /* Canonical one-line description (also part of task fingerprints). */
     std::string describe() const;
@@ -52,6 +67,7 @@ struct Preset {
     std::optional<uint64_t> source_episodes;
     std::optional<uint32_t> eval_episodes;
     std::optional<uint32_t> curve_bin;
+    std::optional<uint32_t> checkpoint_episodes;
 };
 
 struct ExperimentSpec {
@@ -68,6 +84,15 @@ struct ExperimentSpec {
     std::vector<SourceSpec> sources;
     uint32_t eval_episodes = 50; /* held-out evaluation episodes per best policy */
     uint64_t eval_seed = 0x5eed;  /* seeds the held-out episode set (same for all runs) */
+    /* Transfer at equal budgets ([evaluation], docs/simevo.md "Checkpoints"): the best
+     * member of every target run is evaluated on the first checkpoint_episodes held-out
+     * episodes after these target episodes (beyond the budget: dropped) and after every
+     * checkpoint_every episodes (0 = not), the latter to find when its held-out arrival
+     * first reaches arrival_threshold. */
+    std::vector<uint64_t> checkpoints = {100, 250, 500, 1000};
+    uint64_t checkpoint_every = 50;
+    uint32_t checkpoint_episodes = 20;
+    double arrival_threshold = 0.8; /* fraction; the file gives percent */
     std::map<std::string, Preset> presets;
 };
 

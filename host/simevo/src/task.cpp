@@ -3,6 +3,7 @@
  */
 #include "task.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cinttypes>
 #include <cmath>
@@ -21,8 +22,9 @@ namespace qnav {
 
 namespace {
 
-const char *kJournalHeader = "episode,R,f1,f2,tau_c,reached,parent,explored,policy,parent_R,best_fitness\n";
+const char *kJournalHeader = "step,R,f1,f2,tau_c,arrived,parent,explored,policy,parent_R,best_fitness\n";
 const char *kEvalHeader = "eval_episode,R,f1,f2,tau_c,reached\n";
+const char *kCheckpointHeader = "checkpoint,episodes,n,R,arrived,tau_c\n";
 
 std::vector<std::string> split_csv(const std::string &line)
 {
@@ -69,18 +71,23 @@ std::string fmt_outcome(const EpisodeOutcome &o)
     return buf;
 }
 
-/* Parses "R,f1,f2,tau_c,reached" starting at field k. */
-bool parse_outcome(const std::vector<std::string> &f, std::size_t k, EpisodeOutcome &o)
+/* Parses "R,f1,f2,tau_c,reached" starting at field k; reached counts arrivals, at most
+ * max_reached (1 for one episode, k for a journal step); *arrived gets the count. */
+bool parse_outcome(const std::vector<std::string> &f, std::size_t k, EpisodeOutcome &o,
+                   uint32_t max_reached = 1, uint32_t *arrived = nullptr)
 {
     uint64_t tau = 0;
     uint64_t reached = 0;
     if (!parse_double(f[k], o.R) || !parse_double(f[k + 1], o.f1) ||
         !parse_double(f[k + 2], o.f2) || !parse_u64(f[k + 3], tau) ||
-        !parse_u64(f[k + 4], reached) || reached > 1 || tau > UINT32_MAX) {
+        !parse_u64(f[k + 4], reached) || reached > max_reached || tau > UINT32_MAX) {
         return false;
     }
     o.tau_c = static_cast<uint32_t>(tau);
-    o.reached = reached == 1;
+    o.reached = reached == max_reached;
+    if (arrived != nullptr) {
+        *arrived = static_cast<uint32_t>(reached);
+    }
     return true;
 }
 
@@ -188,31 +195,119 @@ bool run_eval(EpisodeRunner &runner, const qnav_policy_t &policy, const TaskDef 
     return true;
 }
 
-/* Fitness of a policy over k episodes: mean R, f1, f2; tau_c summed; reached = all
- * reached. Episode j of evaluation `index` runs with mix_seed(base, index * k + j). */
-EpisodeOutcome run_k(EpisodeRunner &runner, const qnav_policy_t &policy, uint64_t base, uint64_t index, uint32_t k)
+/* A policy's score over the k episodes of one step: mean R, f1, f2; tau_c summed;
+ * reached = all arrived. */
+struct StepOutcome {
+    EpisodeOutcome o;
+    uint32_t arrived = 0;
+};
+
+/* Episode j of step `step` runs with mix_seed(base, step * k + j): the candidate and the
+ * parent it is compared with face the same k start points. */
+StepOutcome run_k(EpisodeRunner &runner, const qnav_policy_t &policy, uint64_t base, uint64_t step, uint32_t k)
 {
-    if (k <= 1) {
-        return runner.run(policy, mix_seed(base, index));
-    }
-    EpisodeOutcome sum;
-    sum.reached = true;
+    StepOutcome sum;
     for (uint32_t j = 0; j < k; ++j) {
-        const EpisodeOutcome o = runner.run(policy, mix_seed(base, index * k + j));
-        sum.R += o.R;
-        sum.f1 += o.f1;
-        sum.f2 += o.f2;
-        sum.tau_c += o.tau_c;
-        sum.reached = sum.reached && o.reached;
+        const EpisodeOutcome o = runner.run(policy, mix_seed(base, step * k + j));
+        sum.o.R += o.R;
+        sum.o.f1 += o.f1;
+        sum.o.f2 += o.f2;
+        sum.o.tau_c += o.tau_c;
+        sum.arrived += o.reached ? 1 : 0;
     }
-    sum.R /= k;
-    sum.f1 /= k;
-    sum.f2 /= k;
+    sum.o.R /= k;
+    sum.o.f1 /= k;
+    sum.o.f2 /= k;
+    sum.o.reached = sum.arrived == k;
     return sum;
 }
 
-/* Seeds of parent re-evaluations: a stream apart from the candidates'. */
-uint64_t parent_base(const TaskDef &t) { return mix_seed(t.episode_seed_base, 0x706172656e74ull); }
+std::string fmt_step(const StepOutcome &s)
+{
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%.17g,%.6f,%.6f,%" PRIu32 ",%" PRIu32, s.o.R, s.o.f1, s.o.f2, s.o.tau_c,
+                  s.arrived);
+    return buf;
+}
+
+/* The checkpoint journal of a target task: the rows already there are kept; reach()
+ * evaluates the best member at every checkpoint passed and not yet recorded, so a resumed
+ * task (which replays the evolution step by step) completes exactly the missing ones. */
+class CheckpointLog {
+public:
+    CheckpointLog(const TaskDef &t, EpisodeRunner &runner, const TaskObserver &obs)
+        : t_(t), runner_(runner), obs_(obs), path_(join_path(t.dir, "checkpoints.csv"))
+    {
+        if (t.checkpoints.empty()) {
+            return;
+        }
+        std::string text;
+        std::size_t keep = 0;
+        if (read_file(path_, text) && !text.empty()) {
+            const Lines L = split_lines(text);
+            if (!L.lines.empty()) {
+                if (L.lines[0] + "\n" != kCheckpointHeader) {
+                    throw UserError(path_ + ":1: not a simevo checkpoint file");
+                }
+                keep = L.ends[0];
+                for (std::size_t i = 1; i < L.lines.size() && done_ < t.checkpoints.size(); ++i) {
+                    const auto f = split_csv(L.lines[i]);
+                    uint64_t c = 0;
+                    if (f.size() != 6 || !parse_u64(f[0], c) || c != t.checkpoints[done_]) {
+                        throw UserError(path_ + ":" + std::to_string(i + 1) + ": malformed row");
+                    }
+                    ++done_;
+                    keep = L.ends[i];
+                }
+            }
+        }
+        if (obs_.episodes_done && done_ > 0) {
+            obs_.episodes_done(done_ * t.checkpoint_episodes, true);
+        }
+        fd_ = open_journal_at(path_, keep, kCheckpointHeader);
+    }
+    ~CheckpointLog()
+    {
+        if (fd_ >= 0) {
+            ::close(fd_);
+        }
+    }
+    CheckpointLog(const CheckpointLog &) = delete;
+    CheckpointLog &operator=(const CheckpointLog &) = delete;
+
+    void reach(const Evolution &evo, uint64_t episodes)
+    {
+        while (done_ < t_.checkpoints.size() && t_.checkpoints[done_] <= episodes) {
+            const qnav_policy_t &best = evo.members()[static_cast<std::size_t>(evo.best_index())].policy;
+            CheckpointRow r;
+            r.checkpoint = t_.checkpoints[done_];
+            r.episodes = episodes;
+            r.n = t_.checkpoint_episodes;
+            for (uint32_t i = 0; i < r.n; ++i) {
+                const EpisodeOutcome o = runner_.run(best, mix_seed(t_.eval_seed_base, i));
+                r.R += o.R / r.n;
+                r.arrived += o.reached ? 1 : 0;
+                r.tau_c += o.tau_c;
+            }
+            char row[200];
+            std::snprintf(row, sizeof row, "%" PRIu64 ",%" PRIu64 ",%" PRIu32 ",%.17g,%" PRIu32 ",%" PRIu64 "\n",
+                          r.checkpoint, r.episodes, r.n, r.R, r.arrived, r.tau_c);
+            write_all(fd_, row, path_);
+            if (obs_.episodes_done) {
+                obs_.episodes_done(r.n, false);
+            }
+            ++done_;
+        }
+    }
+
+private:
+    const TaskDef &t_;
+    EpisodeRunner &runner_;
+    const TaskObserver &obs_;
+    std::string path_;
+    std::size_t done_ = 0;
+    int fd_ = -1;
+};
 
 } // namespace
 
@@ -266,12 +361,30 @@ std::string task_settings_text(const TaskDef &t, const std::string &source_finge
           << "\n";
     }
     o << "eval_episodes=" << t.eval_episodes << "\neval_seed_base=" << t.eval_seed_base << "\n";
+    if (!t.checkpoints.empty()) {
+        o << "checkpoints=";
+        for (std::size_t i = 0; i < t.checkpoints.size(); ++i) {
+            o << (i ? "," : "") << t.checkpoints[i];
+        }
+        o << " checkpoint_episodes=" << t.checkpoint_episodes << "\n";
+    }
     return o.str();
+}
+
+uint64_t task_steps(const TaskDef &t)
+{
+    // Rounded up, so that every checkpoint within the budget is reached.
+    const uint64_t k = std::max<uint32_t>(1, t.evolution.episodes_per_candidate);
+    return std::max<uint64_t>(1, (t.episodes + k - 1) / k);
 }
 
 uint64_t task_total_episodes(const TaskDef &t)
 {
-    return (t.kind == TaskKind::Evolve ? t.episodes : 0) + t.eval_episodes;
+    if (t.kind != TaskKind::Evolve) {
+        return t.eval_episodes;
+    }
+    return task_steps(t) * t.evolution.episodes_per_candidate +
+           static_cast<uint64_t>(t.checkpoints.size()) * t.checkpoint_episodes + t.eval_episodes;
 }
 
 namespace {
@@ -297,14 +410,37 @@ JournalColumns read_journal(const std::string &csv_path)
     JournalColumns c;
     for (std::size_t i = 1; i < L.lines.size(); ++i) {
         const auto f = split_csv(L.lines[i]);
-        double r = 0.0, best = 0.0;
-        if (f.size() != 11 || !parse_double(f[1], r) || !parse_double(f[10], best)) {
+        double best = 0.0;
+        EpisodeOutcome o;
+        uint32_t arrived = 0;
+        if (f.size() != 11 || !parse_outcome(f, 1, o, UINT32_MAX, &arrived) || !parse_double(f[10], best)) {
             throw UserError(csv_path + ":" + std::to_string(i + 1) + ": malformed row");
         }
-        c.R.push_back(r);
+        c.R.push_back(o.R);
+        c.arrived.push_back(arrived);
         c.best_fitness.push_back(best);
     }
     return c;
+}
+
+std::vector<CheckpointRow> read_checkpoints(const std::string &csv_path)
+{
+    const Lines L = read_with_header(csv_path, kCheckpointHeader, "checkpoint file");
+    std::vector<CheckpointRow> v;
+    for (std::size_t i = 1; i < L.lines.size(); ++i) {
+        const auto f = split_csv(L.lines[i]);
+        CheckpointRow r;
+        uint64_t n = 0, arrived = 0;
+        if (f.size() != 6 || !parse_u64(f[0], r.checkpoint) || !parse_u64(f[1], r.episodes) ||
+            !parse_u64(f[2], n) || !parse_double(f[3], r.R) || !parse_u64(f[4], arrived) ||
+            !parse_u64(f[5], r.tau_c) || n == 0 || n > UINT32_MAX || arrived > n) {
+            throw UserError(csv_path + ":" + std::to_string(i + 1) + ": malformed row");
+        }
+        r.n = static_cast<uint32_t>(n);
+        r.arrived = static_cast<uint32_t>(arrived);
+        v.push_back(r);
+    }
+    return v;
 }
 
 std::vector<EpisodeOutcome> read_eval(const std::string &csv_path)
@@ -321,6 +457,57 @@ std::vector<EpisodeOutcome> read_eval(const std::string &csv_path)
     }
     return v;
 }
+
+namespace {
+/* Replay the journal (if any) through evo: same proposals, recorded outcomes, no
+ * simulation except checkpoints missing from their file. Returns the bytes of the journal
+ * to keep (complete, matching lines). */
+std::size_t replay_journal(const TaskDef &t, const std::string &journal_path, Evolution &evo,
+                           CheckpointLog &checkpoints, const TaskObserver &obs)
+{
+    std::string text;
+    if (!read_file(journal_path, text) || text.empty()) {
+        return 0;
+    }
+    const Lines L = split_lines(text);
+    if (L.lines.empty()) {
+        return 0; // killed while writing the header
+    }
+    if (L.lines[0] + "\n" != kJournalHeader) {
+        throw UserError(journal_path + ":1: not a simevo episode journal");
+    }
+    const uint32_t k = t.evolution.episodes_per_candidate;
+    std::size_t keep = L.ends[0];
+    for (std::size_t i = 1; i < L.lines.size() && evo.episodes_done() < task_steps(t); ++i) {
+        const std::string where = journal_path + ":" + std::to_string(i + 1) + ": ";
+        const auto f = split_csv(L.lines[i]);
+        uint64_t step = 0;
+        EpisodeOutcome o;
+        if (f.size() != 11 || !parse_u64(f[0], step) || !parse_outcome(f, 1, o, k)) {
+            throw UserError(where + "malformed journal row");
+        }
+        const Candidate c = evo.propose();
+        EpisodeOutcome po;
+        const bool has_parent = t.evolution.reevaluate_parent && c.parent >= 0;
+        if (has_parent != !f[9].empty() || (has_parent && !parse_double(f[9], po.R))) {
+            throw UserError(where + "parent re-evaluation missing or unexpected");
+        }
+        char fp[16];
+        std::snprintf(fp, sizeof fp, "%08" PRIx32, policy_fingerprint(c.policy));
+        if (step != c.episode || f[8] != fp) {
+            throw UserError(where + "journal does not match this program and settings "
+                                    "(step or policy differs); use another --out");
+        }
+        evo.accept(c, o, has_parent ? &po : nullptr);
+        keep = L.ends[i];
+        if (obs.episodes_done) {
+            obs.episodes_done(k, true);
+        }
+        checkpoints.reach(evo, evo.episodes_done() * k);
+    }
+    return keep;
+}
+} // namespace
 
 bool run_task(const TaskDef &t, const std::string &source_policy_path, const RunnerFactory &make,
               const TaskObserver &obs, const std::atomic<bool> &stop)
@@ -372,85 +559,46 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
     Evolution evo = source_policy_path.empty()
                         ? Evolution(t.evolution, t.evolution_seed)
                         : Evolution(t.evolution, t.evolution_seed, source);
-
-    // Replay the journal (if any): same proposals, recorded outcomes, no simulation.
-    std::string text;
-    std::size_t keep = 0;
-    if (read_file(journal_path, text) && !text.empty()) {
-        const Lines L = split_lines(text);
-        if (L.lines.empty()) {
-            keep = 0; // killed while writing the header
-        } else {
-            if (L.lines[0] + "\n" != kJournalHeader) {
-                throw UserError(journal_path + ":1: not a simevo episode journal");
-            }
-            keep = L.ends[0];
-            for (std::size_t i = 1; i < L.lines.size() && evo.episodes_done() < t.episodes; ++i) {
-                const std::string where = journal_path + ":" + std::to_string(i + 1) + ": ";
-                const auto f = split_csv(L.lines[i]);
-                uint64_t ep = 0;
-                EpisodeOutcome o;
-                if (f.size() != 11 || !parse_u64(f[0], ep) || !parse_outcome(f, 1, o)) {
-                    throw UserError(where + "malformed journal row");
-                }
-                const Candidate c = evo.propose();
-                EpisodeOutcome po;
-                const bool has_parent = t.evolution.reevaluate_parent && c.parent >= 0;
-                if (has_parent != !f[9].empty() || (has_parent && !parse_double(f[9], po.R))) {
-                    throw UserError(where + "parent re-evaluation missing or unexpected");
-                }
-                char fp[16];
-                std::snprintf(fp, sizeof fp, "%08" PRIx32, policy_fingerprint(c.policy));
-                if (ep != c.episode || f[8] != fp) {
-                    throw UserError(where + "journal does not match this program and settings "
-                                            "(episode or policy differs); use another --out");
-                }
-                evo.accept(c, o, has_parent ? &po : nullptr);
-                keep = L.ends[i];
-            }
-            if (obs.episodes_done && evo.episodes_done() > 0) {
-                obs.episodes_done(evo.episodes_done(), true);
-            }
-        }
-    }
+    CheckpointLog checkpoints(t, *runner, obs);
+    const std::size_t keep = replay_journal(t, journal_path, evo, checkpoints, obs);
     const int fd = open_journal_at(journal_path, keep, kJournalHeader);
     FdGuard guard{fd};
     if (obs.best && evo.episodes_done() > 0) {
         obs.best(t.label, evo.best_so_far());
     }
-
-    while (evo.episodes_done() < t.episodes) {
+    const uint32_t k = t.evolution.episodes_per_candidate;
+    while (evo.episodes_done() < task_steps(t)) {
         if (stop.load()) {
             return false;
         }
         const Candidate c = evo.propose();
-        const uint32_t k = t.evolution.episodes_per_candidate;
-        const EpisodeOutcome o = run_k(*runner, c.policy, t.episode_seed_base, c.episode, k);
+        const StepOutcome o = run_k(*runner, c.policy, t.episode_seed_base, c.episode, k);
         const bool has_parent = t.evolution.reevaluate_parent && c.parent >= 0;
-        EpisodeOutcome po;
+        StepOutcome po;
         char parent_r[40] = "";
         if (has_parent) {
-            po = run_k(*runner, evo.members()[static_cast<std::size_t>(c.parent)].policy, parent_base(t), c.episode, k);
-            std::snprintf(parent_r, sizeof parent_r, "%.17g", po.R);
+            po = run_k(*runner, evo.members()[static_cast<std::size_t>(c.parent)].policy, t.episode_seed_base, c.episode, k);
+            std::snprintf(parent_r, sizeof parent_r, "%.17g", po.o.R);
         }
-        evo.accept(c, o, has_parent ? &po : nullptr);
+        evo.accept(c, o.o, has_parent ? &po.o : nullptr);
         char row[360];
         std::snprintf(row, sizeof row, "%" PRIu64 ",%s,%d,%d,%08" PRIx32 ",%s,%.17g\n", c.episode,
-                      fmt_outcome(o).c_str(), static_cast<int>(c.parent), c.explored ? 1 : 0,
+                      fmt_step(o).c_str(), static_cast<int>(c.parent), c.explored ? 1 : 0,
                       policy_fingerprint(c.policy), parent_r, evo.best_so_far());
         write_all(fd, row, journal_path);
         if (obs.episodes_done) {
-            obs.episodes_done(1, false);
+            obs.episodes_done(k, false);
         }
         if (obs.best) {
             obs.best(t.label, evo.best_so_far());
         }
+        checkpoints.reach(evo, evo.episodes_done() * k);
     }
 
     const int32_t b = evo.best_index();
     const qnav_policy_t best = evo.members()[static_cast<std::size_t>(b)].policy;
     char comment[200];
-    std::snprintf(comment, sizeof comment, "simevo %s run %u: best of %" PRIu64 " episodes, R = %.6f",
+    std::snprintf(comment, sizeof comment, "simevo %s run %u: best after %" PRIu64 " episodes, R = %.6f",
                   t.label.c_str(), t.run + 1, t.episodes, evo.members()[static_cast<std::size_t>(b)].fitness);
     char err[QNAV_POLICY_IO_ERRLEN] = {0};
     if (qnav_policy_write(best_path.c_str(), &best, comment, err, sizeof err) != 0) {

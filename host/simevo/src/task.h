@@ -3,8 +3,11 @@
  * transfer or direct; with or without a held-out evaluation of its best policy), or the
  * held-out evaluation of the probabilistic policy. A task lives in its own folder:
  *   task.txt      the resolved settings (a resumed task must match them exactly)
- *   episodes.csv  the episode journal: one line per finished episode, appended with one
- *                 write(); a kill leaves at most a partial last line, which resume drops
+ *   episodes.csv  the journal: one line per evolution step (a candidate scored on k
+ *                 episodes), appended with one write(); a kill leaves at most a partial
+ *                 last line, which resume drops
+ *   checkpoints.csv  held-out evaluations of the best member after given numbers of
+ *                 target episodes (journaled the same way; target tasks only)
  *   best.policy   the best member at the end (policy file, atomic)
  *   eval.csv      held-out episodes of the best (or probabilistic) policy (atomic)
  *   done          written last (atomic): the task is complete
@@ -35,15 +38,24 @@ struct TaskDef {
     uint32_t run = 0;                /* run index, 0-based */
     Scenario scenario;
     uint64_t context_seed = 1;       /* qnav_sim_config_t.seed */
-    uint64_t episodes = 0;           /* evolution episodes */
+    uint64_t episodes = 0;           /* evolution budget in simulated candidate episodes:
+                                        task_steps() steps of k episodes each */
     EvolutionParams evolution;
     uint64_t evolution_seed = 0;     /* seeds the Evolution's Rng */
-    uint64_t episode_seed_base = 0;  /* episode T runs with mix_seed(base, T) */
+    uint64_t episode_seed_base = 0;  /* episode j of step s runs with mix_seed(base, s*k+j),
+                                        for the candidate and the re-evaluated parent */
     int source_task = -1;            /* index of the task whose best.policy seeds this */
     std::string source_policy_file;  /* or a policy file that seeds it */
     uint32_t eval_episodes = 0;      /* held-out evaluation of the best; 0 = none */
     uint64_t eval_seed_base = 0;     /* held-out episode i runs with mix_seed(base, i) */
+    std::vector<uint64_t> checkpoints; /* target episodes (increasing, <= episodes) after
+                                          which the best member is evaluated held out */
+    uint32_t checkpoint_episodes = 0;  /* the first this many held-out episodes */
 };
+
+/* Evolution steps of a task: budget / k rounded up (so a step may end up to k - 1
+ * episodes past the budget), at least 1. */
+uint64_t task_steps(const TaskDef &t);
 
 /* Creates the runner a task uses (the simulator, or a fake in tests). */
 using RunnerFactory = std::function<std::unique_ptr<EpisodeRunner>(const Scenario &, uint64_t)>;
@@ -70,12 +82,23 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
 uint64_t task_total_episodes(const TaskDef &t);
 
 /* Reading finished task outputs. Throw UserError on malformed files. */
-/* An episode journal's R column and its best_fitness column (population best after
- * each candidate), one entry per episode. */
+/* An episode journal's columns, one entry per step: the candidate's mean R over its k
+ * episodes, how many of them arrived, and the population best's fitness after it. */
 struct JournalColumns {
     std::vector<double> R, best_fitness;
+    std::vector<uint32_t> arrived;
 };
 JournalColumns read_journal(const std::string &csv_path);
+/* One held-out evaluation of the best member at a checkpoint. */
+struct CheckpointRow {
+    uint64_t checkpoint = 0; /* nominal target episodes */
+    uint64_t episodes = 0;   /* target episodes actually run (the first step's end >= it) */
+    uint32_t n = 0;          /* held-out episodes */
+    double R = 0;            /* their mean R */
+    uint32_t arrived = 0;    /* how many reached the destination */
+    uint64_t tau_c = 0;      /* their recovery ticks, summed */
+};
+std::vector<CheckpointRow> read_checkpoints(const std::string &csv_path);
 std::vector<EpisodeOutcome> read_eval(const std::string &csv_path);
 
 /* The canonical settings text written to task.txt. */

@@ -114,8 +114,31 @@ typedef struct {
     double episode_limit_s;    /* episode time limit, s */
     uint32_t n_obstacles;      /* circles + boxes */
     uint32_t n_start_zones;    /* rectangles the start point is drawn from */
+    const char *source;        /* file it was read from (the name given to _parse);
+                                  owned by the env */
 } qnav_sim_env_info_t;
 void qnav_sim_env_info(const qnav_sim_env_t *env, qnav_sim_env_info_t *info);
+
+/* How an episode's figures become its fitness R (docs/sim.md, "Fitness"). */
+typedef enum {
+    /* Default. An episode that reaches the destination: Eq. 1-3 as in the paper. One that
+     * does not: f2 = 0 (no reward for time) and f1 = progress toward the destination,
+     * (d_start - d_end) / d_start clamped to [0, 1], so it earns at most 1 - tau_c and an
+     * arrival up to 11 - tau_c. */
+    QNAV_SIM_FITNESS_PROGRESS = 0,
+    /* Eq. 1-3 literally for every episode (ablation): a robot that circles until the time
+     * limit still earns ~6 of an arrival's 6.5-8.5. */
+    QNAV_SIM_FITNESS_PAPER = 1
+} qnav_sim_fitness_rule_t;
+
+/* The rule's name as experiment files and command lines spell it ("progress", "paper"),
+ * or NULL for a value that is not a rule. */
+const char *qnav_sim_fitness_rule_name(qnav_sim_fitness_rule_t rule);
+/* The rule called name (as above). Returns QNAV_SIM_OK and *rule, QNAV_SIM_E_NULL, or
+ * QNAV_SIM_E_PARAM for an unknown name (*rule unchanged). */
+qnav_sim_status_t qnav_sim_fitness_rule_parse(const char *name, qnav_sim_fitness_rule_t *rule);
+/* The known rules' names, comma separated ("progress, paper"), for messages. */
+const char *qnav_sim_fitness_rule_names(void);
 
 /* Context settings. Obtain with qnav_sim_config_default(), then edit. */
 typedef struct {
@@ -127,16 +150,18 @@ typedef struct {
     uint64_t seed;             /* context seed; an episode's randomness depends only on
                                   (seed, episode_seed), never on earlier episodes */
     double episode_limit_s;    /* episode time limit, s; 0 = the environment's */
+    qnav_sim_fitness_rule_t fitness;  /* how R is computed (qnav_sim_result_t.R) */
 } qnav_sim_config_t;
 
-/* Defaults: profile's sectors, no noise, seed 1, the environment's limit. */
+/* Defaults: profile's sectors, no noise, seed 1, the environment's limit, fitness
+ * QNAV_SIM_FITNESS_PROGRESS. */
 void qnav_sim_config_default(qnav_sim_config_t *cfg);
 
 /*
  * Create a context for (robot, env, cfg); the context keeps its own copies, so robot and
  * env may be freed afterwards. Returns QNAV_SIM_OK and *out, or QNAV_SIM_E_NULL,
  * QNAV_SIM_E_PARAM (n_sectors > 360, noise outside [0, 1] or not finite, limit outside
- * [0, 36000] s) with a "FIELD: problem" line in err, QNAV_SIM_E_WORLD (a start zone closer
+ * [0, 36000] s, fitness not a qnav_sim_fitness_rule_t) with a "FIELD: problem" line in err, QNAV_SIM_E_WORLD (a start zone closer
  * than the robot's radius to an obstacle or wall: "FILE:LINE: ...") or QNAV_SIM_E_NOMEM.
  */
 qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_env_t *env,
@@ -150,15 +175,20 @@ void qnav_sim_ctrl_config(const qnav_sim_t *sim, qnav_ctrl_config_t *cfg);
 
 /* The episode's figures (paper Eq. 1-3; definitions in docs/sim.md). */
 typedef struct {
+    qnav_sim_fitness_rule_t fitness; /* the rule f1, f2 and R were computed with */
     double l;                  /* path length driven, m (sum of per-tick displacement) */
     double beta_l;             /* best path length: straight line from the start to the
                                   edge of the destination circle, m */
     double tau_l;              /* time used, s (ticks * QNAV_SIM_TICK_S) */
     double beta_tau;           /* shortest possible time: beta_l from rest at the
                                   profile's v_max and accel, s */
-    double f1;                 /* Eq. 2: l/beta_l if l <= beta_l else beta_l/l */
+    double d_start_m;          /* robot centre to the destination circle's edge at the
+                                  start, m (>= 0; equals beta_l) */
+    double d_end_m;            /* the same at the end of the episode (0 when reached), m */
+    double f1;                 /* Eq. 2: l/beta_l if l <= beta_l else beta_l/l; progress
+                                  rule, not reached: (d_start - d_end)/d_start in [0, 1] */
     double f2;                 /* Eq. 3: tau_l/beta_tau if tau_l <= beta_tau else
-                                  beta_tau/tau_l */
+                                  beta_tau/tau_l; progress rule, not reached: 0 */
     uint32_t tau_c;            /* ticks spent in collision recovery */
     double R;                  /* Eq. 1: eta1*f1 + eta2*f2 - tau_c, eta1 = 1, eta2 = 10 */
     bool reached;              /* the robot centre came within dest_radius_m */
@@ -266,9 +296,10 @@ qnav_sim_status_t qnav_sim_advance(qnav_sim_t *sim);
 qnav_sim_status_t qnav_sim_state(const qnav_sim_t *sim, qnav_sim_state_t *state);
 qnav_sim_status_t qnav_sim_result(const qnav_sim_t *sim, qnav_sim_result_t *res);
 
-/* Fitness of an episode from its raw figures (Eq. 1-3), for tests and tools. Fills f1,
- * f2 and R of res from l, beta_l, tau_l, beta_tau and tau_c. */
-void qnav_sim_fitness(qnav_sim_result_t *res);
+/* Fitness of an episode from its raw figures, for tests and tools: sets res->fitness to
+ * rule and fills f1, f2 and R from l, beta_l, tau_l, beta_tau, tau_c, reached, d_start_m
+ * and d_end_m (an unknown rule is treated as QNAV_SIM_FITNESS_PROGRESS). */
+void qnav_sim_fitness(qnav_sim_result_t *res, qnav_sim_fitness_rule_t rule);
 
 #ifdef __cplusplus
 }

@@ -24,6 +24,24 @@ void qnav_tekbot_config_default(qnav_tekbot_config_t *cfg)
     cfg->tick_ms = 100;
     cfg->link_timeout_ms = 300;
     cfg->spin_deg = 60;
+    cfg->body_radius_mm = 120;
+    cfg->safety_mm = 50;
+    cfg->sonar_offset_mm = 120;
+    cfg->v_max_mm_s = 500;
+    cfg->decel_mm_s2 = 2000;
+}
+
+/* The controller configuration this board's sonar and body give. */
+static void ctrl_config(const qnav_tekbot_config_t *cfg, qnav_ctrl_config_t *cc)
+{
+    qnav_ctrl_config_default(cc);
+    cc->n_sectors = cfg->n_sectors;
+    cc->max_range_mm = cfg->max_range_mm;
+    cc->body_radius_mm = cfg->body_radius_mm;
+    cc->safety_mm = cfg->safety_mm;
+    cc->sensor_offset_mm = cfg->sonar_offset_mm;
+    cc->v_max_mm_s = cfg->v_max_mm_s;
+    cc->decel_mm_s2 = cfg->decel_mm_s2;
 }
 
 static qnav_q1_15_t sat_q15(int32_t v)
@@ -89,9 +107,7 @@ qnav_tekbot_status_t qnav_tekbot_init(qnav_tekbot_t *bot, const qnav_tekbot_conf
     bot->cmd.flags = QNAV_LINK_CMD_STOP;
 
     qnav_policy_prob_default(&bot->policy);
-    qnav_ctrl_config_default(&cc);
-    cc.n_sectors = cfg->n_sectors;
-    cc.max_range_mm = cfg->max_range_mm;
+    ctrl_config(cfg, &cc);
     bot->ctrl_ready = (uint8_t)(qnav_ctrl_init(&bot->ctrl, &cc, &bot->policy) == QNAV_OK);
     n = qnav_link_policy_to_blob(&bot->policy, blob, sizeof blob);
     bot->policy_crc = n > 0 ? qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) : 0u;
@@ -123,9 +139,7 @@ static void commit_upload(qnav_tekbot_t *bot, const qnav_link_policy_commit_t *c
     int8_t status = qnav_link_upload_commit(&bot->upload, cm, &fresh);
 
     if (status == QNAV_LINK_ACK_OK) {
-        qnav_ctrl_config_default(&cc);
-        cc.n_sectors = bot->cfg.n_sectors;
-        cc.max_range_mm = bot->cfg.max_range_mm;
+        ctrl_config(&bot->cfg, &cc);
         if (qnav_ctrl_init(&bot->ctrl, &cc, &fresh) == QNAV_OK) {
             bot->policy = fresh;
             bot->policy_crc = cm->crc;

@@ -37,6 +37,12 @@ typedef struct {
     uint16_t link_timeout_ms;    /* motors stop after this long without a good frame, ms */
     qnav_deg_t spin_deg;         /* at or beyond this |heading| the robot turns in place,
                                     deg (1..180) */
+    qnav_mm_t body_radius_mm;    /* centre to the farthest point of the body, mm: the
+                                    controller's obstacle enlargement (docs/architecture.md) */
+    qnav_mm_t safety_mm;         /* safety distance added to the radius, mm */
+    qnav_mm_t sonar_offset_mm;   /* centre to the transducers, mm (ranges start there) */
+    uint16_t v_max_mm_s;         /* speed at full command, mm/s (speed guard) */
+    uint16_t decel_mm_s2;        /* braking deceleration, mm/s^2; 0: no speed guard */
 } qnav_tekbot_config_t;
 
 /* Counters for tests and the debugger. */
@@ -74,7 +80,9 @@ typedef struct {
     qnav_tekbot_stats_t stats;
 } qnav_tekbot_t;
 
-/* Defaults: 8 sectors, 5000 mm, 100 ms tick, 300 ms link timeout, spin beyond 60 deg. */
+/* Defaults: 8 sectors, 5000 mm, 100 ms tick, 300 ms link timeout, spin beyond 60 deg; the
+ * body of data/robots/tekbot.toml (radius 120 mm with the sonar on its rim, safety 50 mm,
+ * 500 mm/s, braking 2000 mm/s^2). */
 void qnav_tekbot_config_default(qnav_tekbot_config_t *cfg);
 
 /* Check cfg and hal, start the link and the controller with the hand-tuned probabilistic
