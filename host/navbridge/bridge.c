@@ -32,14 +32,40 @@ uint16_t qnav_bridge_policy_crc(const qnav_policy_t *policy)
     return qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n);
 }
 
+static int bridge_ctrl_reinit(qnav_bridge_ctrl_t *bc)
+{
+    bc->have_last = 0;
+    return bc->method != NULL &&
+           qnav_nav_init(&bc->nav, bc->method, &bc->cfg, &bc->policy) == QNAV_OK;
+}
+
 void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg,
-                           const qnav_policy_t *policy)
+                           const char *controller, const qnav_policy_t *policy)
 {
     memset(bc, 0, sizeof *bc);
     bc->cfg = *cfg;
     bc->policy = *policy;
     bc->policy_crc = qnav_bridge_policy_crc(policy);
-    bc->ready = qnav_ctrl_init(&bc->ctrl, &bc->cfg, &bc->policy) == QNAV_OK;
+    bc->method = qnav_nav_find(controller != NULL ? controller : "body");
+    bc->ready = bridge_ctrl_reinit(bc);
+}
+
+/* The previous decision seen from now. The scan has no compass heading, so the turn made
+ * since is taken from how the goal's bearing moved (exact for a distant goal). */
+static qnav_cdeg_t prev_heading_cdeg(const qnav_bridge_ctrl_t *bc, int16_t goal_cdeg)
+{
+    int32_t a;
+    if (!bc->have_last) {
+        return 0;
+    }
+    a = (int32_t)bc->last_heading_deg * 100 + ((int32_t)goal_cdeg - bc->last_goal_cdeg);
+    a %= 36000;
+    if (a < -18000) {
+        a += 36000;
+    } else if (a >= 18000) {
+        a -= 36000;
+    }
+    return (qnav_cdeg_t)a;
 }
 
 void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
@@ -58,7 +84,7 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
         (n != bc->cfg.n_sectors || scan->max_range_mm != bc->cfg.max_range_mm || !bc->ready)) {
         bc->cfg.n_sectors = (uint16_t)n;
         bc->cfg.max_range_mm = (qnav_mm_t)scan->max_range_mm;
-        bc->ready = qnav_ctrl_init(&bc->ctrl, &bc->cfg, &bc->policy) == QNAV_OK;
+        bc->ready = bridge_ctrl_reinit(bc);
     }
     for (k = 0; k < n; ++k) {
         int32_t r = scan->ranges_mm[k];
@@ -66,16 +92,25 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
     }
     in.ranges_mm = ranges;
     in.goal_bearing_cdeg = scan->goal_bearing_cdeg;
+    in.prev_heading_cdeg = prev_heading_cdeg(bc, scan->goal_bearing_cdeg);
+    if (qualities != NULL) {
+        memset(qualities, 0, sizeof(int16_t) * QNAV_PATHS);
+    }
     if (n == 0 || !bc->ready) {
         /* a scan the controller cannot take: the step reports not-ready and stops */
-        qnav_ctrl_t dead;
+        qnav_nav_t dead;
         memset(&dead, 0, sizeof dead);
-        qnav_ctrl_step(&dead, &in, &out, NULL);
-        if (qualities != NULL) {
-            memset(qualities, 0, sizeof(int16_t) * QNAV_PATHS);
-        }
+        qnav_nav_step(&dead, &in, &out);
+    } else if (qualities != NULL && qnav_nav_paths(&bc->nav) != NULL) {
+        /* the path-quality controllers also give every path's quality for lcm-spy */
+        qnav_ctrl_step(qnav_nav_paths(&bc->nav), &in, &out, qualities);
     } else {
-        qnav_ctrl_step(&bc->ctrl, &in, &out, qualities);
+        qnav_nav_step(&bc->nav, &in, &out);
+    }
+    if (!(out.flags & QNAV_FLAG_NOT_READY)) {
+        bc->have_last = 1;
+        bc->last_heading_deg = out.heading_deg;
+        bc->last_goal_cdeg = scan->goal_bearing_cdeg;
     }
     memset(cmd, 0, sizeof *cmd);
     cmd->utime = scan->utime;
@@ -98,6 +133,7 @@ void qnav_bridge_config_default(qnav_bridge_config_t *cfg)
     cfg->timeout_ms = 300;
     cfg->heartbeat_ms = 100;
     cfg->status_ms = 500;
+    cfg->controller = "body";
     qnav_ctrl_config_default(&cfg->ctrl);
     qnav_policy_prob_default(&cfg->policy);
 }
@@ -245,7 +281,7 @@ void qnav_bridge_init(qnav_bridge_t *b, const qnav_bridge_config_t *cfg, lcm_t *
     b->write_user = write_user;
     qnav_link_rx_init(&b->rx);
     qnav_link_tx_init(&b->tx);
-    qnav_bridge_ctrl_init(&b->bc, &cfg->ctrl, &cfg->policy);
+    qnav_bridge_ctrl_init(&b->bc, &cfg->ctrl, cfg->controller, &cfg->policy);
     b->now_ms = now_ms;
     b->started_ms = now_ms;
     b->last_scan_ms = -1;

@@ -29,6 +29,7 @@ void qnav_tekbot_config_default(qnav_tekbot_config_t *cfg)
     cfg->sonar_offset_mm = 120;
     cfg->v_max_mm_s = 500;
     cfg->decel_mm_s2 = 2000;
+    cfg->controller = "body";
 }
 
 /* The controller configuration this board's sonar and body give. */
@@ -108,7 +109,8 @@ qnav_tekbot_status_t qnav_tekbot_init(qnav_tekbot_t *bot, const qnav_tekbot_conf
 
     qnav_policy_prob_default(&bot->policy);
     ctrl_config(cfg, &cc);
-    bot->ctrl_ready = (uint8_t)(qnav_ctrl_init(&bot->ctrl, &cc, &bot->policy) == QNAV_OK);
+    bot->ctrl_ready =
+        (uint8_t)(qnav_nav_init_named(&bot->nav, cfg->controller, &cc, &bot->policy) == QNAV_OK);
     n = qnav_link_policy_to_blob(&bot->policy, blob, sizeof blob);
     bot->policy_crc = n > 0 ? qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) : 0u;
     bot->hal.motors_set(bot->hal.ctx, 0, 0);
@@ -140,15 +142,16 @@ static void commit_upload(qnav_tekbot_t *bot, const qnav_link_policy_commit_t *c
 
     if (status == QNAV_LINK_ACK_OK) {
         ctrl_config(&bot->cfg, &cc);
-        if (qnav_ctrl_init(&bot->ctrl, &cc, &fresh) == QNAV_OK) {
+        if (qnav_nav_init(&bot->nav, qnav_nav_find(bot->cfg.controller), &cc, &fresh) ==
+            QNAV_OK) {
             bot->policy = fresh;
             bot->policy_crc = cm->crc;
             bot->ctrl_ready = 1;
             bot->stats.uploads_ok++;
         } else {
             /* keep driving with the policy we had */
-            bot->ctrl_ready =
-                (uint8_t)(qnav_ctrl_init(&bot->ctrl, &cc, &bot->policy) == QNAV_OK);
+            bot->ctrl_ready = (uint8_t)(qnav_nav_init(&bot->nav, qnav_nav_find(bot->cfg.controller),
+                                                      &cc, &bot->policy) == QNAV_OK);
             status = QNAV_LINK_ACK_REJECTED;
         }
     }
@@ -270,6 +273,7 @@ void qnav_tekbot_tick(qnav_tekbot_t *bot)
     uint8_t moving;
     qnav_q1_15_t left;
     qnav_q1_15_t right;
+    qnav_cdeg_t heading;
 
     if (bot == NULL) {
         return;
@@ -289,12 +293,15 @@ void qnav_tekbot_tick(qnav_tekbot_t *bot)
     for (k = n; k < bot->cfg.n_sectors; ++k) {
         bot->ranges[k] = bot->cfg.max_range_mm; /* a missing sonar reads as clear */
     }
+    heading = bot->hal.heading_cdeg(bot->hal.ctx);
     in.ranges_mm = bot->ranges;
     in.goal_bearing_cdeg = 0;
     if (bot->have_goal) {
-        in.goal_bearing_cdeg = wrap_cdeg((int32_t)bot->goal.bearing_cdeg -
-                                         (int32_t)bot->hal.heading_cdeg(bot->hal.ctx));
+        in.goal_bearing_cdeg = wrap_cdeg((int32_t)bot->goal.bearing_cdeg - (int32_t)heading);
     }
+    /* the previous decision, seen from where the robot points now */
+    in.prev_heading_cdeg =
+        bot->have_decision ? wrap_cdeg((int32_t)bot->decided_cdeg - (int32_t)heading) : 0;
 
     /* decide */
     out.heading_deg = 0;
@@ -302,7 +309,9 @@ void qnav_tekbot_tick(qnav_tekbot_t *bot)
     out.quality = 0;
     out.flags = 0;
     if (bot->mode == QNAV_LINK_MODE_ONBOARD) {
-        qnav_ctrl_step(&bot->ctrl, &in, &out, NULL);
+        qnav_nav_step(&bot->nav, &in, &out);
+        bot->decided_cdeg = wrap_cdeg((int32_t)heading + 100 * (int32_t)out.heading_deg);
+        bot->have_decision = 1;
     } else if (bot->mode == QNAV_LINK_MODE_OFFBOARD &&
                (now - bot->cmd_ms) <= bot->cfg.link_timeout_ms) {
         out.heading_deg = bot->cmd.heading_deg;

@@ -17,6 +17,7 @@
 
 #include "qnav/board_hal.h"
 #include "qnav/ctrl.h"
+#include "qnav/nav.h"
 #include "qnav/link.h"
 
 #ifdef __cplusplus
@@ -27,7 +28,7 @@ typedef enum {
     QNAV_TEKBOT_OK = 0,
     QNAV_TEKBOT_E_NULL = -1,     /* a required pointer or HAL function was null */
     QNAV_TEKBOT_E_CONFIG = -2,   /* a config field is out of range */
-    QNAV_TEKBOT_E_CTRL = -3      /* the controller refused the default policy */
+    QNAV_TEKBOT_E_CTRL = -3      /* no such controller, or it refused the default policy */
 } qnav_tekbot_status_t;
 
 typedef struct {
@@ -43,6 +44,8 @@ typedef struct {
     qnav_mm_t sonar_offset_mm;   /* centre to the transducers, mm (ranges start there) */
     uint16_t v_max_mm_s;         /* speed at full command, mm/s (speed guard) */
     uint16_t decel_mm_s2;        /* braking deceleration, mm/s^2; 0: no speed guard */
+    const char *controller;      /* a name in libqnav's controller table (qnav/nav.h):
+                                    "body" (default), "literal", "vfh" */
 } qnav_tekbot_config_t;
 
 /* Counters for tests and the debugger. */
@@ -61,8 +64,10 @@ typedef struct {
     qnav_link_rx_t rx;
     qnav_link_tx_t tx;
     qnav_link_upload_t upload;
-    qnav_ctrl_t ctrl;
-    qnav_policy_t policy;        /* the policy ctrl was made from */
+    qnav_nav_t nav;              /* the chosen controller (cfg.controller) and its state */
+    qnav_policy_t policy;        /* the policy nav was made from (if it takes one) */
+    qnav_cdeg_t decided_cdeg;    /* last decision's heading in the world (compass), 0.01 deg */
+    uint8_t have_decision;       /* decided_cdeg is set */
     uint16_t policy_crc;
     uint8_t ctrl_ready;
     uint8_t mode;                /* QNAV_LINK_MODE_* last requested by the bridge (0 none) */
