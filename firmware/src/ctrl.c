@@ -217,9 +217,7 @@ uint16_t qnav_ctrl_sector_of_path(uint16_t n_sectors, uint16_t path_deg)
     return (uint16_t)(s % n_sectors);
 }
 
-/* Destination bearing in centidegrees to the nearest whole degree (halves away from
- * zero) in 0..359. 16-bit arithmetic: one division, no 32-bit ones (costly on AVR). */
-static uint16_t bearing_deg(qnav_cdeg_t cdeg)
+uint16_t qnav_whole_deg(qnav_cdeg_t cdeg)
 {
     int16_t d = (int16_t)(cdeg / 100);
     int16_t rest = (int16_t)(cdeg - d * 100);
@@ -397,8 +395,8 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     best.heading = 0;
     flags = qnav_clearance_levels(&ctrl->clr, in->ranges_mm, lvl);
     it.lvl = lvl;
-    it.goal = bearing_deg(in->goal_bearing_cdeg);
-    it.prev = bearing_deg(in->prev_heading_cdeg);
+    it.goal = qnav_whole_deg(in->goal_bearing_cdeg);
+    it.prev = qnav_whole_deg(in->prev_heading_cdeg);
     it.path = 0;
     /* the keys land in qualities[] and are turned into qualities below */
     paths_best(ctrl, &it, &best, qualities);

@@ -96,6 +96,10 @@ static inline uint8_t qnav_angle_dist_deg(uint16_t a, uint16_t b)
     return (uint8_t)(d > QNAV_DTHETA_MAX ? QNAV_PATHS - d : d);
 }
 
+/* An angle in centidegrees to the nearest whole degree (halves away from zero), 0..359.
+ * 16-bit arithmetic: one division, no 32-bit ones (costly on AVR). */
+uint16_t qnav_whole_deg(qnav_cdeg_t cdeg);
+
 /* dtheta of a run's first path and its direction, from the path and the goal. */
 void qnav_run_shape(qnav_run_t *r, uint16_t goal);
 

@@ -7,6 +7,7 @@
  */
 #include "qnav/vfh.h"
 #include "clearance.h"
+#include "ctrl_internal.h"
 
 #define QNAV_VFH_MAGIC 0x5646u
 
@@ -77,25 +78,6 @@ void qnav_vfh_state_reset(qnav_vfh_state_t *state)
     }
 }
 
-/* Whole degrees 0..359 of a centidegree angle (rounded, halves away from zero). */
-static uint16_t deg_of(qnav_cdeg_t cdeg)
-{
-    int16_t d = (int16_t)(cdeg / 100);
-    int16_t rest = (int16_t)(cdeg - d * 100);
-    if (rest >= 50) {
-        ++d;
-    } else if (rest <= -50) {
-        --d;
-    }
-    while (d < 0) {
-        d = (int16_t)(d + QNAV_PATHS);
-    }
-    while (d >= (int16_t)QNAV_PATHS) {
-        d = (int16_t)(d - QNAV_PATHS);
-    }
-    return (uint16_t)d;
-}
-
 static uint16_t wrap360(uint16_t d)
 {
     return (uint16_t)(d >= QNAV_PATHS ? d - QNAV_PATHS : d);
@@ -103,8 +85,7 @@ static uint16_t wrap360(uint16_t d)
 
 static uint16_t angle_dist(uint16_t a, uint16_t b)
 {
-    uint16_t d = (uint16_t)(a >= b ? a - b : b - a);
-    return (uint16_t)(d > 180u ? QNAV_PATHS - d : d);
+    return qnav_angle_dist_deg(a, b);
 }
 
 static uint8_t is_blocked(const qnav_vfh_state_t *st, uint16_t k)
@@ -256,14 +237,14 @@ void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ct
         stop(out, (uint8_t)(flags | QNAV_FLAG_NO_PATH));
         return;
     }
-    goal = deg_of(in->goal_bearing_cdeg);
+    goal = qnav_whole_deg(in->goal_bearing_cdeg);
     c.any = 0u;
     c.cost = 0u;
     c.dir = 0u;
     if (n_blocked == 0u) {
         c.dir = goal; /* one opening all round: the goal is its own candidate */
     } else {
-        openings(vfh, state, &c, goal, deg_of(in->prev_heading_cdeg));
+        openings(vfh, state, &c, goal, qnav_whole_deg(in->prev_heading_cdeg));
     }
     /* speed falls linearly with the chosen direction's density, then the speed guard */
     l = lvl[c.dir];

@@ -111,7 +111,8 @@ EpisodeOutcome SimRunner::run_traced(const qnav_policy_t &policy, uint64_t episo
         throw UserError("controller: qnav_ctrl_init refused the policy (status " +
                         std::to_string(static_cast<int>(st)) + ")");
     }
-    if (use_table_ && policy.kind == QNAV_POLICY_NET) {
+    /* a 3-input network has no table (its key depends on the previous heading too) */
+    if (use_table_ && policy.kind == QNAV_POLICY_NET && policy.u.net.inputs == QNAV_NET_INPUTS_PAPER) {
         const qnav_qkey_t *table = table_for(ctrl, policy);
         if (!table || qnav_ctrl_init_table(&ctrl, &ctrl_cfg_, table, qnav_ctrl_rank(&ctrl)) != QNAV_OK) {
             throw UserError("controller: could not compile the policy into a quality table");
