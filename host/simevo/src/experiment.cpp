@@ -251,26 +251,53 @@ std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &e
                                        mix_seed(run_seed, label_hash("episodes:" + label))));
                 src_index = static_cast<int>(tasks.size() - 1);
             }
-            TaskDef tr = evolve("transfer-" + s.label, spec.target, spec.target_episodes, target_episodes_base);
+            TaskDef tr = evolve(condition_label(ConditionKind::Transfer, s.label), spec.target, spec.target_episodes, target_episodes_base);
             tr.source_task = src_index;
             tr.source_policy_file = s.policy_file;
             held_out(tr);
             tasks.push_back(tr);
         }
-        TaskDef d = evolve("direct", spec.target, spec.target_episodes, target_episodes_base);
+        TaskDef d = evolve(condition_label(ConditionKind::Direct), spec.target, spec.target_episodes, target_episodes_base);
         held_out(d);
         tasks.push_back(d);
     }
     TaskDef p;
     p.kind = TaskKind::EvalProbabilistic;
-    p.label = "probabilistic";
-    p.dir = join_path(exp_dir, "probabilistic");
+    p.label = condition_label(ConditionKind::Probabilistic);
+    p.dir = join_path(exp_dir, p.label);
     p.scenario = spec.target;
     p.context_seed = spec.seed;
     p.eval_episodes = spec.eval_episodes;
     p.eval_seed_base = eval_base;
     tasks.push_back(p);
     return tasks;
+}
+
+/* ---- conditions ------------------------------------------------------------------ */
+
+const ConditionDecl kConditions[3] = {
+    {ConditionKind::Transfer, "transfer-", true},
+    {ConditionKind::Direct, "direct", true},
+    {ConditionKind::Probabilistic, "probabilistic", false},
+};
+
+const ConditionDecl &condition_decl(ConditionKind kind)
+{
+    switch (kind) {
+    case ConditionKind::Transfer:
+        return kConditions[0];
+    case ConditionKind::Direct:
+        return kConditions[1];
+    case ConditionKind::Probabilistic:
+        return kConditions[2];
+    }
+    return kConditions[1];
+}
+
+std::string condition_label(ConditionKind kind, const std::string &source)
+{
+    const ConditionDecl &d = condition_decl(kind);
+    return kind == ConditionKind::Transfer ? std::string(d.label) + source : std::string(d.label);
 }
 
 /* ---- pool ------------------------------------------------------------------------ */
@@ -544,7 +571,8 @@ ConditionSummary summarize_condition(const ExperimentSpec &spec, const std::vect
 ConditionSummary summarize_probabilistic(const std::vector<TaskDef> &tasks)
 {
     ConditionSummary prob;
-    prob.label = "probabilistic";
+    prob.kind = ConditionKind::Probabilistic;
+    prob.label = condition_label(prob.kind);
     for (const TaskDef &t : tasks) {
         if (t.kind != TaskKind::EvalProbabilistic) {
             continue;
@@ -595,11 +623,11 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
     S.k = spec.evolution.episodes_per_candidate;
     S.arrival_threshold = spec.arrival_threshold;
     S.checkpoint_episodes = spec.checkpoint_episodes;
-    std::vector<std::string> labels;
+    std::vector<std::pair<ConditionKind, std::string>> labels;
     for (const SourceSpec &s : spec.sources) {
-        labels.push_back("transfer-" + s.label);
+        labels.emplace_back(ConditionKind::Transfer, condition_label(ConditionKind::Transfer, s.label));
     }
-    labels.push_back("direct");
+    labels.emplace_back(ConditionKind::Direct, condition_label(ConditionKind::Direct));
     TaskDef probe;
     probe.episodes = spec.target_episodes;
     probe.evolution = spec.evolution;
@@ -609,8 +637,9 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
     for (uint64_t lo = 0; lo < steps; lo += steps_per_bin) {
         S.bin_end.push_back(std::min(lo + steps_per_bin, steps) * S.k);
     }
-    for (const std::string &label : labels) {
-        S.conditions.push_back(summarize_condition(spec, tasks, label, S, steps, steps_per_bin));
+    for (const auto &kl : labels) {
+        S.conditions.push_back(summarize_condition(spec, tasks, kl.second, S, steps, steps_per_bin));
+        S.conditions.back().kind = kl.first;
     }
     S.conditions.push_back(summarize_probabilistic(tasks));
     const ConditionSummary &prob = S.conditions.back();
@@ -622,7 +651,8 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
         compare_checkpoints(c, direct, spec.target_episodes);
         Comparison cmp;
         cmp.a = c.label;
-        cmp.b = "direct";
+        cmp.b = direct.label;
+        cmp.b_kind = direct.kind;
         cmp.difference = c.final_mean - direct.final_mean;
         cmp.improvement_pct = pct(c.final_mean, direct.final_mean);
         cmp.speedup_pct = (c.episodes_to_90 > 0 && direct.episodes_to_90 > 0)
@@ -639,7 +669,8 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
         const ConditionSummary &c = S.conditions[i];
         Comparison cmp;
         cmp.a = c.label;
-        cmp.b = "probabilistic";
+        cmp.b = prob.label;
+        cmp.b_kind = prob.kind;
         cmp.difference = c.final_mean - prob.final_mean;
         cmp.improvement_pct = pct(c.final_mean, prob.final_mean);
         cmp.speedup_pct = std::nan("");
@@ -676,9 +707,9 @@ std::string quality_csv(const ExperimentSummary &S, const std::string &exp_dir, 
                         const qnav_policy_t &prob)
 {
     std::vector<std::pair<std::string, qnav_policy_t>> policies;
-    policies.emplace_back("probabilistic", prob);
+    policies.emplace_back(condition_label(ConditionKind::Probabilistic), prob);
     for (const ConditionSummary &c : S.conditions) {
-        if (c.label == "probabilistic" || c.best_run < 0) {
+        if (!condition_decl(c.kind).evolved || c.best_run < 0) {
             continue;
         }
         const std::string path = join_path(join_path(run_dir(exp_dir, static_cast<uint32_t>(c.best_run)), c.label), "best.policy");
@@ -733,7 +764,7 @@ std::string episodes_csv(const ExperimentSummary &S, const std::string &exp_dir,
     for (const ConditionSummary &c : S.conditions) {
         qnav_policy_t policy = runner.probabilistic_policy();
         std::string name = c.label;
-        if (c.label != "probabilistic") {
+        if (condition_decl(c.kind).evolved) {
             if (c.best_run < 0) {
                 continue;
             }
@@ -786,7 +817,7 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
           << (c.episodes_to_90 > 0 ? json_num(c.episodes_to_90) : "null")
           << ", \"reached_rate\": " << json_num(c.reached_rate) << ", \"arrival\": " << json_interval(c.arrival)
           << ", \"tau_c\": " << json_interval(c.tau_c) << json_checkpoints(c)
-          << ", \"online_mean\": " << json_num(c.label == "probabilistic" ? std::nan("") : c.online_mean) << ", \"best_run\": " << (c.best_run + 1) << "}"
+          << ", \"online_mean\": " << json_num(!condition_decl(c.kind).evolved ? std::nan("") : c.online_mean) << ", \"best_run\": " << (c.best_run + 1) << "}"
           << (i + 1 < S.conditions.size() ? "," : "") << "\n";
     }
     o << "  ],\n  \"comparisons\": [\n";
@@ -800,7 +831,7 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
           << ", \"df\": " << json_num(c.t.valid ? c.t.df : std::nan(""))
           << ", \"p\": " << json_num(c.t.valid ? c.t.p : std::nan(""))
           << ", \"mann_whitney_p\": " << json_num(c.mann_whitney.valid ? c.mann_whitney.p : std::nan(""))
-          << ", \"online_difference\": " << json_num(c.b == "direct" ? c.online_difference : std::nan(""))
+          << ", \"online_difference\": " << json_num(c.b_kind == ConditionKind::Direct ? c.online_difference : std::nan(""))
           << ", \"online_p\": " << json_num(c.online.valid ? c.online.p : std::nan("")) << "}"
           << (i + 1 < S.comparisons.size() ? "," : "") << "\n";
     }
@@ -840,7 +871,7 @@ std::string checkpoint_tables_md(const ExperimentSummary &S)
             if (!k.listed) {
                 continue;
             }
-            const bool direct = c.label == "direct";
+            const bool direct = c.kind == ConditionKind::Direct;
             o << "| " << c.label << " | " << k.checkpoint << " | " << num_interval(k.R_ci) << " | "
               << pct_interval(k.arrival_ci) << " | " << num_interval(k.tau_c_ci, 1) << " | "
               << (direct ? "-" : fmt_p(k.R_vs_direct)) << " | " << (direct ? "-" : fmt_p(k.arrival_vs_direct))
@@ -865,7 +896,7 @@ std::string checkpoint_tables_md(const ExperimentSummary &S)
                               : reached.size() % 2 ? reached[reached.size() / 2]
                                                    : 0.5 * (reached[reached.size() / 2 - 1] + reached[reached.size() / 2]);
         o << "| " << c.label << " | " << fmt(median, 0) << " | " << reached.size() << " | " << c.threshold_not_reached
-          << " | " << (c.label == "direct" ? "-" : fmt_p(c.threshold_vs_direct)) << " |\n";
+          << " | " << (c.kind == ConditionKind::Direct ? "-" : fmt_p(c.threshold_vs_direct)) << " |\n";
     }
     o << "\nCheckpoints are checked at the end of the first step that reaches them (k = " << S.k
       << " episodes per step); a run that does not reach the threshold within the budget is ranked after every run "
@@ -895,7 +926,7 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
       << S.bin_end.front() << " episodes | last bin | episodes to 90% | best fitness at the end |\n"
       << "|---|---|---|---|---|---|---|---|---|\n";
     for (const ConditionSummary &c : S.conditions) {
-        const bool prob = c.label == "probabilistic";
+        const bool prob = c.kind == ConditionKind::Probabilistic;
         o << "| " << c.label << " | " << fmt(c.final_mean) << " ± " << fmt(c.final_ci) << " | " << pct_interval(c.arrival)
           << " | " << num_interval(c.tau_c, 1) << " | " << fmt(c.final_sd)
           << " | " << (prob ? "-" : fmt(c.start)) << " | " << (prob ? "-" : fmt(c.end)) << " | "
@@ -908,8 +939,8 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
           << (std::isfinite(c.improvement_pct) ? fmt(c.improvement_pct, 1) + "%" : "n/a") << " | "
           << (std::isfinite(c.speedup_pct) ? fmt(c.speedup_pct, 0) + "%" : "-") << " | "
           << (c.test == "welch" ? "Welch t" : "one-sample t") << " | " << fmt_p(c.t) << " | "
-          << (c.b == "probabilistic" ? "-" : fmt_p(c.mann_whitney)) << " | "
-          << (c.b == "probabilistic" ? "-" : fmt(c.online_difference) + " (" + fmt_p(c.online) + ")") << " |\n";
+          << (c.b_kind == ConditionKind::Probabilistic ? "-" : fmt_p(c.mann_whitney)) << " | "
+          << (c.b_kind == ConditionKind::Probabilistic ? "-" : fmt(c.online_difference) + " (" + fmt_p(c.online) + ")") << " |\n";
     }
     o << "\nArrival and recovery ticks: per run the fraction of its best policy's held-out episodes that reached the "
          "destination and its mean recovery ticks (tau_c) per episode, 95% CI over runs (Student t, clipped to the "

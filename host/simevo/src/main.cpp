@@ -99,7 +99,7 @@ void print_transfer_arrival(const ExperimentSpec &s, const std::string &dir)
 {
     const ExperimentSummary S = summarize(s, plan_tasks(s, dir));
     for (const ConditionSummary &c : S.conditions) {
-        if (c.label.rfind("transfer-", 0) != 0 || c.best_run < 0) {
+        if (c.kind != ConditionKind::Transfer || c.best_run < 0) {
             continue;
         }
         char run[16];
@@ -317,7 +317,7 @@ int main(int argc, char **argv)
                 }
                 // Label: the last two path components (run folders all hold "best.policy"),
                 // made unique with a number when needed.
-                std::string label = "probabilistic";
+                std::string label = condition_label(ConditionKind::Probabilistic);
                 if (arg != "prob") {
                     const std::size_t last = arg.find_last_of('/');
                     const std::size_t prev = last == std::string::npos || last == 0 ? std::string::npos
