@@ -76,21 +76,27 @@ static void init_prev_follower(qnav_ctrl_t *c)
     assert_int_equal(qnav_ctrl_init(c, &cfg, &p), QNAV_OK);
 }
 
+/* 16 clear sectors, goal straight ahead, previous heading prev_cdeg. */
+static void clear_scan(qnav_mm_t *ranges, qnav_ctrl_input_t *in, qnav_cdeg_t prev_cdeg)
+{
+    uint16_t s;
+    for (s = 0; s < 16; ++s) {
+        ranges[s] = 5000;
+    }
+    in->ranges_mm = ranges;
+    in->goal_bearing_cdeg = 0;
+    in->prev_heading_cdeg = prev_cdeg;
+}
+
 static void test_three_input_network_turns_towards_the_previous_heading(void **state)
 {
     qnav_ctrl_t c;
     qnav_mm_t ranges[16];
     qnav_ctrl_output_t out;
     qnav_ctrl_input_t in;
-    uint16_t s;
     (void)state;
-    for (s = 0; s < 16; ++s) {
-        ranges[s] = 5000;
-    }
     init_prev_follower(&c);
-    in.ranges_mm = ranges;
-    in.goal_bearing_cdeg = 0;
-    in.prev_heading_cdeg = 4000;
+    clear_scan(ranges, &in, 4000);
     qnav_ctrl_step(&c, &in, &out, NULL);
     assert_int_equal(out.heading_deg, 40);
     /* same input, same answer: the step remembers nothing */
@@ -143,16 +149,11 @@ static void test_three_input_network_has_no_table_but_network_mode_with_qualitie
     qnav_ctrl_output_t a;
     qnav_ctrl_output_t b;
     qnav_ctrl_input_t in;
-    uint16_t s;
     (void)state;
     init_prev_follower(&c);
     assert_int_equal(qnav_ctrl_build_table(&c, table), QNAV_E_NO_TABLE);
-    for (s = 0; s < 16; ++s) {
-        ranges[s] = (qnav_mm_t)(s == 2u ? 400u : 5000u);
-    }
-    in.ranges_mm = ranges;
-    in.goal_bearing_cdeg = 0;
-    in.prev_heading_cdeg = 4500; /* inside sector 2's blocked wedge */
+    clear_scan(ranges, &in, 4500);
+    ranges[2] = 400; /* the previous heading lies in sector 2's blocked wedge */
     qnav_ctrl_step(&c, &in, &a, NULL);
     qnav_ctrl_step(&c, &in, &b, q);
     assert_int_equal(a.heading_deg, b.heading_deg);

@@ -29,6 +29,29 @@ static void init_vfh(qnav_vfh_t *v, qnav_vfh_state_t *st)
     qnav_vfh_state_reset(st);
 }
 
+/* One VFH+ controller with its state, 16 sectors all clear, goal straight ahead. */
+typedef struct {
+    qnav_vfh_t v;
+    qnav_vfh_state_t st;
+    qnav_mm_t r[16];
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+} fixture_t;
+
+static void setup(fixture_t *f, qnav_mm_t range)
+{
+    init_vfh(&f->v, &f->st);
+    fill(f->r, 16, range);
+    f->in.ranges_mm = f->r;
+    f->in.goal_bearing_cdeg = 0;
+    f->in.prev_heading_cdeg = 0;
+}
+
+static void step(fixture_t *f)
+{
+    qnav_vfh_step(&f->v, &f->st, &f->in, &f->out);
+}
+
 static void test_vfh_init_rejects_bad_parameters(void **state)
 {
     qnav_vfh_t v;
@@ -48,118 +71,89 @@ static void test_vfh_init_rejects_bad_parameters(void **state)
 
 static void test_vfh_drives_at_goal_in_open_space_at_full_speed(void **state)
 {
-    qnav_vfh_t v;
-    qnav_vfh_state_t st;
-    qnav_mm_t r[16];
-    qnav_ctrl_input_t in = {r, -3000, 0};
-    qnav_ctrl_output_t out;
+    fixture_t f;
     (void)state;
-    init_vfh(&v, &st);
-    fill(r, 16, 5000);
-    qnav_vfh_step(&v, &st, &in, &out);
-    assert_int_equal(out.heading_deg, -30);
-    assert_int_equal(out.speed, QNAV_Q1_15_MAX);
+    setup(&f, 5000);
+    f.in.goal_bearing_cdeg = -3000;
+    step(&f);
+    assert_int_equal(f.out.heading_deg, -30);
+    assert_int_equal(f.out.speed, QNAV_Q1_15_MAX);
 }
 
 static void test_vfh_steers_around_an_obstacle_on_the_goal_line(void **state)
 {
-    qnav_vfh_t v;
-    qnav_vfh_state_t st;
-    qnav_mm_t r[16];
-    qnav_ctrl_input_t in = {r, 0, 0};
-    qnav_ctrl_output_t out;
+    fixture_t f;
     (void)state;
-    init_vfh(&v, &st);
-    fill(r, 16, 5000);
-    r[0] = 600; /* straight ahead, 0.6 m */
-    qnav_vfh_step(&v, &st, &in, &out);
-    assert_true(out.heading_deg > 20 || out.heading_deg < -20);
-    assert_true(out.heading_deg < 90 && out.heading_deg > -90);
-    assert_true(out.speed > 0);
+    setup(&f, 5000);
+    f.r[0] = 600; /* straight ahead, 0.6 m */
+    step(&f);
+    assert_true(f.out.heading_deg > 20 || f.out.heading_deg < -20);
+    assert_true(f.out.heading_deg < 90 && f.out.heading_deg > -90);
+    assert_true(f.out.speed > 0);
 }
 
 static void test_vfh_hysteresis_keeps_a_sector_blocked_between_the_thresholds(void **state)
 {
-    qnav_vfh_t v;
-    qnav_vfh_state_t st;
+    fixture_t f;
     qnav_vfh_state_t fresh;
-    qnav_mm_t r[16];
-    qnav_ctrl_input_t in = {r, 0, 0};
-    qnav_ctrl_output_t first;
-    qnav_ctrl_output_t kept;
     qnav_ctrl_output_t forgot;
     (void)state;
-    init_vfh(&v, &st);
-    fill(r, 16, 5000);
-    r[0] = 700; /* blocked: nearer than 1.0 m */
-    qnav_vfh_step(&v, &st, &in, &first);
-    r[0] = 1200; /* between tau_high (1.0 m) and tau_low (1.4 m) */
-    qnav_vfh_step(&v, &st, &in, &kept);
-    assert_true(first.heading_deg != 0);
-    assert_true(kept.heading_deg != 0); /* the goal's sector is still blocked */
+    setup(&f, 5000);
+    f.r[0] = 700; /* blocked: nearer than 1.0 m */
+    step(&f);
+    assert_true(f.out.heading_deg != 0);
+    f.r[0] = 1200; /* between tau_high (1.0 m) and tau_low (1.4 m) */
+    step(&f);
+    assert_true(f.out.heading_deg != 0); /* the goal's sector is still blocked */
     qnav_vfh_state_reset(&fresh);
-    qnav_vfh_step(&v, &fresh, &in, &forgot);
+    qnav_vfh_step(&f.v, &fresh, &f.in, &forgot);
     assert_int_equal(forgot.heading_deg, 0); /* a fresh state sees it free */
-    r[0] = 2000; /* beyond tau_low: free again */
-    qnav_vfh_step(&v, &st, &in, &kept);
-    assert_int_equal(kept.heading_deg, 0);
+    f.r[0] = 2000; /* beyond tau_low: free again */
+    step(&f);
+    assert_int_equal(f.out.heading_deg, 0);
 }
 
 static void test_vfh_previous_direction_breaks_a_symmetric_choice(void **state)
 {
-    qnav_vfh_t v;
-    qnav_vfh_state_t st;
-    qnav_mm_t r[16];
-    qnav_ctrl_input_t in = {r, 0, 0};
-    qnav_ctrl_output_t left;
-    qnav_ctrl_output_t right;
+    fixture_t f;
+    qnav_deg_t left;
     (void)state;
-    init_vfh(&v, &st);
-    fill(r, 16, 5000);
-    r[0] = 600;
-    in.prev_heading_cdeg = 6000;
-    qnav_vfh_step(&v, &st, &in, &left);
-    qnav_vfh_state_reset(&st);
-    in.prev_heading_cdeg = -6000;
-    qnav_vfh_step(&v, &st, &in, &right);
-    assert_true(left.heading_deg > 0);
-    assert_true(right.heading_deg < 0);
-    assert_int_equal(left.heading_deg, -right.heading_deg);
+    setup(&f, 5000);
+    f.r[0] = 600;
+    f.in.prev_heading_cdeg = 6000;
+    step(&f);
+    left = f.out.heading_deg;
+    qnav_vfh_state_reset(&f.st);
+    f.in.prev_heading_cdeg = -6000;
+    step(&f);
+    assert_true(left > 0);
+    assert_true(f.out.heading_deg < 0);
+    assert_int_equal(left, -f.out.heading_deg);
 }
 
 static void test_vfh_slows_near_obstacles_and_stops_when_boxed_in(void **state)
 {
-    qnav_vfh_t v;
-    qnav_vfh_state_t st;
-    qnav_mm_t r[16];
-    qnav_ctrl_input_t in = {r, 0, 0};
-    qnav_ctrl_output_t out;
+    fixture_t f;
     (void)state;
-    init_vfh(&v, &st);
-    fill(r, 16, 1500); /* free everywhere (beyond 1.4 m) but nearer than slow_mm */
-    qnav_vfh_step(&v, &st, &in, &out);
-    assert_true(out.speed > 0 && out.speed < QNAV_Q1_15_MAX);
-    fill(r, 16, 300);
-    qnav_vfh_step(&v, &st, &in, &out);
-    assert_int_equal(out.speed, 0);
-    assert_true((out.flags & QNAV_FLAG_NO_PATH) != 0);
+    setup(&f, 1500); /* free everywhere (beyond 1.4 m) but nearer than slow_mm */
+    step(&f);
+    assert_true(f.out.speed > 0 && f.out.speed < QNAV_Q1_15_MAX);
+    fill(f.r, 16, 300);
+    step(&f);
+    assert_int_equal(f.out.speed, 0);
+    assert_true((f.out.flags & QNAV_FLAG_NO_PATH) != 0);
 }
 
 static void test_vfh_without_init_or_state_commands_stop(void **state)
 {
-    qnav_vfh_t v;
-    qnav_vfh_state_t st;
-    qnav_mm_t r[16];
-    qnav_ctrl_input_t in = {r, 0, 0};
-    qnav_ctrl_output_t out;
+    fixture_t f;
     (void)state;
-    memset(&v, 0, sizeof v);
-    fill(r, 16, 5000);
-    qnav_vfh_step(&v, &st, &in, &out);
-    assert_int_equal(out.flags, QNAV_FLAG_NOT_READY);
-    init_vfh(&v, &st);
-    qnav_vfh_step(&v, NULL, &in, &out);
-    assert_int_equal(out.flags, QNAV_FLAG_NOT_READY);
+    setup(&f, 5000);
+    qnav_vfh_step(&f.v, NULL, &f.in, &f.out);
+    assert_int_equal(f.out.flags, QNAV_FLAG_NOT_READY);
+    memset(&f.v, 0, sizeof f.v);
+    step(&f);
+    assert_int_equal(f.out.flags, QNAV_FLAG_NOT_READY);
 }
 
 static void test_table_selects_controllers_by_name(void **state)
