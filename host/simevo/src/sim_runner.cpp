@@ -3,6 +3,8 @@
  */
 #include "sim_runner.h"
 
+#include "qnav/nav.h"
+
 #include <cstring>
 
 
@@ -68,10 +70,16 @@ SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t conte
     if (qnav_sim_create(robot, env, &cfg, &sim_, err, sizeof err) != QNAV_SIM_OK) {
         throw UserError(std::string("simulator (") + scenario.describe() + "): " + err);
     }
-    qnav_sim_ctrl_config(sim_, &ctrl_cfg_);
-    if (scenario.controller == ControllerReading::Literal) {
-        qnav_ctrl_config_literal(&ctrl_cfg_);
+    /* the reading is a row of libqnav's controller table: its adjust hook (literal:
+     * qnav_ctrl_config_literal) gives the configuration every episode uses */
+    qnav_ctrl_config_t shared;
+    qnav_sim_ctrl_config(sim_, &shared);
+    const qnav_nav_method_t *m = qnav_nav_find(controller_reading_name(scenario.controller));
+    if (m == nullptr || !m->uses_policy) {
+        throw UserError(std::string("controller ") + controller_reading_name(scenario.controller) +
+                        ": not a policy controller of libqnav's table");
     }
+    qnav_nav_config(m, &shared, &ctrl_cfg_);
     qnav_sim_robot_prob_policy(robot, &prob_);
 }
 
