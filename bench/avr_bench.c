@@ -16,6 +16,7 @@
 #include <util/delay_basic.h>
 
 #include "bench_common.h"
+#include "qnav/vfh.h"
 #include "target_io.h"
 
 static volatile uint16_t overflows;
@@ -200,6 +201,7 @@ int main(void)
         }
         for (k = 0; k < QNAV_BENCH_SCANS; ++k) {
             in.goal_bearing_cdeg = qnav_bench_scan(k, ranges);
+            in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
             c = time_step(&in, &out);
             sum += c;
             lo = c < lo ? c : lo;
@@ -238,6 +240,43 @@ int main(void)
             qnav_target_put_u32((sum / QNAV_BENCH_SCANS + (c + 8u) / 32u) / ((c + 8u) / 16u));
             qnav_target_put(" such calls\n");
         }
+    }
+
+    {
+        /* VFH+ (qnav/vfh.h) on the same scans, through its own step */
+        static qnav_vfh_t vfh;
+        static qnav_vfh_state_t vstate;
+        qnav_vfh_config_t vcfg;
+        uint32_t lo = 0xfffffffful;
+        uint32_t hi = 0;
+        uint32_t sum = 0;
+        qnav_vfh_config_default(&vcfg);
+        vcfg.body.n_sectors = QNAV_BENCH_SECTORS;
+        vcfg.body.max_range_mm = QNAV_BENCH_MAX_RANGE_MM;
+        if (qnav_vfh_init(&vfh, &vcfg) != QNAV_OK) {
+            qnav_target_put("VFH+ init failed\n");
+            ok = 0;
+        }
+        qnav_vfh_state_reset(&vstate);
+        for (k = 0; k < QNAV_BENCH_SCANS; ++k) {
+            in.goal_bearing_cdeg = qnav_bench_scan(k, ranges);
+            in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
+            timer_start();
+            qnav_vfh_step(&vfh, &vstate, &in, &out);
+            c = timer_stop() - overhead;
+            sum += c;
+            lo = c < lo ? c : lo;
+            hi = c > hi ? c : hi;
+        }
+        qnav_target_put("VFH+ (alpha 5 deg, 72 sectors): mean ");
+        put_cycles(sum / QNAV_BENCH_SCANS);
+        qnav_target_put(", min ");
+        qnav_target_put_u32(lo);
+        qnav_target_put(", max ");
+        qnav_target_put_u32(hi);
+        qnav_target_put("; sizeof(qnav_vfh_t) + state ");
+        qnav_target_put_u32(sizeof(qnav_vfh_t) + sizeof(qnav_vfh_state_t));
+        qnav_target_put(" bytes\n");
     }
 
     qnav_target_put("sizeof(qnav_ctrl_t) ");

@@ -20,10 +20,13 @@
 #define QNAV_BENCH_MAX_RANGE_MM 5000u
 #define QNAV_BENCH_SCANS 8u
 
-enum { QNAV_BENCH_NET = 0, QNAV_BENCH_PROB, QNAV_BENCH_TABLE, QNAV_BENCH_MODES };
+enum { QNAV_BENCH_NET = 0, QNAV_BENCH_PROB, QNAV_BENCH_TABLE, QNAV_BENCH_NET3, QNAV_BENCH_MODES };
 
 static const char *const qnav_bench_mode_names[QNAV_BENCH_MODES] = {
-    "network H=12", "probabilistic", "table"};
+    "network H=12", "probabilistic", "table", "network H=12, 3 inputs (every path)"};
+
+/* The previous tick's heading the benchmark passes in (3-input network, VFH+). */
+#define QNAV_BENCH_PREV_CDEG 2500
 
 /* Scan k (0..QNAV_BENCH_SCANS-1) into ranges[QNAV_BENCH_SECTORS]; returns its bearing. */
 static inline qnav_cdeg_t qnav_bench_scan(uint8_t k, qnav_mm_t *ranges)
@@ -47,15 +50,25 @@ static inline qnav_status_t qnav_bench_init(qnav_ctrl_t *ctrl, uint8_t mode)
     qnav_ctrl_config_default(&cfg);
     cfg.n_sectors = QNAV_BENCH_SECTORS;
     cfg.max_range_mm = QNAV_BENCH_MAX_RANGE_MM;
-    if (mode == QNAV_BENCH_NET) {
+    switch (mode) {
+    case QNAV_BENCH_NET:
         qnav_vectors_net_policy(&policy, 12u, QNAV_VECTORS_NET12_SEED, 0u);
         return qnav_ctrl_init(ctrl, &cfg, &policy);
-    }
-    if (mode == QNAV_BENCH_PROB) {
+    case QNAV_BENCH_PROB:
         qnav_policy_prob_default(&policy);
         return qnav_ctrl_init(ctrl, &cfg, &policy);
+    case QNAV_BENCH_NET3:
+        /* the same network with a third input whose weights mirror w_theta's */
+        qnav_vectors_net_policy(&policy, 12u, QNAV_VECTORS_NET12_SEED, 0u);
+        policy.u.net.inputs = QNAV_NET_INPUTS_PREV;
+        for (uint8_t j = 0; j < 12u; ++j) {
+            policy.u.net.w_prev[j] = (qnav_q8_8_t)(-policy.u.net.w_theta[j] / 2);
+        }
+        return qnav_ctrl_init(ctrl, &cfg, &policy);
+    default:
+        return qnav_ctrl_init_table(ctrl, &cfg, qnav_vectors_net12_table,
+                                    QNAV_VECTORS_NET12_TABLE_RANK);
     }
-    return qnav_ctrl_init_table(ctrl, &cfg, qnav_vectors_net12_table, QNAV_VECTORS_NET12_TABLE_RANK);
 }
 
 #endif /* QNAV_BENCH_COMMON_H */

@@ -49,6 +49,7 @@ static double run(const qnav_ctrl_t *ctrl, uint32_t iters)
         uint32_t k = i % QNAV_BENCH_SCANS;
         in.ranges_mm = ranges[k];
         in.goal_bearing_cdeg = bearings[k];
+        in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
         qnav_ctrl_step(ctrl, &in, &out, 0);
         acc += out.heading_deg + out.speed;
     }
@@ -61,7 +62,7 @@ int main(void)
     qnav_ctrl_t ctrl;
     uint8_t mode;
     uint8_t k;
-    static const double target_ns[QNAV_BENCH_MODES] = {2000.0, 0.0, 500.0};
+    static const double target_ns[QNAV_BENCH_MODES] = {2000.0, 0.0, 500.0, 0.0};
 
     for (k = 0; k < QNAV_BENCH_SCANS; ++k) {
         bearings[k] = qnav_bench_scan(k, ranges[k]);

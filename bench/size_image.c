@@ -78,6 +78,7 @@ int main(void)
         }
         in.ranges_mm = ranges;
         in.goal_bearing_cdeg = goal;
+        in.prev_heading_cdeg = 0; /* 2-input policies ignore it */
         qnav_ctrl_step(&ctrl, &in, &out, 0);
         command.heading_deg = out.heading_deg;
         command.speed = out.speed;

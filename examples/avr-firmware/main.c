@@ -47,6 +47,7 @@ int main(void)
     } else {
         in.ranges_mm = ranges;
         in.goal_bearing_cdeg = 3000;
+        in.prev_heading_cdeg = 0; /* 2-input policies ignore it */
         qnav_ctrl_step(&nav, &in, &out, 0);
         snprintf(line, sizeof line, "fixed scan: heading %d speed %d\n", (int)out.heading_deg,
                  (int)out.speed);

@@ -43,6 +43,7 @@ static void fixed_decision(const qnav_policy_t *policy)
     }
     in.ranges_mm = ranges;
     in.goal_bearing_cdeg = 3000;
+    in.prev_heading_cdeg = 0; /* 2-input policies ignore it */
     qnav_ctrl_step(&ctrl, &in, &out, NULL);
     printf("fixed scan: heading %d speed %d\n", (int)out.heading_deg, (int)out.speed);
 }

@@ -26,27 +26,27 @@ static const uint16_t sin_deg_q15[91] QNAV_FLASH = {
 /* Control tick the speed guard allows for reacting, ms (DESIGN.md §4: 0.1 s). */
 #define QNAV_GUARD_REACTION_MS 100u
 
-uint8_t qnav_clearance_level_of(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm)
+uint8_t qnav_clearance_level_of(const qnav_clearance_t *c, qnav_mm_t range_mm)
 {
     uint32_t level;
     /* For ranges of 32 mm and more the scale fits 16 bits: a 16x16 multiply (AVR) */
-    if (ctrl->level_scale <= 0xFFFFu) {
-        level = ((uint32_t)range_mm * (uint16_t)ctrl->level_scale + 32768u) >> 16;
+    if (c->level_scale <= 0xFFFFu) {
+        level = ((uint32_t)range_mm * (uint16_t)c->level_scale + 32768u) >> 16;
     } else {
-        level = ((uint32_t)range_mm * ctrl->level_scale + 32768u) >> 16;
+        level = ((uint32_t)range_mm * c->level_scale + 32768u) >> 16;
     }
     return (uint8_t)(level > QNAV_DIST_LEVELS - 1u ? QNAV_DIST_LEVELS - 1u : level);
 }
 
 /* The smallest range (mm) that maps to level or above: the nearest an obstacle read at
  * that level can be, so both tables below err on the safe side. */
-static uint32_t level_floor_mm(const qnav_ctrl_t *ctrl, uint8_t level)
+static uint32_t level_floor_mm(const qnav_clearance_t *c, uint8_t level)
 {
     uint32_t lo = 0;
-    uint32_t hi = ctrl->max_range_mm;
+    uint32_t hi = c->max_range_mm;
     while (lo < hi) {
         uint32_t mid = (lo + hi) / 2u;
-        if (qnav_clearance_level_of(ctrl, (qnav_mm_t)mid) >= level) {
+        if (qnav_clearance_level_of(c, (qnav_mm_t)mid) >= level) {
             hi = mid;
         } else {
             lo = mid + 1u;
@@ -111,26 +111,45 @@ static qnav_q1_15_t stop_speed(uint32_t s_mm, uint32_t v_max_mm_s, uint32_t dece
     return (qnav_q1_15_t)((v * 32768u) / v_max_mm_s);
 }
 
-void qnav_clearance_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg)
+void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
 {
     uint32_t margin = (uint32_t)cfg->body_radius_mm + cfg->safety_mm;
     uint8_t level;
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
         /* from the robot's centre: readings start at the transducers */
-        uint32_t d = level_floor_mm(ctrl, level) + cfg->sensor_offset_mm;
+        uint32_t d = level_floor_mm(c, level) + cfg->sensor_offset_mm;
         if (d > 65535u) {
             d = 65535u;
         }
-        ctrl->enlarge_deg[level] = enlarge_deg(margin, d);
+        c->enlarge_deg[level] = enlarge_deg(margin, d);
         if (cfg->v_max_mm_s == 0u || cfg->decel_mm_s2 == 0u) {
-            ctrl->speed_cap[level] = QNAV_Q1_15_MAX;
+            c->speed_cap[level] = QNAV_Q1_15_MAX;
         } else if (level == QNAV_DIST_LEVELS - 1u) {
-            ctrl->speed_cap[level] = QNAV_Q1_15_MAX; /* nothing seen within range */
+            c->speed_cap[level] = QNAV_Q1_15_MAX; /* nothing seen within range */
         } else {
-            ctrl->speed_cap[level] = stop_speed(d > margin ? d - margin : 0u, cfg->v_max_mm_s,
+            c->speed_cap[level] = stop_speed(d > margin ? d - margin : 0u, cfg->v_max_mm_s,
                                                 cfg->decel_mm_s2);
         }
     }
+}
+
+qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
+{
+    if (cfg->n_sectors < 1u || cfg->n_sectors > QNAV_MAX_SECTORS) {
+        return QNAV_E_SECTORS;
+    }
+    if (cfg->max_range_mm == 0u) {
+        return QNAV_E_RANGE;
+    }
+    c->n_sectors = cfg->n_sectors;
+    c->max_range_mm = cfg->max_range_mm;
+    c->level_scale = ((uint32_t)(QNAV_DIST_LEVELS - 1) * 65536u + cfg->max_range_mm / 2u) /
+                     cfg->max_range_mm;
+    c->sector_paths = (uint16_t)(QNAV_PATHS / cfg->n_sectors);
+    c->sector_span = (uint16_t)(c->sector_paths * cfg->n_sectors);
+    c->first_sector_paths = (uint16_t)((QNAV_PATHS / 2u + cfg->n_sectors - 1u) / cfg->n_sectors);
+    qnav_clearance_init(c, cfg);
+    return QNAV_OK;
 }
 
 /* Lower lvl[p..p+k-1] to at most level (no wrap; a branch-free min the compiler can
@@ -163,32 +182,32 @@ static void paint(uint8_t *lvl, uint16_t first, uint16_t n, uint8_t gamma, uint8
 /* Sector lengths follow from path * N + 180 wrapping past 360: a sector whose first path
  * has phase p holds q = 360 / N paths, or q + 1 when p + q * N is still below 360; sector 0
  * is cut in two, paths 0.. and the last ones before 360. */
-uint8_t qnav_clearance_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges, uint8_t *lvl)
+uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint8_t *lvl)
 {
     uint16_t path = 0;
     uint16_t sector = 0;
     uint16_t phase = QNAV_PATHS / 2u;
-    uint16_t count = ctrl->first_sector_paths;
+    uint16_t count = c->first_sector_paths;
     uint8_t flags = 0;
     memset(lvl, QNAV_DIST_LEVELS - 1, QNAV_PATHS);
     for (;;) {
         qnav_mm_t r = ranges[sector];
         uint16_t n = count < QNAV_PATHS - path ? count : (uint16_t)(QNAV_PATHS - path);
         uint8_t level;
-        if (r > ctrl->max_range_mm) {
-            r = ctrl->max_range_mm;
+        if (r > c->max_range_mm) {
+            r = c->max_range_mm;
             flags |= QNAV_FLAG_RANGE_CLIPPED;
         }
-        level = qnav_clearance_level_of(ctrl, r);
+        level = qnav_clearance_level_of(c, r);
         if (level != QNAV_DIST_LEVELS - 1u) {
-            paint(lvl, path, n, ctrl->enlarge_deg[level], level);
+            paint(lvl, path, n, c->enlarge_deg[level], level);
         }
         path = (uint16_t)(path + n);
         if (path >= QNAV_PATHS) {
             return flags;
         }
-        phase = (uint16_t)(phase + count * ctrl->n_sectors - QNAV_PATHS);
-        count = (uint16_t)(ctrl->sector_paths + (phase + ctrl->sector_span < QNAV_PATHS ? 1u : 0u));
-        sector = (uint16_t)(sector + 1u == ctrl->n_sectors ? 0u : sector + 1u);
+        phase = (uint16_t)(phase + count * c->n_sectors - QNAV_PATHS);
+        count = (uint16_t)(c->sector_paths + (phase + c->sector_span < QNAV_PATHS ? 1u : 0u));
+        sector = (uint16_t)(sector + 1u == c->n_sectors ? 0u : sector + 1u);
     }
 }

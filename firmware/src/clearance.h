@@ -13,8 +13,13 @@
 
 #include "qnav/ctrl.h"
 
-/* Fill ctrl->enlarge_deg[] and ctrl->speed_cap[] from cfg (init time; integer only). */
-void qnav_clearance_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg);
+/* Check cfg's sensor fields and derive everything in c (init time; integer only).
+ * Returns QNAV_OK, QNAV_E_SECTORS or QNAV_E_RANGE (c is then unusable). */
+QNAV_CHECK_RESULT qnav_status_t qnav_clearance_setup(qnav_clearance_t *c,
+                                                     const qnav_ctrl_config_t *cfg);
+
+/* Fill c->enlarge_deg[] and c->speed_cap[] from cfg (init time; integer only). */
+void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg);
 
 /*
  * The distance level of every path (lvl[i] for path i, i = 0..359) from the n_sectors
@@ -22,9 +27,9 @@ void qnav_clearance_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg);
  * Returns QNAV_FLAG_RANGE_CLIPPED when a range above max_range_mm was clipped, else 0.
  * @par Cost: 360 byte writes plus count + 2 * gamma per sector nearer than the maximum.
  */
-uint8_t qnav_clearance_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges, uint8_t *lvl);
+uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint8_t *lvl);
 
 /* Level of a range already known to be at most max_range_mm. */
-uint8_t qnav_clearance_level_of(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm);
+uint8_t qnav_clearance_level_of(const qnav_clearance_t *c, qnav_mm_t range_mm);
 
 #endif /* QNAV_CLEARANCE_H */

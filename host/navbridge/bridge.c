@@ -30,14 +30,40 @@ uint16_t qnav_bridge_policy_crc(const qnav_policy_t *policy)
     return qnav_link_policy_crc(policy);
 }
 
+static int bridge_ctrl_reinit(qnav_bridge_ctrl_t *bc)
+{
+    bc->have_last = 0;
+    return bc->method != NULL &&
+           qnav_nav_init(&bc->nav, bc->method, &bc->cfg, &bc->policy) == QNAV_OK;
+}
+
 void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg,
-                           const qnav_policy_t *policy)
+                           const char *controller, const qnav_policy_t *policy)
 {
     memset(bc, 0, sizeof *bc);
     bc->cfg = *cfg;
     bc->policy = *policy;
     bc->policy_crc = qnav_bridge_policy_crc(policy);
-    bc->ready = qnav_ctrl_init(&bc->ctrl, &bc->cfg, &bc->policy) == QNAV_OK;
+    bc->method = qnav_nav_find(controller != NULL ? controller : "body");
+    bc->ready = bridge_ctrl_reinit(bc);
+}
+
+/* The previous decision seen from now. The scan has no compass heading, so the turn made
+ * since is taken from how the goal's bearing moved (exact for a distant goal). */
+static qnav_cdeg_t prev_heading_cdeg(const qnav_bridge_ctrl_t *bc, int16_t goal_cdeg)
+{
+    int32_t a;
+    if (!bc->have_last) {
+        return 0;
+    }
+    a = (int32_t)bc->last_heading_deg * 100 + ((int32_t)goal_cdeg - bc->last_goal_cdeg);
+    a %= 36000;
+    if (a < -18000) {
+        a += 36000;
+    } else if (a >= 18000) {
+        a -= 36000;
+    }
+    return (qnav_cdeg_t)a;
 }
 
 void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
@@ -56,7 +82,7 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
         (n != bc->cfg.n_sectors || scan->max_range_mm != bc->cfg.max_range_mm || !bc->ready)) {
         bc->cfg.n_sectors = (uint16_t)n;
         bc->cfg.max_range_mm = (qnav_mm_t)scan->max_range_mm;
-        bc->ready = qnav_ctrl_init(&bc->ctrl, &bc->cfg, &bc->policy) == QNAV_OK;
+        bc->ready = bridge_ctrl_reinit(bc);
     }
     for (k = 0; k < n; ++k) {
         int32_t r = scan->ranges_mm[k];
@@ -64,16 +90,25 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
     }
     in.ranges_mm = ranges;
     in.goal_bearing_cdeg = scan->goal_bearing_cdeg;
+    in.prev_heading_cdeg = prev_heading_cdeg(bc, scan->goal_bearing_cdeg);
+    if (qualities != NULL) {
+        memset(qualities, 0, sizeof(int16_t) * QNAV_PATHS);
+    }
     if (n == 0 || !bc->ready) {
         /* a scan the controller cannot take: the step reports not-ready and stops */
-        qnav_ctrl_t dead;
+        qnav_nav_t dead;
         memset(&dead, 0, sizeof dead);
-        qnav_ctrl_step(&dead, &in, &out, NULL);
-        if (qualities != NULL) {
-            memset(qualities, 0, sizeof(int16_t) * QNAV_PATHS);
-        }
+        qnav_nav_step(&dead, &in, &out);
+    } else if (qualities != NULL && qnav_nav_paths(&bc->nav) != NULL) {
+        /* the path-quality controllers also give every path's quality for lcm-spy */
+        qnav_ctrl_step(qnav_nav_paths(&bc->nav), &in, &out, qualities);
     } else {
-        qnav_ctrl_step(&bc->ctrl, &in, &out, qualities);
+        qnav_nav_step(&bc->nav, &in, &out);
+    }
+    if (!(out.flags & QNAV_FLAG_NOT_READY)) {
+        bc->have_last = 1;
+        bc->last_heading_deg = out.heading_deg;
+        bc->last_goal_cdeg = scan->goal_bearing_cdeg;
     }
     memset(cmd, 0, sizeof *cmd);
     cmd->utime = scan->utime;
@@ -81,8 +116,8 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
     cmd->heading_deg = out.heading_deg;
     cmd->speed_q15 = out.speed;
     cmd->quality_q15 = out.quality;
-    cmd->speed = out.speed / 32768.0;
-    cmd->quality = out.quality / 32768.0;
+    cmd->speed = QNAV_Q1_15_TO_REAL(out.speed);
+    cmd->quality = QNAV_Q1_15_TO_REAL(out.quality);
     cmd->flags = (int8_t)out.flags;
     cmd->stop_reason = QNAV_STOP_NONE;
     cmd->source = QNAV_SOURCE_BRIDGE;
@@ -96,6 +131,7 @@ void qnav_bridge_config_default(qnav_bridge_config_t *cfg)
     cfg->timeout_ms = 300;
     cfg->heartbeat_ms = 100;
     cfg->status_ms = 500;
+    cfg->controller = "body";
     qnav_ctrl_config_default(&cfg->ctrl);
     qnav_policy_prob_default(&cfg->policy);
 }
@@ -244,7 +280,7 @@ void qnav_bridge_init(qnav_bridge_t *b, const qnav_bridge_config_t *cfg, lcm_t *
     b->write_user = write_user;
     qnav_link_rx_init(&b->rx);
     qnav_link_tx_init(&b->tx);
-    qnav_bridge_ctrl_init(&b->bc, &cfg->ctrl, &cfg->policy);
+    qnav_bridge_ctrl_init(&b->bc, &cfg->ctrl, cfg->controller, &cfg->policy);
     b->now_ms = now_ms;
     b->started_ms = now_ms;
     b->last_scan_ms = -1;
@@ -298,7 +334,7 @@ static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
     q.scan_seq = s.seq;
     q.best_deg = c.heading_deg;
     for (k = 0; k < QNAV_PATHS; ++k) {
-        q.quality[k] = (float)q.quality_q15[k] / 32768.0f;
+        q.quality[k] = (float)QNAV_Q1_15_TO_REAL(q.quality_q15[k]);
     }
     PUBLISH(b, QNAV_CH_QUALITIES, qnav_path_qualities_t, &q);
 }
@@ -319,8 +355,8 @@ static void on_board_command(qnav_bridge_t *b, const qnav_link_frame_t *f)
     c.heading_deg = lc.heading_deg;
     c.speed_q15 = lc.speed;
     c.quality_q15 = lc.quality;
-    c.speed = lc.speed / 32768.0;
-    c.quality = lc.quality / 32768.0;
+    c.speed = QNAV_Q1_15_TO_REAL(lc.speed);
+    c.quality = QNAV_Q1_15_TO_REAL(lc.quality);
     c.flags = (int8_t)(lc.flags & 0x7Fu);
     c.stop_reason = (lc.flags & QNAV_LINK_CMD_STOP) ? QNAV_STOP_BOARD : QNAV_STOP_NONE;
     c.source = QNAV_SOURCE_BOARD;

@@ -18,6 +18,7 @@
 #include <lcm/eventlog.h>
 
 #include "qnav/ctrl.h"
+#include "qnav/nav.h"
 #include "qnav/link.h"
 #include "qnav_command_t.h"
 #include "qnav_goal_t.h"
@@ -63,6 +64,8 @@ typedef struct {
     uint32_t heartbeat_ms;        /* bridge heartbeat period, ms (100) */
     uint32_t status_ms;           /* link status publish period, ms (500) */
     qnav_ctrl_config_t ctrl;      /* n_sectors is taken from each scan */
+    const char *controller;       /* a name in libqnav's controller table: "body" (default),
+                                     "literal", "vfh" (qnav/nav.h) */
     qnav_policy_t policy;         /* offboard: drives the robot; onboard: qualities shown */
     int upload;                   /* onboard: upload policy to the board */
 } qnav_bridge_config_t;
@@ -70,15 +73,20 @@ typedef struct {
 /* The controller step of the bridge, shared with the replay: re-initialises when the
  * scan's sector count or range changes. */
 typedef struct {
-    qnav_ctrl_t ctrl;
+    qnav_nav_t nav;
+    const qnav_nav_method_t *method; /* the controller (null: unknown name, never ready) */
     qnav_ctrl_config_t cfg;
     qnav_policy_t policy;
-    int ready;                    /* qnav_ctrl_init succeeded for cfg */
+    int ready;                    /* qnav_nav_init succeeded for cfg */
     uint16_t policy_crc;          /* CRC-16 of the policy blob */
+    int have_last;                /* a decision was made since init */
+    int16_t last_heading_deg;     /* its heading, robot frame then */
+    int16_t last_goal_cdeg;       /* the goal bearing it saw */
 } qnav_bridge_ctrl_t;
 
+/* controller: a name of the table in qnav/nav.h (null: "body"). */
 void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg,
-                           const qnav_policy_t *policy);
+                           const char *controller, const qnav_policy_t *policy);
 /* Run the controller on an LCM scan; fills cmd (integer and float fields, source BRIDGE)
  * and qualities (360 Q1.15 values, may be NULL). */
 void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,

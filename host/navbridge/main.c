@@ -52,13 +52,14 @@ static void usage(FILE *f)
             "usage: navbridge --device PATH [--baud N] [--lcm-url URL] [--mode offboard|onboard]\n"
             "                 [--policy FILE] [--upload] [--timeout-ms N] [--log FILE]\n"
             "                 [--goal DEG[:METRES] | --goal-at X:Y | --waypoints X:Y,...]\n"
-            "                 [--goal-radius M]\n"
-            "       navbridge --replay LOG [--policy FILE]\n"
+            "                 [--goal-radius M] [--controller NAME]\n"
+            "       navbridge --replay LOG [--policy FILE] [--controller NAME]\n"
             "  --device PATH      serial port to the board (or the SIL robot's pty)\n"
             "  --baud N           serial rate, default 57600\n"
             "  --lcm-url URL      LCM provider URL, default LCM's own default\n"
             "  --mode M           offboard (bridge runs libqnav, default) or onboard\n"
             "  --policy FILE      policy file; default: hand-tuned probabilistic policy\n"
+            "  --controller NAME  offboard controller: body (default), literal, vfh\n"
             "  --upload           onboard: upload --policy to the board at start\n"
             "  --timeout-ms N     stop the robot after N ms without scans/heartbeats (300)\n"
             "  --log FILE         also write every published message to an LCM log\n"
@@ -137,6 +138,7 @@ int main(int argc, char **argv)
         {"goal", required_argument, NULL, 'g'},    {"version", no_argument, NULL, 'V'},
         {"goal-at", required_argument, NULL, 'A'}, {"waypoints", required_argument, NULL, 'W'},
         {"goal-radius", required_argument, NULL, 'G'},
+        {"controller", required_argument, NULL, 'c'},
         {NULL, 0, NULL, 0}};
     const char *device = NULL, *lcm_url = NULL, *policy_path = NULL, *log_path = NULL;
     const char *replay_path = NULL;
@@ -160,6 +162,14 @@ int main(int argc, char **argv)
         case 'd': device = optarg; break;
         case 'u': lcm_url = optarg; break;
         case 'p': policy_path = optarg; break;
+        case 'c':
+            if (qnav_nav_find(optarg) == NULL) {
+                fprintf(stderr, "navbridge: --controller %s: no such controller (body, literal, vfh)\n",
+                        optarg);
+                return 2;
+            }
+            cfg.controller = optarg;
+            break;
         case 'l': log_path = optarg; break;
         case 'r': replay_path = optarg; break;
         case 'U': cfg.upload = 1; break;
@@ -264,7 +274,7 @@ int main(int argc, char **argv)
 
     if (replay_path != NULL) {
         qnav_replay_result_t res;
-        if (qnav_replay_log(replay_path, &cfg.ctrl, &cfg.policy, &res, stdout, err,
+        if (qnav_replay_log(replay_path, &cfg.ctrl, cfg.controller, &cfg.policy, &res, stdout, err,
                             sizeof err) != 0) {
             fprintf(stderr, "navbridge: %s\n", err);
             return 2;

@@ -21,7 +21,7 @@ typedef struct {
     qnav_command_t cmd;
 } pending_t;
 
-int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg,
+int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg, const char *controller,
                     const qnav_policy_t *policy, qnav_replay_result_t *res, FILE *out,
                     char *err, size_t errlen)
 {
@@ -40,7 +40,7 @@ int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg,
         snprintf(err, errlen, "%s: cannot open LCM log (%s)", path, strerror(errno));
         return -1;
     }
-    qnav_bridge_ctrl_init(&bc, cfg, policy);
+    qnav_bridge_ctrl_init(&bc, cfg, controller, policy);
     while ((ev = lcm_eventlog_read_next_event(log)) != NULL) {
         events++;
         if (strcmp(ev->channel, QNAV_CH_SCAN) == 0) {

@@ -23,14 +23,15 @@ typedef struct {
 } qnav_replay_result_t;
 
 /*
- * Replay the log at path with policy and ctrl config cfg (n_sectors and max range are
+ * Replay the log at path with the controller of that name (qnav/nav.h; null: "body"),
+ * policy and ctrl config cfg (n_sectors and max range are
  * taken from each scan). Commands whose policy CRC is set and differs from policy's (a
  * trial with an upload part-way) are counted in other_policy, not compared. Differences
  * are listed on out (may be NULL), at most 10.
  * Returns 0, or -1 with "PATH: problem" in err when the log cannot be read or holds no
  * events (not an LCM log).
  */
-int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg,
+int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg, const char *controller,
                     const qnav_policy_t *policy, qnav_replay_result_t *res, FILE *out,
                     char *err, size_t errlen);
 

@@ -272,6 +272,15 @@ qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
                    [&] { *res = sim->sim->run_episode(ctrl, episode_seed, trace, user); });
 }
 
+qnav_sim_status_t qnav_sim_run_episode_nav(qnav_sim_t *sim, qnav_nav_t *nav, uint64_t episode_seed,
+                                           qnav_sim_result_t *res, qnav_sim_trace_fn trace,
+                                           void *user) {
+    if (!sim || !nav || !res) return QNAV_SIM_E_NULL;
+    sim->last_error[0] = '\0';
+    return guarded(sim->last_error, sizeof sim->last_error,
+                   [&] { *res = sim->sim->run_episode(nav, episode_seed, trace, user); });
+}
+
 qnav_sim_status_t qnav_sim_reset(qnav_sim_t *sim, uint64_t episode_seed) {
     if (!sim) return QNAV_SIM_E_NULL;
     sim->last_error[0] = '\0';
@@ -307,7 +316,7 @@ qnav_sim_status_t qnav_sim_scan(const qnav_sim_t *sim, qnav_sim_scan_t *scan) {
 qnav_sim_status_t qnav_sim_command(qnav_sim_t *sim, const qnav_ctrl_output_t *out) {
     if (!sim || !out) return QNAV_SIM_E_NULL;
     if (!sim->sim->started()) return QNAV_SIM_E_STATE;
-    sim->sim->command(out->heading_deg, out->speed / 32768.0);
+    sim->sim->command(out->heading_deg, QNAV_Q1_15_TO_REAL(out->speed));
     return QNAV_SIM_OK;
 }
 

@@ -174,6 +174,7 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     l_m_ = 0;
     wheel_l_ = wheel_r_ = 0;
     cmd_heading_deg_ = cmd_speed_ = 0;
+    have_prev_ = false;
     target_heading_ = heading_;
     target_speed_ = 0;
     marks_.clear();
@@ -189,6 +190,9 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
 void Simulation::command(double heading_deg, double speed) {
     cmd_heading_deg_ = std::isfinite(heading_deg) ? heading_deg : 0.0;
     cmd_speed_ = std::isfinite(speed) ? std::clamp(speed, 0.0, 1.0) : 0.0;
+    // The decision in the world, from the heading the robot sensed when it made it.
+    prev_world_rad_ = sensed_heading_ + cmd_heading_deg_ * kPi / 180.0;
+    have_prev_ = true;
 }
 
 void Simulation::compute_scan() {
@@ -215,6 +219,8 @@ void Simulation::compute_scan() {
     if (ps > 0) hd += ps * kPi * rng_sensor_.normal();
     const double bearing = std::atan2(env_.dest_y_m - pos_.y, env_.dest_x_m - pos_.x) - hd;
     scan_.goal_bearing_cdeg = to_cdeg(bearing);
+    sensed_heading_ = hd;
+    scan_.prev_heading_cdeg = have_prev_ ? to_cdeg(prev_world_rad_ - hd) : 0;
     if (profiling_) prof_.sonar_s += std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
@@ -463,14 +469,41 @@ qnav_sim_sample_t Simulation::sample() const {
     return s;
 }
 
+namespace {
+void step_ctrl(void *self, const qnav_ctrl_input_t *in, qnav_ctrl_output_t *out) {
+    qnav_ctrl_step(static_cast<const qnav_ctrl_t *>(self), in, out, nullptr);
+}
+void step_nav(void *self, const qnav_ctrl_input_t *in, qnav_ctrl_output_t *out) {
+    qnav_nav_step(static_cast<qnav_nav_t *>(self), in, out);
+}
+}  // namespace
+
 qnav_sim_result_t Simulation::run_episode(const qnav_ctrl_t *ctrl, std::uint64_t episode_seed,
                                           qnav_sim_trace_fn trace, void *user) {
-    if (ctrl->n_sectors != cfg_.n_sectors)
-        throw SimError(QNAV_SIM_E_PARAM, "controller: n_sectors " + std::to_string(ctrl->n_sectors) +
+    return run_episode_with(step_ctrl, const_cast<qnav_ctrl_t *>(ctrl), ctrl->clr.n_sectors,
+                            ctrl->clr.max_range_mm, episode_seed, trace, user);
+}
+
+qnav_sim_result_t Simulation::run_episode(qnav_nav_t *nav, std::uint64_t episode_seed,
+                                          qnav_sim_trace_fn trace, void *user) {
+    std::uint16_t n = 0;
+    qnav_mm_t range = 0;
+    qnav_nav_sensors(nav, &n, &range);
+    if (qnav_nav_method(nav) == nullptr)
+        throw SimError(QNAV_SIM_E_PARAM, "controller: not initialised (qnav_nav_init failed or was not called)");
+    qnav_nav_reset(nav);
+    return run_episode_with(step_nav, nav, n, range, episode_seed, trace, user);
+}
+
+qnav_sim_result_t Simulation::run_episode_with(StepFn step, void *self, std::uint16_t n_sectors,
+                                               qnav_mm_t max_range_mm, std::uint64_t episode_seed,
+                                               qnav_sim_trace_fn trace, void *user) {
+    if (n_sectors != cfg_.n_sectors)
+        throw SimError(QNAV_SIM_E_PARAM, "controller: n_sectors " + std::to_string(n_sectors) +
                                              " does not match the simulation's " +
                                              std::to_string(cfg_.n_sectors));
-    if (ctrl->max_range_mm != max_range_mm_)
-        throw SimError(QNAV_SIM_E_PARAM, "controller: max_range_mm " + std::to_string(ctrl->max_range_mm) +
+    if (max_range_mm != max_range_mm_)
+        throw SimError(QNAV_SIM_E_PARAM, "controller: max_range_mm " + std::to_string(max_range_mm) +
                                              " does not match the robot's " +
                                              std::to_string(max_range_mm_));
     using Clock = std::chrono::steady_clock;
@@ -484,13 +517,14 @@ qnav_sim_result_t Simulation::run_episode(const qnav_ctrl_t *ctrl, std::uint64_t
     qnav_ctrl_output_t out;
     while (!done_) {
         in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
+        in.prev_heading_cdeg = scan_.prev_heading_cdeg;
         Clock::time_point t0;
         if (profiling_) t0 = Clock::now();
-        qnav_ctrl_step(ctrl, &in, &out, nullptr);
+        step(self, &in, &out);
         if (profiling_) prof_.controller_s += std::chrono::duration<double>(Clock::now() - t0).count();
         if (out.flags & QNAV_FLAG_NOT_READY)
             throw SimError(QNAV_SIM_E_PARAM, "controller: not initialised (qnav_ctrl_init failed or was not called)");
-        command(out.heading_deg, out.speed / 32768.0);
+        command(out.heading_deg, QNAV_Q1_15_TO_REAL(out.speed));
         advance();
         if (trace) {
             const qnav_sim_sample_t s = sample();

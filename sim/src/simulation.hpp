@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "env.hpp"
+#include "qnav/nav.h"
 #include "qnav/sim.h"
 #include "rng.hpp"
 #include "robot.hpp"
@@ -62,8 +63,16 @@ public:
     const std::vector<CollisionMark> &collision_marks() const { return marks_; }
 
     // Whole episode with a libqnav controller; throws SimError on a mismatched controller.
+    // Any controller of the table in qnav/nav.h (reset at the start of the episode).
+    qnav_sim_result_t run_episode(qnav_nav_t *nav, std::uint64_t episode_seed,
+                                  qnav_sim_trace_fn trace, void *user);
     qnav_sim_result_t run_episode(const qnav_ctrl_t *ctrl, std::uint64_t episode_seed,
                                   qnav_sim_trace_fn trace, void *user);
+    // The loop both run_episode()s share: scan -> step(self) -> command -> advance.
+    using StepFn = void (*)(void *self, const qnav_ctrl_input_t *in, qnav_ctrl_output_t *out);
+    qnav_sim_result_t run_episode_with(StepFn step, void *self, std::uint16_t n_sectors,
+                                       qnav_mm_t max_range_mm, std::uint64_t episode_seed,
+                                       qnav_sim_trace_fn trace, void *user);
 
     void set_profiling(bool on) { profiling_ = on; }
     // Benchmark reference only: the straightforward way (a Box2D ray cast per degree for
@@ -109,6 +118,9 @@ private:
     double clearance_m_ = 0;            // centre to nearest surface after the last step, m
     bool body_stale_ = false;           // Box2D body not moved since free steps
     double cmd_heading_deg_ = 0, cmd_speed_ = 0;  // last command, as given
+    double sensed_heading_ = 0;   // heading (with sensor noise) of the current scan, rad
+    double prev_world_rad_ = 0;   // last command's heading in the world, rad
+    bool have_prev_ = false;      // a command was given since reset
     double target_heading_ = 0, target_speed_ = 0;  // this tick, with actuation noise
     std::vector<double> true_dist_;  // centre distances of the last scan before noise, m
     qnav_sim_scan_t scan_{};

@@ -25,6 +25,7 @@
 #include "capi_internal.hpp"
 #include "error.hpp"
 #include "qnav/ctrl.h"
+#include "qnav/nav.h"
 #include "qnav/sim.h"
 #include "rng.hpp"
 #include "svg.hpp"
@@ -120,13 +121,11 @@ qnav_policy_t read_policy(const std::string &path, const qnav_sim_robot_t *robot
 #endif
 }
 
-// Initialise ctrl for sim from a policy, in network/probabilistic or table mode; literal:
-// the paper's per-sector reading without enlargement, guard or pre-activation rank.
+// Initialise ctrl for sim from a policy, in network/probabilistic or table mode (bench).
 void init_ctrl(const qnav_sim_t *sim, const qnav_policy_t &pol, bool table,
-               std::vector<qnav_qkey_t> &table_buf, qnav_ctrl_t *ctrl, bool literal = false) {
+               std::vector<qnav_qkey_t> &table_buf, qnav_ctrl_t *ctrl) {
     qnav_ctrl_config_t cc;
     qnav_sim_ctrl_config(sim, &cc);
-    if (literal) qnav_ctrl_config_literal(&cc);
     qnav_status_t st = qnav_ctrl_init(ctrl, &cc, &pol);
     if (st != QNAV_OK)
         throw SimError(QNAV_SIM_E_PARAM, "policy: rejected by qnav_ctrl_init (status " + std::to_string(st) + ")");
@@ -137,6 +136,35 @@ void init_ctrl(const qnav_sim_t *sim, const qnav_policy_t &pol, bool table,
         if (st != QNAV_OK)
             throw SimError(QNAV_SIM_E_PARAM, "policy: table mode failed (status " + std::to_string(st) + ")");
     }
+}
+
+// Names of every controller in libqnav's table, for messages: "body, literal, vfh".
+std::string controller_names() {
+    std::string s;
+    for (std::uint8_t i = 0; i < qnav_nav_count(); ++i) s += (i ? ", " : "") + std::string(qnav_nav_method_at(i)->name);
+    return s;
+}
+
+// Initialise nav as the controller called name (libqnav's table, qnav/nav.h) for sim;
+// table: compile a path-quality controller's policy into table mode.
+void init_nav(const qnav_sim_t *sim, const std::string &name, const qnav_policy_t &pol, bool table,
+              std::vector<qnav_qkey_t> &table_buf, qnav_nav_t *nav) {
+    const qnav_nav_method_t *m = qnav_nav_find(name.c_str());
+    if (!m) throw SimError(QNAV_SIM_E_PARAM, "--controller: no controller '" + name + "' (" + controller_names() + ")");
+    qnav_ctrl_config_t cc;
+    qnav_sim_ctrl_config(sim, &cc);
+    qnav_status_t st = qnav_nav_init(nav, m, &cc, &pol);
+    if (st != QNAV_OK)
+        throw SimError(QNAV_SIM_E_PARAM, "--controller " + name + ": " + qnav_status_str(st));
+    if (!table) return;
+    qnav_ctrl_t *ctrl = qnav_nav_paths(nav);
+    if (!ctrl) throw SimError(QNAV_SIM_E_PARAM, "--table: controller " + name + " has no quality table");
+    qnav_ctrl_config_t own;
+    qnav_nav_config(m, &cc, &own);
+    table_buf.assign(QNAV_QTABLE_ENTRIES, 0);
+    st = qnav_ctrl_build_table(ctrl, table_buf.data());
+    if (st == QNAV_OK) st = qnav_ctrl_init_table(ctrl, &own, table_buf.data(), qnav_ctrl_rank(ctrl));
+    if (st != QNAV_OK) throw SimError(QNAV_SIM_E_PARAM, std::string("--table: ") + qnav_status_str(st));
 }
 
 void print_result(unsigned long long episode, const qnav_sim_result_t &r) {
@@ -153,7 +181,7 @@ struct RunOpts {
     std::uint64_t seed = 1, episode = 0;
     unsigned episodes = 1;
     bool table = false;
-    std::string controller = "body";
+    std::string controller = "body";  // a name in libqnav's controller table (qnav/nav.h)
     long svg_tick = -1;
 };
 
@@ -172,16 +200,22 @@ int cmd_run(const RunOpts &o) {
     qnav::Simulation &sim = *l.sim->sim;
     const qnav_policy_t pol = read_policy(o.policy, l.robot);
     std::vector<qnav_qkey_t> tbuf;
-    qnav_ctrl_t ctrl;
-    init_ctrl(l.sim, pol, o.table, tbuf, &ctrl, o.controller == "literal");
+    qnav_nav_t nav;
+    init_nav(l.sim, o.controller, pol, o.table, tbuf, &nav);
+    const bool uses_policy = qnav_nav_method(&nav)->uses_policy != 0;
+    if (!uses_policy && !o.policy.empty())
+        throw SimError(QNAV_SIM_E_PARAM, "--policy: controller " + o.controller + " takes no policy");
     std::printf("robot %s  env %s  sectors %u  sensor noise %.3f  actuation noise %.3f  seed %llu  "
-                "fitness %s  policy %s%s\n",
+                "controller %s  fitness %s  policy %s%s\n",
                 ri.name, sim.env().name.c_str(), sim.config().n_sectors, ps, pa,
-                static_cast<unsigned long long>(o.seed), qnav_sim_fitness_rule_name(rule),
-                o.policy.empty() ? "probabilistic (default)" : o.policy.c_str(),
+                static_cast<unsigned long long>(o.seed), o.controller.c_str(),
+                qnav_sim_fitness_rule_name(rule),
+                !uses_policy ? "none" : o.policy.empty() ? "probabilistic (default)" : o.policy.c_str(),
                 o.table ? " (table mode)" : "");
     double sum_r = 0;
     unsigned reached = 0;
+    unsigned long long tau_c = 0;
+    double path_m = 0, turn_deg = 0;  // smoothness: heading change per metre driven
     for (unsigned e = 0; e < o.episodes; ++e) {
         const std::uint64_t es = o.episode + e;
         qnav::EpisodePicture pic;
@@ -190,7 +224,12 @@ int cmd_run(const RunOpts &o) {
         std::string csv = "tick,x_m,y_m,heading_rad,speed_mps,cmd_heading_deg,cmd_speed,recovering,collided\n";
         // Every sample of the episode: the trajectory row, the path, and the sonar at the
         // chosen tick (or the last one before the episode ended).
+        bool have_last = false;
+        double last_heading = 0;
         auto grab = [&](const qnav_sim_sample_t &smp) {
+            if (have_last) turn_deg += std::fabs(std::remainder(smp.heading_rad - last_heading, 2 * M_PI)) * 180.0 / M_PI;
+            have_last = true;
+            last_heading = smp.heading_rad;
             if (want_trace) {
                 char line[256];
                 std::snprintf(line, sizeof line, "%u,%.6f,%.6f,%.6f,%.4f,%d,%.4f,%d,%d\n", smp.tick,
@@ -210,10 +249,12 @@ int cmd_run(const RunOpts &o) {
             }
         };
         auto trace = [](void *user, const qnav_sim_sample_t *smp) { (*static_cast<decltype(grab) *>(user))(*smp); };
-        const qnav_sim_result_t r = sim.run_episode(&ctrl, es, want_trace || want_pic ? +trace : nullptr, &grab);
+        const qnav_sim_result_t r = sim.run_episode(&nav, es, +trace, &grab);
         print_result(static_cast<unsigned long long>(es), r);
         sum_r += r.R;
         reached += r.reached;
+        tau_c += r.tau_c;
+        path_m += r.l;
         if (want_trace) {
             write_output(o.trace, csv);
             std::printf("trajectory: %s\n", o.trace.c_str());
@@ -232,9 +273,13 @@ int cmd_run(const RunOpts &o) {
             std::printf("picture: %s\n", o.svg.c_str());
         }
     }
-    if (o.episodes > 1)
+    if (o.episodes > 1) {
         std::printf("mean R %.3f over %u episodes, %u reached (%.1f%%)\n", sum_r / o.episodes, o.episodes,
                     reached, 100.0 * reached / o.episodes);
+        std::printf("recovery ticks %.2f per episode  path %.2f m per episode  heading change %.1f deg/m\n",
+                    static_cast<double>(tau_c) / o.episodes, path_m / o.episodes,
+                    path_m > 0 ? turn_deg / path_m : 0.0);
+    }
     return 0;
 }
 
@@ -391,8 +436,9 @@ int main(int argc, char **argv) {
     run->add_flag("--table", ro.table, "run the controller in table mode");
     run->add_option("--controller", ro.controller,
                     "body: obstacles enlarged by the robot's radius + safety distance, speed guard, "
-                    "rank by pre-activation; literal: the paper's per-sector reading (ablation)")
-        ->check(CLI::IsMember({"body", "literal"}))->capture_default_str();
+                    "rank by pre-activation; literal: the paper's per-sector reading (ablation); "
+                    "vfh: VFH+ (Ulrich & Borenstein 1998), no policy")
+        ->capture_default_str();
     run->add_option("--svg", ro.svg, "write the first episode's picture here");
     run->add_option("--trace", ro.trace, "write the first episode's trajectory here (CSV, one row per tick)");
     run->add_option("--svg-tick", ro.svg_tick, "tick whose sonar sectors are drawn (default 0; past the end: the last tick)")->check(CLI::NonNegativeNumber);

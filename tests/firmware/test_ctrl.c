@@ -38,7 +38,7 @@ static int32_t rng_range(int32_t lo, int32_t hi) /* inclusive */
 static void random_net(qnav_policy_t *p, uint8_t hidden, int32_t max_raw)
 {
     qnav_policy_net_zero(p, hidden);
-    for (uint16_t k = 0; k < QNAV_NET_WEIGHTS(hidden); ++k) {
+    for (uint16_t k = 0; k < qnav_net_weight_count(&p->u.net); ++k) {
         *qnav_net_weight(&p->u.net, k) = (qnav_q8_8_t)rng_range(-max_raw, max_raw);
     }
 }

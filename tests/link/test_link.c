@@ -508,7 +508,7 @@ static void test_policy_blob_round_trips_network_and_probabilistic(void **state)
     (void)state;
     make_net(&a, QNAV_MAX_HIDDEN);
     n = qnav_link_policy_to_blob(&a, blob, sizeof blob);
-    assert_int_equal(n, QNAV_LINK_POLICY_MAX_BYTES);
+    assert_int_equal(n, 2 + 2 * QNAV_NET_WEIGHTS(QNAV_MAX_HIDDEN));
     assert_int_equal(qnav_link_policy_from_blob(blob, (uint16_t)n, &b), QNAV_LINK_OK);
     assert_int_equal(b.kind, QNAV_POLICY_NET);
     assert_int_equal(b.u.net.hidden, QNAV_MAX_HIDDEN);
@@ -524,6 +524,53 @@ static void test_policy_blob_round_trips_network_and_probabilistic(void **state)
     assert_int_equal(b.u.prob.k_goal, 777);
     blob[0] = 9;
     assert_int_equal(qnav_link_policy_from_blob(blob, 6, &b), QNAV_LINK_E_VALUE);
+}
+
+static void test_policy_blob_round_trips_a_three_input_network(void **state)
+{
+    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
+    qnav_policy_t a, b;
+    uint16_t k;
+    int32_t n;
+    (void)state;
+    qnav_policy_net_zero_inputs(&a, QNAV_MAX_HIDDEN, QNAV_NET_INPUTS_PREV);
+    for (k = 0; k < qnav_net_weight_count(&a.u.net); ++k) {
+        *qnav_net_weight(&a.u.net, k) = (qnav_q8_8_t)(k * 173 - 5000);
+    }
+    n = qnav_link_policy_to_blob(&a, blob, sizeof blob);
+    assert_int_equal(n, QNAV_LINK_POLICY_MAX_BYTES);
+    assert_int_equal(blob[1], 0x80u | QNAV_MAX_HIDDEN);
+    assert_int_equal(qnav_link_policy_from_blob(blob, (uint16_t)n, &b), QNAV_LINK_OK);
+    assert_int_equal(b.u.net.inputs, QNAV_NET_INPUTS_PREV);
+    assert_memory_equal(b.u.net.w_prev, a.u.net.w_prev, sizeof a.u.net.w_prev);
+    assert_memory_equal(b.u.net.w_out, a.u.net.w_out, sizeof a.u.net.w_out);
+    /* the same bytes read as a 2-input blob have the wrong length */
+    blob[1] = QNAV_MAX_HIDDEN;
+    assert_int_equal(qnav_link_policy_from_blob(blob, (uint16_t)n, &b), QNAV_LINK_E_LENGTH);
+    blob[1] = 0x40u | QNAV_MAX_HIDDEN; /* an unused shape bit */
+    assert_int_equal(qnav_link_policy_from_blob(blob, (uint16_t)n, &b), QNAV_LINK_E_VALUE);
+}
+
+static void test_policy_blob_refuses_a_policy_that_does_not_validate(void **state)
+{
+    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
+    qnav_policy_t a;
+    (void)state;
+    qnav_policy_net_zero(&a, 3);
+    a.u.net.inputs = 4;
+    assert_int_equal(qnav_link_policy_to_blob(&a, blob, sizeof blob), QNAV_LINK_E_VALUE);
+    qnav_policy_prob_default(&a);
+    a.u.prob.k_safe = 0;
+    assert_int_equal(qnav_link_policy_to_blob(&a, blob, sizeof blob), QNAV_LINK_E_VALUE);
+}
+
+static void test_link_status_str_names_every_status(void **state)
+{
+    (void)state;
+    assert_string_equal(qnav_link_status_str(QNAV_LINK_OK), "ok");
+    assert_string_equal(qnav_link_status_str(QNAV_LINK_E_LENGTH),
+                        "payload length wrong for the message");
+    assert_string_equal(qnav_link_status_str(-99), "unknown link status");
 }
 
 /* Upload blob in chunks; return the commit's status. */
@@ -718,6 +765,9 @@ int main(void)
         cmocka_unit_test(test_fuzz_every_truncation_is_dropped),
         cmocka_unit_test(test_fuzz_random_damage_never_yields_a_frame_that_was_not_sent),
         cmocka_unit_test(test_policy_blob_round_trips_network_and_probabilistic),
+        cmocka_unit_test(test_policy_blob_round_trips_a_three_input_network),
+        cmocka_unit_test(test_policy_blob_refuses_a_policy_that_does_not_validate),
+        cmocka_unit_test(test_link_status_str_names_every_status),
         cmocka_unit_test(test_upload_in_chunks_delivers_the_policy),
         cmocka_unit_test(test_upload_with_wrong_crc_is_refused),
         cmocka_unit_test(test_upload_with_missing_chunk_is_refused),

@@ -143,6 +143,59 @@ static void test_reader_accepts_documented_network_file(void **state)
     assert_string_equal(qnav_policy_meta_get(&meta, "source"), "simevo --env dense");
 }
 
+static const char net3_text[] = "qnav-policy 2\n"
+                                "kind network\n"
+                                "qformat Q8.8\n"
+                                "hidden 2\n"
+                                "inputs 3\n"
+                                "unit 0 -512 300 -77 12 -40\n"
+                                "unit 1 256 -128 99 0 1024\n"
+                                "b_out 5\n"
+                                "end\n";
+
+static void test_version_2_file_with_three_inputs_reads_and_writes_back_the_same(void **state)
+{
+    qnav_policy_t p;
+    qnav_policy_t q;
+    char buf[1024];
+    char err[QNAV_POLICY_IO_ERRLEN] = "";
+    int n;
+    (void)state;
+    assert_int_equal(qnav_policy_parse(net3_text, sizeof net3_text - 1, "n3.policy", &p, err,
+                                       sizeof err),
+                     0);
+    assert_int_equal(p.u.net.inputs, 3);
+    assert_int_equal(p.u.net.w_prev[0], -77);
+    assert_int_equal(p.u.net.b_hidden[0], 12);
+    assert_int_equal(p.u.net.w_prev[1], 99);
+    assert_int_equal(p.u.net.w_out[1], 1024);
+    assert_int_equal(qnav_policy_file_version(&p), 2);
+    n = qnav_policy_format(&p, NULL, NULL, buf, sizeof buf, err, sizeof err);
+    assert_true(n > 0 && (size_t)n < sizeof buf);
+    assert_non_null(strstr(buf, "qnav-policy 2\n"));
+    assert_non_null(strstr(buf, "inputs 3\n"));
+    assert_int_equal(qnav_policy_parse(buf, (size_t)n, "again", &q, err, sizeof err), 0);
+    assert_true(qnav_policy_equal(&p, &q));
+    q.u.net.w_prev[1] = 98;
+    assert_false(qnav_policy_equal(&p, &q));
+}
+
+static void test_two_input_network_is_still_written_as_version_1(void **state)
+{
+    qnav_policy_t p;
+    char buf[1024];
+    char err[QNAV_POLICY_IO_ERRLEN] = "";
+    int n;
+    (void)state;
+    qnav_policy_net_zero(&p, 2);
+    n = qnav_policy_format(&p, NULL, NULL, buf, sizeof buf, err, sizeof err);
+    assert_true(n > 0);
+    assert_memory_equal(buf, "qnav-policy 1\n", 14);
+    assert_null(strstr(buf, "inputs"));
+    assert_string_equal(qnav_policy_kind_name(QNAV_POLICY_NET), "network");
+    assert_null(qnav_policy_kind_name(9));
+}
+
 static void test_reader_accepts_crlf_line_endings(void **state)
 {
     qnav_policy_t p;
@@ -657,6 +710,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reader_accepts_documented_network_file),
+        cmocka_unit_test(test_version_2_file_with_three_inputs_reads_and_writes_back_the_same),
+        cmocka_unit_test(test_two_input_network_is_still_written_as_version_1),
         cmocka_unit_test(test_reader_accepts_crlf_line_endings),
         cmocka_unit_test(test_reader_accepts_missing_final_newline_after_end),
         cmocka_unit_test(test_reader_leaves_output_untouched_on_error),

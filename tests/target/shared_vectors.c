@@ -246,6 +246,7 @@ int main(void)
         cfg.max_range_mm = spec->max_range_mm;
         in.ranges_mm = ranges;
         in.goal_bearing_cdeg = spec->goal_cdeg;
+        in.prev_heading_cdeg = 0; /* 2-input policies ignore it */
         for (p = 0; p < N_POLICIES; ++p) {
             qnav_status_t st;
             uint32_t hash;
@@ -293,6 +294,7 @@ int main(void)
     make_scan(&scans[0]);
     in.ranges_mm = ranges;
     in.goal_bearing_cdeg = 0;
+    in.prev_heading_cdeg = 0; /* 2-input policies ignore it */
     qnav_ctrl_step(&ctrl, &in, &out, qualities);
     put_result(&out, fnv1a_qualities());
 

@@ -16,6 +16,7 @@
 #ifndef QNAV_CTRL_H
 #define QNAV_CTRL_H
 
+#include "qnav/check.h"
 #include "qnav/fixed.h"
 #include "qnav/policy.h"
 #include "qnav/qnav_config.h"
@@ -34,8 +35,15 @@ typedef enum {
     QNAV_E_POLICY_KIND = -5,  /* policy kind unknown */
     QNAV_E_HIDDEN = -6,       /* hidden units outside 1..QNAV_MAX_HIDDEN */
     QNAV_E_PROB_PARAM = -7,   /* a probabilistic parameter outside (0, 64] */
-    QNAV_E_RANK = -8          /* rank is not a qnav_rank_t */
+    QNAV_E_RANK = -8,         /* rank is not a qnav_rank_t */
+    QNAV_E_INPUTS = -9,       /* network inputs neither 2 nor 3 */
+    QNAV_E_NO_TABLE = -10,    /* this policy cannot be compiled into a 2-D table (3 inputs) */
+    QNAV_E_VFH_PARAM = -11,   /* a VFH+ parameter out of range (qnav/vfh.h) */
+    QNAV_E_NAME = -12         /* no controller of that name (qnav/nav.h) */
 } qnav_status_t;
+
+/* One line of text for a status ("ok", "n_sectors outside 1..360", ...); never null. */
+const char *qnav_status_str(qnav_status_t status);
 
 /* What the step maximises over the paths (docs/architecture.md, "Argmax"). */
 typedef enum {
@@ -84,6 +92,11 @@ typedef struct {
     const qnav_mm_t *ranges_mm;       /* n_sectors ranges, mm; above max_range_mm clipped */
     qnav_cdeg_t goal_bearing_cdeg;    /* destination bearing in the robot frame, 0.01 deg,
                                          counter-clockwise positive; any value (wrapped) */
+    qnav_cdeg_t prev_heading_cdeg;    /* the heading chosen at the previous tick, seen in
+                                         this tick's robot frame (the previous output's
+                                         heading minus the turn made since), 0.01 deg; 0
+                                         on the first tick. Read by 3-input networks and
+                                         VFH+; the step itself keeps no memory */
 } qnav_ctrl_input_t;
 
 /* One control tick's decision. */
@@ -99,27 +112,37 @@ typedef struct {
     int32_t bias_z;    /* hidden bias, units of 2^-19 */
     int32_t per_deg;   /* weight per degree of dtheta, units of 2^-19 */
     int32_t per_level; /* weight per distance level, units of 2^-19 */
+    int32_t per_prev;  /* weight per degree of dprev (3 inputs, else 0), units of 2^-19 */
     int16_t out;       /* output weight, Q8.8 */
 } qnav_ctrl_unit_t;
+
+/* What clearance.c derives from a configuration: how ranges become per-path distance
+ * levels, the enlargement and the speed guard. Shared by every controller that looks at
+ * paths (the path-quality controller, VFH+). Private: reach it through functions. */
+typedef struct {
+    uint16_t n_sectors;
+    qnav_mm_t max_range_mm;
+    uint32_t level_scale;             /* distance level = (range * scale + 2^15) >> 16 */
+    uint16_t sector_paths;            /* 360 / N: paths in a sector, or one more */
+    uint16_t sector_span;             /* sector_paths * N */
+    uint16_t first_sector_paths;      /* paths 0.. that lie in sector 0: ceil(180 / N) */
+    uint8_t enlarge_deg[QNAV_DIST_LEVELS];      /* obstacle enlargement gamma by level, deg */
+    qnav_q1_15_t speed_cap[QNAV_DIST_LEVELS];   /* speed guard by level, Q1.15 of v_max */
+} qnav_clearance_t;
 
 /* The controller. Caller-owned (a static on an MCU, a vector element on a host); fields
  * are private: reach them through the functions below. */
 typedef struct {
     uint16_t magic;                   /* set by a successful init */
-    uint8_t kind;                     /* QNAV_POLICY_PROB, QNAV_POLICY_NET, or 0 for table */
+    uint8_t kind;                     /* the policy's qnav_policy_kind_t (table mode: the
+                                         kind that built the table is not known, table set) */
     uint8_t hidden;
+    uint8_t inputs;                   /* network inputs, 2 or 3 */
     uint8_t rank;                     /* qnav_rank_t of the keys (table: as given at init) */
-    uint16_t n_sectors;
-    qnav_mm_t max_range_mm;
-    uint32_t level_scale;             /* distance level = (range * scale + 2^15) >> 16 */
+    qnav_clearance_t clr;             /* levels, enlargement, speed guard */
     uint32_t speed_scale;             /* speed = min(MAX, (quality * scale) >> 15) */
-    uint16_t sector_paths;            /* 360 / N: paths in a sector, or one more */
-    uint16_t sector_span;             /* sector_paths * N */
-    uint16_t first_sector_paths;      /* paths 0.. that lie in sector 0: ceil(180 / N) */
     qnav_q1_15_t full_speed_quality;
     const qnav_qkey_t *table;         /* table mode: [QNAV_DIST_LEVELS][181] rank keys */
-    uint8_t enlarge_deg[QNAV_DIST_LEVELS];      /* obstacle enlargement gamma by level, deg */
-    qnav_q1_15_t speed_cap[QNAV_DIST_LEVELS];   /* speed guard by level, Q1.15 of v_max */
     int32_t out_bias_z;               /* network output bias, units of 2^-15 */
     union {
         struct {
@@ -146,10 +169,11 @@ void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg);
 /*
  * Check cfg and policy and derive the step's parameters into ctrl.
  * Returns QNAV_OK, or QNAV_E_NULL, QNAV_E_SECTORS, QNAV_E_RANGE, QNAV_E_SPEED, QNAV_E_RANK,
- * QNAV_E_POLICY_KIND, QNAV_E_HIDDEN, QNAV_E_PROB_PARAM; on error ctrl is left not ready
+ * QNAV_E_POLICY_KIND, QNAV_E_HIDDEN, QNAV_E_INPUTS, QNAV_E_PROB_PARAM (the policy is
+ * checked by qnav_policy_validate()); on error ctrl is left not ready
  * (a step then commands a stop). The policy is not referenced after init returns.
  */
-qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
+QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
                              const qnav_policy_t *policy);
 
 /*
@@ -160,7 +184,7 @@ qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
  * must be in program memory. The table must outlive ctrl. Same statuses as
  * qnav_ctrl_init().
  */
-qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
+QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
                                    const qnav_qkey_t *table, qnav_rank_t rank);
 
 /* The qnav_rank_t of an initialised controller's keys (QNAV_RANK_QUALITY when not ready). */
@@ -180,7 +204,8 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
 
 /*
  * The rank key the policy gives one (distance level, dtheta) pair: the single function
- * that both the network/probabilistic step and every compiled table evaluate.
+ * that both the network/probabilistic step and every compiled table evaluate (a 3-input
+ * network: with the path on the previous heading, dprev = 0).
  * level is clamped to 0..QNAV_DIST_LEVELS-1, dtheta_deg to 0..180. -32767 if not ready.
  */
 qnav_qkey_t qnav_ctrl_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta_deg);
@@ -195,10 +220,11 @@ qnav_q1_15_t qnav_ctrl_key_quality(const qnav_ctrl_t *ctrl, qnav_qkey_t key);
 /*
  * Compile the controller's policy into a key table of QNAV_QTABLE_ENTRIES entries
  * (caller's buffer, in RAM), for qnav_ctrl_init_table(..., qnav_ctrl_rank(ctrl)).
- * Returns QNAV_OK, QNAV_E_NULL, or QNAV_E_POLICY_KIND when ctrl is not initialised with a
- * policy.
+ * Returns QNAV_OK, QNAV_E_NULL, QNAV_E_POLICY_KIND when ctrl is not initialised with a
+ * policy, or QNAV_E_NO_TABLE for a 3-input network (its key depends on dprev too: a 3-D
+ * table of 32 x 181 x 181 keys, 371 KB, does not fit a small board).
  */
-qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_qkey_t *table);
+QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_qkey_t *table);
 
 /* The distance level a range maps to under this controller (clipped to max range). */
 uint8_t qnav_ctrl_level(const qnav_ctrl_t *ctrl, qnav_mm_t range_mm);

@@ -29,8 +29,15 @@
 #endif
 #endif
 
-/* Hidden units of a newly made network policy when nothing else is asked for. */
+/* Hidden units of a newly made network policy when nothing else is asked for: 12, or
+ * QNAV_MAX_HIDDEN when that is smaller (so every QNAV_MAX_HIDDEN in 1..32 builds). */
+#ifndef QNAV_DEFAULT_HIDDEN
+#if QNAV_MAX_HIDDEN < 12
+#define QNAV_DEFAULT_HIDDEN QNAV_MAX_HIDDEN
+#else
 #define QNAV_DEFAULT_HIDDEN 12
+#endif
+#endif
 
 /* Largest number of sonar sectors (any N in 1..360 is valid input). */
 #define QNAV_MAX_SECTORS 360

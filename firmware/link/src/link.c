@@ -676,58 +676,77 @@ int32_t qnav_link_pose_unpack(const uint8_t *p, uint16_t len, qnav_link_pose_t *
 
 /* ---- policy blobs ---- */
 
+/* Byte 1 of a network blob: hidden units in bits 0..5, bit 7 set for the third input. */
+#define BLOB_NET_PREV 0x80u
+#define BLOB_NET_HIDDEN 0x3Fu
+
+static int32_t net_to_blob(const qnav_net_t *src, uint8_t *out, uint16_t cap)
+{
+    qnav_net_t net = *src; /* qnav_net_weight() takes a mutable net: use a copy */
+    uint16_t nw = qnav_net_weight_count(&net);
+    uint16_t need = (uint16_t)(2u + 2u * nw);
+    uint16_t k;
+    if (cap < need) {
+        return QNAV_LINK_E_SPACE;
+    }
+    out[0] = QNAV_POLICY_NET;
+    out[1] = (uint8_t)(net.hidden | (net.inputs == QNAV_NET_INPUTS_PREV ? BLOB_NET_PREV : 0u));
+    for (k = 0; k < nw; ++k) {
+        put_u16(&out[2u + 2u * k], as_u16(*qnav_net_weight(&net, k)));
+    }
+    return (int32_t)need;
+}
+
 int32_t qnav_link_policy_to_blob(const qnav_policy_t *policy, uint8_t *out, uint16_t cap)
 {
-    uint16_t need;
-    uint16_t k;
-    uint16_t nw;
-    qnav_net_t net;
-    const qnav_q8_8_t *w;
-
     if (policy == NULL || out == NULL) {
         return QNAV_LINK_E_NULL;
     }
-    if (policy->kind == QNAV_POLICY_PROB) {
-        need = 6u;
-        if (cap < need) {
+    if (qnav_policy_validate(policy) != QNAV_POLICY_OK) {
+        return QNAV_LINK_E_VALUE;
+    }
+    switch ((qnav_policy_kind_t)policy->kind) {
+    case QNAV_POLICY_PROB:
+        if (cap < 6u) {
             return QNAV_LINK_E_SPACE;
         }
         out[0] = QNAV_POLICY_PROB;
         out[1] = 0u;
         put_u16(&out[2], as_u16(policy->u.prob.k_goal));
         put_u16(&out[4], as_u16(policy->u.prob.k_safe));
-        return (int32_t)need;
+        return 6;
+    case QNAV_POLICY_NET:
+        return net_to_blob(&policy->u.net, out, cap);
     }
-    if (policy->kind != QNAV_POLICY_NET) {
+    return QNAV_LINK_E_VALUE;
+}
+
+static int32_t net_from_blob(const uint8_t *blob, uint16_t len, qnav_policy_t *p)
+{
+    uint8_t hidden = (uint8_t)(blob[1] & BLOB_NET_HIDDEN);
+    uint16_t nw;
+    uint16_t k;
+    if ((blob[1] & (uint8_t)~(BLOB_NET_HIDDEN | BLOB_NET_PREV)) != 0u || hidden < 1u ||
+        hidden > QNAV_MAX_HIDDEN) {
         return QNAV_LINK_E_VALUE;
     }
-    if (policy->u.net.hidden < 1u || policy->u.net.hidden > QNAV_MAX_HIDDEN) {
-        return QNAV_LINK_E_VALUE;
+    qnav_policy_net_zero_inputs(p, hidden, (blob[1] & BLOB_NET_PREV) != 0u
+                                               ? (uint8_t)QNAV_NET_INPUTS_PREV
+                                               : (uint8_t)QNAV_NET_INPUTS_PAPER);
+    nw = qnav_net_weight_count(&p->u.net);
+    if (len != 2u + 2u * nw) {
+        return QNAV_LINK_E_LENGTH;
     }
-    nw = (uint16_t)QNAV_NET_WEIGHTS(policy->u.net.hidden);
-    need = (uint16_t)(2u + 2u * nw);
-    if (cap < need) {
-        return QNAV_LINK_E_SPACE;
-    }
-    net = policy->u.net; /* qnav_net_weight() takes a mutable net: use a copy */
-    out[0] = QNAV_POLICY_NET;
-    out[1] = net.hidden;
     for (k = 0; k < nw; ++k) {
-        w = qnav_net_weight(&net, k);
-        if (w == NULL) {
-            return QNAV_LINK_E_VALUE;
-        }
-        put_u16(&out[2u + 2u * k], as_u16(*w));
+        *qnav_net_weight(&p->u.net, k) = as_i16(get_u16(&blob[2u + 2u * k]));
     }
-    return (int32_t)need;
+    return QNAV_LINK_OK;
 }
 
 int32_t qnav_link_policy_from_blob(const uint8_t *blob, uint16_t len, qnav_policy_t *policy)
 {
     qnav_policy_t p;
-    uint16_t nw;
-    uint16_t k;
-    qnav_q8_8_t *w;
+    int32_t rc = QNAV_LINK_E_VALUE;
 
     if (blob == NULL || policy == NULL) {
         return QNAV_LINK_E_NULL;
@@ -735,7 +754,8 @@ int32_t qnav_link_policy_from_blob(const uint8_t *blob, uint16_t len, qnav_polic
     if (len < 2u) {
         return QNAV_LINK_E_LENGTH;
     }
-    if (blob[0] == QNAV_POLICY_PROB) {
+    switch ((qnav_policy_kind_t)blob[0]) {
+    case QNAV_POLICY_PROB:
         if (len != 6u) {
             return QNAV_LINK_E_LENGTH;
         }
@@ -745,29 +765,35 @@ int32_t qnav_link_policy_from_blob(const uint8_t *blob, uint16_t len, qnav_polic
         qnav_policy_prob_default(&p);
         p.u.prob.k_goal = as_i16(get_u16(&blob[2]));
         p.u.prob.k_safe = as_i16(get_u16(&blob[4]));
-        *policy = p;
-        return QNAV_LINK_OK;
+        rc = QNAV_LINK_OK;
+        break;
+    case QNAV_POLICY_NET:
+        rc = net_from_blob(blob, len, &p);
+        break;
     }
-    if (blob[0] != QNAV_POLICY_NET) {
-        return QNAV_LINK_E_VALUE;
-    }
-    if (blob[1] < 1u || blob[1] > QNAV_MAX_HIDDEN) {
-        return QNAV_LINK_E_VALUE;
-    }
-    nw = (uint16_t)QNAV_NET_WEIGHTS(blob[1]);
-    if (len != 2u + 2u * nw) {
-        return QNAV_LINK_E_LENGTH;
-    }
-    qnav_policy_net_zero(&p, blob[1]);
-    for (k = 0; k < nw; ++k) {
-        w = qnav_net_weight(&p.u.net, k);
-        if (w == NULL) {
-            return QNAV_LINK_E_VALUE;
-        }
-        *w = as_i16(get_u16(&blob[2u + 2u * k]));
+    if (rc != QNAV_LINK_OK) {
+        return rc;
     }
     *policy = p;
     return QNAV_LINK_OK;
+}
+
+const char *qnav_link_status_str(int32_t status)
+{
+    switch (status) {
+    case QNAV_LINK_OK:
+        return "ok";
+    case QNAV_LINK_E_NULL:
+        return "a required pointer was null";
+    case QNAV_LINK_E_SPACE:
+        return "the output buffer is too small";
+    case QNAV_LINK_E_LENGTH:
+        return "payload length wrong for the message";
+    case QNAV_LINK_E_VALUE:
+        return "a field is out of its range";
+    default:
+        return status > 0 ? "ok (bytes written)" : "unknown link status";
+    }
 }
 
 void qnav_link_upload_init(qnav_link_upload_t *up)

@@ -3,8 +3,10 @@
  * text format in docs/policy-format.md. The reader works on a length-delimited buffer
  * (never relying on a terminating NUL), copies each line into a bounded local buffer after
  * checking its length, and refuses anything malformed with one "FILE:LINE: problem" line.
- * A parsed policy is finally run through qnav_ctrl_init(), so the reader accepts exactly
- * what the controller accepts.
+ * A parsed policy is finally run through qnav_policy_validate() and qnav_ctrl_init(), so
+ * the reader accepts exactly what the controller accepts. Version 1 files (two-input
+ * networks, the probabilistic policy) are read and written unchanged; version 2 adds the
+ * network's 'inputs' line for the previous-decision input.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -22,7 +24,7 @@
 #include "qnav/ctrl.h"
 
 #define MAGIC "qnav-policy"
-#define K_RAW_MAX (64L * 256L) /* 64.0 in Q8.8: largest probabilistic parameter */
+#define K_RAW_MAX ((long)QNAV_PROB_PARAM_MAX_RAW) /* 64.0 in Q8.8 */
 #define MAX_TOKENS 8           /* the longest valid line has 6 tokens */
 
 /* ---- small helpers ------------------------------------------------------------------- */
@@ -79,66 +81,104 @@ static void quote_bytes(const char *s, size_t n, size_t max, char *out, size_t o
     out[o] = '\0';
 }
 
-static const char *policy_kind_name(uint8_t kind)
+const char *qnav_policy_kind_name(uint8_t kind)
 {
-    return kind == (uint8_t)QNAV_POLICY_NET ? "network" : "probabilistic";
+    switch ((qnav_policy_kind_t)kind) {
+    case QNAV_POLICY_PROB:
+        return "probabilistic";
+    case QNAV_POLICY_NET:
+        return "network";
+    }
+    return NULL;
+}
+
+int qnav_policy_kind_from_name(const char *name, size_t len, uint8_t *kind)
+{
+    static const qnav_policy_kind_t kinds[] = {QNAV_POLICY_PROB, QNAV_POLICY_NET};
+    size_t i;
+    for (i = 0; i < sizeof kinds / sizeof kinds[0]; ++i) {
+        const char *n = qnav_policy_kind_name((uint8_t)kinds[i]);
+        if (strlen(n) == len && memcmp(n, name, len) == 0) {
+            *kind = (uint8_t)kinds[i];
+            return 0;
+        }
+    }
+    return -1;
+}
+
+int qnav_policy_file_version(const qnav_policy_t *policy)
+{
+    switch ((qnav_policy_kind_t)policy->kind) {
+    case QNAV_POLICY_PROB:
+        return 1;
+    case QNAV_POLICY_NET:
+        return policy->u.net.inputs == QNAV_NET_INPUTS_PAPER ? 1 : 2;
+    }
+    return QNAV_POLICY_FORMAT_VERSION;
 }
 
 /* ---- checks on a policy in memory ---------------------------------------------------- */
 
 int qnav_policy_check(const qnav_policy_t *policy, char *err, size_t errlen)
 {
-    if (policy == NULL) {
-        set_err(err, errlen, "no policy (null pointer)");
-        return -1;
-    }
-    if (policy->kind == (uint8_t)QNAV_POLICY_NET) {
-        if (policy->u.net.hidden < 1u || policy->u.net.hidden > QNAV_MAX_HIDDEN) {
-            set_err(err, errlen, "hidden %u outside 1..%d", (unsigned)policy->u.net.hidden,
-                    QNAV_MAX_HIDDEN);
-            return -1;
-        }
+    qnav_policy_status_t st = qnav_policy_validate(policy);
+    switch (st) {
+    case QNAV_POLICY_OK:
         return 0;
-    }
-    if (policy->kind == (uint8_t)QNAV_POLICY_PROB) {
+    case QNAV_POLICY_E_KIND:
+        set_err(err, errlen, "unknown policy kind %u", (unsigned)policy->kind);
+        return -1;
+    case QNAV_POLICY_E_HIDDEN:
+        set_err(err, errlen, "hidden %u outside 1..%d", (unsigned)policy->u.net.hidden,
+                QNAV_MAX_HIDDEN);
+        return -1;
+    case QNAV_POLICY_E_INPUTS:
+        set_err(err, errlen, "inputs %u: a network has 2 or 3 inputs",
+                (unsigned)policy->u.net.inputs);
+        return -1;
+    case QNAV_POLICY_E_PROB_PARAM:
         if (policy->u.prob.k_goal <= 0 || policy->u.prob.k_goal > K_RAW_MAX) {
             set_err(err, errlen, "k_goal %d outside (0, 64]: raw Q8.8 must be 1..%ld",
                     (int)policy->u.prob.k_goal, K_RAW_MAX);
-            return -1;
-        }
-        if (policy->u.prob.k_safe <= 0 || policy->u.prob.k_safe > K_RAW_MAX) {
+        } else {
             set_err(err, errlen, "k_safe %d outside (0, 64]: raw Q8.8 must be 1..%ld",
                     (int)policy->u.prob.k_safe, K_RAW_MAX);
-            return -1;
         }
-        return 0;
+        return -1;
+    case QNAV_POLICY_E_NULL:
+        break;
     }
-    set_err(err, errlen, "unknown policy kind %u", (unsigned)policy->kind);
+    set_err(err, errlen, "%s", qnav_policy_status_str(st));
     return -1;
 }
 
 int qnav_policy_equal(const qnav_policy_t *a, const qnav_policy_t *b)
 {
-    unsigned j;
+    uint16_t k;
+    uint16_t n;
+    qnav_net_t na;
+    qnav_net_t nb;
     if (a == NULL || b == NULL || a->kind != b->kind) {
         return 0;
     }
-    if (a->kind == (uint8_t)QNAV_POLICY_PROB) {
+    switch ((qnav_policy_kind_t)a->kind) {
+    case QNAV_POLICY_PROB:
         return a->u.prob.k_goal == b->u.prob.k_goal && a->u.prob.k_safe == b->u.prob.k_safe;
-    }
-    if (a->kind != (uint8_t)QNAV_POLICY_NET || a->u.net.hidden != b->u.net.hidden ||
-        a->u.net.hidden > QNAV_MAX_HIDDEN || a->u.net.b_out != b->u.net.b_out) {
-        return 0;
-    }
-    for (j = 0; j < a->u.net.hidden; ++j) {
-        if (a->u.net.w_theta[j] != b->u.net.w_theta[j] ||
-            a->u.net.w_dist[j] != b->u.net.w_dist[j] ||
-            a->u.net.b_hidden[j] != b->u.net.b_hidden[j] ||
-            a->u.net.w_out[j] != b->u.net.w_out[j]) {
+    case QNAV_POLICY_NET:
+        na = a->u.net;
+        nb = b->u.net;
+        n = qnav_net_weight_count(&na);
+        if (n == 0 || na.hidden != nb.hidden || na.inputs != nb.inputs) {
             return 0;
         }
+        for (k = 0; k < n; ++k) {
+            if (*qnav_net_weight(&na, k) != *qnav_net_weight(&nb, k)) {
+                return 0;
+            }
+        }
+        return 1;
     }
-    return 1;
+    return 0;
 }
 
 /* ---- metadata ------------------------------------------------------------------------ */
@@ -264,6 +304,8 @@ typedef struct {
     unsigned long kind_line;
     unsigned long qformat_line;
     unsigned long hidden_line;
+    unsigned long inputs_line;
+    long version;       /* format version of line 1 */
     unsigned long b_out_line;
     unsigned long k_goal_line;
     unsigned long k_safe_line;
@@ -365,21 +407,22 @@ static int line_magic(parser_t *ps, const token_t *tok, size_t ntok)
     long v = 0;
     char q[80];
     if (ntok == 0 || !tok_is(&tok[0], MAGIC)) {
-        return fail(ps, "not a qnav policy file: line 1 must be 'qnav-policy %d'",
-                    QNAV_POLICY_FORMAT_VERSION);
+        return fail(ps, "not a qnav policy file: line 1 must be 'qnav-policy %d' (or %d)",
+                    QNAV_POLICY_FORMAT_VERSION_MIN, QNAV_POLICY_FORMAT_VERSION);
     }
     if (ntok != 2) {
         return fail(ps, "line 1 must be 'qnav-policy %d' (two tokens, found %zu)",
-                    QNAV_POLICY_FORMAT_VERSION, ntok);
+                    QNAV_POLICY_FORMAT_VERSION_MIN, ntok);
     }
     quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
     if (parse_int(&tok[1], &v) != 0) {
         return fail(ps, "format version '%s' is not an integer", q);
     }
-    if (v != QNAV_POLICY_FORMAT_VERSION) {
-        return fail(ps, "unsupported format version %s (this reader reads version %d)", q,
-                    QNAV_POLICY_FORMAT_VERSION);
+    if (v < QNAV_POLICY_FORMAT_VERSION_MIN || v > QNAV_POLICY_FORMAT_VERSION) {
+        return fail(ps, "unsupported format version %s (this reader reads versions %d..%d)", q,
+                    QNAV_POLICY_FORMAT_VERSION_MIN, QNAV_POLICY_FORMAT_VERSION);
     }
+    ps->version = v;
     return 0;
 }
 
@@ -387,15 +430,18 @@ static int line_unit(parser_t *ps, const token_t *tok, size_t ntok)
 {
     long j = 0;
     unsigned h = ps->pol.u.net.hidden;
+    size_t nw = (size_t)ps->pol.u.net.inputs + 2u;
     char q[80];
     char what[32];
-    qnav_q8_8_t w[4];
     size_t k;
     if (ps->hidden_line == 0) {
         return fail(ps, "'unit' before 'hidden'");
     }
+    if (ps->version >= 2 && ps->inputs_line == 0) {
+        return fail(ps, "'unit' before 'inputs' (version 2 names a network's inputs)");
+    }
     if (ntok < 2) {
-        return fail(ps, "'unit' needs an index and 4 weights");
+        return fail(ps, "'unit' needs an index and %zu weights", nw);
     }
     quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
     if (parse_int(&tok[1], &j) != 0) {
@@ -410,20 +456,20 @@ static int line_unit(parser_t *ps, const token_t *tok, size_t ntok)
     if ((unsigned)j > ps->next_unit) {
         return fail(ps, "unit %ld out of order: expected unit %u", j, ps->next_unit);
     }
-    if (ntok != 6) {
-        return fail(ps, "unit %ld: expected 4 weights (w_theta w_dist b_hidden w_out), found %zu",
-                    j, ntok - 2);
+    if (ntok != 2 + nw) {
+        return fail(ps, "unit %ld: expected %zu weights (%s), found %zu", j, nw,
+                    nw == 4u ? "w_theta w_dist b_hidden w_out"
+                             : "w_theta w_dist w_prev b_hidden w_out",
+                    ntok - 2);
     }
     (void)snprintf(what, sizeof what, "unit %ld: ", j);
-    for (k = 0; k < 4; ++k) {
-        if (parse_q88(ps, &tok[2 + k], what, &w[k]) != 0) {
+    for (k = 0; k < nw; ++k) {
+        /* the file's order is the flat weight order of qnav_net_weight() */
+        if (parse_q88(ps, &tok[2 + k], what, qnav_net_weight(&ps->pol.u.net,
+                                                             (uint16_t)((size_t)j * nw + k))) != 0) {
             return -1;
         }
     }
-    ps->pol.u.net.w_theta[j] = w[0];
-    ps->pol.u.net.w_dist[j] = w[1];
-    ps->pol.u.net.b_hidden[j] = w[2];
-    ps->pol.u.net.w_out[j] = w[3];
     ps->unit_line[j] = ps->line;
     ps->next_unit++;
     return 0;
@@ -485,9 +531,13 @@ static int line_end(parser_t *ps, size_t ntok)
     if (ps->qformat_line == 0) {
         return fail(ps, "missing 'qformat'");
     }
-    if (ps->pol.kind == (uint8_t)QNAV_POLICY_NET) {
+    switch ((qnav_policy_kind_t)ps->pol.kind) {
+    case QNAV_POLICY_NET:
         if (ps->hidden_line == 0) {
             return fail(ps, "missing 'hidden'");
+        }
+        if (ps->version >= 2 && ps->inputs_line == 0) {
+            return fail(ps, "missing 'inputs'");
         }
         if (ps->next_unit < ps->pol.u.net.hidden) {
             return fail(ps, "missing unit %u (hidden %u needs units 0..%u)", ps->next_unit,
@@ -496,19 +546,22 @@ static int line_end(parser_t *ps, size_t ntok)
         if (ps->b_out_line == 0) {
             return fail(ps, "missing 'b_out'");
         }
-    } else {
+        break;
+    case QNAV_POLICY_PROB:
         if (ps->k_goal_line == 0) {
             return fail(ps, "missing 'k_goal'");
         }
         if (ps->k_safe_line == 0) {
             return fail(ps, "missing 'k_safe'");
         }
+        break;
     }
     /* final word to the controller: the file is good exactly when init accepts it */
     qnav_ctrl_config_default(&cfg);
     st = qnav_ctrl_init(&ctrl, &cfg, &ps->pol);
     if (st != QNAV_OK) {
-        return fail(ps, "policy refused by qnav_ctrl_init (status %d)", (int)st);
+        return fail(ps, "policy refused by qnav_ctrl_init: %s (status %d)", qnav_status_str(st),
+                    (int)st);
     }
     return 0;
 }
@@ -530,13 +583,12 @@ static int line_key(parser_t *ps, const char *body, size_t blen, const token_t *
         if (want_values(ps, ntok, 1, "kind") != 0) {
             return -1;
         }
-        if (tok_is(&tok[1], "network")) {
-            ps->pol.kind = (uint8_t)QNAV_POLICY_NET;
-        } else if (tok_is(&tok[1], "probabilistic")) {
-            ps->pol.kind = (uint8_t)QNAV_POLICY_PROB;
-        } else {
+        if (qnav_policy_kind_from_name(tok[1].p, tok[1].n, &ps->pol.kind) != 0) {
             quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
             return fail(ps, "unknown kind '%s' (expected 'network' or 'probabilistic')", q);
+        }
+        if (ps->pol.kind == (uint8_t)QNAV_POLICY_NET) {
+            ps->pol.u.net.inputs = QNAV_NET_INPUTS_PAPER; /* version 2 may say 3 */
         }
         ps->kind_line = ps->line;
         return 0;
@@ -561,6 +613,26 @@ static int line_key(parser_t *ps, const char *body, size_t blen, const token_t *
     }
     if (tok_is(key, "end")) {
         return line_end(ps, ntok);
+    }
+    if (tok_is(key, "inputs") && ps->version >= 2) {
+        long n = 0;
+        if (!net) {
+            return fail(ps, "'inputs' is not a key of kind probabilistic");
+        }
+        if (once(ps, &ps->inputs_line, "inputs") != 0 ||
+            want_values(ps, ntok, 1, "inputs") != 0) {
+            return -1;
+        }
+        if (ps->next_unit != 0) {
+            return fail(ps, "'inputs' after the first 'unit'");
+        }
+        quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
+        if (parse_int(&tok[1], &n) != 0 ||
+            (n != (long)QNAV_NET_INPUTS_PAPER && n != (long)QNAV_NET_INPUTS_PREV)) {
+            return fail(ps, "inputs '%s': a network has 2 or 3 inputs", q);
+        }
+        ps->pol.u.net.inputs = (uint8_t)n;
+        return 0;
     }
     if (tok_is(key, "hidden") || tok_is(key, "unit") || tok_is(key, "b_out")) {
         if (!net) {
@@ -884,6 +956,33 @@ static void emit_comment(out_t *o, const char *c)
     } while (i < n);
 }
 
+/* A network's unit lines (the flat weight order) and b_out. */
+static void emit_net(out_t *o, const qnav_net_t *net)
+{
+    qnav_net_t n = *net;
+    size_t per = (size_t)n.inputs + 2u;
+    size_t j;
+    size_t k;
+    emit(o, "%s", per == 4u
+                      ? "# unit j  w_theta  w_dist b_hidden   w_out   (raw Q8.8 = value * 256)\n"
+                      : "# unit j  w_theta  w_dist  w_prev b_hidden   w_out   (raw Q8.8 = value * 256)\n");
+    for (j = 0; j < n.hidden; ++j) {
+        emit(o, "unit %2zu ", j);
+        for (k = 0; k < per; ++k) {
+            emit(o, " %*d", k == per - 2u ? 8 : 7, /* b_hidden's column is wider */
+                 (int)*qnav_net_weight(&n, (uint16_t)(j * per + k)));
+        }
+        emit(o, "   #");
+        for (k = 0; k < per; ++k) {
+            emit_real(o, *qnav_net_weight(&n, (uint16_t)(j * per + k)));
+        }
+        emit(o, "\n");
+    }
+    emit(o, "b_out %d   #", (int)n.b_out);
+    emit_real(o, n.b_out);
+    emit(o, "\n");
+}
+
 int qnav_policy_format(const qnav_policy_t *policy, const qnav_policy_meta_t *meta,
                        const char *comment, char *buf, size_t buflen, char *err,
                        size_t errlen)
@@ -930,39 +1029,32 @@ int qnav_policy_format(const qnav_policy_t *policy, const qnav_policy_meta_t *me
     if (buf != NULL && buflen > 0) {
         buf[0] = '\0';
     }
-    emit(&o, "%s %d\n", MAGIC, QNAV_POLICY_FORMAT_VERSION);
+    emit(&o, "%s %d\n", MAGIC, qnav_policy_file_version(policy));
     if (comment != NULL) {
         emit_comment(&o, comment);
     }
-    emit(&o, "kind %s\n", policy_kind_name(policy->kind));
+    emit(&o, "kind %s\n", qnav_policy_kind_name(policy->kind));
     emit(&o, "qformat Q8.8\n");
     if (policy->kind == (uint8_t)QNAV_POLICY_NET) {
         emit(&o, "hidden %u\n", (unsigned)policy->u.net.hidden);
+        if (qnav_policy_file_version(policy) >= 2) {
+            emit(&o, "inputs %u\n", (unsigned)policy->u.net.inputs);
+        }
     }
     for (i = 0; meta != NULL && i < meta->count; ++i) {
         emit(&o, "meta %s %s\n", meta->entry[i].name, meta->entry[i].value);
     }
-    if (policy->kind == (uint8_t)QNAV_POLICY_NET) {
-        const qnav_net_t *n = &policy->u.net;
-        emit(&o, "# unit j  w_theta  w_dist b_hidden   w_out   (raw Q8.8 = value * 256)\n");
-        for (i = 0; i < n->hidden; ++i) {
-            emit(&o, "unit %2zu  %7d %7d %8d %7d   #", i, (int)n->w_theta[i],
-                 (int)n->w_dist[i], (int)n->b_hidden[i], (int)n->w_out[i]);
-            emit_real(&o, n->w_theta[i]);
-            emit_real(&o, n->w_dist[i]);
-            emit_real(&o, n->b_hidden[i]);
-            emit_real(&o, n->w_out[i]);
-            emit(&o, "\n");
-        }
-        emit(&o, "b_out %d   #", (int)n->b_out);
-        emit_real(&o, n->b_out);
-        emit(&o, "\n");
-    } else {
+    switch ((qnav_policy_kind_t)policy->kind) {
+    case QNAV_POLICY_NET:
+        emit_net(&o, &policy->u.net);
+        break;
+    case QNAV_POLICY_PROB:
         emit(&o, "k_goal %d   #", (int)policy->u.prob.k_goal);
         emit_real(&o, policy->u.prob.k_goal);
         emit(&o, "\nk_safe %d   #", (int)policy->u.prob.k_safe);
         emit_real(&o, policy->u.prob.k_safe);
         emit(&o, "\n");
+        break;
     }
     emit(&o, "end\n");
     return (int)o.len;

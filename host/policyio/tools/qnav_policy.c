@@ -26,7 +26,7 @@
 static const char *const usage_text =
     "usage: qnav-policy check FILE\n"
     "       qnav-policy show FILE\n"
-    "       qnav-policy new --kind probabilistic|network [--hidden H] [--seed S] OUT\n"
+    "       qnav-policy new --kind probabilistic|network [--hidden H] [--inputs 2|3] [--seed S] OUT\n"
     "       qnav-policy header --mode network|probabilistic|table --name NAME IN OUT.h\n"
     "Policy files are described in docs/policy-format.md.\n";
 
@@ -127,14 +127,26 @@ static int cmd_show(int argc, char **argv)
         printf("k_safe: %s  (P_safe = 1 - exp(-k_safe * level / (levels - 1)))\n", b);
         return 0;
     }
-    printf("kind: network\nhidden: %u\n", (unsigned)p.u.net.hidden);
-    printf("%4s %14s %14s %14s %14s\n", "unit", "w_theta", "w_dist", "b_hidden", "w_out");
+    printf("kind: network\nhidden: %u\ninputs: %u\n", (unsigned)p.u.net.hidden,
+           (unsigned)p.u.net.inputs);
+    if (p.u.net.inputs == QNAV_NET_INPUTS_PREV) {
+        printf("%4s %14s %14s %14s %14s %14s\n", "unit", "w_theta", "w_dist", "w_prev",
+               "b_hidden", "w_out");
+    } else {
+        printf("%4s %14s %14s %14s %14s\n", "unit", "w_theta", "w_dist", "b_hidden", "w_out");
+    }
     for (i = 0; i < p.u.net.hidden; ++i) {
         q88_text(p.u.net.w_theta[i], a, sizeof a);
         q88_text(p.u.net.w_dist[i], b, sizeof b);
         q88_text(p.u.net.b_hidden[i], c, sizeof c);
         q88_text(p.u.net.w_out[i], d, sizeof d);
-        printf("%4zu %14s %14s %14s %14s\n", i, a, b, c, d);
+        if (p.u.net.inputs == QNAV_NET_INPUTS_PREV) {
+            char e[32];
+            q88_text(p.u.net.w_prev[i], e, sizeof e);
+            printf("%4zu %14s %14s %14s %14s %14s\n", i, a, b, e, c, d);
+        } else {
+            printf("%4zu %14s %14s %14s %14s\n", i, a, b, c, d);
+        }
     }
     q88_text(p.u.net.b_out, a, sizeof a);
     printf("b_out: %s\n", a);
@@ -164,7 +176,9 @@ static int cmd_new(int argc, char **argv)
     static const struct option opts[] = {{"kind", required_argument, NULL, 'k'},
                                          {"hidden", required_argument, NULL, 'H'},
                                          {"seed", required_argument, NULL, 's'},
+                                         {"inputs", required_argument, NULL, 'i'},
                                          {NULL, 0, NULL, 0}};
+    uint64_t inputs = QNAV_NET_INPUTS_PAPER;
     const char *kind = NULL;
     uint64_t hidden = QNAV_DEFAULT_HIDDEN;
     uint64_t seed = 1;
@@ -181,6 +195,13 @@ static int cmd_new(int argc, char **argv)
         switch (opt) {
         case 'k':
             kind = optarg;
+            break;
+        case 'i':
+            if (parse_u64(optarg, 255, &inputs) != 0 ||
+                (inputs != QNAV_NET_INPUTS_PAPER && inputs != QNAV_NET_INPUTS_PREV)) {
+                return usage_error("new: --inputs '%s' must be 2 or 3", optarg);
+            }
+            have_hidden = 1; /* a network option, like --hidden */
             break;
         case 'H':
             if (parse_u64(optarg, 255, &hidden) != 0 || hidden < 1 ||
@@ -211,7 +232,7 @@ static int cmd_new(int argc, char **argv)
     qnav_policy_meta_clear(&meta);
     if (strcmp(kind, "probabilistic") == 0) {
         if (have_hidden || have_seed) {
-            return usage_error("new: --hidden and --seed apply to --kind network only");
+            return usage_error("new: --hidden, --inputs and --seed apply to --kind network only");
         }
         qnav_policy_prob_default(&p);
         (void)qnav_policy_meta_set(&meta, "source", "qnav-policy new --kind probabilistic",
@@ -219,12 +240,19 @@ static int cmd_new(int argc, char **argv)
     } else if (strcmp(kind, "network") == 0) {
         uint64_t state = seed;
         uint16_t k;
-        qnav_policy_net_zero(&p, (uint8_t)hidden);
-        for (k = 0; k < QNAV_NET_WEIGHTS(hidden); ++k) {
+        qnav_policy_net_zero_inputs(&p, (uint8_t)hidden, (uint8_t)inputs);
+        for (k = 0; k < qnav_net_weight_count(&p.u.net); ++k) {
             *qnav_net_weight(&p.u.net, k) = random_weight(&state);
         }
-        (void)snprintf(src, sizeof src, "qnav-policy new --kind network --hidden %u --seed %llu",
-                       (unsigned)hidden, (unsigned long long)seed);
+        if (inputs == QNAV_NET_INPUTS_PAPER) {
+            (void)snprintf(src, sizeof src,
+                           "qnav-policy new --kind network --hidden %u --seed %llu",
+                           (unsigned)hidden, (unsigned long long)seed);
+        } else {
+            (void)snprintf(src, sizeof src,
+                           "qnav-policy new --kind network --hidden %u --inputs 3 --seed %llu",
+                           (unsigned)hidden, (unsigned long long)seed);
+        }
         (void)qnav_policy_meta_set(&meta, "source", src, NULL, 0);
     } else {
         return usage_error("new: --kind '%s' must be 'probabilistic' or 'network'", kind);
@@ -456,10 +484,19 @@ static int header_body(int argc, char **argv, const char *cmd)
         qnav_qkey_t *table = (qnav_qkey_t *)malloc(sizeof(qnav_qkey_t) * QNAV_QTABLE_ENTRIES);
         unsigned level;
         unsigned d;
+        qnav_status_t st = QNAV_E_NULL;
         qnav_ctrl_config_default(&cfg);
-        if (table == NULL || qnav_ctrl_init(&ctrl, &cfg, &p) != QNAV_OK ||
-            qnav_ctrl_build_table(&ctrl, table) != QNAV_OK) {
-            fprintf(stderr, "%s: cannot build the quality table\n", in);
+        if (table != NULL) {
+            st = qnav_ctrl_init(&ctrl, &cfg, &p);
+        }
+        if (st == QNAV_OK) {
+            st = qnav_ctrl_build_table(&ctrl, table);
+        }
+        if (st != QNAV_OK) {
+            fprintf(stderr, "%s: cannot build the quality table: %s%s\n", in, qnav_status_str(st),
+                    st == QNAV_E_NO_TABLE ? " (use --mode network: the board then evaluates "
+                                            "every path, docs/performance.md)"
+                                          : "");
             free(table);
             free(t.p);
             return EXIT_FAILED;
@@ -497,8 +534,10 @@ static int header_body(int argc, char **argv, const char *cmd)
         put(&t, "static const qnav_policy_t %s = {\n", name);
         put(&t, "    .kind = (uint8_t)QNAV_POLICY_NET,\n    .u = {\n        .net = {\n");
         put(&t, "            .hidden = %u,\n", (unsigned)n->hidden);
+        put(&t, "            .inputs = %u,\n", (unsigned)n->inputs);
         put_array(&t, "w_theta", n->w_theta, n->hidden, 0);
         put_array(&t, "w_dist", n->w_dist, n->hidden, 0);
+        put_array(&t, "w_prev", n->w_prev, n->hidden, 0);
         put_array(&t, "b_hidden", n->b_hidden, n->hidden, 0);
         put_array(&t, "w_out", n->w_out, n->hidden, 0);
         put(&t, "            .b_out = %d\n        }\n    }\n};\n", (int)n->b_out);

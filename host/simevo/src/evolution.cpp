@@ -23,6 +23,9 @@ const char *evolution_params_problem(const EvolutionParams &p)
     if (p.hidden < 1 || p.hidden > QNAV_MAX_HIDDEN) {
         return "hidden: must be 1.." QNAV_SIMEVO_STR(QNAV_MAX_HIDDEN) " (QNAV_MAX_HIDDEN)";
     }
+    if (p.inputs != QNAV_NET_INPUTS_PAPER && p.inputs != QNAV_NET_INPUTS_PREV) {
+        return "inputs: must be 2 or 3";
+    }
     if (!(p.mutation_scale > 0.0 && p.mutation_scale <= 128.0)) {
         return "mutation_scale: must be in (0, 128]";
     }
@@ -51,7 +54,7 @@ qnav_q8_8_t to_q8_8_saturated(double raw)
     return static_cast<qnav_q8_8_t>(r);
 }
 
-uint16_t weight_count(const qnav_net_t &net) { return static_cast<uint16_t>(QNAV_NET_WEIGHTS(net.hidden)); }
+uint16_t weight_count(const qnav_net_t &net) { return qnav_net_weight_count(&net); }
 } // namespace
 
 void mutate_network(qnav_net_t &net, Rng &rng, double scale, double clip)
@@ -70,6 +73,9 @@ uint32_t policy_fingerprint(const qnav_policy_t &policy)
     if (policy.kind == QNAV_POLICY_NET) {
         qnav_net_t net = policy.u.net;
         h = fnv1a64(&net.hidden, 1, h);
+        if (net.inputs != QNAV_NET_INPUTS_PAPER) {
+            h = fnv1a64(&net.inputs, 1, h); /* 2-input fingerprints stay as they were */
+        }
         const uint16_t n = weight_count(net);
         for (uint16_t k = 0; k < n; ++k) {
             const int16_t w = *qnav_net_weight(&net, k);
@@ -89,7 +95,8 @@ Evolution::Evolution(const EvolutionParams &params, uint64_t seed)
       best_so_far_(-std::numeric_limits<double>::infinity())
 {
     for (Member &m : pop_) {
-        qnav_policy_net_zero(&m.policy, static_cast<uint8_t>(params_.hidden));
+        qnav_policy_net_zero_inputs(&m.policy, static_cast<uint8_t>(params_.hidden),
+                                    static_cast<uint8_t>(params_.inputs));
         qnav_net_t &net = m.policy.u.net;
         const uint16_t n = weight_count(net);
         for (uint16_t k = 0; k < n; ++k) {

@@ -54,6 +54,7 @@ struct EvolutionParams {
     uint32_t population = 40;      /* members, >= 2 */
     double epsilon = 0.1;          /* probability of mutating a random member, [0, 1] */
     uint32_t hidden = 12;          /* hidden units of new networks, 1..QNAV_MAX_HIDDEN */
+    uint32_t inputs = 2;           /* network inputs: 2 (paper) or 3 (previous decision, §5) */
     double mutation_scale = 0.3;   /* Cauchy scale, weight units (assumed; paper: none) */
     double mutation_clip = 10.0;   /* Cauchy samples clipped to [-clip, clip] (paper) */
     uint32_t episodes_per_candidate = 1; /* episodes averaged into one fitness value (paper:

@@ -258,26 +258,53 @@ std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &e
                                        mix_seed(run_seed, label_hash("episodes:" + label))));
                 src_index = static_cast<int>(tasks.size() - 1);
             }
-            TaskDef tr = evolve("transfer-" + s.label, spec.target, spec.target_episodes, target_episodes_base);
+            TaskDef tr = evolve(condition_label(ConditionKind::Transfer, s.label), spec.target, spec.target_episodes, target_episodes_base);
             tr.source_task = src_index;
             tr.source_policy_file = s.policy_file;
             held_out(tr);
             tasks.push_back(tr);
         }
-        TaskDef d = evolve("direct", spec.target, spec.target_episodes, target_episodes_base);
+        TaskDef d = evolve(condition_label(ConditionKind::Direct), spec.target, spec.target_episodes, target_episodes_base);
         held_out(d);
         tasks.push_back(d);
     }
     TaskDef p;
     p.kind = TaskKind::EvalProbabilistic;
-    p.label = "probabilistic";
-    p.dir = join_path(exp_dir, "probabilistic");
+    p.label = condition_label(ConditionKind::Probabilistic);
+    p.dir = join_path(exp_dir, p.label);
     p.scenario = spec.target;
     p.context_seed = spec.seed;
     p.eval_episodes = spec.eval_episodes;
     p.eval_seed_base = eval_base;
     tasks.push_back(p);
     return tasks;
+}
+
+/* ---- conditions ------------------------------------------------------------------ */
+
+const ConditionDecl kConditions[3] = {
+    {ConditionKind::Transfer, "transfer-", true},
+    {ConditionKind::Direct, "direct", true},
+    {ConditionKind::Probabilistic, "probabilistic", false},
+};
+
+const ConditionDecl &condition_decl(ConditionKind kind)
+{
+    switch (kind) {
+    case ConditionKind::Transfer:
+        return kConditions[0];
+    case ConditionKind::Direct:
+        return kConditions[1];
+    case ConditionKind::Probabilistic:
+        return kConditions[2];
+    }
+    return kConditions[1];
+}
+
+std::string condition_label(ConditionKind kind, const std::string &source)
+{
+    const ConditionDecl &d = condition_decl(kind);
+    return kind == ConditionKind::Transfer ? std::string(d.label) + source : std::string(d.label);
 }
 
 /* ---- pool ------------------------------------------------------------------------ */
@@ -543,8 +570,8 @@ ConditionSummary summarize_condition(const ExperimentSpec &spec, const std::vect
 ConditionSummary summarize_probabilistic(const std::vector<TaskDef> &tasks)
 {
     ConditionSummary prob;
-    prob.label = "probabilistic";
     prob.kind = ConditionKind::Probabilistic;
+    prob.label = condition_label(prob.kind);
     for (const TaskDef &t : tasks) {
         if (t.kind != TaskKind::EvalProbabilistic) {
             continue;
@@ -595,12 +622,11 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
     S.k = spec.evolution.episodes_per_candidate;
     S.arrival_threshold = spec.arrival_threshold;
     S.checkpoint_episodes = spec.checkpoint_episodes;
-    // The conditions evolved in the target: one transfer per source, then direct.
-    std::vector<std::pair<std::string, ConditionKind>> labels;
+    std::vector<std::pair<ConditionKind, std::string>> labels;
     for (const SourceSpec &s : spec.sources) {
-        labels.emplace_back("transfer-" + s.label, ConditionKind::Transfer);
+        labels.emplace_back(ConditionKind::Transfer, condition_label(ConditionKind::Transfer, s.label));
     }
-    labels.emplace_back("direct", ConditionKind::Direct);
+    labels.emplace_back(ConditionKind::Direct, condition_label(ConditionKind::Direct));
     TaskDef probe;
     probe.episodes = spec.target_episodes;
     probe.evolution = spec.evolution;
@@ -610,8 +636,8 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
     for (uint64_t lo = 0; lo < steps; lo += steps_per_bin) {
         S.bin_end.push_back(std::min(lo + steps_per_bin, steps) * S.k);
     }
-    for (const auto &lk : labels) {
-        S.conditions.push_back(summarize_condition(spec, tasks, lk.first, lk.second, S, steps, steps_per_bin));
+    for (const auto &kl : labels) {
+        S.conditions.push_back(summarize_condition(spec, tasks, kl.second, kl.first, S, steps, steps_per_bin));
     }
     S.conditions.push_back(summarize_probabilistic(tasks));
     const ConditionSummary &prob = S.conditions.back();
@@ -623,8 +649,8 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
         compare_checkpoints(c, direct, spec.target_episodes);
         Comparison cmp;
         cmp.a = c.label;
-        cmp.b = "direct";
-        cmp.b_kind = ConditionKind::Direct;
+        cmp.b = direct.label;
+        cmp.b_kind = direct.kind;
         cmp.difference = c.final_mean - direct.final_mean;
         cmp.improvement_pct = pct(c.final_mean, direct.final_mean);
         cmp.speedup_pct = (c.episodes_to_90 > 0 && direct.episodes_to_90 > 0)
@@ -641,8 +667,8 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
         const ConditionSummary &c = S.conditions[i];
         Comparison cmp;
         cmp.a = c.label;
-        cmp.b = "probabilistic";
-        cmp.b_kind = ConditionKind::Probabilistic;
+        cmp.b = prob.label;
+        cmp.b_kind = prob.kind;
         cmp.difference = c.final_mean - prob.final_mean;
         cmp.improvement_pct = pct(c.final_mean, prob.final_mean);
         cmp.speedup_pct = std::nan("");
@@ -679,9 +705,9 @@ std::string quality_csv(const ExperimentSummary &S, const std::string &exp_dir, 
                         const qnav_policy_t &prob)
 {
     std::vector<std::pair<std::string, qnav_policy_t>> policies;
-    policies.emplace_back("probabilistic", prob);
+    policies.emplace_back(condition_label(ConditionKind::Probabilistic), prob);
     for (const ConditionSummary &c : S.conditions) {
-        if (c.kind == ConditionKind::Probabilistic || c.best_run < 0) {
+        if (!condition_decl(c.kind).evolved || c.best_run < 0) {
             continue;
         }
         const std::string path = join_path(join_path(run_dir(exp_dir, static_cast<uint32_t>(c.best_run)), c.label), "best.policy");
@@ -736,7 +762,7 @@ std::string episodes_csv(const ExperimentSummary &S, const std::string &exp_dir,
     for (const ConditionSummary &c : S.conditions) {
         qnav_policy_t policy = runner.probabilistic_policy();
         std::string name = c.label;
-        if (c.kind != ConditionKind::Probabilistic) {
+        if (condition_decl(c.kind).evolved) {
             if (c.best_run < 0) {
                 continue;
             }
@@ -789,7 +815,7 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
           << (c.episodes_to_90 > 0 ? json_num(c.episodes_to_90) : "null")
           << ", \"reached_rate\": " << json_num(c.reached_rate) << ", \"arrival\": " << json_interval(c.arrival)
           << ", \"tau_c\": " << json_interval(c.tau_c) << json_checkpoints(c)
-          << ", \"online_mean\": " << json_num(c.kind == ConditionKind::Probabilistic ? std::nan("") : c.online_mean) << ", \"best_run\": " << (c.best_run + 1) << "}"
+          << ", \"online_mean\": " << json_num(!condition_decl(c.kind).evolved ? std::nan("") : c.online_mean) << ", \"best_run\": " << (c.best_run + 1) << "}"
           << (i + 1 < S.conditions.size() ? "," : "") << "\n";
     }
     o << "  ],\n  \"comparisons\": [\n";

@@ -65,16 +65,26 @@ struct CheckpointSummary {
     TestResult arrival_vs_direct;     /* Mann-Whitney on the arrival fractions */
 };
 
-/* What a condition is: the summary dispatches on this, never on its label's text. */
+/* The conditions an experiment compares, declared once (docs/simevo.md): what each is
+ * and its label. Code asks a condition its kind, never compares label strings. */
 enum class ConditionKind {
-    Transfer,      /* "transfer-<source label>": seeded from a source's best */
-    Direct,        /* "direct": a random initial population in the target */
-    Probabilistic  /* "probabilistic": the hand-tuned policy, held out only */
+    Transfer,      /* evolved in the target from a source's best ("transfer-SOURCE") */
+    Direct,        /* evolved in the target from a random population */
+    Probabilistic  /* the hand-tuned probabilistic policy: a reference, not evolved */
 };
+struct ConditionDecl {
+    ConditionKind kind;
+    const char *label;   /* the label, or its prefix for Transfer */
+    bool evolved;        /* has runs, learning curves and checkpoints */
+};
+extern const ConditionDecl kConditions[3];
+const ConditionDecl &condition_decl(ConditionKind kind);
+/* "transfer-" + source, "direct", "probabilistic". */
+std::string condition_label(ConditionKind kind, const std::string &source = std::string());
 
 struct ConditionSummary {
-    std::string label;               /* "transfer-open", "direct", "probabilistic" */
     ConditionKind kind = ConditionKind::Direct;
+    std::string label;               /* condition_label(kind, source) */
     std::vector<double> final_per_run; /* held-out mean R per run (probabilistic: per episode) */
     double final_mean = 0, final_ci = 0, final_sd = 0;
     std::vector<double> curve_mean, curve_ci; /* candidates' R: per bin, mean over runs */
@@ -108,7 +118,7 @@ struct ConditionSummary {
 
 struct Comparison {
     std::string a, b;
-    ConditionKind b_kind = ConditionKind::Direct; /* Direct (runs vs runs) or Probabilistic */
+    ConditionKind b_kind = ConditionKind::Direct; /* what b is */
     double difference = 0;       /* mean_a - mean_b, R units */
     double improvement_pct = 0;  /* (mean_a - mean_b) / |mean_b| * 100; NaN when
                                     |mean_b| < 1 (a percentage of almost nothing) */

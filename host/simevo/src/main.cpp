@@ -369,7 +369,7 @@ int main(int argc, char **argv)
                 }
                 // Label: the last two path components (run folders all hold "best.policy"),
                 // made unique with a number when needed.
-                std::string label = "probabilistic";
+                std::string label = condition_label(ConditionKind::Probabilistic);
                 if (arg != "prob") {
                     const std::size_t last = arg.find_last_of('/');
                     const std::size_t prev = last == std::string::npos || last == 0 ? std::string::npos

@@ -3,6 +3,8 @@
  */
 #include "sim_runner.h"
 
+#include "qnav/nav.h"
+
 #include <cstring>
 
 
@@ -68,10 +70,16 @@ SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t conte
     if (qnav_sim_create(robot, env, &cfg, &sim_, err, sizeof err) != QNAV_SIM_OK) {
         throw UserError(std::string("simulator (") + scenario.describe() + "): " + err);
     }
-    qnav_sim_ctrl_config(sim_, &ctrl_cfg_);
-    if (scenario.controller == ControllerReading::Literal) {
-        qnav_ctrl_config_literal(&ctrl_cfg_);
+    /* the reading is a row of libqnav's controller table: its adjust hook (literal:
+     * qnav_ctrl_config_literal) gives the configuration every episode uses */
+    qnav_ctrl_config_t shared;
+    qnav_sim_ctrl_config(sim_, &shared);
+    const qnav_nav_method_t *m = qnav_nav_find(controller_reading_name(scenario.controller));
+    if (m == nullptr || !m->uses_policy) {
+        throw UserError(std::string("controller ") + controller_reading_name(scenario.controller) +
+                        ": not a policy controller of libqnav's table");
     }
+    qnav_nav_config(m, &shared, &ctrl_cfg_);
     qnav_sim_robot_prob_policy(robot, &prob_);
 }
 
@@ -111,7 +119,8 @@ EpisodeOutcome SimRunner::run_traced(const qnav_policy_t &policy, uint64_t episo
         throw UserError("controller: qnav_ctrl_init refused the policy (status " +
                         std::to_string(static_cast<int>(st)) + ")");
     }
-    if (use_table_ && policy.kind == QNAV_POLICY_NET) {
+    /* a 3-input network has no table (its key depends on the previous heading too) */
+    if (use_table_ && policy.kind == QNAV_POLICY_NET && policy.u.net.inputs == QNAV_NET_INPUTS_PAPER) {
         const qnav_qkey_t *table = table_for(ctrl, policy);
         if (!table || qnav_ctrl_init_table(&ctrl, &ctrl_cfg_, table, qnav_ctrl_rank(&ctrl)) != QNAV_OK) {
             throw UserError("controller: could not compile the policy into a quality table");

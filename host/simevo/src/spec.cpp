@@ -225,7 +225,7 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
 {
     if (auto *n = root.get("evolution")) {
         const toml::table &t = p.table(*n, "evolution");
-        p.only_keys(t, {"population", "epsilon", "hidden", "mutation_scale", "mutation_clip",
+        p.only_keys(t, {"population", "epsilon", "hidden", "inputs", "mutation_scale", "mutation_clip",
                         "episodes_per_candidate", "reevaluate_parent", "init", "init_scale",
                         "fitness", "controller"},
                     "evolution");
@@ -238,6 +238,10 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
         }
         if (auto *v = t.get("hidden")) {
             e.hidden = static_cast<uint32_t>(p.integer(*v, "hidden", 1, QNAV_MAX_HIDDEN));
+        }
+        if (auto *v = t.get("inputs")) {
+            e.inputs = static_cast<uint32_t>(p.integer(*v, "inputs", QNAV_NET_INPUTS_PAPER,
+                                                       QNAV_NET_INPUTS_PREV));
         }
         if (auto *v = t.get("mutation_scale")) {
             e.mutation_scale = p.number(*v, "mutation_scale", 1e-6, 128.0);

@@ -367,7 +367,9 @@ std::string task_settings_text(const TaskDef &t, const std::string &source_finge
           << " mutation_clip=" << e.mutation_clip << " episodes_per_candidate=" << e.episodes_per_candidate
           << " reevaluate_parent=" << (e.reevaluate_parent ? 1 : 0)
           << " init=" << (e.init == InitKind::Cauchy ? "cauchy" : "uniform")
-          << " init_scale=" << e.init_scale << "\n"
+          << " init_scale=" << e.init_scale
+          << (e.inputs != QNAV_NET_INPUTS_PAPER ? " inputs=" + std::to_string(e.inputs) : std::string())
+          << "\n"
           << "evolution_seed=" << t.evolution_seed << "\n"
           << "episode_seed_base=" << t.episode_seed_base << "\n"
           << "source=" << (source_fingerprint.empty() ? "none (random population)" : source_fingerprint)

@@ -25,6 +25,7 @@
 #include <stdint.h>
 
 #include "qnav/ctrl.h"
+#include "qnav/nav.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -224,6 +225,15 @@ qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
                                        uint64_t episode_seed, qnav_sim_result_t *res,
                                        qnav_sim_trace_fn trace, void *user);
 
+/*
+ * The same with any controller of the table in qnav/nav.h (path-quality "body" or
+ * "literal", "vfh", ...): qnav_nav_reset() first, then every tick qnav_nav_step(). nav must
+ * be initialised for this context's sensors. Same statuses.
+ */
+qnav_sim_status_t qnav_sim_run_episode_nav(qnav_sim_t *sim, qnav_nav_t *nav, uint64_t episode_seed,
+                                           qnav_sim_result_t *res, qnav_sim_trace_fn trace,
+                                           void *user);
+
 /* The one-line message of the last failing call on this context (run_episode, reset,
  * advance, place), or "" when none failed. Valid until the next call on the context. */
 const char *qnav_sim_last_error(const qnav_sim_t *sim);
@@ -239,6 +249,10 @@ typedef struct {
                                               noisy, clipped to [min, max] range, mm */
     qnav_cdeg_t goal_bearing_cdeg;         /* destination bearing, robot frame, 0.01 deg,
                                               -18000..17999, from the noisy heading */
+    qnav_cdeg_t prev_heading_cdeg;         /* the last command's heading (qnav_sim_command)
+                                              in this tick's robot frame, from the same
+                                              sensed heading, 0.01 deg; 0 before the first
+                                              command: qnav_ctrl_input_t.prev_heading_cdeg */
 } qnav_sim_scan_t;
 
 /* The robot's true state. */

@@ -37,6 +37,7 @@ void qnav_board_config_default(qnav_board_config_t *cfg)
     cfg->decel_mm_s2 = 0;
     cfg->um_per_count = 1000;
     cfg->nvm_offset = 0;
+    cfg->controller = "body";
 }
 
 /* The controller configuration this board's sonar and body give. */
@@ -103,7 +104,7 @@ static void load_policy(qnav_board_t *bot)
         /* the slot is remembered even if refused, so the next commit keeps it intact */
         bot->store_slot = slot;
         bot->store_seq = seq;
-        if (qnav_ctrl_init(&bot->ctrl, &cc, &stored) == QNAV_OK) {
+        if (qnav_nav_init_named(&bot->nav, bot->cfg.controller, &cc, &stored) == QNAV_OK) {
             bot->policy = stored;
             bot->policy_crc = crc;
             bot->policy_source = QNAV_BOARD_POLICY_STORED;
@@ -113,7 +114,8 @@ static void load_policy(qnav_board_t *bot)
     }
     qnav_policy_prob_default(&bot->policy);
     bot->policy_source = QNAV_BOARD_POLICY_BUILTIN;
-    bot->ctrl_ready = (uint8_t)(qnav_ctrl_init(&bot->ctrl, &cc, &bot->policy) == QNAV_OK);
+    bot->ctrl_ready = (uint8_t)(qnav_nav_init_named(&bot->nav, bot->cfg.controller, &cc,
+                                                    &bot->policy) == QNAV_OK);
     bot->policy_crc = qnav_link_policy_crc(&bot->policy);
 }
 
@@ -168,7 +170,7 @@ static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm
 
     if (status == QNAV_LINK_ACK_OK) {
         ctrl_config(&bot->cfg, &cc);
-        if (qnav_ctrl_init(&bot->ctrl, &cc, &fresh) == QNAV_OK) {
+        if (qnav_nav_init_named(&bot->nav, bot->cfg.controller, &cc, &fresh) == QNAV_OK) {
             bot->policy = fresh;
             bot->policy_crc = cm->crc;
             bot->policy_source = QNAV_BOARD_POLICY_UPLOADED;
@@ -182,7 +184,8 @@ static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm
         } else {
             /* keep driving with the policy we had */
             bot->ctrl_ready =
-                (uint8_t)(qnav_ctrl_init(&bot->ctrl, &cc, &bot->policy) == QNAV_OK);
+                (uint8_t)(qnav_nav_init_named(&bot->nav, bot->cfg.controller, &cc,
+                                              &bot->policy) == QNAV_OK);
             status = QNAV_LINK_ACK_REJECTED;
         }
     }
@@ -417,7 +420,7 @@ static void decide(qnav_board_t *bot, uint32_t now, const qnav_ctrl_input_t *in,
     out->quality = 0;
     out->flags = 0;
     if (bot->mode == QNAV_LINK_MODE_ONBOARD) {
-        qnav_ctrl_step(&bot->ctrl, in, out, NULL);
+        qnav_nav_step(&bot->nav, in, out);
     } else if (bot->mode == QNAV_LINK_MODE_OFFBOARD &&
                (now - bot->cmd_ms) <= bot->cfg.link_timeout_ms) {
         out->heading_deg = bot->cmd.heading_deg;
@@ -462,8 +465,16 @@ void qnav_board_tick(qnav_board_t *bot)
     }
     in.ranges_mm = bot->ranges;
     in.goal_bearing_cdeg = goal_bearing(bot, &dist_mm);
+    /* the previous decision, seen from where the robot points now (3-input policies) */
+    in.prev_heading_cdeg = bot->have_decision
+                               ? qnav_board_wrap_cdeg((int32_t)bot->decided_cdeg -
+                                                      (int32_t)bot->pose.heading_cdeg)
+                               : 0;
 
     decide(bot, now, &in, &out);
+    bot->decided_cdeg =
+        qnav_board_wrap_cdeg((int32_t)bot->pose.heading_cdeg + 100 * (int32_t)out.heading_deg);
+    bot->have_decision = 1;
     moving = (uint8_t)(bot->link_ok && !bot->hold_stop && bot->have_goal && bot->mode != 0u &&
                        out.speed > 0);
     if (!moving) {

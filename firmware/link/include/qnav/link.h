@@ -116,8 +116,9 @@ typedef enum {
 #define QNAV_LINK_ACK_BAD_POLICY (-3)  /* blob does not decode to a policy */
 #define QNAV_LINK_ACK_REJECTED (-4)    /* the controller refused it (qnav_ctrl_init) */
 
-/* Largest policy blob: kind, hidden, then 4H+1 weights of 2 bytes. */
-#define QNAV_LINK_POLICY_MAX_BYTES (2u + 2u * QNAV_NET_WEIGHTS(QNAV_MAX_HIDDEN))
+/* Largest policy blob: kind, hidden, then up to 5H+1 weights of 2 bytes (3 inputs). */
+#define QNAV_LINK_POLICY_MAX_BYTES \
+    (2u + 2u * QNAV_NET_WEIGHTS_IN(QNAV_MAX_HIDDEN, QNAV_NET_INPUTS_PREV))
 
 /* ---- Statuses and counters ----------------------------------------------------------- */
 
@@ -328,18 +329,24 @@ int32_t qnav_link_pose_unpack(const uint8_t *p, uint16_t len, qnav_link_pose_t *
 /* ---- Policy blobs (what an upload carries) -------------------------------------------- */
 
 /*
- * Serialize a policy: [kind u8][hidden u8 (0 for PROB)][weights i16 LE]: PROB k_goal,
- * k_safe; NET the 4H+1 weights in qnav_net_weight() order. Returns bytes written or
- * QNAV_LINK_E_NULL / _VALUE (unknown kind, H out of range) / _SPACE.
+ * Serialize a policy: [kind u8][shape u8][weights i16 LE]: PROB shape 0, k_goal, k_safe;
+ * NET shape = H, plus 0x80 with the previous-decision input, then the 4H+1 (5H+1)
+ * weights in qnav_net_weight() order. Returns bytes written or QNAV_LINK_E_NULL / _VALUE
+ * (policy refused by qnav_policy_validate) / _SPACE.
  */
-int32_t qnav_link_policy_to_blob(const qnav_policy_t *policy, uint8_t *out, uint16_t cap);
+QNAV_CHECK_RESULT int32_t qnav_link_policy_to_blob(const qnav_policy_t *policy, uint8_t *out, uint16_t cap);
 
 /* The CRC-16 of a policy's blob: what heartbeats, acks and commands call the policy's
  * CRC (0 when it cannot be serialised). */
 uint16_t qnav_link_policy_crc(const qnav_policy_t *policy);
 
 /* Parse a blob back; QNAV_LINK_OK or QNAV_LINK_E_NULL / _LENGTH / _VALUE. */
+QNAV_CHECK_RESULT
 int32_t qnav_link_policy_from_blob(const uint8_t *blob, uint16_t len, qnav_policy_t *policy);
+
+/* One line of text for a QNAV_LINK_* status (a positive value is a byte count); never
+ * null. */
+const char *qnav_link_status_str(int32_t status);
 
 /* Receiver of a chunked upload; caller-owned. */
 typedef struct {

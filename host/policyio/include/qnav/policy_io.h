@@ -36,8 +36,11 @@ int qnav_policy_write(const char *path, const qnav_policy_t *policy, const char 
 
 /* ---- Additions: format limits, metadata, in-memory rendering, checks ---------------- */
 
-/* The format version this library reads and writes (line 1: "qnav-policy 1"). */
-#define QNAV_POLICY_FORMAT_VERSION 1
+/* The format versions this library reads (line 1: "qnav-policy 1" or "qnav-policy 2").
+ * It writes the oldest version that can hold the policy: 1, or 2 for a network with the
+ * previous-decision input (docs/policy-format.md). */
+#define QNAV_POLICY_FORMAT_VERSION 2
+#define QNAV_POLICY_FORMAT_VERSION_MIN 1
 /* Longest line, in bytes, not counting the line ending. */
 #define QNAV_POLICY_LINE_MAX 256
 /* Largest file the reader accepts, in bytes. */
@@ -100,6 +103,15 @@ int qnav_policy_check(const qnav_policy_t *policy, char *err, size_t errlen);
 
 /* 1 when a and b are the same policy (kind, shape and every weight in use), else 0. */
 int qnav_policy_equal(const qnav_policy_t *a, const qnav_policy_t *b);
+
+/* The file name of a policy kind ("probabilistic", "network"), or null for an unknown one. */
+const char *qnav_policy_kind_name(uint8_t kind);
+
+/* The kind named by the len bytes at name: 0 with *kind, or -1 when no kind has that name. */
+int qnav_policy_kind_from_name(const char *name, size_t len, uint8_t *kind);
+
+/* The format version qnav_policy_format() writes for policy (1 or 2). */
+int qnav_policy_file_version(const qnav_policy_t *policy);
 
 /* Write len bytes to path atomically (temporary file in the same directory, fsync,
  * rename, fsync of the directory). 0, or -1 with "PATH: what failed" in err. */

@@ -25,6 +25,7 @@
 
 #include "qnav/board_hal.h"
 #include "qnav/ctrl.h"
+#include "qnav/nav.h"
 #include "qnav/link.h"
 
 #ifdef __cplusplus
@@ -59,6 +60,8 @@ typedef struct {
     uint16_t um_per_count;       /* wheel travel per encoder count, micrometres (> 0) */
     uint16_t nvm_offset;         /* first byte of the policy store in the HAL's storage;
                                     it takes QNAV_BOARD_STORE_BYTES bytes */
+    const char *controller;      /* a name in libqnav's controller table (qnav/nav.h):
+                                    "body" (default), "literal", "vfh" */
 } qnav_board_config_t;
 
 /* The policy store: two slots, each [magic 'Q' 'P'][format 1][sequence u8][blob length
@@ -99,8 +102,11 @@ typedef struct {
     qnav_link_rx_t rx;
     qnav_link_tx_t tx;
     qnav_link_upload_t upload;
-    qnav_ctrl_t ctrl;
-    qnav_policy_t policy;        /* the policy ctrl was made from */
+    qnav_nav_t nav;              /* the chosen controller (cfg.controller) and its state */
+    qnav_policy_t policy;        /* the policy nav was made from (if it takes one) */
+    qnav_cdeg_t decided_cdeg;    /* last decision's heading in the world (compass), 0.01 deg:
+                                    the previous-decision input of 3-input policies */
+    uint8_t have_decision;       /* decided_cdeg is set */
     uint16_t policy_crc;
     uint8_t policy_source;       /* qnav_board_policy_source_t */
     uint8_t store_slot;          /* slot the running stored policy is in (0/1), 0xFF none */

@@ -1,0 +1,134 @@
+/*
+ * What the path-quality controller (ctrl.c) shares with each policy kind's evaluation
+ * (policy_<kind>.c), private to libqnav: the runs the step cuts the 360 paths into, the
+ * best-path record and its total order, and one prototype block per kind. Adding a
+ * kind means one block here, one file, and a case in every switch of ctrl.c that -Wswitch
+ * names (docs/architecture.md, "Adding a policy kind").
+ */
+#ifndef QNAV_CTRL_INTERNAL_H
+#define QNAV_CTRL_INTERNAL_H
+
+#include "qnav/ctrl.h"
+
+#define QNAV_CTRL_MAGIC 0x514Eu
+#define QNAV_TABLE_STRIDE (QNAV_DTHETA_MAX + 1)
+/* No key: below every key a policy gives (keys are -32767..32767). */
+#define QNAV_KEY_NONE (-32767 - 1)
+
+/* The network arithmetic shifts signed values right and relies on it being arithmetic
+ * (implementation-defined in C99; true on gcc, avr-gcc and arm-none-eabi-gcc). */
+typedef char qnav_arith_shift_check[((-8 >> 1) == -4) ? 1 : -1];
+
+static inline int16_t qnav_sat16(int32_t v)
+{
+    if (v > 32767) {
+        return 32767;
+    }
+    if (v < -32768) {
+        return -32768;
+    }
+    return (int16_t)v;
+}
+
+/*
+ * A run: consecutive paths of one distance level along which dtheta moves one way. Within
+ * a run each hidden unit's pre-activation is monotone, which is what lets the network step
+ * bound a whole run from its two ends (docs/architecture.md).
+ */
+typedef struct {
+    uint16_t first;      /* first path, degrees */
+    uint8_t count;       /* paths in the run, 1..180 */
+    uint8_t level;       /* distance level of every path of the run */
+    uint8_t dtheta0;     /* dtheta of the first path */
+    int8_t dir;          /* +1 or -1: change of dtheta from one path to the next */
+} qnav_run_t;
+
+/* The best path so far under the controller's total order (key, then smaller dtheta,
+ * then smaller turn, then counter-clockwise). */
+typedef struct {
+    qnav_qkey_t key;
+    uint8_t dtheta;
+    qnav_deg_t heading;
+} qnav_best_t;
+
+/* Walks the 360 paths once and hands out their runs in path order. */
+typedef struct {
+    const uint8_t *lvl;   /* distance level of every path */
+    uint16_t goal;        /* destination, whole degrees 0..359 */
+    uint16_t prev;        /* heading chosen at the previous tick, whole degrees 0..359 */
+    uint16_t path;        /* next path to hand out */
+} qnav_run_iter_t;
+
+/* Offer path (with its key and dtheta) to best under the total order above. Inline: the
+ * network calls it once per path. */
+static inline void qnav_best_consider(qnav_best_t *best, qnav_qkey_t key, uint16_t path,
+                                      uint8_t dtheta)
+{
+    qnav_deg_t heading;
+    int16_t turn;
+    int16_t best_turn;
+    if (key < best->key) {
+        return;
+    }
+    heading = (qnav_deg_t)(path <= 180u ? (int16_t)path : (int16_t)path - 360);
+    if (key == best->key) {
+        if (dtheta != best->dtheta) {
+            if (dtheta > best->dtheta) {
+                return;
+            }
+        } else {
+            turn = (int16_t)(heading < 0 ? -heading : heading);
+            best_turn = (int16_t)(best->heading < 0 ? -best->heading : best->heading);
+            if (turn > best_turn || (turn == best_turn && heading < best->heading)) {
+                return;
+            }
+        }
+    }
+    best->key = key;
+    best->dtheta = dtheta;
+    best->heading = heading;
+}
+
+/* Angular distance between two whole-degree directions 0..359, in 0..180. */
+static inline uint8_t qnav_angle_dist_deg(uint16_t a, uint16_t b)
+{
+    uint16_t d = (uint16_t)(a >= b ? a - b : b - a);
+    return (uint8_t)(d > QNAV_DTHETA_MAX ? QNAV_PATHS - d : d);
+}
+
+/* An angle in centidegrees to the nearest whole degree (halves away from zero), 0..359.
+ * 16-bit arithmetic: one division, no 32-bit ones (costly on AVR). */
+uint16_t qnav_whole_deg(qnav_cdeg_t cdeg);
+
+/* dtheta of a run's first path and its direction, from the path and the goal. */
+void qnav_run_shape(qnav_run_t *r, uint16_t goal);
+
+/* The next run into *r; 0 when all 360 paths have been handed out. */
+uint8_t qnav_run_next(qnav_run_iter_t *it, qnav_run_t *r);
+
+/* ---- policy_prob.c: probabilistic navigation (paper §3.2) --------------------------- */
+
+/* Tabulate P_goal and P_safe into ctrl->p.prob (parameters already validated). */
+void qnav_prob_eval_init(qnav_ctrl_t *ctrl, const qnav_prob_params_t *p);
+/* The quality of one (level, dtheta), Q1.15: the kind's key. */
+qnav_qkey_t qnav_prob_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta);
+/* Every run of it into best; keys (may be null) receives every path's key. */
+void qnav_prob_eval_paths(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best,
+                          qnav_qkey_t *keys);
+
+/* ---- policy_net.c: the evolved network (paper §3.3; 3 inputs: §5) ------------------- */
+
+/* Derive the per-unit integer parameters into ctrl (network already validated). */
+void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net);
+/* The key of one (level, dtheta); a 3-input network with the path on the previous
+ * heading (dprev = 0). */
+qnav_qkey_t qnav_net_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta);
+/* Every path of it into best (best first when keys is null); keys as above. */
+void qnav_net_eval_paths(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best,
+                         qnav_qkey_t *keys);
+/* One table row (dtheta 0..180 at level) by the same additions as the step. */
+void qnav_net_eval_row(const qnav_ctrl_t *ctrl, uint8_t level, qnav_qkey_t *row);
+/* The quality a pre-activation key stands for. */
+qnav_q1_15_t qnav_net_eval_key_quality(qnav_qkey_t key);
+
+#endif /* QNAV_CTRL_INTERNAL_H */

@@ -1,0 +1,227 @@
+/*
+ * Unit tests of VFH+ and of the controller table: configuration checks, choice of
+ * direction through openings, hysteresis kept in the caller's state, the cost weights,
+ * speed reduction near obstacles, and selection of controllers by name.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "qnav/nav.h"
+#include "qnav/vfh.h"
+
+static void fill(qnav_mm_t *r, uint16_t n, qnav_mm_t v)
+{
+    uint16_t s;
+    for (s = 0; s < n; ++s) {
+        r[s] = v;
+    }
+}
+
+static void init_vfh(qnav_vfh_t *v, qnav_vfh_state_t *st)
+{
+    qnav_vfh_config_t cfg;
+    qnav_vfh_config_default(&cfg);
+    assert_int_equal(qnav_vfh_init(v, &cfg), QNAV_OK);
+    qnav_vfh_state_reset(st);
+}
+
+/* One VFH+ controller with its state, 16 sectors all clear, goal straight ahead. */
+typedef struct {
+    qnav_vfh_t v;
+    qnav_vfh_state_t st;
+    qnav_mm_t r[16];
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+} fixture_t;
+
+static void setup(fixture_t *f, qnav_mm_t range)
+{
+    init_vfh(&f->v, &f->st);
+    fill(f->r, 16, range);
+    f->in.ranges_mm = f->r;
+    f->in.goal_bearing_cdeg = 0;
+    f->in.prev_heading_cdeg = 0;
+}
+
+static void step(fixture_t *f)
+{
+    qnav_vfh_step(&f->v, &f->st, &f->in, &f->out);
+}
+
+static void test_vfh_init_rejects_bad_parameters(void **state)
+{
+    qnav_vfh_t v;
+    qnav_vfh_config_t cfg;
+    (void)state;
+    qnav_vfh_config_default(&cfg);
+    cfg.sector_deg = 7; /* does not divide 360 */
+    assert_int_equal(qnav_vfh_init(&v, &cfg), QNAV_E_VFH_PARAM);
+    qnav_vfh_config_default(&cfg);
+    cfg.free_mm = (qnav_mm_t)(cfg.blocked_mm - 1u);
+    assert_int_equal(qnav_vfh_init(&v, &cfg), QNAV_E_VFH_PARAM);
+    qnav_vfh_config_default(&cfg);
+    cfg.body.n_sectors = 0;
+    assert_int_equal(qnav_vfh_init(&v, &cfg), QNAV_E_SECTORS);
+    assert_int_equal(qnav_vfh_init(NULL, &cfg), QNAV_E_NULL);
+}
+
+static void test_vfh_drives_at_goal_in_open_space_at_full_speed(void **state)
+{
+    fixture_t f;
+    (void)state;
+    setup(&f, 5000);
+    f.in.goal_bearing_cdeg = -3000;
+    step(&f);
+    assert_int_equal(f.out.heading_deg, -30);
+    assert_int_equal(f.out.speed, QNAV_Q1_15_MAX);
+}
+
+static void test_vfh_steers_around_an_obstacle_on_the_goal_line(void **state)
+{
+    fixture_t f;
+    (void)state;
+    setup(&f, 5000);
+    f.r[0] = 600; /* straight ahead, 0.6 m */
+    step(&f);
+    assert_true(f.out.heading_deg > 20 || f.out.heading_deg < -20);
+    assert_true(f.out.heading_deg < 90 && f.out.heading_deg > -90);
+    assert_true(f.out.speed > 0);
+}
+
+static void test_vfh_hysteresis_keeps_a_sector_blocked_between_the_thresholds(void **state)
+{
+    fixture_t f;
+    qnav_vfh_state_t fresh;
+    qnav_ctrl_output_t forgot;
+    (void)state;
+    setup(&f, 5000);
+    f.r[0] = 700; /* blocked: nearer than 1.0 m */
+    step(&f);
+    assert_true(f.out.heading_deg != 0);
+    f.r[0] = 1200; /* between tau_high (1.0 m) and tau_low (1.4 m) */
+    step(&f);
+    assert_true(f.out.heading_deg != 0); /* the goal's sector is still blocked */
+    qnav_vfh_state_reset(&fresh);
+    qnav_vfh_step(&f.v, &fresh, &f.in, &forgot);
+    assert_int_equal(forgot.heading_deg, 0); /* a fresh state sees it free */
+    f.r[0] = 2000; /* beyond tau_low: free again */
+    step(&f);
+    assert_int_equal(f.out.heading_deg, 0);
+}
+
+static void test_vfh_previous_direction_breaks_a_symmetric_choice(void **state)
+{
+    fixture_t f;
+    qnav_deg_t left;
+    (void)state;
+    setup(&f, 5000);
+    f.r[0] = 600;
+    f.in.prev_heading_cdeg = 6000;
+    step(&f);
+    left = f.out.heading_deg;
+    qnav_vfh_state_reset(&f.st);
+    f.in.prev_heading_cdeg = -6000;
+    step(&f);
+    assert_true(left > 0);
+    assert_true(f.out.heading_deg < 0);
+    assert_int_equal(left, -f.out.heading_deg);
+}
+
+static void test_vfh_slows_near_obstacles_and_stops_when_boxed_in(void **state)
+{
+    fixture_t f;
+    (void)state;
+    setup(&f, 1500); /* free everywhere (beyond 1.4 m) but nearer than slow_mm */
+    step(&f);
+    assert_true(f.out.speed > 0 && f.out.speed < QNAV_Q1_15_MAX);
+    fill(f.r, 16, 300);
+    step(&f);
+    assert_int_equal(f.out.speed, 0);
+    assert_true((f.out.flags & QNAV_FLAG_NO_PATH) != 0);
+}
+
+static void test_vfh_without_init_or_state_commands_stop(void **state)
+{
+    fixture_t f;
+    (void)state;
+    setup(&f, 5000);
+    qnav_vfh_step(&f.v, NULL, &f.in, &f.out);
+    assert_int_equal(f.out.flags, QNAV_FLAG_NOT_READY);
+    memset(&f.v, 0, sizeof f.v);
+    step(&f);
+    assert_int_equal(f.out.flags, QNAV_FLAG_NOT_READY);
+}
+
+static void test_table_selects_controllers_by_name(void **state)
+{
+    qnav_nav_t nav;
+    qnav_ctrl_config_t cfg;
+    qnav_policy_t p;
+    qnav_mm_t r[16];
+    qnav_ctrl_input_t in = {r, 2000, 0};
+    qnav_ctrl_output_t a;
+    qnav_ctrl_output_t b;
+    qnav_ctrl_t direct;
+    uint8_t i;
+    (void)state;
+    assert_int_equal(qnav_nav_count(), 3);
+    for (i = 0; i < qnav_nav_count(); ++i) {
+        assert_ptr_equal(qnav_nav_find(qnav_nav_method_at(i)->name), qnav_nav_method_at(i));
+    }
+    assert_null(qnav_nav_find("pid"));
+    qnav_ctrl_config_default(&cfg);
+    qnav_policy_prob_default(&p);
+    assert_int_equal(qnav_nav_init_named(&nav, "pid", &cfg, &p), QNAV_E_NAME);
+    qnav_nav_step(&nav, &in, &a);
+    assert_int_equal(a.flags, QNAV_FLAG_NOT_READY);
+    assert_int_equal(qnav_nav_init_named(&nav, "body", &cfg, NULL), QNAV_E_NULL);
+
+    /* "body" through the table is qnav_ctrl_step itself */
+    fill(r, 16, 5000);
+    r[1] = 500;
+    assert_int_equal(qnav_nav_init_named(&nav, "body", &cfg, &p), QNAV_OK);
+    assert_int_equal(qnav_ctrl_init(&direct, &cfg, &p), QNAV_OK);
+    qnav_nav_step(&nav, &in, &a);
+    qnav_ctrl_step(&direct, &in, &b, NULL);
+    assert_memory_equal(&a, &b, sizeof a);
+    assert_non_null(qnav_nav_paths(&nav));
+
+    /* "vfh" takes no policy and has no path-quality controller inside */
+    assert_int_equal(qnav_nav_init_named(&nav, "vfh", &cfg, NULL), QNAV_OK);
+    assert_null(qnav_nav_paths(&nav));
+    qnav_nav_step(&nav, &in, &a);
+    assert_int_equal(a.flags & QNAV_FLAG_NOT_READY, 0);
+}
+
+static void test_literal_entry_applies_the_literal_reading(void **state)
+{
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_config_t seen;
+    (void)state;
+    qnav_ctrl_config_default(&cfg);
+    qnav_nav_config(qnav_nav_find("literal"), &cfg, &seen);
+    assert_int_equal(seen.body_radius_mm, 0);
+    assert_int_equal(seen.rank, QNAV_RANK_QUALITY);
+    qnav_nav_config(qnav_nav_find("body"), &cfg, &seen);
+    assert_int_equal(seen.body_radius_mm, cfg.body_radius_mm);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_vfh_init_rejects_bad_parameters),
+        cmocka_unit_test(test_vfh_drives_at_goal_in_open_space_at_full_speed),
+        cmocka_unit_test(test_vfh_steers_around_an_obstacle_on_the_goal_line),
+        cmocka_unit_test(test_vfh_hysteresis_keeps_a_sector_blocked_between_the_thresholds),
+        cmocka_unit_test(test_vfh_previous_direction_breaks_a_symmetric_choice),
+        cmocka_unit_test(test_vfh_slows_near_obstacles_and_stops_when_boxed_in),
+        cmocka_unit_test(test_vfh_without_init_or_state_commands_stop),
+        cmocka_unit_test(test_table_selects_controllers_by_name),
+        cmocka_unit_test(test_literal_entry_applies_the_literal_reading),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
