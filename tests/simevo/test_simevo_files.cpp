@@ -457,6 +457,30 @@ static void test_shares_in_separate_processes_merge_to_the_local_run_byte_for_by
     assert_non_null(std::strstr(slurp(join_path(root, "c4.err")).c_str(), "settings.txt: this output folder holds tiny with other settings"));
 }
 
+static void test_slurm_scripts_run_stage_two_after_stage_one_and_keep_foreign_files(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::vector<std::string> args = {"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--out", root, "--array-limit", "3",
+                                           "--tasks-per-job", "2", "--partition", "debug", "--time", "5"};
+    assert_int_equal(wait_exit(spawn(args, join_path(root, "s.err"))), 0);
+    const std::string submit = slurp(join_path(root, "tiny/slurm/submit.sh"));
+    // 5 stage-1 tasks in 3 array tasks, 2 transfers in 1, after stage 1 succeeded
+    assert_non_null(std::strstr(submit.c_str(), "sbatch --parsable --array=1-3%3 tasks.sbatch 1 3)\n"));
+    assert_non_null(std::strstr(submit.c_str(),
+                                "--array=1-1%3 --dependency=afterok:$a --kill-on-invalid-dep=yes tasks.sbatch 2 1)\n"));
+    assert_non_null(std::strstr(submit.c_str(), "--dependency=afterany:$after summarize.sbatch"));
+    const std::string tasks = slurp(join_path(root, "tiny/slurm/tasks.sbatch"));
+    assert_non_null(std::strstr(tasks.c_str(), "#SBATCH --partition=debug\n#SBATCH --time=5\n"));
+    assert_non_null(std::strstr(tasks.c_str(), "--stage \"$1\" --tasks \"$SLURM_ARRAY_TASK_ID/$2\"\n"));
+    assert_true(file_exists(join_path(root, "tiny/run.txt")));
+    // A file in slurm/ that simevo did not write is left alone.
+    write_file_atomic(join_path(root, "tiny/slurm/summarize.sbatch"), "#!/bin/sh\necho mine\n");
+    assert_int_equal(wait_exit(spawn(args, join_path(root, "s2.err"))), 1);
+    assert_non_null(std::strstr(slurp(join_path(root, "s2.err")).c_str(), "exists and was not written by simevo slurm"));
+    assert_true(slurp(join_path(root, "tiny/slurm/summarize.sbatch")) == "#!/bin/sh\necho mine\n");
+}
+
 static void test_program_killed_by_pid_resumes_to_identical_results(void **state)
 {
     (void)state;
@@ -824,6 +848,7 @@ int main(void)
         cmocka_unit_test(test_program_rejects_bad_input_with_one_line),
         cmocka_unit_test(test_program_killed_by_pid_resumes_to_identical_results),
         cmocka_unit_test(test_shares_in_separate_processes_merge_to_the_local_run_byte_for_byte),
+        cmocka_unit_test(test_slurm_scripts_run_stage_two_after_stage_one_and_keep_foreign_files),
         cmocka_unit_test(test_table_mode_and_network_mode_give_identical_results),
         cmocka_unit_test(test_atomic_write_never_follows_a_planted_symlink),
         cmocka_unit_test(test_plot_child_dies_when_simevo_is_killed),

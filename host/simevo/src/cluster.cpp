@@ -45,16 +45,6 @@ void set_controller(ExperimentSpec &s, const std::string &name)
     for_each_scenario(s, [c](Scenario &sc) { sc.controller = c; });
 }
 
-/* s in single quotes for sh. */
-std::string sh_quote(const std::string &s)
-{
-    std::string q = "'";
-    for (char c : s) {
-        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    }
-    return q + "'";
-}
-
 /* Writes path unless it holds content already; a different file there is not ours to
  * overwrite unless it carries our header line. */
 void write_script(const std::string &path, const std::string &content)
@@ -68,6 +58,15 @@ void write_script(const std::string &path, const std::string &content)
 }
 
 } // namespace
+
+std::string sh_quote(const std::string &s)
+{
+    std::string q = "'";
+    for (char c : s) {
+        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    }
+    return q + "'";
+}
 
 ExperimentSpec load_run_spec(const std::string &path, const RunArgs &a)
 {

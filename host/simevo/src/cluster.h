@@ -54,6 +54,9 @@ std::vector<char> select_share(const std::vector<TaskDef> &tasks, const Share &s
  * "...: started, not finished (failed, killed or still running; N journal lines)". */
 std::vector<std::string> unfinished_tasks(const std::vector<TaskDef> &tasks, const std::string &exp_dir);
 
+/* s in single quotes for sh. */
+std::string sh_quote(const std::string &s);
+
 struct SlurmOptions {
     std::string simevo;          /* absolute path of the simevo program */
     std::string experiment_file; /* absolute */

@@ -255,7 +255,7 @@ int write_slurm(const std::pair<std::string, ExperimentSpec> &ps, const RunArgs 
         return 0;
     }
     std::fflush(stdout);
-    const int rc = std::system(("/bin/sh '" + script + "'").c_str());
+    const int rc = std::system(("/bin/sh " + sh_quote(script)).c_str());
     if (rc != 0) {
         throw UserError(script + ": sbatch failed (exit " + std::to_string(WIFEXITED(rc) ? WEXITSTATUS(rc) : -1) + ")");
     }
