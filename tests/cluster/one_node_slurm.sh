@@ -6,7 +6,8 @@
 # NoInAddrAny,NoCtldInAddrAny so both daemons listen on 127.0.0.1 only.
 #
 #   . tests/cluster/one_node_slurm.sh; cluster_up DIR   # sets SLURM_CONF; returns 77 with
-#                                                       # the reason on stderr if it cannot
+#       the reason on stderr when it cannot try (not root, a program missing), 1 with the
+#       daemon's log when a daemon does not come up
 #   cluster_down                                        # stops every daemon by its PID
 # cluster_up leaves the daemons' PIDs in CLUSTER_PIDS; callers trap cluster_down on exit.
 # Its variables are prefixed cl_ (sh has no locals).
@@ -14,6 +15,7 @@
 CLUSTER_PIDS=""
 
 cluster_skip() { echo "one-node Slurm cluster not started: $*" >&2; return 77; }
+cluster_fail() { echo "one-node Slurm cluster failed: $*" >&2; return 1; }
 
 # A free TCP port on 127.0.0.1 from a range few services use.
 cluster_free_port() {
@@ -40,15 +42,16 @@ cluster_up() {
     done
     PATH=$PATH:/usr/sbin
     mkdir -p "$cl_dir/state" "$cl_dir/spool" "$cl_dir/munge" && chmod 700 "$cl_dir/munge" || return 1
-    mungekey -c -k "$cl_dir/munge/munge.key" >/dev/null 2>&1 || { cluster_skip "mungekey failed"; return 77; }
+    mungekey -c -k "$cl_dir/munge/munge.key" >/dev/null 2>&1 || { cluster_fail "mungekey -c failed"; return 1; }
     munged -F -f --socket="$cl_dir/munge/munge.sock" --key-file="$cl_dir/munge/munge.key" \
         --pid-file="$cl_dir/munge/munged.pid" --log-file="$cl_dir/munge/munged.log" --seed-file="$cl_dir/munge/munged.seed" \
         >"$cl_dir/munge/munged.out" 2>&1 &
     CLUSTER_PIDS="$!"
     cluster_wait_for 10 test -S "$cl_dir/munge/munge.sock" ||
-        { cluster_skip "munged did not start: $(tail -n 1 "$cl_dir/munge/munged.out" "$cl_dir/munge/munged.log" 2>/dev/null | tr '\n' ' ')"; return 77; }
+        { cluster_fail "munged did not start: $(tail -n 1 "$cl_dir/munge/munged.out" "$cl_dir/munge/munged.log" 2>/dev/null | tr '\n' ' ')"; return 1; }
     cl_host=$(hostname -s)
-    cl_ctld_port=$(cluster_free_port 26817)
+    # ports from the process id, so two test runs at once are unlikely to race for one
+    cl_ctld_port=$(cluster_free_port $((20000 + ($$ % 4000) * 2)))
     cl_slurmd_port=$(cluster_free_port $((ctld_port + 1)))
     cat >"$cl_dir/slurm.conf" <<CONF
 ClusterName=qnavtest
@@ -83,11 +86,11 @@ CONF
     slurmctld -D -i -f "$SLURM_CONF" >"$cl_dir/slurmctld.out" 2>&1 &
     CLUSTER_PIDS="$CLUSTER_PIDS $!"
     cluster_wait_for 20 scontrol ping ||
-        { cluster_skip "slurmctld did not answer: $(tail -n 2 "$cl_dir/slurmctld.log" "$cl_dir/slurmctld.out" 2>/dev/null | tr '\n' ' ')"; return 77; }
+        { cluster_fail "slurmctld did not answer: $(tail -n 2 "$cl_dir/slurmctld.log" "$cl_dir/slurmctld.out" 2>/dev/null | tr '\n' ' ')"; return 1; }
     slurmd -D -N qnavnode -f "$SLURM_CONF" >"$cl_dir/slurmd.out" 2>&1 &
     CLUSTER_PIDS="$CLUSTER_PIDS $!"
     cluster_wait_for 30 sh -c 'sinfo -h -o %t | grep -qx idle' ||
-        { cluster_skip "slurmd did not register: $(tail -n 2 "$cl_dir/slurmd.log" "$cl_dir/slurmd.out" 2>/dev/null | tr '\n' ' ')"; return 77; }
+        { cluster_fail "slurmd did not register: $(tail -n 2 "$cl_dir/slurmd.log" "$cl_dir/slurmd.out" 2>/dev/null | tr '\n' ' ')"; return 1; }
     return 0
 }
 

@@ -3,7 +3,8 @@
 # only): tiny.toml as a two-stage job array (5 stage-1 tasks, 2 transfers after them with
 # afterok) plus a summarize job, waited for with a bounded timeout, then every merged file
 # compared (cmp) with a local `simevo run` of the same experiment. Exit 77 (CTest skip) with
-# the reason when the cluster cannot start (not root, packages missing).
+# the reason when the cluster cannot be tried (not root, packages missing); a daemon that
+# does not come up although it could is a failure (exit 1).
 #   test_slurm.sh SIMEVO SOURCE_DIR
 set -u
 simevo=$1
