@@ -122,13 +122,11 @@ RunArgs parse_run_record(const std::string &text, const std::string &path, std::
         if (line.empty() || line[0] == '#') {
             continue;
         }
-        const std::size_t eq = line.find(" = ");
-        const std::size_t eq_empty = line.size() >= 2 && line.compare(line.size() - 2, 2, " =") == 0 ? line.size() - 2 : std::string::npos;
-        const std::size_t at = eq != std::string::npos ? eq : eq_empty;
+        const std::size_t at = line.find(" = "); // an empty value is "key = "
         if (at == std::string::npos) {
             throw UserError(path + ":" + std::to_string(n) + ": expected 'key = value'");
         }
-        kv[line.substr(0, at)] = at + 3 <= line.size() ? line.substr(at + 3) : "";
+        kv[line.substr(0, at)] = line.substr(at + 3);
     }
     auto get = [&](const char *k) {
         auto it = kv.find(k);
