@@ -1,5 +1,5 @@
 #!/bin/sh
-# The README's and docs/hil.md's example blocks, run verbatim (docs.examples_run_verbatim):
+# The README's, docs/hil.md's and docs/cluster.md's example blocks, run verbatim (docs.examples_run_verbatim):
 # each block marked `<!-- doc-example: NAME ... -->` is extracted, written to WORK/NAME.sh
 # and run with sh in WORK (a fresh folder) with the installed tree PREFIX/bin on PATH and
 # no QNAV_* variables, inside a private network namespace (loopback up, multicast routed to
@@ -21,7 +21,7 @@ extract() { # FILE NAME -> the fenced block after the marker
         want && /^```/ { if (inside) exit; inside = 1; next }
         inside { print }' "$1"
 }
-for pair in "$src/README.md readme" "$src/docs/hil.md hil-sil"; do
+for pair in "$src/README.md readme" "$src/docs/hil.md hil-sil" "$src/docs/cluster.md cluster-parallel"; do
     set -- $pair
     extract "$1" "$2" > "$work/$2.sh"
     [ -s "$work/$2.sh" ] || { echo "run_examples.sh: no block '$2' in $1" >&2; exit 1; }
@@ -31,7 +31,7 @@ done
 
 fail() { echo "run_examples.sh: $*" >&2; for f in "$work"/*.err; do echo "--- $f"; tail -n 5 "$f"; done >&2; exit 1; }
 r=$work/runs
-[ "$(grep -c '^exit 0$' "$work/status.txt")" -eq 2 ] || fail "a block failed: $(tr '\n' ' ' < "$work/status.txt")"
+[ "$(grep -c '^exit 0$' "$work/status.txt")" -eq 3 ] || fail "a block failed: $(tr '\n' ' ' < "$work/status.txt")"
 [ "$(grep -c ' Fig\. ' "$work/readme.out")" -eq "$(ls "$src/experiments" | grep -c '\.toml$')" ] || fail "simevo list"
 [ -s "$r/q/open-to-dense/summary.md" ] || fail "no summary.md from simevo run"
 head -c 4 "$r/q/open-to-dense/learning.png" | grep -q PNG || fail "no learning.png"
@@ -42,4 +42,7 @@ grep -q 'device hung up: link lost' "$work/readme.err" || fail "navbridge did no
 grep -q '^replay: \([0-9]*\) scans, \1 commands compared: \1 identical, 0 differ' "$work/hil-sil.out" \
     || fail "hil.md's replay is not identical"
 [ ! -e "$r/qnav-link" ] || fail "the pty link outlived the trial"
-echo "run_examples.sh: README and docs/hil.md examples ran verbatim"
+grep -q '^open-to-dense: merged 11 tasks; summary runs/gp/open-to-dense/summary.md$' "$work/cluster-parallel.out" \
+    || fail "cluster.md's GNU parallel shares were not merged"
+grep -q '^complete$' "$r/gp/open-to-dense/STATUS" || fail "cluster.md's merged experiment is not complete"
+echo "run_examples.sh: README, docs/hil.md and docs/cluster.md examples ran verbatim"

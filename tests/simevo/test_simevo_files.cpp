@@ -394,6 +394,93 @@ static int count_lines(const std::string &path)
     return n;
 }
 
+/* Every file under a and b is the same (same names, same bytes); a holds a summary. */
+static void assert_same_files(const std::string &a, const std::string &b)
+{
+    std::map<std::string, std::string> fa, fb;
+    collect(a, "", fa);
+    collect(b, "", fb);
+    assert_int_equal(fa.size(), fb.size());
+    for (auto &kv : fa) {
+        assert_true(fb.count(kv.first) == 1);
+        if (kv.second != fb[kv.first]) {
+            print_error("differs: %s\n", kv.first.c_str());
+            fail();
+        }
+    }
+    assert_true(fa.count("tiny/summary.md") == 1);
+    assert_true(fa["tiny/STATUS"] == "complete\n");
+}
+
+static void test_shares_in_separate_processes_merge_to_the_local_run_byte_for_byte(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::string a = join_path(root, "a"), b = join_path(root, "b"), c = join_path(root, "c");
+    auto run = [&](const std::string &out, std::vector<std::string> extra) {
+        std::vector<std::string> v = {"run", SIMEVO_TEST_DIR "/tiny.toml", "--no-plot", "--no-progress", "-j", "1", "--out", out};
+        v.insert(v.end(), extra.begin(), extra.end());
+        return v;
+    };
+    auto summarize = [&](const std::string &out) {
+        return std::vector<std::string>{"summarize", join_path(out, "tiny"), "--no-plot"};
+    };
+    assert_int_equal(wait_exit(spawn(run(a, {}), join_path(root, "a.err"))), 0);
+
+    // Three shares one after another; summarize refuses until all are done.
+    assert_int_equal(wait_exit(spawn(run(b, {"--tasks", "1/3"}), join_path(root, "b1.err"))), 0);
+    assert_int_equal(wait_exit(spawn(run(b, {"--tasks", "2/3"}), join_path(root, "b2.err"))), 0);
+    assert_false(file_exists(join_path(b, "tiny/summary.md")));
+    assert_int_equal(wait_exit(spawn(summarize(b), join_path(root, "bs.err"))), 1);
+    const std::string missing = slurp(join_path(root, "bs.err"));
+    assert_non_null(std::strstr(missing.c_str(), "tiny/probabilistic: not started"));
+    assert_non_null(std::strstr(missing.c_str(), "3 of 7 tasks not finished; no summary written"));
+    assert_false(file_exists(join_path(b, "tiny/summary.md")));
+    assert_int_equal(wait_exit(spawn(run(b, {"--tasks", "3/3"}), join_path(root, "b3.err"))), 0);
+    assert_int_equal(wait_exit(spawn(summarize(b), join_path(root, "bs2.err"))), 0);
+    assert_same_files(a, b);
+
+    // Stage 2 before its sources says so; two stage-1 processes at once do not conflict.
+    assert_int_equal(wait_exit(spawn(run(c, {"--stage", "2"}), join_path(root, "c0.err"))), 1);
+    assert_non_null(std::strstr(slurp(join_path(root, "c0.err")).c_str(),
+                                "tiny/run-001/transfer-open: its source task"));
+    const pid_t p1 = spawn(run(c, {"--stage", "1", "--tasks", "1/2"}), join_path(root, "c1.err"));
+    const pid_t p2 = spawn(run(c, {"--stage", "1", "--tasks", "2/2"}), join_path(root, "c2.err"));
+    assert_int_equal(wait_exit(p1), 0);
+    assert_int_equal(wait_exit(p2), 0);
+    assert_int_equal(wait_exit(spawn(run(c, {"--stage", "2"}), join_path(root, "c3.err"))), 0);
+    assert_int_equal(wait_exit(spawn(summarize(c), join_path(root, "cs.err"))), 0);
+    assert_same_files(a, c);
+
+    // A share of another preset is refused: the folder holds other settings.
+    assert_int_equal(wait_exit(spawn(run(c, {"--tasks", "1/2", "--runs", "3"}), join_path(root, "c4.err"))), 1);
+    assert_non_null(std::strstr(slurp(join_path(root, "c4.err")).c_str(), "settings.txt: this output folder holds tiny with other settings"));
+}
+
+static void test_slurm_scripts_run_stage_two_after_stage_one_and_keep_foreign_files(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::vector<std::string> args = {"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--out", root, "--array-limit", "3",
+                                           "--tasks-per-job", "2", "--partition", "debug", "--time", "5"};
+    assert_int_equal(wait_exit(spawn(args, join_path(root, "s.err"))), 0);
+    const std::string submit = slurp(join_path(root, "tiny/slurm/submit.sh"));
+    // 5 stage-1 tasks in 3 array tasks, 2 transfers in 1, after stage 1 succeeded
+    assert_non_null(std::strstr(submit.c_str(), "sbatch --parsable --array=1-3%3 tasks.sbatch 1 3)\n"));
+    assert_non_null(std::strstr(submit.c_str(),
+                                "--array=1-1%3 --dependency=afterok:$a --kill-on-invalid-dep=yes tasks.sbatch 2 1)\n"));
+    assert_non_null(std::strstr(submit.c_str(), "--dependency=afterany:$after summarize.sbatch"));
+    const std::string tasks = slurp(join_path(root, "tiny/slurm/tasks.sbatch"));
+    assert_non_null(std::strstr(tasks.c_str(), "#SBATCH --partition=debug\n#SBATCH --time=5\n"));
+    assert_non_null(std::strstr(tasks.c_str(), "--stage \"$1\" --tasks \"$SLURM_ARRAY_TASK_ID/$2\"\n"));
+    assert_true(file_exists(join_path(root, "tiny/run.txt")));
+    // A file in slurm/ that simevo did not write is left alone.
+    write_file_atomic(join_path(root, "tiny/slurm/summarize.sbatch"), "#!/bin/sh\necho mine\n");
+    assert_int_equal(wait_exit(spawn(args, join_path(root, "s2.err"))), 1);
+    assert_non_null(std::strstr(slurp(join_path(root, "s2.err")).c_str(), "exists and was not written by simevo slurm"));
+    assert_true(slurp(join_path(root, "tiny/slurm/summarize.sbatch")) == "#!/bin/sh\necho mine\n");
+}
+
 static void test_program_killed_by_pid_resumes_to_identical_results(void **state)
 {
     (void)state;
@@ -431,25 +518,13 @@ static void test_program_killed_by_pid_resumes_to_identical_results(void **state
     assert_false(file_exists(join_path(b, "tiny/probabilistic/done")));
 
     assert_int_equal(wait_exit(spawn(with_out(b), join_path(root, "b2.err"))), 0);
-    std::map<std::string, std::string> fa, fb;
-    collect(a, "", fa);
-    collect(b, "", fb);
-    assert_int_equal(fa.size(), fb.size());
-    for (auto &kv : fa) {
-        assert_true(fb.count(kv.first) == 1);
-        if (kv.second != fb[kv.first]) {
-            print_error("differs: %s\n", kv.first.c_str());
-            fail();
-        }
-    }
-    assert_true(fa.count("tiny/summary.md") == 1);
-    assert_true(fa["tiny/STATUS"] == "complete\n");
+    assert_same_files(a, b);
 
-    // While another process holds the folder's lock, simevo refuses to touch it.
-    const int lfd = open(join_path(a, "tiny/.lock").c_str(), O_RDWR);
+    // While another process holds a task's lock, simevo refuses to run that task.
+    const int lfd = open(join_path(a, "tiny/run-001/source-open/.lock").c_str(), O_RDWR);
     assert_true(lfd >= 0 && flock(lfd, LOCK_EX | LOCK_NB) == 0);
     assert_int_equal(wait_exit(spawn(with_out(a), join_path(root, "lock.err"))), 1);
-    assert_non_null(std::strstr(slurp(join_path(root, "lock.err")).c_str(), "another simevo is running in this folder"));
+    assert_non_null(std::strstr(slurp(join_path(root, "lock.err")).c_str(), "run-001/source-open: another simevo is running this task"));
     close(lfd);
 
     // The same folder with other settings is refused and left as it was.
@@ -640,7 +715,7 @@ static void test_program_command_line_names_unknown_options_and_subcommands(void
     e = run_for_error({"bogus"}, st);
     assert_int_equal(st, 2);
     assert_string_equal(e.c_str(),
-                        "simevo: bogus: unknown subcommand (known: run, list, evolve, eval, quality) (see simevo --help)\n");
+                        "simevo: bogus: unknown subcommand (known: run, summarize, slurm, list, evolve, eval, quality) (see simevo --help)\n");
     e = run_for_error({"eval", "prob", "--bogus"}, st);
     assert_int_equal(st, 2);
     assert_one_line_containing(e, "--bogus");
@@ -772,6 +847,8 @@ int main(void)
         cmocka_unit_test(test_experiment_results_do_not_depend_on_thread_count_and_summary_reads_them),
         cmocka_unit_test(test_program_rejects_bad_input_with_one_line),
         cmocka_unit_test(test_program_killed_by_pid_resumes_to_identical_results),
+        cmocka_unit_test(test_shares_in_separate_processes_merge_to_the_local_run_byte_for_byte),
+        cmocka_unit_test(test_slurm_scripts_run_stage_two_after_stage_one_and_keep_foreign_files),
         cmocka_unit_test(test_table_mode_and_network_mode_give_identical_results),
         cmocka_unit_test(test_atomic_write_never_follows_a_planted_symlink),
         cmocka_unit_test(test_plot_child_dies_when_simevo_is_killed),

@@ -309,12 +309,60 @@ std::string condition_label(ConditionKind kind, const std::string &source)
 
 /* ---- pool ------------------------------------------------------------------------ */
 
-void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, unsigned jobs,
-               bool progress, const std::string &title)
+namespace {
+
+/* Holds flock on DIR/.lock for one task: any number of simevo processes may work on one
+ * experiment, but never two on the same task (their journals would interleave). */
+class TaskLock {
+public:
+    explicit TaskLock(const std::string &dir)
+    {
+        make_dirs(dir);
+        const std::string path = join_path(dir, ".lock");
+        fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+        if (fd_ < 0 || ::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+            if (fd_ >= 0) {
+                ::close(fd_);
+            }
+            throw UserError(dir + ": another simevo is running this task (or its .lock cannot be locked)");
+        }
+    }
+    ~TaskLock() { ::close(fd_); }
+    TaskLock(const TaskLock &) = delete;
+    TaskLock &operator=(const TaskLock &) = delete;
+
+private:
+    int fd_ = -1;
+};
+
+/* A selected transfer whose source task is neither selected nor done cannot start. */
+void check_sources_finished(const std::vector<TaskDef> &tasks, const std::vector<char> &selected)
 {
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+        const int src = tasks[i].source_task;
+        if (!selected[i] || src < 0 || selected[static_cast<std::size_t>(src)]) {
+            continue;
+        }
+        const TaskDef &s = tasks[static_cast<std::size_t>(src)];
+        if (!file_exists(join_path(s.dir, "done"))) {
+            throw UserError(tasks[i].dir + ": its source task " + s.dir +
+                            " is not finished (run the share that holds it first, e.g. --stage 1)");
+        }
+    }
+}
+
+} // namespace
+
+void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, unsigned jobs,
+               bool progress, const std::string &title, std::vector<char> selected)
+{
+    if (selected.empty()) {
+        selected.assign(tasks.size(), 1);
+    }
+    check_sources_finished(tasks, selected);
     uint64_t total = 0;
-    for (const TaskDef &t : tasks) {
-        total += task_total_episodes(t);
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+        total += selected[i] ? task_total_episodes(tasks[i]) : 0;
     }
     Progress prog(total, progress, title);
     TaskObserver obs;
@@ -323,6 +371,9 @@ void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, uns
 
     enum State { Pending, Running, Done, Failed };
     std::vector<State> state(tasks.size(), Pending);
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+        state[i] = selected[i] ? Pending : Done; // another share's (checked above)
+    }
     std::mutex mu;
     std::condition_variable cv;
     std::atomic<bool> stop{false};
@@ -366,6 +417,7 @@ void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, uns
             bool ok = false;
             std::string error;
             try {
+                const TaskLock lock(t.dir);
                 ok = run_task(t, source_path, make, obs, stop);
             } catch (const std::exception &e) {
                 error = e.what();
@@ -1072,25 +1124,24 @@ void write_outputs(const ExperimentSpec &spec, const ExperimentSummary &S, const
 
 } // namespace
 
-std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
+namespace {
+
+/* FILE holds CONTENT, or it is written now; a folder made with other settings is refused
+ * before anything in it is touched. */
+void write_or_compare(const std::string &path, const std::string &content, const std::string &what)
 {
-    const std::string exp_dir = join_path(opt.out_dir, spec.name);
-    make_dirs(exp_dir);
-    // One simevo per experiment folder: two writers would interleave their journals.
-    const std::string lock_path = join_path(exp_dir, ".lock");
-    const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (lock_fd < 0 || ::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
-        if (lock_fd >= 0) {
-            ::close(lock_fd);
+    std::string existing;
+    if (read_file(path, existing)) {
+        if (existing != content) {
+            throw UserError(path + ": this output folder holds " + what + "; use another --out");
         }
-        throw UserError(exp_dir + ": another simevo is running in this folder (or it cannot be locked)");
+    } else {
+        write_file_atomic(path, content);
     }
-    struct LockGuard {
-        int fd;
-        ~LockGuard() { ::close(fd); }
-    } lock_guard{lock_fd};
-    const std::vector<TaskDef> tasks = plan_tasks(spec, exp_dir);
-    // Refuse a folder made with other settings before touching anything in it.
+}
+
+std::string settings_text(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks, const std::string &exp_dir)
+{
     std::string settings = "# simevo experiment " + spec.name + ": the settings of every task\n";
     for (const TaskDef &t : tasks) {
         // a transfer's source policy does not exist yet: name the task that will make it
@@ -1099,28 +1150,19 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
                                        : t.source_policy_file;
         settings += "\n[" + t.dir.substr(exp_dir.size() + 1) + "]\n" + task_settings_text(t, source);
     }
-    const std::string settings_path = join_path(exp_dir, "settings.txt");
-    std::string existing;
-    if (read_file(settings_path, existing)) {
-        if (existing != settings) {
-            throw UserError(settings_path + ": this output folder holds " + spec.name +
-                            " with other settings (preset, runs, episodes or seeds); use another --out");
-        }
-    } else {
-        write_file_atomic(settings_path, settings);
-    }
-    const std::string status_path = join_path(exp_dir, "STATUS");
-    write_file_atomic(status_path, "incomplete: running or interrupted; rerun the same command to resume\n");
+    return settings;
+}
 
-    SimWorlds worlds;
-    // Load every robot and environment up front so a bad name fails before any work.
+/* Every robot, environment and source policy file of the plan, so a bad one fails before
+ * any work. */
+void probe_inputs(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks, SimWorlds &worlds, bool use_table)
+{
     std::set<std::string> probed;
     for (const TaskDef &t : tasks) {
         if (probed.insert(t.scenario.describe()).second) {
-            SimRunner probe(worlds, t.scenario, t.context_seed, opt.use_table);
+            SimRunner probe(worlds, t.scenario, t.context_seed, use_table);
         }
     }
-    SimRunner target_runner(worlds, spec.target, spec.seed, opt.use_table);
     for (const SourceSpec &s : spec.sources) {
         if (!s.policy_file.empty()) {
             try {
@@ -1130,19 +1172,59 @@ std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
             }
         }
     }
+}
 
+} // namespace
+
+std::vector<TaskDef> prepare_experiment(const ExperimentSpec &spec, const RunOptions &opt)
+{
+    const std::string exp_dir = join_path(opt.out_dir, spec.name);
+    make_dirs(exp_dir);
+    const std::vector<TaskDef> tasks = plan_tasks(spec, exp_dir);
+    write_or_compare(join_path(exp_dir, "settings.txt"), settings_text(spec, tasks, exp_dir),
+                     spec.name + " with other settings (preset, runs, episodes or seeds)");
+    if (!opt.run_record.empty()) {
+        write_or_compare(join_path(exp_dir, "run.txt"), opt.run_record,
+                         spec.name + " run with other options (experiment file, preset or overrides)");
+    }
+    if (!file_exists(join_path(exp_dir, "summary.md"))) {
+        write_file_atomic(join_path(exp_dir, "STATUS"),
+                          "incomplete: running or interrupted; rerun the same command to resume\n");
+    }
+    SimWorlds worlds;
+    probe_inputs(spec, tasks, worlds, opt.use_table);
+    return tasks;
+}
+
+void finish_experiment(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks, const RunOptions &opt)
+{
+    const std::string exp_dir = join_path(opt.out_dir, spec.name);
+    SimWorlds worlds;
+    SimRunner target_runner(worlds, spec.target, spec.seed, opt.use_table);
+    const ExperimentSummary S = summarize(spec, tasks);
+    write_outputs(spec, S, tasks, exp_dir, worlds, target_runner, opt);
+    write_file_atomic(join_path(exp_dir, "summary.md"), summary_md(spec, S, opt, opt.plots));
+    write_file_atomic(join_path(exp_dir, "STATUS"), "complete\n");
+}
+
+void run_experiment_tasks(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks, const RunOptions &opt,
+                          const std::vector<char> &selected)
+{
+    SimWorlds worlds;
     const bool use_table = opt.use_table;
     RunnerFactory make = [&worlds, use_table](const Scenario &sc, uint64_t seed) -> std::unique_ptr<EpisodeRunner> {
         return std::make_unique<SimRunner>(worlds, sc, seed, use_table);
     };
     const bool progress = opt.progress < 0 ? ::isatty(2) != 0 : opt.progress != 0;
-    run_tasks(tasks, make, opt.jobs, progress, spec.name);
+    run_tasks(tasks, make, opt.jobs, progress, spec.name, selected);
+}
 
-    const ExperimentSummary S = summarize(spec, tasks);
-    write_outputs(spec, S, tasks, exp_dir, worlds, target_runner, opt);
-    write_file_atomic(join_path(exp_dir, "summary.md"), summary_md(spec, S, opt, opt.plots));
-    write_file_atomic(status_path, "complete\n");
-    return exp_dir;
+std::string run_experiment(const ExperimentSpec &spec, const RunOptions &opt)
+{
+    const std::vector<TaskDef> tasks = prepare_experiment(spec, opt);
+    run_experiment_tasks(spec, tasks, opt, {});
+    finish_experiment(spec, tasks, opt);
+    return join_path(opt.out_dir, spec.name);
 }
 
 } // namespace qnav

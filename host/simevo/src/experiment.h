@@ -32,6 +32,8 @@ struct RunOptions {
     std::string preset = "full";    /* recorded in the summary's command line */
     std::string overrides;          /* the command line's overrides (" --runs 3 ..."), also
                                        recorded there, so the line regenerates these results */
+    std::string run_record;         /* run.txt: what `simevo summarize` rebuilds the spec
+                                       from (written once, compared later); "" = none */
 };
 
 /* Target episodes after which a target run's best member is evaluated held out: the
@@ -41,10 +43,13 @@ std::vector<uint64_t> checkpoint_grid(const ExperimentSpec &spec);
 /* Tasks of an experiment, in an order where every source precedes its transfers. */
 std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &exp_dir);
 
-/* Run tasks on `jobs` threads; a task with source_task waits for it. Throws UserError on
- * the first failure (others are stopped). */
+/* Run tasks on `jobs` threads; a task with source_task waits for it. Each task is locked
+ * (flock on its folder's .lock) while it runs. selected (empty = all) names the tasks to
+ * run; the others belong to other processes, and a selected transfer whose source is not
+ * selected needs that source's done file, else UserError. Throws UserError on the first
+ * failure (others are stopped). */
 void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, unsigned jobs,
-               bool progress, const std::string &title);
+               bool progress, const std::string &title, std::vector<char> selected = {});
 
 /* Summary statistics of a finished experiment, from its task folders only. */
 
@@ -154,6 +159,14 @@ void run_plot(const RunOptions &opt, const std::string &script, const std::strin
 /* Where an experiment's best policy of one condition is copied (best-<condition>.policy
  * beside summary.md; written with the summary). */
 std::string best_policy_copy(const std::string &exp_dir, const std::string &condition);
+
+/* The three steps of a run. prepare: create OUT/<name>, refuse a folder with other
+ * settings (settings.txt, run.txt), check every input; returns the plan. run: the selected
+ * tasks (empty = all) on opt.jobs threads. finish: summary, curves, policies, plots. */
+std::vector<TaskDef> prepare_experiment(const ExperimentSpec &spec, const RunOptions &opt);
+void run_experiment_tasks(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks, const RunOptions &opt,
+                          const std::vector<char> &selected);
+void finish_experiment(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks, const RunOptions &opt);
 
 /* Run a spec end to end (resuming what is there). Returns the experiment folder. Throws
  * UserError. */

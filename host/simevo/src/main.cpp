@@ -1,7 +1,8 @@
 /*
  * simevo: evolve navigation policies in the simulator with the paper's ε-greedy
  * neuro-evolution, transfer them between situations, and run the paper's five transfer
- * experiments with summaries and plots. Subcommands: run, list, evolve, eval, quality.
+ * experiments with summaries and plots. Subcommands: run, summarize, slurm, list, evolve,
+ * eval, quality.
  * Every problem ends in one line on stderr: exit status 2 for bad usage or bad input found
  * before any work starts (options, experiment files, policy files, robots, environments),
  * 1 for a failure while running (docs/cli.md).
@@ -14,11 +15,15 @@
 #include <chrono>
 #include <cinttypes>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
+#include <sys/wait.h>
 #include <dirent.h>
 #include <algorithm>
 #include <unistd.h>
 
+#include "cluster.h"
 #include "experiment.h"
 #include "files.h"
 #include "qnav/policy_io.h"
@@ -67,16 +72,6 @@ std::string resolve_experiment(const std::string &arg, const std::string &dir)
     return path;
 }
 
-/* set(scenario) for the target and every source of s (settings that apply to all). */
-template <typename F>
-void for_each_scenario(ExperimentSpec &s, F set)
-{
-    set(s.target);
-    for (SourceSpec &src : s.sources) {
-        set(src.scenario);
-    }
-}
-
 /* The rule --fitness names ("" = the default). Throws UserError. */
 qnav_sim_fitness_rule_t fitness_option(const std::string &name)
 {
@@ -87,43 +82,122 @@ qnav_sim_fitness_rule_t fitness_option(const std::string &name)
     return rule;
 }
 
-/* --controller NAME for every scenario of s. Throws UserError. */
-void set_controller(ExperimentSpec &s, const std::string &name)
+/* The options of `simevo run` that change results (also taken by `simevo slurm`). */
+void add_run_args(CLI::App *c, RunArgs &a)
 {
-    ControllerReading c;
-    if (!controller_reading_parse(name, &c)) {
-        throw UserError("--controller: '" + name + "' is not one of body, literal");
+    c->add_option("--preset", a.preset, "'full' (the file's values) or a preset the file defines, e.g. 'quick'")->capture_default_str();
+    c->add_option("--runs", a.runs, "override the number of independent runs")->check(CLI::Range(int64_t(1), int64_t(10000)));
+    c->add_option("--episodes", a.episodes, "override target episodes")->check(CLI::Range(int64_t(1), int64_t(100000000)));
+    c->add_option("--source-episodes", a.source_episodes, "override source episodes")->check(CLI::Range(int64_t(1), int64_t(100000000)));
+    c->add_option("--eval-episodes", a.eval_episodes, "override held-out evaluation episodes")->check(CLI::Range(int64_t(1), int64_t(1000000)));
+    c->add_option("--seed", a.seed, "override the master seed")->check(CLI::Range(int64_t(0), INT64_MAX));
+    c->add_option("--per-candidate", a.per_candidate, "override episodes per candidate (k)")->check(CLI::Range(int64_t(1), int64_t(1000)));
+    c->add_option("--fitness", a.fitness, "override the fitness rule: progress or paper (docs/sim.md)");
+    c->add_option("--controller", a.controller,
+                  "override the controller's reading: body, or literal (the paper's per-sector "
+                  "mapping, no speed guard, rank by quality; docs/architecture.md)");
+    c->add_flag("--network-mode", a.network_mode, "run the controller in network mode instead of table mode");
+}
+
+/* An absolute path for a file that exists (scripts and run.txt must work from anywhere). */
+std::string absolute_path(const std::string &path)
+{
+    char *r = ::realpath(path.c_str(), nullptr);
+    if (!r) {
+        throw UserError(path + ": " + std::strerror(errno));
     }
-    for_each_scenario(s, [c](Scenario &sc) { sc.controller = c; });
+    std::string out = r;
+    std::free(r);
+    return out;
 }
 
-/* --fitness NAME for every scenario of s. Throws UserError. */
-void set_fitness(ExperimentSpec &s, const std::string &name)
+/* OUT made absolute (created if missing). */
+std::string absolute_dir(const std::string &dir)
 {
-    const qnav_sim_fitness_rule_t rule = fitness_option(name);
-    for_each_scenario(s, [rule](Scenario &sc) { sc.fitness = rule; });
+    make_dirs(dir);
+    return absolute_path(dir);
 }
 
-/* The overrides given to `simevo run` that change results, as flags (" --runs 3 --fitness
- * paper"); --network-mode is not one (bit-identical to table mode by design). */
-std::string override_flags(int64_t runs, int64_t episodes, int64_t source_episodes, int64_t eval_episodes, int64_t seed,
-                           int64_t per_candidate, const std::string &fitness, const std::string &controller)
+/* Specs of every experiment named (all parsed first: a bad file fails before any work),
+ * with every robot, environment and source policy file checked. */
+std::vector<std::pair<std::string, ExperimentSpec>> load_run_specs(const std::vector<std::string> &names,
+                                                                   const std::string &experiments_dir,
+                                                                   const RunArgs &args)
 {
-    std::string o;
-    auto add = [&o](const char *flag, int64_t v, bool given) {
-        if (given) {
-            o += std::string(" ") + flag + " " + std::to_string(v);
+    std::vector<std::string> paths;
+    for (const auto &n : names) {
+        if (n == "all") {
+            for (const auto &k : list_experiments(experiments_dir)) {
+                paths.push_back(join_path(experiments_dir, k + ".toml"));
+            }
+        } else {
+            paths.push_back(resolve_experiment(n, experiments_dir));
         }
-    };
-    add("--runs", runs, runs > 0);
-    add("--episodes", episodes, episodes > 0);
-    add("--source-episodes", source_episodes, source_episodes > 0);
-    add("--eval-episodes", eval_episodes, eval_episodes > 0);
-    add("--seed", seed, seed >= 0);
-    add("--per-candidate", per_candidate, per_candidate > 0);
-    o += fitness.empty() ? "" : " --fitness " + fitness;
-    o += controller.empty() ? "" : " --controller " + controller;
-    return o;
+    }
+    std::vector<std::pair<std::string, ExperimentSpec>> specs;
+    for (const auto &p : paths) {
+        specs.emplace_back(absolute_path(p), load_run_spec(p, args));
+    }
+    SimWorlds probe_worlds;
+    for (const auto &ps : specs) {
+        const ExperimentSpec &s = ps.second;
+        SimRunner target(probe_worlds, s.target, s.seed, true);
+        for (const auto &src : s.sources) {
+            SimRunner source(probe_worlds, src.scenario, s.seed, true);
+            if (!src.policy_file.empty()) {
+                (void)read_policy_file(src.policy_file);
+            }
+        }
+    }
+    return specs;
+}
+
+/* RunOptions of a run with these args (plots, progress and folders set by the caller). */
+void set_run_options(RunOptions &opt, const RunArgs &args, const std::string &experiment_file)
+{
+    opt.use_table = !args.network_mode;
+    opt.preset = args.preset;
+    opt.overrides = override_flags(args);
+    opt.run_record = run_record_text(experiment_file, args);
+}
+
+/* `simevo summarize DIR`: the experiment's spec from DIR/run.txt, every task finished, then
+ * the same outputs as a local run. Returns the exit status. */
+int summarize_folder(const std::string &dir_arg, RunOptions opt, bool &started)
+{
+    std::string dir = dir_arg;
+    while (dir.size() > 1 && dir.back() == '/') {
+        dir.pop_back();
+    }
+    const std::string record_path = join_path(dir, "run.txt");
+    std::string record;
+    if (!read_file(record_path, record)) {
+        throw UserError(record_path + ": not found; " + dir + " is not a simevo experiment folder");
+    }
+    std::string file;
+    const RunArgs args = parse_run_record(record, record_path, &file);
+    const ExperimentSpec spec = load_run_spec(file, args);
+    const std::size_t slash = dir.find_last_of('/');
+    const std::string base = slash == std::string::npos ? dir : dir.substr(slash + 1);
+    if (base != spec.name) {
+        throw UserError(dir + ": holds experiment '" + spec.name + "' (" + record_path + "), the folder must be named so");
+    }
+    opt.out_dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : dir.substr(0, slash));
+    set_run_options(opt, args, file);
+    started = true; // bad input above is exit 2; what fails from here on, 1
+    const std::vector<TaskDef> tasks = prepare_experiment(spec, opt);
+    const std::vector<std::string> missing = unfinished_tasks(tasks, join_path(opt.out_dir, spec.name));
+    for (const std::string &m : missing) {
+        std::fprintf(stderr, "simevo: %s/%s\n", dir.c_str(), m.c_str());
+    }
+    if (!missing.empty()) {
+        std::fprintf(stderr, "simevo: %s: %zu of %zu tasks not finished; no summary written (rerun their shares)\n",
+                     dir.c_str(), missing.size(), tasks.size());
+        return QNAV_EXIT_FAILURE;
+    }
+    finish_experiment(spec, tasks, opt);
+    std::printf("%s: merged %zu tasks; summary %s/summary.md\n", spec.name.c_str(), tasks.size(), dir.c_str());
+    return 0;
 }
 
 /* What a user takes to a robot: each transfer's best policy and how often it arrives. */
@@ -140,6 +214,52 @@ void print_transfer_arrival(const ExperimentSpec &s, const std::string &dir)
                     100.0 * c.arrival_per_run[static_cast<std::size_t>(c.best_run)], s.eval_episodes,
                     100.0 * c.arrival.mean);
     }
+}
+
+/* `simevo run --tasks I/N [--stage S]`: the share's tasks only, no summary. */
+void run_share(const ExperimentSpec &s, const RunOptions &opt, const Share &share,
+               std::chrono::steady_clock::time_point t0)
+{
+    const std::vector<TaskDef> tasks = prepare_experiment(s, opt);
+    const std::vector<char> selected = select_share(tasks, share);
+    std::size_t n = 0;
+    for (char c : selected) {
+        n += c != 0;
+    }
+    run_experiment_tasks(s, tasks, opt, selected);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("%s: share %u/%u%s: %zu tasks done in %.1f s; when every share is done: simevo summarize %s\n",
+                s.name.c_str(), share.index, share.count,
+                share.stage ? (" of stage " + std::to_string(share.stage)).c_str() : "", n, secs,
+                join_path(opt.out_dir, s.name).c_str());
+}
+
+/* `simevo slurm`: the folder prepared as for a run, the scripts written, and submitted. */
+int write_slurm(const std::pair<std::string, ExperimentSpec> &ps, const RunArgs &args, RunOptions opt,
+                SlurmOptions so, bool plots, bool submit)
+{
+    so.simevo = absolute_path("/proc/self/exe");
+    so.experiment_file = ps.first;
+    so.out_dir = absolute_dir(opt.out_dir);
+    so.tools_dir = absolute_path(opt.tools_dir);
+    so.plots = plots;
+    opt.out_dir = so.out_dir;
+    set_run_options(opt, args, ps.first);
+    const std::vector<TaskDef> tasks = prepare_experiment(ps.second, opt);
+    const std::string exp_dir = join_path(so.out_dir, ps.second.name);
+    const std::string script = write_slurm_scripts(tasks, exp_dir, args, so);
+    std::printf("%s: %zu tasks (%zu in stage 1, %zu in stage 2 after their sources); submit with: sh %s\n",
+                ps.second.name.c_str(), tasks.size(), stage_tasks(tasks, 1).size(), stage_tasks(tasks, 2).size(),
+                script.c_str());
+    if (!submit) {
+        return 0;
+    }
+    std::fflush(stdout);
+    const int rc = std::system(("/bin/sh " + sh_quote(script)).c_str());
+    if (rc != 0) {
+        throw UserError(script + ": sbatch failed (exit " + std::to_string(WIFEXITED(rc) ? WEXITSTATUS(rc) : -1) + ")");
+    }
+    return 0;
 }
 
 Scenario scenario_from(const std::string &env, const std::string &robot, uint32_t sectors, double noise,
@@ -171,28 +291,45 @@ int main(int argc, char **argv)
     std::vector<std::string> names;
     RunOptions opt;
     opt.tools_dir = resource_dir("QNAV_TOOLS_DIR", "tools", std::string(QNAV_SOURCE_DIR) + "/tools");
-    std::string preset = "full";
-    int64_t runs = 0, episodes = 0, source_episodes = 0, eval_episodes = 0, seed = -1, per_candidate = 0;
-    std::string fitness, controller;
-    bool no_plot = false, no_progress = false, network_mode = false;
+    RunArgs run_args;
+    std::string fitness;
+    bool no_plot = false, no_progress = false;
+    std::string share_text;
+    int stage = 0;
     run->add_option("experiment", names, "experiment name(s), a .toml path, or 'all'")->required();
-    run->add_option("--preset", preset, "'full' (the file's values) or a preset the file defines, e.g. 'quick'")->capture_default_str();
+    add_run_args(run, run_args);
     run->add_option("--out", opt.out_dir, "output folder; results go to OUT/<experiment>")->capture_default_str();
     run->add_option("-j,--jobs", opt.jobs, "worker threads (0 = all cores)")->capture_default_str();
-    run->add_option("--runs", runs, "override the number of independent runs")->check(CLI::Range(int64_t(1), int64_t(10000)));
-    run->add_option("--episodes", episodes, "override target episodes")->check(CLI::Range(int64_t(1), int64_t(100000000)));
-    run->add_option("--source-episodes", source_episodes, "override source episodes")->check(CLI::Range(int64_t(1), int64_t(100000000)));
-    run->add_option("--eval-episodes", eval_episodes, "override held-out evaluation episodes")->check(CLI::Range(int64_t(1), int64_t(1000000)));
-    run->add_option("--seed", seed, "override the master seed")->check(CLI::Range(int64_t(0), INT64_MAX));
-    run->add_option("--per-candidate", per_candidate, "override episodes per candidate (k)")->check(CLI::Range(int64_t(1), int64_t(1000)));
-    run->add_option("--fitness", fitness, "override the fitness rule: progress or paper (docs/sim.md)");
-    run->add_option("--controller", controller,
-                    "override the controller's reading: body, or literal (the paper's per-sector "
-                    "mapping, no speed guard, rank by quality; docs/architecture.md)");
     run->add_option("--tools-dir", opt.tools_dir, "folder with plot_learning.py and plot_policy.py")->capture_default_str();
+    run->add_option("--tasks", share_text,
+                    "run only the I-th of N shares of the tasks (I/N); no summary: 'simevo summarize' merges "
+                    "(docs/cluster.md)");
+    run->add_option("--stage", stage, "with --tasks: share out only stage 1 (no dependency) or stage 2 (transfers "
+                                      "from an evolved source)")->check(CLI::Range(1, 2));
     run->add_flag("--no-plot", no_plot, "skip the PNG plots");
     run->add_flag("--no-progress", no_progress, "no progress line even on a terminal");
-    run->add_flag("--network-mode", network_mode, "run the controller in network mode instead of table mode");
+
+    auto *summ = app.add_subcommand("summarize", "merge the finished tasks of an experiment folder into its summary");
+    std::string summ_dir;
+    summ->add_option("folder", summ_dir, "experiment folder (OUT/<experiment>)")->required();
+    summ->add_option("--tools-dir", opt.tools_dir, "folder with the plot scripts")->capture_default_str();
+    summ->add_flag("--no-plot", no_plot, "skip the PNG plots");
+
+    auto *slurm = app.add_subcommand("slurm", "write (and with --submit submit) Slurm job arrays for an experiment");
+    std::string slurm_name;
+    SlurmOptions so;
+    bool submit = false;
+    slurm->add_option("experiment", slurm_name, "experiment name or .toml path")->required();
+    add_run_args(slurm, run_args);
+    slurm->add_option("--out", opt.out_dir, "output folder (shared by every node); results go to OUT/<experiment>")->capture_default_str();
+    slurm->add_option("--partition", so.partition, "Slurm partition (default: the cluster's)");
+    slurm->add_option("--time", so.time, "time limit per array task, e.g. 2:00:00 (default: the partition's)");
+    slurm->add_option("--array-limit", so.array_limit, "at most this many array tasks at once (0 = no limit)")->capture_default_str();
+    slurm->add_option("--tasks-per-job", so.tasks_per_job, "simevo tasks per array task")->capture_default_str()->check(CLI::Range(1u, 1000000u));
+    slurm->add_option("-j,--jobs", so.jobs, "threads per array task (--cpus-per-task)")->capture_default_str()->check(CLI::Range(1u, 1024u));
+    slurm->add_option("--tools-dir", opt.tools_dir, "folder with the plot scripts, for the summarize job")->capture_default_str();
+    slurm->add_flag("--no-plot", no_plot, "the summarize job skips the PNG plots");
+    slurm->add_flag("--submit", submit, "submit the arrays with sbatch now");
 
     auto *lst = app.add_subcommand("list", "list the experiment files");
 
@@ -269,61 +406,41 @@ int main(int argc, char **argv)
             return 0;
         }
         if (*run) {
-            std::vector<std::string> paths;
-            for (const auto &n : names) {
-                if (n == "all") {
-                    for (const auto &k : list_experiments(experiments_dir)) {
-                        paths.push_back(join_path(experiments_dir, k + ".toml"));
-                    }
-                } else {
-                    paths.push_back(resolve_experiment(n, experiments_dir));
-                }
+            if (stage != 0 && share_text.empty()) {
+                share_text = "1/1";
             }
-            // Parse everything first: a bad file fails before any work starts.
-            std::vector<ExperimentSpec> specs;
-            for (const auto &p : paths) {
-                ExperimentSpec s = load_experiment(p);
-                apply_preset(s, preset);
-                if (runs > 0) s.runs = static_cast<uint32_t>(runs);
-                if (episodes > 0) s.target_episodes = static_cast<uint64_t>(episodes);
-                if (source_episodes > 0) for (auto &src : s.sources) src.episodes = static_cast<uint64_t>(source_episodes);
-                if (eval_episodes > 0) s.eval_episodes = static_cast<uint32_t>(eval_episodes);
-                if (seed >= 0) s.seed = static_cast<uint64_t>(seed);
-                if (per_candidate > 0) s.evolution.episodes_per_candidate = static_cast<uint32_t>(per_candidate);
-                if (!fitness.empty()) set_fitness(s, fitness);
-                if (!controller.empty()) set_controller(s, controller);
-                specs.push_back(s);
-            }
+            const Share share = share_text.empty() ? Share{} : parse_share(share_text, stage);
+            const auto specs = load_run_specs(names, experiments_dir, run_args);
             opt.plots = !no_plot;
             opt.progress = no_progress ? 0 : -1;
-            opt.use_table = !network_mode;
-            opt.preset = preset;
-            opt.overrides = override_flags(runs, episodes, source_episodes, eval_episodes, seed, per_candidate, fitness,
-                                           controller);
-            // every robot, environment and source policy file now, not after other runs
-            SimWorlds probe_worlds;
-            for (const auto &s : specs) {
-                SimRunner target(probe_worlds, s.target, s.seed, true);
-                for (const auto &src : s.sources) {
-                    SimRunner source(probe_worlds, src.scenario, s.seed, true);
-                    if (!src.policy_file.empty()) {
-                        (void)read_policy_file(src.policy_file);
-                    }
-                }
-            }
             started = true;
-            for (const auto &s : specs) {
+            for (const auto &ps : specs) {
+                const ExperimentSpec &s = ps.second;
+                set_run_options(opt, run_args, ps.first);
                 const auto t0 = std::chrono::steady_clock::now();
-                const std::string dir = run_experiment(s, opt);
-                const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-                std::printf("%s: complete in %.1f s; summary %s/summary.md\n", s.name.c_str(), secs, dir.c_str());
-                if (opt.plots) {
-                    std::printf("%s: plot %s/learning.png\n", s.name.c_str(), dir.c_str());
+                if (share_text.empty()) {
+                    const std::string dir = run_experiment(s, opt);
+                    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                    std::printf("%s: complete in %.1f s; summary %s/summary.md\n", s.name.c_str(), secs, dir.c_str());
+                    if (opt.plots) {
+                        std::printf("%s: plot %s/learning.png\n", s.name.c_str(), dir.c_str());
+                    }
+                    print_transfer_arrival(s, dir);
+                } else {
+                    run_share(s, opt, share, t0);
                 }
-                print_transfer_arrival(s, dir);
                 std::fflush(stdout);
             }
             return 0;
+        }
+        if (*summ) {
+            opt.plots = !no_plot;
+            return summarize_folder(summ_dir, opt, started);
+        }
+        if (*slurm) {
+            const auto specs = load_run_specs({slurm_name}, experiments_dir, run_args);
+            started = true;
+            return write_slurm(specs.front(), run_args, opt, so, !no_plot, submit);
         }
         if (*evolve) {
             if (const char *p = evolution_params_problem(ep); *p) {
