@@ -6,8 +6,9 @@ Usage: plot_learning.py EXPERIMENT_DIR [OUT.png]
 Reads EXPERIMENT_DIR/curves.csv and summary.json (written by `simevo run`) and draws, per
 condition, the mean over runs with its 95% confidence band of (left) the population's best
 fitness, (middle) the R of the candidates (binned) and (right) the fraction of the
-candidates' episodes that reached the destination (binned); the probabilistic policy is a
-horizontal reference band (its held-out mean and 95% CI). Writes EXPERIMENT_DIR/learning.png
+candidates' episodes that reached the destination (binned); the two references, the
+probabilistic policy (dashed) and VFH+ (dotted), are horizontal bands (their held-out mean
+and 95% CI). Writes EXPERIMENT_DIR/learning.png
 unless OUT.png is given. Needs matplotlib only.
 """
 import os
@@ -40,7 +41,7 @@ def main(argv):
     read_csv(os.path.join(exp, "curves.csv"), add)
 
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.6), dpi=110, layout="constrained")
-    colors = {"direct": "tab:red", "probabilistic": "tab:gray"}
+    colors = {"direct": "tab:red", "probabilistic": "tab:gray", "vfh": "tab:brown"}
     palette = ["tab:blue", "tab:green", "tab:purple", "tab:orange"]
     conds = {c["label"]: c for c in summary["conditions"]}
     transfer = [k for k in curves if k.startswith("transfer-")]
@@ -63,16 +64,18 @@ def main(argv):
             ax.plot(c["episode"], [v * scale for v in c[m_key]], color=colors[k], lw=1.8, label=label)
             ax.fill_between(c["episode"], [v * scale for v in c[lo_key]], [v * scale for v in c[hi_key]],
                             color=colors[k], alpha=0.2, lw=0)
-        p = conds.get("probabilistic")
-        if p and ref == "final_mean" and p["final_mean"] is not None:
-            mean = p["final_mean"]
-            ci = p["final_ci95"] or 0.0
-            ax.axhline(mean, color=colors["probabilistic"], ls="--", lw=1.5, label="probabilistic (held out)")
-            ax.axhspan(mean - ci, mean + ci, color=colors["probabilistic"], alpha=0.15, lw=0)
-        elif p and ref == "arrival" and p.get("arrival"):
-            a = p["arrival"]
-            ax.axhline(100 * a["mean"], color=colors["probabilistic"], ls="--", lw=1.5, label="probabilistic (held out)")
-            ax.axhspan(100 * a["ci95_low"], 100 * a["ci95_high"], color=colors["probabilistic"], alpha=0.15, lw=0)
+        for ref_label, ls in (("probabilistic", "--"), ("vfh", ":")):
+            p = conds.get(ref_label)
+            name = "probabilistic (held out)" if ref_label == "probabilistic" else "VFH+ (held out)"
+            if p and ref == "final_mean" and p["final_mean"] is not None:
+                mean = p["final_mean"]
+                ci = p["final_ci95"] or 0.0
+                ax.axhline(mean, color=colors[ref_label], ls=ls, lw=1.5, label=name)
+                ax.axhspan(mean - ci, mean + ci, color=colors[ref_label], alpha=0.15, lw=0)
+            elif p and ref == "arrival" and p.get("arrival"):
+                a = p["arrival"]
+                ax.axhline(100 * a["mean"], color=colors[ref_label], ls=ls, lw=1.5, label=name)
+                ax.axhspan(100 * a["ci95_low"], 100 * a["ci95_high"], color=colors[ref_label], alpha=0.15, lw=0)
         ax.set_xlabel("episode in the target situation")
         ax.set_ylabel(ylabel, fontsize=9)
         ax.grid(alpha=0.3)

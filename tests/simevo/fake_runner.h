@@ -42,6 +42,15 @@ public:
         o.reached = d2 < 4.0;
         return o;
     }
+    EpisodeOutcome run_controller(const char *, uint64_t episode_seed) override
+    {
+        ++calls; // a policy-free reference (VFH+): a fixed score, like the probabilistic one
+        Rng r(episode_seed ^ 0x5646u);
+        EpisodeOutcome o;
+        o.R = -25.0 + (r.uniform01() - 0.5);
+        o.reached = r.uniform01() < 0.5;
+        return o;
+    }
     std::atomic<long> calls{0};
 
 private:

@@ -33,9 +33,9 @@ def main(exe, src):
     with open(os.path.join(exp, "episodes.csv")) as f:
         rows = list(csv.DictReader(f))
     conditions = sorted({row["condition"].split(" (")[0] for row in rows})
-    assert conditions == ["direct", "probabilistic", "transfer-open"], conditions
+    assert conditions == ["direct", "probabilistic", "transfer-open", "vfh"], conditions
     episodes = {(row["condition"], row["episode"]) for row in rows}
-    assert len(episodes) == 3 * 3, episodes  # 3 conditions x 3 held-out episodes
+    assert len(episodes) == 4 * 3, episodes  # 4 conditions (with VFH+) x 3 held-out episodes
     w, h = png_size(os.path.join(exp, "episodes.png"))
     assert h > w, f"episodes.png {w}x{h}: expected 3 rows of 3 panels (taller than wide)"
 

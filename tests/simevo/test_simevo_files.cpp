@@ -315,8 +315,11 @@ arrival_threshold = 50
     assert_true(f1 == f3);
 
     const ExperimentSummary S = summarize(spec, t1);
-    assert_int_equal(S.conditions.size(), 4); // transfer-a, transfer-b, direct, probabilistic
-    assert_int_equal(S.comparisons.size(), 5);
+    assert_int_equal(S.conditions.size(), 5); // transfer-a, transfer-b, direct, probabilistic, vfh
+    assert_int_equal(S.comparisons.size(), 8); // 2 vs direct, 3 vs each reference
+    assert_string_equal(S.conditions[4].label.c_str(), "vfh");
+    assert_int_equal(S.conditions[4].final_per_run.size(), 7); // VFH+: per episode, same held-out set
+    assert_true(std::fabs(S.conditions[4].final_mean - S.conditions[3].final_mean) > 1.0); // its own episodes
     const ConditionSummary &direct = S.conditions[2];
     assert_string_equal(direct.label.c_str(), "direct");
     assert_int_equal(direct.final_per_run.size(), 3);

@@ -33,6 +33,9 @@ class EpisodeRunner {
 public:
     virtual ~EpisodeRunner() = default;
     virtual EpisodeOutcome run(const qnav_policy_t &policy, uint64_t episode_seed) = 0;
+    /* One episode driven by a policy-free controller of libqnav's table (qnav/nav.h),
+     * e.g. "vfh" for the VFH+ reference. */
+    virtual EpisodeOutcome run_controller(const char *controller, uint64_t episode_seed) = 0;
     /* The probabilistic policy to compare against: the one tuned for the runner's robot
      * (libqnav's defaults unless a runner knows better). */
     virtual qnav_policy_t probabilistic_policy() const

@@ -282,10 +282,11 @@ std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &e
 
 /* ---- conditions ------------------------------------------------------------------ */
 
-const ConditionDecl kConditions[3] = {
+const ConditionDecl kConditions[4] = {
     {ConditionKind::Transfer, "transfer-", true},
     {ConditionKind::Direct, "direct", true},
     {ConditionKind::Probabilistic, "probabilistic", false},
+    {ConditionKind::Vfh, "vfh", false},
 };
 
 const ConditionDecl &condition_decl(ConditionKind kind)
@@ -297,6 +298,8 @@ const ConditionDecl &condition_decl(ConditionKind kind)
         return kConditions[1];
     case ConditionKind::Probabilistic:
         return kConditions[2];
+    case ConditionKind::Vfh:
+        return kConditions[3];
     }
     return kConditions[1];
 }
@@ -619,17 +622,20 @@ ConditionSummary summarize_condition(const ExperimentSpec &spec, const std::vect
     return c;
 }
 
-ConditionSummary summarize_probabilistic(const std::vector<TaskDef> &tasks)
+/* A reference (kind Probabilistic: eval.csv, Vfh: eval-vfh.csv of the reference task):
+ * one policy or controller, so its CIs are over episodes. */
+ConditionSummary summarize_reference(const std::vector<TaskDef> &tasks, ConditionKind kind)
 {
     ConditionSummary prob;
-    prob.kind = ConditionKind::Probabilistic;
+    prob.kind = kind;
     prob.label = condition_label(prob.kind);
     for (const TaskDef &t : tasks) {
         if (t.kind != TaskKind::EvalProbabilistic) {
             continue;
         }
         double reached = 0;
-        const auto ev = read_eval(join_path(t.dir, "eval.csv"));
+        const auto ev =
+            read_eval(join_path(t.dir, kind == ConditionKind::Vfh ? "eval-vfh.csv" : "eval.csv"));
         for (const auto &o : ev) {
             prob.final_per_run.push_back(o.R);
             prob.arrival_per_run.push_back(o.reached ? 1.0 : 0.0);
@@ -691,8 +697,10 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
     for (const auto &kl : labels) {
         S.conditions.push_back(summarize_condition(spec, tasks, kl.second, kl.first, S, steps, steps_per_bin));
     }
-    S.conditions.push_back(summarize_probabilistic(tasks));
-    const ConditionSummary &prob = S.conditions.back();
+    const std::size_t first_reference = S.conditions.size();
+    for (ConditionKind r : {ConditionKind::Probabilistic, ConditionKind::Vfh}) {
+        S.conditions.push_back(summarize_reference(tasks, r));
+    }
 
     const ConditionSummary &direct = S.conditions[labels.size() - 1];
     auto pct = [](double a, double b) { return std::fabs(b) >= 1.0 ? (a - b) / std::fabs(b) * 100.0 : std::nan(""); };
@@ -715,18 +723,21 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
         cmp.online = welch_t_test(c.online_per_run, direct.online_per_run);
         S.comparisons.push_back(cmp);
     }
-    for (std::size_t i = 0; i < labels.size(); ++i) {
-        const ConditionSummary &c = S.conditions[i];
-        Comparison cmp;
-        cmp.a = c.label;
-        cmp.b = prob.label;
-        cmp.b_kind = prob.kind;
-        cmp.difference = c.final_mean - prob.final_mean;
-        cmp.improvement_pct = pct(c.final_mean, prob.final_mean);
-        cmp.speedup_pct = std::nan("");
-        cmp.test = "one-sample";
-        cmp.t = one_sample_t_test(c.final_per_run, prob.final_mean);
-        S.comparisons.push_back(cmp);
+    for (std::size_t r = first_reference; r < S.conditions.size(); ++r) {
+        const ConditionSummary &prob = S.conditions[r];
+        for (std::size_t i = 0; i < labels.size(); ++i) {
+            const ConditionSummary &c = S.conditions[i];
+            Comparison cmp;
+            cmp.a = c.label;
+            cmp.b = prob.label;
+            cmp.b_kind = prob.kind;
+            cmp.difference = c.final_mean - prob.final_mean;
+            cmp.improvement_pct = pct(c.final_mean, prob.final_mean);
+            cmp.speedup_pct = std::nan("");
+            cmp.test = "one-sample";
+            cmp.t = one_sample_t_test(c.final_per_run, prob.final_mean);
+            S.comparisons.push_back(cmp);
+        }
     }
     return S;
 }
@@ -824,7 +835,9 @@ std::string episodes_csv(const ExperimentSummary &S, const std::string &exp_dir,
         }
         for (uint32_t i = 0; i < std::min(kPictureEpisodes, eval_episodes); ++i) {
             std::vector<qnav_sim_sample_t> trace;
-            const EpisodeOutcome out = runner.run_traced(policy, mix_seed(eval_base, i), &trace);
+            const uint64_t seed = mix_seed(eval_base, i);
+            const EpisodeOutcome out = c.kind == ConditionKind::Vfh ? runner.run_controller_traced("vfh", seed, &trace)
+                                                                    : runner.run_traced(policy, seed, &trace);
             for (const qnav_sim_sample_t &smp : trace) {
                 char b[256];
                 std::snprintf(b, sizeof b, ",%u,%u,%.4f,%.4f,%d,%d,%.4f,%d,%u\n", i, smp.tick, smp.x_m, smp.y_m,
@@ -976,7 +989,7 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
       << S.bin_end.front() << " episodes | last bin | episodes to 90% | best fitness at the end |\n"
       << "|---|---|---|---|---|---|---|---|---|\n";
     for (const ConditionSummary &c : S.conditions) {
-        const bool prob = c.kind == ConditionKind::Probabilistic;
+        const bool prob = !condition_decl(c.kind).evolved;
         o << "| " << c.label << " | " << fmt(c.final_mean) << " ± " << fmt(c.final_ci) << " | " << pct_interval(c.arrival)
           << " | " << num_interval(c.tau_c, 1) << " | " << fmt(c.final_sd)
           << " | " << (prob ? "-" : fmt(c.start)) << " | " << (prob ? "-" : fmt(c.end)) << " | "
@@ -989,13 +1002,14 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
           << (std::isfinite(c.improvement_pct) ? fmt(c.improvement_pct, 1) + "%" : "n/a") << " | "
           << (std::isfinite(c.speedup_pct) ? fmt(c.speedup_pct, 0) + "%" : "-") << " | "
           << (c.test == "welch" ? "Welch t" : "one-sample t") << " | " << fmt_p(c.t) << " | "
-          << (c.b_kind == ConditionKind::Probabilistic ? "-" : fmt_p(c.mann_whitney)) << " | "
-          << (c.b_kind == ConditionKind::Probabilistic ? "-" : fmt(c.online_difference) + " (" + fmt_p(c.online) + ")") << " |\n";
+          << (!condition_decl(c.b_kind).evolved ? "-" : fmt_p(c.mann_whitney)) << " | "
+          << (!condition_decl(c.b_kind).evolved ? "-" : fmt(c.online_difference) + " (" + fmt_p(c.online) + ")") << " |\n";
     }
     o << "\nArrival and recovery ticks: per run the fraction of its best policy's held-out episodes that reached the "
          "destination and its mean recovery ticks (tau_c) per episode, 95% CI over runs (Student t, clipped to the "
-         "possible range); the probabilistic policy is one policy, so its CIs are over episodes (arrival: Wilson score "
-         "interval). "
+         "possible range); the references (the probabilistic policy hand-tuned for the robot, and VFH+: libqnav's "
+         "'vfh' controller with its documented defaults, docs/architecture.md) are one policy or controller each, so "
+         "their CIs are over episodes (arrival: Wilson score interval). "
          "Candidates' R = mean R of the networks evaluated (mutants, each on k episodes), binned by target episodes, mean over runs. "
          "Best fitness = the population's best member's fitness (mean R of its episodes; biased upwards by selection), mean over runs. "
          "Online R = mean R of all candidates of a run (the area under its learning curve; higher = learns faster and better). "
@@ -1078,7 +1092,7 @@ namespace {
 void write_best_policies(const ExperimentSummary &S, const std::string &exp_dir)
 {
     for (const ConditionSummary &c : S.conditions) {
-        if (c.kind == ConditionKind::Probabilistic || c.best_run < 0) {
+        if (!condition_decl(c.kind).evolved || c.best_run < 0) {
             continue;
         }
         const std::string from =

@@ -75,14 +75,15 @@ struct CheckpointSummary {
 enum class ConditionKind {
     Transfer,      /* evolved in the target from a source's best ("transfer-SOURCE") */
     Direct,        /* evolved in the target from a random population */
-    Probabilistic  /* the hand-tuned probabilistic policy: a reference, not evolved */
+    Probabilistic, /* the hand-tuned probabilistic policy: a reference, not evolved */
+    Vfh            /* VFH+ (libqnav's "vfh" controller): a second reference, no policy */
 };
 struct ConditionDecl {
     ConditionKind kind;
     const char *label;   /* the label, or its prefix for Transfer */
     bool evolved;        /* has runs, learning curves and checkpoints */
 };
-extern const ConditionDecl kConditions[3];
+extern const ConditionDecl kConditions[4];
 const ConditionDecl &condition_decl(ConditionKind kind);
 /* "transfer-" + source, "direct", "probabilistic". */
 std::string condition_label(ConditionKind kind, const std::string &source = std::string());

@@ -145,4 +145,39 @@ EpisodeOutcome SimRunner::run_traced(const qnav_policy_t &policy, uint64_t episo
     return out;
 }
 
+EpisodeOutcome SimRunner::run_controller(const char *controller, uint64_t episode_seed)
+{
+    return run_controller_traced(controller, episode_seed, nullptr);
+}
+
+EpisodeOutcome SimRunner::run_controller_traced(const char *controller, uint64_t episode_seed,
+                                                std::vector<qnav_sim_sample_t> *trace)
+{
+    qnav_ctrl_config_t shared;
+    qnav_sim_ctrl_config(sim_, &shared);
+    qnav_nav_t nav;
+    const qnav_status_t st = qnav_nav_init_named(&nav, controller, &shared, nullptr);
+    if (st != QNAV_OK) {
+        throw UserError(std::string("controller ") + controller + ": qnav_nav_init refused it (" +
+                        qnav_status_str(st) + ")");
+    }
+    qnav_sim_result_t res;
+    auto append = [](void *user, const qnav_sim_sample_t *smp) {
+        static_cast<std::vector<qnav_sim_sample_t> *>(user)->push_back(*smp);
+    };
+    const qnav_sim_status_t s =
+        qnav_sim_run_episode_nav(sim_, &nav, episode_seed, &res, trace ? +append : nullptr, trace);
+    if (s != QNAV_SIM_OK) {
+        throw UserError("simulator: episode failed (status " + std::to_string(static_cast<int>(s)) +
+                        "): " + qnav_sim_last_error(sim_));
+    }
+    EpisodeOutcome out;
+    out.R = res.R;
+    out.f1 = res.f1;
+    out.f2 = res.f2;
+    out.tau_c = res.tau_c;
+    out.reached = res.reached;
+    return out;
+}
+
 } // namespace qnav

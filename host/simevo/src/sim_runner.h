@@ -49,6 +49,12 @@ public:
     SimRunner &operator=(const SimRunner &) = delete;
 
     EpisodeOutcome run(const qnav_policy_t &policy, uint64_t episode_seed) override;
+    /* The same episode driven by a policy-free controller ("vfh"), configured from the
+     * robot profile like the path-quality controller. Throws UserError. */
+    EpisodeOutcome run_controller(const char *controller, uint64_t episode_seed) override;
+    /* run_controller, with every tick's sample appended to *trace when not null. */
+    EpisodeOutcome run_controller_traced(const char *controller, uint64_t episode_seed,
+                                         std::vector<qnav_sim_sample_t> *trace);
     /* The same episode, with every trajectory sample appended to *trace (for pictures). */
     EpisodeOutcome run_traced(const qnav_policy_t &policy, uint64_t episode_seed,
                               std::vector<qnav_sim_sample_t> *trace);

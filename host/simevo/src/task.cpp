@@ -168,13 +168,14 @@ std::size_t resume_rows(const std::string &path, const char *header, const char 
     return keep;
 }
 
-/* Held-out evaluation, journaled like the evolution (eval.partial, one line per episode)
- * and renamed to eval.csv when complete. Returns false when stopped. */
-bool run_eval(EpisodeRunner &runner, const qnav_policy_t &policy, const TaskDef &t,
-              const TaskObserver &obs, const std::atomic<bool> &stop)
+/* Held-out evaluation, journaled like the evolution (STEM.partial, one line per episode)
+ * and renamed to STEM.csv when complete; episode(seed) runs one episode. Returns false
+ * when stopped. */
+bool run_eval_episodes(const std::function<EpisodeOutcome(uint64_t)> &episode, const char *stem,
+                       const TaskDef &t, const TaskObserver &obs, const std::atomic<bool> &stop)
 {
-    const std::string partial = join_path(t.dir, "eval.partial");
-    const std::string final_path = join_path(t.dir, "eval.csv");
+    const std::string partial = join_path(t.dir, std::string(stem) + ".partial");
+    const std::string final_path = join_path(t.dir, std::string(stem) + ".csv");
     if (file_exists(final_path)) { // killed between the rename and "done"
         if (obs.episodes_done) {
             obs.episodes_done(static_cast<uint32_t>(read_eval(final_path).size()), true);
@@ -204,7 +205,7 @@ bool run_eval(EpisodeRunner &runner, const qnav_policy_t &policy, const TaskDef 
         if (stop.load()) {
             return false;
         }
-        const EpisodeOutcome o = runner.run(policy, mix_seed(t.eval_seed_base, i));
+        const EpisodeOutcome o = episode(mix_seed(t.eval_seed_base, i));
         write_all(fd, std::to_string(i) + "," + fmt_outcome(o) + "\n", partial);
         if (obs.episodes_done) {
             obs.episodes_done(1, false);
@@ -214,6 +215,13 @@ bool run_eval(EpisodeRunner &runner, const qnav_policy_t &policy, const TaskDef 
         throw UserError(final_path + ": cannot write (" + std::strerror(errno) + ")");
     }
     return true;
+}
+
+/* The held-out evaluation of a policy: eval.csv. */
+bool run_eval(EpisodeRunner &runner, const qnav_policy_t &policy, const TaskDef &t,
+              const TaskObserver &obs, const std::atomic<bool> &stop)
+{
+    return run_eval_episodes([&](uint64_t seed) { return runner.run(policy, seed); }, "eval", t, obs, stop);
 }
 
 /* A policy's score over the k episodes of one step: mean R, f1, f2; tau_c summed;
@@ -356,7 +364,7 @@ std::string task_settings_text(const TaskDef &t, const std::string &source_finge
     o.precision(17);
     const EvolutionParams &e = t.evolution;
     o << "# simevo task settings; a resumed task must match them exactly\n"
-      << "kind=" << (t.kind == TaskKind::Evolve ? "evolve" : "eval-probabilistic") << "\n"
+      << "kind=" << (t.kind == TaskKind::Evolve ? "evolve" : "eval-probabilistic+vfh") << "\n"
       << "label=" << t.label << "\nrun=" << t.run << "\n"
       << "scenario=" << t.scenario.describe() << "\n"
       << "context_seed=" << t.context_seed << "\n";
@@ -396,7 +404,7 @@ uint64_t task_steps(const TaskDef &t)
 uint64_t task_total_episodes(const TaskDef &t)
 {
     if (t.kind != TaskKind::Evolve) {
-        return t.eval_episodes;
+        return 2u * static_cast<uint64_t>(t.eval_episodes); /* probabilistic and VFH+ */
     }
     return task_steps(t) * t.evolution.episodes_per_candidate +
            static_cast<uint64_t>(t.checkpoints.size()) * t.checkpoint_episodes + t.eval_episodes;
@@ -607,8 +615,14 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
     std::unique_ptr<EpisodeRunner> runner = make(t.scenario, t.context_seed);
 
     if (t.kind == TaskKind::EvalProbabilistic) {
+        // the references on the same held-out episodes: the hand-tuned probabilistic
+        // policy (eval.csv) and VFH+ (eval-vfh.csv), one task so shares stay as they were
         const qnav_policy_t prob = runner->probabilistic_policy();
         if (!run_eval(*runner, prob, t, obs, stop)) {
+            return false;
+        }
+        if (!run_eval_episodes([&](uint64_t seed) { return runner->run_controller("vfh", seed); },
+                               "eval-vfh", t, obs, stop)) {
             return false;
         }
         write_file_atomic(done_path, "complete\n");

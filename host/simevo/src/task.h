@@ -10,6 +10,7 @@
  *                 target episodes (journaled the same way; target tasks only)
  *   best.policy   the best member at the end (policy file, atomic)
  *   eval.csv      held-out episodes of the best (or probabilistic) policy (atomic)
+ *   eval-vfh.csv  the reference task only: VFH+ on the same held-out episodes (atomic)
  *   done          written last (atomic): the task is complete
  * Resuming replays the journal through Evolution (same draws, recorded R values) without
  * simulating, so the finished files equal those of an uninterrupted run byte for byte.
