@@ -83,6 +83,32 @@ SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t conte
     qnav_sim_robot_prob_policy(robot, &prob_);
 }
 
+namespace {
+
+/* A trace callback: the sample appended to the std::vector<qnav_sim_sample_t> in user. */
+void append_sample(void *user, const qnav_sim_sample_t *smp)
+{
+    static_cast<std::vector<qnav_sim_sample_t> *>(user)->push_back(*smp);
+}
+
+} // namespace
+
+/* The episode's figures, or UserError with the simulator's message. */
+EpisodeOutcome SimRunner::outcome(qnav_sim_status_t s, const qnav_sim_result_t &res) const
+{
+    if (s != QNAV_SIM_OK) {
+        throw UserError("simulator: episode failed (status " + std::to_string(static_cast<int>(s)) +
+                        "): " + qnav_sim_last_error(sim_));
+    }
+    EpisodeOutcome out;
+    out.R = res.R;
+    out.f1 = res.f1;
+    out.f2 = res.f2;
+    out.tau_c = res.tau_c;
+    out.reached = res.reached;
+    return out;
+}
+
 SimRunner::~SimRunner() { qnav_sim_destroy(sim_); }
 
 const qnav_qkey_t *SimRunner::table_for(const qnav_ctrl_t &ctrl, const qnav_policy_t &policy)
@@ -127,22 +153,9 @@ EpisodeOutcome SimRunner::run_traced(const qnav_policy_t &policy, uint64_t episo
         }
     }
     qnav_sim_result_t res;
-    auto append = [](void *user, const qnav_sim_sample_t *smp) {
-        static_cast<std::vector<qnav_sim_sample_t> *>(user)->push_back(*smp);
-    };
     const qnav_sim_status_t s = qnav_sim_run_episode(sim_, &ctrl, episode_seed, &res,
-                                                     trace ? +append : nullptr, trace);
-    if (s != QNAV_SIM_OK) {
-        throw UserError("simulator: episode failed (status " + std::to_string(static_cast<int>(s)) +
-                        "): " + qnav_sim_last_error(sim_));
-    }
-    EpisodeOutcome out;
-    out.R = res.R;
-    out.f1 = res.f1;
-    out.f2 = res.f2;
-    out.tau_c = res.tau_c;
-    out.reached = res.reached;
-    return out;
+                                                     trace ? +append_sample : nullptr, trace);
+    return outcome(s, res);
 }
 
 EpisodeOutcome SimRunner::run_controller(const char *controller, uint64_t episode_seed)
@@ -162,22 +175,9 @@ EpisodeOutcome SimRunner::run_controller_traced(const char *controller, uint64_t
                         qnav_status_str(st) + ")");
     }
     qnav_sim_result_t res;
-    auto append = [](void *user, const qnav_sim_sample_t *smp) {
-        static_cast<std::vector<qnav_sim_sample_t> *>(user)->push_back(*smp);
-    };
     const qnav_sim_status_t s =
-        qnav_sim_run_episode_nav(sim_, &nav, episode_seed, &res, trace ? +append : nullptr, trace);
-    if (s != QNAV_SIM_OK) {
-        throw UserError("simulator: episode failed (status " + std::to_string(static_cast<int>(s)) +
-                        "): " + qnav_sim_last_error(sim_));
-    }
-    EpisodeOutcome out;
-    out.R = res.R;
-    out.f1 = res.f1;
-    out.f2 = res.f2;
-    out.tau_c = res.tau_c;
-    out.reached = res.reached;
-    return out;
+        qnav_sim_run_episode_nav(sim_, &nav, episode_seed, &res, trace ? +append_sample : nullptr, trace);
+    return outcome(s, res);
 }
 
 } // namespace qnav

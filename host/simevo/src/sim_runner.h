@@ -64,6 +64,8 @@ public:
     const qnav_ctrl_config_t &ctrl_config() const { return ctrl_cfg_; }
 
 private:
+    /* An episode's figures from the simulator's status and result; UserError on failure. */
+    EpisodeOutcome outcome(qnav_sim_status_t s, const qnav_sim_result_t &res) const;
     /* policy's quality table, compiled by ctrl (initialised with policy), or null when it
      * cannot be. The last two are kept: an evolution step runs a new candidate and then,
      * mostly, the same best member as its parent, whose table need not be built again. */
