@@ -853,6 +853,17 @@ static void test_slurm_sweep_writes_each_members_scripts_and_one_submit_for_all(
     assert_non_null(std::strstr(slurp(join_path(out, "tiny2/run.txt")).c_str(), "\nruns = 3\n"));
     // 3 runs: 3 x (source, direct) + probabilistic = 7 in stage 1, 3 transfers in stage 2
     assert_non_null(std::strstr(slurp(join_path(out, "tiny/slurm/submit.sh")).c_str(), "--array=1-7 tasks.sbatch 1 7)"));
+
+    // The shipped example sweep: three members by name, one submit line each.
+    const std::string out2 = join_path(root, "out2");
+    assert_int_equal(wait_exit(spawn({"--experiments", SIMEVO_SOURCE_DIR "/experiments", "slurm",
+                                      SIMEVO_SOURCE_DIR "/sweeps/open-to-dense-noise.toml", "--out", out2, "--preset", "quick"},
+                                     join_path(root, "s2.err"))), 0);
+    assert_non_null(std::strstr(slurp(join_path(out2, "open-to-dense.noise-0.1/run.txt")).c_str(), "\nvary = noise=0.1\n"));
+    const std::string all = slurp(join_path(out2, "open-to-dense-noise/slurm/submit.sh"));
+    assert_non_null(std::strstr(all.c_str(), "/open-to-dense.noise-0/slurm/submit.sh'\nsh '"));
+    assert_non_null(std::strstr(all.c_str(), "/open-to-dense.noise-0.05/slurm/submit.sh'\nsh '"));
+    assert_non_null(std::strstr(all.c_str(), "/open-to-dense.noise-0.1/slurm/submit.sh'\n"));
 }
 
 static void test_sweep_file_problems_are_one_line_with_file_and_line(void **state)

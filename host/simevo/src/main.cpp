@@ -261,7 +261,7 @@ int summarize_sweep(const std::string &dir, const std::string &record_path, cons
                      dir.c_str(), unfinished, members.size());
         return QNAV_EXIT_FAILURE;
     }
-    std::printf("%s: merged %zu experiments\n", dir.c_str(), members.size());
+    std::printf("%s: merged %zu experiment%s\n", dir.c_str(), members.size(), members.size() == 1 ? "" : "s");
     return 0;
 }
 
