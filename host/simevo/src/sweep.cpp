@@ -77,19 +77,6 @@ bool is_path(const std::string &arg)
     return arg.find('/') != std::string::npos || (arg.size() > 5 && arg.compare(arg.size() - 5, 5, ".toml") == 0);
 }
 
-bool valid_sweep_name(const std::string &s)
-{
-    if (s.empty() || s.size() > 64) {
-        return false;
-    }
-    for (char c : s) {
-        if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_')) {
-            return false;
-        }
-    }
-    return true;
-}
-
 class SweepParser {
 public:
     SweepParser(std::string file, const std::function<std::string(const std::string &)> &resolve)
@@ -259,7 +246,7 @@ Sweep load_sweep(const std::string &path, const std::function<std::string(const 
         throw UserError(path + ":1: name: missing (the sweep's identifier)");
     }
     sw.name = p.str(*root.get("name"), "name");
-    if (!valid_sweep_name(sw.name)) {
+    if (!valid_name(sw.name)) {
         p.fail(*root.get("name"), "name: use 1-64 characters a-z, 0-9, '-', '_'");
     }
     const toml::node *list = root.get("experiments"), *one = root.get("experiment"), *vary = root.get("vary");
