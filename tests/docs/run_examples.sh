@@ -21,7 +21,8 @@ extract() { # FILE NAME -> the fenced block after the marker
         want && /^```/ { if (inside) exit; inside = 1; next }
         inside { print }' "$1"
 }
-for pair in "$src/README.md readme" "$src/docs/hil.md hil-sil" "$src/docs/cluster.md cluster-parallel"; do
+for pair in "$src/README.md readme" "$src/docs/hil.md hil-sil" "$src/docs/cluster.md cluster-parallel" \
+            "$src/docs/cluster.md cluster-sweep"; do
     set -- $pair
     extract "$1" "$2" > "$work/$2.sh"
     [ -s "$work/$2.sh" ] || { echo "run_examples.sh: no block '$2' in $1" >&2; exit 1; }
@@ -31,7 +32,7 @@ done
 
 fail() { echo "run_examples.sh: $*" >&2; for f in "$work"/*.err; do echo "--- $f"; tail -n 5 "$f"; done >&2; exit 1; }
 r=$work/runs
-[ "$(grep -c '^exit 0$' "$work/status.txt")" -eq 3 ] || fail "a block failed: $(tr '\n' ' ' < "$work/status.txt")"
+[ "$(grep -c '^exit 0$' "$work/status.txt")" -eq 4 ] || fail "a block failed: $(tr '\n' ' ' < "$work/status.txt")"
 [ "$(grep -c ' Fig\. ' "$work/readme.out")" -eq "$(ls "$src/experiments" | grep -c '\.toml$')" ] || fail "simevo list"
 [ -s "$r/q/open-to-dense/summary.md" ] || fail "no summary.md from simevo run"
 head -c 4 "$r/q/open-to-dense/learning.png" | grep -q PNG || fail "no learning.png"
@@ -45,4 +46,7 @@ grep -q '^replay: \([0-9]*\) scans, \1 commands compared: \1 identical, 0 differ
 grep -q '^open-to-dense: merged 11 tasks; summary runs/gp/open-to-dense/summary.md$' "$work/cluster-parallel.out" \
     || fail "cluster.md's GNU parallel shares were not merged"
 grep -q '^complete$' "$r/gp/open-to-dense/STATUS" || fail "cluster.md's merged experiment is not complete"
+grep -q '^runs/sw/noise: merged 2 experiments$' "$work/cluster-sweep.out" || fail "cluster.md's sweep was not merged"
+grep -q '^identical$' "$work/cluster-sweep.out" || fail "cluster.md's sweep member differs from the experiment run directly"
+grep -q '^vary = noise=0.05$' "$r/sw/open-to-dense.noise-0.05/run.txt" || fail "the sweep member's run.txt has no variation"
 echo "run_examples.sh: README, docs/hil.md and docs/cluster.md examples ran verbatim"

@@ -10,7 +10,10 @@
  * work, 1 after). Also the defects of issue 11: temporary files never follow a planted
  * symlink, a plot script dies with simevo, zero episodes and NaN noise are refused, noise
  * above the simulator's 1 in a file fails at its line before any output, the progress
- * line fits the terminal, unknown options and subcommands are named.
+ * line fits the terminal, unknown options and subcommands are named. Sweeps (issue 12): a
+ * sweep's shares merge to the files of its member experiment run directly with the same
+ * --vary, `simevo slurm` writes each member's scripts and one submit.sh for all, and bad
+ * sweep files fail at their line.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -776,6 +779,143 @@ static void test_experiment_file_problems_are_found_before_any_output(void **sta
     assert_false(file_exists(out));
 }
 
+/* Every file under dir, by path relative to it; dir holds a finished experiment. */
+static std::map<std::string, std::string> finished_files(const std::string &dir)
+{
+    std::map<std::string, std::string> f;
+    collect(dir, "", f);
+    assert_true(f.count("summary.md") == 1);
+    assert_true(f["STATUS"] == "complete\n");
+    return f;
+}
+
+/* A sweep of tiny over two noise levels, at path (members tiny.noise-0, tiny.noise-0.05). */
+static void write_noise_sweep(const std::string &path)
+{
+    write_file_atomic(path, "name = \"tiny-noise\"\nexperiment = \"" SIMEVO_TEST_DIR "/tiny.toml\"\n"
+                            "[vary]\nnoise = [0, 0.05]\n");
+}
+
+static void test_sweep_shares_merge_to_the_member_experiment_run_directly_with_its_variation(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::string sweep = join_path(root, "sweep.toml"), a = join_path(root, "a"), b = join_path(root, "b");
+    write_noise_sweep(sweep);
+    auto run = [&](const std::string &file, const std::string &out, std::vector<std::string> extra) {
+        std::vector<std::string> v = {"run", file, "--no-plot", "--no-progress", "-j", "1", "--out", out};
+        v.insert(v.end(), extra.begin(), extra.end());
+        return v;
+    };
+    const std::vector<std::string> summarize = {"summarize", join_path(b, "tiny-noise"), "--no-plot"};
+    assert_int_equal(wait_exit(spawn(run(SIMEVO_TEST_DIR "/tiny.toml", a, {"--vary", "noise=0.05"}), join_path(root, "a.err"))), 0);
+
+    // The sweep's shares (each share of every member), then the sweep-level merge.
+    assert_int_equal(wait_exit(spawn(run(sweep, b, {"--stage", "1", "--tasks", "1/2"}), join_path(root, "b1.err"))), 0);
+    assert_int_equal(wait_exit(spawn(run(sweep, b, {"--stage", "1", "--tasks", "2/2"}), join_path(root, "b2.err"))), 0);
+    assert_int_equal(wait_exit(spawn(summarize, join_path(root, "bs.err"))), 1);
+    const std::string missing = slurp(join_path(root, "bs.err"));
+    assert_non_null(std::strstr(missing.c_str(), "tiny.noise-0/run-002/transfer-open: not started"));
+    assert_non_null(std::strstr(missing.c_str(), "tiny.noise-0.05/run-001/transfer-open: not started"));
+    assert_non_null(std::strstr(missing.c_str(), "tiny-noise: 2 of 2 experiments not finished"));
+    assert_int_equal(wait_exit(spawn(run(sweep, b, {"--stage", "2"}), join_path(root, "b3.err"))), 0);
+    assert_int_equal(wait_exit(spawn(summarize, join_path(root, "bs2.err"))), 0);
+
+    const auto direct = finished_files(join_path(a, "tiny.noise-0.05"));
+    assert_true(direct == finished_files(join_path(b, "tiny.noise-0.05")));
+    assert_true(slurp(join_path(b, "tiny-noise/sweep.txt")).find("member = tiny.noise-0\nmember = tiny.noise-0.05\n") !=
+                std::string::npos);
+    // The variation is the target's noise only; the open source keeps the file's 0.
+    const std::string settings = direct.at("settings.txt");
+    assert_non_null(std::strstr(settings.c_str(), "environment=dense robot=tekbot sectors=16 sensor_noise=0.050000000000000003 actuation_noise=0.050000000000000003"));
+    assert_non_null(std::strstr(settings.c_str(), "environment=open robot=tekbot sectors=16 sensor_noise=0 actuation_noise=0 "));
+    assert_true(finished_files(join_path(b, "tiny.noise-0")).at("settings.txt") != settings);
+
+    // A member folder alone merges again from its run.txt (the variation recorded there).
+    assert_non_null(std::strstr(direct.at("run.txt").c_str(), "\nvary = noise=0.05\n"));
+    assert_int_equal(wait_exit(spawn({"summarize", join_path(b, "tiny.noise-0.05"), "--no-plot"}, join_path(root, "m.err"))), 0);
+    assert_true(direct == finished_files(join_path(b, "tiny.noise-0.05")));
+}
+
+static void test_slurm_sweep_writes_each_members_scripts_and_one_submit_for_all(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::string out = join_path(root, "out"), sweep = join_path(root, "pair.toml");
+    std::string tiny = slurp(SIMEVO_TEST_DIR "/tiny.toml");
+    tiny.replace(tiny.find("name = \"tiny\""), 13, "name = \"tiny2\"");
+    write_file_atomic(join_path(root, "tiny2.toml"), tiny);
+    // a path relative to the sweep file's folder, and an absolute one
+    write_file_atomic(sweep, "name = \"pair\"\nexperiments = [\"tiny2.toml\", \"" SIMEVO_TEST_DIR "/tiny.toml\"]\n");
+    assert_int_equal(wait_exit(spawn({"slurm", sweep, "--out", out, "--runs", "3"}, join_path(root, "s.err"))), 0);
+    const std::string submit = slurp(join_path(out, "pair/slurm/submit.sh"));
+    assert_non_null(std::strstr(submit.c_str(), ("\nsh '" + out + "/tiny2/slurm/submit.sh'\nsh '" + out +
+                                                 "/tiny/slurm/submit.sh'\n").c_str()));
+    assert_non_null(std::strstr(slurp(join_path(out, "tiny2/slurm/tasks.sbatch")).c_str(), "/tiny2.toml' --out"));
+    assert_non_null(std::strstr(slurp(join_path(out, "tiny/slurm/tasks.sbatch")).c_str(), "--preset 'full' --runs 3 --no-plot"));
+    assert_non_null(std::strstr(slurp(join_path(out, "tiny2/run.txt")).c_str(), "\nruns = 3\n"));
+    // 3 runs: 3 x (source, direct) + probabilistic = 7 in stage 1, 3 transfers in stage 2
+    assert_non_null(std::strstr(slurp(join_path(out, "tiny/slurm/submit.sh")).c_str(), "--array=1-7 tasks.sbatch 1 7)"));
+
+    // The shipped example sweep: three members by name, one submit line each.
+    const std::string out2 = join_path(root, "out2");
+    assert_int_equal(wait_exit(spawn({"--experiments", SIMEVO_SOURCE_DIR "/experiments", "slurm",
+                                      SIMEVO_SOURCE_DIR "/sweeps/open-to-dense-noise.toml", "--out", out2, "--preset", "quick"},
+                                     join_path(root, "s2.err"))), 0);
+    assert_non_null(std::strstr(slurp(join_path(out2, "open-to-dense.noise-0.1/run.txt")).c_str(), "\nvary = noise=0.1\n"));
+    const std::string all = slurp(join_path(out2, "open-to-dense-noise/slurm/submit.sh"));
+    assert_non_null(std::strstr(all.c_str(), "/open-to-dense.noise-0/slurm/submit.sh'\nsh '"));
+    assert_non_null(std::strstr(all.c_str(), "/open-to-dense.noise-0.05/slurm/submit.sh'\nsh '"));
+    assert_non_null(std::strstr(all.c_str(), "/open-to-dense.noise-0.1/slurm/submit.sh'\n"));
+}
+
+static void test_sweep_file_problems_are_one_line_with_file_and_line(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::string out = join_path(root, "out"), bad = join_path(root, "bad.toml");
+    const std::string head = "name = \"s\"\nexperiment = \"" SIMEVO_TEST_DIR "/tiny.toml\"\n";
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {head + "[vary]\nspeed = [1, 2]\n", ":4: [vary]: unknown key 'speed' (one of noise, sectors)"},
+        {head + "[vary]\nnoise = [0, 2]\n", ":4: noise: 2 is not in [0, 1]"},
+        {head + "[vary]\nnoise = [0.05, 0.050]\n", ":4: noise: 0.05 is listed twice"},
+        {head + "[vary]\nsectors = [8, 8.5]\n", ":4: sectors: expected an integer"},
+        {head + "[vary]\nsectors = []\n", ":4: sectors: expected a non-empty list of values"},
+        {head + "[vary]\nnoise = [0]\nsectors = [8]\n", ":3: [vary]: give exactly one key"},
+        {head, ":1: a sweep needs 'experiments = [...]', or 'experiment' with one [vary] key"},
+        {"name = \"s\"\nexperiments = [\"open-to-dense\", \"no-such\"]\n", ":2: experiments: unknown experiment 'no-such'"},
+        {"name = \"s\"\nexperiments = [\"" SIMEVO_TEST_DIR "/tiny.toml\", \"" SIMEVO_TEST_DIR "/tiny.toml\"]\n",
+         ":2: experiment 'tiny' is in the sweep twice"},
+        {"name = \"tiny\"\nexperiments = [\"" SIMEVO_TEST_DIR "/tiny.toml\"]\n", ":2: experiment 'tiny' has the sweep's name"},
+        {"name = \"s\"\nexperiments = [\"missing.toml\"]\nruns = 3\n", ":3: unknown key 'runs' in a sweep file"},
+        {"name = \"s\"\nexperiments = [\"missing.toml\"]\n", ":2: experiments: " + root + "/missing.toml: no such experiment file"},
+    };
+    for (const auto &c : cases) {
+        write_file_atomic(bad, c.first);
+        int st = 0;
+        const std::string e = run_for_error({"--experiments", SIMEVO_SOURCE_DIR "/experiments", "run", bad, "--out", out}, st);
+        if (e.find(bad + c.second) == std::string::npos) {
+            print_error("expected '%s%s', got: %s", bad.c_str(), c.second.c_str(), e.c_str());
+        }
+        assert_int_equal(st, 2);
+        assert_one_line_containing(e, (bad + c.second).c_str());
+    }
+    assert_false(file_exists(out));
+
+    int st = 0;
+    write_noise_sweep(bad);
+    assert_one_line_containing(run_for_error({"run", bad, "--vary", "noise=0.1", "--out", out}, st),
+                               "--vary: not with a sweep file");
+    assert_int_equal(st, 2);
+    assert_one_line_containing(run_for_error({"run", SIMEVO_TEST_DIR "/tiny.toml", "--vary", "noise= 0.1", "--out", out}, st),
+                               "--vary: ' 0.1' is not a number");
+    assert_int_equal(st, 2);
+    assert_one_line_containing(run_for_error({"run", SIMEVO_TEST_DIR "/tiny.toml", "--vary", "speed=1", "--out", out}, st),
+                               "--vary: 'speed=1' is not KEY=VALUE with KEY one of noise, sectors");
+    assert_int_equal(st, 2);
+    assert_false(file_exists(out));
+}
+
 /* On a 40-column terminal every progress redraw fits in 39 columns (a longer line wraps,
  * and each redraw then scrolls a line instead of replacing it). */
 static void test_progress_line_is_cut_to_the_terminal_width(void **state)
@@ -859,6 +999,9 @@ int main(void)
         cmocka_unit_test(test_program_refuses_zero_episodes_and_impossible_noise),
         cmocka_unit_test(test_experiment_file_problems_are_found_before_any_output),
         cmocka_unit_test(test_progress_line_is_cut_to_the_terminal_width),
+        cmocka_unit_test(test_sweep_shares_merge_to_the_member_experiment_run_directly_with_its_variation),
+        cmocka_unit_test(test_slurm_sweep_writes_each_members_scripts_and_one_submit_for_all),
+        cmocka_unit_test(test_sweep_file_problems_are_one_line_with_file_and_line),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

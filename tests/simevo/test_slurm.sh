@@ -4,7 +4,8 @@
 # afterok) plus a summarize job, waited for with a bounded timeout, then every merged file
 # compared (cmp) with a local `simevo run` of the same experiment. Exit 77 (CTest skip) with
 # the reason when the cluster cannot be tried (not root, packages missing); a daemon that
-# does not come up although it could is a failure (exit 1).
+# does not come up although it could is a failure (exit 1). Then a sweep (tiny at noise 0.05)
+# through its submit.sh: the member's files equal a local `simevo run tiny --vary noise=0.05`.
 #   test_slurm.sh SIMEVO SOURCE_DIR
 set -u
 simevo=$1
@@ -45,3 +46,17 @@ done
 extra=$(cd "$d/out" && find . -type f ! -path './tiny/slurm/*' | sort | while read -r f; do [ -f "$d/local/$f" ] || echo "$f"; done)
 [ -z "$extra" ] || fail "files only in the Slurm run: $extra"
 echo "PASS: all $(cd "$d/local" && find . -type f | wc -l) files of the Slurm run equal the local run's (cmp); STATUS $(cat "$d/out/tiny/STATUS")"
+
+printf 'name = "sw"\nexperiment = "%s"\n[vary]\nnoise = [0.05]\n' "$exp" > "$d/sw.toml"
+"$simevo" run "$exp" --vary noise=0.05 --out "$d/local-sw" --no-progress -j 2 --tools-dir "$src/tools" >/dev/null || fail "local --vary run"
+"$simevo" slurm "$d/sw.toml" --out "$d/sw" --array-limit 2 --time 10 --tools-dir "$src/tools" --submit >"$d/submit-sw.txt" ||
+    fail "simevo slurm SWEEP --submit: $(cat "$d/submit-sw.txt")"
+cat "$d/submit-sw.txt"
+cluster_wait_for 300 sh -c '[ -z "$(squeue -h 2>/dev/null)" ]' || fail "sweep jobs not done within 300 s"
+"$simevo" summarize "$d/sw/sw" >"$d/summarize-sw.txt" || fail "sweep summarize: $(cat "$d/summarize-sw.txt")"
+grep -q "^$d/sw/sw: merged 1 experiment$" "$d/summarize-sw.txt" || fail "sweep summarize: $(cat "$d/summarize-sw.txt")"
+m=tiny.noise-0.05
+for f in $(cd "$d/local-sw" && find . -type f | sort); do
+    cmp -s "$d/local-sw/$f" "$d/sw/$f" || fail "sweep member differs from the local --vary run: $f"
+done
+echo "PASS: sweep member $m: all $(cd "$d/local-sw" && find . -type f | wc -l) files equal the local --vary run's (cmp)"

@@ -12,6 +12,7 @@
 
 #include "files.h"
 #include "qnav/sim.h"
+#include "sweep.h"
 
 namespace qnav {
 
@@ -80,6 +81,7 @@ ExperimentSpec load_run_spec(const std::string &path, const RunArgs &a)
     if (a.per_candidate > 0) s.evolution.episodes_per_candidate = static_cast<uint32_t>(a.per_candidate);
     if (!a.fitness.empty()) set_fitness(s, a.fitness);
     if (!a.controller.empty()) set_controller(s, a.controller);
+    if (!a.vary.empty()) apply_vary(s, a.vary);
     return s;
 }
 
@@ -99,6 +101,7 @@ std::string override_flags(const RunArgs &a)
     add("--per-candidate", a.per_candidate, a.per_candidate > 0);
     o += a.fitness.empty() ? "" : " --fitness " + a.fitness;
     o += a.controller.empty() ? "" : " --controller " + a.controller;
+    o += a.vary.empty() ? "" : " --vary " + a.vary;
     return o;
 }
 
@@ -110,6 +113,9 @@ std::string run_record_text(const std::string &experiment_file, const RunArgs &a
       << "\nepisodes = " << a.episodes << "\nsource_episodes = " << a.source_episodes
       << "\neval_episodes = " << a.eval_episodes << "\nseed = " << a.seed << "\nper_candidate = " << a.per_candidate
       << "\nfitness = " << a.fitness << "\ncontroller = " << a.controller << "\n";
+    if (!a.vary.empty()) {
+        o << "vary = " << a.vary << "\n";
+    }
     return o.str();
 }
 
@@ -156,6 +162,7 @@ RunArgs parse_run_record(const std::string &text, const std::string &path, std::
     a.per_candidate = num("per_candidate");
     a.fitness = get("fitness");
     a.controller = get("controller");
+    a.vary = kv.count("vary") ? kv["vary"] : "";
     return a;
 }
 
@@ -223,6 +230,20 @@ std::vector<std::string> unfinished_tasks(const std::vector<TaskDef> &tasks, con
                         " journal lines)");
     }
     return lines;
+}
+
+std::string write_sweep_submit(const std::string &sweep_dir, const std::vector<std::string> &member_scripts)
+{
+    const std::string dir = join_path(sweep_dir, "slurm");
+    make_dirs(dir);
+    std::string s = "#!/bin/sh\n# written by simevo slurm (docs/cluster.md); regenerate rather than edit\n"
+                    "# submits every member of the sweep (each: stage 1, stage 2, summarize)\nset -e\n";
+    for (const std::string &m : member_scripts) {
+        s += "sh " + sh_quote(m) + "\n";
+    }
+    const std::string path = join_path(dir, "submit.sh");
+    write_script(path, s);
+    return path;
 }
 
 std::string write_slurm_scripts(const std::vector<TaskDef> &tasks, const std::string &exp_dir, const RunArgs &a,

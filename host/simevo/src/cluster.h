@@ -23,6 +23,8 @@ struct RunArgs {
     std::string preset = "full";
     int64_t runs = 0, episodes = 0, source_episodes = 0, eval_episodes = 0, seed = -1, per_candidate = 0;
     std::string fitness, controller;
+    std::string vary; /* "" or "KEY=VALUE": the target situation varied, the experiment
+                         renamed NAME.KEY-VALUE (a sweep member; sweep.h) */
     bool network_mode = false;
 };
 
@@ -32,7 +34,8 @@ ExperimentSpec load_run_spec(const std::string &path, const RunArgs &args);
  * (bit-identical to table mode by design). */
 std::string override_flags(const RunArgs &args);
 /* run.txt: the experiment file (absolute) and args but network_mode (bit-identical to
- * table mode, so not part of the results' identity), one "key = value" per line. */
+ * table mode, so not part of the results' identity), one "key = value" per line; the
+ * "vary" line only when there is a variation (so older folders' run.txt still match). */
 std::string run_record_text(const std::string &experiment_file, const RunArgs &args);
 /* Parses run.txt text (path names it in errors); sets *experiment_file. Throws UserError. */
 RunArgs parse_run_record(const std::string &text, const std::string &path, std::string *experiment_file);
@@ -68,6 +71,9 @@ struct SlurmOptions {
     uint32_t tasks_per_job = 1;  /* simevo tasks per array task */
     uint32_t jobs = 1;           /* threads (and --cpus-per-task) per array task */
 };
+/* Writes sweep_dir/slurm/submit.sh, which runs every member's submit.sh in turn. Returns
+ * its path. */
+std::string write_sweep_submit(const std::string &sweep_dir, const std::vector<std::string> &member_scripts);
 /* Writes exp_dir/slurm/{tasks.sbatch,summarize.sbatch,submit.sh}; a file there that
  * simevo did not write with this content is refused. Returns the submit.sh path. */
 std::string write_slurm_scripts(const std::vector<TaskDef> &tasks, const std::string &exp_dir, const RunArgs &args,

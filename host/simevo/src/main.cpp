@@ -29,6 +29,7 @@
 #include "qnav/policy_io.h"
 #include "sim_runner.h"
 #include "stats.h"
+#include "sweep.h"
 
 #ifndef QNAV_SOURCE_DIR
 #define QNAV_SOURCE_DIR "."
@@ -96,6 +97,9 @@ void add_run_args(CLI::App *c, RunArgs &a)
     c->add_option("--controller", a.controller,
                   "override the controller's reading: body, or literal (the paper's per-sector "
                   "mapping, no speed guard, rank by quality; docs/architecture.md)");
+    c->add_option("--vary", a.vary,
+                  "KEY=VALUE: set the target situation's noise or sectors and name the experiment "
+                  "NAME.KEY-VALUE (one member of a sweep; docs/cluster.md)");
     c->add_flag("--network-mode", a.network_mode, "run the controller in network mode instead of table mode");
 }
 
@@ -118,29 +122,54 @@ std::string absolute_dir(const std::string &dir)
     return absolute_path(dir);
 }
 
-/* Specs of every experiment named (all parsed first: a bad file fails before any work),
- * with every robot, environment and source policy file checked. */
-std::vector<std::pair<std::string, ExperimentSpec>> load_run_specs(const std::vector<std::string> &names,
-                                                                   const std::string &experiments_dir,
-                                                                   const RunArgs &args)
+/* One experiment to run: its file (absolute), the options it runs with, its spec. */
+struct RunItem {
+    std::string file;
+    RunArgs args;
+    ExperimentSpec spec;
+};
+
+/* An experiment file or a sweep file's members as (path, args) pairs in order. */
+void add_run_paths(const std::string &path, const RunArgs &args, const std::string &experiments_dir,
+                   std::vector<std::pair<std::string, RunArgs>> &paths, std::vector<Sweep> &sweeps)
 {
-    std::vector<std::string> paths;
+    if (!is_sweep_file(path)) {
+        paths.emplace_back(path, args);
+        return;
+    }
+    if (!args.vary.empty()) {
+        throw UserError("--vary: not with a sweep file (" + path + "); its members are the variations");
+    }
+    sweeps.push_back(load_sweep(path, [&](const std::string &n) { return resolve_experiment(n, experiments_dir); }));
+    for (const SweepMember &mb : sweeps.back().members) {
+        RunArgs a = args;
+        a.vary = mb.vary;
+        paths.emplace_back(mb.experiment_file, a);
+    }
+}
+
+/* Every experiment named, sweeps expanded into their members (all parsed first: a bad file
+ * fails before any work), with every robot, environment and source policy file checked. */
+std::vector<RunItem> load_run_specs(const std::vector<std::string> &names, const std::string &experiments_dir,
+                                    const RunArgs &args, std::vector<Sweep> &sweeps)
+{
+    std::vector<std::pair<std::string, RunArgs>> paths;
     for (const auto &n : names) {
         if (n == "all") {
             for (const auto &k : list_experiments(experiments_dir)) {
-                paths.push_back(join_path(experiments_dir, k + ".toml"));
+                paths.emplace_back(join_path(experiments_dir, k + ".toml"), args);
             }
         } else {
-            paths.push_back(resolve_experiment(n, experiments_dir));
+            add_run_paths(resolve_experiment(n, experiments_dir), args, experiments_dir, paths, sweeps);
         }
     }
-    std::vector<std::pair<std::string, ExperimentSpec>> specs;
+    std::vector<RunItem> items;
     for (const auto &p : paths) {
-        specs.emplace_back(absolute_path(p), load_run_spec(p, args));
+        items.push_back({absolute_path(p.first), p.second, load_run_spec(p.first, p.second)});
     }
     SimWorlds probe_worlds;
-    for (const auto &ps : specs) {
-        const ExperimentSpec &s = ps.second;
+    for (const RunItem &it : items) {
+        const ExperimentSpec &s = it.spec;
         SimRunner target(probe_worlds, s.target, s.seed, true);
         for (const auto &src : s.sources) {
             SimRunner source(probe_worlds, src.scenario, s.seed, true);
@@ -149,7 +178,7 @@ std::vector<std::pair<std::string, ExperimentSpec>> load_run_specs(const std::ve
             }
         }
     }
-    return specs;
+    return items;
 }
 
 /* RunOptions of a run with these args (plots, progress and folders set by the caller). */
@@ -161,6 +190,8 @@ void set_run_options(RunOptions &opt, const RunArgs &args, const std::string &ex
     opt.run_record = run_record_text(experiment_file, args);
 }
 
+int summarize_sweep(const std::string &dir, const std::string &record_path, const RunOptions &opt, bool &started);
+
 /* `simevo summarize DIR`: the experiment's spec from DIR/run.txt, every task finished, then
  * the same outputs as a local run. Returns the exit status. */
 int summarize_folder(const std::string &dir_arg, RunOptions opt, bool &started)
@@ -170,6 +201,9 @@ int summarize_folder(const std::string &dir_arg, RunOptions opt, bool &started)
         dir.pop_back();
     }
     const std::string record_path = join_path(dir, "run.txt");
+    if (file_exists(join_path(dir, "sweep.txt"))) {
+        return summarize_sweep(dir, join_path(dir, "sweep.txt"), opt, started);
+    }
     std::string record;
     if (!read_file(record_path, record)) {
         throw UserError(record_path + ": not found; " + dir + " is not a simevo experiment folder");
@@ -197,6 +231,37 @@ int summarize_folder(const std::string &dir_arg, RunOptions opt, bool &started)
     }
     finish_experiment(spec, tasks, opt);
     std::printf("%s: merged %zu tasks; summary %s/summary.md\n", spec.name.c_str(), tasks.size(), dir.c_str());
+    return 0;
+}
+
+/* `simevo summarize DIR/SWEEP`: every member folder listed in DIR/SWEEP/sweep.txt merged
+ * as `simevo summarize DIR/MEMBER` would; each member's unfinished tasks are named. Returns
+ * the exit status (1 when any member is not finished). */
+int summarize_sweep(const std::string &dir, const std::string &record_path, const RunOptions &opt, bool &started)
+{
+    std::string record;
+    (void)read_file(record_path, record);
+    const std::vector<std::string> members = parse_sweep_record(record, record_path);
+    const std::string out = dir.find('/') == std::string::npos ? "." : dir.substr(0, dir.find_last_of('/'));
+    std::size_t unfinished = 0;
+    for (const std::string &name : members) {
+        const std::string member_dir = join_path(out.empty() ? "/" : out, name);
+        if (!file_exists(join_path(member_dir, "run.txt"))) {
+            std::fprintf(stderr, "simevo: %s: not started (no run.txt)\n", member_dir.c_str());
+            ++unfinished;
+            continue;
+        }
+        bool member_started = false;
+        unfinished += summarize_folder(member_dir, opt, member_started) != 0;
+        started = started || member_started;
+        std::fflush(stdout);
+    }
+    if (unfinished > 0) {
+        std::fprintf(stderr, "simevo: %s: %zu of %zu experiments not finished (their missing tasks above)\n",
+                     dir.c_str(), unfinished, members.size());
+        return QNAV_EXIT_FAILURE;
+    }
+    std::printf("%s: merged %zu experiment%s\n", dir.c_str(), members.size(), members.size() == 1 ? "" : "s");
     return 0;
 }
 
@@ -234,23 +299,42 @@ void run_share(const ExperimentSpec &s, const RunOptions &opt, const Share &shar
                 join_path(opt.out_dir, s.name).c_str());
 }
 
-/* `simevo slurm`: the folder prepared as for a run, the scripts written, and submitted. */
-int write_slurm(const std::pair<std::string, ExperimentSpec> &ps, const RunArgs &args, RunOptions opt,
-                SlurmOptions so, bool plots, bool submit)
+/* `simevo slurm` for one experiment: the folder prepared as for a run and the scripts
+ * written. Returns the submit.sh path. */
+std::string write_slurm(const RunItem &it, RunOptions opt, SlurmOptions so, bool plots)
 {
     so.simevo = absolute_path("/proc/self/exe");
-    so.experiment_file = ps.first;
+    so.experiment_file = it.file;
     so.out_dir = absolute_dir(opt.out_dir);
     so.tools_dir = absolute_path(opt.tools_dir);
     so.plots = plots;
     opt.out_dir = so.out_dir;
-    set_run_options(opt, args, ps.first);
-    const std::vector<TaskDef> tasks = prepare_experiment(ps.second, opt);
-    const std::string exp_dir = join_path(so.out_dir, ps.second.name);
-    const std::string script = write_slurm_scripts(tasks, exp_dir, args, so);
+    set_run_options(opt, it.args, it.file);
+    const std::vector<TaskDef> tasks = prepare_experiment(it.spec, opt);
+    const std::string exp_dir = join_path(so.out_dir, it.spec.name);
+    const std::string script = write_slurm_scripts(tasks, exp_dir, it.args, so);
     std::printf("%s: %zu tasks (%zu in stage 1, %zu in stage 2 after their sources); submit with: sh %s\n",
-                ps.second.name.c_str(), tasks.size(), stage_tasks(tasks, 1).size(), stage_tasks(tasks, 2).size(),
+                it.spec.name.c_str(), tasks.size(), stage_tasks(tasks, 1).size(), stage_tasks(tasks, 2).size(),
                 script.c_str());
+    return script;
+}
+
+/* `simevo slurm NAME|SWEEP`: every experiment's scripts (a sweep's members each, plus the
+ * sweep's submit.sh that submits them all), and with --submit the last submitted. */
+int write_slurm_all(const std::vector<RunItem> &items, const std::vector<Sweep> &sweeps, const RunOptions &opt,
+                    const SlurmOptions &so, bool plots, bool submit)
+{
+    std::vector<std::string> scripts;
+    for (const RunItem &it : items) {
+        scripts.push_back(write_slurm(it, opt, so, plots));
+    }
+    std::string script = scripts.front();
+    if (!sweeps.empty()) {
+        const std::string dir = write_sweep_record(absolute_dir(opt.out_dir), sweeps.front());
+        script = write_sweep_submit(dir, scripts);
+        std::printf("%s: %zu experiments; submit them all with: sh %s\n", sweeps.front().name.c_str(), scripts.size(),
+                    script.c_str());
+    }
     if (!submit) {
         return 0;
     }
@@ -296,7 +380,7 @@ int main(int argc, char **argv)
     bool no_plot = false, no_progress = false;
     std::string share_text;
     int stage = 0;
-    run->add_option("experiment", names, "experiment name(s), a .toml path, or 'all'")->required();
+    run->add_option("experiment", names, "experiment name(s), a .toml path, a sweep file, or 'all'")->required();
     add_run_args(run, run_args);
     run->add_option("--out", opt.out_dir, "output folder; results go to OUT/<experiment>")->capture_default_str();
     run->add_option("-j,--jobs", opt.jobs, "worker threads (0 = all cores)")->capture_default_str();
@@ -311,7 +395,7 @@ int main(int argc, char **argv)
 
     auto *summ = app.add_subcommand("summarize", "merge the finished tasks of an experiment folder into its summary");
     std::string summ_dir;
-    summ->add_option("folder", summ_dir, "experiment folder (OUT/<experiment>)")->required();
+    summ->add_option("folder", summ_dir, "experiment or sweep folder (OUT/<experiment>, OUT/<sweep>)")->required();
     summ->add_option("--tools-dir", opt.tools_dir, "folder with the plot scripts")->capture_default_str();
     summ->add_flag("--no-plot", no_plot, "skip the PNG plots");
 
@@ -319,7 +403,7 @@ int main(int argc, char **argv)
     std::string slurm_name;
     SlurmOptions so;
     bool submit = false;
-    slurm->add_option("experiment", slurm_name, "experiment name or .toml path")->required();
+    slurm->add_option("experiment", slurm_name, "experiment name, .toml path or sweep file")->required();
     add_run_args(slurm, run_args);
     slurm->add_option("--out", opt.out_dir, "output folder (shared by every node); results go to OUT/<experiment>")->capture_default_str();
     slurm->add_option("--partition", so.partition, "Slurm partition (default: the cluster's)");
@@ -410,13 +494,17 @@ int main(int argc, char **argv)
                 share_text = "1/1";
             }
             const Share share = share_text.empty() ? Share{} : parse_share(share_text, stage);
-            const auto specs = load_run_specs(names, experiments_dir, run_args);
+            std::vector<Sweep> sweeps;
+            const auto items = load_run_specs(names, experiments_dir, run_args, sweeps);
             opt.plots = !no_plot;
             opt.progress = no_progress ? 0 : -1;
             started = true;
-            for (const auto &ps : specs) {
-                const ExperimentSpec &s = ps.second;
-                set_run_options(opt, run_args, ps.first);
+            for (const Sweep &sw : sweeps) {
+                (void)write_sweep_record(opt.out_dir, sw);
+            }
+            for (const RunItem &it : items) {
+                const ExperimentSpec &s = it.spec;
+                set_run_options(opt, it.args, it.file);
                 const auto t0 = std::chrono::steady_clock::now();
                 if (share_text.empty()) {
                     const std::string dir = run_experiment(s, opt);
@@ -438,9 +526,10 @@ int main(int argc, char **argv)
             return summarize_folder(summ_dir, opt, started);
         }
         if (*slurm) {
-            const auto specs = load_run_specs({slurm_name}, experiments_dir, run_args);
+            std::vector<Sweep> sweeps;
+            const auto items = load_run_specs({slurm_name}, experiments_dir, run_args, sweeps);
             started = true;
-            return write_slurm(specs.front(), run_args, opt, so, !no_plot, submit);
+            return write_slurm_all(items, sweeps, opt, so, !no_plot, submit);
         }
         if (*evolve) {
             if (const char *p = evolution_params_problem(ep); *p) {

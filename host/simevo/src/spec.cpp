@@ -176,6 +176,8 @@ private:
     std::string name_;
 };
 
+} // namespace
+
 bool valid_name(const std::string &s)
 {
     if (s.empty() || s.size() > 64) {
@@ -188,8 +190,6 @@ bool valid_name(const std::string &s)
     }
     return true;
 }
-
-} // namespace
 
 namespace {
 

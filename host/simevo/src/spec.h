@@ -98,6 +98,8 @@ struct ExperimentSpec {
     std::map<std::string, Preset> presets;
 };
 
+/* An identifier of an experiment, source or sweep: 1-64 characters a-z, 0-9, '-', '_'. */
+bool valid_name(const std::string &s);
 /* Parse a spec from text; name is used in messages. Throws UserError. */
 ExperimentSpec parse_experiment(const std::string &text, const std::string &name);
 /* Read and parse a file. Throws UserError (missing file, parse error). */
