@@ -1021,8 +1021,10 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
         o << "![learning curves](learning.png)\n\n![policy quality](policy.png)\n\n"
           << "![held-out episodes of the best policies](episodes.png)\n\n";
     }
-    o << "Regenerate: `simevo run " << spec.name << " --preset " << opt.preset << opt.overrides
-      << "` (with the same `--out`)\n";
+    // a sweep member is named NAME.KEY-VALUE (names have no dots): the command names NAME
+    // and the variation is in the overrides (--vary KEY=VALUE)
+    o << "Regenerate: `simevo run " << spec.name.substr(0, spec.name.find('.')) << " --preset " << opt.preset
+      << opt.overrides << "` (with the same `--out`)\n";
     return o.str();
 }
 
