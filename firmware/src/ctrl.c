@@ -19,7 +19,7 @@ void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg)
     }
     cfg->n_sectors = 16u;
     cfg->max_range_mm = 5000u;
-    cfg->full_speed_quality = QNAV_Q1_15(0.9);
+    cfg->full_speed_quality = 29491; /* 0.9 in Q1.15 */
     cfg->body_radius_mm = 120u;
     cfg->safety_mm = 50u;
     cfg->sensor_offset_mm = 120u;

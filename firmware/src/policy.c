@@ -11,8 +11,8 @@ void qnav_policy_prob_default(qnav_policy_t *policy)
         return;
     }
     policy->kind = (uint8_t)QNAV_POLICY_PROB;
-    policy->u.prob.k_goal = QNAV_Q8_8(1.0);
-    policy->u.prob.k_safe = QNAV_Q8_8(4.0);
+    policy->u.prob.k_goal = 256;  /* 1.0 in Q8.8 */
+    policy->u.prob.k_safe = 1024; /* 4.0 in Q8.8 */
 }
 
 void qnav_policy_net_zero_inputs(qnav_policy_t *policy, uint8_t hidden, uint8_t inputs)

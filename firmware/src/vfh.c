@@ -19,7 +19,7 @@ void qnav_vfh_config_default(qnav_vfh_config_t *cfg)
     qnav_ctrl_config_default(&cfg->body);
     cfg->sector_deg = 5u;
     cfg->blocked_mm = 1000u;
-    cfg->free_mm = 1400u;
+    cfg->open_mm = 1400u;
     cfg->wide_sectors = 16u;
     cfg->mu_goal = 5u;
     cfg->mu_current = 2u;
@@ -47,14 +47,14 @@ qnav_status_t qnav_vfh_init(qnav_vfh_t *vfh, const qnav_vfh_config_t *cfg)
         return st;
     }
     if (cfg->sector_deg < 1u || cfg->sector_deg > 30u || QNAV_PATHS % cfg->sector_deg != 0u ||
-        cfg->free_mm < cfg->blocked_mm || cfg->wide_sectors < 1u || cfg->wide_sectors > 180u ||
+        cfg->open_mm < cfg->blocked_mm || cfg->wide_sectors < 1u || cfg->wide_sectors > 180u ||
         cfg->slow_mm == 0u) {
         return QNAV_E_VFH_PARAM;
     }
     vfh->sector_deg = cfg->sector_deg;
     vfh->n_hist = (uint16_t)(QNAV_PATHS / cfg->sector_deg);
     vfh->level_blocked = level_at(&vfh->clr, cfg->blocked_mm);
-    vfh->level_free = level_at(&vfh->clr, cfg->free_mm);
+    vfh->level_open = level_at(&vfh->clr, cfg->open_mm);
     vfh->level_slow = level_at(&vfh->clr, cfg->slow_mm);
     if (vfh->level_slow == 0u) {
         vfh->level_slow = 1u;
@@ -102,7 +102,7 @@ static void set_blocked(qnav_vfh_state_t *st, uint16_t k, uint8_t b)
 
 /*
  * The binary histogram: sector k (centred on k * alpha) takes the lowest level (densest)
- * of its alpha paths; below level_blocked it is blocked, at or above level_free free, in
+ * of its alpha paths; below level_blocked it is blocked, at or above level_open free, in
  * between as last tick. Returns the number of blocked sectors.
  */
 static uint16_t binary_histogram(const qnav_vfh_t *v, qnav_vfh_state_t *st, const uint8_t *lvl)
@@ -123,7 +123,7 @@ static uint16_t binary_histogram(const qnav_vfh_t *v, qnav_vfh_state_t *st, cons
         }
         if (low < v->level_blocked) {
             set_blocked(st, k, 1u);
-        } else if (low >= v->level_free) {
+        } else if (low >= v->level_open) {
             set_blocked(st, k, 0u);
         }
         n_blocked = (uint16_t)(n_blocked + is_blocked(st, k));

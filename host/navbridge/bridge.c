@@ -11,6 +11,7 @@
 
 #include <math.h>
 
+#include "qnav/fixed_host.h"
 #include "qnav_link_status_t.h"
 #include "qnav_odometry_t.h"
 #include "qnav_path_qualities_t.h"

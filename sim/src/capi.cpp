@@ -10,6 +10,7 @@
 #include <string>
 
 #include "capi_internal.hpp"
+#include "qnav/fixed_host.h"
 #include "qnav/paths.hpp"
 #include "error.hpp"
 #include "tomlread.hpp"

@@ -8,6 +8,7 @@
 #include <box2d/box2d.h>
 
 #include "error.hpp"
+#include "qnav/fixed_host.h"
 
 namespace qnav {
 

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 
 #include "qnav/ctrl.h"
+#include "qnav/fixed_host.h"
 #include "reference.h"
 
 #ifndef M_PI
@@ -555,7 +556,7 @@ static void test_enlargement_blocks_paths_beside_a_near_obstacle(void **state)
     qnav_policy_prob_default(&p);
     init_body(&c, 360, 3000, 120, 50, 0, &p);
     fill(ranges, 360, 3000);
-    ranges[0] = 500; /* one 1-degree reading straight ahead, 0.5 m from the centre */
+    ranges[0] = 500; /* one 1-degree reading straight ahead, 0.5 m from the sonar (0.62 m from the centre) */
     assert_int_equal(qnav_ctrl_path_levels(&c, ranges, lvl), 0);
     uint8_t near = qnav_ctrl_level(&c, 500);
     /* the body (0.17 m with the margin) hits it on every path within asin(0.17 / D) */

@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include "qnav/ctrl.h"
+#include "qnav/fixed_host.h"
 #include "qnav/policy.h"
 
 static void test_validate_accepts_defaults_and_names_each_broken_rule(void **state)

@@ -26,18 +26,8 @@ typedef int16_t qnav_deg_t;
 #define QNAV_Q8_8_MAX 32767
 #define QNAV_Q8_8_MIN (-32767 - 1)
 
-/* Literal conversions from compile-time constants (x must be a constant expression).
- * Both round halves away from zero and saturate to the type's range. */
-#define QNAV_Q1_15(x)                                                                    \
-    ((qnav_q1_15_t)((x) >= 1.0 ? QNAV_Q1_15_MAX                                          \
-                    : (x) <= -1.0 ? -QNAV_Q1_15_MAX - 1                                  \
-                    : (x) < 0 ? (int32_t)((x) * (double)QNAV_Q1_15_ONE_RAW - 0.5)        \
-                              : (int32_t)((x) * (double)QNAV_Q1_15_ONE_RAW + 0.5)))
-#define QNAV_Q8_8(x) ((qnav_q8_8_t)((x) < 0 ? (int32_t)((x) * 256.0 - 0.5) : (int32_t)((x) * 256.0 + 0.5)))
-
-/* Raw values back to real numbers, for host programs and tests only (the firmware has no
- * floating point): QNAV_Q1_15_TO_REAL(16384) is 0.5. */
-#define QNAV_Q1_15_TO_REAL(q) ((double)(q) / (double)QNAV_Q1_15_ONE_RAW)
-#define QNAV_Q8_8_TO_REAL(q) ((double)(q) / (double)QNAV_Q8_8_ONE)
+/* Conversions from and to real numbers, for host programs and tests, are in
+ * qnav/fixed_host.h: the firmware has no floating point, not even in constant
+ * expressions, so its sources write raw values. */
 
 #endif /* QNAV_FIXED_H */

@@ -36,7 +36,7 @@ typedef struct {
                                  default 5 (VFH+ paper) */
     qnav_mm_t blocked_mm;     /* tau_high: a sector whose nearest enlarged reading is nearer
                                  than this is blocked, mm; default 1000 (assumed) */
-    qnav_mm_t free_mm;        /* tau_low: a sector is free again only beyond this, mm;
+    qnav_mm_t open_mm;        /* tau_low: a sector is free again only beyond this, mm;
                                  >= blocked_mm; in between it keeps last tick's value.
                                  Default 1400 (assumed) */
     uint8_t wide_sectors;     /* s_max: an opening of more sectors is wide, 1..180;
@@ -58,7 +58,7 @@ typedef struct {
     uint8_t sector_deg;
     uint16_t n_hist;          /* K = 360 / alpha */
     uint8_t level_blocked;    /* a sector below this distance level is blocked */
-    uint8_t level_free;       /* at or above this level it is free */
+    uint8_t level_open;       /* at or above this level it is free */
     uint8_t level_slow;       /* level at and above which the speed is full */
     uint8_t wide_sectors;
     uint8_t mu_goal;
