@@ -286,7 +286,7 @@ const ConditionDecl kConditions[4] = {
     {ConditionKind::Transfer, "transfer-", true},
     {ConditionKind::Direct, "direct", true},
     {ConditionKind::Probabilistic, "probabilistic", false},
-    {ConditionKind::Vfh, "vfh", false},
+    {ConditionKind::Vfh, kVfhController, false},
 };
 
 const ConditionDecl &condition_decl(ConditionKind kind)
@@ -635,7 +635,7 @@ ConditionSummary summarize_reference(const std::vector<TaskDef> &tasks, Conditio
         }
         double reached = 0;
         const auto ev =
-            read_eval(join_path(t.dir, kind == ConditionKind::Vfh ? "eval-vfh.csv" : "eval.csv"));
+            read_eval(join_path(t.dir, kind == ConditionKind::Vfh ? std::string(kVfhEvalStem) + ".csv" : "eval.csv"));
         for (const auto &o : ev) {
             prob.final_per_run.push_back(o.R);
             prob.arrival_per_run.push_back(o.reached ? 1.0 : 0.0);
@@ -836,7 +836,7 @@ std::string episodes_csv(const ExperimentSummary &S, const std::string &exp_dir,
         for (uint32_t i = 0; i < std::min(kPictureEpisodes, eval_episodes); ++i) {
             std::vector<qnav_sim_sample_t> trace;
             const uint64_t seed = mix_seed(eval_base, i);
-            const EpisodeOutcome out = c.kind == ConditionKind::Vfh ? runner.run_controller_traced("vfh", seed, &trace)
+            const EpisodeOutcome out = c.kind == ConditionKind::Vfh ? runner.run_controller_traced(kVfhController, seed, &trace)
                                                                     : runner.run_traced(policy, seed, &trace);
             for (const qnav_sim_sample_t &smp : trace) {
                 char b[256];

@@ -621,8 +621,8 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
         if (!run_eval(*runner, prob, t, obs, stop)) {
             return false;
         }
-        if (!run_eval_episodes([&](uint64_t seed) { return runner->run_controller("vfh", seed); },
-                               "eval-vfh", t, obs, stop)) {
+        if (!run_eval_episodes([&](uint64_t seed) { return runner->run_controller(kVfhController, seed); },
+                               kVfhEvalStem, t, obs, stop)) {
             return false;
         }
         write_file_atomic(done_path, "complete\n");

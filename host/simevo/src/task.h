@@ -32,6 +32,11 @@ namespace qnav {
 
 enum class TaskKind { Evolve, EvalProbabilistic };
 
+/* The second reference the EvalProbabilistic task runs: libqnav's controller of this name
+ * (VFH+), journaled as <task dir>/kVfhEvalStem.csv. One home for both names. */
+constexpr const char *kVfhController = "vfh";
+constexpr const char *kVfhEvalStem = "eval-vfh";
+
 struct TaskDef {
     TaskKind kind = TaskKind::Evolve;
     std::string dir;                 /* output folder */
