@@ -117,6 +117,24 @@ qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
     return QNAV_OK;
 }
 
+/* The shape of every row of the table (init time: one read per entry). */
+static void table_shapes(qnav_ctrl_t *ctrl)
+{
+    uint16_t level;
+    uint16_t d;
+    for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
+        const qnav_qkey_t *row = &ctrl->table[level * QNAV_TABLE_STRIDE];
+        qnav_row_shape_t *s = &ctrl->p.net.row[level];
+        qnav_qkey_t prev = QNAV_FLASH_READ_I16(&row[0]);
+        qnav_row_shape_start(s, prev);
+        for (d = 1; d <= QNAV_DTHETA_MAX; ++d) {
+            qnav_qkey_t key = QNAV_FLASH_READ_I16(&row[d]);
+            qnav_row_shape_next(s, (uint8_t)d, prev, key);
+            prev = key;
+        }
+    }
+}
+
 qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
                                    const qnav_qkey_t *table, qnav_rank_t rank)
 {
@@ -132,6 +150,7 @@ qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *
     }
     ctrl->table = table;
     ctrl->rank = (uint8_t)rank;
+    table_shapes(ctrl);
     ctrl->kind = 0u;
     ctrl->magic = QNAV_CTRL_MAGIC;
     return QNAV_OK;
@@ -236,43 +255,139 @@ uint16_t qnav_whole_deg(qnav_cdeg_t cdeg)
 }
 
 
-/* dtheta of a run's first path and its direction, from the path and the goal. */
-void qnav_run_shape(qnav_run_t *r, uint16_t goal)
-{
-    uint16_t offset = (uint16_t)(r->first >= goal ? r->first - goal : r->first + QNAV_PATHS - goal);
-    r->dtheta0 = (uint8_t)(offset <= QNAV_DTHETA_MAX ? offset : QNAV_PATHS - offset);
-    r->dir = (int8_t)(offset < QNAV_DTHETA_MAX ? 1 : -1);
-}
-
-/* The next run into *r; 0 when all 360 paths have been handed out. A run ends where the
- * level changes, where dtheta turns (at the goal and opposite it) and after path 359. */
+/*
+ * The next run into *r; 0 when all 360 paths have been handed out. Runs come outward
+ * from the goal: of the two sides (counter-clockwise: paths goal + 0..180, dtheta rising
+ * with the path; clockwise: goal - 1..179, dtheta falling with the path), the one whose
+ * next path is nearer the goal gives the next run, so runs arrive by their smallest
+ * dtheta. A run ends where the level changes, at the side's end and at the wrap from path
+ * 359 to 0 (a run's paths are first..first + count - 1).
+ */
 uint8_t qnav_run_next(qnav_run_iter_t *it, qnav_run_t *r)
 {
-    uint16_t end;
-    uint16_t to_turn;
     uint16_t p;
+    uint16_t limit;
     uint8_t level;
-    if (it->path >= QNAV_PATHS) {
+    uint8_t k;
+    if (it->up <= QNAV_DTHETA_MAX && (it->down >= QNAV_DTHETA_MAX || it->up <= it->down)) {
+        p = (uint16_t)(it->goal + it->up);
+        if (p >= QNAV_PATHS) {
+            p = (uint16_t)(p - QNAV_PATHS);
+        }
+        limit = (uint16_t)(QNAV_DTHETA_MAX + 1u - it->up);
+        if (limit > QNAV_PATHS - p) {
+            limit = (uint16_t)(QNAV_PATHS - p);
+        }
+        level = it->lvl[p];
+        {
+            const uint8_t *q = it->lvl + p + 1;
+            const uint8_t *end = it->lvl + p + limit;
+            while (q != end && *q == level) {
+                ++q;
+            }
+            k = (uint8_t)(q - (it->lvl + p));
+        }
+        r->first = p;
+        r->dtheta0 = (uint8_t)it->up;
+        r->dir = 1;
+        it->up = (uint16_t)(it->up + k);
+    } else if (it->down < QNAV_DTHETA_MAX) {
+        p = (uint16_t)(it->goal >= it->down ? it->goal - it->down
+                                            : it->goal + QNAV_PATHS - it->down);
+        limit = (uint16_t)(QNAV_DTHETA_MAX - it->down);
+        if (limit > p + 1u) {
+            limit = (uint16_t)(p + 1u);
+        }
+        level = it->lvl[p];
+        {
+            const uint8_t *q = it->lvl + p;            /* the run's lowest path so far */
+            const uint8_t *stop = q + 1 - limit;       /* the lowest it may reach */
+            while (q != stop && q[-1] == level) {
+                --q;
+            }
+            k = (uint8_t)((it->lvl + p) - q + 1);
+        }
+        r->first = (uint16_t)(p + 1u - k);
+        r->dtheta0 = (uint8_t)(it->down + k - 1u);
+        r->dir = -1;
+        it->down = (uint16_t)(it->down + k);
+    } else {
         return 0;
     }
-    r->first = it->path;
-    qnav_run_shape(r, it->goal);
-    to_turn = (uint16_t)(r->dir > 0 ? QNAV_DTHETA_MAX - r->dtheta0 : r->dtheta0);
-    if (to_turn == 0u) {
-        to_turn = QNAV_DTHETA_MAX; /* starts at the goal, or opposite it going down */
-    }
-    end = (uint16_t)(it->path + to_turn);
-    if (end > QNAV_PATHS) {
-        end = QNAV_PATHS;
-    }
-    level = it->lvl[it->path];
-    p = (uint16_t)(it->path + 1u);
-    while (p < end && it->lvl[p] == level) {
-        ++p;
-    }
-    r->count = (uint8_t)(p - it->path);
+    r->count = k;
     r->level = level;
-    it->path = p;
+    return 1;
+}
+
+/* Start it over the levels lvl with the goal and previous heading in whole degrees. */
+void qnav_run_start(qnav_run_iter_t *it, const uint8_t *lvl, uint16_t goal, uint16_t prev)
+{
+    it->lvl = lvl;
+    it->goal = goal;
+    it->prev = prev;
+    it->up = 0;
+    it->down = 1;
+}
+
+void qnav_row_shape_start(qnav_row_shape_t *s, qnav_qkey_t key0)
+{
+    s->top = key0;
+    s->top_d = 0;
+    s->fall_d = 0;
+}
+
+void qnav_row_shape_next(qnav_row_shape_t *s, uint8_t d, qnav_qkey_t prev, qnav_qkey_t key)
+{
+    if (key > s->top) {
+        s->top = key;
+        s->top_d = d;
+    }
+    if (key > prev) {
+        s->fall_d = d; /* the last rise so far ends here */
+    }
+}
+
+/*
+ * Every key of the run is at most the row's top, so a top below the best (or equal, with
+ * every dtheta of the run larger than the best's: the tie is lost) rules the run out. A run
+ * that holds the top's dtheta has its best there: the top is the largest key and top_d the
+ * smallest dtheta with it. From fall_d on the keys never rise, so of the paths at or
+ * beyond fall_d only the one nearest the goal can win (ties prefer the smaller dtheta);
+ * and since runs arrive by their smallest dtheta (qnav_run_next), once such a path of a
+ * level has been offered, a later run of that level that lies wholly beyond fall_d and
+ * starts farther out cannot win either: settled[level] records that path's dtheta.
+ */
+uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t *best,
+                        uint8_t *settled)
+{
+    const qnav_row_shape_t *s = &row[r->level];
+    uint8_t a = qnav_run_dmin(r);
+    uint8_t b = (uint8_t)(a + (uint8_t)(r->count - 1u));
+    uint8_t e;
+    if (s->top < best->key || (s->top == best->key && a > best->dtheta)) {
+        return 0;
+    }
+    if (s->top_d >= a && s->top_d <= b) {
+        qnav_best_consider(best, s->top, qnav_run_path_at(r, s->top_d), s->top_d);
+        return 0;
+    }
+    if (a >= s->fall_d) {
+        if (settled[r->level] != QNAV_UNSETTLED && a > settled[r->level]) {
+            return 0;
+        }
+        settled[r->level] = a;
+        e = a;
+    } else if (b >= s->fall_d) {
+        settled[r->level] = s->fall_d;
+        e = s->fall_d;
+    } else {
+        e = b;
+    }
+    if (r->dir < 0) { /* keep dtheta a..e */
+        r->first = (uint16_t)(r->first + (uint8_t)(b - e));
+        r->dtheta0 = e;
+    }
+    r->count = (uint8_t)((uint8_t)(e - a) + 1u);
     return 1;
 }
 
@@ -348,8 +463,12 @@ static void paths_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t
 {
     qnav_run_t r;
     if (ctrl->table != 0) {
+        uint8_t settled[QNAV_DIST_LEVELS];
+        qnav_settled_clear(settled);
         while (qnav_run_next(it, &r)) {
-            eval_table_run(ctrl, &r, best, keys);
+            if (keys != 0 || qnav_run_reduce(ctrl->p.net.row, &r, best, settled)) {
+                eval_table_run(ctrl, &r, best, keys);
+            }
         }
         return;
     }
@@ -394,10 +513,8 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     best.dtheta = 0;
     best.heading = 0;
     flags = qnav_clearance_levels(&ctrl->clr, in->ranges_mm, lvl);
-    it.lvl = lvl;
-    it.goal = qnav_whole_deg(in->goal_bearing_cdeg);
-    it.prev = qnav_whole_deg(in->prev_heading_cdeg);
-    it.path = 0;
+    qnav_run_start(&it, lvl, qnav_whole_deg(in->goal_bearing_cdeg),
+                   qnav_whole_deg(in->prev_heading_cdeg));
     /* the keys land in qualities[] and are turned into qualities below */
     paths_best(ctrl, &it, &best, qualities);
     if (qualities != 0) {

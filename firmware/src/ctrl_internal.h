@@ -51,12 +51,14 @@ typedef struct {
     qnav_deg_t heading;
 } qnav_best_t;
 
-/* Walks the 360 paths once and hands out their runs in path order. */
+/* Walks the 360 paths once and hands out their runs outward from the goal
+ * (qnav_run_next). */
 typedef struct {
     const uint8_t *lvl;   /* distance level of every path */
     uint16_t goal;        /* destination, whole degrees 0..359 */
     uint16_t prev;        /* heading chosen at the previous tick, whole degrees 0..359 */
-    uint16_t path;        /* next path to hand out */
+    uint16_t up;          /* next dtheta counter-clockwise of the goal (0..180; 181: done) */
+    uint16_t down;        /* next dtheta clockwise of the goal (1..179; 180: done) */
 } qnav_run_iter_t;
 
 /* Offer path (with its key and dtheta) to best under the total order above. Inline: the
@@ -96,14 +98,55 @@ static inline uint8_t qnav_angle_dist_deg(uint16_t a, uint16_t b)
     return (uint8_t)(d > QNAV_DTHETA_MAX ? QNAV_PATHS - d : d);
 }
 
+/* The path of run r whose dtheta is d (d within the run). */
+static inline uint16_t qnav_run_path_at(const qnav_run_t *r, uint8_t d)
+{
+    uint8_t k = (uint8_t)(r->dir > 0 ? d - r->dtheta0 : r->dtheta0 - d);
+    return (uint16_t)(r->first + k);
+}
+
+/* The smallest dtheta of run r. */
+static inline uint8_t qnav_run_dmin(const qnav_run_t *r)
+{
+    return (uint8_t)(r->dir > 0 ? r->dtheta0 : r->dtheta0 + 1u - r->count);
+}
+
+/* Row shapes (docs/architecture.md, "Row shapes"): start a shape with the key at dtheta 0,
+ * then feed the keys at dtheta 1..180 in order (prev: the key at d - 1). */
+void qnav_row_shape_start(qnav_row_shape_t *s, qnav_qkey_t key0);
+void qnav_row_shape_next(qnav_row_shape_t *s, uint8_t d, qnav_qkey_t prev, qnav_qkey_t key);
+
+/* settled[level] of a step: no path of that level offered yet beyond its row's fall_d. */
+#define QNAV_UNSETTLED 0xFFu
+
+static inline void qnav_settled_clear(uint8_t *settled)
+{
+    uint16_t i;
+    for (i = 0; i < QNAV_DIST_LEVELS; ++i) {
+        settled[i] = QNAV_UNSETTLED;
+    }
+}
+
+/*
+ * What the shape of a run's row decides before any evaluation (runs must come from
+ * qnav_run_next, in its order; settled: QNAV_DIST_LEVELS bytes, cleared by
+ * qnav_settled_clear at the step's start). Returns 0 when nothing is left to do: no path
+ * of r can beat best, or the row's top lies in r and was offered to best. Otherwise
+ * narrows r to the paths that can still hold its best path and returns 1; the caller must
+ * then offer r's best to best. A run of one path needs only that path's key.
+ */
+uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t *best,
+                        uint8_t *settled);
+
 /* An angle in centidegrees to the nearest whole degree (halves away from zero), 0..359.
  * 16-bit arithmetic: one division, no 32-bit ones (costly on AVR). */
 uint16_t qnav_whole_deg(qnav_cdeg_t cdeg);
 
-/* dtheta of a run's first path and its direction, from the path and the goal. */
-void qnav_run_shape(qnav_run_t *r, uint16_t goal);
+/* Start it over the levels lvl (goal and previous heading in whole degrees 0..359). */
+void qnav_run_start(qnav_run_iter_t *it, const uint8_t *lvl, uint16_t goal, uint16_t prev);
 
-/* The next run into *r; 0 when all 360 paths have been handed out. */
+/* The next run into *r, outward from the goal: runs arrive by their smallest dtheta. 0
+ * when all 360 paths have been handed out. */
 uint8_t qnav_run_next(qnav_run_iter_t *it, qnav_run_t *r);
 
 /* ---- policy_prob.c: probabilistic navigation (paper §3.2) --------------------------- */

@@ -3,8 +3,10 @@
  * units -> 1 sigmoid output, Q8.8 weights; optionally a third input, the angular distance
  * dprev between the path and the previous tick's heading (paper §5). Its key is the
  * output's pre-activation, companded into 16 bits (docs/qformats.md), or the quality under
- * QNAV_RANK_QUALITY. Two inputs: the step bounds whole runs of paths and searches them
- * best first; three inputs: every path is evaluated (dprev breaks the runs' shape, and a
+ * QNAV_RANK_QUALITY. Two inputs: init learns the shape of every row of keys (a level,
+ * dtheta 0..180), which settles most runs of paths with one evaluation or none; the rest
+ * are searched by halving with exact bounds, never more than one sigmoid per hidden unit
+ * and path. Three inputs: every path is evaluated (dprev breaks the runs' shape, and a
  * table would need a third dimension, docs/architecture.md).
  */
 #include "ctrl_internal.h"
@@ -19,28 +21,6 @@ static int32_t div_round(int32_t num, int32_t den)
     return (num >= 0) ? (num + den / 2) / den : -((-num + den / 2) / den);
 }
 
-/* @par Scaling and overflow: a Q8.8 weight times 2048 is in units of 2^-19 (|.| <= 2^26);
- * per degree and per level divide that by 180 and by QNAV_DIST_LEVELS - 1, so each
- * input's term over its whole range stays within 2^26 and a 3-input pre-activation within
- * 2^28. The output bias times 128 is in units of 2^-15. */
-void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net)
-{
-    uint8_t j;
-    ctrl->hidden = net->hidden;
-    ctrl->inputs = net->inputs;
-    for (j = 0; j < net->hidden; ++j) {
-        qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
-        u->bias_z = (int32_t)net->b_hidden[j] * 2048;
-        u->per_deg = div_round((int32_t)net->w_theta[j] * 2048, QNAV_DTHETA_MAX);
-        u->per_level = div_round((int32_t)net->w_dist[j] * 2048, QNAV_DIST_LEVELS - 1);
-        u->per_prev = net->inputs == QNAV_NET_INPUTS_PREV
-                          ? div_round((int32_t)net->w_prev[j] * 2048, QNAV_DTHETA_MAX)
-                          : 0;
-        u->out = net->w_out[j];
-    }
-    ctrl->out_bias_z = (int32_t)net->b_out * 128;
-}
-
 /*
  * One hidden unit's share of the output pre-activation, in units of 2^-15.
  * z is the unit's pre-activation in units of 2^-19 (|z| < 2^29).
@@ -50,7 +30,16 @@ void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net)
  */
 static inline int32_t unit_share(int32_t z, int16_t out)
 {
-    int16_t h = qnav_sigmoid_q5_11(qnav_sat16((z + 128) >> 8));
+    int16_t h;
+    /* the sigmoid's flat ends, without the table or the multiply: h = 0 gives 0, and
+     * h = 32767 gives (out * 2^15 - out + 128) >> 8 = out * 128 + ((128 - out) >> 8) */
+    if (z < (int32_t)QNAV_SIGMOID_LAST_ZERO * 256 + 128) {
+        return 0;
+    }
+    if (z >= (int32_t)QNAV_SIGMOID_FIRST_TOP * 256 - 128) {
+        return (int32_t)out * 128 + (((int32_t)128 - out) >> 8);
+    }
+    h = qnav_sigmoid_q5_11(qnav_sat16((z + 128) >> 8));
     return ((int32_t)out * h + 128) >> 8;
 }
 
@@ -98,10 +87,31 @@ qnav_q1_15_t qnav_net_eval_key_quality(qnav_qkey_t key)
     return qnav_sigmoid_q5_11(qnav_sat16(z));
 }
 
-/* a * b for a small unsigned b. */
+/* a * b for a small unsigned b (the low 32 bits, which is the product: |a * b| < 2^31
+ * wherever it is used). avr-gcc would call its 32 x 32 bit __mulsi3 (about 70 cycles):
+ * four 8 x 8 bit MULs do it in 16; the shared vectors check it on the ATmega128. */
 static inline int32_t mul_u8(int32_t a, uint8_t b)
 {
+#if defined(__AVR__) && defined(__AVR_HAVE_MUL__)
+    int32_t r;
+    __asm__("mul %A1, %2\n\t"
+            "movw %A0, r0\n\t"
+            "mul %C1, %2\n\t"
+            "movw %C0, r0\n\t"
+            "mul %B1, %2\n\t"
+            "add %B0, r0\n\t"
+            "adc %C0, r1\n\t"
+            "clr r1\n\t"
+            "adc %D0, r1\n\t"
+            "mul %D1, %2\n\t"
+            "add %D0, r0\n\t"
+            "clr r1"
+            : "=&r"(r)
+            : "r"(a), "r"(b));
+    return r;
+#else
     return a * (int32_t)b;
+#endif
 }
 
 static inline int32_t unit_base(const qnav_ctrl_unit_t *u, uint8_t level)
@@ -115,7 +125,7 @@ static int32_t path_acc(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta, 
     int32_t acc = ctrl->out_bias_z;
     uint8_t j;
     for (j = 0; j < ctrl->hidden; ++j) {
-        const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
+        const qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
         acc += unit_share(unit_base(u, level) + mul_u8(u->per_deg, dtheta) +
                               mul_u8(u->per_prev, dprev),
                           u->out);
@@ -125,34 +135,56 @@ static int32_t path_acc(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta, 
 
 qnav_qkey_t qnav_net_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
 {
-    return net_key_of(ctrl, path_acc(ctrl, level, dtheta, 0u));
+    int32_t acc = ctrl->out_bias_z;
+    uint8_t j;
+    /* dprev = 0: the third input's term is 0 */
+    for (j = 0; j < ctrl->hidden; ++j) {
+        const qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
+        acc += unit_share(unit_base(u, level) + mul_u8(u->per_deg, dtheta), u->out);
+    }
+    return net_key_of(ctrl, acc);
 }
 
-/* Every path of a run; pre-activations walk by one degree's weight per path. */
+/* Paths evaluated together by eval_run: one unit at a time over all of them, so that its
+ * pre-activation stays in registers (on the ATmega128 about half the cycles of one path
+ * at a time). */
+#define QNAV_EVAL_CHUNK 16u
+
+/* Every path of a run; each unit's pre-activation walks by one degree's weight per path
+ * (the same integers as the per-path products). */
 static void eval_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *best,
                      qnav_qkey_t *keys)
 {
-    int32_t z[QNAV_MAX_HIDDEN];
-    uint8_t k;
-    uint8_t j;
+    int32_t acc[QNAV_EVAL_CHUNK];
+    uint8_t done = 0;
     uint8_t dtheta = r->dtheta0;
-    for (j = 0; j < ctrl->hidden; ++j) {
-        const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
-        z[j] = unit_base(u, r->level) + mul_u8(u->per_deg, r->dtheta0);
-    }
-    for (k = 0; k < r->count; ++k, dtheta = (uint8_t)(dtheta + r->dir)) {
-        int32_t acc = ctrl->out_bias_z;
-        qnav_qkey_t q;
+    while (done < r->count) {
+        uint8_t n = (uint8_t)(r->count - done);
+        if (n > QNAV_EVAL_CHUNK) {
+            n = QNAV_EVAL_CHUNK;
+        }
+        uint8_t k;
+        uint8_t j;
+        for (k = 0; k < n; ++k) {
+            acc[k] = ctrl->out_bias_z;
+        }
         for (j = 0; j < ctrl->hidden; ++j) {
-            const qnav_ctrl_unit_t *u = &ctrl->p.unit[j];
-            acc += unit_share(z[j], u->out);
-            z[j] = (r->dir > 0) ? z[j] + u->per_deg : z[j] - u->per_deg;
+            const qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
+            int32_t step = r->dir > 0 ? u->per_deg : -u->per_deg;
+            int32_t z = unit_base(u, r->level) + mul_u8(u->per_deg, dtheta);
+            int16_t out = u->out;
+            for (k = 0; k < n; ++k) {
+                acc[k] += unit_share(z, out);
+                z += step;
+            }
         }
-        q = net_key_of(ctrl, acc);
-        if (keys != 0) {
-            keys[r->first + k] = q;
+        for (k = 0; k < n; ++k, ++done, dtheta = (uint8_t)(dtheta + r->dir)) {
+            qnav_qkey_t q = net_key_of(ctrl, acc[k]);
+            if (keys != 0) {
+                keys[r->first + done] = q;
+            }
+            qnav_best_consider(best, q, (uint16_t)(r->first + done), dtheta);
         }
-        qnav_best_consider(best, q, (uint16_t)(r->first + k), dtheta);
     }
 }
 
@@ -172,124 +204,189 @@ void qnav_net_eval_row(const qnav_ctrl_t *ctrl, uint8_t level, qnav_qkey_t *row)
     eval_run(ctrl, &r, &ignore, row);
 }
 
-/* A run kept for the network's best-first search, with its bound. */
-typedef struct {
-    uint16_t first;
-    uint8_t count;
-    uint8_t level;
-    qnav_qkey_t bound;   /* no path of the run exceeds it; QNAV_KEY_NONE once evaluated */
-} pending_t;
-
-/* How the dtheta term moves in the current run (see bound_runs). */
-typedef struct {
-    uint8_t level;
-    uint8_t span;     /* paths in the run - 1 */
-    uint8_t up;       /* dtheta rises along the run */
-    uint8_t step_up;  /* the run's first dtheta is above the previous run's last */
-    uint8_t first;    /* first run of the step: c starts from dtheta0 */
-    uint8_t dtheta0;
-} run_walk_t;
-
-/* One unit's largest share over a run; advances its dtheta term c (per_deg * dtheta at
- * the end of the previous run) to the run's end. */
-static inline int32_t bound_unit(const qnav_ctrl_unit_t *u, int32_t *c_io, const run_walk_t *rw)
+/* The shape of every row (init time): each row evaluated in pieces by eval_run, the same
+ * integers as the step. @par Cost: 181 * QNAV_DIST_LEVELS paths of H units (ATmega128:
+ * docs/performance.md). */
+static void row_shapes(qnav_ctrl_t *ctrl)
 {
-    int32_t base = unit_base(u, rw->level);
-    int32_t c = rw->first ? mul_u8(u->per_deg, rw->dtheta0)
-                          : (rw->step_up ? *c_io + u->per_deg : *c_io - u->per_deg);
-    int32_t dz = mul_u8(u->per_deg, rw->span);
-    int32_t z0 = base + c;
-    int32_t z1;
-    c = rw->up ? c + dz : c - dz;
-    *c_io = c;
-    z1 = base + c;
-    return unit_share(((u->out >= 0) == (z1 > z0)) ? z1 : z0, u->out);
+    qnav_qkey_t keys[16];
+    qnav_best_t ignore;
+    qnav_run_t r;
+    uint16_t level;
+    for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
+        qnav_row_shape_t *s = &ctrl->p.net.row[level];
+        qnav_qkey_t prev = 0;
+        uint8_t d = 0;
+        r.first = 0;
+        r.level = (uint8_t)level;
+        r.dir = 1;
+        while (d <= QNAV_DTHETA_MAX) {
+            uint8_t k;
+            r.dtheta0 = d;
+            r.count = (uint8_t)(QNAV_DTHETA_MAX + 1 - d < 16 ? QNAV_DTHETA_MAX + 1 - d : 16);
+            ignore.key = QNAV_KEY_NONE;
+            eval_run(ctrl, &r, &ignore, keys);
+            for (k = 0; k < r.count; ++k, ++d) {
+                if (d == 0) {
+                    qnav_row_shape_start(s, keys[0]);
+                } else {
+                    qnav_row_shape_next(s, d, prev, keys[k]);
+                }
+                prev = keys[k];
+            }
+        }
+    }
+}
+
+/* @par Scaling and overflow: a Q8.8 weight times 2048 is in units of 2^-19 (|.| <= 2^26);
+ * per degree and per level divide that by 180 and by QNAV_DIST_LEVELS - 1, so each
+ * input's term over its whole range stays within 2^26 and a 3-input pre-activation within
+ * 2^28. The output bias times 128 is in units of 2^-15. */
+void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net)
+{
+    uint8_t j;
+    ctrl->hidden = net->hidden;
+    ctrl->inputs = net->inputs;
+    for (j = 0; j < net->hidden; ++j) {
+        qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
+        u->bias_z = (int32_t)net->b_hidden[j] * 2048;
+        u->per_deg = div_round((int32_t)net->w_theta[j] * 2048, QNAV_DTHETA_MAX);
+        u->per_level = div_round((int32_t)net->w_dist[j] * 2048, QNAV_DIST_LEVELS - 1);
+        u->per_prev = net->inputs == QNAV_NET_INPUTS_PREV
+                          ? div_round((int32_t)net->w_prev[j] * 2048, QNAV_DTHETA_MAX)
+                          : 0;
+        u->out = net->w_out[j];
+    }
+    ctrl->out_bias_z = (int32_t)net->b_out * 128;
+    if (net->inputs == QNAV_NET_INPUTS_PAPER) {
+        row_shapes(ctrl);
+    }
+}
+
+/* Do unit u's shares rise along run r (dtheta moving by r->dir per path)? A unit whose
+ * pre-activation does not move is constant: either answer holds. */
+static inline uint8_t rises_along(const qnav_ctrl_unit_t *u, const qnav_run_t *r)
+{
+    uint8_t z_up = (uint8_t)(r->dir > 0 ? u->per_deg > 0 : u->per_deg < 0);
+    return (uint8_t)((u->out >= 0) == z_up);
 }
 
 /*
- * First pass: bound every run. Along a run each hidden unit's pre-activation is linear in
- * dtheta, and rounding, saturation, the interpolated sigmoid and the output weight all
- * keep order, so a unit's share is largest at one end, the end where out * z is larger:
- * one sigmoid per unit bounds the whole run, and the key is monotone in the output's
- * accumulator. The dtheta term is carried from run to run (neighbouring paths differ by
- * one degree). Runs whose bound is below the best so far are dropped; runs beyond cap are
- * evaluated at once (same answer). Returns the runs kept in runs[].
+ * Each unit's share at one of two paths of run r (offsets i_lo, i_hi): at i_hi for the
+ * units whose shares rise along the run (summed into *s_hi), at i_lo for the others
+ * (*s_lo). Along a run every unit's pre-activation is linear in the path, and rounding,
+ * saturation, the interpolated sigmoid and the output weight all keep order, so each share
+ * is monotone: over offsets lo..hi the largest output accumulator any path can have is the
+ * output bias plus the rising units' shares at hi plus the others' at lo, and for a single
+ * path (lo = hi) that is its exact accumulator. One sigmoid per unit.
  */
-static uint16_t bound_runs(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, pending_t *runs,
-                           uint16_t cap, qnav_best_t *best)
+static void two_sums(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_t i_lo, uint8_t i_hi,
+                     int32_t *s_lo, int32_t *s_hi)
 {
-    int32_t c[QNAV_MAX_HIDDEN];
-    run_walk_t rw;
-    uint8_t prev_end = 0;
-    uint16_t n = 0;
+    uint8_t d_lo = (uint8_t)(r->dir > 0 ? r->dtheta0 + i_lo : r->dtheta0 - i_lo);
+    uint8_t d_hi = (uint8_t)(r->dir > 0 ? r->dtheta0 + i_hi : r->dtheta0 - i_hi);
+    int32_t lo = 0;
+    int32_t hi = 0;
     uint8_t j;
-    qnav_run_t r;
-    rw.first = 1;
-    while (qnav_run_next(it, &r)) {
-        int32_t acc = ctrl->out_bias_z;
-        qnav_qkey_t bound;
-        rw.level = r.level;
-        rw.span = (uint8_t)(r.count - 1u);
-        rw.up = (uint8_t)(r.dir > 0);
-        rw.step_up = (uint8_t)(r.dtheta0 > prev_end);
-        rw.dtheta0 = r.dtheta0;
-        for (j = 0; j < ctrl->hidden; ++j) {
-            acc += bound_unit(&ctrl->p.unit[j], &c[j], &rw);
-        }
-        rw.first = 0;
-        prev_end = (uint8_t)(rw.up ? r.dtheta0 + rw.span : r.dtheta0 - rw.span);
-        bound = net_key_of(ctrl, acc);
-        if (r.count == 1u) {
-            qnav_best_consider(best, bound, r.first, r.dtheta0); /* the bound is exact */
-        } else if (bound < best->key) {
-            /* cannot win: the best only rises */
-        } else if (n < cap) {
-            runs[n].first = r.first;
-            runs[n].count = r.count;
-            runs[n].level = r.level;
-            runs[n].bound = bound;
-            ++n;
+    for (j = 0; j < ctrl->hidden; ++j) {
+        const qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
+        int32_t base = unit_base(u, r->level);
+        if (rises_along(u, r)) {
+            hi += unit_share(base + mul_u8(u->per_deg, d_hi), u->out);
         } else {
-            eval_run(ctrl, &r, best, 0);
+            lo += unit_share(base + mul_u8(u->per_deg, d_lo), u->out);
         }
     }
-    return n;
+    *s_lo = lo;
+    *s_hi = hi;
 }
 
-/* Best-first over the runs' bounds: stop when no run left can reach the best. */
-static void search_runs(const qnav_ctrl_t *ctrl, pending_t *runs, uint16_t n, uint16_t goal,
-                        qnav_best_t *best)
+/* Paths lo..hi (offsets) of a run and the two halves of their bound (see two_sums). */
+typedef struct {
+    uint8_t lo;
+    uint8_t hi;
+    int32_t s_lo;
+    int32_t s_hi;
+} span_t;
+
+/* Halving a span of at most 181 paths takes at most 8 levels. */
+#define QNAV_SPAN_DEPTH 8
+
+/*
+ * The best path of run r by branch and bound: a span whose bound cannot beat the best is
+ * dropped; otherwise it is halved, and each half's bound needs one new sigmoid per unit
+ * (the rising units' shares at the left half's end, the others' at the right half's
+ * start; the outer ends are the parent's). A span of one path is exact. So a run of k
+ * paths costs at most k sigmoids per unit whatever the pruning does: the worst case is
+ * the cost of evaluating every path, bounded by design (docs/architecture.md).
+ */
+static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *best)
 {
-    uint16_t i;
+    span_t stack[QNAV_SPAN_DEPTH];
+    uint8_t depth = 0;
+    span_t n;
+    n.lo = 0;
+    n.hi = (uint8_t)(r->count - 1u);
+    two_sums(ctrl, r, n.lo, n.hi, &n.s_lo, &n.s_hi);
     for (;;) {
-        pending_t *top = 0;
-        qnav_run_t r;
-        for (i = 0; i < n; ++i) {
-            if (runs[i].bound != QNAV_KEY_NONE && (top == 0 || runs[i].bound > top->bound)) {
-                top = &runs[i];
+        qnav_qkey_t bound = net_key_of(ctrl, ctrl->out_bias_z + n.s_lo + n.s_hi);
+        uint8_t i_near = r->dir > 0 ? n.lo : n.hi; /* nearest the goal */
+        uint8_t d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + i_near : r->dtheta0 - i_near);
+        if (n.lo == n.hi) {
+            qnav_best_consider(best, bound, (uint16_t)(r->first + n.lo), d_near);
+        } else if (bound > best->key || (bound == best->key && d_near <= best->dtheta)) {
+            uint8_t mid = (uint8_t)(n.lo + (uint8_t)(n.hi - n.lo) / 2u);
+            span_t left;
+            span_t right;
+            qnav_qkey_t k_left;
+            qnav_qkey_t k_right;
+            left.lo = n.lo;
+            left.hi = mid;
+            left.s_lo = n.s_lo;
+            right.lo = (uint8_t)(mid + 1u);
+            right.hi = n.hi;
+            right.s_hi = n.s_hi;
+            two_sums(ctrl, r, right.lo, left.hi, &right.s_lo, &left.s_hi);
+            k_left = net_key_of(ctrl, ctrl->out_bias_z + left.s_lo + left.s_hi);
+            k_right = net_key_of(ctrl, ctrl->out_bias_z + right.s_lo + right.s_hi);
+            /* the more promising half first (on equal bounds, the one nearer the goal); the
+             * other waits */
+            if (k_left > k_right || (k_left == k_right && r->dir > 0)) {
+                stack[depth++] = right;
+                n = left;
+            } else {
+                stack[depth++] = left;
+                n = right;
             }
+            continue;
         }
-        if (top == 0 || top->bound < best->key) {
+        if (depth == 0u) {
             return;
         }
-        r.first = top->first;
-        r.count = top->count;
-        r.level = top->level;
-        qnav_run_shape(&r, goal);
-        eval_run(ctrl, &r, best, 0);
-        top->bound = QNAV_KEY_NONE;
+        n = stack[--depth];
     }
 }
 
-/* Two inputs, no keys wanted: bound every run, then search the runs best first. */
-static void best_first(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best)
+/*
+ * Two inputs, no keys wanted: every run, outward from the goal, settled by its row's shape
+ * (qnav_run_reduce); what that leaves is one path to evaluate, or a search.
+ */
+static void two_inputs_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best)
 {
-    pending_t runs[QNAV_MAX_RUNS];
-    uint16_t n;
-    /* the path straight at the goal first: a good best prunes runs before they are kept */
-    qnav_best_consider(best, qnav_net_eval_key(ctrl, it->lvl[it->goal], 0), it->goal, 0);
-    n = bound_runs(ctrl, it, runs, QNAV_MAX_RUNS, best);
-    search_runs(ctrl, runs, n, it->goal, best);
+    uint8_t settled[QNAV_DIST_LEVELS];
+    qnav_run_t r;
+    qnav_settled_clear(settled);
+    while (qnav_run_next(it, &r)) {
+        if (!qnav_run_reduce(ctrl->p.net.row, &r, best, settled)) {
+            continue;
+        }
+        if (r.count == 1u) {
+            qnav_best_consider(best, qnav_net_eval_key(ctrl, r.level, r.dtheta0), r.first,
+                               r.dtheta0);
+        } else {
+            search_run(ctrl, &r, best);
+        }
+    }
 }
 
 /*
@@ -319,7 +416,7 @@ void qnav_net_eval_paths(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best
     if (ctrl->inputs == QNAV_NET_INPUTS_PREV) {
         eval_paths_prev(ctrl, it, best, keys);
     } else if (keys == 0) {
-        best_first(ctrl, it, best);
+        two_inputs_best(ctrl, it, best);
     } else {
         while (qnav_run_next(it, &r)) {
             eval_run(ctrl, &r, best, keys);

@@ -16,6 +16,7 @@
 #include "qnav/ctrl.h"
 #include "qnav/fixed_host.h"
 #include "reference.h"
+#include "sigmoid_lut.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -801,6 +802,111 @@ static void check_table_mode_identical(const qnav_policy_t *p, uint16_t n)
     }
 }
 
+/* The flat ends that the network's share skips the table for are the table's. */
+static void test_sigmoid_flat_ends_match_the_table(void **state)
+{
+    (void)state;
+    for (int32_t v = -32768; v <= 32767; ++v) {
+        int16_t h = qnav_sigmoid_q5_11((int16_t)v);
+        if (v <= QNAV_SIGMOID_LAST_ZERO) {
+            assert_int_equal(h, 0);
+        } else if (v >= QNAV_SIGMOID_FIRST_TOP) {
+            assert_int_equal(h, 32767);
+        }
+    }
+    assert_true(qnav_sigmoid_q5_11(QNAV_SIGMOID_LAST_ZERO + 1) > 0);
+    assert_true(qnav_sigmoid_q5_11(QNAV_SIGMOID_FIRST_TOP - 1) < 32767);
+}
+
+/* Scans with the structure real ones have (clear, one obstacle at the goal, a corridor, a
+ * wall behind) besides random ones: the row-shape shortcuts and the run search meet
+ * their ties and edge cases there. */
+static void structured_scan(qnav_mm_t *ranges, uint16_t n, qnav_mm_t max_mm, unsigned kind,
+                            qnav_cdeg_t *goal)
+{
+    int32_t g = rng_range(-18000, 18000);
+    fill(ranges, n, max_mm);
+    switch (kind % 5u) {
+    case 0: /* clear; the goal on a whole degree, often exactly ahead or behind */
+        g = (rng_u32() % 2u) ? 0 : (rng_u32() % 2u ? 18000 : rng_range(-180, 180) * 100);
+        break;
+    case 1: /* one obstacle straight at the goal */
+        for (uint16_t s = 0; s < n; ++s) {
+            int32_t deg = (int32_t)(s * 360u / n);
+            int32_t off = deg - g / 100;
+            off = ((off % 360) + 540) % 360 - 180;
+            if (off >= -20 && off <= 20) {
+                ranges[s] = (qnav_mm_t)rng_range(300, max_mm - 1);
+            }
+        }
+        break;
+    case 2: /* a corridor: walls on both sides, the goal along it */
+        for (uint16_t s = 0; s < n; ++s) {
+            uint32_t deg = s * 360u / n;
+            if ((deg > 40u && deg < 140u) || (deg > 220u && deg < 320u)) {
+                ranges[s] = (qnav_mm_t)rng_range(250, 900);
+            }
+        }
+        g = rng_range(-1500, 1500);
+        break;
+    case 3: /* a wall behind, goal behind */
+        for (uint16_t s = 0; s < n; ++s) {
+            uint32_t deg = s * 360u / n;
+            if (deg > 120u && deg < 240u) {
+                ranges[s] = 600;
+            }
+        }
+        g = 18000 - rng_range(0, 3000);
+        break;
+    default:
+        random_scan(ranges, n, max_mm);
+        break;
+    }
+    *goal = (qnav_cdeg_t)g;
+}
+
+/* The step without qualities skips most evaluations (row shapes, settled levels, the run
+ * search); with qualities it evaluates every path and picks the best by the same order.
+ * Both must decide exactly the same, for nets from mild to saturated, both ranks, all
+ * sector counts. */
+static void test_fast_step_equals_every_path_evaluation(void **state)
+{
+    (void)state;
+    static const uint16_t sectors[] = {1, 5, 8, 16, 32, 64, 180, 360};
+    static const int32_t scales[] = {128, 768, 4096, 32767};
+    static qnav_q1_15_t q[QNAV_PATHS];
+    qnav_mm_t ranges[360];
+    unsigned checked = 0;
+    for (unsigned k = 0; k < 6000; ++k) {
+        uint16_t n = sectors[k % 8u];
+        qnav_policy_t p;
+        qnav_ctrl_t c;
+        qnav_ctrl_input_t in;
+        qnav_ctrl_output_t fast;
+        qnav_ctrl_output_t full;
+        qnav_cdeg_t goal;
+        random_net(&p, (uint8_t)rng_range(1, QNAV_MAX_HIDDEN), scales[(k / 8u) % 4u]);
+        if ((k / 32u) % 3u == 2u) {
+            init_literal(&c, n, 4000, &p); /* quality rank: long runs of equal keys */
+        } else {
+            init_or_fail(&c, n, 4000, &p);
+        }
+        structured_scan(ranges, n, 4000, k / 96u, &goal);
+        in.ranges_mm = ranges;
+        in.goal_bearing_cdeg = goal;
+        in.prev_heading_cdeg = 0;
+        qnav_ctrl_step(&c, &in, &fast, NULL);
+        qnav_ctrl_step(&c, &in, &full, q);
+        if (fast.heading_deg != full.heading_deg || fast.speed != full.speed ||
+            fast.quality != full.quality || fast.flags != full.flags) {
+            fail_msg("scan %u (N = %u, kind %u): fast heading %d, every path %d", k, n,
+                     (k / 96u) % 5u, fast.heading_deg, full.heading_deg);
+        }
+        ++checked;
+    }
+    assert_int_equal(checked, 6000);
+}
+
 static void test_table_mode_is_bit_identical_to_network_mode(void **state)
 {
     (void)state;
@@ -887,6 +993,8 @@ int main(void)
         cmocka_unit_test(test_speed_guard_caps_speed_to_stop_within_clearance),
         cmocka_unit_test(test_saturated_network_ranks_by_preactivation),
         cmocka_unit_test(test_preactivation_rank_agrees_with_float_network_on_saturated_nets),
+        cmocka_unit_test(test_sigmoid_flat_ends_match_the_table),
+        cmocka_unit_test(test_fast_step_equals_every_path_evaluation),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_network_mode),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_probabilistic_mode),
         cmocka_unit_test(test_build_table_refuses_a_table_controller),

@@ -130,6 +130,14 @@ typedef struct {
     qnav_q1_15_t speed_cap[QNAV_DIST_LEVELS];   /* speed guard by level, Q1.15 of v_max */
 } qnav_clearance_t;
 
+/* What init learns of one row of keys (a distance level, dtheta 0..180), so that the step
+ * can find a run's best path without evaluating it (docs/architecture.md, "Row shapes"). */
+typedef struct {
+    qnav_qkey_t top;   /* the row's largest key */
+    uint8_t top_d;     /* the smallest dtheta with that key */
+    uint8_t fall_d;    /* the smallest dtheta from which the key never rises again */
+} qnav_row_shape_t;
+
 /* The controller. Caller-owned (a static on an MCU, a vector element on a host); fields
  * are private: reach them through the functions below. */
 typedef struct {
@@ -149,7 +157,10 @@ typedef struct {
             qnav_q1_15_t goal[QNAV_DTHETA_MAX + 1]; /* P_goal by dtheta */
             qnav_q1_15_t safe[QNAV_DIST_LEVELS];    /* P_safe by distance level */
         } prob;
-        qnav_ctrl_unit_t unit[QNAV_MAX_HIDDEN];
+        struct {
+            qnav_row_shape_t row[QNAV_DIST_LEVELS]; /* 2-input network and table mode */
+            qnav_ctrl_unit_t unit[QNAV_MAX_HIDDEN]; /* network */
+        } net;
     } p;
 } qnav_ctrl_t;
 

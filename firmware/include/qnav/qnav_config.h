@@ -42,18 +42,6 @@
 /* Largest number of sonar sectors (any N in 1..360 is valid input). */
 #define QNAV_MAX_SECTORS 360
 
-/* Network mode keeps up to this many runs of paths (docs/architecture.md) on the stack,
- * 6 bytes each, to search them best first; runs whose bound is already below the best
- * path are dropped, and a run that finds no room is evaluated at once, with the same
- * result. A scan of N sectors has at most N + 3 runs. */
-#ifndef QNAV_MAX_RUNS
-#if defined(__AVR__)
-#define QNAV_MAX_RUNS 24
-#else
-#define QNAV_MAX_RUNS (QNAV_MAX_SECTORS + 3)
-#endif
-#endif
-
 /* 1: lookup tables and compiled quality tables are read from program memory (AVR flash);
  * 0: they are ordinary const data. Defaults to 1 on AVR. */
 #ifndef QNAV_TABLES_IN_FLASH
@@ -72,9 +60,6 @@
 #endif
 #if QNAV_DEFAULT_HIDDEN > QNAV_MAX_HIDDEN
 #error "QNAV_DEFAULT_HIDDEN must not exceed QNAV_MAX_HIDDEN"
-#endif
-#if QNAV_MAX_RUNS < 1
-#error "QNAV_MAX_RUNS must be at least 1"
 #endif
 #if QNAV_TABLES_IN_FLASH && !defined(__AVR__)
 #error "QNAV_TABLES_IN_FLASH is for AVR targets only"
