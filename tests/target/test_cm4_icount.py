@@ -175,6 +175,18 @@ class FakeQemuLog(unittest.TestCase):
         r = self.run_fake(log, "M\tx\t-\n")
         self.assertEqual((r.returncode, r.stdout), (0, "M\tx\t10\n"), r.stderr)
 
+    def test_a_begin_inside_a_region_is_bad_input(self):
+        b, _ = begin_end_addresses()
+        log = block(b, "4770") + trace(0x1000, b) + trace(0x1000, b)
+        assert_one_line_error(self, self.run_fake(log, ""), 2, REGIONS,
+                              "qnav_bench_begin called again before qnav_bench_end")
+
+    def test_an_end_outside_a_region_is_bad_input(self):
+        _, e = begin_end_addresses()
+        log = block(e, "4770") + trace(0x1200, e)
+        assert_one_line_error(self, self.run_fake(log, ""), 2, REGIONS,
+                              "qnav_bench_end called without qnav_bench_begin")
+
     def test_a_disassembly_that_disagrees_with_the_translator_is_a_run_failure(self):
         log = (block(0x400, "2001") + trace(0x1100, 0x400)
                + "Disassembler disagrees with translator over instruction decoding\n")
