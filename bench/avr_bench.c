@@ -9,7 +9,7 @@
  * One image cannot hold every compiled table (11 584 B of flash each) beside the scans,
  * and libqnav reads flash data with 16-bit addresses (LPM): QNAV_BENCH_TABLE_GROUP = 0
  * builds the network image (network, probabilistic and 3-input modes, the naive float
- * network for comparison), 1..7 a table image with that group's table (bench_tables.h).
+ * network and VFH+ for comparison), 1..7 a table image with that group's table (bench_tables.h).
  * The program refuses to run when its flash data reach past 64 KB.
  * simavr's console drops control characters, so M lines use '~' for TAB; bench/run-bench
  * turns it back.
@@ -22,6 +22,7 @@
 #include <util/delay_basic.h>
 
 #include "bench_grid.h"
+#include "qnav/vfh.h"
 #include "target_io.h"
 
 #ifndef QNAV_BENCH_TABLE_GROUP
@@ -263,6 +264,56 @@ static void naive_comparison(void)
     PUT("\n");
 }
 
+
+/* VFH+ (qnav/vfh.h), the second controller, on every 32-sector scan through its own step
+ * (free text: the M lines are the path-quality controller's). */
+static void vfh_comparison(void)
+{
+    static qnav_vfh_t vfh;
+    static qnav_vfh_state_t vstate;
+    qnav_mm_t *r = qnav_bench_scratch_ranges();
+    qnav_vfh_config_t vcfg;
+    uint32_t lo = 0xfffffffful, hi = 0, sum = 0;
+    uint8_t n = 0;
+    uint16_t s;
+    qnav_vfh_config_default(&vcfg);
+    vcfg.body.n_sectors = 32u;
+    vcfg.body.max_range_mm = qnav_bench_max_range_mm();
+    if (qnav_vfh_init(&vfh, &vcfg) != QNAV_OK) {
+        PUT("VFH+ init failed\n");
+        return;
+    }
+    for (s = 0; s < qnav_bench_scan_count(); ++s) {
+        qnav_ctrl_input_t in;
+        qnav_ctrl_output_t out;
+        uint8_t type, k;
+        uint32_t c;
+        if (qnav_bench_load_scan(s, r, &in.goal_bearing_cdeg, &type, &k) != 32u) {
+            continue;
+        }
+        in.ranges_mm = r;
+        in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
+        qnav_vfh_state_reset(&vstate);
+        timer_start();
+        qnav_vfh_step(&vfh, &vstate, &in, &out);
+        c = timer_stop() - overhead;
+        sum += c;
+        lo = c < lo ? c : lo;
+        hi = c > hi ? c : hi;
+        ++n;
+    }
+    PUT("VFH+ (default config) on the ");
+    qnav_target_put_u32(n);
+    PUT(" 32-sector scans: mean ");
+    put_cycles(sum / n);
+    PUT(", min ");
+    qnav_target_put_u32(lo);
+    PUT(", max ");
+    qnav_target_put_u32(hi);
+    PUT("; sizeof(qnav_vfh_t) + state ");
+    qnav_target_put_u32(sizeof(qnav_vfh_t) + sizeof(qnav_vfh_state_t));
+    PUT(" bytes\n");
+}
 #endif
 
 int main(void)
@@ -331,6 +382,7 @@ int main(void)
     }
 #if !QNAV_BENCH_TABLE_GROUP
     naive_comparison();
+    vfh_comparison();
 #endif
     if (bad != 0u) {
         PUT("MISMATCH count ");
