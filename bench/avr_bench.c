@@ -1,23 +1,47 @@
 /*
  * Cycle benchmark of qnav_ctrl_step() on an ATmega128 at 16 MHz, run under simavr
- * (cycle-accurate). Timer1 counts every clock (clk/1) and its overflow interrupt extends
- * it to 32 bits; the fixed cost of starting and stopping the timer is measured and
- * subtracted, and a delay loop of known length checks the method. Each mode (network
- * H = 12, probabilistic, table from flash) is timed on 8 scans of 32 sectors; the peak
- * stack of a step is found by painting free RAM and looking for the high-water mark.
- * A naive float network (float weights, avr-libc expf, 360 paths x 12 hidden, the
- * straightforward way) is timed the same way for comparison. Every figure printed is
- * measured here; targets are printed next to them for reading, not used to pass or fail.
+ * (cycle-accurate), over the benchmark set (bench_grid.h). Timer1 counts every clock
+ * (clk/1) and its overflow interrupt extends it to 32 bits; the fixed cost of starting
+ * and stopping the timer is measured and subtracted, and a delay loop of known length
+ * checks the method. The peak stack of a step is found by painting free RAM before every
+ * measured step and looking for the high-water mark after it.
+ *
+ * One image cannot hold every compiled table (11 584 B of flash each) beside the scans,
+ * and libqnav reads flash data with 16-bit addresses (LPM): QNAV_BENCH_TABLE_GROUP = 0
+ * builds the network image (network, probabilistic and 3-input modes, the naive float
+ * network and VFH+ for comparison), 1..7 a table image with that group's table (bench_tables.h).
+ * The program refuses to run when its flash data reach past 64 KB.
+ * simavr's console drops control characters, so M lines use '~' for TAB; bench/run-bench
+ * turns it back.
  */
 #include <avr/interrupt.h>
 #include <avr/io.h>
+#include <avr/pgmspace.h>
 #include <math.h>
 #include <stdint.h>
 #include <util/delay_basic.h>
 
-#include "bench_common.h"
+#include "bench_grid.h"
 #include "qnav/vfh.h"
 #include "target_io.h"
+
+#ifndef QNAV_BENCH_TABLE_GROUP
+#define QNAV_BENCH_TABLE_GROUP 0
+#endif
+#if QNAV_BENCH_TABLE_GROUP
+#include "bench_tables.h"
+#endif
+
+/* Text from flash: 4 KB of RAM has no room for this program's messages. */
+static void put_flash(const char *s)
+{
+    char c[2];
+    c[1] = '\0';
+    while ((c[0] = (char)pgm_read_byte(s++)) != '\0') {
+        qnav_target_put(c);
+    }
+}
+#define PUT(s) put_flash(PSTR(s))
 
 static volatile uint16_t overflows;
 
@@ -54,19 +78,57 @@ static uint32_t timer_stop(void)
     return ((uint32_t)overflows << 16) + c;
 }
 
-static qnav_ctrl_t ctrl;
-static qnav_mm_t ranges[QNAV_BENCH_SECTORS];
 static uint32_t overhead;
+static uint16_t peak_stack[QNAV_BENCH_MODES];
+static uint32_t steps[QNAV_BENCH_MODES];
 
-/* Cycles of one step (timer overhead removed). */
-static uint32_t time_step(const qnav_ctrl_input_t *in, qnav_ctrl_output_t *out)
+extern uint8_t __heap_start;
+extern const uint8_t __ctors_start[];
+#define PAINT 0xA5u
+
+/* Paint from the end of .bss to a little below the stack pointer, time one step, and
+ * record how many bytes below this frame's stack pointer it wrote. */
+static uint32_t measure(const qnav_ctrl_t *c, const qnav_ctrl_input_t *in,
+                        qnav_ctrl_output_t *out, uint8_t mode)
 {
-    uint32_t c;
+    uint8_t *p = &__heap_start;
+    uint16_t sp = SP;
+    uint8_t *stop = (uint8_t *)(sp - 16u);
+    uint32_t cycles;
+    uint16_t used;
+    while (p < stop) {
+        *(volatile uint8_t *)p = PAINT;
+        ++p;
+    }
     timer_start();
-    qnav_ctrl_step(&ctrl, in, out, 0);
-    c = timer_stop();
-    return c - overhead;
+    qnav_ctrl_step(c, in, out, 0);
+    cycles = timer_stop() - overhead;
+    p = &__heap_start;
+    while (p < stop && *(volatile uint8_t *)p == PAINT) {
+        ++p;
+    }
+    used = (uint16_t)(sp - (uint16_t)p + 1u);
+    if (used > peak_stack[mode]) {
+        peak_stack[mode] = used;
+    }
+    ++steps[mode];
+    return cycles;
 }
+
+#if QNAV_BENCH_TABLE_GROUP
+static const qnav_qkey_t *flash_table(uint8_t index, const qnav_policy_t *p, uint8_t *rank)
+{
+    uint8_t j;
+    (void)p;
+    for (j = 0; j < QNAV_BENCH_GROUP_TABLES; ++j) {
+        if (qnav_bench_group_policy[j] == index) {
+            *rank = qnav_bench_group_rank[j];
+            return qnav_bench_group_table[j];
+        }
+    }
+    return 0;
+}
+#endif
 
 /* "<cycles> cycles (<ms> ms at 16 MHz)" */
 static void put_cycles(uint32_t cycles)
@@ -74,55 +136,36 @@ static void put_cycles(uint32_t cycles)
     uint32_t us = (cycles + F_CPU / 2000000ul) / (F_CPU / 1000000ul);
     uint32_t frac = us % 1000u;
     qnav_target_put_u32(cycles);
-    qnav_target_put(" cycles (");
+    PUT(" cycles (");
     qnav_target_put_u32(us / 1000u);
-    qnav_target_put(frac < 100u ? (frac < 10u ? ".00" : ".0") : ".");
+    if (frac < 10u) {
+        PUT(".00");
+    } else if (frac < 100u) {
+        PUT(".0");
+    } else {
+        PUT(".");
+    }
     qnav_target_put_u32(frac);
-    qnav_target_put(" ms at 16 MHz)");
+    PUT(" ms at 16 MHz)");
 }
 
-/* ---- stack high-water mark ---------------------------------------------------------- */
-
-extern uint8_t __heap_start;
-#define PAINT 0xA5u
-
-/* Paint from the end of .bss to a little below the current stack pointer, run one step,
- * and return how many bytes below the caller's stack pointer it wrote. Inlined so the
- * painting runs in main's frame and the step is called from a known stack pointer. */
-static inline __attribute__((always_inline)) uint16_t step_stack_bytes(
-    const qnav_ctrl_input_t *in, qnav_ctrl_output_t *out)
-{
-    uint8_t *p = &__heap_start;
-    uint16_t sp = SP;
-    uint8_t *stop = (uint8_t *)(sp - 16u);
-    while (p < stop) {
-        *(volatile uint8_t *)p = PAINT;
-        ++p;
-    }
-    qnav_ctrl_step(&ctrl, in, out, 0);
-    p = &__heap_start;
-    while (p < stop && *(volatile uint8_t *)p == PAINT) {
-        ++p;
-    }
-    return (uint16_t)(sp - (uint16_t)p + 1u);
-}
-
+#if !QNAV_BENCH_TABLE_GROUP
 /* ---- naive float network, for the ratio ---------------------------------------------- */
 
-static float w_theta_f[12], w_dist_f[12], b_hidden_f[12], w_out_f[12], b_out_f;
+static float w_theta_f[12], w_dist_f[12], b_hidden_f[12], w_out_f[12], b_out_f; /* H = 12 */
+static uint8_t hidden_f;
 
-static void naive_load(void)
+static void naive_load(const qnav_policy_t *policy)
 {
-    qnav_policy_t policy;
     uint8_t j;
-    qnav_vectors_net_policy(&policy, 12u, QNAV_VECTORS_NET12_SEED, 0u);
-    for (j = 0; j < 12u; ++j) {
-        w_theta_f[j] = (float)policy.u.net.w_theta[j] / 256.0f;
-        w_dist_f[j] = (float)policy.u.net.w_dist[j] / 256.0f;
-        b_hidden_f[j] = (float)policy.u.net.b_hidden[j] / 256.0f;
-        w_out_f[j] = (float)policy.u.net.w_out[j] / 256.0f;
+    hidden_f = policy->u.net.hidden;
+    for (j = 0; j < hidden_f; ++j) {
+        w_theta_f[j] = (float)policy->u.net.w_theta[j] / 256.0f;
+        w_dist_f[j] = (float)policy->u.net.w_dist[j] / 256.0f;
+        b_hidden_f[j] = (float)policy->u.net.b_hidden[j] / 256.0f;
+        w_out_f[j] = (float)policy->u.net.w_out[j] / 256.0f;
     }
-    b_out_f = (float)policy.u.net.b_out / 256.0f;
+    b_out_f = (float)policy->u.net.b_out / 256.0f;
 }
 
 /* The straightforward float controller: for every path, its sector's range, the angular
@@ -146,7 +189,7 @@ __attribute__((noinline)) static int16_t naive_float_step(const qnav_mm_t *r, ui
         if (dtheta > 180.0f) {
             dtheta = 360.0f - dtheta;
         }
-        for (j = 0; j < 12u; ++j) {
+        for (j = 0; j < hidden_f; ++j) {
             float z = w_theta_f[j] * (dtheta / 180.0f) + w_dist_f[j] * (d / max_mm) + b_hidden_f[j];
             acc += w_out_f[j] / (1.0f + expf(-z));
         }
@@ -159,150 +202,193 @@ __attribute__((noinline)) static int16_t naive_float_step(const qnav_mm_t *r, ui
     return (int16_t)(best > 180 ? best - 360 : best);
 }
 
+/* The naive float network against the fixed-point network step, both on the first
+ * evolved H = 12 policy, over every dense 32-sector scan. */
+static void naive_comparison(void)
+{
+    qnav_mm_t *r = qnav_bench_scratch_ranges();
+    qnav_ctrl_t *c = qnav_bench_scratch_ctrl();
+    qnav_policy_t *p = qnav_bench_scratch_policy();
+    char id[QNAV_BENCH_ID_LEN];
+    qnav_ctrl_config_t cfg;
+    volatile int16_t naive_heading; /* kept: the call must not be optimised away */
+    uint32_t naive = 0, fixed = 0;
+    uint8_t scans = 0, i = 0;
+    uint16_t s;
+    while (i < qnav_bench_policy_count() &&
+           (qnav_bench_load_policy(i, p, id) != QNAV_BENCH_SET_EVOLVED ||
+            p->kind != QNAV_POLICY_NET || p->u.net.hidden != 12u)) {
+        ++i;
+    }
+    if (i == qnav_bench_policy_count()) {
+        return;
+    }
+    naive_load(p);
+    qnav_bench_config(&cfg, 32u);
+    if (qnav_ctrl_init(c, &cfg, p) != QNAV_OK) {
+        return;
+    }
+    for (s = 0; s < qnav_bench_scan_count(); ++s) {
+        qnav_ctrl_input_t in;
+        qnav_ctrl_output_t out;
+        uint8_t type, k;
+        uint32_t t;
+        if (qnav_bench_load_scan(s, r, &in.goal_bearing_cdeg, &type, &k) != 32u ||
+            type != QNAV_BENCH_SCAN_DENSE) {
+            continue;
+        }
+        in.ranges_mm = r;
+        in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
+        timer_start();
+        naive_heading = naive_float_step(r, 32u, (float)in.goal_bearing_cdeg / 100.0f,
+                               (float)qnav_bench_max_range_mm());
+        t = timer_stop() - overhead;
+        naive += t;
+        timer_start();
+        qnav_ctrl_step(c, &in, &out, 0);
+        fixed += timer_stop() - overhead;
+        ++scans;
+    }
+    PUT("naive float network (expf, 360 paths x H, per-sector ranges), ");
+    qnav_target_put(id);
+    PUT(", mean of ");
+    qnav_target_put_u32(scans);
+    PUT(" dense 32-sector scans: ");
+    put_cycles(naive / scans);
+    PUT("; fixed-point network step ");
+    put_cycles(fixed / scans);
+    PUT("; ratio ");
+    qnav_target_put_u32((naive + fixed / 2u) / fixed);
+    PUT(".");
+    qnav_target_put_u32(((naive * 10u + fixed / 2u) / fixed) % 10u);
+    PUT("\n");
+}
+
+
+/* VFH+ (qnav/vfh.h), the second controller, on every 32-sector scan through its own step
+ * (free text: the M lines are the path-quality controller's). */
+static void vfh_comparison(void)
+{
+    static qnav_vfh_t vfh;
+    static qnav_vfh_state_t vstate;
+    qnav_mm_t *r = qnav_bench_scratch_ranges();
+    qnav_vfh_config_t vcfg;
+    uint32_t lo = 0xfffffffful, hi = 0, sum = 0;
+    uint8_t n = 0;
+    uint16_t s;
+    qnav_vfh_config_default(&vcfg);
+    vcfg.body.n_sectors = 32u;
+    vcfg.body.max_range_mm = qnav_bench_max_range_mm();
+    if (qnav_vfh_init(&vfh, &vcfg) != QNAV_OK) {
+        PUT("VFH+ init failed\n");
+        return;
+    }
+    for (s = 0; s < qnav_bench_scan_count(); ++s) {
+        qnav_ctrl_input_t in;
+        qnav_ctrl_output_t out;
+        uint8_t type, k;
+        uint32_t c;
+        if (qnav_bench_load_scan(s, r, &in.goal_bearing_cdeg, &type, &k) != 32u) {
+            continue;
+        }
+        in.ranges_mm = r;
+        in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
+        qnav_vfh_state_reset(&vstate);
+        timer_start();
+        qnav_vfh_step(&vfh, &vstate, &in, &out);
+        c = timer_stop() - overhead;
+        sum += c;
+        lo = c < lo ? c : lo;
+        hi = c > hi ? c : hi;
+        ++n;
+    }
+    PUT("VFH+ (default config) on the ");
+    qnav_target_put_u32(n);
+    PUT(" 32-sector scans: mean ");
+    put_cycles(sum / n);
+    PUT(", min ");
+    qnav_target_put_u32(lo);
+    PUT(", max ");
+    qnav_target_put_u32(hi);
+    PUT("; sizeof(qnav_vfh_t) + state ");
+    qnav_target_put_u32(sizeof(qnav_vfh_t) + sizeof(qnav_vfh_state_t));
+    PUT(" bytes\n");
+}
+#endif
+
 int main(void)
 {
-    qnav_ctrl_input_t in;
-    qnav_ctrl_output_t out;
+    qnav_bench_hooks_t hooks;
+    uint16_t bad;
     uint32_t c;
     uint8_t mode;
-    uint8_t k;
-    uint32_t net_mean = 0;
-    uint16_t peak_stack = 0;
-    uint8_t ok = 1;
-    int16_t naive_heading;
 
-    in.ranges_mm = ranges;
+    if (pgm_get_far_address(__ctors_start) > 0x10000ul) {
+        /* .progmem ends where the constructors begin: past 64 KB, LPM reads wrap */
+        PUT("program-memory data end past 64 KB (at ");
+        qnav_target_put_u32(pgm_get_far_address(__ctors_start));
+        PUT("): fewer fixtures per image\n");
+        qnav_target_exit(1u);
+    }
     timer_start();
     overhead = timer_stop();
-
-    qnav_target_put("qnav AVR benchmark: ATmega128, 16 MHz, simavr; 32 sectors, 360 paths\n");
-    qnav_target_put("timer overhead subtracted: ");
+    PUT("qnav AVR benchmark: ATmega128, 16 MHz, simavr; image ");
+    qnav_target_put_u32(QNAV_BENCH_TABLE_GROUP);
+    if (QNAV_BENCH_TABLE_GROUP) {
+        PUT(" (table group)\n");
+    } else {
+        PUT(" (network modes)\n");
+    }
+    PUT("timer overhead subtracted: ");
     qnav_target_put_u32(overhead);
-    qnav_target_put(" cycles\n");
+    PUT(" cycles\n");
     timer_start();
     _delay_loop_2(50000u); /* 4 cycles per count: 200000 */
     c = timer_stop() - overhead;
-    qnav_target_put("check: _delay_loop_2(50000), 200000 cycles by the datasheet, measured ");
+    PUT("check: _delay_loop_2(50000), 200000 cycles by the datasheet, measured ");
     qnav_target_put_u32(c);
-    qnav_target_put("\n");
+    PUT("\n");
+
+    hooks.target = "avr";
+    hooks.sep = '~';
+    hooks.measure = measure;
+    hooks.has_value = 1;
+#if QNAV_BENCH_TABLE_GROUP
+    hooks.modes = QNAV_BENCH_MODE_BIT(QNAV_BENCH_TABLE);
+    hooks.table = flash_table;
+#else
+    hooks.modes = (uint8_t)(QNAV_BENCH_MODE_BIT(QNAV_BENCH_NETWORK) |
+                            QNAV_BENCH_MODE_BIT(QNAV_BENCH_PROB) |
+                            QNAV_BENCH_MODE_BIT(QNAV_BENCH_NETWORK3));
+    hooks.table = 0;
+#endif
+    bad = qnav_bench_grid(&hooks);
 
     for (mode = 0; mode < QNAV_BENCH_MODES; ++mode) {
-        uint32_t lo = 0xfffffffful;
-        uint32_t hi = 0;
-        uint32_t sum = 0;
-        uint16_t stack;
-        qnav_status_t st = qnav_bench_init(&ctrl, mode);
-        if (st != QNAV_OK) {
-            qnav_target_put("init failed: ");
-            qnav_target_put_i32(st);
-            qnav_target_put("\n");
-            ok = 0;
+        if (steps[mode] == 0u) {
             continue;
         }
-        for (k = 0; k < QNAV_BENCH_SCANS; ++k) {
-            in.goal_bearing_cdeg = qnav_bench_scan(k, ranges);
-            in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
-            c = time_step(&in, &out);
-            sum += c;
-            lo = c < lo ? c : lo;
-            hi = c > hi ? c : hi;
-        }
-        in.goal_bearing_cdeg = qnav_bench_scan(0, ranges);
-        stack = step_stack_bytes(&in, &out);
-        peak_stack = stack > peak_stack ? stack : peak_stack;
-        qnav_target_put(qnav_bench_mode_names[mode]);
-        qnav_target_put(": mean ");
-        put_cycles(sum / QNAV_BENCH_SCANS);
-        qnav_target_put(", min ");
-        qnav_target_put_u32(lo);
-        qnav_target_put(", max ");
-        qnav_target_put_u32(hi);
-        qnav_target_put("; step stack ");
-        qnav_target_put_u32(stack);
-        qnav_target_put(" bytes\n");
-        if (mode == QNAV_BENCH_NET) {
-            net_mean = sum / QNAV_BENCH_SCANS;
-        }
-        if (mode != QNAV_BENCH_PROB) {
-            /* Cost of one path's quality through the public function: how many path
-             * evaluations a step's cycles amount to. */
-            volatile qnav_q1_15_t q;
-            uint8_t lv;
-            timer_start();
-            for (lv = 0; lv < 16u; ++lv) {
-                q = qnav_ctrl_quality(&ctrl, (uint8_t)(lv * 2u), (uint8_t)(lv * 11u));
-            }
-            c = timer_stop() - overhead;
-            (void)q;
-            qnav_target_put("  one qnav_ctrl_quality() call: ");
-            qnav_target_put_u32((c + 8u) / 16u);
-            qnav_target_put(" cycles (mean of 16); step = ");
-            qnav_target_put_u32((sum / QNAV_BENCH_SCANS + (c + 8u) / 32u) / ((c + 8u) / 16u));
-            qnav_target_put(" such calls\n");
-        }
+        PUT("peak step stack, ");
+        qnav_target_put(qnav_bench_mode_name(mode));
+        PUT(" (");
+        qnav_target_put_u32(steps[mode]);
+        PUT(" steps): ");
+        qnav_target_put_u32(peak_stack[mode]);
+        PUT(" bytes; sizeof(qnav_ctrl_t) ");
+        qnav_target_put_u32(sizeof(qnav_ctrl_t));
+        PUT(" bytes; controller RAM = sizeof + peak stack = ");
+        qnav_target_put_u32(sizeof(qnav_ctrl_t) + peak_stack[mode]);
+        PUT(" bytes (table in flash)\n");
     }
-
-    {
-        /* VFH+ (qnav/vfh.h) on the same scans, through its own step */
-        static qnav_vfh_t vfh;
-        static qnav_vfh_state_t vstate;
-        qnav_vfh_config_t vcfg;
-        uint32_t lo = 0xfffffffful;
-        uint32_t hi = 0;
-        uint32_t sum = 0;
-        qnav_vfh_config_default(&vcfg);
-        vcfg.body.n_sectors = QNAV_BENCH_SECTORS;
-        vcfg.body.max_range_mm = QNAV_BENCH_MAX_RANGE_MM;
-        if (qnav_vfh_init(&vfh, &vcfg) != QNAV_OK) {
-            qnav_target_put("VFH+ init failed\n");
-            ok = 0;
-        }
-        qnav_vfh_state_reset(&vstate);
-        for (k = 0; k < QNAV_BENCH_SCANS; ++k) {
-            in.goal_bearing_cdeg = qnav_bench_scan(k, ranges);
-            in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
-            timer_start();
-            qnav_vfh_step(&vfh, &vstate, &in, &out);
-            c = timer_stop() - overhead;
-            sum += c;
-            lo = c < lo ? c : lo;
-            hi = c > hi ? c : hi;
-        }
-        qnav_target_put("VFH+ (alpha 5 deg, 72 sectors): mean ");
-        put_cycles(sum / QNAV_BENCH_SCANS);
-        qnav_target_put(", min ");
-        qnav_target_put_u32(lo);
-        qnav_target_put(", max ");
-        qnav_target_put_u32(hi);
-        qnav_target_put("; sizeof(qnav_vfh_t) + state ");
-        qnav_target_put_u32(sizeof(qnav_vfh_t) + sizeof(qnav_vfh_state_t));
-        qnav_target_put(" bytes\n");
+#if !QNAV_BENCH_TABLE_GROUP
+    naive_comparison();
+    vfh_comparison();
+#endif
+    if (bad != 0u) {
+        PUT("MISMATCH count ");
+        qnav_target_put_u32(bad);
+        PUT("\n");
     }
-
-    qnav_target_put("sizeof(qnav_ctrl_t) ");
-    qnav_target_put_u32(sizeof(qnav_ctrl_t));
-    qnav_target_put(" bytes; controller RAM = sizeof + peak step stack + table RAM (0, table in flash) = ");
-    qnav_target_put_u32(sizeof(qnav_ctrl_t) + peak_stack);
-    qnav_target_put(" bytes (target <= 1024)\n");
-
-    naive_load();
-    in.goal_bearing_cdeg = qnav_bench_scan(0, ranges);
-    timer_start();
-    naive_heading = naive_float_step(ranges, QNAV_BENCH_SECTORS, 0.0f, (float)QNAV_BENCH_MAX_RANGE_MM);
-    c = timer_stop() - overhead;
-    qnav_target_put("naive float network (expf, 360 x 12): ");
-    put_cycles(c);
-    qnav_target_put(", heading ");
-    qnav_target_put_i32(naive_heading);
-    qnav_target_put("\n");
-    if (net_mean != 0u) {
-        qnav_target_put("ratio naive float / fixed-point network: ");
-        qnav_target_put_u32((c + net_mean / 2u) / net_mean);
-        qnav_target_put(".");
-        qnav_target_put_u32(((c * 10u + net_mean / 2u) / net_mean) % 10u);
-        qnav_target_put("\n");
-    }
-    qnav_target_put("targets: network <= 100000 cycles, table <= 8000 cycles, RAM <= 1024 bytes\n");
-    qnav_target_exit(ok ? 0u : 1u);
+    qnav_target_exit(bad ? 1u : 0u);
     return 0;
 }

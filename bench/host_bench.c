@@ -1,9 +1,10 @@
 /*
- * Host benchmark of qnav_ctrl_step(): nanoseconds per step in network (H = 12),
- * probabilistic and table mode on the same 32-sector scans as the AVR benchmark, through
- * the real library code path. Each repetition runs enough steps to last about 20 ms
- * (CLOCK_MONOTONIC); the median of 7 repetitions is printed. Meaningful only in an
- * optimised build without sanitizers (preset host-release); the build flags are printed.
+ * Host benchmark of qnav_ctrl_step() over the benchmark set (bench_grid.h): the value of
+ * each M line is picoseconds per step (ns x 1000, an integer), the median of 5
+ * repetitions, each running the same step enough times to last at least 50 us
+ * (CLOCK_MONOTONIC). Tables are compiled into RAM for every 2-input network. Meaningful
+ * only in an optimised build without sanitizers (preset host-release); the build flags
+ * are printed. Exit status 1 on a heading mismatch.
  */
 #define _POSIX_C_SOURCE 199309L
 #include <stdint.h>
@@ -11,13 +12,16 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "bench_common.h"
+#include "bench_grid.h"
 
 #ifndef QNAV_BENCH_BUILD
 #define QNAV_BENCH_BUILD "unknown"
 #endif
 
-#define REPS 7
+#define REPS 5
+#define MIN_BATCH_NS 50000.0
+
+static volatile int32_t sink;
 
 static double now_ns(void)
 {
@@ -33,67 +37,59 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static qnav_mm_t ranges[QNAV_BENCH_SCANS][QNAV_BENCH_SECTORS];
-static qnav_cdeg_t bearings[QNAV_BENCH_SCANS];
-static volatile int32_t sink;
-
-/* Time `iters` steps cycling over the scans; returns ns per step. */
-static double run(const qnav_ctrl_t *ctrl, uint32_t iters)
+/* ns per step over `iters` steps. */
+static double batch(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
+                    qnav_ctrl_output_t *out, uint32_t iters)
 {
-    qnav_ctrl_input_t in;
-    qnav_ctrl_output_t out;
     int32_t acc = 0;
     uint32_t i;
     double t0 = now_ns();
     for (i = 0; i < iters; ++i) {
-        uint32_t k = i % QNAV_BENCH_SCANS;
-        in.ranges_mm = ranges[k];
-        in.goal_bearing_cdeg = bearings[k];
-        in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
-        qnav_ctrl_step(ctrl, &in, &out, 0);
-        acc += out.heading_deg + out.speed;
+        qnav_ctrl_step(ctrl, in, out, 0);
+        acc += out->heading_deg;
     }
     sink = acc;
     return (now_ns() - t0) / (double)iters;
 }
 
+static uint32_t measure(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
+                        qnav_ctrl_output_t *out, uint8_t mode)
+{
+    double per[REPS];
+    uint32_t iters = 1;
+    int r;
+    (void)mode;
+    while (batch(ctrl, in, out, iters) * (double)iters < MIN_BATCH_NS && iters < (1u << 24)) {
+        iters *= 2u;
+    }
+    for (r = 0; r < REPS; ++r) {
+        per[r] = batch(ctrl, in, out, iters);
+    }
+    qsort(per, REPS, sizeof per[0], cmp_double);
+    return (uint32_t)(per[REPS / 2] * 1000.0 + 0.5);
+}
+
 int main(void)
 {
-    qnav_ctrl_t ctrl;
-    uint8_t mode;
-    uint8_t k;
-    static const double target_ns[QNAV_BENCH_MODES] = {2000.0, 0.0, 500.0, 0.0};
-
-    for (k = 0; k < QNAV_BENCH_SCANS; ++k) {
-        bearings[k] = qnav_bench_scan(k, ranges[k]);
-    }
-    printf("qnav host benchmark: 32 sectors, 360 paths, median of %d repetitions of ~20 ms\n",
-           REPS);
-    printf("build: %s\n", QNAV_BENCH_BUILD);
-    for (mode = 0; mode < QNAV_BENCH_MODES; ++mode) {
-        double per[REPS];
-        uint32_t iters = 16;
-        int r;
-        qnav_status_t st = qnav_bench_init(&ctrl, mode);
-        if (st != QNAV_OK) {
-            fprintf(stderr, "host_bench: init of mode %s failed with status %d\n",
-                    qnav_bench_mode_names[mode], (int)st);
-            return 1;
-        }
-        while (run(&ctrl, iters) * (double)iters < 20e6 && iters < (1u << 30)) {
-            iters *= 2u;
-        }
-        for (r = 0; r < REPS; ++r) {
-            per[r] = run(&ctrl, iters);
-        }
-        qsort(per, REPS, sizeof per[0], cmp_double);
-        printf("%-14s %10.1f ns/step (min %.1f, max %.1f, %u steps per repetition)",
-               qnav_bench_mode_names[mode], per[REPS / 2], per[0], per[REPS - 1],
-               (unsigned)iters);
-        if (target_ns[mode] > 0.0) {
-            printf("  target <= %.0f ns", target_ns[mode]);
-        }
-        printf("\n");
+    qnav_bench_hooks_t hooks;
+    uint16_t bad;
+    printf("qnav host benchmark: values are ps per step (ns x 1000), median of %d repetitions "
+           "of >= %.0f us\nbuild: %s\n", REPS, MIN_BATCH_NS / 1000.0, QNAV_BENCH_BUILD);
+    printf("sizeof(qnav_ctrl_t) %u bytes\n", (unsigned)sizeof(qnav_ctrl_t));
+    hooks.target = "host";
+    hooks.sep = '\t';
+    hooks.modes = (uint8_t)(QNAV_BENCH_MODE_BIT(QNAV_BENCH_NETWORK) | QNAV_BENCH_MODE_BIT(QNAV_BENCH_PROB) |
+                            QNAV_BENCH_MODE_BIT(QNAV_BENCH_TABLE) |
+                            QNAV_BENCH_MODE_BIT(QNAV_BENCH_NETWORK3));
+    hooks.measure = measure;
+    hooks.has_value = 1;
+    hooks.table = qnav_bench_ram_table;
+    fflush(stdout);
+    bad = qnav_bench_grid(&hooks);
+    fflush(stdout);
+    if (bad != 0u) {
+        printf("MISMATCH count %u\n", (unsigned)bad);
+        return 1;
     }
     return 0;
 }
