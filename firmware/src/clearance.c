@@ -54,6 +54,14 @@ static uint32_t level_floor_mm(const qnav_clearance_t *c, uint8_t level)
     return lo;
 }
 
+/* The nearest an obstacle read at level can be, from the robot's centre (readings start
+ * at the transducers), at most 65535 mm. */
+static uint32_t level_distance_mm(const qnav_clearance_t *c, uint8_t level)
+{
+    uint32_t d = level_floor_mm(c, level) + c->sensor_offset_mm;
+    return d > 65535u ? 65535u : d;
+}
+
 /* Smallest whole degree g with sin(g) >= margin / d (90 when d <= margin). */
 static uint8_t enlarge_deg(uint32_t margin_mm, uint32_t d_mm)
 {
@@ -114,22 +122,25 @@ void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
 {
     uint32_t margin = (uint32_t)cfg->body_radius_mm + cfg->safety_mm;
     uint8_t level;
+    c->margin_mm = margin > 65535u ? 65535u : (uint16_t)margin;
+    c->sensor_offset_mm = cfg->sensor_offset_mm;
+    c->v_max_mm_s = cfg->v_max_mm_s;
+    c->decel_mm_s2 = cfg->decel_mm_s2;
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
-        /* from the robot's centre: readings start at the transducers */
-        uint32_t d = level_floor_mm(c, level) + cfg->sensor_offset_mm;
-        if (d > 65535u) {
-            d = 65535u;
-        }
-        c->enlarge_deg[level] = enlarge_deg(margin, d);
-        if (cfg->v_max_mm_s == 0u || cfg->decel_mm_s2 == 0u) {
-            c->speed_cap[level] = QNAV_Q1_15_MAX;
-        } else if (level == QNAV_DIST_LEVELS - 1u) {
-            c->speed_cap[level] = QNAV_Q1_15_MAX; /* nothing seen within range */
-        } else {
-            c->speed_cap[level] = stop_speed(d > margin ? d - margin : 0u, cfg->v_max_mm_s,
-                                                cfg->decel_mm_s2);
-        }
+        c->enlarge_deg[level] = enlarge_deg(margin, level_distance_mm(c, level));
     }
+}
+
+/* The speed guard's cap is made when asked for (once a step, for the chosen path's level)
+ * rather than tabulated: 64 bytes of RAM for about 2 000 cycles on the ATmega128. */
+qnav_q1_15_t qnav_clearance_speed_cap(const qnav_clearance_t *c, uint8_t level)
+{
+    uint32_t d;
+    if (c->v_max_mm_s == 0u || c->decel_mm_s2 == 0u || level >= QNAV_DIST_LEVELS - 1u) {
+        return QNAV_Q1_15_MAX; /* no guard, or nothing seen within range */
+    }
+    d = level_distance_mm(c, level);
+    return stop_speed(d > c->margin_mm ? d - c->margin_mm : 0u, c->v_max_mm_s, c->decel_mm_s2);
 }
 
 qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)

@@ -290,7 +290,7 @@ uint8_t qnav_run_next(qnav_run_iter_t *it, qnav_run_t *r)
         r->first = p;
         r->dtheta0 = (uint8_t)it->up;
         r->dir = 1;
-        it->up = (uint16_t)(it->up + k);
+        it->up = (uint8_t)(it->up + k);
     } else if (it->down < QNAV_DTHETA_MAX) {
         p = (uint16_t)(it->goal >= it->down ? it->goal - it->down
                                             : it->goal + QNAV_PATHS - it->down);
@@ -308,9 +308,9 @@ uint8_t qnav_run_next(qnav_run_iter_t *it, qnav_run_t *r)
             k = (uint8_t)((it->lvl + p) - q + 1);
         }
         r->first = (uint16_t)(p + 1u - k);
-        r->dtheta0 = (uint8_t)(it->down + k - 1u);
+        r->dtheta0 = (uint8_t)((uint8_t)(it->down + k) - 1u);
         r->dir = -1;
-        it->down = (uint16_t)(it->down + k);
+        it->down = (uint8_t)(it->down + k);
     } else {
         return 0;
     }
@@ -322,11 +322,18 @@ uint8_t qnav_run_next(qnav_run_iter_t *it, qnav_run_t *r)
 /* Start it over the levels lvl with the goal and previous heading in whole degrees. */
 void qnav_run_start(qnav_run_iter_t *it, const uint8_t *lvl, uint16_t goal, uint16_t prev)
 {
+    uint8_t i;
     it->lvl = lvl;
     it->goal = goal;
     it->prev = prev;
     it->up = 0;
     it->down = 1;
+    for (i = 0; i < sizeof it->settled; ++i) {
+        it->settled[i] = 0;
+    }
+    it->fresh = 0;
+    it->fresh_level = 0;
+    it->fresh_a = 0;
 }
 
 void qnav_row_shape_start(qnav_row_shape_t *s, qnav_qkey_t key0)
@@ -352,18 +359,24 @@ void qnav_row_shape_next(qnav_row_shape_t *s, uint8_t d, qnav_qkey_t prev, qnav_
  * every dtheta of the run larger than the best's: the tie is lost) rules the run out. A run
  * that holds the top's dtheta has its best there: the top is the largest key and top_d the
  * smallest dtheta with it. From fall_d on the keys never rise, so of the paths at or
- * beyond fall_d only the one nearest the goal can win (ties prefer the smaller dtheta);
- * and since runs arrive by their smallest dtheta (qnav_run_next), once such a path of a
- * level has been offered, a later run of that level that lies wholly beyond fall_d and
- * starts farther out cannot win either: settled[level] records that path's dtheta.
+ * beyond fall_d only the one nearest the goal can win (ties prefer the smaller dtheta).
+ * Runs arrive by their smallest dtheta (qnav_run_next), so once a run of a level that lies
+ * wholly beyond fall_d has had its first path offered, a later such run of that level
+ * cannot win either: its keys are at most that path's, its dtheta larger. The one
+ * exception is the run straight after it on the other side starting at the same dtheta
+ * (equal keys, equal dtheta: the turn decides), which "fresh" recognises.
  */
 uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t *best,
-                        uint8_t *settled)
+                        qnav_run_iter_t *it)
 {
     const qnav_row_shape_t *s = &row[r->level];
     uint8_t a = qnav_run_dmin(r);
     uint8_t b = (uint8_t)(a + (uint8_t)(r->count - 1u));
+    uint8_t byte = (uint8_t)(r->level >> 3);
+    uint8_t bit = (uint8_t)(1u << (r->level & 7u));
+    uint8_t mirror = (uint8_t)(it->fresh && it->fresh_level == r->level && it->fresh_a == a);
     uint8_t e;
+    it->fresh = 0;
     if (s->top < best->key || (s->top == best->key && a > best->dtheta)) {
         return 0;
     }
@@ -372,16 +385,19 @@ uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t 
         return 0;
     }
     if (a >= s->fall_d) {
-        if (settled[r->level] != QNAV_UNSETTLED && a > settled[r->level]) {
-            return 0;
+        if ((it->settled[byte] & bit) != 0u) {
+            if (!mirror) {
+                return 0;
+            }
+        } else {
+            it->settled[byte] = (uint8_t)(it->settled[byte] | bit);
+            it->fresh = 1;
+            it->fresh_level = r->level;
+            it->fresh_a = a;
         }
-        settled[r->level] = a;
         e = a;
-    } else if (b >= s->fall_d) {
-        settled[r->level] = s->fall_d;
-        e = s->fall_d;
     } else {
-        e = b;
+        e = b < s->fall_d ? b : s->fall_d;
     }
     if (r->dir < 0) { /* keep dtheta a..e */
         r->first = (uint16_t)(r->first + (uint8_t)(b - e));
@@ -463,10 +479,8 @@ static void paths_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t
 {
     qnav_run_t r;
     if (ctrl->table != 0) {
-        uint8_t settled[QNAV_DIST_LEVELS];
-        qnav_settled_clear(settled);
         while (qnav_run_next(it, &r)) {
-            if (keys != 0 || qnav_run_reduce(ctrl->p.net.row, &r, best, settled)) {
+            if (keys != 0 || qnav_run_reduce(ctrl->p.net.row, &r, best, it)) {
                 eval_table_run(ctrl, &r, best, keys);
             }
         }
@@ -537,7 +551,7 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
         flags |= QNAV_FLAG_FULL_SPEED;
     }
     path = (uint16_t)(best.heading < 0 ? best.heading + QNAV_PATHS : best.heading);
-    cap = ctrl->clr.speed_cap[lvl[path]];
+    cap = qnav_clearance_speed_cap(&ctrl->clr, lvl[path]);
     if (speed > (uint32_t)cap) {
         speed = (uint32_t)cap;
         flags |= QNAV_FLAG_SPEED_GUARD;

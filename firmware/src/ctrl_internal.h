@@ -11,6 +11,7 @@
 #include "qnav/ctrl.h"
 
 #define QNAV_CTRL_MAGIC 0x514Eu
+
 #define QNAV_TABLE_STRIDE (QNAV_DTHETA_MAX + 1)
 /* No key: below every key a policy gives (keys are -32767..32767). */
 #define QNAV_KEY_NONE (-32767 - 1)
@@ -57,8 +58,14 @@ typedef struct {
     const uint8_t *lvl;   /* distance level of every path */
     uint16_t goal;        /* destination, whole degrees 0..359 */
     uint16_t prev;        /* heading chosen at the previous tick, whole degrees 0..359 */
-    uint16_t up;          /* next dtheta counter-clockwise of the goal (0..180; 181: done) */
-    uint16_t down;        /* next dtheta clockwise of the goal (1..179; 180: done) */
+    uint8_t up;           /* next dtheta counter-clockwise of the goal (0..180; 181: done) */
+    uint8_t down;         /* next dtheta clockwise of the goal (1..179; 180: done) */
+    /* for qnav_run_reduce: levels one of whose paths at or beyond its row's fall_d has
+     * been offered (a bit each), and whether the previous run did that, at which dtheta */
+    uint8_t settled[(QNAV_DIST_LEVELS + 7) / 8];
+    uint8_t fresh;
+    uint8_t fresh_level;
+    uint8_t fresh_a;
 } qnav_run_iter_t;
 
 /* Offer path (with its key and dtheta) to best under the total order above. Inline: the
@@ -116,27 +123,15 @@ static inline uint8_t qnav_run_dmin(const qnav_run_t *r)
 void qnav_row_shape_start(qnav_row_shape_t *s, qnav_qkey_t key0);
 void qnav_row_shape_next(qnav_row_shape_t *s, uint8_t d, qnav_qkey_t prev, qnav_qkey_t key);
 
-/* settled[level] of a step: no path of that level offered yet beyond its row's fall_d. */
-#define QNAV_UNSETTLED 0xFFu
-
-static inline void qnav_settled_clear(uint8_t *settled)
-{
-    uint16_t i;
-    for (i = 0; i < QNAV_DIST_LEVELS; ++i) {
-        settled[i] = QNAV_UNSETTLED;
-    }
-}
-
 /*
- * What the shape of a run's row decides before any evaluation (runs must come from
- * qnav_run_next, in its order; settled: QNAV_DIST_LEVELS bytes, cleared by
- * qnav_settled_clear at the step's start). Returns 0 when nothing is left to do: no path
- * of r can beat best, or the row's top lies in r and was offered to best. Otherwise
- * narrows r to the paths that can still hold its best path and returns 1; the caller must
- * then offer r's best to best. A run of one path needs only that path's key.
+ * What the shape of a run's row decides before any evaluation (r must be the run that
+ * qnav_run_next just handed out of it). Returns 0 when nothing is left to do: no path of
+ * r can beat best, or the row's top lies in r and was offered to best. Otherwise narrows
+ * r to the paths that can still hold its best path and returns 1; the caller must then
+ * offer r's best to best. A run of one path needs only that path's key.
  */
 uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t *best,
-                        uint8_t *settled);
+                        qnav_run_iter_t *it);
 
 /* An angle in centidegrees to the nearest whole degree (halves away from zero), 0..359.
  * 16-bit arithmetic: one division, no 32-bit ones (costly on AVR). */

@@ -133,7 +133,8 @@ static int32_t path_acc(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta, 
     return acc;
 }
 
-qnav_qkey_t qnav_net_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
+/* The key of one 2-input path (inline: the step calls it without a frame of its own). */
+static inline qnav_qkey_t key_of_path(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
 {
     int32_t acc = ctrl->out_bias_z;
     uint8_t j;
@@ -143,6 +144,11 @@ qnav_qkey_t qnav_net_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dt
         acc += unit_share(unit_base(u, level) + mul_u8(u->per_deg, dtheta), u->out);
     }
     return net_key_of(ctrl, acc);
+}
+
+qnav_qkey_t qnav_net_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
+{
+    return key_of_path(ctrl, level, dtheta);
 }
 
 /* Paths evaluated together by eval_run: one unit at a time over all of them, so that its
@@ -280,8 +286,8 @@ static inline uint8_t rises_along(const qnav_ctrl_unit_t *u, const qnav_run_t *r
  * output bias plus the rising units' shares at hi plus the others' at lo, and for a single
  * path (lo = hi) that is its exact accumulator. One sigmoid per unit.
  */
-static void two_sums(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_t i_lo, uint8_t i_hi,
-                     int32_t *s_lo, int32_t *s_hi)
+static inline void two_sums(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_t i_lo,
+                            uint8_t i_hi, int32_t *s_lo, int32_t *s_hi)
 {
     uint8_t d_lo = (uint8_t)(r->dir > 0 ? r->dtheta0 + i_lo : r->dtheta0 - i_lo);
     uint8_t d_hi = (uint8_t)(r->dir > 0 ? r->dtheta0 + i_hi : r->dtheta0 - i_hi);
@@ -309,6 +315,13 @@ typedef struct {
     int32_t s_hi;
 } span_t;
 
+/* A span left for later: its paths only (its bound is made again when it is taken up,
+ * which keeps the stack at 2 bytes a span on the ATmega128's 4 KB). */
+typedef struct {
+    uint8_t lo;
+    uint8_t hi;
+} later_t;
+
 /* Halving a span of at most 181 paths takes at most 8 levels. */
 #define QNAV_SPAN_DEPTH 8
 
@@ -316,13 +329,14 @@ typedef struct {
  * The best path of run r by branch and bound: a span whose bound cannot beat the best is
  * dropped; otherwise it is halved, and each half's bound needs one new sigmoid per unit
  * (the rising units' shares at the left half's end, the others' at the right half's
- * start; the outer ends are the parent's). A span of one path is exact. So a run of k
- * paths costs at most k sigmoids per unit whatever the pruning does: the worst case is
- * the cost of evaluating every path, bounded by design (docs/architecture.md).
+ * start; the outer ends are the parent's). A span of one path is exact. The half left for
+ * later costs one sigmoid per unit again when it is taken up, so a run of k paths costs
+ * fewer than 2 k sigmoids per unit whatever the pruning does, and in the usual case far
+ * fewer (docs/architecture.md, "Row shapes").
  */
 static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *best)
 {
-    span_t stack[QNAV_SPAN_DEPTH];
+    later_t stack[QNAV_SPAN_DEPTH];
     uint8_t depth = 0;
     span_t n;
     n.lo = 0;
@@ -335,35 +349,38 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
         if (n.lo == n.hi) {
             qnav_best_consider(best, bound, (uint16_t)(r->first + n.lo), d_near);
         } else if (bound > best->key || (bound == best->key && d_near <= best->dtheta)) {
+            /* halves lo..mid and mid + 1..hi: the left keeps n.s_lo, the right n.s_hi */
             uint8_t mid = (uint8_t)(n.lo + (uint8_t)(n.hi - n.lo) / 2u);
-            span_t left;
-            span_t right;
+            int32_t left_hi;
+            int32_t right_lo;
             qnav_qkey_t k_left;
             qnav_qkey_t k_right;
-            left.lo = n.lo;
-            left.hi = mid;
-            left.s_lo = n.s_lo;
-            right.lo = (uint8_t)(mid + 1u);
-            right.hi = n.hi;
-            right.s_hi = n.s_hi;
-            two_sums(ctrl, r, right.lo, left.hi, &right.s_lo, &left.s_hi);
-            k_left = net_key_of(ctrl, ctrl->out_bias_z + left.s_lo + left.s_hi);
-            k_right = net_key_of(ctrl, ctrl->out_bias_z + right.s_lo + right.s_hi);
+            two_sums(ctrl, r, (uint8_t)(mid + 1u), mid, &right_lo, &left_hi);
+            k_left = net_key_of(ctrl, ctrl->out_bias_z + n.s_lo + left_hi);
+            k_right = net_key_of(ctrl, ctrl->out_bias_z + right_lo + n.s_hi);
             /* the more promising half first (on equal bounds, the one nearer the goal); the
              * other waits */
             if (k_left > k_right || (k_left == k_right && r->dir > 0)) {
-                stack[depth++] = right;
-                n = left;
+                stack[depth].lo = (uint8_t)(mid + 1u);
+                stack[depth].hi = n.hi;
+                n.hi = mid;
+                n.s_hi = left_hi;
             } else {
-                stack[depth++] = left;
-                n = right;
+                stack[depth].lo = n.lo;
+                stack[depth].hi = mid;
+                n.lo = (uint8_t)(mid + 1u);
+                n.s_lo = right_lo;
             }
+            ++depth;
             continue;
         }
         if (depth == 0u) {
             return;
         }
-        n = stack[--depth];
+        --depth;
+        n.lo = stack[depth].lo;
+        n.hi = stack[depth].hi;
+        two_sums(ctrl, r, n.lo, n.hi, &n.s_lo, &n.s_hi);
     }
 }
 
@@ -373,15 +390,13 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
  */
 static void two_inputs_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best)
 {
-    uint8_t settled[QNAV_DIST_LEVELS];
     qnav_run_t r;
-    qnav_settled_clear(settled);
     while (qnav_run_next(it, &r)) {
-        if (!qnav_run_reduce(ctrl->p.net.row, &r, best, settled)) {
+        if (!qnav_run_reduce(ctrl->p.net.row, &r, best, it)) {
             continue;
         }
         if (r.count == 1u) {
-            qnav_best_consider(best, qnav_net_eval_key(ctrl, r.level, r.dtheta0), r.first,
+            qnav_best_consider(best, key_of_path(ctrl, r.level, r.dtheta0), r.first,
                                r.dtheta0);
         } else {
             search_run(ctrl, &r, best);

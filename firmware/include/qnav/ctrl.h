@@ -127,7 +127,10 @@ typedef struct {
     uint16_t sector_span;             /* sector_paths * N */
     uint16_t first_sector_paths;      /* paths 0.. that lie in sector 0: ceil(180 / N) */
     uint8_t enlarge_deg[QNAV_DIST_LEVELS];      /* obstacle enlargement gamma by level, deg */
-    qnav_q1_15_t speed_cap[QNAV_DIST_LEVELS];   /* speed guard by level, Q1.15 of v_max */
+    uint16_t margin_mm;               /* body radius + safety distance (speed guard) */
+    qnav_mm_t sensor_offset_mm;
+    uint16_t v_max_mm_s;
+    uint16_t decel_mm_s2;
 } qnav_clearance_t;
 
 /* What init learns of one row of keys (a distance level, dtheta 0..180), so that the step
