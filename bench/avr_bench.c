@@ -202,6 +202,54 @@ __attribute__((noinline)) static int16_t naive_float_step(const qnav_mm_t *r, ui
     return (int16_t)(best > 180 ? best - 360 : best);
 }
 
+/* What qnav_ctrl_init costs for every network of the set (2 inputs: it learns the shape
+ * of each of the 32 rows of keys, docs/architecture.md "Row shapes"); not a step, so not
+ * an M line: printed per hidden-unit count as min / max. */
+static void init_times(void)
+{
+    static const uint8_t hs[] = {4u, 8u, 12u, 16u};
+    qnav_ctrl_t *c = qnav_bench_scratch_ctrl();
+    qnav_policy_t *p = qnav_bench_scratch_policy();
+    char id[QNAV_BENCH_ID_LEN];
+    qnav_ctrl_config_t cfg;
+    uint8_t h, i;
+    qnav_bench_config(&cfg, 32u);
+    for (h = 0; h < sizeof hs; ++h) {
+        uint32_t lo = 0xFFFFFFFFul, hi = 0;
+        uint8_t count = 0;
+        for (i = 0; i < qnav_bench_policy_count(); ++i) {
+            uint32_t t;
+            qnav_status_t st;
+            (void)qnav_bench_load_policy(i, p, id);
+            if (p->kind != QNAV_POLICY_NET || p->u.net.hidden != hs[h] ||
+                p->u.net.inputs != QNAV_NET_INPUTS_PAPER) {
+                continue;
+            }
+            timer_start();
+            st = qnav_ctrl_init(c, &cfg, p);
+            t = timer_stop() - overhead;
+            if (st != QNAV_OK) {
+                continue;
+            }
+            lo = t < lo ? t : lo;
+            hi = t > hi ? t : hi;
+            ++count;
+        }
+        if (count == 0u) {
+            continue;
+        }
+        PUT("qnav_ctrl_init, 2-input network H=");
+        qnav_target_put_u32(hs[h]);
+        PUT(" (");
+        qnav_target_put_u32(count);
+        PUT(" policies): min ");
+        put_cycles(lo);
+        PUT(", max ");
+        put_cycles(hi);
+        PUT("\n");
+    }
+}
+
 /* The naive float network against the fixed-point network step, both on the first
  * evolved H = 12 policy, over every dense 32-sector scan. */
 static void naive_comparison(void)
@@ -381,6 +429,7 @@ int main(void)
         PUT(" bytes (table in flash)\n");
     }
 #if !QNAV_BENCH_TABLE_GROUP
+    init_times();
     naive_comparison();
     vfh_comparison();
 #endif

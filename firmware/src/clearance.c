@@ -25,12 +25,23 @@ static const uint16_t sin_deg_q15[91] QNAV_FLASH = {
 /* Control tick the speed guard allows for reacting, ms (DESIGN.md §4: 0.1 s). */
 #define QNAV_GUARD_REACTION_MS 100u
 
+/* a * b, 16 x 16 -> 32 bits: avr-gcc's __umulhisi3 (about 20 cycles) rather than the
+ * 32 x 16 bit __muluhisi3 it picks for the expression written in place. */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((noinline))
+#endif
+static uint32_t mul_u16(uint16_t a, uint16_t b)
+{
+    return (uint32_t)a * b;
+}
+
 uint8_t qnav_clearance_level_of(const qnav_clearance_t *c, qnav_mm_t range_mm)
 {
     uint32_t level;
     /* For ranges of 32 mm and more the scale fits 16 bits: a 16x16 multiply (AVR) */
     if (c->level_scale <= 0xFFFFu) {
-        level = ((uint32_t)range_mm * (uint16_t)c->level_scale + 32768u) >> 16;
+        uint16_t scale = (uint16_t)c->level_scale;
+        level = (mul_u16(range_mm, scale) + 32768u) >> 16;
     } else {
         level = ((uint32_t)range_mm * c->level_scale + 32768u) >> 16;
     }
@@ -190,7 +201,11 @@ static void paint(uint8_t *lvl, uint16_t first, uint16_t n, uint8_t gamma, uint8
 }
 
 /* Every path at the farthest level: four bytes per iteration (avr-libc's memset takes
- * about 6 cycles a byte on the ATmega128, this loop under 3). */
+ * about 6 cycles a byte on the ATmega128, this loop under 3; GCC would turn the loop back
+ * into a memset call). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
 static void fill_clear(uint8_t *lvl)
 {
     uint8_t *p = lvl;

@@ -315,24 +315,48 @@ typedef struct {
     int32_t s_hi;
 } span_t;
 
-/* A span left for later: its paths only (its bound is made again when it is taken up,
- * which keeps the stack at 2 bytes a span on the ATmega128's 4 KB). */
+/* A span left for later: its paths and its bound (its sums are made again if it is taken
+ * up, which keeps the stack at 4 bytes a span on the ATmega128's 4 KB). */
 typedef struct {
     uint8_t lo;
     uint8_t hi;
+    qnav_qkey_t bound;
 } later_t;
 
-/* Halving a span of at most 181 paths takes at most 8 levels. */
-#define QNAV_SPAN_DEPTH 8
+/* Spans of at most this many paths are evaluated path by path: bounding them costs as
+ * much as it can save. */
+#define QNAV_SPAN_DIRECT 4u
+
+/* Halving a span of at most 181 paths down to QNAV_SPAN_DIRECT leaves at most 6 halves
+ * waiting (181, 91, 46, 23, 12, 6 are halved; 3 is not). */
+#define QNAV_SPAN_DEPTH 6
+
+/* Can a span whose bound is `bound` and whose path nearest the goal has dtheta d_near
+ * still beat best? */
+static inline uint8_t may_win(const qnav_best_t *best, qnav_qkey_t bound, uint8_t d_near)
+{
+    return (uint8_t)(bound > best->key || (bound == best->key && d_near <= best->dtheta));
+}
+
+/* Offsets lo..hi of run r, each path evaluated. */
+static inline void span_direct(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_t lo,
+                               uint8_t hi, qnav_best_t *best)
+{
+    uint8_t i;
+    for (i = lo; i <= hi; ++i) {
+        uint8_t d = (uint8_t)(r->dir > 0 ? r->dtheta0 + i : r->dtheta0 - i);
+        qnav_best_consider(best, key_of_path(ctrl, r->level, d), (uint16_t)(r->first + i), d);
+    }
+}
 
 /*
  * The best path of run r by branch and bound: a span whose bound cannot beat the best is
- * dropped; otherwise it is halved, and each half's bound needs one new sigmoid per unit
- * (the rising units' shares at the left half's end, the others' at the right half's
- * start; the outer ends are the parent's). A span of one path is exact. The half left for
- * later costs one sigmoid per unit again when it is taken up, so a run of k paths costs
- * fewer than 2 k sigmoids per unit whatever the pruning does, and in the usual case far
- * fewer (docs/architecture.md, "Row shapes").
+ * dropped; a short one is evaluated path by path; otherwise it is halved, and each half's
+ * bound needs one new sigmoid per unit (the rising units' shares at the left half's end,
+ * the others' at the right half's start; the outer ends are the parent's). The half left
+ * for later keeps its bound and costs one sigmoid per unit again only if it is taken up.
+ * So a run of k paths costs fewer than 2 k sigmoids per unit whatever the pruning does,
+ * and in the usual case far fewer (docs/architecture.md, "Row shapes").
  */
 static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *best)
 {
@@ -341,14 +365,15 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
     span_t n;
     n.lo = 0;
     n.hi = (uint8_t)(r->count - 1u);
+    if (r->count <= QNAV_SPAN_DIRECT) {
+        span_direct(ctrl, r, n.lo, n.hi, best);
+        return;
+    }
     two_sums(ctrl, r, n.lo, n.hi, &n.s_lo, &n.s_hi);
     for (;;) {
         qnav_qkey_t bound = net_key_of(ctrl, ctrl->out_bias_z + n.s_lo + n.s_hi);
-        uint8_t i_near = r->dir > 0 ? n.lo : n.hi; /* nearest the goal */
-        uint8_t d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + i_near : r->dtheta0 - i_near);
-        if (n.lo == n.hi) {
-            qnav_best_consider(best, bound, (uint16_t)(r->first + n.lo), d_near);
-        } else if (bound > best->key || (bound == best->key && d_near <= best->dtheta)) {
+        uint8_t d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + n.lo : r->dtheta0 - n.hi);
+        if (may_win(best, bound, d_near)) {
             /* halves lo..mid and mid + 1..hi: the left keeps n.s_lo, the right n.s_hi */
             uint8_t mid = (uint8_t)(n.lo + (uint8_t)(n.hi - n.lo) / 2u);
             int32_t left_hi;
@@ -363,24 +388,41 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
             if (k_left > k_right || (k_left == k_right && r->dir > 0)) {
                 stack[depth].lo = (uint8_t)(mid + 1u);
                 stack[depth].hi = n.hi;
+                stack[depth].bound = k_right;
                 n.hi = mid;
                 n.s_hi = left_hi;
             } else {
                 stack[depth].lo = n.lo;
                 stack[depth].hi = mid;
+                stack[depth].bound = k_left;
                 n.lo = (uint8_t)(mid + 1u);
                 n.s_lo = right_lo;
             }
             ++depth;
-            continue;
+            if ((uint8_t)(n.hi - n.lo) >= QNAV_SPAN_DIRECT) {
+                continue;
+            }
+            span_direct(ctrl, r, n.lo, n.hi, best);
         }
-        if (depth == 0u) {
-            return;
+        /* the next waiting span that may still win */
+        for (;;) {
+            if (depth == 0u) {
+                return;
+            }
+            --depth;
+            n.lo = stack[depth].lo;
+            n.hi = stack[depth].hi;
+            d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + n.lo : r->dtheta0 - n.hi);
+            if (!may_win(best, stack[depth].bound, d_near)) {
+                continue;
+            }
+            if ((uint8_t)(n.hi - n.lo) < QNAV_SPAN_DIRECT) {
+                span_direct(ctrl, r, n.lo, n.hi, best);
+                continue;
+            }
+            two_sums(ctrl, r, n.lo, n.hi, &n.s_lo, &n.s_hi);
+            break;
         }
-        --depth;
-        n.lo = stack[depth].lo;
-        n.hi = stack[depth].hi;
-        two_sums(ctrl, r, n.lo, n.hi, &n.s_lo, &n.s_hi);
     }
 }
 
