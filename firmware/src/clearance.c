@@ -184,20 +184,67 @@ static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
     }
 }
 
-/* Lower the level of n paths from first on, widened by gamma on both sides, to level. */
-static void paint(uint8_t *lvl, uint16_t first, uint16_t n, uint8_t gamma, uint8_t level)
+/* Lower the level of the k paths from p on (wrapping past 359; k <= 360) to level. */
+static void paint(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
 {
-    uint16_t p = (uint16_t)(first >= gamma ? first - gamma : first + QNAV_PATHS - gamma);
-    uint16_t k = (uint16_t)(n + 2u * gamma);
-    if (k > QNAV_PATHS) {
-        k = QNAV_PATHS;
-    }
     if (p + k <= QNAV_PATHS) {
         lower(lvl, p, k, level);
     } else {
         lower(lvl, p, (uint16_t)(QNAV_PATHS - p), level);
         lower(lvl, 0u, (uint16_t)(p + k - QNAV_PATHS), level);
     }
+}
+
+/*
+ * Paint one piece (n paths from first on, all of one sector) at level, widened by its
+ * gamma on both sides, except where a neighbouring piece already covers it at a level no
+ * higher. gamma only shrinks as the level grows, so a left neighbour at a level <= this
+ * one's covers this piece's left widening and as far as its own right widening reaches
+ * (gamma_prev + gamma paths); a right neighbour at a strictly lower level covers this
+ * piece's right widening back to where its own left widening starts (gamma_next + gamma
+ * paths). Ties leave the overlap to the left piece's right widening, so each skipped path
+ * is painted by a chain of neighbours ending in one that paints it (docs/architecture.md,
+ * "Clearance that respects the body"). Walls of similar readings paint about n paths a
+ * piece instead of n + 2 gamma.
+ */
+static void paint_piece(uint8_t *lvl, const qnav_clearance_t *c, uint16_t first, uint16_t n,
+                        uint8_t level, uint8_t prev, uint8_t next)
+{
+    uint8_t gamma = c->enlarge_deg[level];
+    uint16_t k = (uint16_t)(n + 2u * gamma);
+    uint16_t skip_left = 0;
+    uint16_t skip_right = 0;
+    uint16_t p = (uint16_t)(first >= gamma ? first - gamma : first + QNAV_PATHS - gamma);
+    if (k >= QNAV_PATHS) {
+        paint(lvl, 0u, QNAV_PATHS, level); /* the whole circle */
+        return;
+    }
+    if (prev <= level) {
+        skip_left = (uint16_t)(c->enlarge_deg[prev] + gamma);
+    }
+    if (next < level) {
+        skip_right = (uint16_t)(c->enlarge_deg[next] + gamma);
+    }
+    if (skip_left + skip_right >= k) {
+        return;
+    }
+    p = (uint16_t)(p + skip_left);
+    if (p >= QNAV_PATHS) {
+        p = (uint16_t)(p - QNAV_PATHS);
+    }
+    paint(lvl, p, (uint16_t)(k - skip_left - skip_right), level);
+}
+
+/* The level of sector s's reading (clipped to the maximum range, flagged in *flags). */
+static uint8_t sector_level(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint16_t s,
+                            uint8_t *flags)
+{
+    qnav_mm_t r = ranges[s];
+    if (r > c->max_range_mm) {
+        r = c->max_range_mm;
+        *flags |= QNAV_FLAG_RANGE_CLIPPED;
+    }
+    return qnav_clearance_level_of(c, r);
 }
 
 /* Every path at the farthest level: four bytes per iteration (avr-libc's memset takes
@@ -221,7 +268,8 @@ static void fill_clear(uint8_t *lvl)
 
 /* Sector lengths follow from path * N + 180 wrapping past 360: a sector whose first path
  * has phase p holds q = 360 / N paths, or q + 1 when p + q * N is still below 360; sector 0
- * is cut in two, paths 0.. and the last ones before 360. */
+ * is cut in two pieces, paths 0.. and the last ones before 360. Pieces are painted in path
+ * order, each knowing its neighbours' levels (the piece before piece 0 holds path 359). */
 uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint8_t *lvl)
 {
     uint16_t path = 0;
@@ -229,18 +277,23 @@ uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges
     uint16_t phase = QNAV_PATHS / 2u;
     uint16_t count = c->first_sector_paths;
     uint8_t flags = 0;
+    uint8_t level0 = sector_level(c, ranges, 0u, &flags);
+    /* path 359 lies in sector 0 (its last piece) when N <= 180, else in sector N - 1 */
+    uint8_t prev = c->n_sectors <= QNAV_DTHETA_MAX
+                       ? level0 : sector_level(c, ranges, (uint16_t)(c->n_sectors - 1u), &flags);
+    uint8_t level = level0;
     fill_clear(lvl);
     for (;;) {
-        qnav_mm_t r = ranges[sector];
         uint16_t n = count < QNAV_PATHS - path ? count : (uint16_t)(QNAV_PATHS - path);
-        uint8_t level;
-        if (r > c->max_range_mm) {
-            r = c->max_range_mm;
-            flags |= QNAV_FLAG_RANGE_CLIPPED;
+        uint16_t next_sector = (uint16_t)(sector + 1u == c->n_sectors ? 0u : sector + 1u);
+        uint8_t next;
+        if (path + n >= QNAV_PATHS || next_sector == 0u) {
+            next = level0; /* piece 0, or sector 0's last piece */
+        } else {
+            next = sector_level(c, ranges, next_sector, &flags);
         }
-        level = qnav_clearance_level_of(c, r);
         if (level != QNAV_DIST_LEVELS - 1u) {
-            paint(lvl, path, n, c->enlarge_deg[level], level);
+            paint_piece(lvl, c, path, n, level, prev, next);
         }
         path = (uint16_t)(path + n);
         if (path >= QNAV_PATHS) {
@@ -248,6 +301,8 @@ uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges
         }
         phase = (uint16_t)(phase + count * c->n_sectors - QNAV_PATHS);
         count = (uint16_t)(c->sector_paths + (phase + c->sector_span < QNAV_PATHS ? 1u : 0u));
-        sector = (uint16_t)(sector + 1u == c->n_sectors ? 0u : sector + 1u);
+        sector = next_sector;
+        prev = level;
+        level = next;
     }
 }

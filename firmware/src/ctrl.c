@@ -124,13 +124,10 @@ static void table_shapes(qnav_ctrl_t *ctrl)
     uint16_t d;
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
         const qnav_qkey_t *row = &ctrl->table[level * QNAV_TABLE_STRIDE];
-        qnav_row_shape_t *s = &ctrl->p.net.row[level];
-        qnav_qkey_t prev = QNAV_FLASH_READ_I16(&row[0]);
-        qnav_row_shape_start(s, prev);
+        qnav_row_scan_t sc;
+        qnav_row_shape_start(&sc, &ctrl->p.net.in.row[level], QNAV_FLASH_READ_I16(&row[0]));
         for (d = 1; d <= QNAV_DTHETA_MAX; ++d) {
-            qnav_qkey_t key = QNAV_FLASH_READ_I16(&row[d]);
-            qnav_row_shape_next(s, (uint8_t)d, prev, key);
-            prev = key;
+            qnav_row_shape_next(&sc, (uint8_t)d, QNAV_FLASH_READ_I16(&row[d]));
         }
     }
 }
@@ -379,22 +376,37 @@ void qnav_run_start(qnav_run_iter_t *it, const uint8_t *lvl, uint16_t goal, uint
     it->fresh_a = 0;
 }
 
-void qnav_row_shape_start(qnav_row_shape_t *s, qnav_qkey_t key0)
+void qnav_row_shape_start(qnav_row_scan_t *sc, qnav_row_shape_t *s, qnav_qkey_t key0)
 {
+    sc->shape = s;
+    sc->prev = key0;
+    sc->last_fall = 0;
+    sc->rose = 0;
     s->top = key0;
     s->top_d = 0;
     s->fall_d = 0;
+    s->dip_d = 0;
+    s->lead_end = QNAV_DTHETA_MAX;
 }
 
-void qnav_row_shape_next(qnav_row_shape_t *s, uint8_t d, qnav_qkey_t prev, qnav_qkey_t key)
+void qnav_row_shape_next(qnav_row_scan_t *sc, uint8_t d, qnav_qkey_t key)
 {
+    qnav_row_shape_t *s = sc->shape;
     if (key > s->top) {
         s->top = key;
         s->top_d = d;
     }
-    if (key > prev) {
+    if (key < sc->prev) {
+        sc->last_fall = d; /* from here the keys rise or stay until the next fall */
+    } else if (key > sc->prev) {
+        if (!sc->rose) {
+            s->lead_end = (uint8_t)(d - 1u); /* the first rise ends the leading fall */
+            sc->rose = 1;
+        }
         s->fall_d = d; /* the last rise so far ends here */
+        s->dip_d = sc->last_fall;
     }
+    sc->prev = key;
 }
 
 /*
@@ -409,6 +421,16 @@ void qnav_row_shape_next(qnav_row_shape_t *s, uint8_t d, qnav_qkey_t prev, qnav_
  * exception is the run straight after it on the other side starting at the same dtheta
  * (equal keys, equal dtheta: the turn decides), which "fresh" recognises.
  */
+/* Narrow r (its dtheta a..b) to dtheta a..e. */
+static void keep_dtheta(qnav_run_t *r, uint8_t a, uint8_t b, uint8_t e)
+{
+    if (r->dir < 0) {
+        r->first = (uint16_t)(r->first + (uint8_t)(b - e));
+        r->dtheta0 = e;
+    }
+    r->count = (uint8_t)((uint8_t)(e - a) + 1u);
+}
+
 uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t *best,
                         qnav_run_iter_t *it)
 {
@@ -421,16 +443,16 @@ uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t 
     uint8_t e;
     it->fresh = 0;
     if (s->top < best->key || (s->top == best->key && a > best->dtheta)) {
-        return 0;
+        return QNAV_RUN_DONE;
     }
     if (s->top_d >= a && s->top_d <= b) {
         qnav_best_consider(best, s->top, qnav_run_path_at(r, s->top_d), s->top_d);
-        return 0;
+        return QNAV_RUN_DONE;
     }
     if (a >= s->fall_d) {
         if ((it->settled[byte] & bit) != 0u) {
             if (!mirror) {
-                return 0;
+                return QNAV_RUN_DONE;
             }
         } else {
             it->settled[byte] = (uint8_t)(it->settled[byte] | bit);
@@ -438,16 +460,22 @@ uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t 
             it->fresh_level = r->level;
             it->fresh_a = a;
         }
-        e = a;
-    } else {
-        e = b < s->fall_d ? b : s->fall_d;
+        keep_dtheta(r, a, b, a);
+        return QNAV_RUN_ALL;
     }
-    if (r->dir < 0) { /* keep dtheta a..e */
-        r->first = (uint16_t)(r->first + (uint8_t)(b - e));
-        r->dtheta0 = e;
+    e = b < s->fall_d ? b : s->fall_d;
+    keep_dtheta(r, a, b, e);
+    if (a >= s->dip_d) {
+        return QNAV_RUN_RISING;
     }
-    r->count = (uint8_t)((uint8_t)(e - a) + 1u);
-    return 1;
+    if (e <= s->lead_end) {
+        keep_dtheta(r, a, e, a); /* keys never rise along a..e: the nearest wins */
+        return QNAV_RUN_ALL;
+    }
+    if (s->dip_d <= s->lead_end + 1u) {
+        return QNAV_RUN_VALLEY;
+    }
+    return QNAV_RUN_ALL;
 }
 
 /* Table mode: read a run's row. Along the run the tie order prefers earlier paths when
@@ -523,7 +551,7 @@ static void paths_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t
     qnav_run_t r;
     if (ctrl->table != 0) {
         while (qnav_run_next(it, &r)) {
-            if (keys != 0 || qnav_run_reduce(ctrl->p.net.row, &r, best, it)) {
+            if (keys != 0 || qnav_run_reduce(ctrl->p.net.in.row, &r, best, it) != QNAV_RUN_DONE) {
                 eval_table_run(ctrl, &r, best, keys);
             }
         }

@@ -119,16 +119,33 @@ static inline uint8_t qnav_run_dmin(const qnav_run_t *r)
 }
 
 /* Row shapes (docs/architecture.md, "Row shapes"): start a shape with the key at dtheta 0,
- * then feed the keys at dtheta 1..180 in order (prev: the key at d - 1). */
-void qnav_row_shape_start(qnav_row_shape_t *s, qnav_qkey_t key0);
-void qnav_row_shape_next(qnav_row_shape_t *s, uint8_t d, qnav_qkey_t prev, qnav_qkey_t key);
+ * then feed the keys at dtheta 1..180 in order. */
+typedef struct {
+    qnav_row_shape_t *shape;
+    qnav_qkey_t prev;     /* the key at the previous dtheta */
+    uint8_t last_fall;    /* the dtheta of the last fall so far (0: none) */
+    uint8_t rose;         /* a rise has been seen */
+} qnav_row_scan_t;
+void qnav_row_shape_start(qnav_row_scan_t *sc, qnav_row_shape_t *s, qnav_qkey_t key0);
+void qnav_row_shape_next(qnav_row_scan_t *sc, uint8_t d, qnav_qkey_t key);
+
+/* What qnav_run_reduce leaves to do with the run it narrowed. */
+#define QNAV_RUN_DONE 0u   /* nothing: no path of it can win, or its best was offered */
+#define QNAV_RUN_ALL 1u    /* its best is one of its paths (one path: that path's key) */
+#define QNAV_RUN_RISING 2u /* keys never fall from its smallest dtheta to its largest: the
+                              best is the first, by dtheta, of the paths with the key at the
+                              largest dtheta */
+#define QNAV_RUN_VALLEY 3u /* keys never rise from its smallest dtheta to the row's
+                              lead_end and never fall from the row's dip_d (<= lead_end + 1)
+                              on: the best is the path at the smallest dtheta, or the best
+                              of dip_d.. as for QNAV_RUN_RISING */
 
 /*
  * What the shape of a run's row decides before any evaluation (r must be the run that
- * qnav_run_next just handed out of it). Returns 0 when nothing is left to do: no path of
- * r can beat best, or the row's top lies in r and was offered to best. Otherwise narrows
- * r to the paths that can still hold its best path and returns 1; the caller must then
- * offer r's best to best. A run of one path needs only that path's key.
+ * qnav_run_next just handed out of it). Returns QNAV_RUN_DONE when nothing is left to do;
+ * otherwise r is narrowed to the paths that can still hold its best path and the code says
+ * what is known of them; the caller must then offer r's best to best. Any code but
+ * QNAV_RUN_DONE can also be served by evaluating every path of the narrowed r.
  */
 uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t *best,
                         qnav_run_iter_t *it);

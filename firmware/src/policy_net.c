@@ -5,7 +5,7 @@
  * output's pre-activation, companded into 16 bits (docs/qformats.md), or the quality under
  * QNAV_RANK_QUALITY. Two inputs: init learns the shape of every row of keys (a level,
  * dtheta 0..180), which settles most runs of paths with one evaluation or none; the rest
- * are searched by halving with exact bounds, never more than one sigmoid per hidden unit
+ * are searched by halving with exact bounds, never more than two sigmoids per hidden unit
  * and path. Three inputs: every path is evaluated (dprev breaks the runs' shape, and a
  * table would need a third dimension, docs/architecture.md).
  */
@@ -119,15 +119,16 @@ static inline int32_t unit_base(const qnav_ctrl_unit_t *u, uint8_t level)
     return u->bias_z + mul_u8(u->per_level, level);
 }
 
-/* The output accumulator of one path (dprev 0 for a 2-input network: per_prev is 0). */
-static int32_t path_acc(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta, uint8_t dprev)
+/* The output accumulator of one path of a 3-input network. */
+static int32_t path_acc_prev(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta,
+                             uint8_t dprev)
 {
     int32_t acc = ctrl->out_bias_z;
     uint8_t j;
     for (j = 0; j < ctrl->hidden; ++j) {
         const qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
         acc += unit_share(unit_base(u, level) + mul_u8(u->per_deg, dtheta) +
-                              mul_u8(u->per_prev, dprev),
+                              mul_u8(ctrl->p.net.in.per_prev[j], dprev),
                           u->out);
     }
     return acc;
@@ -220,8 +221,7 @@ static void row_shapes(qnav_ctrl_t *ctrl)
     qnav_run_t r;
     uint16_t level;
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
-        qnav_row_shape_t *s = &ctrl->p.net.row[level];
-        qnav_qkey_t prev = 0;
+        qnav_row_scan_t sc;
         uint8_t d = 0;
         r.first = 0;
         r.level = (uint8_t)level;
@@ -234,11 +234,10 @@ static void row_shapes(qnav_ctrl_t *ctrl)
             eval_run(ctrl, &r, &ignore, keys);
             for (k = 0; k < r.count; ++k, ++d) {
                 if (d == 0) {
-                    qnav_row_shape_start(s, keys[0]);
+                    qnav_row_shape_start(&sc, &ctrl->p.net.in.row[level], keys[0]);
                 } else {
-                    qnav_row_shape_next(s, d, prev, keys[k]);
+                    qnav_row_shape_next(&sc, d, keys[k]);
                 }
-                prev = keys[k];
             }
         }
     }
@@ -258,10 +257,11 @@ void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net)
         u->bias_z = (int32_t)net->b_hidden[j] * 2048;
         u->per_deg = div_round((int32_t)net->w_theta[j] * 2048, QNAV_DTHETA_MAX);
         u->per_level = div_round((int32_t)net->w_dist[j] * 2048, QNAV_DIST_LEVELS - 1);
-        u->per_prev = net->inputs == QNAV_NET_INPUTS_PREV
-                          ? div_round((int32_t)net->w_prev[j] * 2048, QNAV_DTHETA_MAX)
-                          : 0;
         u->out = net->w_out[j];
+        if (net->inputs == QNAV_NET_INPUTS_PREV) {
+            ctrl->p.net.in.per_prev[j] =
+                div_round((int32_t)net->w_prev[j] * 2048, QNAV_DTHETA_MAX);
+        }
     }
     ctrl->out_bias_z = (int32_t)net->b_out * 128;
     if (net->inputs == QNAV_NET_INPUTS_PAPER) {
@@ -426,22 +426,65 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
     }
 }
 
+/* The path of run r at dtheta d, its key offered to best. */
+static inline void offer_at(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_t d,
+                            qnav_best_t *best)
+{
+    qnav_best_consider(best, key_of_path(ctrl, r->level, d), qnav_run_path_at(r, d), d);
+}
+
+/* The best of run r's paths at dtheta lo..hi, along which the keys never fall: the first
+ * of the paths with the key at hi. Two keys when the last step rises; otherwise a halving
+ * search for where that key's plateau starts. */
+static inline void offer_rising(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_t lo,
+                                uint8_t hi, qnav_best_t *best)
+{
+    qnav_qkey_t top = key_of_path(ctrl, r->level, hi);
+    if (lo < hi && key_of_path(ctrl, r->level, (uint8_t)(hi - 1u)) == top) {
+        hi = (uint8_t)(hi - 1u);
+        while (lo < hi) {
+            uint8_t mid = (uint8_t)(lo + (uint8_t)(hi - lo) / 2u);
+            if (key_of_path(ctrl, r->level, mid) == top) {
+                hi = mid;
+            } else {
+                lo = (uint8_t)(mid + 1u);
+            }
+        }
+    }
+    qnav_best_consider(best, top, qnav_run_path_at(r, hi), hi);
+}
+
 /*
  * Two inputs, no keys wanted: every run, outward from the goal, settled by its row's shape
- * (qnav_run_reduce); what that leaves is one path to evaluate, or a search.
+ * (qnav_run_reduce); what that leaves is one path or two to evaluate, or a search.
  */
 static void two_inputs_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best)
 {
     qnav_run_t r;
     while (qnav_run_next(it, &r)) {
-        if (!qnav_run_reduce(ctrl->p.net.row, &r, best, it)) {
-            continue;
-        }
-        if (r.count == 1u) {
-            qnav_best_consider(best, key_of_path(ctrl, r.level, r.dtheta0), r.first,
-                               r.dtheta0);
-        } else {
-            search_run(ctrl, &r, best);
+        uint8_t a;
+        uint8_t e;
+        switch (qnav_run_reduce(ctrl->p.net.in.row, &r, best, it)) {
+        case QNAV_RUN_DONE:
+            break;
+        case QNAV_RUN_ALL:
+            if (r.count == 1u) {
+                qnav_best_consider(best, key_of_path(ctrl, r.level, r.dtheta0), r.first,
+                                   r.dtheta0);
+            } else {
+                search_run(ctrl, &r, best);
+            }
+            break;
+        case QNAV_RUN_RISING:
+            a = qnav_run_dmin(&r);
+            offer_rising(ctrl, &r, a, (uint8_t)(a + (uint8_t)(r.count - 1u)), best);
+            break;
+        default: /* QNAV_RUN_VALLEY */
+            a = qnav_run_dmin(&r);
+            e = (uint8_t)(a + (uint8_t)(r.count - 1u));
+            offer_at(ctrl, &r, a, best);
+            offer_rising(ctrl, &r, ctrl->p.net.in.row[r.level].dip_d, e, best);
+            break;
         }
     }
 }
@@ -457,7 +500,7 @@ static void eval_paths_prev(const qnav_ctrl_t *ctrl, const qnav_run_iter_t *it,
     uint16_t p;
     for (p = 0; p < QNAV_PATHS; ++p) {
         uint8_t dtheta = qnav_angle_dist_deg(p, it->goal);
-        qnav_qkey_t q = net_key_of(ctrl, path_acc(ctrl, it->lvl[p], dtheta,
+        qnav_qkey_t q = net_key_of(ctrl, path_acc_prev(ctrl, it->lvl[p], dtheta,
                                                   qnav_angle_dist_deg(p, it->prev)));
         if (keys != 0) {
             keys[p] = q;

@@ -16,6 +16,7 @@
 #include "qnav/ctrl.h"
 #include "qnav/fixed_host.h"
 #include "reference.h"
+#include "ctrl_internal.h"
 #include "sigmoid_lut.h"
 
 #ifndef M_PI
@@ -907,6 +908,195 @@ static void test_fast_step_equals_every_path_evaluation(void **state)
     assert_int_equal(checked, 6000);
 }
 
+/* A row of keys with the features that break shortcuts: plateaus, single-path spikes and
+ * dips, valleys, several peaks, long flat stretches. kind 0: stretches of random slope;
+ * 1: a valley (falls, then rises); 2: a peak (rises, then falls); both with flat steps. */
+static void synthetic_row(qnav_qkey_t *row, unsigned kind)
+{
+    int32_t v = rng_range(-200, 200);
+    int32_t slope = rng_range(-3, 3);
+    unsigned turn = (unsigned)rng_range(0, QNAV_DTHETA_MAX);
+    for (unsigned d = 0; d <= QNAV_DTHETA_MAX; ++d) {
+        uint32_t pick = rng_u32() % 100u;
+        if (kind == 0u) {
+            if (pick < 6u) {
+                slope = rng_range(-3, 3); /* a new stretch: rising, falling or flat */
+            }
+            if (pick == 50u) {
+                row[d] = (qnav_qkey_t)(v + rng_range(-5, 5)); /* a spike or a dip */
+                continue;
+            }
+        } else {
+            int32_t sign = (d < turn) == (kind == 1u) ? -1 : 1;
+            slope = pick < 30u ? 0 : sign * rng_range(0, 2); /* flat steps on the way */
+        }
+        v += slope;
+        row[d] = (qnav_qkey_t)v;
+    }
+}
+
+/* What qnav_run_reduce claims of a narrowed run must hold of the keys, and the run's best
+ * path (the brute-force best of the run as handed out) must stay reachable: checked on
+ * synthetic rows of every shape in table mode, where reduce reads the table's shapes. */
+static void test_run_reduce_keeps_its_promises_on_any_row(void **state)
+{
+    (void)state;
+    static qnav_qkey_t table[QNAV_QTABLE_ENTRIES];
+    uint8_t lvl[QNAV_PATHS];
+    unsigned codes[4] = {0, 0, 0, 0};
+    for (unsigned trial = 0; trial < 1500; ++trial) {
+        qnav_ctrl_config_t cfg;
+        qnav_ctrl_t c;
+        qnav_run_iter_t it;
+        qnav_run_t r;
+        qnav_best_t best = {QNAV_KEY_NONE, 0, 0};
+        qnav_ctrl_config_default(&cfg);
+        for (unsigned level = 0; level < QNAV_DIST_LEVELS; ++level) {
+            synthetic_row(&table[level * (QNAV_DTHETA_MAX + 1)], (trial + level) % 3u);
+        }
+        assert_int_equal(qnav_ctrl_init_table(&c, &cfg, table, QNAV_RANK_PREACT), QNAV_OK);
+        for (unsigned p = 0; p < QNAV_PATHS;) { /* runs of random levels and lengths */
+            uint8_t level = (uint8_t)rng_range(0, QNAV_DIST_LEVELS - 1);
+            unsigned len = (unsigned)rng_range(1, 40);
+            for (; len > 0 && p < QNAV_PATHS; --len, ++p) {
+                lvl[p] = level;
+            }
+        }
+        qnav_run_start(&it, lvl, (uint16_t)rng_range(0, 359), 0);
+        while (qnav_run_next(&it, &r)) {
+            const qnav_qkey_t *row = &table[r.level * (QNAV_DTHETA_MAX + 1)];
+            const qnav_row_shape_t *sh = &c.p.net.in.row[r.level];
+            uint8_t a0 = qnav_run_dmin(&r);
+            uint8_t b0 = (uint8_t)(a0 + r.count - 1u);
+            /* the run's own best by the step's order, before reduce (dtheta, then turn) */
+            qnav_best_t own = best;
+            for (uint8_t d = a0; d <= b0; ++d) {
+                qnav_best_consider(&own, row[d], qnav_run_path_at(&r, d), d);
+            }
+            qnav_run_t kept = r;
+            uint8_t code = qnav_run_reduce(c.p.net.in.row, &kept, &best, &it);
+            assert_true(code <= QNAV_RUN_VALLEY);
+            ++codes[code];
+            if (code == QNAV_RUN_DONE) {
+                /* nothing of the run beats what best now holds */
+                qnav_best_t check = best;
+                for (uint8_t d = a0; d <= b0; ++d) {
+                    qnav_best_consider(&check, row[d], qnav_run_path_at(&r, d), d);
+                }
+                assert_int_equal(check.key, best.key);
+                assert_int_equal(check.dtheta, best.dtheta);
+                assert_int_equal(check.heading, best.heading);
+                continue;
+            }
+            uint8_t a = qnav_run_dmin(&kept);
+            uint8_t e = (uint8_t)(a + kept.count - 1u);
+            assert_true(a == a0 && e <= b0);
+            if (code == QNAV_RUN_RISING) {
+                for (uint8_t d = a; d < e; ++d) {
+                    assert_true(row[d] <= row[d + 1]);
+                }
+            } else if (code == QNAV_RUN_VALLEY) {
+                assert_true(sh->dip_d > a && sh->dip_d <= e);
+                assert_true(sh->dip_d <= sh->lead_end + 1u);
+                for (uint8_t d = a; d < sh->lead_end && d < e; ++d) {
+                    assert_true(row[d] >= row[d + 1]);
+                }
+                for (uint8_t d = sh->dip_d; d < e; ++d) {
+                    assert_true(row[d] <= row[d + 1]);
+                }
+            }
+            /* the kept paths hold the run's best: offering them reaches the same record */
+            for (uint8_t d = a; d <= e; ++d) {
+                qnav_best_consider(&best, row[d], qnav_run_path_at(&kept, d), d);
+            }
+            assert_int_equal(best.key, own.key);
+            assert_int_equal(best.dtheta, own.dtheta);
+            assert_int_equal(best.heading, own.heading);
+        }
+    }
+    print_message("reduce: %u done, %u all, %u rising, %u valley\n", codes[0], codes[1],
+                  codes[2], codes[3]);
+    for (unsigned k = 0; k < 4; ++k) {
+        assert_true(codes[k] > 100u); /* every rule met often enough to mean something */
+    }
+}
+
+/* The enlargement as first written: every obstacle sector lowers its own paths widened by
+ * its level's gamma on both sides, one path at a time. */
+static void reference_levels(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
+                             uint8_t *lvl)
+{
+    for (unsigned p = 0; p < QNAV_PATHS; ++p) {
+        lvl[p] = QNAV_DIST_LEVELS - 1;
+    }
+    for (unsigned p = 0; p < QNAV_PATHS; ++p) {
+        uint16_t s = qnav_ctrl_sector_of_path(n, (uint16_t)p);
+        uint8_t level = qnav_ctrl_level(c, ranges[s]);
+        int gamma = c->clr.enlarge_deg[level];
+        if (level == QNAV_DIST_LEVELS - 1) {
+            continue;
+        }
+        for (int d = -gamma; d <= gamma; ++d) {
+            unsigned q = (unsigned)(((int)p + d + 720) % 360);
+            lvl[q] = lvl[q] < level ? lvl[q] : level;
+        }
+    }
+}
+
+/* The step paints each piece only where no neighbour already covers it at a level no
+ * higher; the levels must be those of painting everything. Walls that rise, fall and stay
+ * level, all-equal scans (the skip chain runs around the circle), random ones. */
+static void test_path_levels_equal_painting_every_sector(void **state)
+{
+    (void)state;
+    static const uint16_t sectors[] = {1, 2, 3, 4, 5, 7, 8, 12, 16, 31, 32, 64, 90, 179, 180,
+                                       181, 240, 359, 360};
+    qnav_mm_t ranges[360];
+    uint8_t got[QNAV_PATHS];
+    uint8_t want[QNAV_PATHS];
+    qnav_policy_t p;
+    qnav_policy_prob_default(&p);
+    for (unsigned k = 0; k < 3000; ++k) {
+        uint16_t n = sectors[k % (sizeof sectors / sizeof sectors[0])];
+        qnav_ctrl_t c;
+        init_or_fail(&c, n, 4000, &p);
+        switch ((k / 19u) % 6u) {
+        case 0:
+            random_scan(ranges, n, 4000);
+            break;
+        case 1: /* one range everywhere */
+            fill(ranges, n, (qnav_mm_t)rng_range(0, 4500));
+            break;
+        case 2: /* a wall that comes nearer, then recedes */
+            for (uint16_t s2 = 0; s2 < n; ++s2) {
+                int32_t d = (int32_t)s2 * 2 * 4000 / n - 4000;
+                ranges[s2] = (qnav_mm_t)(d < 0 ? -d : d) + (qnav_mm_t)rng_range(0, 50);
+            }
+            break;
+        case 3: /* steps: runs of equal ranges */
+            for (uint16_t s2 = 0; s2 < n; ++s2) {
+                ranges[s2] = (qnav_mm_t)(((s2 / 3u) * 377u) % 4200u);
+            }
+            break;
+        default: {
+            qnav_cdeg_t goal;
+            structured_scan(ranges, n, 4000, k, &goal);
+            break;
+        }
+        }
+        assert_int_equal(qnav_ctrl_path_levels(&c, ranges, got) & QNAV_FLAG_NOT_READY, 0);
+        reference_levels(&c, ranges, n, want);
+        if (memcmp(got, want, sizeof got) != 0) {
+            unsigned q = 0;
+            while (got[q] == want[q]) {
+                ++q;
+            }
+            fail_msg("scan %u (N = %u, kind %u): path %u level %u, painting everything %u", k,
+                     n, (k / 19u) % 6u, q, got[q], want[q]);
+        }
+    }
+}
+
 static void test_table_mode_is_bit_identical_to_network_mode(void **state)
 {
     (void)state;
@@ -995,6 +1185,8 @@ int main(void)
         cmocka_unit_test(test_preactivation_rank_agrees_with_float_network_on_saturated_nets),
         cmocka_unit_test(test_sigmoid_flat_ends_match_the_table),
         cmocka_unit_test(test_fast_step_equals_every_path_evaluation),
+        cmocka_unit_test(test_path_levels_equal_painting_every_sector),
+        cmocka_unit_test(test_run_reduce_keeps_its_promises_on_any_row),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_network_mode),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_probabilistic_mode),
         cmocka_unit_test(test_build_table_refuses_a_table_controller),

@@ -112,7 +112,6 @@ typedef struct {
     int32_t bias_z;    /* hidden bias, units of 2^-19 */
     int32_t per_deg;   /* weight per degree of dtheta, units of 2^-19 */
     int32_t per_level; /* weight per distance level, units of 2^-19 */
-    int32_t per_prev;  /* weight per degree of dprev (3 inputs, else 0), units of 2^-19 */
     int16_t out;       /* output weight, Q8.8 */
 } qnav_ctrl_unit_t;
 
@@ -139,6 +138,8 @@ typedef struct {
     qnav_qkey_t top;   /* the row's largest key */
     uint8_t top_d;     /* the smallest dtheta with that key */
     uint8_t fall_d;    /* the smallest dtheta from which the key never rises again */
+    uint8_t dip_d;     /* the smallest dtheta from which the key never falls up to fall_d */
+    uint8_t lead_end;  /* the largest dtheta up to which the key never rises from dtheta 0 */
 } qnav_row_shape_t;
 
 /* The controller. Caller-owned (a static on an MCU, a vector element on a host); fields
@@ -161,8 +162,12 @@ typedef struct {
             qnav_q1_15_t safe[QNAV_DIST_LEVELS];    /* P_safe by distance level */
         } prob;
         struct {
-            qnav_row_shape_t row[QNAV_DIST_LEVELS]; /* 2-input network and table mode */
             qnav_ctrl_unit_t unit[QNAV_MAX_HIDDEN]; /* network */
+            union {
+                qnav_row_shape_t row[QNAV_DIST_LEVELS]; /* 2 inputs, and table mode */
+                int32_t per_prev[QNAV_MAX_HIDDEN];      /* 3 inputs: weight per degree of
+                                                           dprev, units of 2^-19 */
+            } in;
         } net;
     } p;
 } qnav_ctrl_t;
