@@ -25,17 +25,15 @@ static const uint16_t sin_deg_q15[91] QNAV_FLASH = {
 /* Control tick the speed guard allows for reacting, ms (DESIGN.md §4: 0.1 s). */
 #define QNAV_GUARD_REACTION_MS 100u
 
-/* a * b, 16 x 16 -> 32 bits: avr-gcc's __umulhisi3 (about 20 cycles) rather than the
- * 32 x 16 bit __muluhisi3 it picks for the expression written in place. */
-#if defined(__GNUC__) && !defined(__clang__)
-__attribute__((noinline))
-#endif
-static uint32_t mul_u16(uint16_t a, uint16_t b)
+/* a * b, 16 x 16 -> 32 bits (avr-gcc: __umulhisi3, about 20 cycles, where the expression
+ * written in place gets the 32 x 16 bit __muluhisi3). */
+static inline uint32_t mul_u16(uint16_t a, uint16_t b)
 {
     return (uint32_t)a * b;
 }
 
-uint8_t qnav_clearance_level_of(const qnav_clearance_t *c, qnav_mm_t range_mm)
+/* The level of a range at most max_range_mm (inline for the step's sector loop). */
+static inline uint8_t level_of(const qnav_clearance_t *c, qnav_mm_t range_mm)
 {
     uint32_t level;
     /* For ranges of 32 mm and more the scale fits 16 bits: a 16x16 multiply (AVR) */
@@ -46,6 +44,11 @@ uint8_t qnav_clearance_level_of(const qnav_clearance_t *c, qnav_mm_t range_mm)
         level = ((uint32_t)range_mm * c->level_scale + 32768u) >> 16;
     }
     return (uint8_t)(level > QNAV_DIST_LEVELS - 1u ? QNAV_DIST_LEVELS - 1u : level);
+}
+
+uint8_t qnav_clearance_level_of(const qnav_clearance_t *c, qnav_mm_t range_mm)
+{
+    return level_of(c, range_mm);
 }
 
 /* The smallest range (mm) that maps to level or above: the nearest an obstacle read at
@@ -236,7 +239,7 @@ static void paint_piece(uint8_t *lvl, const qnav_clearance_t *c, uint16_t first,
 }
 
 /* The level of sector s's reading (clipped to the maximum range, flagged in *flags). */
-static uint8_t sector_level(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint16_t s,
+static inline uint8_t sector_level(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint16_t s,
                             uint8_t *flags)
 {
     qnav_mm_t r = ranges[s];
@@ -244,7 +247,7 @@ static uint8_t sector_level(const qnav_clearance_t *c, const qnav_mm_t *ranges, 
         r = c->max_range_mm;
         *flags |= QNAV_FLAG_RANGE_CLIPPED;
     }
-    return qnav_clearance_level_of(c, r);
+    return level_of(c, r);
 }
 
 /* Every path at the farthest level: four bytes per iteration (avr-libc's memset takes

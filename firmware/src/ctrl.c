@@ -380,13 +380,13 @@ void qnav_row_shape_start(qnav_row_scan_t *sc, qnav_row_shape_t *s, qnav_qkey_t 
 {
     sc->shape = s;
     sc->prev = key0;
-    sc->last_fall = 0;
-    sc->rose = 0;
+    sc->last_rise = 0;
+    sc->rising = 0;
     s->top = key0;
     s->top_d = 0;
     s->fall_d = 0;
-    s->dip_d = 0;
-    s->lead_end = QNAV_DTHETA_MAX;
+    s->peak_lo = QNAV_PEAK_NONE;
+    s->peak_hi = 0;
 }
 
 void qnav_row_shape_next(qnav_row_scan_t *sc, uint8_t d, qnav_qkey_t key)
@@ -396,15 +396,19 @@ void qnav_row_shape_next(qnav_row_scan_t *sc, uint8_t d, qnav_qkey_t key)
         s->top = key;
         s->top_d = d;
     }
-    if (key < sc->prev) {
-        sc->last_fall = d; /* from here the keys rise or stay until the next fall */
-    } else if (key > sc->prev) {
-        if (!sc->rose) {
-            s->lead_end = (uint8_t)(d - 1u); /* the first rise ends the leading fall */
-            sc->rose = 1;
-        }
+    if (key > sc->prev) {
         s->fall_d = d; /* the last rise so far ends here */
-        s->dip_d = sc->last_fall;
+        sc->last_rise = d;
+        sc->rising = 1;
+    } else if (key < sc->prev && sc->rising) {
+        /* a rise, equal keys, a fall: an interior peak last_rise..d - 1 */
+        if (s->peak_lo == QNAV_PEAK_NONE) {
+            s->peak_lo = sc->last_rise;
+            s->peak_hi = (uint8_t)(d - 1u);
+        } else {
+            s->peak_lo = QNAV_PEAK_MANY;
+        }
+        sc->rising = 0;
     }
     sc->prev = key;
 }
@@ -465,17 +469,13 @@ uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t 
     }
     e = b < s->fall_d ? b : s->fall_d;
     keep_dtheta(r, a, b, e);
-    if (a >= s->dip_d) {
-        return QNAV_RUN_RISING;
+    if (s->peak_lo == QNAV_PEAK_MANY) {
+        return QNAV_RUN_ALL; /* peaks somewhere: search */
     }
-    if (e <= s->lead_end) {
-        keep_dtheta(r, a, e, a); /* keys never rise along a..e: the nearest wins */
-        return QNAV_RUN_ALL;
+    if (s->peak_lo == QNAV_PEAK_NONE || !(a < s->peak_lo && s->peak_hi < e)) {
+        return QNAV_RUN_VALLEY; /* no interior peak inside a..e */
     }
-    if (s->dip_d <= s->lead_end + 1u) {
-        return QNAV_RUN_VALLEY;
-    }
-    return QNAV_RUN_ALL;
+    return QNAV_RUN_PEAK;
 }
 
 /* Table mode: read a run's row. Along the run the tie order prefers earlier paths when

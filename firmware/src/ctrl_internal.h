@@ -123,22 +123,27 @@ static inline uint8_t qnav_run_dmin(const qnav_run_t *r)
 typedef struct {
     qnav_row_shape_t *shape;
     qnav_qkey_t prev;     /* the key at the previous dtheta */
-    uint8_t last_fall;    /* the dtheta of the last fall so far (0: none) */
-    uint8_t rose;         /* a rise has been seen */
+    uint8_t last_rise;    /* the dtheta of the last rise so far */
+    uint8_t rising;       /* a rise since the last fall */
 } qnav_row_scan_t;
+
+/* qnav_row_shape_t.peak_lo when a row has no interior peak, or more than one. */
+#define QNAV_PEAK_NONE 255u
+#define QNAV_PEAK_MANY 254u
 void qnav_row_shape_start(qnav_row_scan_t *sc, qnav_row_shape_t *s, qnav_qkey_t key0);
 void qnav_row_shape_next(qnav_row_scan_t *sc, uint8_t d, qnav_qkey_t key);
 
-/* What qnav_run_reduce leaves to do with the run it narrowed. */
+/* What qnav_run_reduce leaves to do with the run it narrowed. A row is valley-shaped on
+ * dtheta a..e when no interior peak lies inside (keys first never rise, then never fall):
+ * its best is then the path at a, or, when the key at e is larger, the first path by
+ * dtheta with the key at e. */
 #define QNAV_RUN_DONE 0u   /* nothing: no path of it can win, or its best was offered */
 #define QNAV_RUN_ALL 1u    /* its best is one of its paths (one path: that path's key) */
-#define QNAV_RUN_RISING 2u /* keys never fall from its smallest dtheta to its largest: the
-                              best is the first, by dtheta, of the paths with the key at the
-                              largest dtheta */
-#define QNAV_RUN_VALLEY 3u /* keys never rise from its smallest dtheta to the row's
-                              lead_end and never fall from the row's dip_d (<= lead_end + 1)
-                              on: the best is the path at the smallest dtheta, or the best
-                              of dip_d.. as for QNAV_RUN_RISING */
+#define QNAV_RUN_VALLEY 2u /* the row is valley-shaped on it */
+#define QNAV_RUN_PEAK 3u   /* it holds the row's single interior peak peak_lo..peak_hi and
+                              is valley-shaped on either side: its best is the path at its
+                              smallest dtheta, at peak_lo, or that of peak_hi + 1.. as for
+                              QNAV_RUN_VALLEY */
 
 /*
  * What the shape of a run's row decides before any evaluation (r must be the run that

@@ -433,30 +433,38 @@ static inline void offer_at(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_
     qnav_best_consider(best, key_of_path(ctrl, r->level, d), qnav_run_path_at(r, d), d);
 }
 
-/* The best of run r's paths at dtheta lo..hi, along which the keys never fall: the first
- * of the paths with the key at hi. Two keys when the last step rises; otherwise a halving
- * search for where that key's plateau starts. */
-static inline void offer_rising(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_t lo,
+/* The best of run r's paths at dtheta lo..hi, on which the row is valley-shaped (keys
+ * first never rise, then never fall): the path at lo unless the key at hi is larger, then
+ * the first path with the key at hi. The keys below it before the valley are at most the
+ * key at lo, so "key >= the key at hi" is false, then true, over lo..hi: a halving search
+ * finds where, when the last step is flat. */
+static inline void offer_valley(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_t lo,
                                 uint8_t hi, qnav_best_t *best)
 {
-    qnav_qkey_t top = key_of_path(ctrl, r->level, hi);
-    if (lo < hi && key_of_path(ctrl, r->level, (uint8_t)(hi - 1u)) == top) {
+    qnav_qkey_t k_lo = key_of_path(ctrl, r->level, lo);
+    qnav_qkey_t k_hi = lo == hi ? k_lo : key_of_path(ctrl, r->level, hi);
+    if (k_hi <= k_lo) {
+        qnav_best_consider(best, k_lo, qnav_run_path_at(r, lo), lo);
+        return;
+    }
+    if (key_of_path(ctrl, r->level, (uint8_t)(hi - 1u)) >= k_hi) {
+        uint8_t x = (uint8_t)(lo + 1u); /* the key at lo is below k_hi */
         hi = (uint8_t)(hi - 1u);
-        while (lo < hi) {
-            uint8_t mid = (uint8_t)(lo + (uint8_t)(hi - lo) / 2u);
-            if (key_of_path(ctrl, r->level, mid) == top) {
+        while (x < hi) {
+            uint8_t mid = (uint8_t)(x + (uint8_t)(hi - x) / 2u);
+            if (key_of_path(ctrl, r->level, mid) >= k_hi) {
                 hi = mid;
             } else {
-                lo = (uint8_t)(mid + 1u);
+                x = (uint8_t)(mid + 1u);
             }
         }
     }
-    qnav_best_consider(best, top, qnav_run_path_at(r, hi), hi);
+    qnav_best_consider(best, k_hi, qnav_run_path_at(r, hi), hi);
 }
 
 /*
  * Two inputs, no keys wanted: every run, outward from the goal, settled by its row's shape
- * (qnav_run_reduce); what that leaves is one path or two to evaluate, or a search.
+ * (qnav_run_reduce); what that leaves is a few paths to evaluate, or a search.
  */
 static void two_inputs_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best)
 {
@@ -475,16 +483,19 @@ static void two_inputs_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_b
                 search_run(ctrl, &r, best);
             }
             break;
-        case QNAV_RUN_RISING:
+        case QNAV_RUN_VALLEY:
             a = qnav_run_dmin(&r);
-            offer_rising(ctrl, &r, a, (uint8_t)(a + (uint8_t)(r.count - 1u)), best);
+            offer_valley(ctrl, &r, a, (uint8_t)(a + (uint8_t)(r.count - 1u)), best);
             break;
-        default: /* QNAV_RUN_VALLEY */
+        default: { /* QNAV_RUN_PEAK */
+            const qnav_row_shape_t *s = &ctrl->p.net.in.row[r.level];
             a = qnav_run_dmin(&r);
             e = (uint8_t)(a + (uint8_t)(r.count - 1u));
             offer_at(ctrl, &r, a, best);
-            offer_rising(ctrl, &r, ctrl->p.net.in.row[r.level].dip_d, e, best);
+            offer_at(ctrl, &r, s->peak_lo, best);
+            offer_valley(ctrl, &r, (uint8_t)(s->peak_hi + 1u), e, best);
             break;
+        }
         }
     }
 }

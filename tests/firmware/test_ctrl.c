@@ -910,7 +910,8 @@ static void test_fast_step_equals_every_path_evaluation(void **state)
 
 /* A row of keys with the features that break shortcuts: plateaus, single-path spikes and
  * dips, valleys, several peaks, long flat stretches. kind 0: stretches of random slope;
- * 1: a valley (falls, then rises); 2: a peak (rises, then falls); both with flat steps. */
+ * 1: a valley (falls, then rises); 2: a peak (rises, then falls); 3: a peak, a valley and
+ * a higher end; all with flat steps. */
 static void synthetic_row(qnav_qkey_t *row, unsigned kind)
 {
     int32_t v = rng_range(-200, 200);
@@ -926,13 +927,30 @@ static void synthetic_row(qnav_qkey_t *row, unsigned kind)
                 row[d] = (qnav_qkey_t)(v + rng_range(-5, 5)); /* a spike or a dip */
                 continue;
             }
-        } else {
+        } else if (kind < 3u) {
             int32_t sign = (d < turn) == (kind == 1u) ? -1 : 1;
             slope = pick < 30u ? 0 : sign * rng_range(0, 2); /* flat steps on the way */
+        } else { /* rises to a peak, falls, rises again higher: the top at the far end */
+            int32_t sign = d < turn / 2u ? 1 : (d < turn ? -1 : 1);
+            slope = pick < 30u ? 0 : sign * rng_range(0, d < turn ? 2 : 4);
         }
         v += slope;
         row[d] = (qnav_qkey_t)v;
     }
+}
+
+/* Keys on lo..hi first never rise, then never fall (no rise is followed by a fall). */
+static int valley_shaped(const qnav_qkey_t *row, uint8_t lo, uint8_t hi)
+{
+    int rose = 0;
+    for (unsigned d = lo; d < hi; ++d) {
+        if (row[d + 1] > row[d]) {
+            rose = 1;
+        } else if (row[d + 1] < row[d] && rose) {
+            return 0;
+        }
+    }
+    return 1;
 }
 
 /* What qnav_run_reduce claims of a narrowed run must hold of the keys, and the run's best
@@ -952,7 +970,7 @@ static void test_run_reduce_keeps_its_promises_on_any_row(void **state)
         qnav_best_t best = {QNAV_KEY_NONE, 0, 0};
         qnav_ctrl_config_default(&cfg);
         for (unsigned level = 0; level < QNAV_DIST_LEVELS; ++level) {
-            synthetic_row(&table[level * (QNAV_DTHETA_MAX + 1)], (trial + level) % 3u);
+            synthetic_row(&table[level * (QNAV_DTHETA_MAX + 1)], (trial + level) % 4u);
         }
         assert_int_equal(qnav_ctrl_init_table(&c, &cfg, table, QNAV_RANK_PREACT), QNAV_OK);
         for (unsigned p = 0; p < QNAV_PATHS;) { /* runs of random levels and lengths */
@@ -975,7 +993,7 @@ static void test_run_reduce_keeps_its_promises_on_any_row(void **state)
             }
             qnav_run_t kept = r;
             uint8_t code = qnav_run_reduce(c.p.net.in.row, &kept, &best, &it);
-            assert_true(code <= QNAV_RUN_VALLEY);
+            assert_true(code <= QNAV_RUN_PEAK);
             ++codes[code];
             if (code == QNAV_RUN_DONE) {
                 /* nothing of the run beats what best now holds */
@@ -991,19 +1009,18 @@ static void test_run_reduce_keeps_its_promises_on_any_row(void **state)
             uint8_t a = qnav_run_dmin(&kept);
             uint8_t e = (uint8_t)(a + kept.count - 1u);
             assert_true(a == a0 && e <= b0);
-            if (code == QNAV_RUN_RISING) {
-                for (uint8_t d = a; d < e; ++d) {
-                    assert_true(row[d] <= row[d + 1]);
+            if (code == QNAV_RUN_VALLEY) {
+                assert_true(valley_shaped(row, a, e));
+            } else if (code == QNAV_RUN_PEAK) {
+                assert_true(sh->peak_lo != QNAV_PEAK_NONE && sh->peak_lo != QNAV_PEAK_MANY);
+                assert_true(a < sh->peak_lo && sh->peak_hi < e);
+                assert_true(valley_shaped(row, a, sh->peak_hi));
+                assert_true(valley_shaped(row, (uint8_t)(sh->peak_hi + 1u), e));
+                assert_true(row[sh->peak_lo - 1u] < row[sh->peak_lo]);
+                for (uint8_t d = sh->peak_lo; d < sh->peak_hi; ++d) {
+                    assert_true(row[d] == row[d + 1]);
                 }
-            } else if (code == QNAV_RUN_VALLEY) {
-                assert_true(sh->dip_d > a && sh->dip_d <= e);
-                assert_true(sh->dip_d <= sh->lead_end + 1u);
-                for (uint8_t d = a; d < sh->lead_end && d < e; ++d) {
-                    assert_true(row[d] >= row[d + 1]);
-                }
-                for (uint8_t d = sh->dip_d; d < e; ++d) {
-                    assert_true(row[d] <= row[d + 1]);
-                }
+                assert_true(row[sh->peak_hi + 1u] < row[sh->peak_hi]);
             }
             /* the kept paths hold the run's best: offering them reaches the same record */
             for (uint8_t d = a; d <= e; ++d) {
@@ -1014,7 +1031,7 @@ static void test_run_reduce_keeps_its_promises_on_any_row(void **state)
             assert_int_equal(best.heading, own.heading);
         }
     }
-    print_message("reduce: %u done, %u all, %u rising, %u valley\n", codes[0], codes[1],
+    print_message("reduce: %u done, %u all, %u valley, %u peak\n", codes[0], codes[1],
                   codes[2], codes[3]);
     for (unsigned k = 0; k < 4; ++k) {
         assert_true(codes[k] > 100u); /* every rule met often enough to mean something */

@@ -138,8 +138,9 @@ typedef struct {
     qnav_qkey_t top;   /* the row's largest key */
     uint8_t top_d;     /* the smallest dtheta with that key */
     uint8_t fall_d;    /* the smallest dtheta from which the key never rises again */
-    uint8_t dip_d;     /* the smallest dtheta from which the key never falls up to fall_d */
-    uint8_t lead_end;  /* the largest dtheta up to which the key never rises from dtheta 0 */
+    uint8_t peak_lo;   /* the row's one interior peak: keys rise into peak_lo, stay equal */
+    uint8_t peak_hi;   /* to peak_hi and fall after it; peak_lo 255: no interior peak,
+                          254: more than one */
 } qnav_row_shape_t;
 
 /* The controller. Caller-owned (a static on an MCU, a vector element on a host); fields
