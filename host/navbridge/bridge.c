@@ -668,9 +668,12 @@ void qnav_bridge_poll(qnav_bridge_t *b, int64_t now_ms)
     if (b->upload_state == QNAV_BRIDGE_UPLOAD_WAITING && b->last_heartbeat_ms >= 0) {
         send_upload(b);
     } else if (b->upload_state == QNAV_BRIDGE_UPLOAD_SENT &&
-               now_ms - b->upload_sent_ms > (b->cfg.timeout_ms > 1000u ? (int64_t)b->cfg.timeout_ms : 1000)) {
-        /* the board's answer is awaited 1 s, or the watchdog's time when that is longer
-         * (a slow link, or simavr slower than real time on a loaded machine) */
+               now_ms - b->upload_sent_ms >
+                   (b->cfg.timeout_ms > QNAV_BRIDGE_UPLOAD_WAIT_MS ? (int64_t)b->cfg.timeout_ms
+                                                                   : QNAV_BRIDGE_UPLOAD_WAIT_MS)) {
+        /* the board's answer is awaited QNAV_BRIDGE_UPLOAD_WAIT_MS, or the watchdog's time
+         * when that is longer (a slow link, or simavr slower than real time on a loaded
+         * machine) */
         if (b->upload_tries < 3) {
             send_upload(b);
         } else {

@@ -52,7 +52,14 @@ extern "C" {
 
 /* link_status_t.last_upload_status besides the board's QNAV_LINK_ACK_* answers. */
 #define QNAV_BRIDGE_UPLOAD_NONE_YET 1
-#define QNAV_BRIDGE_UPLOAD_NO_ANSWER (-5) /* three tries, one second apart, never acked */
+#define QNAV_BRIDGE_UPLOAD_NO_ANSWER (-5) /* three tries, QNAV_BRIDGE_UPLOAD_WAIT_MS apart,
+                                              never acked */
+
+/* How long a policy upload's answer is awaited before the upload is sent again. The board
+ * answers after initialising the new controller (a 2-input network's init evaluates every
+ * row of keys: up to 1.2 s on a 16 MHz ATmega128 at H = 16, docs/performance.md) and
+ * committing it to EEPROM (about 1 s): 3 s leaves room for both. */
+#define QNAV_BRIDGE_UPLOAD_WAIT_MS 3000
 
 /* Writes bytes to the serial port; returns 0 or -1. */
 typedef int (*qnav_bridge_write_fn)(void *user, const uint8_t *bytes, size_t n);

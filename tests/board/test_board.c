@@ -573,7 +573,7 @@ static void test_bridge_reports_no_answer_when_the_board_never_acks_an_upload(vo
                          (uint16_t)sizeof wire);
     assert_true(n > 0);
     qnav_bridge_on_bytes(&b, wire, (size_t)n, 10);
-    for (t = 10; t <= 5000; t += 10) {
+    for (t = 10; t <= 4 * QNAV_BRIDGE_UPLOAD_WAIT_MS; t += 10) {
         qnav_bridge_poll(&b, t);
     }
     assert_int_equal(b.upload_tries, 3);

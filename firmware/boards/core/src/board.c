@@ -158,7 +158,9 @@ static void send(qnav_board_t *bot, uint8_t id, const uint8_t *payload, int32_t 
 }
 
 /* A committed upload: switch controllers only when the new one initialises, then keep it
- * in storage (the drive is stopped first: an EEPROM write blocks for milliseconds a byte). */
+ * in storage. The drive is stopped first: no tick runs while the new controller
+ * initialises (a 2-input network's init evaluates every row of keys, up to about 1.2 s on
+ * the ATmega128) and the EEPROM write blocks for milliseconds a byte. */
 static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm)
 {
     qnav_policy_t fresh;
@@ -170,13 +172,13 @@ static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm
 
     if (status == QNAV_LINK_ACK_OK) {
         ctrl_config(&bot->cfg, &cc);
+        bot->hal.drive(bot->hal.ctx, 0, 0);
         if (qnav_nav_init_named(&bot->nav, bot->cfg.controller, &cc, &fresh) == QNAV_OK) {
             bot->policy = fresh;
             bot->policy_crc = cm->crc;
             bot->policy_source = QNAV_BOARD_POLICY_UPLOADED;
             bot->ctrl_ready = 1;
             bot->stats.uploads_ok++;
-            bot->hal.drive(bot->hal.ctx, 0, 0);
             if (!qnav_board_store_save(&bot->hal, bot->cfg.nvm_offset, &fresh, &crc,
                                        &bot->store_slot, &bot->store_seq)) {
                 bot->stats.store_writes_failed++;
