@@ -6,6 +6,7 @@
  */
 #include "clearance.h"
 
+#include <string.h>
 
 #include "qnav/flash.h"
 
@@ -250,12 +251,11 @@ static inline uint8_t sector_level(const qnav_clearance_t *c, const qnav_mm_t *r
     return level_of(c, r);
 }
 
-/* Every path at the farthest level: four bytes per iteration (avr-libc's memset takes
- * about 6 cycles a byte on the ATmega128, this loop under 3; GCC would turn the loop back
- * into a memset call). */
-#if defined(__GNUC__) && !defined(__clang__)
+/* Every path at the farthest level. On AVR four bytes per iteration: avr-libc's memset
+ * takes about 6 cycles a byte on the ATmega128, this loop under 3 (and GCC would turn the
+ * loop back into a memset call); elsewhere the C library's memset, which stores words. */
+#if defined(__AVR__)
 __attribute__((optimize("no-tree-loop-distribute-patterns")))
-#endif
 static void fill_clear(uint8_t *lvl)
 {
     uint8_t *p = lvl;
@@ -268,6 +268,12 @@ static void fill_clear(uint8_t *lvl)
         p += 4;
     }
 }
+#else
+static void fill_clear(uint8_t *lvl)
+{
+    memset(lvl, QNAV_DIST_LEVELS - 1, QNAV_PATHS);
+}
+#endif
 
 /* Sector lengths follow from path * N + 180 wrapping past 360: a sector whose first path
  * has phase p holds q = 360 / N paths, or q + 1 when p + q * N is still below 360; sector 0
