@@ -443,7 +443,10 @@ static inline void offer_valley(const qnav_ctrl_t *ctrl, const qnav_run_t *r, ui
 {
     qnav_qkey_t k_lo = key_of_path(ctrl, r->level, lo);
     qnav_qkey_t k_hi = lo == hi ? k_lo : key_of_path(ctrl, r->level, hi);
-    if (k_hi <= k_lo) {
+    /* the path at lo wins, or no path with the key at hi can beat the best wherever its
+     * plateau starts (then the path at lo cannot either: its key is lower) */
+    if (k_hi <= k_lo || k_hi < best->key ||
+        (k_hi == best->key && (uint8_t)(lo + 1u) > best->dtheta)) {
         qnav_best_consider(best, k_lo, qnav_run_path_at(r, lo), lo);
         return;
     }
