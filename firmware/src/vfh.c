@@ -19,7 +19,7 @@ void qnav_vfh_config_default(qnav_vfh_config_t *cfg)
     qnav_ctrl_config_default(&cfg->body);
     cfg->sector_deg = 5u;
     cfg->blocked_mm = 1000u;
-    cfg->open_mm = 1400u;
+    cfg->clear_mm = 1400u;
     cfg->wide_sectors = 16u;
     cfg->mu_goal = 5u;
     cfg->mu_current = 2u;
@@ -47,14 +47,14 @@ qnav_status_t qnav_vfh_init(qnav_vfh_t *vfh, const qnav_vfh_config_t *cfg)
         return st;
     }
     if (cfg->sector_deg < 1u || cfg->sector_deg > 30u || QNAV_PATHS % cfg->sector_deg != 0u ||
-        cfg->open_mm < cfg->blocked_mm || cfg->wide_sectors < 1u || cfg->wide_sectors > 180u ||
+        cfg->clear_mm < cfg->blocked_mm || cfg->wide_sectors < 1u || cfg->wide_sectors > 180u ||
         cfg->slow_mm == 0u) {
         return QNAV_E_VFH_PARAM;
     }
     vfh->sector_deg = cfg->sector_deg;
     vfh->n_hist = (uint16_t)(QNAV_PATHS / cfg->sector_deg);
     vfh->level_blocked = level_at(&vfh->clr, cfg->blocked_mm);
-    vfh->level_open = level_at(&vfh->clr, cfg->open_mm);
+    vfh->level_clear = level_at(&vfh->clr, cfg->clear_mm);
     vfh->level_slow = level_at(&vfh->clr, cfg->slow_mm);
     if (vfh->level_slow == 0u) {
         vfh->level_slow = 1u;
@@ -102,7 +102,7 @@ static void set_blocked(qnav_vfh_state_t *st, uint16_t k, uint8_t b)
 
 /*
  * The binary histogram: sector k (centred on k * alpha) takes the lowest level (densest)
- * of its alpha paths; below level_blocked it is blocked, at or above level_open free, in
+ * of its alpha paths; below level_blocked it is blocked, at or above level_clear free, in
  * between as last tick. Returns the number of blocked sectors.
  */
 static uint16_t binary_histogram(const qnav_vfh_t *v, qnav_vfh_state_t *st, const uint8_t *lvl)
@@ -123,7 +123,7 @@ static uint16_t binary_histogram(const qnav_vfh_t *v, qnav_vfh_state_t *st, cons
         }
         if (low < v->level_blocked) {
             set_blocked(st, k, 1u);
-        } else if (low >= v->level_open) {
+        } else if (low >= v->level_clear) {
             set_blocked(st, k, 0u);
         }
         n_blocked = (uint16_t)(n_blocked + is_blocked(st, k));
@@ -159,8 +159,8 @@ static void offer(const qnav_vfh_t *v, choice_t *c, uint16_t dir, uint16_t goal,
     c->any = 1u;
 }
 
-/* The candidates of one opening of n free sectors starting at sector first. */
-static void opening(const qnav_vfh_t *v, choice_t *c, uint16_t first, uint16_t n, uint16_t goal,
+/* The candidates of one gap of n free sectors starting at sector first. */
+static void gap(const qnav_vfh_t *v, choice_t *c, uint16_t first, uint16_t n, uint16_t goal,
                     uint16_t prev)
 {
     uint16_t right = (uint16_t)(first * v->sector_deg);
@@ -179,8 +179,8 @@ static void opening(const qnav_vfh_t *v, choice_t *c, uint16_t first, uint16_t n
     }
 }
 
-/* Walk the circle from a blocked sector and offer every opening's candidates. */
-static void openings(const qnav_vfh_t *v, const qnav_vfh_state_t *st, choice_t *c,
+/* Walk the circle from a blocked sector and offer every gap's candidates. */
+static void gaps(const qnav_vfh_t *v, const qnav_vfh_state_t *st, choice_t *c,
                      uint16_t goal, uint16_t prev)
 {
     uint16_t start = 0;
@@ -198,7 +198,7 @@ static void openings(const qnav_vfh_t *v, const qnav_vfh_state_t *st, choice_t *
             }
             ++run_n;
         } else if (run_n != 0u) {
-            opening(v, c, run_first, run_n, goal, prev);
+            gap(v, c, run_first, run_n, goal, prev);
             run_n = 0;
         }
     }
@@ -242,9 +242,9 @@ void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ct
     c.cost = 0u;
     c.dir = 0u;
     if (n_blocked == 0u) {
-        c.dir = goal; /* one opening all round: the goal is its own candidate */
+        c.dir = goal; /* one gap all round: the goal is its own candidate */
     } else {
-        openings(vfh, state, &c, goal, qnav_whole_deg(in->prev_heading_cdeg));
+        gaps(vfh, state, &c, goal, qnav_whole_deg(in->prev_heading_cdeg));
     }
     /* speed falls linearly with the chosen direction's density, then the speed guard */
     l = lvl[c.dir];

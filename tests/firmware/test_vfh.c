@@ -1,6 +1,6 @@
 /*
  * Unit tests of VFH+ and of the controller table: configuration checks, choice of
- * direction through openings, hysteresis kept in the caller's state, the cost weights,
+ * direction through gaps, hysteresis kept in the caller's state, the cost weights,
  * speed reduction near obstacles, and selection of controllers by name.
  */
 #include <setjmp.h>
@@ -61,7 +61,7 @@ static void test_vfh_init_rejects_bad_parameters(void **state)
     cfg.sector_deg = 7; /* does not divide 360 */
     assert_int_equal(qnav_vfh_init(&v, &cfg), QNAV_E_VFH_PARAM);
     qnav_vfh_config_default(&cfg);
-    cfg.open_mm = (qnav_mm_t)(cfg.blocked_mm - 1u);
+    cfg.clear_mm = (qnav_mm_t)(cfg.blocked_mm - 1u);
     assert_int_equal(qnav_vfh_init(&v, &cfg), QNAV_E_VFH_PARAM);
     qnav_vfh_config_default(&cfg);
     cfg.body.n_sectors = 0;

@@ -7,8 +7,8 @@
  * readings it builds the polar obstacle density per 1-degree path with the readings
  * enlarged by robot radius + safety distance (clearance.c, shared with the path-quality
  * controller), reduces it to K sectors of alpha degrees, thresholds it with two levels
- * into a binary histogram, finds the openings, takes candidate directions from them
- * (a narrow opening's middle; a wide opening's two sides and the goal when it lies
+ * into a binary histogram, finds the gaps, takes candidate directions from them
+ * (a narrow gap's middle; a wide gap's two sides and the goal when it lies
  * inside) and picks the one of least cost mu_goal * |c - goal| + mu_current * |c| +
  * mu_prev * |c - previous heading|; the speed falls with the chosen direction's density
  * and is capped by the speed guard. Fixed point, no heap, no file-scope state.
@@ -36,10 +36,10 @@ typedef struct {
                                  default 5 (VFH+ paper) */
     qnav_mm_t blocked_mm;     /* tau_high: a sector whose nearest enlarged reading is nearer
                                  than this is blocked, mm; default 1000 (assumed) */
-    qnav_mm_t open_mm;        /* tau_low: a sector is free again only beyond this, mm;
+    qnav_mm_t clear_mm;       /* tau_low: a sector is free again only beyond this, mm;
                                  >= blocked_mm; in between it keeps last tick's value.
                                  Default 1400 (assumed) */
-    uint8_t wide_sectors;     /* s_max: an opening of more sectors is wide, 1..180;
+    uint8_t wide_sectors;     /* s_max: a gap of more sectors is wide, 1..180;
                                  default 16 (VFH+ paper: 16 sectors of 5 deg) */
     uint8_t mu_goal;          /* cost weight of the angle to the goal; default 5 (VFH+ paper,
                                  mu1 > mu2 + mu3 for a goal-oriented robot) */
@@ -58,7 +58,7 @@ typedef struct {
     uint8_t sector_deg;
     uint16_t n_hist;          /* K = 360 / alpha */
     uint8_t level_blocked;    /* a sector below this distance level is blocked */
-    uint8_t level_open;       /* at or above this level it is free */
+    uint8_t level_clear;      /* at or above this level it is free */
     uint8_t level_slow;       /* level at and above which the speed is full */
     uint8_t wide_sectors;
     uint8_t mu_goal;
@@ -89,7 +89,7 @@ void qnav_vfh_state_reset(qnav_vfh_state_t *state);
  * before the speed guard (VFH+ has no path quality). Ties in cost go to the smaller turn,
  * then counter-clockwise. Updates state.
  * @par Cost: the clearance levels (as the path-quality controller), 360 byte reads for the
- * histogram, and a few operations per opening.
+ * histogram, and a few operations per gap.
  */
 void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ctrl_input_t *in,
                    qnav_ctrl_output_t *out);
