@@ -185,13 +185,7 @@ static void board_config(qnav_sim_t *sim, const sil_hal_t *hal, qnav_board_confi
         return;
     }
     qnav_sim_ctrl_config(sim, &cc);
-    bc->n_sectors = cc.n_sectors;
-    bc->max_range_mm = cc.max_range_mm;
-    bc->body_radius_mm = cc.body_radius_mm;
-    bc->safety_mm = cc.safety_mm;
-    bc->sonar_offset_mm = cc.sensor_offset_mm;
-    bc->v_max_mm_s = cc.v_max_mm_s;
-    bc->decel_mm_s2 = cc.decel_mm_s2;
+    qnav_board_config_from_ctrl(bc, &cc);
 }
 
 /* The pty, raw from the start; the slave stays open so the master never sees EIO while

@@ -581,10 +581,41 @@ static void test_bridge_reports_no_answer_when_the_board_never_acks_an_upload(vo
     assert_int_equal(b.last_upload_status, QNAV_BRIDGE_UPLOAD_NO_ANSWER);
 }
 
+/* A controller configuration survives the trip through a board configuration: the
+ * board core and the SIL robot map the same fields the same way. */
+static void test_board_config_round_trips_the_controller_fields(void **state)
+{
+    qnav_board_config_t bc;
+    qnav_ctrl_config_t in;
+    qnav_ctrl_config_t out;
+    (void)state;
+    qnav_tekbot_config_default(&bc);
+    qnav_ctrl_config_default(&in);
+    in.n_sectors = 23;
+    in.max_range_mm = 3210;
+    in.body_radius_mm = 171;
+    in.safety_mm = 42;
+    in.sensor_offset_mm = 99;
+    in.v_max_mm_s = 650;
+    in.decel_mm_s2 = 1750;
+    qnav_board_config_from_ctrl(&bc, &in);
+    qnav_board_ctrl_config(&bc, &out);
+    assert_int_equal(out.n_sectors, in.n_sectors);
+    assert_int_equal(out.max_range_mm, in.max_range_mm);
+    assert_int_equal(out.body_radius_mm, in.body_radius_mm);
+    assert_int_equal(out.safety_mm, in.safety_mm);
+    assert_int_equal(out.sensor_offset_mm, in.sensor_offset_mm);
+    assert_int_equal(out.v_max_mm_s, in.v_max_mm_s);
+    assert_int_equal(out.decel_mm_s2, in.decel_mm_s2);
+    assert_int_equal(out.rank, in.rank);
+    assert_int_equal(out.full_speed_quality, in.full_speed_quality);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mix_turns_counter_clockwise_with_the_right_wheel),
+        cmocka_unit_test(test_board_config_round_trips_the_controller_fields),
         cmocka_unit_test(test_board_is_stopped_until_it_hears_the_bridge),
         cmocka_unit_test(test_onboard_board_drives_with_libqnav_decision),
         cmocka_unit_test(test_board_stops_motors_when_link_goes_quiet),

@@ -41,7 +41,7 @@ void qnav_board_config_default(qnav_board_config_t *cfg)
 }
 
 /* The controller configuration this board's sonar and body give. */
-static void ctrl_config(const qnav_board_config_t *cfg, qnav_ctrl_config_t *cc)
+void qnav_board_ctrl_config(const qnav_board_config_t *cfg, qnav_ctrl_config_t *cc)
 {
     qnav_ctrl_config_default(cc);
     cc->n_sectors = cfg->n_sectors;
@@ -51,6 +51,17 @@ static void ctrl_config(const qnav_board_config_t *cfg, qnav_ctrl_config_t *cc)
     cc->sensor_offset_mm = cfg->sonar_offset_mm;
     cc->v_max_mm_s = cfg->v_max_mm_s;
     cc->decel_mm_s2 = cfg->decel_mm_s2;
+}
+
+void qnav_board_config_from_ctrl(qnav_board_config_t *cfg, const qnav_ctrl_config_t *cc)
+{
+    cfg->n_sectors = cc->n_sectors;
+    cfg->max_range_mm = cc->max_range_mm;
+    cfg->body_radius_mm = cc->body_radius_mm;
+    cfg->safety_mm = cc->safety_mm;
+    cfg->sonar_offset_mm = cc->sensor_offset_mm;
+    cfg->v_max_mm_s = cc->v_max_mm_s;
+    cfg->decel_mm_s2 = cc->decel_mm_s2;
 }
 
 static qnav_q1_15_t sat_q15(int32_t v)
@@ -97,7 +108,7 @@ static void load_policy(qnav_board_t *bot)
     uint16_t crc = 0;
     uint8_t slot = 0xFFu;
     uint8_t seq = 0;
-    ctrl_config(&bot->cfg, &cc);
+    qnav_board_ctrl_config(&bot->cfg, &cc);
     bot->store_slot = 0xFFu;
     bot->store_seq = 0;
     if (qnav_board_store_load(&bot->hal, bot->cfg.nvm_offset, &stored, &crc, &slot, &seq)) {
@@ -171,7 +182,7 @@ static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm
     int8_t status = qnav_link_upload_commit(&bot->upload, cm, &fresh);
 
     if (status == QNAV_LINK_ACK_OK) {
-        ctrl_config(&bot->cfg, &cc);
+        qnav_board_ctrl_config(&bot->cfg, &cc);
         bot->hal.drive(bot->hal.ctx, 0, 0);
         if (qnav_nav_init_named(&bot->nav, bot->cfg.controller, &cc, &fresh) == QNAV_OK) {
             bot->policy = fresh;

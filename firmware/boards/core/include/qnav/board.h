@@ -133,6 +133,14 @@ typedef struct {
  * body margin and no speed guard, 1000 um per count, store at byte 0. */
 void qnav_board_config_default(qnav_board_config_t *cfg);
 
+/* The controller configuration a board configuration gives (sectors, range, body, speed
+ * guard; the rest qnav_ctrl_config_default()'s), and the reverse: cfg's sensor and body
+ * fields set from a controller configuration. One home for the correspondence, used by
+ * the board core and by hosts that describe a robot as a controller configuration (the
+ * SIL robot). */
+void qnav_board_ctrl_config(const qnav_board_config_t *cfg, qnav_ctrl_config_t *cc);
+void qnav_board_config_from_ctrl(qnav_board_config_t *cfg, const qnav_ctrl_config_t *cc);
+
 /* Check cfg and hal, start the link, load the newest whole policy from storage (the
  * built-in policy when there is none or it is corrupt), start the controller; the drive
  * is set to 0. Returns QNAV_BOARD_OK, _E_NULL, _E_CONFIG or _E_CTRL. */
