@@ -26,24 +26,13 @@ static const uint16_t sin_deg_q15[91] QNAV_FLASH = {
 /* Control tick the speed guard allows for reacting, ms (DESIGN.md §4: 0.1 s). */
 #define QNAV_GUARD_REACTION_MS 100u
 
-/* a * b, 16 x 16 -> 32 bits (avr-gcc: __umulhisi3, about 20 cycles, where the expression
- * written in place gets the 32 x 16 bit __muluhisi3). */
-static inline uint32_t mul_u16(uint16_t a, uint16_t b)
-{
-    return (uint32_t)a * b;
-}
-
-/* The level of a range at most max_range_mm (inline for the step's sector loop). */
+/* The level of a range at most max_range_mm (inline for the step's sector loop). A range
+ * below 65536 times a scale below 2^21 stays within 32 bits. (A 16 x 16 bit branch for
+ * scales that fit 16 bits bought nothing: avr-gcc merges it into the same 32 x 16 bit
+ * multiply.) */
 static inline uint8_t level_of(const qnav_clearance_t *c, qnav_mm_t range_mm)
 {
-    uint32_t level;
-    /* For ranges of 32 mm and more the scale fits 16 bits: a 16x16 multiply (AVR) */
-    if (c->level_scale <= 0xFFFFu) {
-        uint16_t scale = (uint16_t)c->level_scale;
-        level = (mul_u16(range_mm, scale) + 32768u) >> 16;
-    } else {
-        level = ((uint32_t)range_mm * c->level_scale + 32768u) >> 16;
-    }
+    uint32_t level = ((uint32_t)range_mm * c->level_scale + 32768u) >> 16;
     return (uint8_t)(level > QNAV_DIST_LEVELS - 1u ? QNAV_DIST_LEVELS - 1u : level);
 }
 

@@ -216,7 +216,7 @@ void qnav_net_eval_row(const qnav_ctrl_t *ctrl, uint8_t level, qnav_qkey_t *row)
  * docs/performance.md). */
 static void row_shapes(qnav_ctrl_t *ctrl)
 {
-    qnav_qkey_t keys[16];
+    qnav_qkey_t keys[QNAV_EVAL_CHUNK];
     qnav_best_t ignore;
     qnav_run_t r;
     uint16_t level;
@@ -229,7 +229,10 @@ static void row_shapes(qnav_ctrl_t *ctrl)
         while (d <= QNAV_DTHETA_MAX) {
             uint8_t k;
             r.dtheta0 = d;
-            r.count = (uint8_t)(QNAV_DTHETA_MAX + 1 - d < 16 ? QNAV_DTHETA_MAX + 1 - d : 16);
+            r.count = (uint8_t)(QNAV_DTHETA_MAX + 1 - d);
+            if (r.count > QNAV_EVAL_CHUNK) {
+                r.count = QNAV_EVAL_CHUNK;
+            }
             ignore.key = QNAV_KEY_NONE;
             eval_run(ctrl, &r, &ignore, keys);
             for (k = 0; k < r.count; ++k, ++d) {
