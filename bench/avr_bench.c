@@ -277,7 +277,7 @@ static void naive_comparison(void)
         return;
     }
     for (s = 0; s < qnav_bench_scan_count(); ++s) {
-        qnav_ctrl_input_t in;
+        qnav_ctrl_input_t in = {0};
         qnav_ctrl_output_t out;
         uint8_t type, k;
         uint32_t t;
@@ -332,7 +332,7 @@ static void vfh_comparison(void)
         return;
     }
     for (s = 0; s < qnav_bench_scan_count(); ++s) {
-        qnav_ctrl_input_t in;
+        qnav_ctrl_input_t in = {0};
         qnav_ctrl_output_t out;
         uint8_t type, k;
         uint32_t c;

@@ -209,7 +209,7 @@ static uint16_t run_policy(const qnav_bench_hooks_t *h, uint8_t index, uint8_t m
         }
     }
     for (s = 0; s < QNAV_BENCH_SCAN_COUNT; ++s) {
-        qnav_ctrl_input_t in;
+        qnav_ctrl_input_t in = {0};
         qnav_ctrl_output_t ref, out;
         uint8_t type, k;
         uint32_t v;

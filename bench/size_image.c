@@ -37,7 +37,7 @@ static const qnav_q8_8_t w_out[12] QNAV_FLASH = {400, -200, 700, 300, -100, 500,
 int main(void)
 {
     qnav_ctrl_config_t cfg;
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in = {0};
     qnav_ctrl_output_t out;
     qnav_mm_t ranges[SECTORS];
     uint8_t i;

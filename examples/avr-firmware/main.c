@@ -32,7 +32,7 @@ static qnav_mm_t ranges[16];
 int main(void)
 {
     qnav_ctrl_config_t cfg;
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in = {0};
     qnav_ctrl_output_t out;
     char line[48];
     uint8_t k;

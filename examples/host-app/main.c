@@ -29,7 +29,7 @@ static void fixed_decision(const qnav_policy_t *policy)
     qnav_ctrl_config_t cfg;
     qnav_ctrl_t ctrl;
     qnav_ctrl_output_t out;
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in = {0};
     int k;
     for (k = 0; k < 16; ++k) {
         ranges[k] = (qnav_mm_t)(k < 2 ? 400 : 3000);

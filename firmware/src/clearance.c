@@ -161,6 +161,19 @@ qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t
                      cfg->max_range_mm;
     c->sector_paths = (uint16_t)(QNAV_PATHS / cfg->n_sectors);
     c->sector_span = (uint16_t)(c->sector_paths * cfg->n_sectors);
+    if (cfg->wedge_pct > 100u) {
+        return QNAV_E_WEDGE;
+    }
+    /* paths left out at each edge of a sector: (100 - pct)% of half its 360/N wedge, at
+     * most so many that its middle path stays */
+    {
+        uint16_t shrink = (uint16_t)(((uint32_t)(100u - cfg->wedge_pct) * QNAV_PATHS) /
+                                     (200u * cfg->n_sectors));
+        uint16_t keep = (uint16_t)((c->sector_paths - 1u) / 2u);
+        c->wedge_shrink = (uint8_t)(shrink < keep ? shrink : keep);
+    }
+    c->wedge_near_level = qnav_clearance_level_of(
+        c, cfg->wedge_near_mm < cfg->max_range_mm ? cfg->wedge_near_mm : cfg->max_range_mm);
     c->first_sector_paths = (uint16_t)((QNAV_PATHS / 2u + cfg->n_sectors - 1u) / cfg->n_sectors);
     qnav_clearance_init(c, cfg);
     return QNAV_OK;
@@ -228,6 +241,38 @@ static void paint_piece(uint8_t *lvl, const qnav_clearance_t *c, uint16_t first,
     paint(lvl, p, (uint16_t)(k - skip_left - skip_right), level);
 }
 
+/*
+ * A piece when readings sit on the central part of their wedge (wedge_shrink > 0): the
+ * reading blocks the piece less wedge_shrink paths at each edge that is a sector's edge
+ * (cut_left, cut_right; sector 0's split at path 0 is no edge), then widened by gamma. The
+ * blocked arc is [first + cut_l - gamma, first + n - cut_r + gamma); it may be empty. The
+ * neighbour skipping above assumes pieces that reach their edges, so every piece paints.
+ */
+static void paint_piece_central(uint8_t *lvl, const qnav_clearance_t *c, uint16_t first,
+                                uint16_t n, uint8_t level, uint8_t cut_left, uint8_t cut_right)
+{
+    int16_t gamma = (int16_t)c->enlarge_deg[level];
+    int16_t shrink = level >= c->wedge_near_level ? (int16_t)c->wedge_shrink : 0;
+    int16_t lo = (int16_t)((int16_t)first + (cut_left ? shrink : 0) - gamma);
+    int16_t hi = (int16_t)((int16_t)(first + n) - (cut_right ? shrink : 0) + gamma);
+    if (hi <= lo) {
+        return;
+    }
+    if (hi - lo >= (int16_t)QNAV_PATHS) {
+        paint(lvl, 0u, QNAV_PATHS, level);
+        return;
+    }
+    if (lo < 0) {
+        lo = (int16_t)(lo + (int16_t)QNAV_PATHS);
+        hi = (int16_t)(hi + (int16_t)QNAV_PATHS);
+    }
+    if (lo >= (int16_t)QNAV_PATHS) {
+        lo = (int16_t)(lo - (int16_t)QNAV_PATHS);
+        hi = (int16_t)(hi - (int16_t)QNAV_PATHS);
+    }
+    paint(lvl, (uint16_t)lo, (uint16_t)(hi - lo), level);
+}
+
 /* The level of sector s's reading (clipped to the maximum range, flagged in *flags). */
 static inline uint8_t sector_level(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint16_t s,
                             uint8_t *flags)
@@ -290,8 +335,14 @@ uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges
         } else {
             next = sector_level(c, ranges, next_sector, &flags);
         }
-        if (level != QNAV_DIST_LEVELS - 1u) {
+        if (level == QNAV_DIST_LEVELS - 1u) {
+            /* nothing seen in this sector */
+        } else if (c->wedge_shrink == 0u) {
             paint_piece(lvl, c, path, n, level, prev, next);
+        } else {
+            /* sector 0 is cut at path 0 (piece 0's left, its last piece's right) */
+            paint_piece_central(lvl, c, path, n, level, (uint8_t)(path != 0u),
+                                (uint8_t)(path + n < QNAV_PATHS));
         }
         path = (uint16_t)(path + n);
         if (path >= QNAV_PATHS) {

@@ -9,6 +9,7 @@
 #include "qnav/ctrl.h"
 #include "clearance.h"
 #include "ctrl_internal.h"
+#include "escape.h"
 #include "qnav/flash.h"
 #include "sigmoid_lut.h"
 
@@ -26,6 +27,11 @@ void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg)
     cfg->v_max_mm_s = 500u;
     cfg->decel_mm_s2 = 2000u;
     cfg->rank = (uint8_t)QNAV_RANK_PREACT;
+    cfg->wedge_pct = 100u;
+    cfg->wedge_near_mm = 0u;
+    cfg->escape_stall_ticks = 20u;
+    cfg->escape_follow_mm = 500u;
+    cfg->escape_follow_s = 20u;
 }
 
 void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg)
@@ -37,6 +43,7 @@ void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg)
     cfg->safety_mm = 0u;
     cfg->decel_mm_s2 = 0u;
     cfg->rank = (uint8_t)QNAV_RANK_QUALITY;
+    cfg->wedge_pct = 100u;
 }
 
 static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg)
@@ -51,6 +58,9 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
         return QNAV_E_NULL;
     }
     st = qnav_clearance_setup(&ctrl->clr, cfg);
+    if (st == QNAV_OK) {
+        st = qnav_escape_setup(&ctrl->clr, cfg);
+    }
     if (st != QNAV_OK) {
         return st;
     }
@@ -537,6 +547,7 @@ static void stop_output(qnav_ctrl_output_t *out, uint8_t flags, qnav_q1_15_t *qu
     out->speed = 0;
     out->quality = 0;
     out->flags = flags;
+    qnav_escape_clear(&out->escape);
     if (qualities != 0) {
         for (i = 0; i < QNAV_PATHS; ++i) {
             qualities[i] = 0;
@@ -586,6 +597,8 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     uint32_t speed;
     qnav_q1_15_t quality;
     qnav_q1_15_t cap;
+    qnav_escape_t esc;
+    uint16_t goal;
 
     if (out == 0) {
         return;
@@ -598,8 +611,9 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     best.dtheta = 0;
     best.heading = 0;
     flags = qnav_clearance_levels(&ctrl->clr, in->ranges_mm, lvl);
-    qnav_run_start(&it, lvl, qnav_whole_deg(in->goal_bearing_cdeg),
-                   qnav_whole_deg(in->prev_heading_cdeg));
+    goal = qnav_escape_goal(&ctrl->clr, lvl, in, &esc);
+    out->escape = esc;
+    qnav_run_start(&it, lvl, goal, qnav_whole_deg(in->prev_heading_cdeg));
     /* the keys land in qualities[] and are turned into qualities below */
     paths_best(ctrl, &it, &best, qualities);
     if (qualities != 0) {
@@ -614,6 +628,7 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
         out->speed = 0;
         out->quality = 0;
         out->flags = (uint8_t)(flags | QNAV_FLAG_NO_PATH);
+        qnav_escape_keep_moving(&ctrl->clr, lvl, &esc, goal, out);
         return;
     }
     speed = ((uint32_t)quality * ctrl->speed_scale) >> 15;
@@ -631,6 +646,7 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     out->speed = (qnav_q1_15_t)speed;
     out->quality = quality;
     out->flags = flags;
+    qnav_escape_keep_moving(&ctrl->clr, lvl, &esc, goal, out);
 }
 
 const char *qnav_status_str(qnav_status_t status)
@@ -662,6 +678,8 @@ const char *qnav_status_str(qnav_status_t status)
         return "a VFH+ parameter out of range";
     case QNAV_E_NAME:
         return "no controller of that name";
+    case QNAV_E_WEDGE:
+        return "wedge_pct above 100";
     }
     return "unknown status";
 }

@@ -8,6 +8,7 @@
 #include "qnav/vfh.h"
 #include "clearance.h"
 #include "ctrl_internal.h"
+#include "escape.h"
 
 #define QNAV_VFH_MAGIC 0x5646u
 
@@ -43,6 +44,9 @@ qnav_status_t qnav_vfh_init(qnav_vfh_t *vfh, const qnav_vfh_config_t *cfg)
         return QNAV_E_NULL;
     }
     st = qnav_clearance_setup(&vfh->clr, &cfg->body);
+    if (st == QNAV_OK) {
+        st = qnav_escape_setup(&vfh->clr, &cfg->body);
+    }
     if (st != QNAV_OK) {
         return st;
     }
@@ -210,6 +214,7 @@ static void stop(qnav_ctrl_output_t *out, uint8_t flags)
     out->speed = 0;
     out->quality = 0;
     out->flags = flags;
+    qnav_escape_clear(&out->escape);
 }
 
 void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ctrl_input_t *in,
@@ -223,6 +228,7 @@ void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ct
     uint8_t l;
     qnav_q1_15_t speed;
     qnav_q1_15_t cap;
+    qnav_escape_t esc;
     if (out == 0) {
         return;
     }
@@ -232,12 +238,14 @@ void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ct
         return;
     }
     flags = qnav_clearance_levels(&vfh->clr, in->ranges_mm, lvl);
+    goal = qnav_escape_goal(&vfh->clr, lvl, in, &esc);
     n_blocked = binary_histogram(vfh, state, lvl);
     if (n_blocked == vfh->n_hist) {
         stop(out, (uint8_t)(flags | QNAV_FLAG_NO_PATH));
+        out->escape = esc;
+        qnav_escape_keep_moving(&vfh->clr, lvl, &esc, goal, out);
         return;
     }
-    goal = qnav_whole_deg(in->goal_bearing_cdeg);
     c.any = 0u;
     c.cost = 0u;
     c.dir = 0u;
@@ -263,4 +271,6 @@ void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ct
     out->heading_deg = (qnav_deg_t)(c.dir <= 180u ? (int16_t)c.dir : (int16_t)c.dir - 360);
     out->speed = speed;
     out->flags = flags;
+    out->escape = esc;
+    qnav_escape_keep_moving(&vfh->clr, lvl, &esc, goal, out);
 }

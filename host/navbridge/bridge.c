@@ -71,7 +71,7 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
                            qnav_command_t *cmd, int16_t *qualities)
 {
     qnav_mm_t ranges[QNAV_MAX_SECTORS];
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in = {0};
     qnav_ctrl_output_t out;
     int k;
     int n = scan->n_sectors;

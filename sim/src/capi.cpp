@@ -262,6 +262,11 @@ void qnav_sim_ctrl_config(const qnav_sim_t *sim, qnav_ctrl_config_t *cfg) {
     cfg->sensor_offset_mm = mm(r.radius_m); // ranges are measured from the body's surface
     cfg->v_max_mm_s = mm(r.v_max_mps);
     cfg->decel_mm_s2 = r.speed_guard ? mm(r.decel_mps2) : 0;
+    cfg->wedge_pct = r.wedge_pct;
+    cfg->wedge_near_mm = mm(r.wedge_near_m);
+    cfg->escape_stall_ticks = static_cast<std::uint8_t>(std::lround(r.escape_stall_s * 10.0));
+    cfg->escape_follow_mm = mm(r.escape_follow_m);
+    cfg->escape_follow_s = static_cast<std::uint8_t>(std::lround(r.escape_follow_s));
 }
 
 qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
@@ -311,6 +316,7 @@ qnav_sim_status_t qnav_sim_scan(const qnav_sim_t *sim, qnav_sim_scan_t *scan) {
     scan->max_range_mm = s.max_range_mm;
     std::memcpy(scan->ranges_mm, s.ranges_mm, sizeof(qnav_mm_t) * s.n_sectors);
     scan->goal_bearing_cdeg = s.goal_bearing_cdeg;
+    scan->goal_range_mm = s.goal_range_mm;
     return QNAV_SIM_OK;
 }
 

@@ -9,7 +9,7 @@ namespace qnav {
 RobotProfile parse_robot_profile(std::string_view text, const std::string &name) {
     TomlReader r(text, name);
     const toml::table &root = r.root();
-    r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery", "probabilistic",
+    r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery", "probabilistic", "escape",
                       "clearance"});
     RobotProfile p;
     p.name = r.string(root, "name");
@@ -63,12 +63,23 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
 
     if (root.get("clearance")) {
         const toml::table &cl = r.table(root, "clearance");
-        r.only_keys(cl, {"safety_m", "speed_guard"});
+        r.only_keys(cl, {"safety_m", "speed_guard", "wedge_pct", "wedge_near_m"});
+        p.wedge_near_m = r.number(cl, "wedge_near_m", 0.0, 65.0, true, p.wedge_near_m);
         p.safety_m = r.number(cl, "safety_m", 0.0, 10.0, true, p.safety_m);
+        if (cl.get("wedge_pct"))
+            p.wedge_pct = static_cast<std::uint8_t>(r.integer(cl, "wedge_pct", 0, 100));
         if (const toml::node *g = cl.get("speed_guard")) {
             if (!g->is_boolean()) r.fail(*g, "'speed_guard' must be true or false");
             p.speed_guard = g->value_or(true);
         }
+    }
+
+    if (root.get("escape")) {
+        const toml::table &es = r.table(root, "escape");
+        r.only_keys(es, {"stall_s", "follow_m", "follow_s"});
+        p.escape_stall_s = r.number(es, "stall_s", 0.0, 25.5, true, p.escape_stall_s);
+        p.escape_follow_m = r.number(es, "follow_m", 0.0, 65.0, true, p.escape_follow_m);
+        p.escape_follow_s = r.number(es, "follow_s", 1.0, 109.0, true, p.escape_follow_s);
     }
 
     const toml::table &rec = r.table(root, "recovery");

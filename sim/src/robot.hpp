@@ -34,6 +34,14 @@ struct RobotProfile {
     // radius_m + safety_m, and the speed guard with decel_mps2
     double safety_m = 0.05;         // safety distance d_s, m (assumed; docs/sim.md)
     bool speed_guard = true;        // cap the speed at what the path's clearance stops in
+    std::uint8_t wedge_pct = 100;   // a reading blocks the central wedge_pct % of its
+                                    // sector's wedge before enlargement (docs/architecture.md)
+    double wedge_near_m = 0.0;      // nearer readings block their whole wedge, m
+    // leaving dead ends (libqnav's escape; docs/architecture.md, "Leaving dead ends")
+    double escape_stall_s = 2.0;    // time without progress before following a boundary,
+                                    // s; 0: no escape
+    double escape_follow_m = 0.5;   // paths with less clearance are blocked when following, m
+    double escape_follow_s = 20.0;  // first follow of one side at most, s
     // typical noise levels (used by the CLI when none are given)
     double noise_sensor = 0.0;      // p_s
     double noise_actuation = 0.0;   // p_a

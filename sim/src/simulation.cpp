@@ -220,6 +220,8 @@ void Simulation::compute_scan() {
     if (ps > 0) hd += ps * kPi * rng_sensor_.normal();
     const double bearing = std::atan2(env_.dest_y_m - pos_.y, env_.dest_x_m - pos_.x) - hd;
     scan_.goal_bearing_cdeg = to_cdeg(bearing);
+    const double goal_m = std::hypot(env_.dest_x_m - pos_.x, env_.dest_y_m - pos_.y);
+    scan_.goal_range_mm = static_cast<qnav_mm_t>(std::clamp(goal_m * 1000.0 + 0.5, 1.0, 65535.0));
     sensed_heading_ = hd;
     scan_.prev_heading_cdeg = have_prev_ ? to_cdeg(prev_world_rad_ - hd) : 0;
     if (profiling_) prof_.sonar_s += std::chrono::duration<double>(Clock::now() - t0).count();
@@ -513,12 +515,14 @@ qnav_sim_result_t Simulation::run_episode_with(StepFn step, void *self, std::uin
         const qnav_sim_sample_t s = sample();
         trace(user, &s);
     }
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in{};
     in.ranges_mm = scan_.ranges_mm;
-    qnav_ctrl_output_t out;
+    qnav_ctrl_output_t out{};
     while (!done_) {
         in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
         in.prev_heading_cdeg = scan_.prev_heading_cdeg;
+        in.goal_range_mm = scan_.goal_range_mm;
+        in.escape = out.escape;
         Clock::time_point t0;
         if (profiling_) t0 = Clock::now();
         step(self, &in, &out);

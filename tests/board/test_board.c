@@ -165,7 +165,7 @@ static void test_onboard_board_drives_with_libqnav_decision(void **state)
     qnav_ctrl_t c;
     qnav_ctrl_config_t cc;
     qnav_policy_t p;
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in = {0};
     qnav_ctrl_output_t want;
     (void)state;
     bench_start(8);

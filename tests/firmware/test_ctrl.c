@@ -882,7 +882,7 @@ static void test_fast_step_equals_every_path_evaluation(void **state)
         uint16_t n = sectors[k % 8u];
         qnav_policy_t p;
         qnav_ctrl_t c;
-        qnav_ctrl_input_t in;
+        qnav_ctrl_input_t in = {0};
         qnav_ctrl_output_t fast;
         qnav_ctrl_output_t full;
         qnav_cdeg_t goal;

@@ -94,7 +94,7 @@ static void test_three_input_network_turns_towards_the_previous_heading(void **s
     qnav_ctrl_t c;
     qnav_mm_t ranges[16];
     qnav_ctrl_output_t out;
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in = {0};
     (void)state;
     init_prev_follower(&c);
     clear_scan(ranges, &in, 4000);
@@ -117,7 +117,7 @@ static void test_two_input_network_ignores_the_previous_heading(void **state)
     qnav_mm_t ranges[16];
     qnav_ctrl_output_t a;
     qnav_ctrl_output_t b;
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in = {0};
     uint16_t s;
     (void)state;
     for (s = 0; s < 16; ++s) {
@@ -149,7 +149,7 @@ static void test_three_input_network_has_no_table_but_network_mode_with_qualitie
     qnav_mm_t ranges[16];
     qnav_ctrl_output_t a;
     qnav_ctrl_output_t b;
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in = {0};
     (void)state;
     init_prev_follower(&c);
     assert_int_equal(qnav_ctrl_build_table(&c, table), QNAV_E_NO_TABLE);

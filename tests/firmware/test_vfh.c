@@ -40,6 +40,7 @@ typedef struct {
 
 static void setup(fixture_t *f, qnav_mm_t range)
 {
+    memset(&f->in, 0, sizeof f->in);
     init_vfh(&f->v, &f->st);
     fill(f->r, 16, range);
     f->in.ranges_mm = f->r;

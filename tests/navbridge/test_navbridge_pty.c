@@ -79,7 +79,7 @@ static void expected_command(const qnav_policy_t *p, const qnav_link_scan_t *s,
 {
     qnav_ctrl_config_t cfg;
     qnav_ctrl_t c;
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in = {0};
     qnav_ctrl_config_default(&cfg);
     cfg.n_sectors = s->n_sectors;
     cfg.max_range_mm = s->max_range_mm;

@@ -78,7 +78,7 @@ static int assert_table_mode_equals_policy_mode(const qnav_policy_t *policy,
             qnav_mm_t ranges[QNAV_MAX_SECTORS];
             qnav_q1_15_t qa[QNAV_PATHS];
             qnav_q1_15_t qb[QNAV_PATHS];
-            qnav_ctrl_input_t in;
+            qnav_ctrl_input_t in = {0};
             qnav_ctrl_output_t a;
             qnav_ctrl_output_t b;
             uint16_t i;

@@ -228,9 +228,9 @@ int main(void)
     uint16_t table_differs = 0;
     uint16_t step_differs = 0;
     qnav_ctrl_config_t cfg;
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in = {0};
     qnav_ctrl_output_t out;
-    qnav_ctrl_output_t net12_out = {0, 0, 0, 0};
+    qnav_ctrl_output_t net12_out = {0};
     uint32_t net12_hash = 0;
 
     qnav_target_put("qnav shared vectors v2: ");

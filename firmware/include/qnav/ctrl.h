@@ -39,7 +39,8 @@ typedef enum {
     QNAV_E_INPUTS = -9,       /* network inputs neither 2 nor 3 */
     QNAV_E_NO_TABLE = -10,    /* this policy cannot be compiled into a 2-D table (3 inputs) */
     QNAV_E_VFH_PARAM = -11,   /* a VFH+ parameter out of range (qnav/vfh.h) */
-    QNAV_E_NAME = -12         /* no controller of that name (qnav/nav.h) */
+    QNAV_E_NAME = -12,        /* no controller of that name (qnav/nav.h) */
+    QNAV_E_WEDGE = -13        /* wedge_pct above 100 */
 } qnav_status_t;
 
 /* One line of text for a status ("ok", "n_sectors outside 1..360", ...); never null. */
@@ -85,7 +86,40 @@ typedef struct {
                                          v T + v^2 / (2 a) within the chosen path's clearance
                                          (T one 0.1 s tick); 0 turns the guard off. Default 2000 */
     uint8_t rank;                     /* a qnav_rank_t; default QNAV_RANK_PREACT */
+    uint8_t wedge_pct;                /* where a sector's reading is placed before the
+                                         enlargement: the central wedge_pct % of its 360/N
+                                         wedge, 0..100 (100: the whole wedge, the most
+                                         cautious; 0: the middle path). Per robot and
+                                         sensor (docs/architecture.md, "Wedge placement");
+                                         default 100 */
+    qnav_mm_t wedge_near_mm;          /* readings nearer than this block their whole wedge
+                                         whatever wedge_pct says, mm; default 0 */
+    uint8_t escape_stall_ticks;       /* ticks without progress toward the destination
+                                         (half of body_radius_mm + safety_mm) before the
+                                         robot follows the boundary in front of it; 0: no
+                                         escape (docs/architecture.md, "Leaving dead
+                                         ends"). Default 20 (2 s) */
+    qnav_mm_t escape_follow_mm;       /* while following, a path with less clearance than
+                                         this counts as blocked, mm; default 500 */
+    uint8_t escape_follow_s;          /* longest first follow of one side before trying
+                                         the other, s (each later try twice as long, at
+                                         most 109 s); default 20 */
 } qnav_ctrl_config_t;
+
+/* The escape memory: what the robot remembers between ticks to leave dead ends
+ * (docs/architecture.md, "Leaving dead ends"). The caller keeps it: each tick's input
+ * carries the previous output's, all zero at the start of an episode. */
+typedef struct {
+    uint16_t best_mm;   /* nearest the robot came to the destination while going to it, mm;
+                           0: not yet */
+    uint16_t hit_mm;    /* best_mm when the current boundary follow began, mm */
+    uint16_t ticks;     /* going: ticks without progress; following: ticks on this side */
+    int8_t side;        /* 0: going to the destination; +1: following a boundary on the
+                           right (going round it counter-clockwise); -1: on the left */
+    int8_t last_side;   /* the side of the last follow (a new stall follows it again, so
+                           the robot does not shuttle between two sides); 0: none yet */
+    uint8_t tries;      /* follows given up for the other side since the last progress */
+} qnav_escape_t;
 
 /* One control tick's input. */
 typedef struct {
@@ -97,6 +131,9 @@ typedef struct {
                                          heading minus the turn made since), 0.01 deg; 0
                                          on the first tick. Read by 3-input networks and
                                          VFH+; the step itself keeps no memory */
+    qnav_mm_t goal_range_mm;          /* distance to the destination, mm (65535 and
+                                         beyond: 65535); 0: unknown, no escape */
+    qnav_escape_t escape;             /* the previous output's escape; zero at the start */
 } qnav_ctrl_input_t;
 
 /* One control tick's decision. */
@@ -105,6 +142,7 @@ typedef struct {
     qnav_q1_15_t speed;       /* F(X(alpha)): fraction of maximum speed, Q1.15, [0, 1) */
     qnav_q1_15_t quality;     /* X(alpha), Q1.15, [0, 1) */
     uint8_t flags;            /* QNAV_FLAG_* */
+    qnav_escape_t escape;     /* to pass in with the next tick's input */
 } qnav_ctrl_output_t;
 
 /* Derived, per-hidden-unit network parameters (docs/qformats.md, "network step"). */
@@ -126,6 +164,11 @@ typedef struct {
     uint16_t sector_span;             /* sector_paths * N */
     uint16_t first_sector_paths;      /* paths 0.. that lie in sector 0: ceil(180 / N) */
     uint8_t enlarge_deg[QNAV_DIST_LEVELS];      /* obstacle enlargement gamma by level, deg */
+    uint8_t wedge_shrink;             /* paths a reading leaves free at each sector edge */
+    uint8_t wedge_near_level;         /* readings below this level block their whole wedge */
+    uint8_t esc_stall_ticks;          /* escape: ticks without progress; 0: off */
+    uint8_t esc_free_level;           /* escape: lowest level of a free path */
+    uint16_t esc_follow_ticks;        /* escape: first follow's length, ticks */
     uint16_t margin_mm;               /* body radius + safety distance (speed guard) */
     qnav_mm_t sensor_offset_mm;
     uint16_t v_max_mm_s;

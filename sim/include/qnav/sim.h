@@ -253,6 +253,10 @@ typedef struct {
                                               in this tick's robot frame, from the same
                                               sensed heading, 0.01 deg; 0 before the first
                                               command: qnav_ctrl_input_t.prev_heading_cdeg */
+    qnav_mm_t goal_range_mm;               /* distance from the robot's centre to the
+                                              destination's, mm, 1..65535 (the pose the
+                                              board's odometry or the inertial sensors give;
+                                              exact): qnav_ctrl_input_t.goal_range_mm */
 } qnav_sim_scan_t;
 
 /* The robot's true state. */

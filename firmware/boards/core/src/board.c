@@ -446,7 +446,7 @@ static void decide(qnav_board_t *bot, uint32_t now, const qnav_ctrl_input_t *in,
 void qnav_board_tick(qnav_board_t *bot)
 {
     qnav_link_command_t tel;
-    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in = {0};
     qnav_ctrl_output_t out;
     uint8_t p[QNAV_LINK_COMMAND_BYTES];
     uint32_t now;

@@ -1,0 +1,172 @@
+/*
+ * Leaving dead ends: the boundary follower in front of every path controller (escape.h;
+ * docs/architecture.md, "Leaving dead ends"). Integer arithmetic only, a few hundred byte
+ * compares a tick.
+ */
+#include "escape.h"
+
+#include "clearance.h"
+#include "ctrl_internal.h"
+
+/* Crawl speed while following a boundary whose policy would stand still: 1/4 of v_max. */
+#define QNAV_ESCAPE_CRAWL ((qnav_q1_15_t)8192)
+/* Longest follow, in ticks, however many tries were given up (about 109 s). */
+#define QNAV_ESCAPE_MAX_FOLLOW 1092u
+
+qnav_status_t qnav_escape_setup(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
+{
+    qnav_mm_t follow = cfg->escape_follow_mm < c->max_range_mm ? cfg->escape_follow_mm
+                                                              : c->max_range_mm;
+    c->esc_stall_ticks = cfg->escape_stall_ticks;
+    c->esc_free_level = qnav_clearance_level_of(c, follow);
+    c->esc_follow_ticks = (uint16_t)(cfg->escape_follow_s * 10u);
+    if (c->esc_follow_ticks == 0u || c->esc_follow_ticks > QNAV_ESCAPE_MAX_FOLLOW) {
+        c->esc_follow_ticks = QNAV_ESCAPE_MAX_FOLLOW;
+    }
+    return QNAV_OK;
+}
+
+static uint16_t wrap(int16_t p)
+{
+    while (p < 0) {
+        p = (int16_t)(p + (int16_t)QNAV_PATHS);
+    }
+    while (p >= (int16_t)QNAV_PATHS) {
+        p = (int16_t)(p - (int16_t)QNAV_PATHS);
+    }
+    return (uint16_t)p;
+}
+
+static uint8_t blocked(const qnav_clearance_t *c, const uint8_t *lvl, int16_t p)
+{
+    return (uint8_t)(lvl[wrap(p)] < c->esc_free_level);
+}
+
+/*
+ * The free path that skirts the boundary on side s (+1: obstacle on the right, the robot
+ * goes round it counter-clockwise; -1: mirrored), from the previous heading h. ref points
+ * at the side (h - 90 s). When ref is blocked, the first free path turning away from the
+ * side; when it is free (the boundary fell away: a corner), the free path next to the
+ * first blocked one turning toward the side, within half a turn; with no boundary there,
+ * 45 degrees toward the side, to find it again. Everything blocked: turn round.
+ */
+static uint16_t skirt(const qnav_clearance_t *c, const uint8_t *lvl, int16_t h, int8_t s)
+{
+    int16_t ref = (int16_t)(h - 90 * s);
+    int16_t k;
+    if (blocked(c, lvl, ref)) {
+        for (k = 1; k < (int16_t)QNAV_PATHS; ++k) {
+            if (!blocked(c, lvl, (int16_t)(ref + s * k))) {
+                return wrap((int16_t)(ref + s * k));
+            }
+        }
+        return wrap((int16_t)(h + 180));
+    }
+    for (k = 1; k <= (int16_t)QNAV_DTHETA_MAX; ++k) {
+        if (blocked(c, lvl, (int16_t)(ref - s * k))) {
+            return wrap((int16_t)(ref - s * k + s));
+        }
+    }
+    return wrap((int16_t)(ref + 45 * s));
+}
+
+/* The side to follow: the one whose nearest free path to the goal is the nearer turn
+ * (counter-clockwise, i.e. going round with the obstacle on the right, on a tie). */
+static int8_t choose_side(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t goal)
+{
+    int16_t g = (int16_t)goal;
+    int16_t k;
+    for (k = 0; k <= (int16_t)QNAV_DTHETA_MAX; ++k) {
+        if (!blocked(c, lvl, (int16_t)(g + k))) {
+            return 1;
+        }
+        if (!blocked(c, lvl, (int16_t)(g - k))) {
+            return -1;
+        }
+    }
+    return 1;
+}
+
+static uint16_t follow_limit(const qnav_clearance_t *c, uint8_t tries)
+{
+    uint16_t t = c->esc_follow_ticks;
+    while (tries-- != 0u && t < QNAV_ESCAPE_MAX_FOLLOW) {
+        t = (uint16_t)(2u * t);
+    }
+    return t < QNAV_ESCAPE_MAX_FOLLOW ? t : QNAV_ESCAPE_MAX_FOLLOW;
+}
+
+void qnav_escape_clear(qnav_escape_t *e)
+{
+    e->best_mm = 0u;
+    e->hit_mm = 0u;
+    e->ticks = 0u;
+    e->side = 0;
+    e->last_side = 0;
+    e->tries = 0u;
+}
+
+uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
+                          const qnav_ctrl_input_t *in, qnav_escape_t *e)
+{
+    uint16_t goal = qnav_whole_deg(in->goal_bearing_cdeg);
+    uint16_t range = in->goal_range_mm;
+    uint16_t progress = (uint16_t)(c->margin_mm / 2u);
+    *e = in->escape;
+    if (c->esc_stall_ticks == 0u || range == 0u) {
+        qnav_escape_clear(e);
+        return goal;
+    }
+    if (e->side != 0) {
+        /* leave when nearer than ever before and the way to the destination is free */
+        if ((uint32_t)range + progress <= e->hit_mm && !blocked(c, lvl, (int16_t)goal)) {
+            e->side = 0;
+            e->best_mm = range;
+            e->ticks = 0u;
+            e->tries = 0u;
+            return goal;
+        }
+        if (++e->ticks >= follow_limit(c, e->tries)) {
+            e->side = (int8_t)-e->side; /* give this side up: the other, for longer */
+            e->last_side = e->side;
+            e->ticks = 0u;
+            if (e->tries < 255u) {
+                ++e->tries;
+            }
+        }
+        return skirt(c, lvl, (int16_t)qnav_whole_deg(in->prev_heading_cdeg), e->side);
+    }
+    if (e->best_mm == 0u || (uint32_t)range + progress <= e->best_mm) {
+        e->best_mm = range;
+        e->ticks = 0u;
+        return goal;
+    }
+    if (++e->ticks < c->esc_stall_ticks) {
+        return goal;
+    }
+    e->side = e->last_side != 0 ? e->last_side : choose_side(c, lvl, goal);
+    e->last_side = e->side;
+    e->hit_mm = e->best_mm;
+    e->ticks = 0u;
+    return skirt(c, lvl, (int16_t)goal, e->side);
+}
+
+void qnav_escape_keep_moving(const qnav_clearance_t *c, const uint8_t *lvl,
+                             const qnav_escape_t *e, uint16_t goal, qnav_ctrl_output_t *out)
+{
+    qnav_q1_15_t cap;
+    if (e->side == 0 || out->speed >= QNAV_ESCAPE_CRAWL) {
+        return;
+    }
+    out->heading_deg = (qnav_deg_t)(goal <= 180u ? (int16_t)goal : (int16_t)goal - 360);
+    out->flags = (uint8_t)(out->flags & (uint8_t)~QNAV_FLAG_NO_PATH);
+    if (blocked(c, lvl, (int16_t)goal)) {
+        out->speed = 0; /* turn in place toward it */
+        return;
+    }
+    cap = qnav_clearance_speed_cap(c, lvl[goal]);
+    out->speed = QNAV_ESCAPE_CRAWL < cap ? QNAV_ESCAPE_CRAWL : cap;
+    if (out->quality < out->speed) {
+        out->quality = out->speed;
+    }
+}

@@ -1,0 +1,45 @@
+/*
+ * Leaving dead ends (private to libqnav): a Bug-family boundary follower in front of every
+ * path controller (docs/architecture.md, "Leaving dead ends"). A memoryless map of
+ * (range, bearing) to quality has local minima: a U-pocket facing the destination, a wall
+ * whose gap lies off the straight line. While the robot makes progress toward the
+ * destination nothing changes. When it has made none for escape_stall_ticks, it follows
+ * the boundary in front of it on one side: the policy is given, instead of the
+ * destination's bearing, the bearing of the free path that skirts the obstacle (the first
+ * free path next to the blocked ones on that side). It goes back to the destination once
+ * it is nearer to it than it has ever been and the way there is free (DistBug's leave
+ * rule); a follow that lasts too long is given up for the other side, each try twice as
+ * long. While following, a step whose policy would stand still crawls along the
+ * boundary or turns in place, so no policy freezes.
+ *
+ * The memory (qnav_escape_t, 8 bytes) is the caller's: it comes in with the step's input
+ * and goes out with its output; the step itself keeps nothing.
+ */
+#ifndef QNAV_ESCAPE_H
+#define QNAV_ESCAPE_H
+
+#include "qnav/ctrl.h"
+
+/* Check and derive the escape's parameters into c (init time). Returns QNAV_OK. */
+QNAV_CHECK_RESULT qnav_status_t qnav_escape_setup(qnav_clearance_t *c,
+                                                  const qnav_ctrl_config_t *cfg);
+
+/*
+ * Update the memory e (from in->escape) with this tick's distance to the destination and
+ * return the bearing, in whole degrees 0..359 (path index), that the controller should
+ * steer for: the destination's while going to it, the boundary's while following one.
+ * Without an escape (configured off, or in->goal_range_mm 0) e is cleared and the
+ * destination's bearing is returned. lvl: the 360 path levels of this tick.
+ */
+uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
+                          const qnav_ctrl_input_t *in, qnav_escape_t *e);
+
+/* Zero the memory (going to the destination, nothing seen yet). */
+void qnav_escape_clear(qnav_escape_t *e);
+
+/* While following a boundary, a decision that stands still becomes a crawl along the
+ * boundary path goal (or a turn in place toward it when that path is not free). */
+void qnav_escape_keep_moving(const qnav_clearance_t *c, const uint8_t *lvl,
+                             const qnav_escape_t *e, uint16_t goal, qnav_ctrl_output_t *out);
+
+#endif /* QNAV_ESCAPE_H */
