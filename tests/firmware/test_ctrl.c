@@ -1114,6 +1114,94 @@ static void test_path_levels_equal_painting_every_sector(void **state)
     }
 }
 
+/* Wedge placement as defined in words (ctrl.h, wedge_pct): a reading nearer than
+ * wedge_near_mm blocks its whole wedge; a farther one leaves shrink paths free at each edge
+ * of its sector (shrink = (100 - pct)% of half the 360/N wedge, at most so many that the
+ * middle path stays), so path p is placed when the paths shrink either side of it are still
+ * in its sector; then each placed path is widened by its level's gamma. */
+static void reference_levels_wedge(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
+                                   unsigned pct, qnav_mm_t near_mm, uint8_t *lvl)
+{
+    unsigned shrink = ((100u - pct) * 360u) / (200u * n);
+    unsigned keep = (360u / n - 1u) / 2u;
+    uint8_t near_level = qnav_ctrl_level(c, near_mm);
+    if (shrink > keep) {
+        shrink = keep;
+    }
+    for (unsigned p = 0; p < QNAV_PATHS; ++p) {
+        lvl[p] = QNAV_DIST_LEVELS - 1;
+    }
+    for (unsigned p = 0; p < QNAV_PATHS; ++p) {
+        uint16_t s = qnav_ctrl_sector_of_path(n, (uint16_t)p);
+        uint8_t level = qnav_ctrl_level(c, ranges[s]);
+        int gamma = c->clr.enlarge_deg[level];
+        unsigned sh = level < near_level ? 0u : shrink;
+        /* one sector: its only edge lies between paths 179 and 180 */
+        unsigned from_edge = p < 180u ? 179u - p : p - 180u;
+        if (level == QNAV_DIST_LEVELS - 1 || (n == 1u && from_edge < sh) ||
+            qnav_ctrl_sector_of_path(n, (uint16_t)((p + 360u - sh) % 360u)) != s ||
+            qnav_ctrl_sector_of_path(n, (uint16_t)((p + sh) % 360u)) != s) {
+            continue;
+        }
+        for (int d = -gamma; d <= gamma; ++d) {
+            unsigned q = (unsigned)(((int)p + d + 720) % 360);
+            lvl[q] = lvl[q] < level ? lvl[q] : level;
+        }
+    }
+}
+
+/* Readings on the central part of their wedge, with and without a near distance, for every
+ * sector count shape: the step's painting equals the definition. */
+static void test_wedge_placement_equals_its_definition(void **state)
+{
+    (void)state;
+    static const uint16_t sectors[] = {1, 2, 3, 5, 7, 8, 12, 16, 31, 32, 64, 90, 179, 180,
+                                       181, 240, 360};
+    static const unsigned pcts[] = {0, 10, 25, 50, 75, 99, 100};
+    qnav_mm_t ranges[360];
+    uint8_t got[QNAV_PATHS];
+    uint8_t want[QNAV_PATHS];
+    qnav_policy_t p;
+    qnav_policy_prob_default(&p);
+    for (unsigned k = 0; k < 2000; ++k) {
+        uint16_t n = sectors[k % (sizeof sectors / sizeof sectors[0])];
+        unsigned pct = pcts[(k / 17u) % (sizeof pcts / sizeof pcts[0])];
+        qnav_mm_t near_mm = (k / 7u) % 2u ? 0u : (qnav_mm_t)rng_range(0, 4000);
+        qnav_ctrl_config_t cfg;
+        qnav_ctrl_t c;
+        qnav_cdeg_t goal;
+        qnav_ctrl_config_default(&cfg);
+        cfg.n_sectors = n;
+        cfg.max_range_mm = 4000;
+        cfg.wedge_pct = (uint8_t)pct;
+        cfg.wedge_near_mm = near_mm;
+        assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_OK);
+        if (k % 2u) {
+            random_scan(ranges, n, 4000);
+        } else {
+            structured_scan(ranges, n, 4000, k, &goal);
+        }
+        assert_int_equal(qnav_ctrl_path_levels(&c, ranges, got) & QNAV_FLAG_NOT_READY, 0);
+        reference_levels_wedge(&c, ranges, n, pct, near_mm, want);
+        if (memcmp(got, want, sizeof got) != 0) {
+            unsigned q = 0;
+            while (got[q] == want[q]) {
+                ++q;
+            }
+            fail_msg("scan %u (N = %u, pct %u, near %u): path %u level %u, definition %u", k, n,
+                     pct, near_mm, q, got[q], want[q]);
+        }
+    }
+    /* above 100 % is refused */
+    {
+        qnav_ctrl_config_t cfg;
+        qnav_ctrl_t c;
+        qnav_ctrl_config_default(&cfg);
+        cfg.wedge_pct = 101;
+        assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_E_WEDGE);
+    }
+}
+
 static void test_table_mode_is_bit_identical_to_network_mode(void **state)
 {
     (void)state;
@@ -1203,6 +1291,7 @@ int main(void)
         cmocka_unit_test(test_sigmoid_flat_ends_match_the_table),
         cmocka_unit_test(test_fast_step_equals_every_path_evaluation),
         cmocka_unit_test(test_path_levels_equal_painting_every_sector),
+        cmocka_unit_test(test_wedge_placement_equals_its_definition),
         cmocka_unit_test(test_run_reduce_keeps_its_promises_on_any_row),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_network_mode),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_probabilistic_mode),

@@ -1,0 +1,218 @@
+/*
+ * The escape memory (firmware/src/escape.c; docs/architecture.md, "Leaving dead ends"):
+ * scripted scans, the memory carried from each output to the next input as a caller does.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "qnav/ctrl.h"
+
+#define N 16
+#define MAX_MM 2500
+
+static void init_ctrl(qnav_ctrl_t *c, const qnav_policy_t *p, uint8_t stall_ticks)
+{
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_config_default(&cfg);
+    cfg.n_sectors = N;
+    cfg.max_range_mm = MAX_MM;
+    cfg.escape_stall_ticks = stall_ticks;
+    assert_int_equal(qnav_ctrl_init(c, &cfg, p), QNAV_OK);
+}
+
+/* A wall across the front: sectors -1, 0 and +1 read near, the rest nothing. */
+static void wall_ahead(qnav_mm_t *r, qnav_mm_t near_mm)
+{
+    for (unsigned k = 0; k < N; ++k) {
+        r[k] = MAX_MM;
+    }
+    r[0] = near_mm;
+    r[1] = near_mm;
+    r[N - 1] = near_mm;
+}
+
+/* One tick: the previous output's memory comes back in, as every caller must do. */
+static void tick(const qnav_ctrl_t *c, qnav_ctrl_input_t *in, qnav_ctrl_output_t *out)
+{
+    qnav_ctrl_step(c, in, out, NULL);
+    in->escape = out->escape;
+    in->prev_heading_cdeg = (qnav_cdeg_t)(out->heading_deg * 100);
+}
+
+/* Facing a wall with the destination behind it and no progress: the robot goes for the
+ * destination until the stall time is up, then follows the wall (turns well off the
+ * destination's bearing); once nearer than ever with the way free it goes back to it. */
+static void test_follows_after_a_stall_and_leaves_when_nearer(void **state)
+{
+    (void)state;
+    qnav_policy_t p;
+    qnav_ctrl_t c;
+    qnav_mm_t r[N];
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+    qnav_policy_prob_default(&p);
+    init_ctrl(&c, &p, 20);
+    memset(&in, 0, sizeof in);
+    wall_ahead(r, 300);
+    in.ranges_mm = r;
+    in.goal_bearing_cdeg = 0;
+    in.goal_range_mm = 3000;
+    for (unsigned t = 0; t < 20; ++t) {
+        tick(&c, &in, &out);
+        assert_int_equal(out.escape.side, 0);
+    }
+    tick(&c, &in, &out);
+    assert_int_not_equal(out.escape.side, 0);
+    assert_int_equal(out.escape.hit_mm, 3000);
+    for (unsigned t = 0; t < 10; ++t) {
+        tick(&c, &in, &out);
+        assert_int_not_equal(out.escape.side, 0);
+        /* along the wall, never into it: well away from straight ahead */
+        assert_true(out.heading_deg >= 30 || out.heading_deg <= -30);
+        assert_true(out.speed > 0);
+    }
+    /* nearer by less than the progress step: still following */
+    in.goal_range_mm = 2950;
+    wall_ahead(r, MAX_MM);
+    tick(&c, &in, &out);
+    assert_int_not_equal(out.escape.side, 0);
+    /* nearer than ever and the way free: back to the destination */
+    in.goal_range_mm = 2500;
+    tick(&c, &in, &out);
+    assert_int_equal(out.escape.side, 0);
+    assert_int_equal(out.escape.best_mm, 2500);
+    assert_true(out.heading_deg <= 5 && out.heading_deg >= -5);
+}
+
+/* Progress resets the stall count: a robot that keeps getting nearer never follows. */
+static void test_progress_never_follows(void **state)
+{
+    (void)state;
+    qnav_policy_t p;
+    qnav_ctrl_t c;
+    qnav_mm_t r[N];
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+    qnav_policy_prob_default(&p);
+    init_ctrl(&c, &p, 20);
+    memset(&in, 0, sizeof in);
+    wall_ahead(r, 300);
+    in.ranges_mm = r;
+    in.goal_range_mm = 9000;
+    for (unsigned t = 0; t < 200; ++t) {
+        tick(&c, &in, &out);
+        assert_int_equal(out.escape.side, 0);
+        in.goal_range_mm = (qnav_mm_t)(in.goal_range_mm - 40u); /* 0.4 m/s */
+    }
+}
+
+/* A follow that does not get nearer is given up for the other side after escape_follow_s,
+ * and the next try lasts twice as long. */
+static void test_a_long_follow_tries_the_other_side(void **state)
+{
+    (void)state;
+    qnav_policy_t p;
+    qnav_ctrl_t c;
+    qnav_mm_t r[N];
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+    int8_t first;
+    unsigned t;
+    qnav_policy_prob_default(&p);
+    init_ctrl(&c, &p, 20);
+    memset(&in, 0, sizeof in);
+    wall_ahead(r, 300);
+    in.ranges_mm = r;
+    in.goal_range_mm = 3000;
+    for (t = 0; t < 21; ++t) {
+        tick(&c, &in, &out);
+    }
+    first = out.escape.side;
+    assert_int_not_equal(first, 0);
+    for (t = 0; t < 199; ++t) {
+        tick(&c, &in, &out);
+        assert_int_equal(out.escape.side, first);
+    }
+    tick(&c, &in, &out);
+    assert_int_equal(out.escape.side, -first);
+    assert_int_equal(out.escape.tries, 1);
+    for (t = 0; t < 399; ++t) {
+        tick(&c, &in, &out);
+        assert_int_equal(out.escape.side, -first);
+    }
+    tick(&c, &in, &out);
+    assert_int_equal(out.escape.side, first);
+}
+
+/* No policy freezes: a network whose quality is 0 on every path stands still (NO_PATH)
+ * until the stall time is up, then crawls along the boundary. Without an escape it stands
+ * still for ever. */
+static void test_a_policy_of_zeros_does_not_freeze(void **state)
+{
+    (void)state;
+    qnav_policy_t p;
+    qnav_ctrl_t c;
+    qnav_ctrl_t off;
+    qnav_mm_t r[N];
+    qnav_ctrl_input_t in;
+    qnav_ctrl_input_t in_off;
+    qnav_ctrl_output_t out;
+    unsigned moving = 0;
+    qnav_policy_net_zero(&p, 4);
+    p.u.net.b_out = (qnav_q8_8_t)-32768;
+    init_ctrl(&c, &p, 20);
+    init_ctrl(&off, &p, 0);
+    memset(&in, 0, sizeof in);
+    wall_ahead(r, 400);
+    in.ranges_mm = r;
+    in.goal_range_mm = 3000;
+    in_off = in;
+    for (unsigned t = 0; t < 60; ++t) {
+        tick(&c, &in, &out);
+        if (out.speed > 0) {
+            ++moving;
+            assert_int_equal(out.flags & QNAV_FLAG_NO_PATH, 0);
+        }
+        tick(&off, &in_off, &out);
+        assert_int_equal(out.speed, 0);
+        assert_int_not_equal(out.flags & QNAV_FLAG_NO_PATH, 0);
+    }
+    assert_true(moving >= 30);
+}
+
+/* Without a distance to the destination (0) there is no escape, and the memory stays 0. */
+static void test_no_range_no_escape(void **state)
+{
+    (void)state;
+    qnav_policy_t p;
+    qnav_ctrl_t c;
+    qnav_mm_t r[N];
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+    qnav_policy_prob_default(&p);
+    init_ctrl(&c, &p, 20);
+    memset(&in, 0, sizeof in);
+    wall_ahead(r, 300);
+    in.ranges_mm = r;
+    for (unsigned t = 0; t < 100; ++t) {
+        tick(&c, &in, &out);
+        assert_int_equal(out.escape.side, 0);
+        assert_int_equal(out.escape.best_mm, 0);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_follows_after_a_stall_and_leaves_when_nearer),
+        cmocka_unit_test(test_progress_never_follows),
+        cmocka_unit_test(test_a_long_follow_tries_the_other_side),
+        cmocka_unit_test(test_a_policy_of_zeros_does_not_freeze),
+        cmocka_unit_test(test_no_range_no_escape),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
