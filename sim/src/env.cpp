@@ -300,7 +300,19 @@ std::string environment_to_toml(const Environment &env) {
     std::ostringstream os;
     os.precision(6);
     os << "# qnav environment (format: docs/sim.md). Units: metres, degrees, seconds.\n";
-    os << "name = \"" << env.name << "\"\n";
+    os << "name = \"";
+    for (const unsigned char ch : env.name) {  // a TOML basic string: escape what ends it
+        if (ch == '"' || ch == '\\') {
+            os << '\\' << ch;
+        } else if (ch < 0x20 || ch == 0x7f) {
+            char u[8];
+            std::snprintf(u, sizeof u, "\\u%04x", ch);
+            os << u;
+        } else {
+            os << ch;
+        }
+    }
+    os << "\"\n";
     os << "episode_limit_s = " << env.episode_limit_s << "\n\n";
     os << "[arena]\nwidth_m = " << env.width_m << "\nheight_m = " << env.height_m << "\n\n";
     os << "[destination]\nx_m = " << env.dest_x_m << "\ny_m = " << env.dest_y_m
