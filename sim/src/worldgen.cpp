@@ -52,6 +52,45 @@ public:
             for (int i = i0; i <= i1; ++i)
                 if (nearest_point(s, {(i + 0.5) * cell_, (j + 0.5) * cell_}, &q) < clear_) at(i, j) += delta;
     }
+    // Add s unless it cuts a start zone off from the destination (then leave the grid as
+    // it was and return false). Most obstacles are settled locally: in a window two cells
+    // wider than the cells s can block, every pair of border cells (and zone centres and
+    // destination cells) that were joined inside the window before must still be joined
+    // after; then any path through the window can be rerouted inside it. Otherwise the
+    // whole grid is flooded.
+    bool add_if_passable(const Shape &s, const Environment &env) {
+        const double reach = s.r + clear_;
+        const int i0 = std::max(0, static_cast<int>(std::floor((s.c.x - reach) / cell_)) - 2);
+        const int i1 = std::min(nx_ - 1, static_cast<int>(std::floor((s.c.x + reach) / cell_)) + 2);
+        const int j0 = std::max(0, static_cast<int>(std::floor((s.c.y - reach) / cell_)) - 2);
+        const int j1 = std::min(ny_ - 1, static_cast<int>(std::floor((s.c.y + reach) / cell_)) + 2);
+        const std::vector<int> before = local_labels(i0, i1, j0, j1);
+        add(s, +1);
+        const std::vector<int> after = local_labels(i0, i1, j0, j1);
+        const int w = i1 - i0 + 1;
+        std::vector<int> maps(before.size(), -1);  // before-label -> after-label
+        bool local_ok = true;
+        const double r2 = env.dest_radius_m * env.dest_radius_m;
+        std::vector<char> terminal(before.size(), 0);
+        for (const StartZone &z : env.start_zones) {
+            const int k = cell_of(z.x_m + z.w_m / 2, z.y_m + z.h_m / 2);
+            const int i = k % nx_, j = k / nx_;
+            if (i >= i0 && i <= i1 && j >= j0 && j <= j1) terminal[(j - j0) * w + (i - i0)] = 1;
+        }
+        for (int j = j0; j <= j1 && local_ok; ++j)
+            for (int i = i0; i <= i1 && local_ok; ++i) {
+                const int k = (j - j0) * w + (i - i0);
+                const double dx = (i + 0.5) * cell_ - env.dest_x_m, dy = (j + 0.5) * cell_ - env.dest_y_m;
+                const bool term = terminal[k] || i == i0 || i == i1 || j == j0 || j == j1 || dx * dx + dy * dy <= r2;
+                if (!term || before[k] < 0) continue;
+                if (after[k] < 0) local_ok = false;
+                else if (maps[before[k]] < 0) maps[before[k]] = after[k];
+                else if (maps[before[k]] != after[k]) local_ok = false;
+            }
+        if (local_ok || path_m(env) >= 0) return true;
+        add(s, -1);
+        return false;
+    }
     // Longest BFS distance (m) from the destination disc to a zone centre; -1 if one is cut off.
     double path_m(const Environment &env) const {
         std::vector<int> dist(blocked_.size(), -1);
@@ -92,6 +131,37 @@ public:
 
 private:
     int &at(int i, int j) { return blocked_[static_cast<std::size_t>(j) * nx_ + i]; }
+    // Components of the free cells of the window [i0, i1] x [j0, j1] (4-connected,
+    // inside the window only); -1 for blocked cells.
+    std::vector<int> local_labels(int i0, int i1, int j0, int j1) const {
+        const int w = i1 - i0 + 1, h = j1 - j0 + 1;
+        std::vector<int> lab(static_cast<std::size_t>(w) * h, -1);
+        std::vector<int> stack;
+        int next = 0;
+        for (int start = 0; start < w * h; ++start) {
+            const int si = start % w + i0, sj = start / w + j0;
+            if (lab[start] >= 0 || blocked_[static_cast<std::size_t>(sj) * nx_ + si]) continue;
+            lab[start] = next;
+            stack.push_back(start);
+            while (!stack.empty()) {
+                const int k = stack.back();
+                stack.pop_back();
+                const int a = k % w, b = k / w;
+                const int da[4] = {1, -1, 0, 0}, db[4] = {0, 0, 1, -1};
+                for (int d = 0; d < 4; ++d) {
+                    const int x = a + da[d], y = b + db[d];
+                    if (x < 0 || y < 0 || x >= w || y >= h) continue;
+                    const int m = y * w + x;
+                    if (lab[m] < 0 && !blocked_[static_cast<std::size_t>(y + j0) * nx_ + (x + i0)]) {
+                        lab[m] = next;
+                        stack.push_back(m);
+                    }
+                }
+            }
+            ++next;
+        }
+        return lab;
+    }
     int cell_of(double x, double y) const {
         const int i = std::clamp(static_cast<int>(x / cell_), 0, nx_ - 1);
         const int j = std::clamp(static_cast<int>(y / cell_), 0, ny_ - 1);
@@ -191,11 +261,7 @@ void scatter(Ctx &c, Environment &env, PassGrid &grid, double x0, double y0, dou
         for (const Shape &o : placed)
             if (!bad && norm(o.c - s.c) < o.r + s.r && shape_distance(o, s) <= 0.0) bad = true;
         if (bad) continue;
-        grid.add(s, +1);
-        if (grid.path_m(env) < 0) {
-            grid.add(s, -1);
-            continue;
-        }
+        if (!grid.add_if_passable(s, env)) continue;
         if (circle)
             env.circles.push_back(co);
         else
@@ -402,8 +468,14 @@ void build_pocket(Ctx &c, Environment &env) {
     const double lo = zh / 2 + 0.8 * c.s + depth, hi = len - env.dest_radius_m - 1.0 * c.s - thick;
     const Vec2 bottom = start + std::clamp(c.uni(lo, hi), lo, std::max(lo, hi)) * u;
     add_pocket(c, env, bottom, u, wi, depth, thick, true);
-    // The straight line's approach to the pocket stays free of clutter.
-    std::vector<Shape> keepout{make_segment(start, bottom)};
+    // The straight lines from the zone's centre and corners to the goal stay free of
+    // clutter up to the pocket's bottom.
+    std::vector<Shape> keepout;
+    for (const Vec2 p : {start, Vec2{zx - zw / 2, zy - zh / 2}, Vec2{zx + zw / 2, zy - zh / 2},
+                         Vec2{zx - zw / 2, zy + zh / 2}, Vec2{zx + zw / 2, zy + zh / 2}}) {
+        const Vec2 up = (1.0 / norm(goal - p)) * (goal - p);
+        keepout.push_back(make_segment(p, p + (dot(bottom - p, u) / dot(up, u)) * up));
+    }
     for (const BoxObstacle &b : env.boxes) keepout.push_back(shape_of(b));
     std::vector<Shape> avoid = keepout;
     avoid.push_back(make_circle(goal.x, goal.y, env.dest_radius_m));
