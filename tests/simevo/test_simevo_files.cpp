@@ -618,6 +618,37 @@ static void test_program_rejects_bad_input_with_one_line(void **state)
     assert_one_line_containing(e, "no preset 'nope'");
 }
 
+/* Issue 20: a value that ends an #SBATCH line (a newline in --partition, --time or the
+ * output folder) became a shell command in tasks.sbatch; each is refused with one line
+ * before any file is written, and a folder with a space or '#' is quoted in --output. */
+static void test_slurm_refuses_values_that_would_break_an_sbatch_line(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::string out = join_path(root, "out");
+    int st = 0;
+    std::string e = run_for_error({"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--out", out, "--partition", "p\ntouch X"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--partition: 'p\\ntouch X' is not a Slurm partition name");
+    e = run_for_error({"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--out", out, "--time", "5\ntouch X"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--time: '5\\ntouch X' is not a Slurm time limit");
+    e = run_for_error({"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--out", out + "\ntouch X"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "cannot go on an #SBATCH line");
+    assert_false(file_exists(out));
+    assert_false(file_exists(out + "\ntouch X"));
+
+    const std::string odd = join_path(root, "a b#c%d");
+    assert_int_equal(wait_exit(spawn({"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--out", odd, "--partition", "debug,long",
+                                      "--time", "1-02:30:00"},
+                                     join_path(root, "ok.err"))),
+                     0);
+    const std::string tasks = slurp(join_path(odd, "tiny/slurm/tasks.sbatch"));
+    assert_non_null(std::strstr(tasks.c_str(), "#SBATCH --partition=debug,long\n#SBATCH --time=1-02:30:00\n"));
+    assert_non_null(std::strstr(tasks.c_str(), ("#SBATCH --output=\"" + root + "/a b#c%%d/tiny/slurm/%x-%A_%a.out\"\n").c_str()));
+}
+
 /* The temporary name write_file_atomic used before it made them with mkstemp: a planted
  * symlink there was followed and the file it pointed to overwritten. */
 static void test_atomic_write_never_follows_a_planted_symlink(void **state)
@@ -980,8 +1011,11 @@ static void test_progress_line_is_cut_to_the_terminal_width(void **state)
     assert_int_equal(longest, 39); /* cut (the whole line is longer), never more */
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    if (argc > 1) {
+        cmocka_set_test_filter(argv[1]); /* e.g. test_slurm_*: one test while working on it */
+    }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_task_stopped_and_resumed_matches_uninterrupted_bytes),
         cmocka_unit_test(test_candidate_and_parent_face_the_same_k_episodes_and_the_budget_counts_episodes),
@@ -992,6 +1026,7 @@ int main(void)
         cmocka_unit_test(test_program_killed_by_pid_resumes_to_identical_results),
         cmocka_unit_test(test_shares_in_separate_processes_merge_to_the_local_run_byte_for_byte),
         cmocka_unit_test(test_slurm_scripts_run_stage_two_after_stage_one_and_keep_foreign_files),
+        cmocka_unit_test(test_slurm_refuses_values_that_would_break_an_sbatch_line),
         cmocka_unit_test(test_table_mode_and_network_mode_give_identical_results),
         cmocka_unit_test(test_atomic_write_never_follows_a_planted_symlink),
         cmocka_unit_test(test_plot_child_dies_when_simevo_is_killed),

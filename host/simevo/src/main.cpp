@@ -528,6 +528,7 @@ int main(int argc, char **argv)
         if (*slurm) {
             std::vector<Sweep> sweeps;
             const auto items = load_run_specs({slurm_name}, experiments_dir, run_args, sweeps);
+            check_slurm_options(so, opt.out_dir);
             started = true;
             return write_slurm_all(items, sweeps, opt, so, !no_plot, submit);
         }
