@@ -909,6 +909,7 @@ static void test_sweep_file_problems_are_one_line_with_file_and_line(void **stat
     const std::vector<std::pair<std::string, std::string>> cases = {
         {head + "[vary]\nspeed = [1, 2]\n", ":4: [vary]: unknown key 'speed' (one of noise, sectors)"},
         {head + "[vary]\nnoise = [0, 2]\n", ":4: noise: 2 is not in [0, 1]"},
+        {head + "[vary]\nsectors = [8, 100000]\n", ":4: sectors: 100000 is not in [0, 360]"},
         {head + "[vary]\nnoise = [0.05, 0.050]\n", ":4: noise: 0.05 is listed twice"},
         {head + "[vary]\nsectors = [8, 8.5]\n", ":4: sectors: expected an integer"},
         {head + "[vary]\nsectors = []\n", ":4: sectors: expected a non-empty list of values"},
@@ -944,7 +945,19 @@ static void test_sweep_file_problems_are_one_line_with_file_and_line(void **stat
     assert_one_line_containing(run_for_error({"run", SIMEVO_TEST_DIR "/tiny.toml", "--vary", "speed=1", "--out", out}, st),
                                "--vary: 'speed=1' is not KEY=VALUE with KEY one of noise, sectors");
     assert_int_equal(st, 2);
+    // Issue 20: bounds and whole numbers printed as integers, not 1e+05 and 3.6e+02.
+    assert_one_line_containing(run_for_error({"run", SIMEVO_TEST_DIR "/tiny.toml", "--vary", "sectors=100000", "--out", out}, st),
+                               "sectors: 100000 is not in [0, 360]");
+    assert_int_equal(st, 2);
+    assert_one_line_containing(run_for_error({"run", SIMEVO_TEST_DIR "/tiny.toml", "--vary", "sectors=2.5", "--out", out}, st),
+                               "sectors: 2.5 is not a whole number");
+    assert_int_equal(st, 2);
     assert_false(file_exists(out));
+    // A whole value names its member folder as an integer too.
+    assert_int_equal(wait_exit(spawn({"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--vary", "sectors=100", "--out", out},
+                                     join_path(root, "v.err"))),
+                     0);
+    assert_true(file_exists(join_path(out, "tiny.sectors-100/run.txt")));
 }
 
 /* On a 40-column terminal every progress redraw fits in 39 columns (a longer line wraps,
