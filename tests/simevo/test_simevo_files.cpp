@@ -432,6 +432,26 @@ static void test_shares_in_separate_processes_merge_to_the_local_run_byte_for_by
         return std::vector<std::string>{"summarize", join_path(out, "tiny"), "--no-plot"};
     };
     assert_int_equal(wait_exit(spawn(run(a, {}), join_path(root, "a.err"))), 0);
+    // The summary's Regenerate line, run as written (with the same --out), finds every task
+    // done and rewrites the same files (issue 20: it named 'tiny', which no folder holds).
+    {
+        const std::string summary = slurp(join_path(a, "tiny/summary.md"));
+        const std::size_t at = summary.find("Regenerate: `simevo run ");
+        assert_true(at != std::string::npos);
+        const std::size_t from = at + std::strlen("Regenerate: `simevo "), to = summary.find('`', from);
+        std::vector<std::string> regen;
+        const std::string line = summary.substr(from, to - from) + " ";
+        for (std::size_t i = 0, sp; (sp = line.find(' ', i)) != std::string::npos; i = sp + 1) {
+            regen.push_back(line.substr(i, sp - i));
+        }
+        assert_string_equal(regen[1].c_str(), SIMEVO_TEST_DIR "/tiny.toml");
+        std::map<std::string, std::string> before, after;
+        collect(a, "", before);
+        regen.insert(regen.end(), {"--no-plot", "--no-progress", "--out", a});
+        assert_int_equal(wait_exit(spawn(regen, join_path(root, "regen.err"))), 0);
+        collect(a, "", after);
+        assert_true(before == after);
+    }
 
     // Three shares one after another; summarize refuses until all are done.
     assert_int_equal(wait_exit(spawn(run(b, {"--tasks", "1/3"}), join_path(root, "b1.err"))), 0);

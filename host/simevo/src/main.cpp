@@ -188,6 +188,7 @@ void set_run_options(RunOptions &opt, const RunArgs &args, const std::string &ex
     opt.preset = args.preset;
     opt.overrides = override_flags(args);
     opt.run_record = run_record_text(experiment_file, args);
+    opt.experiment_file = experiment_file;
 }
 
 int summarize_sweep(const std::string &dir, const std::string &record_path, const RunOptions &opt, bool &started);
