@@ -39,8 +39,15 @@ configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/qnavConfig.cmake.in
   ${CMAKE_CURRENT_BINARY_DIR}/qnavConfig.cmake
   INSTALL_DESTINATION ${QNAV_CMAKE_INSTALL_DIR}
   PATH_VARS QNAV_SHARE_INSTALL_DIR CMAKE_INSTALL_BINDIR)
+# Semantic versioning (CHANGELOG.md): before 1.0 a minor release may break the API, so
+# find_package(qnav 0.Y) accepts 0.Y.z only; from 1.0 on the major number decides.
+if(PROJECT_VERSION_MAJOR EQUAL 0)
+  set(QNAV_VERSION_COMPATIBILITY SameMinorVersion)
+else()
+  set(QNAV_VERSION_COMPATIBILITY SameMajorVersion)
+endif()
 write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/qnavConfigVersion.cmake
-  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMinorVersion)
+  VERSION ${PROJECT_VERSION} COMPATIBILITY ${QNAV_VERSION_COMPATIBILITY})
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/qnavConfig.cmake
               ${CMAKE_CURRENT_BINARY_DIR}/qnavConfigVersion.cmake
         DESTINATION ${QNAV_CMAKE_INSTALL_DIR})

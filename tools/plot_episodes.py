@@ -15,13 +15,10 @@ import math
 import os
 import sys
 
-import matplotlib
+from plotcommon import PlotError, import_pyplot, parse_args, read_csv, read_json, read_toml, run, save
 
-matplotlib.use("Agg")
+plt = import_pyplot("plot_episodes.py")
 import matplotlib.patches as mpatches  # noqa: E402
-import matplotlib.pyplot as plt  # noqa: E402
-
-from plotcommon import PlotError, parse_args, read_csv, read_json, read_toml, run, save  # noqa: E402
 
 
 def draw_env(ax, env):

@@ -14,12 +14,9 @@ unless OUT.png is given. Needs matplotlib only.
 import os
 import sys
 
-import matplotlib
+from plotcommon import import_pyplot, parse_args, read_csv, read_json, run, save
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from plotcommon import parse_args, read_csv, read_json, run, save  # noqa: E402
+plt = import_pyplot("plot_learning.py")
 
 
 def main(argv):

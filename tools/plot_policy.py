@@ -12,13 +12,10 @@ quality. Writes EXPERIMENT_DIR/policy.png unless OUT.png is given.
 import os
 import sys
 
-import matplotlib
+from plotcommon import PlotError, import_pyplot, parse_args, read_csv, run, save
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from plotcommon import PlotError, parse_args, read_csv, run, save  # noqa: E402
+plt = import_pyplot("plot_policy.py")
+import numpy as np  # noqa: E402  (a matplotlib dependency)
 
 
 def main(argv):

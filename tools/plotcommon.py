@@ -9,13 +9,28 @@ import json
 import os
 import sys
 import tempfile
-import tomllib
 
 FORMATS = ("png", "pdf", "svg")
 
 
 class PlotError(Exception):
     """A problem with an input file; str() is the one-line message."""
+
+
+def import_pyplot(prog):
+    """matplotlib.pyplot on the Agg backend. When the python3 running the script cannot
+    import matplotlib (a virtualenv or pyenv python3 first on PATH), one line naming that
+    interpreter and exit status 1, not a traceback."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError as e:
+        sys.stderr.write(f"{prog}: {sys.executable} cannot import {e.name or 'matplotlib'} "
+                         "(install python3-matplotlib, or run the script with /usr/bin/python3)\n")
+        sys.exit(1)
+    return plt
 
 
 def plot_format(path):
@@ -88,6 +103,8 @@ def read_json(path):
 
 def read_toml(path):
     """The parsed TOML file at path (an environment); raise PlotError naming the file."""
+    import tomllib  # Python 3.11+; imported here so that the other tools run on older ones
+
     return _read(path, "rb", tomllib.load, tomllib.TOMLDecodeError, lambda e: f": {e}")
 
 

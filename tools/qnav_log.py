@@ -131,10 +131,7 @@ def write_csv(folder, decoded):
 
 
 def plot(out, decoded):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = plotcommon.import_pyplot("qnav_log.py")  # one line, not a traceback, without matplotlib
 
     fig, (ax_xy, ax_cmd, ax_link) = plt.subplots(1, 3, figsize=(13, 4), dpi=110, layout="constrained")
     t0 = min(rows[0][0] for rows in decoded.values())

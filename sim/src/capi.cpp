@@ -322,12 +322,9 @@ const char *qnav_sim_last_error(const qnav_sim_t *sim) { return sim ? sim->last_
 qnav_sim_status_t qnav_sim_scan(const qnav_sim_t *sim, qnav_sim_scan_t *scan) {
     if (!sim || !scan) return QNAV_SIM_E_NULL;
     if (!sim->sim->started()) return QNAV_SIM_E_STATE;
-    const qnav_sim_scan_t &s = sim->sim->scan();
-    scan->n_sectors = s.n_sectors;
-    scan->max_range_mm = s.max_range_mm;
-    std::memcpy(scan->ranges_mm, s.ranges_mm, sizeof(qnav_mm_t) * s.n_sectors);
-    scan->goal_bearing_cdeg = s.goal_bearing_cdeg;
-    scan->goal_range_mm = s.goal_range_mm;
+    // The whole struct, so that a field added to qnav_sim_scan_t cannot be left unwritten
+    // (prev_heading_cdeg once was); sectors past n_sectors hold what the context holds.
+    *scan = sim->sim->scan();
     return QNAV_SIM_OK;
 }
 

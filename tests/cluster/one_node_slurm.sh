@@ -52,7 +52,7 @@ cluster_up() {
     cl_host=$(hostname -s)
     # ports from the process id, so two test runs at once are unlikely to race for one
     cl_ctld_port=$(cluster_free_port $((20000 + ($$ % 4000) * 2)))
-    cl_slurmd_port=$(cluster_free_port $((ctld_port + 1)))
+    cl_slurmd_port=$(cluster_free_port $((cl_ctld_port + 1)))
     cat >"$cl_dir/slurm.conf" <<CONF
 ClusterName=qnavtest
 SlurmctldHost=localhost

@@ -5,6 +5,7 @@
 #   check_install.sh host      PREFIX WORK SRC CMAKE   examples/host-app via find_package(qnav)
 #   check_install.sh pkgconfig PREFIX WORK SRC         examples/host-app/main.c via qnav.pc
 #   check_install.sh avr       PREFIX WORK SRC CMAKE   examples/avr-firmware, installed toolchain
+#   check_install.sh version   PREFIX WORK SRC CMAKE   find_package(qnav X.Y) by semantic versioning
 # Every check fails loudly (set -e, explicit comparisons); nothing outside WORK is written.
 set -eu
 mode=$1
@@ -87,6 +88,37 @@ avr)
     cat "$work/out.txt"
     # the ATmega128 decides exactly as the host did on the same scan
     cmp "$work/out.txt" "$work/../host-decision.txt" || fail "AVR and host decisions differ"
+    ;;
+version)
+    prefix=$2 work=$3 src=$4 cmake=$5
+    rm -rf "$work" && mkdir -p "$work"
+    v=$(cat "$prefix/share/qnav/VERSION")
+    major=${v%%.*} rest=${v#*.}
+    minor=${rest%%.*}
+    # find_package(qnav REQUEST CONFIG REQUIRED) in a fresh project: 0 when it accepts
+    accepts() {
+        d="$work/request-$1"
+        mkdir -p "$d"
+        printf 'cmake_minimum_required(VERSION 3.25)\nproject(version_check LANGUAGES C CXX)\nfind_package(qnav %s CONFIG REQUIRED)\n' \
+            "$1" > "$d/CMakeLists.txt"
+        "$cmake" -S "$d" -B "$d/build" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" > "$d/cmake.out" 2>&1
+    }
+    accepts "$v" || fail "find_package(qnav $v) refused the installed $v: $(tail -n 3 "$work/request-$v/cmake.out")"
+    accepts "$major.$minor" || fail "find_package(qnav $major.$minor) refused the installed $v"
+    if accepts "$major.$((minor + 1))"; then fail "find_package(qnav $major.$((minor + 1))) took the older $v"; fi
+    if accepts "$((major + 1)).0"; then fail "find_package(qnav $((major + 1)).0) took $v"; fi
+    if [ "$major" -eq 0 ]; then
+        # before 1.0 a minor release may break the API: 0.(Y-1) is not 0.Y
+        if [ "$minor" -gt 0 ] && accepts "0.$((minor - 1))"; then fail "find_package(qnav 0.$((minor - 1))) took $v"; fi
+    elif [ "$minor" -gt 0 ]; then
+        accepts "$major.0" || fail "find_package(qnav $major.0) refused $v (same major version)"
+    fi
+    # a project written for 0.1 calls qnav_ctrl_init_table() without its rank (CHANGELOG.md)
+    if accepts 0.1; then fail "find_package(qnav 0.1) took $v, whose API differs"; fi
+    # the newest version CHANGELOG.md describes is this one
+    newest=$(sed -n 's/^## \([0-9][0-9.]*\) .*/\1/p' "$src/CHANGELOG.md" | head -n 1)
+    [ "$newest" = "$v" ] || fail "CHANGELOG.md's newest entry is '$newest', VERSION says $v"
+    echo "find_package(qnav ...) against $v: $v and $major.$minor accepted; $major.$((minor + 1)), $((major + 1)).0 and 0.1 refused"
     ;;
 *)
     fail "unknown mode"

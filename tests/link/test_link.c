@@ -564,6 +564,28 @@ static void test_policy_blob_refuses_a_policy_that_does_not_validate(void **stat
     assert_int_equal(qnav_link_policy_to_blob(&a, blob, sizeof blob), QNAV_LINK_E_VALUE);
 }
 
+/* Issue 20: from_blob took what to_blob refuses (k_goal or k_safe outside (0, 64]). */
+static void test_policy_blob_reader_refuses_what_the_writer_refuses(void **state)
+{
+    static const uint8_t fuzzed[6] = {0x01, 0x00, 0x00, 0x21, 0x1c, 0x93}; /* k_safe < 0 */
+    static const uint8_t k_goal_zero[6] = {0x01, 0x00, 0x00, 0x00, 0x00, 0x04};
+    static const uint8_t k_safe_above_64[6] = {0x01, 0x00, 0x00, 0x01, 0x01, 0x40};
+    static const uint8_t both_64[6] = {0x01, 0x00, 0x00, 0x40, 0x00, 0x40};
+    qnav_policy_t b;
+    uint8_t out[8];
+    (void)state;
+    b.kind = 0xEEu;
+    assert_int_equal(qnav_link_policy_from_blob(fuzzed, 6, &b), QNAV_LINK_E_VALUE);
+    assert_int_equal(b.kind, 0xEEu); /* left untouched */
+    assert_int_equal(qnav_link_policy_from_blob(k_goal_zero, 6, &b), QNAV_LINK_E_VALUE);
+    assert_int_equal(qnav_link_policy_from_blob(k_safe_above_64, 6, &b), QNAV_LINK_E_VALUE);
+    assert_int_equal(qnav_link_policy_from_blob(both_64, 6, &b), QNAV_LINK_OK);
+    assert_int_equal(b.u.prob.k_goal, 64 * 256);
+    /* whatever the reader accepts, the writer writes back byte for byte */
+    assert_int_equal(qnav_link_policy_to_blob(&b, out, sizeof out), 6);
+    assert_memory_equal(out, both_64, 6);
+}
+
 static void test_link_status_str_names_every_status(void **state)
 {
     (void)state;
@@ -767,6 +789,7 @@ int main(void)
         cmocka_unit_test(test_policy_blob_round_trips_network_and_probabilistic),
         cmocka_unit_test(test_policy_blob_round_trips_a_three_input_network),
         cmocka_unit_test(test_policy_blob_refuses_a_policy_that_does_not_validate),
+        cmocka_unit_test(test_policy_blob_reader_refuses_what_the_writer_refuses),
         cmocka_unit_test(test_link_status_str_names_every_status),
         cmocka_unit_test(test_upload_in_chunks_delivers_the_policy),
         cmocka_unit_test(test_upload_with_wrong_crc_is_refused),

@@ -432,6 +432,26 @@ static void test_shares_in_separate_processes_merge_to_the_local_run_byte_for_by
         return std::vector<std::string>{"summarize", join_path(out, "tiny"), "--no-plot"};
     };
     assert_int_equal(wait_exit(spawn(run(a, {}), join_path(root, "a.err"))), 0);
+    // The summary's Regenerate line, run as written (with the same --out), finds every task
+    // done and rewrites the same files (issue 20: it named 'tiny', which no folder holds).
+    {
+        const std::string summary = slurp(join_path(a, "tiny/summary.md"));
+        const std::size_t at = summary.find("Regenerate: `simevo run ");
+        assert_true(at != std::string::npos);
+        const std::size_t from = at + std::strlen("Regenerate: `simevo "), to = summary.find('`', from);
+        std::vector<std::string> regen;
+        const std::string line = summary.substr(from, to - from) + " ";
+        for (std::size_t i = 0, sp; (sp = line.find(' ', i)) != std::string::npos; i = sp + 1) {
+            regen.push_back(line.substr(i, sp - i));
+        }
+        assert_string_equal(regen[1].c_str(), SIMEVO_TEST_DIR "/tiny.toml");
+        std::map<std::string, std::string> before, after;
+        collect(a, "", before);
+        regen.insert(regen.end(), {"--no-plot", "--no-progress", "--out", a});
+        assert_int_equal(wait_exit(spawn(regen, join_path(root, "regen.err"))), 0);
+        collect(a, "", after);
+        assert_true(before == after);
+    }
 
     // Three shares one after another; summarize refuses until all are done.
     assert_int_equal(wait_exit(spawn(run(b, {"--tasks", "1/3"}), join_path(root, "b1.err"))), 0);
@@ -616,6 +636,37 @@ static void test_program_rejects_bad_input_with_one_line(void **state)
     e = run_for_error({"run", SIMEVO_TEST_DIR "/tiny.toml", "--preset", "nope", "--out", root}, st);
     assert_int_equal(st, 2);
     assert_one_line_containing(e, "no preset 'nope'");
+}
+
+/* Issue 20: a value that ends an #SBATCH line (a newline in --partition, --time or the
+ * output folder) became a shell command in tasks.sbatch; each is refused with one line
+ * before any file is written, and a folder with a space or '#' is quoted in --output. */
+static void test_slurm_refuses_values_that_would_break_an_sbatch_line(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::string out = join_path(root, "out");
+    int st = 0;
+    std::string e = run_for_error({"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--out", out, "--partition", "p\ntouch X"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--partition: 'p\\ntouch X' is not a Slurm partition name");
+    e = run_for_error({"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--out", out, "--time", "5\ntouch X"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "--time: '5\\ntouch X' is not a Slurm time limit");
+    e = run_for_error({"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--out", out + "\ntouch X"}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, "cannot go on an #SBATCH line");
+    assert_false(file_exists(out));
+    assert_false(file_exists(out + "\ntouch X"));
+
+    const std::string odd = join_path(root, "a b#c%d");
+    assert_int_equal(wait_exit(spawn({"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--out", odd, "--partition", "debug,long",
+                                      "--time", "1-02:30:00"},
+                                     join_path(root, "ok.err"))),
+                     0);
+    const std::string tasks = slurp(join_path(odd, "tiny/slurm/tasks.sbatch"));
+    assert_non_null(std::strstr(tasks.c_str(), "#SBATCH --partition=debug,long\n#SBATCH --time=1-02:30:00\n"));
+    assert_non_null(std::strstr(tasks.c_str(), ("#SBATCH --output=\"" + root + "/a b#c%%d/tiny/slurm/%x-%A_%a.out\"\n").c_str()));
 }
 
 /* The temporary name write_file_atomic used before it made them with mkstemp: a planted
@@ -878,6 +929,7 @@ static void test_sweep_file_problems_are_one_line_with_file_and_line(void **stat
     const std::vector<std::pair<std::string, std::string>> cases = {
         {head + "[vary]\nspeed = [1, 2]\n", ":4: [vary]: unknown key 'speed' (one of noise, sectors)"},
         {head + "[vary]\nnoise = [0, 2]\n", ":4: noise: 2 is not in [0, 1]"},
+        {head + "[vary]\nsectors = [8, 100000]\n", ":4: sectors: 100000 is not in [0, 360]"},
         {head + "[vary]\nnoise = [0.05, 0.050]\n", ":4: noise: 0.05 is listed twice"},
         {head + "[vary]\nsectors = [8, 8.5]\n", ":4: sectors: expected an integer"},
         {head + "[vary]\nsectors = []\n", ":4: sectors: expected a non-empty list of values"},
@@ -913,7 +965,19 @@ static void test_sweep_file_problems_are_one_line_with_file_and_line(void **stat
     assert_one_line_containing(run_for_error({"run", SIMEVO_TEST_DIR "/tiny.toml", "--vary", "speed=1", "--out", out}, st),
                                "--vary: 'speed=1' is not KEY=VALUE with KEY one of noise, sectors");
     assert_int_equal(st, 2);
+    // Issue 20: bounds and whole numbers printed as integers, not 1e+05 and 3.6e+02.
+    assert_one_line_containing(run_for_error({"run", SIMEVO_TEST_DIR "/tiny.toml", "--vary", "sectors=100000", "--out", out}, st),
+                               "sectors: 100000 is not in [0, 360]");
+    assert_int_equal(st, 2);
+    assert_one_line_containing(run_for_error({"run", SIMEVO_TEST_DIR "/tiny.toml", "--vary", "sectors=2.5", "--out", out}, st),
+                               "sectors: 2.5 is not a whole number");
+    assert_int_equal(st, 2);
     assert_false(file_exists(out));
+    // A whole value names its member folder as an integer too.
+    assert_int_equal(wait_exit(spawn({"slurm", SIMEVO_TEST_DIR "/tiny.toml", "--vary", "sectors=100", "--out", out},
+                                     join_path(root, "v.err"))),
+                     0);
+    assert_true(file_exists(join_path(out, "tiny.sectors-100/run.txt")));
 }
 
 /* On a 40-column terminal every progress redraw fits in 39 columns (a longer line wraps,
@@ -980,8 +1044,11 @@ static void test_progress_line_is_cut_to_the_terminal_width(void **state)
     assert_int_equal(longest, 39); /* cut (the whole line is longer), never more */
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    if (argc > 1) {
+        cmocka_set_test_filter(argv[1]); /* e.g. test_slurm_*: one test while working on it */
+    }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_task_stopped_and_resumed_matches_uninterrupted_bytes),
         cmocka_unit_test(test_candidate_and_parent_face_the_same_k_episodes_and_the_budget_counts_episodes),
@@ -992,6 +1059,7 @@ int main(void)
         cmocka_unit_test(test_program_killed_by_pid_resumes_to_identical_results),
         cmocka_unit_test(test_shares_in_separate_processes_merge_to_the_local_run_byte_for_byte),
         cmocka_unit_test(test_slurm_scripts_run_stage_two_after_stage_one_and_keep_foreign_files),
+        cmocka_unit_test(test_slurm_refuses_values_that_would_break_an_sbatch_line),
         cmocka_unit_test(test_table_mode_and_network_mode_give_identical_results),
         cmocka_unit_test(test_atomic_write_never_follows_a_planted_symlink),
         cmocka_unit_test(test_plot_child_dies_when_simevo_is_killed),

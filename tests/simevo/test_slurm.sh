@@ -19,6 +19,12 @@ cluster_up "$d/c"
 rc=$?
 [ $rc = 0 ] || exit $rc
 echo "cluster up: daemons $CLUSTER_PIDS, $(sinfo -h -o '%P %t %c cpus')"
+# slurmd's port follows slurmctld's (it once read an unset variable and got port 1)
+ctld_port=$(scontrol show config | sed -n 's/^SlurmctldPort *= *//p')
+slurmd_port=$(scontrol show config | sed -n 's/^SlurmdPort *= *//p')
+echo "ports: slurmctld $ctld_port, slurmd $slurmd_port"
+[ "$slurmd_port" -gt "$ctld_port" ] || fail "slurmd port $slurmd_port is not above slurmctld's $ctld_port"
+ss -ltn | awk '{print $4}' | grep -qx "127.0.0.1:$slurmd_port" || fail "nothing listens on 127.0.0.1:$slurmd_port"
 
 export QNAV_DATA_DIR="$src/data"
 exp="$src/tests/simevo/tiny.toml"

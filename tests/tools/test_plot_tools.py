@@ -86,6 +86,24 @@ class CommandLine(unittest.TestCase):
             self.assertEqual(r.stderr.strip(), f"plot_policy.py: {d}/quality.csv: No such file or directory")
 
 
+class WithoutMatplotlib(unittest.TestCase):
+    """Issue 20: run by a python3 that lacks matplotlib (here: -S, no site-packages), each
+    plot script printed a traceback; now one line naming the interpreter and exit 1."""
+
+    def test_each_plot_script_says_matplotlib_is_missing_in_one_line(self):
+        with tempfile.TemporaryDirectory() as d:
+            quality_csv(d)
+            for script in ("plot_policy.py", "plot_learning.py", "plot_episodes.py"):
+                r = subprocess.run([sys.executable, "-S", os.path.join(TOOLS, script), d],
+                                   capture_output=True, text=True, timeout=100)
+                self.assertEqual(r.returncode, 1, script + ": " + r.stderr)
+                self.assertNotIn("Traceback", r.stderr, script)
+                self.assertEqual(len(r.stderr.strip().splitlines()), 1, script + ": " + r.stderr)
+                self.assertTrue(r.stderr.startswith(f"{script}: {sys.executable} cannot import matplotlib"),
+                                r.stderr)
+                self.assertIn("python3-matplotlib", r.stderr)
+
+
 class SigmoidTable(unittest.TestCase):
     def test_generator_reproduces_the_committed_table_and_refuses_arguments(self):
         r = run_script("gen_sigmoid_lut.py")

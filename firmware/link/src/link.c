@@ -774,6 +774,11 @@ int32_t qnav_link_policy_from_blob(const uint8_t *blob, uint16_t len, qnav_polic
     if (rc != QNAV_LINK_OK) {
         return rc;
     }
+    /* the writer's rule (qnav_link_policy_to_blob), so a blob the writer refuses is refused
+     * here too: a probabilistic k_goal or k_safe outside (0, 64] */
+    if (qnav_policy_validate(&p) != QNAV_POLICY_OK) {
+        return QNAV_LINK_E_VALUE;
+    }
     *policy = p;
     return QNAV_LINK_OK;
 }

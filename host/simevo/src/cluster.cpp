@@ -5,9 +5,11 @@
 #include "cluster.h"
 
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <regex>
 #include <sstream>
 
 #include "files.h"
@@ -58,7 +60,57 @@ void write_script(const std::string &path, const std::string &content)
     write_file_atomic(path, content);
 }
 
+/* v for a one-line message: control characters as \n, \t or \xNN. */
+std::string shown(const std::string &v)
+{
+    std::string o;
+    for (unsigned char c : v) {
+        if (c == '\n') o += "\\n";
+        else if (c == '\t') o += "\\t";
+        else if (c < 0x20 || c == 0x7f) {
+            char b[8];
+            std::snprintf(b, sizeof b, "\\x%02x", c);
+            o += b;
+        } else o += static_cast<char>(c);
+    }
+    return o;
+}
+
+/* The folder in an #SBATCH --output pattern: in double quotes (sbatch splits the line at
+ * blanks and ends it at an unquoted '#'), '%' doubled (Slurm's pattern escape). */
+std::string sbatch_output(const std::string &dir, const std::string &file_pattern)
+{
+    std::string o = "\"";
+    for (char c : dir) {
+        o += c == '%' ? std::string("%%") : std::string(1, c);
+    }
+    return o + "/" + file_pattern + "\"";
+}
+
 } // namespace
+
+void check_slurm_options(const SlurmOptions &o, const std::string &out_dir)
+{
+    // Slurm partition names (comma-separated for several) and time limits (minutes,
+    // M:S, H:M:S, D-H, D-H:M, D-H:M:S, or unlimited): anything else would be sbatch's
+    // error at best and, with a newline, a shell command in tasks.sbatch at worst.
+    static const std::regex partition("[A-Za-z0-9_.-]+(,[A-Za-z0-9_.-]+)*");
+    static const std::regex time("([0-9]+(:[0-9]+){0,2}|[0-9]+-[0-9]+(:[0-9]+){0,2}|UNLIMITED|unlimited|INFINITE|infinite)");
+    if (!o.partition.empty() && !std::regex_match(o.partition, partition)) {
+        throw UserError("--partition: '" + shown(o.partition) +
+                        "' is not a Slurm partition name (letters, digits, '_', '.', '-'; several separated by ',')");
+    }
+    if (!o.time.empty() && !std::regex_match(o.time, time)) {
+        throw UserError("--time: '" + shown(o.time) +
+                        "' is not a Slurm time limit (MINUTES, M:S, H:M:S, D-H, D-H:M, D-H:M:S or unlimited)");
+    }
+    for (unsigned char c : out_dir) {
+        if (c < 0x20 || c == 0x7f || c == '"' || c == '\\') {
+            throw UserError("--out: '" + shown(out_dir) +
+                            "' holds a control character, '\"' or '\\' and cannot go on an #SBATCH line");
+        }
+    }
+}
 
 std::string sh_quote(const std::string &s)
 {
@@ -249,6 +301,7 @@ std::string write_sweep_submit(const std::string &sweep_dir, const std::vector<s
 std::string write_slurm_scripts(const std::vector<TaskDef> &tasks, const std::string &exp_dir, const RunArgs &a,
                                 const SlurmOptions &o)
 {
+    check_slurm_options(o, exp_dir);
     const std::string dir = join_path(exp_dir, "slurm");
     make_dirs(dir);
     std::string head = "#!/bin/sh\n# written by simevo slurm (docs/cluster.md); regenerate rather than edit\n";
@@ -260,10 +313,10 @@ std::string write_slurm_scripts(const std::vector<TaskDef> &tasks, const std::st
                                 (a.network_mode ? " --network-mode" : "") + " --no-plot --no-progress -j " +
                                 std::to_string(o.jobs);
     const std::string tasks_sh = head + "# usage (by submit.sh): sbatch --array=1-N tasks.sbatch STAGE N\n" + sb +
-                                 "#SBATCH --cpus-per-task=" + std::to_string(o.jobs) + "\n#SBATCH --output=" + dir +
-                                 "/%x-%A_%a.out\n#SBATCH --job-name=simevo-tasks\nexec " + run_cmd +
+                                 "#SBATCH --cpus-per-task=" + std::to_string(o.jobs) + "\n#SBATCH --output=" +
+                                 sbatch_output(dir, "%x-%A_%a.out") + "\n#SBATCH --job-name=simevo-tasks\nexec " + run_cmd +
                                  " --stage \"$1\" --tasks \"$SLURM_ARRAY_TASK_ID/$2\"\n";
-    const std::string sum_sh = head + sb + "#SBATCH --output=" + dir + "/%x-%j.out\n#SBATCH --job-name=simevo-summarize\nexec " +
+    const std::string sum_sh = head + sb + "#SBATCH --output=" + sbatch_output(dir, "%x-%j.out") + "\n#SBATCH --job-name=simevo-summarize\nexec " +
                                sh_quote(o.simevo) + " summarize " + sh_quote(exp_dir) + " --tools-dir " +
                                sh_quote(o.tools_dir) + (o.plots ? "" : " --no-plot") + "\n";
     const std::size_t per = o.tasks_per_job;

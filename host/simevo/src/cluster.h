@@ -71,6 +71,10 @@ struct SlurmOptions {
     uint32_t tasks_per_job = 1;  /* simevo tasks per array task */
     uint32_t jobs = 1;           /* threads (and --cpus-per-task) per array task */
 };
+/* Throws UserError (one line naming the option) when --partition or --time is not a
+ * Slurm partition name or time limit, or out_dir holds a character an #SBATCH line
+ * cannot carry (a control character, '"' or '\\'). */
+void check_slurm_options(const SlurmOptions &o, const std::string &out_dir);
 /* Writes sweep_dir/slurm/submit.sh, which runs every member's submit.sh in turn. Returns
  * its path. */
 std::string write_sweep_submit(const std::string &sweep_dir, const std::vector<std::string> &member_scripts);

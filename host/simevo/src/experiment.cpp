@@ -1021,10 +1021,20 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
         o << "![learning curves](learning.png)\n\n![policy quality](policy.png)\n\n"
           << "![held-out episodes of the best policies](episodes.png)\n\n";
     }
-    // a sweep member is named NAME.KEY-VALUE (names have no dots): the command names NAME
-    // and the variation is in the overrides (--vary KEY=VALUE)
-    o << "Regenerate: `simevo run " << spec.name.substr(0, spec.name.find('.')) << " --preset " << opt.preset
-      << opt.overrides << "` (with the same `--out`)\n";
+    // The file run.txt records (an experiment run from a file has no name simevo knows; a
+    // sweep member's variation is in the overrides, --vary KEY=VALUE); without one, the
+    // name (a sweep member is NAME.KEY-VALUE: names have no dots).
+    std::string what = opt.experiment_file;
+    if (what.empty()) {
+        what = spec.name.substr(0, spec.name.find('.'));
+    } else if (what.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_./+-") !=
+               std::string::npos) {
+        std::string q = "'";
+        for (char c : what) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+        what = q + "'";
+    }
+    o << "Regenerate: `simevo run " << what << " --preset " << opt.preset << opt.overrides
+      << "` (with the same `--out`)\n";
     return o.str();
 }
 

@@ -34,6 +34,8 @@ struct RunOptions {
                                        recorded there, so the line regenerates these results */
     std::string run_record;         /* run.txt: what `simevo summarize` rebuilds the spec
                                        from (written once, compared later); "" = none */
+    std::string experiment_file;    /* the file run (run.txt's file), named by the summary's
+                                       Regenerate line; "" = the experiment's name */
 };
 
 /* Target episodes after which a target run's best member is evaluated held out: the

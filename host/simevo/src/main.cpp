@@ -188,6 +188,7 @@ void set_run_options(RunOptions &opt, const RunArgs &args, const std::string &ex
     opt.preset = args.preset;
     opt.overrides = override_flags(args);
     opt.run_record = run_record_text(experiment_file, args);
+    opt.experiment_file = experiment_file;
 }
 
 int summarize_sweep(const std::string &dir, const std::string &record_path, const RunOptions &opt, bool &started);
@@ -528,6 +529,7 @@ int main(int argc, char **argv)
         if (*slurm) {
             std::vector<Sweep> sweeps;
             const auto items = load_run_specs({slurm_name}, experiments_dir, run_args, sweeps);
+            check_slurm_options(so, opt.out_dir);
             started = true;
             return write_slurm_all(items, sweeps, opt, so, !no_plot, submit);
         }

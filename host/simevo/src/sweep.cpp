@@ -42,10 +42,15 @@ const VaryKey *find_vary_key(const std::string &name)
     return nullptr;
 }
 
-/* The shortest decimal text that reads back as v exactly (0.05, not 0.050000000000000003). */
+/* The shortest decimal text that reads back as v exactly (0.05, not 0.050000000000000003);
+ * a whole number as an integer (100000, not 1e+05: it names folders and fills messages). */
 std::string shortest_text(double v)
 {
     char buf[40];
+    if (std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e15) {
+        std::snprintf(buf, sizeof buf, "%.0f", v);
+        return buf;
+    }
     for (int p = 1; p <= 17; ++p) {
         std::snprintf(buf, sizeof buf, "%.*g", p, v);
         if (std::strtod(buf, nullptr) == v) {
@@ -58,9 +63,13 @@ std::string shortest_text(double v)
 /* A value of key k as text, or "" with *problem set when it is out of range. */
 std::string vary_value_text(const VaryKey &k, double v, std::string *problem)
 {
-    if (!std::isfinite(v) || v < k.lo || v > k.hi || (k.integer && v != std::floor(v))) {
-        *problem = std::string(k.name) + ": " + shortest_text(v) + " is not " + (k.integer ? "a whole number in " : "in ") +
-                   "[" + shortest_text(k.lo) + ", " + shortest_text(k.hi) + "]";
+    if (!std::isfinite(v) || v < k.lo || v > k.hi) {
+        *problem = std::string(k.name) + ": " + shortest_text(v) + " is not in [" + shortest_text(k.lo) + ", " +
+                   shortest_text(k.hi) + "]";
+        return "";
+    }
+    if (k.integer && v != std::floor(v)) {
+        *problem = std::string(k.name) + ": " + shortest_text(v) + " is not a whole number";
         return "";
     }
     return shortest_text(v);

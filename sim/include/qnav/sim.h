@@ -293,8 +293,9 @@ qnav_sim_status_t qnav_sim_reset(qnav_sim_t *sim, uint64_t episode_seed);
  * pose) and compute a new scan. QNAV_SIM_E_PARAM for a pose outside the arena. */
 qnav_sim_status_t qnav_sim_place(qnav_sim_t *sim, double x_m, double y_m, double heading_rad);
 
-/* Copy this tick's scan (computed once per tick at reset/advance, so reading it twice
- * gives the same values). QNAV_SIM_E_STATE before the first reset. */
+/* Copy this tick's scan, every field (computed once per tick at reset/advance, so reading
+ * it twice gives the same values; qnav_sim_command changes prev_heading_cdeg only from the
+ * next advance). QNAV_SIM_E_STATE before the first reset. */
 qnav_sim_status_t qnav_sim_scan(const qnav_sim_t *sim, qnav_sim_scan_t *scan);
 
 /* Set the command for the next advance. heading is robot-frame deg (wrapped), speed is a

@@ -340,7 +340,8 @@ QNAV_CHECK_RESULT int32_t qnav_link_policy_to_blob(const qnav_policy_t *policy, 
  * CRC (0 when it cannot be serialised). */
 uint16_t qnav_link_policy_crc(const qnav_policy_t *policy);
 
-/* Parse a blob back; QNAV_LINK_OK or QNAV_LINK_E_NULL / _LENGTH / _VALUE. */
+/* Parse a blob back; QNAV_LINK_OK or QNAV_LINK_E_NULL / _LENGTH / _VALUE (also for a
+ * policy qnav_policy_validate refuses, as the writer does); *policy untouched on error. */
 QNAV_CHECK_RESULT
 int32_t qnav_link_policy_from_blob(const uint8_t *blob, uint16_t len, qnav_policy_t *policy);
 
