@@ -481,11 +481,6 @@ int main(int argc, char **argv) {
     gen->add_option("--name", g_name, "environment name (default: generated-d<density>-s<seed>)");
     gen->add_option("--out", g_out, "TOML file to write")->required();
 
-    std::string rh_robot = "tekbot", rh_out;
-    CLI::App *rh = app.add_subcommand("robot-header", "write a robot's board configuration as a C header (for a firmware build)");
-    rh->add_option("--robot", rh_robot, "robot profile (name or file)")->capture_default_str();
-    rh->add_option("OUT", rh_out, "header file to write")->required();
-
     BenchOpts bo;
     CLI::App *bench = app.add_subcommand("bench", "episodes per second per core, time split");
     bench->add_option("--robot", bo.robot, "robot profile")->capture_default_str();
@@ -501,6 +496,11 @@ int main(int argc, char **argv) {
     bench->add_option("--seed", bo.seed, "context and network seed")->capture_default_str();
     bench->add_option("--sensor-noise", bo.ps, "p_s")->check(qnav::cli::finite_range(0.0, 1.0))->capture_default_str();
     bench->add_option("--actuation-noise", bo.pa, "p_a")->check(qnav::cli::finite_range(0.0, 1.0))->capture_default_str();
+
+    std::string rh_robot = "tekbot", rh_out;
+    CLI::App *rh = app.add_subcommand("robot-header", "write a robot's board configuration as a C header (for a firmware build)");
+    rh->add_option("--robot", rh_robot, "robot profile (name or file)")->capture_default_str();
+    rh->add_option("OUT", rh_out, "header file to write")->required();
 
     if (const int status = qnav::cli::parse(app, argc, argv, "qnav-sim"); status >= 0) return status;
     try {
