@@ -323,7 +323,8 @@ static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
     }
     memset(&q, 0, sizeof q);
     qnav_bridge_ctrl_step(&b->bc, &s, &c, q.quality_q15);
-    if (b->cfg.mode == QNAV_LINK_MODE_OFFBOARD && !b->shutting_down) {
+    if (b->cfg.mode == QNAV_LINK_MODE_OFFBOARD && !b->shutting_down &&
+        (b->cfg.check_config == NULL || b->config_ok)) {
         if (b->watchdog_stop && b->diag != NULL) {
             fprintf(b->diag, "navbridge: scans are back: resuming commands\n");
         }
@@ -390,6 +391,22 @@ static int on_board_heartbeat(qnav_bridge_t *b, const qnav_link_frame_t *f)
     b->board_stored = stored;
     b->board_crc_reported = hb.policy_crc;
     return 1;
+}
+
+/* The board's robot configuration, checked against the operator's robot (--robot). */
+static void on_config(qnav_bridge_t *b, const qnav_link_frame_t *f)
+{
+    qnav_link_config_t m;
+    if (b->cfg.check_config == NULL ||
+        qnav_link_config_unpack(f->payload, f->len, &m) != QNAV_LINK_OK) {
+        return;
+    }
+    if (b->cfg.check_config(b->cfg.check_user, &m, b->config_diff, sizeof b->config_diff) == 0) {
+        b->config_ok = 1;
+    } else {
+        b->config_ok = 0;
+        b->config_refused = 1;
+    }
 }
 
 static void send_route_goal(qnav_bridge_t *b)
@@ -534,6 +551,9 @@ void qnav_bridge_on_bytes(qnav_bridge_t *b, const uint8_t *bytes, size_t n, int6
             break;
         case QNAV_LINK_MSG_POLICY_ACK:
             on_ack(b, &f);
+            break;
+        case QNAV_LINK_MSG_CONFIG:
+            on_config(b, &f);
             break;
         default:
             break; /* goals and uploads only flow to the board */

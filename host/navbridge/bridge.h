@@ -75,6 +75,11 @@ typedef struct {
                                      "literal", "vfh" (qnav/nav.h) */
     qnav_policy_t policy;         /* offboard: drives the robot; onboard: qualities shown */
     int upload;                   /* onboard: upload policy to the board */
+    /* --robot: checks each CONFIG report of the board against the robot's profile; 0 when
+     * it matches, else 1 with "FIELD REPORTED != EXPECTED" in line. NULL: no check. With a
+     * check, offboard commands wait for the first matching report. */
+    int (*check_config)(void *user, const qnav_link_config_t *m, char *line, size_t len);
+    void *check_user;
 } qnav_bridge_config_t;
 
 /* The controller step of the bridge, shared with the replay: re-initialises when the
@@ -139,6 +144,9 @@ typedef struct {
     uint8_t refused_protocol;         /* a board of this other protocol version was heard
                                          (0 none): the bridge must stop (main exits) */
     int heard_board;                  /* a heartbeat of our version came */
+    int config_ok;                    /* the board's last CONFIG report passed check_config */
+    int config_refused;               /* one did not (main exits): config_diff says why */
+    char config_diff[96];
     uint8_t board_stored;             /* last reported QNAV_LINK_STATE_STORED bit */
     uint16_t board_crc_reported;
 

@@ -5,7 +5,9 @@
  * the board. Everything is published on LCM. When the board goes quiet for --timeout-ms
  * it commands a stop; SIGINT/SIGTERM/SIGHUP stop the robot before exiting (status 0); a port that
  * hangs up ends it with status 1 (link lost), and so does a board of another link
- * protocol version (one line saying which). --replay re-runs a
+ * protocol version (one line saying which). With --robot it runs the controller
+ * configuration of that robot's profile and refuses a board whose reported configuration
+ * differs (one line naming the field, status 1). --replay re-runs a
  * recorded trial's scans through the controller and checks the commands are identical.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -30,6 +32,7 @@
 #include "qnav/policy_io.h"
 #include "qnav_goal_t.h"
 #include "replay.h"
+#include "robot_board.h"
 #include "serial.h"
 
 static volatile sig_atomic_t g_stop_signal = 0;
@@ -52,14 +55,16 @@ static void usage(FILE *f)
             "usage: navbridge --device PATH [--baud N] [--lcm-url URL] [--mode offboard|onboard]\n"
             "                 [--policy FILE] [--upload] [--timeout-ms N] [--log FILE]\n"
             "                 [--goal DEG[:METRES] | --goal-at X:Y | --waypoints X:Y,...]\n"
-            "                 [--goal-radius M] [--controller NAME]\n"
-            "       navbridge --replay LOG [--policy FILE] [--controller NAME]\n"
+            "                 [--goal-radius M] [--controller NAME] [--robot NAME|FILE]\n"
+            "       navbridge --replay LOG [--policy FILE] [--controller NAME] [--robot NAME|FILE]\n"
             "  --device PATH      serial port to the board (or the SIL robot's pty)\n"
             "  --baud N           serial rate, default 57600\n"
             "  --lcm-url URL      LCM provider URL, default LCM's own default\n"
             "  --mode M           offboard (bridge runs libqnav, default) or onboard\n"
             "  --policy FILE      policy file; default: hand-tuned probabilistic policy\n"
             "  --controller NAME  offboard controller: body (default), literal, vfh\n"
+            "  --robot NAME|FILE  robot profile (data/robots): the controller runs its\n"
+            "                     configuration, and a board reporting another is refused\n"
             "  --upload           onboard: upload --policy to the board at start\n"
             "  --timeout-ms N     stop the robot after N ms without scans/heartbeats (300)\n"
             "  --log FILE         also write every published message to an LCM log\n"
@@ -122,6 +127,35 @@ static int parse_route(const char *s, qnav_waypoints_t *w)
     }
 }
 
+/* --robot: the board configuration its profile gives. */
+typedef struct {
+    const char *name;
+    qnav_board_config_t expected;
+} robot_check_t;
+
+static int check_board_config(void *user, const qnav_link_config_t *m, char *line, size_t len)
+{
+    return qnav_robot_board_diff(m, &((robot_check_t *)user)->expected, line, len);
+}
+
+/* Load --robot into rc and cfg (controller configuration, check); 0 or 2 after one line. */
+static int use_robot(const char *spec, robot_check_t *rc, qnav_bridge_config_t *cfg)
+{
+    char err[QNAV_SIM_ERRLEN];
+    qnav_sim_robot_t *robot = NULL;
+    if (qnav_sim_robot_load(spec, &robot, err, sizeof err) != QNAV_SIM_OK) {
+        fprintf(stderr, "navbridge: --robot: %s\n", err);
+        return 2;
+    }
+    qnav_robot_board_config(robot, &rc->expected);
+    qnav_sim_robot_free(robot);
+    rc->name = spec;
+    cfg->ctrl = rc->expected.ctrl;
+    cfg->check_config = check_board_config;
+    cfg->check_user = rc;
+    return 0;
+}
+
 static int write_serial(void *user, const uint8_t *bytes, size_t n)
 {
     return qnav_serial_write_all(*(int *)user, bytes, n);
@@ -139,7 +173,10 @@ int main(int argc, char **argv)
         {"goal-at", required_argument, NULL, 'A'}, {"waypoints", required_argument, NULL, 'W'},
         {"goal-radius", required_argument, NULL, 'G'},
         {"controller", required_argument, NULL, 'c'},
+        {"robot", required_argument, NULL, 'R'},
         {NULL, 0, NULL, 0}};
+    static robot_check_t robot_check;
+    const char *robot_spec = NULL;
     const char *device = NULL, *lcm_url = NULL, *policy_path = NULL, *log_path = NULL;
     const char *replay_path = NULL;
     long baud = 57600, timeout_ms = 300;
@@ -171,6 +208,7 @@ int main(int argc, char **argv)
             cfg.controller = optarg;
             break;
         case 'l': log_path = optarg; break;
+        case 'R': robot_spec = optarg; break;
         case 'r': replay_path = optarg; break;
         case 'U': cfg.upload = 1; break;
         case 'b':
@@ -261,6 +299,9 @@ int main(int argc, char **argv)
         return 2;
     }
     cfg.timeout_ms = (uint32_t)timeout_ms;
+    if (robot_spec != NULL && use_robot(robot_spec, &robot_check, &cfg) != 0) {
+        return 2;
+    }
     if (policy_path != NULL) {
         if (qnav_policy_read(policy_path, &cfg.policy, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
@@ -377,6 +418,12 @@ int main(int argc, char **argv)
         if (n > 0 && (p[1].revents & POLLIN)) {
             bridge.now_ms = mono_ms();
             lcm_handle_timeout(lcm, 0);
+        }
+        if (bridge.config_refused) {
+            fprintf(stderr, "navbridge: board configuration differs from robot '%s': %s\n",
+                    robot_check.name, bridge.config_diff);
+            exit_code = 1; /* docs/cli.md: a failure at run time */
+            break;
         }
         if (bridge.refused_protocol != 0) {
             fprintf(stderr, "navbridge: %s: the board speaks link protocol %u, this navbridge "

@@ -29,7 +29,7 @@
 #include "qnav/board.h"
 #include "qnav/cli.h"
 #include "qnav/sim.h"
-#include "qnav/tekbot.h"
+#include "robot_board.h"
 #include "qnav_pose_t.h"
 #include "sil_hal.h"
 
@@ -69,7 +69,8 @@ static void usage(FILE *f)
             "                      [--start X:Y:DEG] [--nvm FILE] [--playback LOG]\n"
             "                      [--lockstep | --tick-ms N] [--reply-ms N] [--wait-s N]\n"
             "                      [--lcm-url URL | --pose]\n"
-            "  --robot, --env   simulator robot profile and environment (tekbot, open)\n"
+            "  --robot, --env   robot profile and environment (tekbot, open): the board\n"
+            "                   core runs the configuration generated from the profile\n"
             "  --sectors N      sonar sectors (0 = the profile's default)\n"
             "  --seed, --episode  simulator seed and episode seed (1, 1)\n"
             "  --noise P        sensor, actuation and wheel-slip (odometry) noise level p (0)\n"
@@ -79,7 +80,8 @@ static void usage(FILE *f)
             "  --nvm FILE       the board's non-volatile storage (made erased if absent);\n"
             "                   default: RAM only\n"
             "  --playback LOG   feed the QNAV_SCAN stream of an LCM log to the board core\n"
-            "                   (TekBot configuration) instead of the simulator\n"
+            "                   (recorded with --robot's configuration) instead of the\n"
+            "                   simulator\n"
             "  --lockstep       wait for each reply instead of the 0.1 s wall clock\n"
             "  --tick-ms N      wall-clock period of a 0.1 s simulated tick (100; smaller\n"
             "                   runs faster than real time)\n"
@@ -174,18 +176,32 @@ static int parse_options(int argc, char **argv, options_t *o)
     return 0;
 }
 
-/* The board configuration: the TekBot's, with the simulated robot's sonar and body. */
-static void board_config(qnav_sim_t *sim, const sil_hal_t *hal, qnav_board_config_t *bc)
+/* The board configuration: the one generated from the robot's profile (the simulator's
+ * sector count when --sectors overrides the profile's). A playback must be a recording of
+ * that robot: 0, or -1 after one line naming the field that differs. */
+static int board_config(const options_t *o, const qnav_sim_robot_t *robot, qnav_sim_t *sim,
+                        const sil_hal_t *hal, qnav_board_config_t *bc)
 {
-    qnav_ctrl_config_t cc;
-    qnav_tekbot_config_default(bc);
-    if (sim == NULL) {
-        bc->n_sectors = hal->playback[0].n_sectors;
-        bc->max_range_mm = hal->playback[0].max_range_mm;
-        return;
+    qnav_robot_board_config(robot, bc);
+    if (sim != NULL) {
+        qnav_sim_ctrl_config(sim, &bc->ctrl);
+        return 0;
     }
-    qnav_sim_ctrl_config(sim, &cc);
-    qnav_board_config_from_ctrl(bc, &cc);
+    if (o->sectors > 0) {
+        bc->ctrl.n_sectors = (uint16_t)o->sectors;
+    }
+    if (hal->playback[0].n_sectors != bc->ctrl.n_sectors ||
+        hal->playback[0].max_range_mm != bc->ctrl.max_range_mm) {
+        int sectors = hal->playback[0].n_sectors != bc->ctrl.n_sectors;
+        fprintf(stderr, "qnav-sil-robot: --playback %s: recorded scans differ from robot '%s': "
+                        "%s %u != %u\n", o->playback, o->robot,
+                sectors ? "n_sectors" : "max_range_mm",
+                sectors ? (unsigned)hal->playback[0].n_sectors
+                        : (unsigned)hal->playback[0].max_range_mm,
+                sectors ? (unsigned)bc->ctrl.n_sectors : (unsigned)bc->ctrl.max_range_mm);
+        return -1;
+    }
+    return 0;
 }
 
 /* The pty, raw from the start; the slave stays open so the master never sees EIO while
@@ -311,14 +327,17 @@ static int start(robot_t *r, const options_t *o, qnav_sim_robot_t **robot,
     qnav_sim_config_t scfg;
     qnav_board_config_t bc;
     qnav_board_hal_t hal;
+    if (qnav_sim_robot_load(o->robot, robot, err, sizeof err) != QNAV_SIM_OK) {
+        fprintf(stderr, "%s\n", err);
+        return 2;
+    }
     if (o->playback != NULL) {
         if (sil_hal_load_playback(&r->hal, o->playback, err, sizeof err) != 0) {
             fprintf(stderr, "qnav-sil-robot: %s\n", err);
             return 2;
         }
     } else {
-        if (qnav_sim_robot_load(o->robot, robot, err, sizeof err) != QNAV_SIM_OK ||
-            qnav_sim_env_load(o->env, env, err, sizeof err) != QNAV_SIM_OK) {
+        if (qnav_sim_env_load(o->env, env, err, sizeof err) != QNAV_SIM_OK) {
             fprintf(stderr, "%s\n", err);
             return 2;
         }
@@ -335,9 +354,6 @@ static int start(robot_t *r, const options_t *o, qnav_sim_robot_t **robot,
                     r->sim != NULL && o->have_start ? "--start: outside the arena" : err);
             return 2;
         }
-        qnav_sim_robot_info_t ri;
-        qnav_sim_robot_info(*robot, &ri);
-        r->hal.track_m = 2.0 * ri.radius_m;
     }
     r->hal.sim = r->sim;
     r->hal.nvm_path = o->nvm;
@@ -347,7 +363,10 @@ static int start(robot_t *r, const options_t *o, qnav_sim_robot_t **robot,
     if (r->hal.fd < 0) {
         return 2;
     }
-    board_config(r->sim, &r->hal, &bc);
+    if (board_config(o, *robot, r->sim, &r->hal, &bc) != 0) {
+        return 2;
+    }
+    r->hal.track_m = bc.track_mm / 1000.0;
     r->hal.um_per_count = bc.um_per_count;
     if (sil_hal_init(&r->hal, &hal, err, sizeof err) != 0) {
         fprintf(stderr, "qnav-sil-robot: %s\n", err);

@@ -1,9 +1,12 @@
 /*
- * qnav-simavr-board: the TekBot firmware image itself (tekbot.elf, built for the ATmega128)
- * running cycle by cycle in simavr, with its USART0 on a pseudo-terminal served from the
- * simulation loop, so navbridge talks to the real board code without hardware. Sonar
- * voltages are fed into ADC0..7 from a slowly changing scene; the encoders stay still, so
- * the heading reads 0. Simulated time is held to the wall clock so the board's 10 Hz tick
+ * qnav-simavr-board: a board's firmware image itself (tekbot-avr.elf or pioneer3dx-avr.elf,
+ * built for the ATmega128) running cycle by cycle in simavr, with its USART0 on a
+ * pseudo-terminal served from the simulation loop, so navbridge talks to the real board
+ * code without hardware. --robot names the robot the image must be built for: the board's
+ * CONFIG report is compared with that profile's configuration and a board that differs is
+ * refused (one line naming the field, status 1). Sonar voltages for the profile's sectors
+ * are fed into ADC0..7 (sectors 8..15 through the PB2 multiplexer) from a slowly changing
+ * scene; the encoders stay still, so the heading reads 0. Simulated time is held to the wall clock so the board's 10 Hz tick
  * and link timeout mean what they say. --eeprom FILE is the MCU's EEPROM across runs
  * (loaded at start, saved at exit: a run is a power cycle); --power-cut-after N stops the
  * MCU dead once N bytes of its EEPROM have changed, as a power loss in the middle of a
@@ -25,12 +28,15 @@
 
 #include <simavr/avr_adc.h>
 #include <simavr/avr_eeprom.h>
+#include <simavr/avr_ioport.h>
 #include <simavr/avr_uart.h>
 #include <simavr/sim_avr.h>
 #include <simavr/sim_elf.h>
 
 #include "ptylink.h"
 #include "qnav/cli.h"
+#include "qnav/link.h"
+#include "robot_board.h"
 
 static volatile sig_atomic_t g_quit = 0;
 
@@ -73,10 +79,36 @@ typedef struct {
     size_t out_len;
 } board_uart_t;
 
+/* The board's CONFIG reports, read from what it sends, against the robot's profile. */
+typedef struct {
+    qnav_link_rx_t rx;
+    const qnav_board_config_t *expected;
+    int checked;                  /* a report matched */
+    int refused;                  /* a report differed: diff says how */
+    char diff[96];
+} config_watch_t;
+
+static config_watch_t g_watch;
+
+static void watch_byte(config_watch_t *w, uint8_t b)
+{
+    qnav_link_frame_t f;
+    qnav_link_config_t m;
+    if (qnav_link_rx_feed(&w->rx, b, &f) && f.msg_id == QNAV_LINK_MSG_CONFIG &&
+        qnav_link_config_unpack(f.payload, f.len, &m) == QNAV_LINK_OK) {
+        if (qnav_robot_board_diff(&m, w->expected, w->diff, sizeof w->diff) == 0) {
+            w->checked = 1;
+        } else {
+            w->refused = 1;
+        }
+    }
+}
+
 static void on_uart_byte(struct avr_irq_t *irq, uint32_t value, void *param)
 {
     board_uart_t *u = (board_uart_t *)param;
     (void)irq;
+    watch_byte(&g_watch, (uint8_t)value);
     if (u->out_len < sizeof u->out) {
         u->out[u->out_len++] = (uint8_t)value;
     } /* else: nobody reads the port, dropped like a UART with no listener */
@@ -165,6 +197,30 @@ static void uart_service(board_uart_t *u, uint64_t cycle)
 static uint32_t range_to_mv(uint32_t mm)
 {
     return (uint32_t)((double)mm / 12.7 * (5000.0 / 1024.0));
+}
+
+/* The sonar scene: ranges of up to 16 sectors, sectors 8..15 on the ADC while the board's
+ * PB2 multiplexer select line is high (hal_avr.c). */
+typedef struct {
+    avr_irq_t *adc[8];
+    uint32_t mm[16];
+    int bank;                     /* 0: sectors 0..7 on ADC0..7, 1: sectors 8..15 */
+} sonar_scene_t;
+
+static void scene_apply(sonar_scene_t *sc)
+{
+    int k;
+    for (k = 0; k < 8; ++k) {
+        avr_raise_irq(sc->adc[k], range_to_mv(sc->mm[8 * sc->bank + k]));
+    }
+}
+
+static void on_mux_select(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    sonar_scene_t *sc = (sonar_scene_t *)param;
+    (void)irq;
+    sc->bank = value != 0u;
+    scene_apply(sc);
 }
 
 #define EEPROM_BYTES 4096 /* ATmega128 */
@@ -262,7 +318,12 @@ int main(int argc, char **argv)
         {"seconds", required_argument, NULL, 's'}, {"help", no_argument, NULL, 'h'},
         {"baud", required_argument, NULL, 'b'},
         {"version", no_argument, NULL, 'V'},       {"eeprom", required_argument, NULL, 'E'},
-        {"power-cut-after", required_argument, NULL, 'C'}, {NULL, 0, NULL, 0}};
+        {"power-cut-after", required_argument, NULL, 'C'},
+        {"robot", required_argument, NULL, 'r'},   {NULL, 0, NULL, 0}};
+    const char *robot_spec = "tekbot";
+    static qnav_board_config_t expected;
+    static sonar_scene_t scene;
+    int sectors, refused = 0;
     const char *eeprom_path = NULL;
     static uint8_t ee_start[EEPROM_BYTES];
     long cut_after = 0, changed = 0;
@@ -271,7 +332,6 @@ int main(int argc, char **argv)
     elf_firmware_t fw;
     avr_t *avr;
     static board_uart_t uart;
-    avr_irq_t *adc[8];
     int64_t t0;
     uint64_t last_scene = (uint64_t)-1;
     int c, k, state = cpu_Running;
@@ -293,6 +353,7 @@ int main(int argc, char **argv)
             break;
         }
         case 'l': link_path = optarg; break;
+        case 'r': robot_spec = optarg; break;
         case 's': {
             char *end = NULL;
             seconds = strtod(optarg, &end);
@@ -313,9 +374,12 @@ int main(int argc, char **argv)
             break;
         }
         case 'h':
-            printf("usage: qnav-simavr-board --elf tekbot.elf [--link PATH] [--seconds S]\n"
-                   "                         [--baud N] [--eeprom FILE [--power-cut-after N]]\n"
-                   "  --elf FILE     the TekBot firmware image (tekbot-avr.elf)\n"
+            printf("usage: qnav-simavr-board --elf IMAGE [--robot NAME|FILE] [--link PATH]\n"
+                   "                         [--seconds S] [--baud N]\n"
+                   "                         [--eeprom FILE [--power-cut-after N]]\n"
+                   "  --elf FILE     the board's firmware image (tekbot-avr.elf, pioneer3dx-avr.elf)\n"
+                   "  --robot R      the robot profile the image must be built for (tekbot): a\n"
+                   "                 board reporting another configuration is refused\n"
                    "  --link PATH    also make PATH a symlink to the board's pty\n"
                    "  --seconds S    stop after S simulated seconds (0: run until a signal)\n"
                    "  --baud N       the firmware's line rate: bytes reach USART0 no faster\n"
@@ -334,6 +398,19 @@ int main(int argc, char **argv)
     if (elf == NULL) {
         fprintf(stderr, "qnav-simavr-board: --elf: required\n");
         return 2;
+    }
+    {
+        char rerr[QNAV_SIM_ERRLEN];
+        qnav_sim_robot_t *robot = NULL;
+        if (qnav_sim_robot_load(robot_spec, &robot, rerr, sizeof rerr) != QNAV_SIM_OK) {
+            fprintf(stderr, "qnav-simavr-board: --robot: %s\n", rerr);
+            return 2;
+        }
+        qnav_robot_board_config(robot, &expected);
+        qnav_sim_robot_free(robot);
+        sectors = expected.ctrl.n_sectors > 16u ? 16 : (int)expected.ctrl.n_sectors;
+        qnav_link_rx_init(&g_watch.rx);
+        g_watch.expected = &expected;
     }
     if (access(elf, R_OK) != 0) {
         fprintf(stderr, "qnav-simavr-board: %s: %s\n", elf, strerror(errno));
@@ -386,23 +463,32 @@ int main(int argc, char **argv)
            link_path ? link_path : "");
     fflush(stdout);
     for (k = 0; k < 8; ++k) {
-        adc[k] = avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0 + k);
+        scene.adc[k] = avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0 + k);
     }
+    avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ('B'), 2), on_mux_select,
+                            &scene);
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
 
     t0 = mono_us();
     while (!g_quit && state != cpu_Done && state != cpu_Crashed) {
         uint64_t sim_us = avr->cycle / (fw.frequency / 1000000u);
-        uint64_t scene = sim_us / 500000u; /* a new scene every 0.5 s */
+        uint64_t step = sim_us / 500000u; /* a new scene every 0.5 s */
         int64_t ahead;
-        if (scene != last_scene) {
-            /* an obstacle that walks round the robot; the rest open at 2 m .. 2.5 m */
-            for (k = 0; k < 8; ++k) {
-                uint32_t mm = ((uint64_t)k == scene % 8u) ? 400u : 2000u + 70u * (uint32_t)k;
-                avr_raise_irq(adc[k], range_to_mv(mm));
+        if (g_watch.refused) {
+            fprintf(stderr, "qnav-simavr-board: board configuration differs from robot '%s': %s\n",
+                    robot_spec, g_watch.diff);
+            refused = 1;
+            break;
+        }
+        if (step != last_scene) {
+            /* an obstacle that walks round the robot; the rest open at 2 m and beyond */
+            for (k = 0; k < 16; ++k) {
+                scene.mm[k] = ((uint64_t)k == step % (uint64_t)sectors)
+                                  ? 400u : 2000u + (uint32_t)(400 / sectors) * (uint32_t)(k % sectors);
             }
-            last_scene = scene;
+            scene_apply(&scene);
+            last_scene = step;
         }
         if (seconds > 0.0 && (double)sim_us >= seconds * 1e6) {
             break;
@@ -427,12 +513,12 @@ int main(int argc, char **argv)
     }
     printf("qnav-simavr-board: stopped after %.2f simulated s (%s)\n",
            (double)avr->cycle / (double)fw.frequency,
-           state == cpu_Crashed ? "crashed" : (g_quit ? "signal" : "done"));
+           refused ? "refused" : state == cpu_Crashed ? "crashed" : (g_quit ? "signal" : "done"));
     fflush(stdout);
     if (eeprom_path != NULL && eeprom_save(avr, eeprom_path) != 0) {
         state = cpu_Crashed;
     }
     /* only the link made here is removed, and only if it is still ours */
     qnav_ptylink_remove(link_path, uart.name);
-    return state == cpu_Crashed ? 1 : 0;
+    return state == cpu_Crashed || refused ? 1 : 0;
 }

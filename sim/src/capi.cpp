@@ -146,6 +146,10 @@ void qnav_sim_robot_info(const qnav_sim_robot_t *robot, qnav_sim_robot_info_t *i
     info->range_min_m = p.range_min_m;
     info->range_max_m = p.range_max_m;
     info->default_sectors = p.default_sectors;
+    info->sonar_offset_m = p.sonar_offset_m;
+    info->wheel_base_m = p.wheel_base_m;
+    info->um_per_count = p.um_per_count;
+    info->tick_ms = p.tick_ms;
     info->sensor_noise = p.noise_sensor;
     info->actuation_noise = p.noise_actuation;
 }
@@ -261,23 +265,13 @@ void qnav_sim_destroy(qnav_sim_t *sim) { delete sim; }
 
 void qnav_sim_ctrl_config(const qnav_sim_t *sim, qnav_ctrl_config_t *cfg) {
     if (!sim || !cfg) return;
-    qnav_ctrl_config_default(cfg);
-    cfg->n_sectors = sim->sim->config().n_sectors;
-    cfg->max_range_mm = sim->sim->max_range_mm();
-    const qnav::RobotProfile &r = sim->sim->robot();
-    auto mm = [](double m) {
-        return static_cast<std::uint16_t>(std::min(65535.0, std::round(m * 1000.0)));
-    };
-    cfg->body_radius_mm = mm(r.radius_m);
-    cfg->safety_mm = mm(r.safety_m);
-    cfg->sensor_offset_mm = mm(r.radius_m); // ranges are measured from the body's surface
-    cfg->v_max_mm_s = mm(r.v_max_mps);
-    cfg->decel_mm_s2 = r.speed_guard ? mm(r.decel_mps2) : 0;
-    cfg->wedge_pct = r.wedge_pct;
-    cfg->wedge_near_mm = mm(r.wedge_near_m);
-    cfg->escape_stall_ticks = static_cast<std::uint8_t>(std::lround(r.escape_stall_s * 10.0));
-    cfg->escape_follow_mm = mm(r.escape_follow_m);
-    cfg->escape_follow_s = static_cast<std::uint8_t>(std::lround(r.escape_follow_s));
+    qnav::robot_ctrl_config(sim->sim->robot(), sim->sim->config().n_sectors, cfg);
+}
+
+void qnav_sim_robot_ctrl_config(const qnav_sim_robot_t *robot, uint16_t n_sectors,
+                                qnav_ctrl_config_t *cfg) {
+    if (!robot || !cfg) return;
+    qnav::robot_ctrl_config(robot->profile, n_sectors, cfg);
 }
 
 qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,

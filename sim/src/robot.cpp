@@ -1,16 +1,20 @@
 // Loading and checking robot profiles from TOML (format in docs/sim.md).
 #include "robot.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "error.hpp"
 #include "tomlread.hpp"
+#include "qnav/sim.h"
 
 namespace qnav {
 
 RobotProfile parse_robot_profile(std::string_view text, const std::string &name) {
     TomlReader r(text, name);
     const toml::table &root = r.root();
-    r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery", "probabilistic", "escape",
-                      "clearance"});
+    r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery", "probabilistic",
+                      "clearance", "odometry", "control", "escape"});
     RobotProfile p;
     p.name = r.string(root, "name");
     if (p.name.empty()) r.fail(root, "'name' must not be empty");
@@ -38,11 +42,12 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
     p.slip_lateral_s = r.number(slip, "lateral_s", 0.0, 1.0);
 
     const toml::table &sonar = r.table(root, "sonar");
-    r.only_keys(sonar, {"range_min_m", "range_max_m", "default_sectors", "cone_deg"});
+    r.only_keys(sonar, {"range_min_m", "range_max_m", "offset_m", "default_sectors", "cone_deg"});
     p.range_min_m = r.number(sonar, "range_min_m", 0.0, 10.0);
     p.range_max_m = r.number(sonar, "range_max_m", 0.05, 65.0);
     if (p.range_min_m >= p.range_max_m)
         r.fail(*sonar.get("range_min_m"), "'range_min_m' must be below 'range_max_m'");
+    p.sonar_offset_m = r.number(sonar, "offset_m", 0.0, p.radius_m);
     p.default_sectors =
         static_cast<std::uint16_t>(r.integer(sonar, "default_sectors", 1, 360));
     p.cone_deg = r.number(sonar, "cone_deg", 0.0, 180.0, true, 0.0);
@@ -61,18 +66,27 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
         p.prob_k_safe = r.number(prob, "k_safe", 1.0 / 256.0, 64.0);
     }
 
-    if (root.get("clearance")) {
-        const toml::table &cl = r.table(root, "clearance");
-        r.only_keys(cl, {"safety_m", "speed_guard", "wedge_pct", "wedge_near_m"});
-        p.wedge_near_m = r.number(cl, "wedge_near_m", 0.0, 65.0, true, p.wedge_near_m);
-        p.safety_m = r.number(cl, "safety_m", 0.0, 10.0, true, p.safety_m);
-        if (cl.get("wedge_pct"))
-            p.wedge_pct = static_cast<std::uint8_t>(r.integer(cl, "wedge_pct", 0, 100));
-        if (const toml::node *g = cl.get("speed_guard")) {
-            if (!g->is_boolean()) r.fail(*g, "'speed_guard' must be true or false");
-            p.speed_guard = g->value_or(true);
-        }
-    }
+    const toml::table &cl = r.table(root, "clearance");
+    r.only_keys(cl, {"safety_m", "speed_guard", "wedge_pct", "wedge_near_m"});
+    p.safety_m = r.number(cl, "safety_m", 0.0, 10.0);
+    if (cl.get("wedge_pct"))
+        p.wedge_pct = static_cast<std::uint8_t>(r.integer(cl, "wedge_pct", 0, 100));
+    p.wedge_near_m = r.number(cl, "wedge_near_m", 0.0, 65.0, true, p.wedge_near_m);
+    const toml::node *guard = cl.get("speed_guard");
+    if (!guard) r.fail(cl, "missing 'speed_guard' (true or false)");
+    if (!guard->is_boolean()) r.fail(*guard, "'speed_guard' must be true or false");
+    p.speed_guard = guard->value_or(true);
+
+    const toml::table &odo = r.table(root, "odometry");
+    r.only_keys(odo, {"um_per_count"});
+    p.um_per_count = static_cast<std::uint32_t>(r.integer(odo, "um_per_count", 1, 65535));
+
+    const toml::table &ctl = r.table(root, "control");
+    r.only_keys(ctl, {"tick_ms"});
+    p.tick_ms = static_cast<std::uint32_t>(r.integer(ctl, "tick_ms", 1, 60000));
+    if (p.tick_ms != static_cast<std::uint32_t>(QNAV_SIM_TICK_S * 1000.0 + 0.5))
+        r.fail(*ctl.get("tick_ms"), "'tick_ms' must be 100: the simulator's tick is fixed "
+                                    "(QNAV_SIM_TICK_S, DESIGN.md section 4)");
 
     if (root.get("escape")) {
         const toml::table &es = r.table(root, "escape");
@@ -92,6 +106,27 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
     p.recovery_back_speed_mps = r.number(rec, "back_speed_mps", 0.0, p.v_max_mps);
     p.recovery_turn_deg = r.number(rec, "turn_deg", 0.0, 360.0);
     return p;
+}
+
+// Metres (or m/s, m/s^2) to the controller's integer millimetres, saturated.
+static std::uint16_t to_mm(double m) {
+    return static_cast<std::uint16_t>(std::min(65535.0, std::round(m * 1000.0)));
+}
+
+void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl_config_t *cfg) {
+    qnav_ctrl_config_default(cfg);
+    cfg->n_sectors = n_sectors ? n_sectors : p.default_sectors;
+    cfg->max_range_mm = to_mm(p.range_max_m);
+    cfg->body_radius_mm = to_mm(p.radius_m);
+    cfg->safety_mm = to_mm(p.safety_m);
+    cfg->sensor_offset_mm = to_mm(p.sonar_offset_m);
+    cfg->v_max_mm_s = to_mm(p.v_max_mps);
+    cfg->decel_mm_s2 = p.speed_guard ? to_mm(p.decel_mps2) : 0;
+    cfg->wedge_pct = p.wedge_pct;
+    cfg->wedge_near_mm = to_mm(p.wedge_near_m);
+    cfg->escape_stall_ticks = static_cast<std::uint8_t>(std::lround(p.escape_stall_s * 10.0));
+    cfg->escape_follow_mm = to_mm(p.escape_follow_m);
+    cfg->escape_follow_s = static_cast<std::uint8_t>(std::lround(p.escape_follow_s));
 }
 
 }  // namespace qnav

@@ -7,6 +7,8 @@
 #include <string>
 #include <string_view>
 
+#include "qnav/ctrl.h"
+
 namespace qnav {
 
 struct RobotProfile {
@@ -27,12 +29,14 @@ struct RobotProfile {
     // sonar
     double range_min_m = 0.05;      // closer obstacles read this, m
     double range_max_m = 3.0;       // farther obstacles are not seen (read max), m
+    double sonar_offset_m = 0.2;    // robot centre to where ranges are measured from (the
+                                    // transducers), m; the sonar reaches range_max_m beyond it
     std::uint16_t default_sectors = 16;
     double cone_deg = 0.0;          // physical cone of one reading, deg; 0 = 360/N (see
                                     // docs/sim.md); wider cones overlap, at most 180
-    // what libqnav's clearance uses (qnav_sim_ctrl_config): obstacle enlargement by
+    // what libqnav's clearance uses (qnav_sim_robot_ctrl_config): obstacle enlargement by
     // radius_m + safety_m, and the speed guard with decel_mps2
-    double safety_m = 0.05;         // safety distance d_s, m (assumed; docs/sim.md)
+    double safety_m = 0.05;         // safety distance d_s, m ([clearance], required)
     bool speed_guard = true;        // cap the speed at what the path's clearance stops in
     std::uint8_t wedge_pct = 100;   // a reading blocks the central wedge_pct % of its
                                     // sector's wedge before enlargement (docs/architecture.md)
@@ -42,6 +46,9 @@ struct RobotProfile {
                                     // s; 0: no escape
     double escape_follow_m = 0.5;   // paths with less clearance are blocked when following, m
     double escape_follow_s = 20.0;  // first follow of one side at most, s
+    // what only the board needs (qnav-sim robot-header)
+    std::uint32_t um_per_count = 1000;  // wheel travel per encoder count, micrometres
+    std::uint32_t tick_ms = 100;        // control tick, ms (the simulator's QNAV_SIM_TICK_S)
     // typical noise levels (used by the CLI when none are given)
     double noise_sensor = 0.0;      // p_s
     double noise_actuation = 0.0;   // p_a
@@ -57,5 +64,11 @@ struct RobotProfile {
 
 // Parse a profile (TOML text); name is used in error messages. Throws SimError.
 RobotProfile parse_robot_profile(std::string_view text, const std::string &name);
+
+// The controller configuration a profile gives at n_sectors (0: the profile's default):
+// the one mapping from a robot description to libqnav (the simulator, the board header
+// generator and navbridge all call it). Fields the profile does not decide keep
+// qnav_ctrl_config_default()'s values.
+void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl_config_t *cfg);
 
 }  // namespace qnav

@@ -77,7 +77,7 @@ Simulation::Simulation(const RobotProfile &robot, const Environment &env, const 
       env_(env),
       cfg_(cfg),
       sonar_(env.obstacle_shapes(), env.width_m, env.height_m, cfg.n_sectors,
-             robot.range_max_m + robot.radius_m, robot.cone_deg * kPi / 180.0) {
+             robot.range_max_m + robot.sonar_offset_m, robot.cone_deg * kPi / 180.0) {
     max_range_mm_ = static_cast<std::uint16_t>(
         std::min(65535.0, std::round(robot_.range_max_m * 1000.0)));
     const double limit_s = cfg_.episode_limit_s > 0 ? cfg_.episode_limit_s : env_.episode_limit_s;
@@ -205,9 +205,9 @@ void Simulation::compute_scan() {
     else
         sonar_.measure(pos_, heading_, true_dist_.data());
     const double ps = cfg_.sensor_noise;
-    const double r = robot_.radius_m, rmin = robot_.range_min_m, rmax = robot_.range_max_m;
+    const double r = robot_.sonar_offset_m, rmin = robot_.range_min_m, rmax = robot_.range_max_m;
     for (std::uint16_t k = 0; k < cfg_.n_sectors; ++k) {
-        double range = true_dist_[k] - r;  // measured from the body surface
+        double range = true_dist_[k] - r;  // measured from the transducers (sonar offset)
         if (!(range <= rmax)) {
             range = rmax;  // no echo within range
         } else {
@@ -246,7 +246,7 @@ private:
 
 void Simulation::reference_scan() {
     std::fill(true_dist_.begin(), true_dist_.end(), kInf);
-    const double len = robot_.range_max_m + robot_.radius_m;
+    const double len = robot_.range_max_m + robot_.sonar_offset_m;
     const double w = 2.0 * kPi / cfg_.n_sectors, half = sonar_.cone() / 2;
     const b2Vec2 p1(static_cast<float>(pos_.x), static_cast<float>(pos_.y));
     for (int deg = 0; deg < 360; ++deg) {

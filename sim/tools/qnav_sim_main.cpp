@@ -27,6 +27,7 @@
 #include "qnav/ctrl.h"
 #include "qnav/nav.h"
 #include "qnav/sim.h"
+#include "robot_board.h"
 #include "rng.hpp"
 #include "svg.hpp"
 #include "worldgen.hpp"
@@ -294,6 +295,27 @@ int cmd_draw_env(const std::string &env, const std::string &robot, const std::st
     return 0;
 }
 
+// The board's configuration header for a robot, from the same mapping the simulator uses
+// (robot_board.h; docs/hil.md, "One robot description").
+int cmd_robot_header(const std::string &robot, const std::string &outp) {
+    char err[QNAV_SIM_ERRLEN];
+    qnav_sim_robot_t *r = nullptr;
+    if (qnav_sim_robot_load(robot.c_str(), &r, err, sizeof err) != QNAV_SIM_OK)
+        throw SimError(QNAV_SIM_E_PARSE, err);
+    char *buf = nullptr;
+    std::size_t len = 0;
+    FILE *mem = open_memstream(&buf, &len);
+    const int st = mem ? qnav_robot_board_header(r, mem) : -1;
+    if (mem) std::fclose(mem);
+    qnav_sim_robot_free(r);
+    const std::string text = buf ? std::string(buf, len) : std::string();
+    std::free(buf);
+    if (st != 0) throw WriteError(outp + ": cannot format the header");
+    write_output(outp, text);
+    std::printf("board configuration header: %s\n", outp.c_str());
+    return 0;
+}
+
 struct GenOpts {
     double density = -1;  // the old form: -1 = not given
     std::string family, difficulty = "0.5", robot, name, out;
@@ -500,12 +522,18 @@ int main(int argc, char **argv) {
     bench->add_option("--sensor-noise", bo.ps, "p_s")->check(qnav::cli::finite_range(0.0, 1.0))->capture_default_str();
     bench->add_option("--actuation-noise", bo.pa, "p_a")->check(qnav::cli::finite_range(0.0, 1.0))->capture_default_str();
 
+    std::string rh_robot = "tekbot", rh_out;
+    CLI::App *rh = app.add_subcommand("robot-header", "write a robot's board configuration as a C header (for a firmware build)");
+    rh->add_option("--robot", rh_robot, "robot profile (name or file)")->capture_default_str();
+    rh->add_option("OUT", rh_out, "header file to write")->required();
+
     if (const int status = qnav::cli::parse(app, argc, argv, "qnav-sim"); status >= 0) return status;
     try {
         if (*run) return cmd_run(ro);
         if (*draw) return cmd_draw_env(de_env, de_robot, de_out);
         if (*gen) return cmd_gen_env(go);
         if (*bench) return cmd_bench(bo);
+        if (*rh) return cmd_robot_header(rh_robot, rh_out);
     } catch (const SimError &e) {
         // a bad robot, environment or policy file, or an impossible parameter
         std::fprintf(stderr, "%s\n", e.what());

@@ -47,7 +47,7 @@ static void bench_start(uint16_t sectors)
         g.sim.ranges_mm[k] = (qnav_mm_t)(1500 + 250 * k);
     }
     qnav_tekbot_config_default(&cfg);
-    cfg.n_sectors = sectors;
+    cfg.ctrl.n_sectors = sectors;
     assert_int_equal(qnav_board_init(&g.bot, &cfg, &g.hal), QNAV_BOARD_OK);
     qnav_link_tx_init(&g.btx);
     qnav_link_rx_init(&g.brx);
@@ -163,6 +163,7 @@ static void test_board_is_stopped_until_it_hears_the_bridge(void **state)
 static void test_onboard_board_drives_with_libqnav_decision(void **state)
 {
     qnav_ctrl_t c;
+    qnav_board_config_t bc;
     qnav_ctrl_config_t cc;
     qnav_policy_t p;
     qnav_ctrl_input_t in = {0};
@@ -176,9 +177,8 @@ static void test_onboard_board_drives_with_libqnav_decision(void **state)
     assert_true(g.telemetry > 0u);
     /* the telemetry is exactly libqnav's step on the reported scan */
     assert_int_equal(g.last_scan.goal_bearing_cdeg, 4500);
-    qnav_ctrl_config_default(&cc);
-    cc.n_sectors = 8;
-    cc.max_range_mm = 5000;
+    qnav_tekbot_config_default(&bc);
+    cc = bc.ctrl; /* the board's controller is configured by its robot's profile */
     qnav_policy_prob_default(&p);
     assert_int_equal(qnav_ctrl_init(&c, &cc, &p), QNAV_OK);
     in.ranges_mm = g.last_scan.ranges_mm;
@@ -581,41 +581,34 @@ static void test_bridge_reports_no_answer_when_the_board_never_acks_an_upload(vo
     assert_int_equal(b.last_upload_status, QNAV_BRIDGE_UPLOAD_NO_ANSWER);
 }
 
-/* A controller configuration survives the trip through a board configuration: the
- * board core and the SIL robot map the same fields the same way. */
-static void test_board_config_round_trips_the_controller_fields(void **state)
+/* The board reports every field its robot's profile decides, and a bridge that expects
+ * another value finds the field by name. */
+static void test_board_reports_its_robot_configuration_field_by_field(void **state)
 {
     qnav_board_config_t bc;
-    qnav_ctrl_config_t in;
-    qnav_ctrl_config_t out;
+    qnav_link_config_t m, back;
+    uint8_t p[QNAV_LINK_CONFIG_MAX_BYTES];
+    int32_t n;
     (void)state;
     qnav_tekbot_config_default(&bc);
-    qnav_ctrl_config_default(&in);
-    in.n_sectors = 23;
-    in.max_range_mm = 3210;
-    in.body_radius_mm = 171;
-    in.safety_mm = 42;
-    in.sensor_offset_mm = 99;
-    in.v_max_mm_s = 650;
-    in.decel_mm_s2 = 1750;
-    qnav_board_config_from_ctrl(&bc, &in);
-    qnav_board_ctrl_config(&bc, &out);
-    assert_int_equal(out.n_sectors, in.n_sectors);
-    assert_int_equal(out.max_range_mm, in.max_range_mm);
-    assert_int_equal(out.body_radius_mm, in.body_radius_mm);
-    assert_int_equal(out.safety_mm, in.safety_mm);
-    assert_int_equal(out.sensor_offset_mm, in.sensor_offset_mm);
-    assert_int_equal(out.v_max_mm_s, in.v_max_mm_s);
-    assert_int_equal(out.decel_mm_s2, in.decel_mm_s2);
-    assert_int_equal(out.rank, in.rank);
-    assert_int_equal(out.full_speed_quality, in.full_speed_quality);
+    qnav_board_config_report(&bc, &m);
+    n = qnav_link_config_pack(&m, p, sizeof p);
+    assert_true(n > 0);
+    assert_int_equal(qnav_link_config_unpack(p, (uint16_t)n, &back), QNAV_LINK_OK);
+    assert_int_equal(back.n, 12);
+    assert_int_equal(back.key[0], 1);
+    assert_int_equal(back.value[0], bc.ctrl.n_sectors);
+    assert_int_equal(back.key[1], 2);
+    assert_int_equal(back.value[1], bc.ctrl.max_range_mm);
+    assert_int_equal(back.key[11], 34);
+    assert_int_equal(back.value[11], bc.um_per_count);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mix_turns_counter_clockwise_with_the_right_wheel),
-        cmocka_unit_test(test_board_config_round_trips_the_controller_fields),
+        cmocka_unit_test(test_board_reports_its_robot_configuration_field_by_field),
         cmocka_unit_test(test_board_is_stopped_until_it_hears_the_bridge),
         cmocka_unit_test(test_onboard_board_drives_with_libqnav_decision),
         cmocka_unit_test(test_board_stops_motors_when_link_goes_quiet),

@@ -672,6 +672,53 @@ static void test_upload_with_missing_chunk_is_refused(void **state)
     assert_int_equal(qnav_link_upload_commit(&up, &cm, &b), QNAV_LINK_ACK_BAD_LENGTH);
 }
 
+/* CONFIG: (key, value) pairs survive framing; a length that is not 1 + 5n is dropped by
+ * the decoder. */
+static void test_config_report_round_trips_and_bad_lengths_are_dropped(void **state)
+{
+    qnav_link_config_t m, got;
+    qnav_link_tx_t tx;
+    qnav_link_rx_t rx;
+    qnav_link_frame_t f;
+    uint8_t p[QNAV_LINK_CONFIG_MAX_BYTES], wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
+    int32_t n, w, i;
+    uint8_t got_frame = 0;
+    (void)state;
+    memset(&m, 0, sizeof m);
+    m.n = 3;
+    m.key[0] = 1;
+    m.value[0] = 16;
+    m.key[1] = 2;
+    m.value[1] = 5000;
+    m.key[2] = 3;
+    m.value[2] = -29491;
+    n = qnav_link_config_pack(&m, p, sizeof p);
+    assert_int_equal(n, 16);
+    qnav_link_tx_init(&tx);
+    qnav_link_rx_init(&rx);
+    w = qnav_link_encode(&tx, QNAV_LINK_MSG_CONFIG, p, (uint16_t)n, wire, sizeof wire);
+    assert_true(w > 0);
+    for (i = 0; i < w; ++i) {
+        got_frame |= qnav_link_rx_feed(&rx, wire[i], &f);
+    }
+    assert_int_equal(got_frame, 1);
+    assert_int_equal(qnav_link_config_unpack(f.payload, f.len, &got), QNAV_LINK_OK);
+    assert_int_equal(got.n, 3);
+    assert_int_equal(got.value[1], 5000);
+    assert_int_equal(got.value[2], -29491);
+    /* one byte short: the count says 3 pairs */
+    assert_int_equal(qnav_link_config_unpack(p, (uint16_t)(n - 1), &got), QNAV_LINK_E_LENGTH);
+    w = qnav_link_encode(&tx, QNAV_LINK_MSG_CONFIG, p, (uint16_t)(n - 1), wire, sizeof wire);
+    got_frame = 0;
+    for (i = 0; i < w; ++i) {
+        got_frame |= qnav_link_rx_feed(&rx, wire[i], &f);
+    }
+    assert_int_equal(got_frame, 0);
+    assert_int_equal(rx.stats.dropped[QNAV_LINK_DROP_LENGTH], 1);
+    m.n = QNAV_LINK_CONFIG_MAX_FIELDS + 1u;
+    assert_int_equal(qnav_link_config_pack(&m, p, sizeof p), QNAV_LINK_E_VALUE);
+}
+
 static void test_heartbeat_carries_the_protocol_version_and_reads_version_1(void **state)
 {
     qnav_link_heartbeat_t hb = {1234, QNAV_LINK_MODE_ONBOARD, 0x15, 7, 1, 0xBEEF, 0}, got;
@@ -766,6 +813,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_heartbeat_carries_the_protocol_version_and_reads_version_1),
+        cmocka_unit_test(test_config_report_round_trips_and_bad_lengths_are_dropped),
         cmocka_unit_test(test_decoder_accepts_heartbeats_of_every_version_length),
         cmocka_unit_test(test_position_goal_and_pose_round_trip_with_negative_coordinates),
         cmocka_unit_test(test_send_frames_once_and_sends_nothing_for_a_failed_pack),

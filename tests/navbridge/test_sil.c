@@ -133,6 +133,65 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     replay_is_identical(log);
 }
 
+/* The Pioneer 3-DX as a second platform: the SIL robot runs the board core with the
+ * configuration generated from its profile; navbridge --robot pioneer3dx accepts it and
+ * drives it to the destination, navbridge --robot tekbot refuses it with one line. */
+static void test_sil_pioneer3dx_is_driven_by_its_robot_and_refused_by_another(void **state)
+{
+    char link[300], log[300], sil_out[300], sil_err[300], nb_out[300], nb_err[300];
+    char text[2048], goal[64];
+    const char *sil[] = {SIL_EXE, "--robot", "pioneer3dx", "--lockstep", "--reply-ms", "3000",
+                         "--link", link, NULL};
+    const char *wrong[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://",
+                           "--goal-at", goal, "--robot", "tekbot", NULL};
+    const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--log", log,
+                        "--goal-at", goal, "--robot", "pioneer3dx", NULL};
+    const char *replay[] = {NAVBRIDGE_EXE, "--replay", log, "--robot", "pioneer3dx", NULL};
+    pid_t ps, pn;
+    (void)state;
+    snprintf(link, sizeof link, "%s/link-p3dx", g_dir);
+    snprintf(log, sizeof log, "%s/p3dx.lcmlog", g_dir);
+    snprintf(sil_out, sizeof sil_out, "%s/sil-p3dx.out", g_dir);
+    snprintf(sil_err, sizeof sil_err, "%s/sil-p3dx.err", g_dir);
+    snprintf(nb_out, sizeof nb_out, "%s/nb-p3dx.out", g_dir);
+    snprintf(nb_err, sizeof nb_err, "%s/nb-p3dx.err", g_dir);
+
+    /* a TekBot bridge: refused at the board's first CONFIG report */
+    ps = qnav_test_spawn(sil, sil_out, sil_err);
+    assert_true(ps > 0);
+    assert_int_equal(qnav_test_wait_path(link, 4000), 0);
+    destination_of(sil_out, goal, sizeof goal);
+    pn = qnav_test_spawn(wrong, nb_out, nb_err);
+    assert_true(pn > 0);
+    assert_int_equal(wait_exit_within(pn, 30000), 1);
+    assert_true(read_text(nb_err, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, "navbridge: board configuration differs from robot 'tekbot': "
+                                 "n_sectors 16 != 8\n"));
+    assert_int_equal(kill(ps, SIGTERM), 0);
+    assert_true(qnav_test_wait_exit(ps) >= 0);
+
+    /* its own bridge drives it to the destination */
+    snprintf(sil_out, sizeof sil_out, "%s/sil-p3dx2.out", g_dir);
+    snprintf(link, sizeof link, "%s/link-p3dx2", g_dir);
+    ps = qnav_test_spawn(sil, sil_out, sil_err);
+    assert_true(ps > 0);
+    assert_int_equal(qnav_test_wait_path(link, 4000), 0);
+    destination_of(sil_out, goal, sizeof goal);
+    pn = qnav_test_spawn(nb, nb_out, nb_err);
+    assert_true(pn > 0);
+    assert_int_equal(qnav_test_wait_exit(ps), 0); /* 0: destination reached */
+    assert_int_equal(wait_exit_within(pn, 3000), 1);
+    assert_true(read_text(sil_out, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, "reached yes"));
+    /* the bridge's controller ran the profile's configuration: the replay with it agrees */
+    snprintf(nb_out, sizeof nb_out, "%s/rp-p3dx.out", g_dir);
+    assert_int_equal(run_program(replay, nb_out, nb_err), 0);
+    assert_true(read_text(nb_out, text, sizeof text) > 0);
+    assert_non_null(strstr(text, "identical, 0 differ"));
+}
+
 static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(void **state)
 {
     char link[300], log[300], pol[300], sil_out[300], sil_err[300], nb_out[300], nb_err[300];
@@ -438,6 +497,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sil_robot_reaches_destination_through_navbridge_over_memq),
+        cmocka_unit_test(test_sil_pioneer3dx_is_driven_by_its_robot_and_refused_by_another),
         cmocka_unit_test(test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically),
         cmocka_unit_test(test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically),
         cmocka_unit_test(test_sil_route_of_three_waypoints_through_dense_replays_identically),

@@ -131,6 +131,20 @@ static void test_bad_robot_profiles_are_refused(void **state) {
     assert_int_equal(parse_robot(t5, &msg), QNAV_SIM_E_PARSE);
     assert_true(msg.find("k_safe") != std::string::npos);
     assert_true(one_line(msg));
+    // every quantity the board needs is in the profile: none has a silent default
+    std::string t6 = good;
+    t6.replace(t6.find("tick_ms = 100"), 13, "tick_ms = 50 ");
+    assert_int_equal(parse_robot(t6, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("'tick_ms' must be 100") != std::string::npos);
+    assert_true(one_line(msg));
+    std::string t7 = good;
+    t7.erase(t7.find("safety_m"), t7.find('\n', t7.find("safety_m")) - t7.find("safety_m") + 1);
+    assert_int_equal(parse_robot(t7, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("missing key 'safety_m'") != std::string::npos);
+    std::string t8 = good;
+    t8.replace(t8.find("offset_m = 0.26"), 15, "offset_m = 0.30");
+    assert_int_equal(parse_robot(t8, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("offset_m") != std::string::npos);
 }
 
 static void test_profile_carries_its_tuned_probabilistic_policy(void **state) {
@@ -396,7 +410,7 @@ static void test_cli_names_unknown_options_and_subcommands_and_prints_its_versio
     assert_int_equal(run_tool("--bogus", &out), 2);
     assert_string_equal(out.c_str(), "qnav-sim: --bogus: unknown option (see qnav-sim --help)\n");
     assert_int_equal(run_tool("bogus", &out), 2);
-    assert_string_equal(out.c_str(), "qnav-sim: bogus: unknown subcommand (known: run, draw-env, gen-env, bench) "
+    assert_string_equal(out.c_str(), "qnav-sim: bogus: unknown subcommand (known: run, draw-env, gen-env, bench, robot-header) "
                                      "(see qnav-sim --help)\n");
     assert_int_equal(run_tool("--version", &out), 0);
     assert_string_equal(out.c_str(), "qnav-sim (qnav) " QNAV_VERSION "\n");

@@ -88,6 +88,7 @@ uint16_t qnav_link_min_payload(uint8_t msg_id)
     case QNAV_LINK_MSG_POLICY_ACK: return QNAV_LINK_POLICY_ACK_BYTES;
     case QNAV_LINK_MSG_HEARTBEAT: return QNAV_LINK_HEARTBEAT_V1_BYTES;
     case QNAV_LINK_MSG_POSE: return QNAV_LINK_POSE_BYTES;
+    case QNAV_LINK_MSG_CONFIG: return 1u;
     default: return 0;
     }
 }
@@ -106,6 +107,8 @@ static uint8_t length_ok(uint8_t msg_id, uint16_t len)
     case QNAV_LINK_MSG_POLICY_CHUNK:
         return (uint8_t)(len > QNAV_LINK_POLICY_CHUNK_HEADER_BYTES &&
                          len <= QNAV_LINK_CHUNK_MAX_BYTES);
+    case QNAV_LINK_MSG_CONFIG:
+        return (uint8_t)(len >= 1u && len <= QNAV_LINK_CONFIG_MAX_BYTES && (len - 1u) % 5u == 0u);
     case QNAV_LINK_MSG_HEARTBEAT:
         /* every version's, so that a peer of another version is heard and refused */
         return (uint8_t)(len >= QNAV_LINK_HEARTBEAT_V1_BYTES &&
@@ -876,4 +879,43 @@ uint16_t qnav_link_policy_crc(const qnav_policy_t *policy)
     uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
     int32_t n = qnav_link_policy_to_blob(policy, blob, (uint16_t)sizeof blob);
     return n > 0 ? qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) : 0u;
+}
+
+int32_t qnav_link_config_pack(const qnav_link_config_t *m, uint8_t *out, uint16_t cap)
+{
+    uint8_t k;
+    uint16_t need;
+    if (m == NULL || out == NULL) {
+        return QNAV_LINK_E_NULL;
+    }
+    if (m->n > QNAV_LINK_CONFIG_MAX_FIELDS) {
+        return QNAV_LINK_E_VALUE;
+    }
+    need = (uint16_t)(1u + 5u * m->n);
+    if (cap < need) {
+        return QNAV_LINK_E_SPACE;
+    }
+    out[0] = m->n;
+    for (k = 0; k < m->n; ++k) {
+        out[1u + 5u * k] = m->key[k];
+        put_u32(&out[2u + 5u * k], (uint32_t)m->value[k]);
+    }
+    return (int32_t)need;
+}
+
+int32_t qnav_link_config_unpack(const uint8_t *p, uint16_t len, qnav_link_config_t *m)
+{
+    uint8_t k;
+    if (p == NULL || m == NULL) {
+        return QNAV_LINK_E_NULL;
+    }
+    if (len < 1u || len > QNAV_LINK_CONFIG_MAX_BYTES || len != 1u + 5u * (uint16_t)p[0]) {
+        return QNAV_LINK_E_LENGTH;
+    }
+    m->n = p[0];
+    for (k = 0; k < m->n; ++k) {
+        m->key[k] = p[1u + 5u * k];
+        m->value[k] = (int32_t)get_u32(&p[2u + 5u * k]);
+    }
+    return QNAV_LINK_OK;
 }

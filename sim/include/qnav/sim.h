@@ -106,6 +106,10 @@ typedef struct {
     double range_min_m;        /* sonar minimum range (closer reads this), m */
     double range_max_m;        /* sonar maximum range (farther is clipped), m */
     uint16_t default_sectors;  /* sector count when the config asks for 0 */
+    double sonar_offset_m;     /* robot centre to the transducers (ranges start there), m */
+    double wheel_base_m;       /* distance between the drive wheels (track), m */
+    uint32_t um_per_count;     /* the board's wheel travel per encoder count, micrometres */
+    uint32_t tick_ms;          /* control tick, ms (QNAV_SIM_TICK_S) */
     double sensor_noise;       /* the profile's typical p_s (qnav-sim's default) */
     double actuation_noise;    /* the profile's typical p_a (qnav-sim's default) */
 } qnav_sim_robot_info_t;
@@ -180,9 +184,20 @@ qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_
                                   size_t errlen);
 void qnav_sim_destroy(qnav_sim_t *sim);
 
-/* The controller configuration that matches this context: n_sectors and max_range_mm
- * (the profile's maximum range in mm) set, full_speed_quality left at its default. */
+/* The controller configuration that matches this context: qnav_sim_robot_ctrl_config() of
+ * its robot at its sector count. */
 void qnav_sim_ctrl_config(const qnav_sim_t *sim, qnav_ctrl_config_t *cfg);
+
+/* The controller configuration a robot profile gives at n_sectors (0: the profile's
+ * default_sectors): the one mapping from a profile to libqnav, used by the simulator, the
+ * board header generator (qnav-sim robot-header) and navbridge --robot. Sets n_sectors,
+ * max_range_mm ([sonar] range_max_m), body_radius_mm ([body] radius_m), safety_mm
+ * ([clearance] safety_m), sensor_offset_mm ([sonar] offset_m), v_max_mm_s ([drive]
+ * v_max_mps), decel_mm_s2 ([drive] decel_mps2, 0 with [clearance] speed_guard = false);
+ * every other field is qnav_ctrl_config_default()'s (docs/sim.md, "One robot
+ * description"). */
+void qnav_sim_robot_ctrl_config(const qnav_sim_robot_t *robot, uint16_t n_sectors,
+                                qnav_ctrl_config_t *cfg);
 
 /* The episode's figures (paper Eq. 1-3; definitions in docs/sim.md). */
 typedef struct {

@@ -17,6 +17,9 @@
 /* Turn part at |heading| >= 90 deg: half of full wheel speed, Q1.15. */
 #define TURN_MAX ((int32_t)16384)
 
+/* Ticks between configuration reports (1 s at 10 Hz; 66 bytes each). */
+#define CONFIG_EVERY 10u
+
 /* Largest wheel travel integrated in one piece, um: keeps travel * cos in Q2.14 inside
  * int32 (131000 * 16384 < 2^31). */
 #define STEP_MAX_UM INT32_C(131000)
@@ -26,42 +29,30 @@ void qnav_board_config_default(qnav_board_config_t *cfg)
     if (cfg == NULL) {
         return;
     }
-    cfg->n_sectors = 8;
-    cfg->max_range_mm = 5000;
+    qnav_ctrl_config_default(&cfg->ctrl);
     cfg->tick_ms = 100;
     cfg->link_timeout_ms = 300;
-    cfg->body_radius_mm = 0;
-    cfg->safety_mm = 0;
-    cfg->sonar_offset_mm = 0;
-    cfg->v_max_mm_s = 500;
-    cfg->decel_mm_s2 = 0;
+    cfg->track_mm = 180;
     cfg->um_per_count = 1000;
     cfg->nvm_offset = 0;
     cfg->controller = "body";
 }
 
-/* The controller configuration this board's sonar and body give. */
-void qnav_board_ctrl_config(const qnav_board_config_t *cfg, qnav_ctrl_config_t *cc)
+void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t *m)
 {
-    qnav_ctrl_config_default(cc);
-    cc->n_sectors = cfg->n_sectors;
-    cc->max_range_mm = cfg->max_range_mm;
-    cc->body_radius_mm = cfg->body_radius_mm;
-    cc->safety_mm = cfg->safety_mm;
-    cc->sensor_offset_mm = cfg->sonar_offset_mm;
-    cc->v_max_mm_s = cfg->v_max_mm_s;
-    cc->decel_mm_s2 = cfg->decel_mm_s2;
-}
-
-void qnav_board_config_from_ctrl(qnav_board_config_t *cfg, const qnav_ctrl_config_t *cc)
-{
-    cfg->n_sectors = cc->n_sectors;
-    cfg->max_range_mm = cc->max_range_mm;
-    cfg->body_radius_mm = cc->body_radius_mm;
-    cfg->safety_mm = cc->safety_mm;
-    cfg->sonar_offset_mm = cc->sensor_offset_mm;
-    cfg->v_max_mm_s = cc->v_max_mm_s;
-    cfg->decel_mm_s2 = cc->decel_mm_s2;
+    uint8_t n = 0;
+    if (cfg == NULL || m == NULL) {
+        return;
+    }
+#define QNAV_BOARD_REPORT_FIELD(id, name, member)                                          \
+    if (n < QNAV_LINK_CONFIG_MAX_FIELDS) {                                                  \
+        m->key[n] = (uint8_t)(id);                                                         \
+        m->value[n] = (int32_t)cfg->member;                                                 \
+        ++n;                                                                                \
+    }
+    QNAV_BOARD_ROBOT_FIELDS(QNAV_BOARD_REPORT_FIELD)
+#undef QNAV_BOARD_REPORT_FIELD
+    m->n = n;
 }
 
 static qnav_q1_15_t sat_q15(int32_t v)
@@ -103,19 +94,18 @@ void qnav_board_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_deg_t spin_
 /* The stored policy when one is whole and the controller takes it, else the built-in. */
 static void load_policy(qnav_board_t *bot)
 {
-    qnav_ctrl_config_t cc;
+    const qnav_ctrl_config_t *cc = &bot->cfg.ctrl;
     qnav_policy_t stored;
     uint16_t crc = 0;
     uint8_t slot = 0xFFu;
     uint8_t seq = 0;
-    qnav_board_ctrl_config(&bot->cfg, &cc);
     bot->store_slot = 0xFFu;
     bot->store_seq = 0;
     if (qnav_board_store_load(&bot->hal, bot->cfg.nvm_offset, &stored, &crc, &slot, &seq)) {
         /* the slot is remembered even if refused, so the next commit keeps it intact */
         bot->store_slot = slot;
         bot->store_seq = seq;
-        if (qnav_nav_init_named(&bot->nav, bot->cfg.controller, &cc, &stored) == QNAV_OK) {
+        if (qnav_nav_init_named(&bot->nav, bot->cfg.controller, cc, &stored) == QNAV_OK) {
             bot->policy = stored;
             bot->policy_crc = crc;
             bot->policy_source = QNAV_BOARD_POLICY_STORED;
@@ -125,7 +115,7 @@ static void load_policy(qnav_board_t *bot)
     }
     qnav_policy_prob_default(&bot->policy);
     bot->policy_source = QNAV_BOARD_POLICY_BUILTIN;
-    bot->ctrl_ready = (uint8_t)(qnav_nav_init_named(&bot->nav, bot->cfg.controller, &cc,
+    bot->ctrl_ready = (uint8_t)(qnav_nav_init_named(&bot->nav, bot->cfg.controller, cc,
                                                     &bot->policy) == QNAV_OK);
     bot->policy_crc = qnav_link_policy_crc(&bot->policy);
 }
@@ -138,8 +128,8 @@ qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t
         hal->uart_read == NULL || hal->uart_write == NULL) {
         return QNAV_BOARD_E_NULL;
     }
-    if (cfg->n_sectors < 1u || cfg->n_sectors > QNAV_LINK_MAX_SECTORS ||
-        cfg->max_range_mm == 0u || cfg->tick_ms == 0u || cfg->link_timeout_ms == 0u ||
+    if (cfg->ctrl.n_sectors < 1u || cfg->ctrl.n_sectors > QNAV_LINK_MAX_SECTORS ||
+        cfg->ctrl.max_range_mm == 0u || cfg->tick_ms == 0u || cfg->link_timeout_ms == 0u ||
         cfg->um_per_count == 0u) {
         return QNAV_BOARD_E_CONFIG;
     }
@@ -175,16 +165,14 @@ static void send(qnav_board_t *bot, uint8_t id, const uint8_t *payload, int32_t 
 static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm)
 {
     qnav_policy_t fresh;
-    qnav_ctrl_config_t cc;
     qnav_link_policy_ack_t ack;
     uint8_t p[QNAV_LINK_POLICY_ACK_BYTES];
     uint16_t crc;
     int8_t status = qnav_link_upload_commit(&bot->upload, cm, &fresh);
 
     if (status == QNAV_LINK_ACK_OK) {
-        qnav_board_ctrl_config(&bot->cfg, &cc);
         bot->hal.drive(bot->hal.ctx, 0, 0);
-        if (qnav_nav_init_named(&bot->nav, bot->cfg.controller, &cc, &fresh) == QNAV_OK) {
+        if (qnav_nav_init_named(&bot->nav, bot->cfg.controller, &bot->cfg.ctrl, &fresh) == QNAV_OK) {
             bot->policy = fresh;
             bot->policy_crc = cm->crc;
             bot->policy_source = QNAV_BOARD_POLICY_UPLOADED;
@@ -197,7 +185,7 @@ static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm
         } else {
             /* keep driving with the policy we had */
             bot->ctrl_ready =
-                (uint8_t)(qnav_nav_init_named(&bot->nav, bot->cfg.controller, &cc,
+                (uint8_t)(qnav_nav_init_named(&bot->nav, bot->cfg.controller, &bot->cfg.ctrl,
                                               &bot->policy) == QNAV_OK);
             status = QNAV_LINK_ACK_REJECTED;
         }
@@ -371,7 +359,7 @@ static void send_scan(qnav_board_t *bot, uint32_t now, qnav_cdeg_t bearing)
 {
     /* packed straight from the ranges buffer (no second copy on the MCU) */
     uint8_t p[QNAV_LINK_MAX_PAYLOAD];
-    uint16_t len = (uint16_t)(QNAV_LINK_SCAN_HEADER_BYTES + 2u * bot->cfg.n_sectors);
+    uint16_t len = (uint16_t)(QNAV_LINK_SCAN_HEADER_BYTES + 2u * bot->cfg.ctrl.n_sectors);
     uint16_t gid = bot->have_goal ? bot->goal.goal_id : 0u;
     uint16_t k;
     p[0] = (uint8_t)(now & 0xFFu);
@@ -380,13 +368,13 @@ static void send_scan(qnav_board_t *bot, uint32_t now, qnav_cdeg_t bearing)
     p[3] = (uint8_t)(now >> 24);
     p[4] = (uint8_t)((uint16_t)bearing & 0xFFu);
     p[5] = (uint8_t)((uint16_t)bearing >> 8);
-    p[6] = (uint8_t)(bot->cfg.max_range_mm & 0xFFu);
-    p[7] = (uint8_t)(bot->cfg.max_range_mm >> 8);
-    p[8] = (uint8_t)(bot->cfg.n_sectors & 0xFFu);
-    p[9] = (uint8_t)(bot->cfg.n_sectors >> 8);
+    p[6] = (uint8_t)(bot->cfg.ctrl.max_range_mm & 0xFFu);
+    p[7] = (uint8_t)(bot->cfg.ctrl.max_range_mm >> 8);
+    p[8] = (uint8_t)(bot->cfg.ctrl.n_sectors & 0xFFu);
+    p[9] = (uint8_t)(bot->cfg.ctrl.n_sectors >> 8);
     p[10] = (uint8_t)(gid & 0xFFu);
     p[11] = (uint8_t)(gid >> 8);
-    for (k = 0; k < bot->cfg.n_sectors; ++k) {
+    for (k = 0; k < bot->cfg.ctrl.n_sectors; ++k) {
         p[QNAV_LINK_SCAN_HEADER_BYTES + 2u * k] = (uint8_t)(bot->ranges[k] & 0xFFu);
         p[QNAV_LINK_SCAN_HEADER_BYTES + 2u * k + 1u] = (uint8_t)(bot->ranges[k] >> 8);
     }
@@ -421,6 +409,17 @@ static void send_status(qnav_board_t *bot, uint32_t now, uint8_t moving, uint32_
     ps.goal_id = bot->have_goal ? bot->goal.goal_id : 0u;
     ps.goal_distance_mm = dist_mm;
     send(bot, QNAV_LINK_MSG_POSE, p, qnav_link_pose_pack(&ps, p, sizeof p));
+}
+
+/* The robot configuration this board runs (navbridge --robot compares it with the
+ * profile's): when the link comes up, so it precedes the first scan a bridge acts on, and
+ * every CONFIG_EVERY ticks for a bridge that attached while the link stayed up. */
+static void send_config(qnav_board_t *bot)
+{
+    qnav_link_config_t m;
+    uint8_t p[QNAV_LINK_CONFIG_MAX_BYTES];
+    qnav_board_config_report(&bot->cfg, &m);
+    send(bot, QNAV_LINK_MSG_CONFIG, p, qnav_link_config_pack(&m, p, sizeof p));
 }
 
 /* This tick's decision: the controller's (onboard) or navbridge's fresh command
@@ -470,11 +469,15 @@ void qnav_board_tick(qnav_board_t *bot)
         qnav_link_upload_init(&bot->upload);
     }
 
+    if ((bot->link_ok && !was_ok) || bot->stats.ticks % CONFIG_EVERY == 0u) {
+        send_config(bot);
+    }
+
     /* sense */
     update_pose(bot);
-    n = bot->hal.sonar_read(bot->hal.ctx, bot->ranges, bot->cfg.n_sectors);
-    for (k = n; k < bot->cfg.n_sectors; ++k) {
-        bot->ranges[k] = bot->cfg.max_range_mm; /* a missing sonar reads as clear */
+    n = bot->hal.sonar_read(bot->hal.ctx, bot->ranges, bot->cfg.ctrl.n_sectors);
+    for (k = n; k < bot->cfg.ctrl.n_sectors; ++k) {
+        bot->ranges[k] = bot->cfg.ctrl.max_range_mm; /* a missing sonar reads as clear */
     }
     in.ranges_mm = bot->ranges;
     in.goal_bearing_cdeg = goal_bearing(bot, &dist_mm);

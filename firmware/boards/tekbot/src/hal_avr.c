@@ -3,13 +3,16 @@
  *   tick    Timer0 compare interrupt every 1 ms
  *   UART    USART0 (PE0 RXD, PE1 TXD), 57600 baud 8N1 with U2X (-0.8 % error),
  *           interrupt-driven receive into a 256-byte ring, polled transmit
- *   sonar   8 analog sonars (MaxBotix LV-EZ class, AN output ~ Vcc/512 per inch) on
- *           ADC0..ADC7, sector k on ADCk; AVcc reference
+ *   sonar   analog sonars (MaxBotix LV-EZ class, AN output ~ Vcc/512 per inch) on
+ *           ADC0..ADC7, sector k on ADC(k mod 8); AVcc reference. Up to 16: sectors 8..15
+ *           through a 2:1 analog multiplexer in front of the ADC whose select line is PB2
+ *           (low: sonars 0..7, high: 8..15)
  *   motors  Timer1 8-bit fast PWM on OC1A (PB5, left) and OC1B (PB6, right); direction on
  *           PB0 (left) and PB1 (right), high = forward
  *   heading wheel-encoder odometry: INT0 (PD0, left) and INT1 (PD1, right), the sign of
  *           each tick taken from that wheel's direction pin; the same counts are the
- *           odometry the core dead-reckons from
+ *           odometry the core dead-reckons from. The heading per count comes from the
+ *           robot's profile (track and encoder scale, qnav/robots.h)
  *   storage the 4 KiB EEPROM (avr-libc eeprom_*_block; a byte takes 8.5 ms to write)
  * Pin choices and scale factors are the knobs at the top; docs/hil.md lists the wiring.
  */
@@ -18,6 +21,7 @@
 #include <avr/io.h>
 
 #include "qnav/board.h"
+#include "qnav/robots.h"
 
 #include "hal_avr.h"
 
@@ -32,11 +36,13 @@
 #ifndef QNAV_TEKBOT_MM_PER_COUNT_X10
 #define QNAV_TEKBOT_MM_PER_COUNT_X10 127UL
 #endif
-/* heading change per differential encoder tick, 0.01 deg: wheel 70 mm diameter, 32 ticks
- * per turn, track 120 mm -> (pi*70/32)/120 rad = 3.28 deg */
-#ifndef QNAV_TEKBOT_CDEG_PER_TICK
-#define QNAV_TEKBOT_CDEG_PER_TICK 328L
-#endif
+/* heading change per differential encoder tick, 1e-6 deg: um_per_count / track_mm rad of
+ * the robot's profile (TekBot: 6872 um per count, 180 mm track -> 2.19 deg) */
+#define UDEG_PER_TICK ((int64_t)QNAV_BOARD_ROBOT_UDEG_PER_COUNT)
+
+/* sonars per ADC bank, and banks behind the PB2 multiplexer */
+#define SONAR_BANK 8u
+#define SONAR_MAX 16u
 
 /* spin_deg of qnav_board_mix: at or beyond this |heading| the TekBot turns in place */
 #ifndef QNAV_TEKBOT_SPIN_DEG
@@ -113,12 +119,18 @@ static uint16_t adc_read(uint8_t ch)
 static uint16_t avr_sonar_read(void *ctx, qnav_mm_t *ranges_mm, uint16_t max)
 {
     uint16_t k;
-    uint16_t n = max < 8u ? max : 8u;
+    uint16_t n = max < SONAR_MAX ? max : SONAR_MAX;
     (void)ctx;
     for (k = 0; k < n; ++k) {
-        uint32_t mm = ((uint32_t)adc_read((uint8_t)k) * QNAV_TEKBOT_MM_PER_COUNT_X10) / 10u;
+        uint32_t mm;
+        if (k == SONAR_BANK) {
+            PORTB |= _BV(PB2); /* the second bank; a 74HC4053 settles in well under the
+                                  ADC's 1.5-cycle sample-and-hold delay */
+        }
+        mm = ((uint32_t)adc_read((uint8_t)(k % SONAR_BANK)) * QNAV_TEKBOT_MM_PER_COUNT_X10) / 10u;
         ranges_mm[k] = (qnav_mm_t)(mm > 65535u ? 65535u : mm);
     }
+    PORTB &= (uint8_t)~_BV(PB2);
     return n;
 }
 
@@ -131,7 +143,7 @@ static qnav_cdeg_t avr_heading_cdeg(void *ctx)
     cli();
     odo = g_right - g_left; /* left forward turns clockwise */
     SREG = sreg;
-    a = (odo * QNAV_TEKBOT_CDEG_PER_TICK) % 36000L;
+    a = (int32_t)(((int64_t)odo * UDEG_PER_TICK / 10000) % 36000L);
     if (a >= 18000L) {
         a -= 36000L;
     } else if (a < -18000L) {
@@ -236,7 +248,7 @@ void qnav_tekbot_hal_avr_init(qnav_board_hal_t *hal)
     UCSR0B = (uint8_t)(_BV(RXEN0) | _BV(TXEN0) | _BV(RXCIE0));
 
     /* Timer1: 8-bit fast PWM, clk/8 (7.8 kHz), non-inverting on OC1A/OC1B */
-    DDRB |= (uint8_t)(_BV(PB0) | _BV(PB1) | _BV(PB5) | _BV(PB6));
+    DDRB |= (uint8_t)(_BV(PB0) | _BV(PB1) | _BV(PB2) | _BV(PB5) | _BV(PB6));
     OCR1A = 0;
     OCR1B = 0;
     TCCR1A = (uint8_t)(_BV(COM1A1) | _BV(COM1B1) | _BV(WGM10));

@@ -49,8 +49,9 @@ extern "C" {
 /* The link protocol this codec speaks, carried in every heartbeat (the handshake: each
  * side refuses a peer of another version). Version 1 (before issue 10) had a 12-byte
  * heartbeat without the version byte and bearing-only goals; version 2 adds the version
- * byte, position goals and the board's POSE. */
-#define QNAV_LINK_PROTOCOL_VERSION 2u
+ * byte, position goals and the board's POSE; version 3 (issue 17) adds the board's CONFIG
+ * report, so that a bridge refuses a board built for another robot. */
+#define QNAV_LINK_PROTOCOL_VERSION 3u
 
 /* Message ids. Direction: B->H board to host (navbridge), H->B host to board. */
 typedef enum {
@@ -61,7 +62,8 @@ typedef enum {
     QNAV_LINK_MSG_POLICY_COMMIT = 0x05, /* H->B end of upload: total length and CRC */
     QNAV_LINK_MSG_POLICY_ACK = 0x06,    /* B->H result of a commit */
     QNAV_LINK_MSG_HEARTBEAT = 0x07,     /* both ways, every tick; carries the protocol version */
-    QNAV_LINK_MSG_POSE = 0x08           /* B->H dead-reckoned pose in the odometry frame */
+    QNAV_LINK_MSG_POSE = 0x08,          /* B->H dead-reckoned pose in the odometry frame */
+    QNAV_LINK_MSG_CONFIG = 0x09         /* B->H the robot configuration the board runs */
 } qnav_link_msg_t;
 
 /* Payload sizes in bytes (the scan's is 12 + 2 * n_sectors). */
@@ -75,13 +77,17 @@ typedef enum {
 #define QNAV_LINK_HEARTBEAT_V1_BYTES 12u  /* version 1's (no version byte) */
 #define QNAV_LINK_HEARTBEAT_MAX_BYTES 32u /* longest a later version may send */
 #define QNAV_LINK_POSE_BYTES 20u
+/* CONFIG: [count u8] then count x ([key u8][value i32]); at most this many fields. */
+#define QNAV_LINK_CONFIG_MAX_FIELDS 20u
+#define QNAV_LINK_CONFIG_MAX_BYTES (1u + 5u * QNAV_LINK_CONFIG_MAX_FIELDS)
 
 /* Largest payload this build accepts: a full scan or a full chunk, whichever is larger. */
 #define QNAV_LINK_SCAN_MAX_BYTES (QNAV_LINK_SCAN_HEADER_BYTES + 2u * QNAV_LINK_MAX_SECTORS)
 #define QNAV_LINK_CHUNK_MAX_BYTES (QNAV_LINK_POLICY_CHUNK_HEADER_BYTES + QNAV_LINK_CHUNK_BYTES)
+#define QNAV_LINK_MAX2_(a, b) ((a) > (b) ? (a) : (b))
 #define QNAV_LINK_MAX_PAYLOAD                                                               \
-    (QNAV_LINK_SCAN_MAX_BYTES > QNAV_LINK_CHUNK_MAX_BYTES ? QNAV_LINK_SCAN_MAX_BYTES        \
-                                                          : QNAV_LINK_CHUNK_MAX_BYTES)
+    QNAV_LINK_MAX2_(QNAV_LINK_MAX2_(QNAV_LINK_SCAN_MAX_BYTES, QNAV_LINK_CHUNK_MAX_BYTES),    \
+                    QNAV_LINK_CONFIG_MAX_BYTES)
 /* Frame before COBS: id + sequence + payload + CRC. */
 #define QNAV_LINK_FRAME_OVERHEAD 5u
 #define QNAV_LINK_MAX_FRAME (QNAV_LINK_MAX_PAYLOAD + QNAV_LINK_FRAME_OVERHEAD)
@@ -299,6 +305,15 @@ typedef struct {
                                           codec's own version */
 } qnav_link_heartbeat_t;
 
+/* The robot configuration a board runs, as (key, value) pairs: the keys are the board
+ * core's QNAV_BOARD_ROBOT_FIELDS ids (qnav/board.h), so the codec needs no change when a
+ * field is added. */
+typedef struct {
+    uint8_t n;                                   /* pairs, 0..QNAV_LINK_CONFIG_MAX_FIELDS */
+    uint8_t key[QNAV_LINK_CONFIG_MAX_FIELDS];    /* field id */
+    int32_t value[QNAV_LINK_CONFIG_MAX_FIELDS];  /* its value, in the field's own unit */
+} qnav_link_config_t;
+
 /* Pack into out (cap bytes); return bytes written or QNAV_LINK_E_NULL/_SPACE/_VALUE.
  * Unpack from a payload; return QNAV_LINK_OK or QNAV_LINK_E_NULL/_LENGTH/_VALUE. */
 int32_t qnav_link_scan_pack(const qnav_link_scan_t *m, uint8_t *out, uint16_t cap);
@@ -325,6 +340,8 @@ int32_t qnav_link_heartbeat_pack(const qnav_link_heartbeat_t *m, uint8_t *out, u
 int32_t qnav_link_heartbeat_unpack(const uint8_t *p, uint16_t len, qnav_link_heartbeat_t *m);
 int32_t qnav_link_pose_pack(const qnav_link_pose_t *m, uint8_t *out, uint16_t cap);
 int32_t qnav_link_pose_unpack(const uint8_t *p, uint16_t len, qnav_link_pose_t *m);
+int32_t qnav_link_config_pack(const qnav_link_config_t *m, uint8_t *out, uint16_t cap);
+int32_t qnav_link_config_unpack(const uint8_t *p, uint16_t len, qnav_link_config_t *m);
 
 /* ---- Policy blobs (what an upload carries) -------------------------------------------- */
 

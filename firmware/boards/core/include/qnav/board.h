@@ -2,14 +2,14 @@
  * The qnav board core: the one board application that runs on every robot and in the
  * software-in-the-loop simulator. A 10 Hz loop reads the sonar, heading and wheel
  * encoders through qnav_board_hal_t, dead-reckons the pose, talks to navbridge over the
- * serial link (heartbeat with the protocol version, scan, pose, goal, command, policy
- * upload and commit) and drives. In onboard mode it runs libqnav itself (the built-in
+ * serial link (heartbeat with the protocol version, the robot configuration it runs,
+ * scan, pose, goal, command, policy upload and commit) and drives. In onboard mode it runs libqnav itself (the built-in
  * hand-tuned policy, or an uploaded one that a commit also writes to non-volatile storage
  * and the next start-up loads); in offboard mode it sends scans and applies navbridge's
  * commands. The drive stops whenever the link goes quiet, a stop is commanded, the peer
  * speaks another protocol version, or there is no goal.
  *
- * Use: qnav_board_config_default() (or a board's own, e.g. qnav_tekbot_config_default())
+ * Use: qnav_board_config_default() (or a robot's generated one, qnav/robots.h)
  * -> edit -> qnav_board_init() -> call qnav_board_poll() as often as possible (it drains
  * the UART and runs a tick every tick_ms). A platform with its own clock (the SIL robot)
  * calls qnav_board_receive() and qnav_board_tick() itself.
@@ -46,23 +46,49 @@ typedef enum {
     QNAV_BOARD_POLICY_UPLOADED = 2  /* committed over the link since start-up */
 } qnav_board_policy_source_t;
 
+/* A board's configuration. Everything a robot's profile (data/robots/NAME.toml) decides is
+ * generated from it (docs/hil.md, "One robot description"): ctrl whole, tick_ms, track_mm
+ * and um_per_count; the rest belongs to the board core. */
 typedef struct {
-    uint16_t n_sectors;          /* sonar sectors the HAL delivers, 1..QNAV_LINK_MAX_SECTORS */
-    qnav_mm_t max_range_mm;      /* sonar maximum range, mm (> 0) */
+    qnav_ctrl_config_t ctrl;     /* the controller's configuration: sonar sectors (the HAL
+                                    delivers them, 1..QNAV_LINK_MAX_SECTORS), range, body,
+                                    safety distance, speed guard, ... (qnav/ctrl.h) */
     uint16_t tick_ms;            /* control period, ms (100 = 10 Hz) */
     uint16_t link_timeout_ms;    /* the drive stops after this long without a good frame, ms */
-    qnav_mm_t body_radius_mm;    /* centre to the farthest point of the body, mm: the
-                                    controller's obstacle enlargement (docs/architecture.md) */
-    qnav_mm_t safety_mm;         /* safety distance added to the radius, mm */
-    qnav_mm_t sonar_offset_mm;   /* centre to the transducers, mm (ranges start there) */
-    uint16_t v_max_mm_s;         /* speed at full command, mm/s (speed guard) */
-    uint16_t decel_mm_s2;        /* braking deceleration, mm/s^2; 0: no speed guard */
+    uint16_t track_mm;           /* distance between the drive wheels, mm (the HAL's heading
+                                    from encoder counts; reported, not used by the core) */
     uint16_t um_per_count;       /* wheel travel per encoder count, micrometres (> 0) */
     uint16_t nvm_offset;         /* first byte of the policy store in the HAL's storage;
                                     it takes QNAV_BOARD_STORE_BYTES bytes */
     const char *controller;      /* a name in libqnav's controller table (qnav/nav.h):
                                     "body" (default), "literal", "vfh" */
 } qnav_board_config_t;
+
+/*
+ * The fields of a board configuration that a robot profile decides, one X(key, name,
+ * member) each: id is the field's key in the link's CONFIG report (never reused), name
+ * what messages call it, member the qnav_board_config_t member. The board reports them,
+ * the header generator (qnav-sim robot-header) writes them and navbridge compares them, all
+ * from this one list: a field added to qnav_ctrl_config_t needs one line here.
+ */
+#define QNAV_BOARD_ROBOT_FIELDS(X)                                                          \
+    X(1, n_sectors, ctrl.n_sectors)                                                         \
+    X(2, max_range_mm, ctrl.max_range_mm)                                                   \
+    X(3, full_speed_quality, ctrl.full_speed_quality)                                       \
+    X(4, body_radius_mm, ctrl.body_radius_mm)                                               \
+    X(5, safety_mm, ctrl.safety_mm)                                                         \
+    X(6, sensor_offset_mm, ctrl.sensor_offset_mm)                                           \
+    X(7, v_max_mm_s, ctrl.v_max_mm_s)                                                       \
+    X(8, decel_mm_s2, ctrl.decel_mm_s2)                                                     \
+    X(9, rank, ctrl.rank)                                                                   \
+    X(10, wedge_pct, ctrl.wedge_pct)                                                        \
+    X(11, wedge_near_mm, ctrl.wedge_near_mm)                                                \
+    X(12, escape_stall_ticks, ctrl.escape_stall_ticks)                                      \
+    X(13, escape_follow_mm, ctrl.escape_follow_mm)                                          \
+    X(14, escape_follow_s, ctrl.escape_follow_s)                                            \
+    X(32, tick_ms, tick_ms)                                                                 \
+    X(33, track_mm, track_mm)                                                               \
+    X(34, um_per_count, um_per_count)
 
 /* The policy store: two slots, each [magic 'Q' 'P'][format 1][sequence u8][blob length
  * u16][CRC-16 u16 over format, sequence, length and blob][blob]. A commit writes the slot
@@ -129,17 +155,14 @@ typedef struct {
     qnav_board_stats_t stats;
 } qnav_board_t;
 
-/* Defaults: 8 sectors, 5000 mm, 100 ms tick, 300 ms link timeout, no
- * body margin and no speed guard, 1000 um per count, store at byte 0. */
+/* Defaults: qnav_ctrl_config_default()'s controller (16 sectors, 5000 mm, a TekBot-class
+ * body), 100 ms tick, 300 ms link timeout, 180 mm track, 1000 um per count, store at byte
+ * 0, controller "body". A robot's board starts from its generated configuration instead
+ * (qnav/robots.h). */
 void qnav_board_config_default(qnav_board_config_t *cfg);
 
-/* The controller configuration a board configuration gives (sectors, range, body, speed
- * guard; the rest qnav_ctrl_config_default()'s), and the reverse: cfg's sensor and body
- * fields set from a controller configuration. One home for the correspondence, used by
- * the board core and by hosts that describe a robot as a controller configuration (the
- * SIL robot). */
-void qnav_board_ctrl_config(const qnav_board_config_t *cfg, qnav_ctrl_config_t *cc);
-void qnav_board_config_from_ctrl(qnav_board_config_t *cfg, const qnav_ctrl_config_t *cc);
+/* The CONFIG report of cfg: every QNAV_BOARD_ROBOT_FIELDS field as (key, value). */
+void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t *m);
 
 /* Check cfg and hal, start the link, load the newest whole policy from storage (the
  * built-in policy when there is none or it is corrupt), start the controller; the drive

@@ -11,9 +11,9 @@
 extern "C" {
 #endif
 
-/* The core's defaults with the body of data/robots/tekbot.toml (radius 120 mm with the
- * sonar on its rim, safety 50 mm, 500 mm/s, braking 2000 mm/s^2) and its encoders (70 mm
- * wheels, 32 counts per turn: 6872 um per count). */
+/* The TekBot's configuration, generated from data/robots/tekbot.toml
+ * (QNAV_ROBOT_TEKBOT_CONFIG of qnav/robot_tekbot.h: sonar, body, speed guard, tick, track,
+ * encoders; docs/hil.md, "One robot description"). */
 void qnav_tekbot_config_default(qnav_board_config_t *cfg);
 
 #ifdef __cplusplus

@@ -1,0 +1,39 @@
+/*
+ * The pioneer3dx's board configuration, generated from its robot profile
+ * (data/robots/pioneer3dx.toml) by
+ *   qnav-sim robot-header --robot pioneer3dx firmware/boards/robots/include/qnav/robot_pioneer3dx.h
+ * Do not edit: change the profile and run the command again. The test
+ * board.robot_headers_match_profiles fails while this file differs from what the
+ * command writes (docs/hil.md, "One robot description").
+ */
+#ifndef QNAV_ROBOT_PIONEER3DX_H
+#define QNAV_ROBOT_PIONEER3DX_H
+
+#define QNAV_ROBOT_PIONEER3DX_NAME "pioneer3dx"
+
+/* Heading change per differential encoder count (right minus left), 1e-6 deg:
+ * um_per_count / track_mm rad. */
+#define QNAV_ROBOT_PIONEER3DX_UDEG_PER_COUNT 84207L
+
+/* A qnav_board_config_t (qnav/board.h): the fields of QNAV_BOARD_ROBOT_FIELDS from the
+ * profile, the rest qnav_board_config_default()'s. */
+#define QNAV_ROBOT_PIONEER3DX_CONFIG \
+    { \
+        .ctrl.n_sectors = 16, \
+        .ctrl.max_range_mm = 5000, \
+        .ctrl.full_speed_quality = 29491, \
+        .ctrl.body_radius_mm = 260, \
+        .ctrl.safety_mm = 50, \
+        .ctrl.sensor_offset_mm = 260, \
+        .ctrl.v_max_mm_s = 1000, \
+        .ctrl.decel_mm_s2 = 600, \
+        .ctrl.rank = 1, \
+        .tick_ms = 100, \
+        .track_mm = 330, \
+        .um_per_count = 485, \
+        .link_timeout_ms = 300, \
+        .nvm_offset = 0, \
+        .controller = "body" \
+    }
+
+#endif /* QNAV_ROBOT_PIONEER3DX_H */

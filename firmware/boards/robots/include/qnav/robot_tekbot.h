@@ -1,0 +1,39 @@
+/*
+ * The tekbot's board configuration, generated from its robot profile
+ * (data/robots/tekbot.toml) by
+ *   qnav-sim robot-header --robot tekbot firmware/boards/robots/include/qnav/robot_tekbot.h
+ * Do not edit: change the profile and run the command again. The test
+ * board.robot_headers_match_profiles fails while this file differs from what the
+ * command writes (docs/hil.md, "One robot description").
+ */
+#ifndef QNAV_ROBOT_TEKBOT_H
+#define QNAV_ROBOT_TEKBOT_H
+
+#define QNAV_ROBOT_TEKBOT_NAME "tekbot"
+
+/* Heading change per differential encoder count (right minus left), 1e-6 deg:
+ * um_per_count / track_mm rad. */
+#define QNAV_ROBOT_TEKBOT_UDEG_PER_COUNT 2187426L
+
+/* A qnav_board_config_t (qnav/board.h): the fields of QNAV_BOARD_ROBOT_FIELDS from the
+ * profile, the rest qnav_board_config_default()'s. */
+#define QNAV_ROBOT_TEKBOT_CONFIG \
+    { \
+        .ctrl.n_sectors = 8, \
+        .ctrl.max_range_mm = 2500, \
+        .ctrl.full_speed_quality = 29491, \
+        .ctrl.body_radius_mm = 120, \
+        .ctrl.safety_mm = 50, \
+        .ctrl.sensor_offset_mm = 120, \
+        .ctrl.v_max_mm_s = 500, \
+        .ctrl.decel_mm_s2 = 2000, \
+        .ctrl.rank = 1, \
+        .tick_ms = 100, \
+        .track_mm = 180, \
+        .um_per_count = 6872, \
+        .link_timeout_ms = 300, \
+        .nvm_offset = 0, \
+        .controller = "body" \
+    }
+
+#endif /* QNAV_ROBOT_TEKBOT_H */

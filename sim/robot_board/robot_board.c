@@ -1,0 +1,108 @@
+/*
+ * A robot profile as a board configuration (robot_board.h): the mapping, the generated
+ * header and the comparison, each walking QNAV_BOARD_ROBOT_FIELDS once.
+ */
+#include "robot_board.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <string.h>
+
+void qnav_robot_board_config(const qnav_sim_robot_t *robot, qnav_board_config_t *cfg)
+{
+    qnav_sim_robot_info_t ri;
+    qnav_board_config_default(cfg);
+    qnav_sim_robot_ctrl_config(robot, 0, &cfg->ctrl);
+    qnav_sim_robot_info(robot, &ri);
+    cfg->tick_ms = (uint16_t)ri.tick_ms;
+    cfg->track_mm = (uint16_t)lround(fmin(65535.0, ri.wheel_base_m * 1000.0));
+    cfg->um_per_count = (uint16_t)ri.um_per_count;
+}
+
+long qnav_robot_board_udeg_per_count(const qnav_board_config_t *cfg)
+{
+    if (cfg->track_mm == 0u) {
+        return 0;
+    }
+    /* (um / 1000) / track_mm rad, in 1e-6 deg */
+    return lround((double)cfg->um_per_count / (1000.0 * cfg->track_mm) * (180.0 / 3.14159265358979323846) * 1e6);
+}
+
+int qnav_robot_board_header(const qnav_sim_robot_t *robot, FILE *out)
+{
+    qnav_board_config_t cfg;
+    qnav_sim_robot_info_t ri;
+    char up[64];
+    size_t k;
+    qnav_sim_robot_info(robot, &ri);
+    qnav_robot_board_config(robot, &cfg);
+    for (k = 0; ri.name[k] != '\0' && k + 1 < sizeof up; ++k) {
+        up[k] = isalnum((unsigned char)ri.name[k]) ? (char)toupper((unsigned char)ri.name[k]) : '_';
+    }
+    up[k] = '\0';
+    fprintf(out,
+            "/*\n"
+            " * The %s's board configuration, generated from its robot profile\n"
+            " * (data/robots/%s.toml) by\n"
+            " *   qnav-sim robot-header --robot %s firmware/boards/robots/include/qnav/robot_%s.h\n"
+            " * Do not edit: change the profile and run the command again. The test\n"
+            " * board.robot_headers_match_profiles fails while this file differs from what the\n"
+            " * command writes (docs/hil.md, \"One robot description\").\n"
+            " */\n"
+            "#ifndef QNAV_ROBOT_%s_H\n"
+            "#define QNAV_ROBOT_%s_H\n\n"
+            "#define QNAV_ROBOT_%s_NAME \"%s\"\n\n"
+            "/* Heading change per differential encoder count (right minus left), 1e-6 deg:\n"
+            " * um_per_count / track_mm rad. */\n"
+            "#define QNAV_ROBOT_%s_UDEG_PER_COUNT %ldL\n\n"
+            "/* A qnav_board_config_t (qnav/board.h): the fields of QNAV_BOARD_ROBOT_FIELDS from the\n"
+            " * profile, the rest qnav_board_config_default()'s. */\n"
+            "#define QNAV_ROBOT_%s_CONFIG \\\n"
+            "    { \\\n",
+            ri.name, ri.name, ri.name, ri.name, up, up, up, ri.name, up,
+            qnav_robot_board_udeg_per_count(&cfg), up);
+#define QNAV_ROBOT_BOARD_PRINT(id, name, member) \
+    fprintf(out, "        .%s = %ld, \\\n", #member, (long)cfg.member);
+    QNAV_BOARD_ROBOT_FIELDS(QNAV_ROBOT_BOARD_PRINT)
+#undef QNAV_ROBOT_BOARD_PRINT
+    fprintf(out,
+            "        .link_timeout_ms = %u, \\\n"
+            "        .nvm_offset = %u, \\\n"
+            "        .controller = \"%s\" \\\n"
+            "    }\n\n"
+            "#endif /* QNAV_ROBOT_%s_H */\n",
+            (unsigned)cfg.link_timeout_ms, (unsigned)cfg.nvm_offset, cfg.controller, up);
+    return fflush(out) == 0 && !ferror(out) ? 0 : -1;
+}
+
+int qnav_robot_board_diff(const qnav_link_config_t *reported, const qnav_board_config_t *expected,
+                          char *line, size_t len)
+{
+    uint8_t i;
+#define QNAV_ROBOT_BOARD_CHECK(id, name, member)                                           \
+    for (i = 0; i < reported->n && reported->key[i] != (id); ++i) {                        \
+    }                                                                                       \
+    if (i == reported->n) {                                                                 \
+        snprintf(line, len, "%s not reported", #name);                                      \
+        return 1;                                                                           \
+    }                                                                                       \
+    if (reported->value[i] != (int32_t)expected->member) {                                  \
+        snprintf(line, len, "%s %ld != %ld", #name, (long)reported->value[i],               \
+                 (long)expected->member);                                                   \
+        return 1;                                                                           \
+    }
+    QNAV_BOARD_ROBOT_FIELDS(QNAV_ROBOT_BOARD_CHECK)
+#undef QNAV_ROBOT_BOARD_CHECK
+    if (len > 0) {
+        line[0] = '\0';
+    }
+    return 0;
+}
+
+int qnav_robot_board_config_diff(const qnav_board_config_t *a, const qnav_board_config_t *b,
+                                 char *line, size_t len)
+{
+    qnav_link_config_t m;
+    qnav_board_config_report(a, &m);
+    return qnav_robot_board_diff(&m, b, line, len);
+}
