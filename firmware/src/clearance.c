@@ -147,6 +147,12 @@ qnav_q1_15_t qnav_clearance_speed_cap(const qnav_clearance_t *c, uint8_t level)
     return stop_speed(d > c->margin_mm ? d - c->margin_mm : 0u, c->v_max_mm_s, c->decel_mm_s2);
 }
 
+qnav_q1_15_t qnav_clearance_turn_cap(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t path)
+{
+    uint8_t level = lvl[path] < lvl[0] ? lvl[path] : lvl[0];
+    return qnav_clearance_speed_cap(c, level);
+}
+
 qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
 {
     if (cfg->n_sectors < 1u || cfg->n_sectors > QNAV_MAX_SECTORS) {

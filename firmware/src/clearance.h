@@ -28,6 +28,10 @@ void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg);
  * division (about 2 000 cycles on the ATmega128); the step asks once. */
 qnav_q1_15_t qnav_clearance_speed_cap(const qnav_clearance_t *c, uint8_t level);
 
+/* The speed guard while turning to path (0..359): the robot still moves along its present
+ * heading (path 0) until it has turned, so the cap is that of the nearer of the two. */
+qnav_q1_15_t qnav_clearance_turn_cap(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t path);
+
 /*
  * The distance level of every path (lvl[i] for path i, i = 0..359) from the n_sectors
  * ranges: the minimum over the sectors whose enlarged arc covers the path.

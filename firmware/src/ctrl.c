@@ -637,7 +637,7 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
         flags |= QNAV_FLAG_FULL_SPEED;
     }
     path = (uint16_t)(best.heading < 0 ? best.heading + QNAV_PATHS : best.heading);
-    cap = qnav_clearance_speed_cap(&ctrl->clr, lvl[path]);
+    cap = qnav_clearance_turn_cap(&ctrl->clr, lvl, path);
     if (speed > (uint32_t)cap) {
         speed = (uint32_t)cap;
         flags |= QNAV_FLAG_SPEED_GUARD;

@@ -164,7 +164,7 @@ void qnav_escape_keep_moving(const qnav_clearance_t *c, const uint8_t *lvl,
         out->speed = 0; /* turn in place toward it */
         return;
     }
-    cap = qnav_clearance_speed_cap(c, lvl[goal]);
+    cap = qnav_clearance_turn_cap(c, lvl, goal);
     out->speed = QNAV_ESCAPE_CRAWL < cap ? QNAV_ESCAPE_CRAWL : cap;
     if (out->quality < out->speed) {
         out->quality = out->speed;

@@ -263,7 +263,7 @@ void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ct
         speed = (qnav_q1_15_t)(((uint32_t)l * QNAV_Q1_15_MAX) / vfh->level_slow);
     }
     out->quality = speed;
-    cap = qnav_clearance_speed_cap(&vfh->clr, l);
+    cap = qnav_clearance_turn_cap(&vfh->clr, lvl, c.dir);
     if (speed > cap) {
         speed = cap;
         flags |= QNAV_FLAG_SPEED_GUARD;

@@ -169,7 +169,7 @@ static void test_onboard_board_drives_with_libqnav_decision(void **state)
     qnav_ctrl_input_t in = {0};
     qnav_ctrl_output_t want;
     (void)state;
-    bench_start(8);
+    bench_start(16); /* the TekBot profile's sector count */
     g.sim.heading_cdeg = 1000;
     goal(1, 5500);
     run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 500);
@@ -595,13 +595,13 @@ static void test_board_reports_its_robot_configuration_field_by_field(void **sta
     n = qnav_link_config_pack(&m, p, sizeof p);
     assert_true(n > 0);
     assert_int_equal(qnav_link_config_unpack(p, (uint16_t)n, &back), QNAV_LINK_OK);
-    assert_int_equal(back.n, 12);
+    assert_int_equal(back.n, 17);
     assert_int_equal(back.key[0], 1);
     assert_int_equal(back.value[0], bc.ctrl.n_sectors);
     assert_int_equal(back.key[1], 2);
     assert_int_equal(back.value[1], bc.ctrl.max_range_mm);
-    assert_int_equal(back.key[11], 34);
-    assert_int_equal(back.value[11], bc.um_per_count);
+    assert_int_equal(back.key[back.n - 1], 34);
+    assert_int_equal(back.value[back.n - 1], bc.um_per_count);
 }
 
 int main(void)

@@ -281,7 +281,7 @@ static void test_navbridge_refuses_a_board_of_another_robot_naming_the_field(voi
     (void)state;
     bridge_against_board(TEKBOT_ELF, "tekbot", "pioneer3dx", "p3dx", text, sizeof text);
     assert_non_null(strstr(text, "navbridge: board configuration differs from robot "
-                                 "'pioneer3dx': n_sectors 8 != 16\n"));
+                                 "'pioneer3dx': max_range_mm 2500 != 5000\n"));
 
     /* the TekBot's profile with another sonar range only: that field is named */
     n = read_text(TEKBOT_PROFILE, toml, sizeof toml);
@@ -310,7 +310,7 @@ static void test_simavr_board_refuses_an_image_of_another_robot(void **state)
     assert_int_equal(run_program(board, out, err), 1);
     assert_true(read_text(err, text, sizeof text) > 0);
     assert_string_equal(text, "qnav-simavr-board: board configuration differs from robot "
-                              "'tekbot': n_sectors 16 != 8\n");
+                              "'tekbot': max_range_mm 5000 != 2500\n");
     assert_true(read_text(out, text, sizeof text) > 0);
     assert_non_null(strstr(text, "(refused)"));
 }

@@ -167,7 +167,7 @@ static void test_sil_pioneer3dx_is_driven_by_its_robot_and_refused_by_another(vo
     assert_true(read_text(nb_err, text, sizeof text) > 0);
     print_message("%s", text);
     assert_non_null(strstr(text, "navbridge: board configuration differs from robot 'tekbot': "
-                                 "n_sectors 16 != 8\n"));
+                                 "max_range_mm 5000 != 2500\n"));
     assert_int_equal(kill(ps, SIGTERM), 0);
     assert_true(qnav_test_wait_exit(ps) >= 0);
 

@@ -38,7 +38,10 @@ struct GuardRun {
 // The Pioneer's profile with the speed guard set as asked.
 static qnav_sim_robot_t *profile(const char *robot, bool guard) {
     std::string text = read_text_file(std::string(QNAV_TEST_DATA_DIR) + "/robots/" + robot + ".toml");
-    text += std::string("\n[clearance]\nspeed_guard = ") + (guard ? "true" : "false") + "\n";
+    const std::string key = "speed_guard = true";
+    const std::size_t at = text.find(key);
+    assert_true(at != std::string::npos);
+    text.replace(at, key.size(), std::string("speed_guard = ") + (guard ? "true" : "false"));
     qnav_sim_robot_t *r = nullptr;
     char err[QNAV_SIM_ERRLEN] = "";
     if (qnav_sim_robot_parse(text.data(), text.size(), "pioneer-guard.toml", &r, err, sizeof err) !=

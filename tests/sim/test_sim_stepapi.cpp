@@ -36,6 +36,7 @@ static qnav_sim_result_t step_episode(qnav_sim_t *sim, qnav_nav_t *nav, uint64_t
     qnav_nav_reset(nav);
     qnav_sim_state_t st;
     assert_int_equal(qnav_sim_state(sim, &st), QNAV_SIM_OK);
+    qnav_ctrl_output_t out{};
     while (!st.done) {
         qnav_sim_scan_t s;
         std::memset(&s, 0xA5, sizeof s);  // a field the call leaves alone shows as garbage
@@ -44,7 +45,8 @@ static qnav_sim_result_t step_episode(qnav_sim_t *sim, qnav_nav_t *nav, uint64_t
         in.ranges_mm = s.ranges_mm;
         in.goal_bearing_cdeg = s.goal_bearing_cdeg;
         in.prev_heading_cdeg = s.prev_heading_cdeg;
-        qnav_ctrl_output_t out;
+        in.goal_range_mm = s.goal_range_mm;
+        in.escape = out.escape;  // the caller carries the escape memory from tick to tick
         qnav_nav_step(nav, &in, &out);
         assert_int_equal(qnav_sim_command(sim, &out), QNAV_SIM_OK);
         assert_int_equal(qnav_sim_advance(sim), QNAV_SIM_OK);

@@ -226,6 +226,9 @@ static void on_frame(qnav_board_t *bot, const qnav_link_frame_t *f, uint32_t now
     case QNAV_LINK_MSG_GOAL: {
         qnav_link_goal_t g;
         if (qnav_link_goal_unpack(f->payload, f->len, &g) == QNAV_LINK_OK) {
+            if (g.goal_id != bot->goal.goal_id) {
+                memset(&bot->escape, 0, sizeof bot->escape); /* a new destination */
+            }
             bot->goal = g;
             bot->have_goal = (uint8_t)(g.goal_id != 0u);
         }
@@ -431,6 +434,7 @@ static void decide(qnav_board_t *bot, uint32_t now, const qnav_ctrl_input_t *in,
     out->speed = 0;
     out->quality = 0;
     out->flags = 0;
+    out->escape = in->escape; /* kept as it was unless the controller decides */
     if (bot->mode == QNAV_LINK_MODE_ONBOARD) {
         qnav_nav_step(&bot->nav, in, out);
     } else if (bot->mode == QNAV_LINK_MODE_OFFBOARD &&
@@ -486,8 +490,12 @@ void qnav_board_tick(qnav_board_t *bot)
                                ? qnav_board_wrap_cdeg((int32_t)bot->decided_cdeg -
                                                       (int32_t)bot->pose.heading_cdeg)
                                : 0;
+    /* the distance to a position goal (0 for a bearing goal: no escape) and the memory */
+    in.goal_range_mm = (qnav_mm_t)(dist_mm > 65535u ? 65535u : dist_mm);
+    in.escape = bot->escape;
 
     decide(bot, now, &in, &out);
+    bot->escape = out.escape;
     bot->decided_cdeg =
         qnav_board_wrap_cdeg((int32_t)bot->pose.heading_cdeg + 100 * (int32_t)out.heading_deg);
     bot->have_decision = 1;

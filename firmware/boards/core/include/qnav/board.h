@@ -133,6 +133,8 @@ typedef struct {
     qnav_cdeg_t decided_cdeg;    /* last decision's heading in the world (compass), 0.01 deg:
                                     the previous-decision input of 3-input policies */
     uint8_t have_decision;       /* decided_cdeg is set */
+    qnav_escape_t escape;        /* the controller's escape memory, carried from each tick's
+                                    decision to the next; cleared with every new goal */
     uint16_t policy_crc;
     uint8_t policy_source;       /* qnav_board_policy_source_t */
     uint8_t store_slot;          /* slot the running stored policy is in (0/1), 0xFF none */

@@ -28,6 +28,11 @@
         .ctrl.v_max_mm_s = 1000, \
         .ctrl.decel_mm_s2 = 600, \
         .ctrl.rank = 1, \
+        .ctrl.wedge_pct = 25, \
+        .ctrl.wedge_near_mm = 500, \
+        .ctrl.escape_stall_ticks = 40, \
+        .ctrl.escape_follow_mm = 800, \
+        .ctrl.escape_follow_s = 20, \
         .tick_ms = 100, \
         .track_mm = 330, \
         .um_per_count = 485, \

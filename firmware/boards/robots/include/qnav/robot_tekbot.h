@@ -19,7 +19,7 @@
  * profile, the rest qnav_board_config_default()'s. */
 #define QNAV_ROBOT_TEKBOT_CONFIG \
     { \
-        .ctrl.n_sectors = 8, \
+        .ctrl.n_sectors = 16, \
         .ctrl.max_range_mm = 2500, \
         .ctrl.full_speed_quality = 29491, \
         .ctrl.body_radius_mm = 120, \
@@ -28,6 +28,11 @@
         .ctrl.v_max_mm_s = 500, \
         .ctrl.decel_mm_s2 = 2000, \
         .ctrl.rank = 1, \
+        .ctrl.wedge_pct = 25, \
+        .ctrl.wedge_near_mm = 0, \
+        .ctrl.escape_stall_ticks = 20, \
+        .ctrl.escape_follow_mm = 500, \
+        .ctrl.escape_follow_s = 20, \
         .tick_ms = 100, \
         .track_mm = 180, \
         .um_per_count = 6872, \
