@@ -236,6 +236,8 @@ static void test_gen_env_writes_the_world_the_spec_loads_and_refuses_bad_names(v
     assert_string_equal(out.c_str(), "world spec 'gen:maze:1:0.5:tekbot': unknown family 'maze' (families: clutter, gaps, corridor, pocket, rooms)\n");
     assert_int_equal(run_tool("gen-env --family gaps --density 0.2 --out " + std::string(dir) + "/x.toml", &out), 2);
     assert_string_equal(out.c_str(), "--density: not with --family (use --difficulty)\n");
+    assert_int_equal(run_tool("gen-env --difficulty 0.2 --out " + std::string(dir) + "/x.toml", &out), 2);
+    assert_string_equal(out.c_str(), "--difficulty: only with --family (the density form takes --density)\n");
     assert_int_equal(run_tool("gen-env --family gaps --name 'a\"\nb' --out " + std::string(dir) + "/x.toml", &out), 2);
     assert_string_equal(out.c_str(), "--name: must not contain control characters (newline, tab, ...)\n");
     assert_int_equal(access((std::string(dir) + "/x.toml").c_str(), F_OK), -1);
