@@ -4,6 +4,7 @@
 #include "sim_runner.h"
 
 #include "qnav/nav.h"
+#include "worlds.h"
 
 #include <cstring>
 
@@ -57,7 +58,24 @@ SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t conte
     : use_table_(use_table)
 {
     const qnav_sim_robot_t *robot = worlds.robot(scenario.robot);
-    const qnav_sim_env_t *env = worlds.env(scenario.environment);
+    if (scenario.distribution) {
+        throw UserError("simulator (" + scenario.describe() + "): a distribution runs through DistributionRunner");
+    }
+    // A generated world is made for this context only (the context copies it): a training
+    // distribution meets up to a million of them, too many to keep.
+    std::unique_ptr<qnav_sim_env_t, void (*)(qnav_sim_env_t *)> own_env(nullptr, qnav_sim_env_free);
+    const qnav_sim_env_t *env = nullptr;
+    if (scenario.environment.compare(0, 4, "gen:") == 0) {
+        char lerr[QNAV_SIM_ERRLEN] = {0};
+        qnav_sim_env_t *h = nullptr;
+        if (qnav_sim_env_load(scenario.environment.c_str(), &h, lerr, sizeof lerr) != QNAV_SIM_OK) {
+            throw UserError("environment '" + scenario.environment + "': " + lerr);
+        }
+        own_env.reset(h);
+        env = h;
+    } else {
+        env = worlds.env(scenario.environment);
+    }
     qnav_sim_config_t cfg;
     qnav_sim_config_default(&cfg);
     cfg.n_sectors = static_cast<uint16_t>(scenario.sectors);
@@ -178,6 +196,32 @@ EpisodeOutcome SimRunner::run_controller_traced(const char *controller, uint64_t
     const qnav_sim_status_t s =
         qnav_sim_run_episode_nav(sim_, &nav, episode_seed, &res, trace ? +append_sample : nullptr, trace);
     return outcome(s, res);
+}
+
+void probe_scenario(SimWorlds &worlds, const Scenario &scenario, uint64_t context_seed, bool use_table)
+{
+    if (!scenario.distribution) {
+        SimRunner probe(worlds, scenario, context_seed, use_table);
+        return;
+    }
+    const Distribution &d = *scenario.distribution;
+    std::vector<uint32_t> sectors = d.sectors;
+    if (sectors.empty()) {
+        sectors.push_back(scenario.sectors);
+    }
+    for (const FamilySpec &f : d.families) {
+        Scenario s = scenario;
+        s.distribution.reset();
+        s.environment = f.family.empty() ? f.environment : family_env_spec(f.family, d.seed_lo, f.difficulty_lo, s.robot);
+        for (uint32_t n : sectors) {
+            s.sectors = n;
+            try {
+                SimRunner probe(worlds, s, context_seed, use_table);
+            } catch (const UserError &e) {
+                throw UserError("distribution " + d.name + ", " + f.label() + ": " + e.what());
+            }
+        }
+    }
 }
 
 } // namespace qnav

@@ -84,6 +84,11 @@ private:
     unsigned least_recent_ = 0; /* index into tables_ to overwrite next */
 };
 
+/* Check that every world a scenario can meet loads and runs: the scenario itself, or for
+ * a distribution each component (a family at its lowest training seed and difficulty) with
+ * each sector count. Throws UserError with the simulator's message. */
+void probe_scenario(SimWorlds &worlds, const Scenario &scenario, uint64_t context_seed, bool use_table);
+
 } // namespace qnav
 
 #endif

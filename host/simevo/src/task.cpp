@@ -18,6 +18,7 @@
 #include "files.h"
 #include "qnav/policy_io.h"
 #include "rng.h"
+#include "worlds.h"
 
 namespace qnav {
 
@@ -533,10 +534,10 @@ std::size_t replay_journal(const TaskDef &t, const std::string &journal_path, Ev
 }
 /* Resume (replay) and continue an evolution to its budget, journaling each step and
  * evaluating the checkpoints. Returns false when stopped. */
-bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, const std::string &journal_path,
-            const TaskObserver &obs, const std::atomic<bool> &stop)
+bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, EpisodeRunner &held_out_runner,
+            const std::string &journal_path, const TaskObserver &obs, const std::atomic<bool> &stop)
 {
-    CheckpointLog checkpoints(t, runner, obs);
+    CheckpointLog checkpoints(t, held_out_runner, obs);
     const std::size_t keep = replay_journal(t, journal_path, evo, checkpoints, obs);
     const int fd = open_journal_at(journal_path, keep, kJournalHeader);
     FdGuard guard{fd};
@@ -573,6 +574,14 @@ bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, const std::
     }
 
     return true;
+}
+/* The runner of a scenario: make's, or over a distribution's worlds. */
+std::unique_ptr<EpisodeRunner> make_runner(const RunnerFactory &make, const Scenario &sc, uint64_t seed)
+{
+    if (sc.distribution) {
+        return std::make_unique<DistributionRunner>(sc, seed, make);
+    }
+    return make(sc, seed);
 }
 } // namespace
 
@@ -612,7 +621,17 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
         return true;
     }
 
-    std::unique_ptr<EpisodeRunner> runner = make(t.scenario, t.context_seed);
+    // Held-out episodes of a distribution run in its validation worlds; of one environment,
+    // at new start points of it (the same runner, as before distributions existed).
+    std::unique_ptr<EpisodeRunner> held_out_owner;
+    std::unique_ptr<EpisodeRunner> runner;
+    if (t.kind == TaskKind::EvalProbabilistic || !t.scenario.distribution) {
+        runner = make_runner(make, validation_scenario(t.scenario), t.context_seed);
+    } else {
+        runner = make_runner(make, t.scenario, t.context_seed);
+        held_out_owner = make_runner(make, validation_scenario(t.scenario), t.context_seed);
+    }
+    EpisodeRunner &held_out = held_out_owner ? *held_out_owner : *runner;
 
     if (t.kind == TaskKind::EvalProbabilistic) {
         // the references on the same held-out episodes: the hand-tuned probabilistic
@@ -632,7 +651,7 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
     Evolution evo = source_policy_path.empty()
                         ? Evolution(t.evolution, t.evolution_seed)
                         : Evolution(t.evolution, t.evolution_seed, source);
-    if (!evolve(t, evo, *runner, journal_path, obs, stop)) {
+    if (!evolve(t, evo, *runner, held_out, journal_path, obs, stop)) {
         return false;
     }
     const int32_t b = evo.best_index();
@@ -645,7 +664,7 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
         throw UserError(err);
     }
     if (t.eval_episodes > 0) {
-        if (!run_eval(*runner, best, t, obs, stop)) {
+        if (!run_eval(held_out, best, t, obs, stop)) {
             return false;
         }
     }
