@@ -14,6 +14,7 @@
 #include "qnav/paths.hpp"
 #include "error.hpp"
 #include "tomlread.hpp"
+#include "worldgen.hpp"
 
 #ifndef QNAV_SIM_DATA_DIR
 #define QNAV_SIM_DATA_DIR "data"
@@ -118,8 +119,18 @@ qnav_sim_status_t qnav_sim_env_parse(const char *text, size_t len, const char *n
 
 qnav_sim_status_t qnav_sim_env_load(const char *spec, qnav_sim_env_t **out, char *err,
                                     size_t errlen) {
+    if (out && spec && qnav::is_world_spec(spec)) {
+        *out = nullptr;
+        return guarded(err, errlen, [&] {
+            auto e = std::make_unique<qnav_sim_env>();
+            e->env = qnav::load_world(spec);
+            *out = e.release();
+        });
+    }
     return load_spec(spec, "envs", "env", qnav_sim_env_parse, out, err, errlen);
 }
+
+const char *qnav_sim_world_families(void) { return qnav::world_family_names(); }
 
 void qnav_sim_env_free(qnav_sim_env_t *env) { delete env; }
 

@@ -186,13 +186,25 @@ int first_walled_in_zone(const Environment &env, double clearance_m, double cell
     for (int j = 0; j < ny; ++j) {
         for (int i = 0; i < nx; ++i) {
             const Vec2 p{(i + 0.5) * cell_m, (j + 0.5) * cell_m};
-            bool ok = p.x >= clearance_m && p.y >= clearance_m &&
-                      p.x <= env.width_m - clearance_m && p.y <= env.height_m - clearance_m;
-            Vec2 q;
-            for (std::size_t k = 0; ok && k < obs.size(); ++k)
-                if (nearest_point(obs[k], p, &q) < clearance_m) ok = false;
-            free[static_cast<std::size_t>(j) * nx + i] = ok;
+            free[static_cast<std::size_t>(j) * nx + i] = p.x >= clearance_m && p.y >= clearance_m &&
+                                                         p.x <= env.width_m - clearance_m &&
+                                                         p.y <= env.height_m - clearance_m;
         }
+    }
+    // An obstacle can only block cells within its bounding circle + clearance (one more
+    // cell of margin): worlds of hundreds of obstacles cost their area, not cells x obstacles.
+    for (const Shape &s : obs) {
+        const double reach = s.r + clearance_m + cell_m;
+        const int i0 = std::max(0, static_cast<int>(std::floor((s.c.x - reach) / cell_m)));
+        const int i1 = std::min(nx - 1, static_cast<int>(std::floor((s.c.x + reach) / cell_m)));
+        const int j0 = std::max(0, static_cast<int>(std::floor((s.c.y - reach) / cell_m)));
+        const int j1 = std::min(ny - 1, static_cast<int>(std::floor((s.c.y + reach) / cell_m)));
+        Vec2 q;
+        for (int j = j0; j <= j1; ++j)
+            for (int i = i0; i <= i1; ++i) {
+                char &f = free[static_cast<std::size_t>(j) * nx + i];
+                if (f && nearest_point(s, {(i + 0.5) * cell_m, (j + 0.5) * cell_m}, &q) < clearance_m) f = 0;
+            }
     }
     auto cell = [&](double x, double y) {
         const int i = std::clamp(static_cast<int>(x / cell_m), 0, nx - 1);
@@ -300,7 +312,19 @@ std::string environment_to_toml(const Environment &env) {
     std::ostringstream os;
     os.precision(6);
     os << "# qnav environment (format: docs/sim.md). Units: metres, degrees, seconds.\n";
-    os << "name = \"" << env.name << "\"\n";
+    os << "name = \"";
+    for (const unsigned char ch : env.name) {  // a TOML basic string: escape what ends it
+        if (ch == '"' || ch == '\\') {
+            os << '\\' << ch;
+        } else if (ch < 0x20 || ch == 0x7f) {
+            char u[8];
+            std::snprintf(u, sizeof u, "\\u%04x", ch);
+            os << u;
+        } else {
+            os << ch;
+        }
+    }
+    os << "\"\n";
     os << "episode_limit_s = " << env.episode_limit_s << "\n\n";
     os << "[arena]\nwidth_m = " << env.width_m << "\nheight_m = " << env.height_m << "\n\n";
     os << "[destination]\nx_m = " << env.dest_x_m << "\ny_m = " << env.dest_y_m

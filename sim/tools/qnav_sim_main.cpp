@@ -1,9 +1,9 @@
 // qnav-sim: the simulator's command-line program. `run` simulates a policy file (or the
 // hand-tuned probabilistic policy) in a named environment with a chosen robot, sector
 // count and noise, prints the episode's figures (paper Eq. 1-3) and writes its picture;
-// `draw-env` draws an environment like the paper's Fig. 6; `gen-env` writes a random
-// environment of a given density; `bench` measures episodes per second per core with the
-// time split into physics, sonar and controller. Bad input: one line, non-zero exit.
+// `draw-env` draws an environment like the paper's Fig. 6; `gen-env` writes a world of a
+// family (worldgen.hpp) or a random environment of a given density; `bench` measures
+// episodes per second per core with the time split into physics, sonar and controller. Bad input: one line, non-zero exit.
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -29,6 +29,7 @@
 #include "qnav/sim.h"
 #include "rng.hpp"
 #include "svg.hpp"
+#include "worldgen.hpp"
 #ifdef QNAV_SIM_HAVE_POLICYIO
 #include "qnav/policy_io.h"
 #endif
@@ -293,19 +294,43 @@ int cmd_draw_env(const std::string &env, const std::string &robot, const std::st
     return 0;
 }
 
-int cmd_gen_env(double density, std::uint64_t seed, const std::string &robot,
-                const std::string &name, const std::string &outp) {
-    Loaded l;
-    char err[QNAV_SIM_ERRLEN] = "";
-    check(qnav_sim_robot_load(robot.c_str(), &l.robot, err, sizeof err), err);
-    qnav::Environment env = qnav::generate_environment(density, seed, l.robot->profile.radius_m);
-    if (!name.empty()) env.name = name;
+struct GenOpts {
+    double density = -1;  // the old form: -1 = not given
+    std::string family, difficulty = "0.5", robot, name, out;
+    std::uint64_t seed = 1;
+};
+
+// --name lands in a TOML string: refuse what would not stay one line (the writer escapes
+// quotes and backslashes).
+void check_env_name(const std::string &name) {
+    if (name.empty()) throw SimError(QNAV_SIM_E_PARAM, "--name: must not be empty");
+    for (unsigned char ch : name)
+        if (ch < 0x20 || ch == 0x7f)
+            throw SimError(QNAV_SIM_E_PARAM, "--name: must not contain control characters (newline, tab, ...)");
+}
+
+int cmd_gen_env(const GenOpts &o) {
+    if (!o.name.empty()) check_env_name(o.name);
+    qnav::Environment env;
+    if (!o.family.empty()) {
+        if (o.density >= 0) throw SimError(QNAV_SIM_E_PARAM, "--density: not with --family (use --difficulty)");
+        const std::string spec = "gen:" + o.family + ":" + std::to_string(o.seed) + ":" + o.difficulty + ":" +
+                                 (o.robot.empty() ? "tekbot" : o.robot);
+        env = qnav::load_world(spec);
+    } else {
+        Loaded l;
+        char err[QNAV_SIM_ERRLEN] = "";
+        const std::string robot = o.robot.empty() ? "pioneer3dx" : o.robot;
+        check(qnav_sim_robot_load(robot.c_str(), &l.robot, err, sizeof err), err);
+        env = qnav::generate_environment(o.density >= 0 ? o.density : 0.2, o.seed, l.robot->profile.radius_m);
+    }
+    if (!o.name.empty()) env.name = o.name;
     const std::string text = qnav::environment_to_toml(env);
     // Check that what we write reads back.
-    qnav::parse_environment(text, outp);
-    write_output(outp, text);
-    std::printf("environment %s: %zu circles, %zu boxes -> %s\n", env.name.c_str(),
-                env.circles.size(), env.boxes.size(), outp.c_str());
+    qnav::parse_environment(text, o.out);
+    write_output(o.out, text);
+    std::printf("environment %s: %zu circles, %zu boxes, %.0f x %.0f m, limit %.0f s -> %s\n", env.name.c_str(),
+                env.circles.size(), env.boxes.size(), env.width_m, env.height_m, env.episode_limit_s, o.out.c_str());
     return 0;
 }
 
@@ -449,15 +474,15 @@ int main(int argc, char **argv) {
     draw->add_option("--robot", de_robot, "robot whose size sets the direct lines' clearance")->capture_default_str();
     draw->add_option("--out", de_out, "SVG file")->required();
 
-    double g_density = 0.2;
-    std::uint64_t g_seed = 1;
-    std::string g_robot = "pioneer3dx", g_name, g_out;
-    CLI::App *gen = app.add_subcommand("gen-env", "write a random environment file");
-    gen->add_option("--density", g_density, "fraction of the obstacle band covered, 0..0.5")->check(qnav::cli::finite_range(0.0, 0.5))->capture_default_str();
-    gen->add_option("--seed", g_seed, "generator seed")->capture_default_str();
-    gen->add_option("--robot", g_robot, "robot that must fit through (clearance)")->capture_default_str();
-    gen->add_option("--name", g_name, "environment name (default: generated-d<density>-s<seed>)");
-    gen->add_option("--out", g_out, "TOML file to write")->required();
+    GenOpts go;
+    CLI::App *gen = app.add_subcommand("gen-env", "write a generated environment file (a world family, or the old density form)");
+    gen->add_option("--family", go.family, std::string("world family: ") + qnav_sim_world_families() + " (docs/sim.md)");
+    gen->add_option("--difficulty", go.difficulty, "with --family: difficulty in [0, 1], at most 3 decimals")->capture_default_str();
+    gen->add_option("--density", go.density, "without --family: fraction of the obstacle band covered, 0..0.5 (default 0.2)")->check(qnav::cli::finite_range(0.0, 0.5));
+    gen->add_option("--seed", go.seed, "generator seed")->capture_default_str();
+    gen->add_option("--robot", go.robot, "robot that must fit through (default: tekbot with --family, else pioneer3dx)");
+    gen->add_option("--name", go.name, "environment name (default: the world spec, or generated-d<density>-s<seed>)");
+    gen->add_option("--out", go.out, "TOML file to write")->required();
 
     BenchOpts bo;
     CLI::App *bench = app.add_subcommand("bench", "episodes per second per core, time split");
@@ -479,7 +504,7 @@ int main(int argc, char **argv) {
     try {
         if (*run) return cmd_run(ro);
         if (*draw) return cmd_draw_env(de_env, de_robot, de_out);
-        if (*gen) return cmd_gen_env(g_density, g_seed, g_robot, g_name, g_out);
+        if (*gen) return cmd_gen_env(go);
         if (*bench) return cmd_bench(bo);
     } catch (const SimError &e) {
         // a bad robot, environment or policy file, or an impossible parameter

@@ -77,9 +77,20 @@ void qnav_sim_robot_free(qnav_sim_robot_t *robot);
 
 /* Environments: as for robots, bare names are looked up as <data>/envs/<name>.toml.
  * A start zone that overlaps an obstacle or leaves the arena, or a destination inside an
- * obstacle, is refused with QNAV_SIM_E_WORLD. */
+ * obstacle, is refused with QNAV_SIM_E_WORLD.
+ * A spec "gen:FAMILY:SEED[:DIFFICULTY[:ROBOT]]" is a generated world (docs/sim.md, "World
+ * families"): FAMILY one of qnav_sim_world_families(), SEED a whole number in
+ * [0, 2^64 - 1], DIFFICULTY in [0, 1] with at most 3 decimals (default 0.5), ROBOT the
+ * robot (name or file) whose body the world is made passable for and whose diameter sets
+ * gap, corridor and door widths (default tekbot). The same spec gives the same world; its
+ * name is the spec with every field spelled out ("gen:gaps:7:0.5:tekbot"). A malformed
+ * spec is QNAV_SIM_E_PARAM with one line naming the field ("world spec 'gen:x:1': unknown
+ * family 'x' (families: ...)"). */
 qnav_sim_status_t qnav_sim_env_load(const char *spec, qnav_sim_env_t **out, char *err,
                                     size_t errlen);
+/* The world families a "gen:" spec may name, comma-separated ("clutter, gaps, ..."); a
+ * static string. */
+const char *qnav_sim_world_families(void);
 qnav_sim_status_t qnav_sim_env_parse(const char *text, size_t len, const char *name,
                                      qnav_sim_env_t **out, char *err, size_t errlen);
 void qnav_sim_env_free(qnav_sim_env_t *env);
