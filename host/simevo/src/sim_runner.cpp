@@ -53,6 +53,36 @@ const qnav_sim_env_t *SimWorlds::env(const std::string &spec)
     return load_once(envs_, spec, "environment", qnav_sim_env_load);
 }
 
+std::shared_ptr<const qnav_sim_env_t> SimWorlds::generated(const std::string &spec)
+{
+    {
+        std::lock_guard<std::mutex> lock(mu_);
+        auto it = generated_.find(spec);
+        if (it != generated_.end()) {
+            return it->second;
+        }
+    }
+    // made outside the lock: other threads go on with their worlds meanwhile
+    char err[QNAV_SIM_ERRLEN] = {0};
+    qnav_sim_env_t *h = nullptr;
+    if (qnav_sim_env_load(spec.c_str(), &h, err, sizeof err) != QNAV_SIM_OK) {
+        throw UserError("environment '" + spec + "': " + err);
+    }
+    std::shared_ptr<const qnav_sim_env_t> env(h, [](const qnav_sim_env_t *e) {
+        qnav_sim_env_free(const_cast<qnav_sim_env_t *>(e));
+    });
+    std::lock_guard<std::mutex> lock(mu_);
+    auto ins = generated_.emplace(spec, env);
+    if (ins.second) {
+        generated_order_.push_back(spec);
+        if (generated_order_.size() > kGeneratedKept) {
+            generated_.erase(generated_order_.front());
+            generated_order_.pop_front();
+        }
+    }
+    return ins.first->second;
+}
+
 SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t context_seed,
                      bool use_table)
     : use_table_(use_table)
@@ -61,18 +91,13 @@ SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t conte
     if (scenario.distribution) {
         throw UserError("simulator (" + scenario.describe() + "): a distribution runs through DistributionRunner");
     }
-    // A generated world is made for this context only (the context copies it): a training
-    // distribution meets up to a million of them, too many to keep.
-    std::unique_ptr<qnav_sim_env_t, void (*)(qnav_sim_env_t *)> own_env(nullptr, qnav_sim_env_free);
+    // a generated world is shared through its own cache (up to a million of them in a
+    // training range: the context copies what it needs, so one may be dropped later)
+    std::shared_ptr<const qnav_sim_env_t> generated;
     const qnav_sim_env_t *env = nullptr;
     if (scenario.environment.compare(0, 4, "gen:") == 0) {
-        char lerr[QNAV_SIM_ERRLEN] = {0};
-        qnav_sim_env_t *h = nullptr;
-        if (qnav_sim_env_load(scenario.environment.c_str(), &h, lerr, sizeof lerr) != QNAV_SIM_OK) {
-            throw UserError("environment '" + scenario.environment + "': " + lerr);
-        }
-        own_env.reset(h);
-        env = h;
+        generated = worlds.generated(scenario.environment);
+        env = generated.get();
     } else {
         env = worlds.env(scenario.environment);
     }

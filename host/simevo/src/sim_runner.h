@@ -9,6 +9,7 @@
 #ifndef QNAV_SIMEVO_SIM_RUNNER_H
 #define QNAV_SIMEVO_SIM_RUNNER_H
 
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -31,11 +32,17 @@ public:
     /* Load (once) what the scenario names. Throws UserError with the sim's message. */
     const qnav_sim_robot_t *robot(const std::string &spec);
     const qnav_sim_env_t *env(const std::string &spec);
+    /* A generated world ("gen:..."), made once and kept while at most kGeneratedKept are
+     * (the oldest dropped first; a caller's reference keeps its own alive). */
+    std::shared_ptr<const qnav_sim_env_t> generated(const std::string &spec);
+    static constexpr std::size_t kGeneratedKept = 8192;
 
 private:
     std::mutex mu_;
     std::map<std::string, qnav_sim_robot_t *> robots_;
     std::map<std::string, qnav_sim_env_t *> envs_;
+    std::map<std::string, std::shared_ptr<const qnav_sim_env_t>> generated_;
+    std::deque<std::string> generated_order_; /* oldest first */
 };
 
 class SimRunner : public EpisodeRunner {

@@ -76,7 +76,10 @@ WorldDraw draw_world(const Scenario &s, uint64_t episode_seed)
     const FamilySpec &f = d.families[w.family];
     // every draw is made whatever the component, so each part's stream stays aligned
     const uint64_t seed = world_seed(rng, d, s.worlds);
-    const double difficulty = between(rng, f.difficulty_lo, f.difficulty_hi);
+    // a world is (family, seed): its difficulty follows from them, so a finite seed range
+    // is a finite set of worlds (each generated once and cached, SimWorlds)
+    Rng world_rng(mix_seed(seed, fnv1a64(f.family.data(), f.family.size())));
+    const double difficulty = between(world_rng, f.difficulty_lo, f.difficulty_hi);
     const uint32_t sectors_pick = d.sectors.empty() ? 0 : rng.below(static_cast<uint32_t>(d.sectors.size()));
     const double noise = between(rng, d.noise_lo, d.noise_hi);
 
@@ -156,14 +159,9 @@ std::vector<std::string> named_environments()
     return names;
 }
 
-extern "C" const char *qnav_sim_world_families(void) __attribute__((weak));
-
 std::vector<std::string> world_families()
 {
     std::vector<std::string> out;
-    if (qnav_sim_world_families == nullptr) {
-        return out;
-    }
     const std::string all = qnav_sim_world_families();
     std::size_t start = 0;
     while (start < all.size()) {
