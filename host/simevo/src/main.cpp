@@ -157,8 +157,13 @@ std::vector<RunItem> load_run_specs(const std::vector<std::string> &names, const
     std::vector<std::pair<std::string, RunArgs>> paths;
     for (const auto &n : names) {
         if (n == "all") {
+            // the paper's experiments (a file that names the figure it reproduces); the
+            // others (generalist) run by name
             for (const auto &k : list_experiments(experiments_dir)) {
-                paths.emplace_back(join_path(experiments_dir, k + ".toml"), args);
+                const std::string path = join_path(experiments_dir, k + ".toml");
+                if (!load_experiment(path).figure.empty()) {
+                    paths.emplace_back(path, args);
+                }
             }
         } else {
             add_run_paths(resolve_experiment(n, experiments_dir), args, experiments_dir, paths, sweeps);
@@ -398,7 +403,7 @@ int main(int argc, char **argv)
     bool no_plot = false, no_progress = false;
     std::string share_text;
     int stage = 0;
-    run->add_option("experiment", names, "experiment name(s), a .toml path, a sweep file, or 'all'")->required();
+    run->add_option("experiment", names, "experiment name(s), a .toml path, a sweep file, or 'all' (the paper's five; generalist by name)")->required();
     add_run_args(run, run_args);
     run->add_option("--out", opt.out_dir, "output folder; results go to OUT/<experiment>")->capture_default_str();
     run->add_option("-j,--jobs", opt.jobs, "worker threads (0 = all cores)")->capture_default_str();
