@@ -67,6 +67,11 @@ struct EvolutionParams {
                                         fitness; docs/simevo.md, "Deviations") */
     InitKind init = InitKind::Cauchy;
     double init_scale = 1.0;       /* see InitKind, weight units */
+    /* Which steps meet the same k episodes (worlds and start points): PerStep = each step
+     * its own k, shared by the candidate and its re-evaluated parent (paired acceptance);
+     * PerGeneration = every block of `population` steps the same k (one world set per
+     * generation). docs/simevo.md, "Distributions of worlds". */
+    enum class WorldSets { PerStep, PerGeneration } world_sets = WorldSets::PerStep;
 };
 
 /* Returns "" when p is valid, else "FIELD: problem". */

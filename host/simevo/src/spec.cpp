@@ -318,7 +318,7 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
         const toml::table &t = p.table(*n, "evolution");
         p.only_keys(t, {"population", "epsilon", "hidden", "inputs", "mutation_scale", "mutation_clip",
                         "episodes_per_candidate", "reevaluate_parent", "init", "init_scale",
-                        "fitness", "controller"},
+                        "fitness", "controller", "world_sets"},
                     "evolution");
         EvolutionParams &e = spec.evolution;
         if (auto *v = t.get("population")) {
@@ -357,6 +357,16 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
                 e.init = InitKind::Uniform;
             } else {
                 p.fail(*v, "init: '" + s + "' is not one of cauchy, uniform");
+            }
+        }
+        if (auto *v = t.get("world_sets")) {
+            const std::string s = p.str(*v, "world_sets");
+            if (s == "per-step") {
+                e.world_sets = EvolutionParams::WorldSets::PerStep;
+            } else if (s == "per-generation") {
+                e.world_sets = EvolutionParams::WorldSets::PerGeneration;
+            } else {
+                p.fail(*v, "world_sets: '" + s + "' is not one of per-step, per-generation");
             }
         }
         if (auto *v = t.get("init_scale")) {

@@ -378,6 +378,7 @@ std::string task_settings_text(const TaskDef &t, const std::string &source_finge
           << " init=" << (e.init == InitKind::Cauchy ? "cauchy" : "uniform")
           << " init_scale=" << e.init_scale
           << (e.inputs != QNAV_NET_INPUTS_PAPER ? " inputs=" + std::to_string(e.inputs) : std::string())
+          << (e.world_sets == EvolutionParams::WorldSets::PerGeneration ? " world_sets=per-generation" : "")
           << "\n"
           << "evolution_seed=" << t.evolution_seed << "\n"
           << "episode_seed_base=" << t.episode_seed_base << "\n"
@@ -550,12 +551,17 @@ bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, EpisodeRunn
             return false;
         }
         const Candidate c = evo.propose();
-        const StepOutcome o = run_k(runner, c.policy, t.episode_seed_base, c.episode, k);
+        // the k episodes of this step: its own (paired with the parent), or its generation's
+        const uint64_t episode_set = t.evolution.world_sets == EvolutionParams::WorldSets::PerGeneration
+                                         ? c.episode / t.evolution.population
+                                         : c.episode;
+        const StepOutcome o = run_k(runner, c.policy, t.episode_seed_base, episode_set, k);
         const bool has_parent = t.evolution.reevaluate_parent && c.parent >= 0;
         StepOutcome po;
         char parent_r[40] = "";
         if (has_parent) {
-            po = run_k(runner, evo.members()[static_cast<std::size_t>(c.parent)].policy, t.episode_seed_base, c.episode, k);
+            po = run_k(runner, evo.members()[static_cast<std::size_t>(c.parent)].policy, t.episode_seed_base,
+                       episode_set, k);
             std::snprintf(parent_r, sizeof parent_r, "%.17g", po.o.R);
         }
         evo.accept(c, o.o, has_parent ? &po.o : nullptr);
