@@ -1133,6 +1133,12 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
       << fmt(spec.evolution.epsilon, 2) << ", " << spec.evolution.hidden << " hidden units; final performance = each run's best policy over "
       << spec.eval_episodes << " held-out episodes (the same set for every run and condition).\n\n"
       << "Target: " << spec.target.describe() << "\n\n";
+    if (spec.target.distribution) {
+        o << "The target is a distribution of worlds: its held-out episodes (final performance, checkpoints, the "
+             "references) run in its validation worlds (world seeds from "
+          << kValidationSeedBase << ", never trained on; docs/simevo.md \"Held-out worlds\"); the episode pictures in `"
+          << picture_scenario(spec.target).environment << "`.\n\n";
+    }
     for (const SourceSpec &s : spec.sources) {
         o << "Source `" << s.label << "`: "
           << (s.policy_file.empty() ? s.scenario.describe() + ", " + std::to_string(s.episodes) + " episodes"

@@ -533,6 +533,18 @@ std::size_t replay_journal(const TaskDef &t, const std::string &journal_path, Ev
         return true;
     });
 }
+/* Which k episodes step `step` runs: its own (paired with its parent), or its generation's. */
+uint64_t step_episode_set(const EvolutionParams &e, uint64_t step)
+{
+    switch (e.world_sets) {
+    case EvolutionParams::WorldSets::PerStep:
+        return step;
+    case EvolutionParams::WorldSets::PerGeneration:
+        return step / e.population;
+    }
+    return step;
+}
+
 /* Resume (replay) and continue an evolution to its budget, journaling each step and
  * evaluating the checkpoints. Returns false when stopped. */
 bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, EpisodeRunner &held_out_runner,
@@ -551,10 +563,7 @@ bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, EpisodeRunn
             return false;
         }
         const Candidate c = evo.propose();
-        // the k episodes of this step: its own (paired with the parent), or its generation's
-        const uint64_t episode_set = t.evolution.world_sets == EvolutionParams::WorldSets::PerGeneration
-                                         ? c.episode / t.evolution.population
-                                         : c.episode;
+        const uint64_t episode_set = step_episode_set(t.evolution, c.episode);
         const StepOutcome o = run_k(runner, c.policy, t.episode_seed_base, episode_set, k);
         const bool has_parent = t.evolution.reevaluate_parent && c.parent >= 0;
         StepOutcome po;
