@@ -286,10 +286,10 @@ std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &e
 /* ---- conditions ------------------------------------------------------------------ */
 
 const ConditionDecl kConditions[4] = {
-    {ConditionKind::Transfer, "transfer-", true},
-    {ConditionKind::Direct, "direct", true},
-    {ConditionKind::Probabilistic, "probabilistic", false},
-    {ConditionKind::Vfh, kVfhController, false},
+    {ConditionKind::Transfer, "transfer-", true, nullptr},
+    {ConditionKind::Direct, "direct", true, nullptr},
+    {ConditionKind::Probabilistic, kReferences[0].label, false, &kReferences[0]},
+    {ConditionKind::Vfh, kReferences[1].label, false, &kReferences[1]},
 };
 
 const ConditionDecl &condition_decl(ConditionKind kind)
@@ -625,8 +625,8 @@ ConditionSummary summarize_condition(const ExperimentSpec &spec, const std::vect
     return c;
 }
 
-/* A reference (kind Probabilistic: eval.csv, Vfh: eval-vfh.csv of the reference task):
- * one policy or controller, so its CIs are over episodes. */
+/* A reference (its row's STEM.csv in the reference task's folder): one policy or
+ * controller, so its CIs are over episodes. */
 ConditionSummary summarize_reference(const std::vector<TaskDef> &tasks, ConditionKind kind)
 {
     ConditionSummary prob;
@@ -637,8 +637,7 @@ ConditionSummary summarize_reference(const std::vector<TaskDef> &tasks, Conditio
             continue;
         }
         double reached = 0;
-        const auto ev =
-            read_eval(join_path(t.dir, kind == ConditionKind::Vfh ? std::string(kVfhEvalStem) + ".csv" : "eval.csv"));
+        const auto ev = read_eval(join_path(t.dir, std::string(condition_decl(kind).reference->eval_stem) + ".csv"));
         for (const auto &o : ev) {
             prob.final_per_run.push_back(o.R);
             prob.arrival_per_run.push_back(o.reached ? 1.0 : 0.0);
@@ -701,8 +700,10 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
         S.conditions.push_back(summarize_condition(spec, tasks, kl.second, kl.first, S, steps, steps_per_bin));
     }
     const std::size_t first_reference = S.conditions.size();
-    for (ConditionKind r : {ConditionKind::Probabilistic, ConditionKind::Vfh}) {
-        S.conditions.push_back(summarize_reference(tasks, r));
+    for (const ConditionDecl &d : kConditions) {
+        if (d.reference != nullptr) {
+            S.conditions.push_back(summarize_reference(tasks, d.kind));
+        }
     }
 
     const ConditionSummary &direct = S.conditions[labels.size() - 1];
@@ -895,8 +896,10 @@ std::string episodes_csv(const ExperimentSummary &S, const std::string &exp_dir,
         for (uint32_t i = 0; i < std::min(kPictureEpisodes, eval_episodes); ++i) {
             std::vector<qnav_sim_sample_t> trace;
             const uint64_t seed = mix_seed(eval_base, i);
-            const EpisodeOutcome out = c.kind == ConditionKind::Vfh ? runner.run_controller_traced(kVfhController, seed, &trace)
-                                                                    : runner.run_traced(policy, seed, &trace);
+            const ReferenceDecl *ref = condition_decl(c.kind).reference;
+            const EpisodeOutcome out = ref != nullptr && ref->controller != nullptr
+                                           ? runner.run_controller_traced(ref->controller, seed, &trace)
+                                           : runner.run_traced(policy, seed, &trace);
             for (const qnav_sim_sample_t &smp : trace) {
                 char b[256];
                 std::snprintf(b, sizeof b, ",%u,%u,%.4f,%.4f,%d,%d,%.4f,%d,%u\n", i, smp.tick, smp.x_m, smp.y_m,
@@ -997,7 +1000,13 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
           << ", \"online_p\": " << json_num(c.online.valid ? c.online.p : std::nan("")) << "}"
           << (i + 1 < S.comparisons.size() ? "," : "") << "\n";
     }
-    o << "  ]" << worlds_json(H) << "\n}\n";
+    o << "  ],\n  \"references\": [";
+    for (std::size_t i = 0; i < kReferenceCount; ++i) {
+        const ReferenceDecl &r = kReferences[i];
+        o << (i ? ", " : "") << "{\"label\": " << json_str(r.label) << ", \"plot_name\": " << json_str(r.plot_name)
+          << ", \"plot_style\": " << json_str(r.plot_style) << ", \"plot_color\": " << json_str(r.plot_color) << "}";
+    }
+    o << "]" << worlds_json(H) << "\n}\n";
     return o.str();
 }
 

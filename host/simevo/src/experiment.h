@@ -89,6 +89,7 @@ struct ConditionDecl {
     ConditionKind kind;
     const char *label;   /* the label, or its prefix for Transfer */
     bool evolved;        /* has runs, learning curves and checkpoints */
+    const ReferenceDecl *reference; /* a reference's row of kReferences (task.h), or null */
 };
 extern const ConditionDecl kConditions[4];
 const ConditionDecl &condition_decl(ConditionKind kind);

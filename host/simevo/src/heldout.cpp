@@ -80,8 +80,8 @@ WorldRow evaluate_one(const Subject &s, const HeldOutWorld &w, uint32_t n, uint6
     std::vector<double> R, tau;
     for (uint32_t i = 0; i < n; ++i) {
         const uint64_t seed = mix_seed(kHeldOutWorldsSeed, i);
-        const EpisodeOutcome o = s.kind == ConditionKind::Vfh ? runner->run_controller(kVfhController, seed)
-                                                              : runner->run(policy, seed);
+        const ReferenceDecl *ref = condition_decl(s.kind).reference;
+        const EpisodeOutcome o = ref != nullptr ? run_reference(*runner, *ref, seed) : runner->run(policy, seed);
         R.push_back(o.R);
         tau.push_back(o.tau_c);
         row.arrived += o.reached ? 1 : 0;

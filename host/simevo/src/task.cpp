@@ -403,10 +403,18 @@ uint64_t task_steps(const TaskDef &t)
     return std::max<uint64_t>(1, (t.episodes + k - 1) / k);
 }
 
+EpisodeOutcome run_reference(EpisodeRunner &runner, const ReferenceDecl &r, uint64_t episode_seed)
+{
+    if (r.controller != nullptr) {
+        return runner.run_controller(r.controller, episode_seed);
+    }
+    return runner.run(runner.probabilistic_policy(), episode_seed);
+}
+
 uint64_t task_total_episodes(const TaskDef &t)
 {
     if (t.kind != TaskKind::Evolve) {
-        return 2u * static_cast<uint64_t>(t.eval_episodes); /* probabilistic and VFH+ */
+        return kReferenceCount * static_cast<uint64_t>(t.eval_episodes); /* every reference */
     }
     return task_steps(t) * t.evolution.episodes_per_candidate +
            static_cast<uint64_t>(t.checkpoints.size()) * t.checkpoint_episodes + t.eval_episodes;
@@ -649,15 +657,12 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
     EpisodeRunner &held_out = held_out_owner ? *held_out_owner : *runner;
 
     if (t.kind == TaskKind::EvalProbabilistic) {
-        // the references on the same held-out episodes: the hand-tuned probabilistic
-        // policy (eval.csv) and VFH+ (eval-vfh.csv), one task so shares stay as they were
-        const qnav_policy_t prob = runner->probabilistic_policy();
-        if (!run_eval(*runner, prob, t, obs, stop)) {
-            return false;
-        }
-        if (!run_eval_episodes([&](uint64_t seed) { return runner->run_controller(kVfhController, seed); },
-                               kVfhEvalStem, t, obs, stop)) {
-            return false;
+        // every reference on the same held-out episodes, one task so shares stay as they were
+        for (const ReferenceDecl &r : kReferences) {
+            if (!run_eval_episodes([&](uint64_t seed) { return run_reference(*runner, r, seed); }, r.eval_stem, t,
+                                   obs, stop)) {
+                return false;
+            }
         }
         write_file_atomic(done_path, "complete\n");
         return true;
