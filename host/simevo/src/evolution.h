@@ -74,6 +74,11 @@ struct EvolutionParams {
     enum class WorldSets { PerStep, PerGeneration } world_sets = WorldSets::PerStep;
 };
 
+/* "cauchy", "uniform" (experiment files and task settings spell them so). */
+const char *init_kind_name(InitKind k);
+/* "per-step", "per-generation". */
+const char *world_sets_name(EvolutionParams::WorldSets w);
+
 /* Returns "" when p is valid, else "FIELD: problem". */
 const char *evolution_params_problem(const EvolutionParams &p);
 

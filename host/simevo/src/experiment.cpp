@@ -310,7 +310,15 @@ const ConditionDecl &condition_decl(ConditionKind kind)
 std::string condition_label(ConditionKind kind, const std::string &source)
 {
     const ConditionDecl &d = condition_decl(kind);
-    return kind == ConditionKind::Transfer ? std::string(d.label) + source : std::string(d.label);
+    switch (kind) {
+    case ConditionKind::Transfer:
+        return std::string(d.label) + source;
+    case ConditionKind::Direct:
+    case ConditionKind::Probabilistic:
+    case ConditionKind::Vfh:
+        break;
+    }
+    return d.label;
 }
 
 /* ---- pool ------------------------------------------------------------------------ */

@@ -351,21 +351,27 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
         }
         if (auto *v = t.get("init")) {
             const std::string s = p.str(*v, "init");
-            if (s == "cauchy") {
-                e.init = InitKind::Cauchy;
-            } else if (s == "uniform") {
-                e.init = InitKind::Uniform;
-            } else {
+            bool known = false;
+            for (InitKind k : {InitKind::Cauchy, InitKind::Uniform}) {
+                if (s == init_kind_name(k)) {
+                    e.init = k;
+                    known = true;
+                }
+            }
+            if (!known) {
                 p.fail(*v, "init: '" + s + "' is not one of cauchy, uniform");
             }
         }
         if (auto *v = t.get("world_sets")) {
             const std::string s = p.str(*v, "world_sets");
-            if (s == "per-step") {
-                e.world_sets = EvolutionParams::WorldSets::PerStep;
-            } else if (s == "per-generation") {
-                e.world_sets = EvolutionParams::WorldSets::PerGeneration;
-            } else {
+            bool known = false;
+            for (auto w : {EvolutionParams::WorldSets::PerStep, EvolutionParams::WorldSets::PerGeneration}) {
+                if (s == world_sets_name(w)) {
+                    e.world_sets = w;
+                    known = true;
+                }
+            }
+            if (!known) {
                 p.fail(*v, "world_sets: '" + s + "' is not one of per-step, per-generation");
             }
         }

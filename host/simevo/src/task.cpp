@@ -359,13 +359,24 @@ qnav_policy_t load_source_policy(const std::string &path)
     return p;
 }
 
+const char *task_kind_name(TaskKind k)
+{
+    switch (k) {
+    case TaskKind::Evolve:
+        return "evolve";
+    case TaskKind::EvalProbabilistic:
+        return "eval-probabilistic+vfh"; /* kept as written before the reference table */
+    }
+    return "evolve";
+}
+
 std::string task_settings_text(const TaskDef &t, const std::string &source_fingerprint)
 {
     std::ostringstream o;
     o.precision(17);
     const EvolutionParams &e = t.evolution;
     o << "# simevo task settings; a resumed task must match them exactly\n"
-      << "kind=" << (t.kind == TaskKind::Evolve ? "evolve" : "eval-probabilistic+vfh") << "\n"
+      << "kind=" << task_kind_name(t.kind) << "\n"
       << "label=" << t.label << "\nrun=" << t.run << "\n"
       << "scenario=" << t.scenario.describe() << "\n"
       << "context_seed=" << t.context_seed << "\n";
@@ -375,10 +386,12 @@ std::string task_settings_text(const TaskDef &t, const std::string &source_finge
           << " hidden=" << e.hidden << " mutation_scale=" << e.mutation_scale
           << " mutation_clip=" << e.mutation_clip << " episodes_per_candidate=" << e.episodes_per_candidate
           << " reevaluate_parent=" << (e.reevaluate_parent ? 1 : 0)
-          << " init=" << (e.init == InitKind::Cauchy ? "cauchy" : "uniform")
+          << " init=" << init_kind_name(e.init)
           << " init_scale=" << e.init_scale
           << (e.inputs != QNAV_NET_INPUTS_PAPER ? " inputs=" + std::to_string(e.inputs) : std::string())
-          << (e.world_sets == EvolutionParams::WorldSets::PerGeneration ? " world_sets=per-generation" : "")
+          /* the default is left out, so fingerprints from before world sets still match */
+          << (e.world_sets != EvolutionParams::WorldSets::PerStep ? std::string(" world_sets=") + world_sets_name(e.world_sets)
+                                                                  : std::string())
           << "\n"
           << "evolution_seed=" << t.evolution_seed << "\n"
           << "episode_seed_base=" << t.episode_seed_base << "\n"

@@ -31,6 +31,8 @@
 namespace qnav {
 
 enum class TaskKind { Evolve, EvalProbabilistic };
+/* The kind as task.txt spells it ("evolve", "eval-probabilistic+vfh"). */
+const char *task_kind_name(TaskKind k);
 
 /* The second reference the EvalProbabilistic task runs: libqnav's controller of this name
  * (VFH+), journaled as <task dir>/kVfhEvalStem.csv. One home for both names. */
