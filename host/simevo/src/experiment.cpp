@@ -790,8 +790,17 @@ HeldOut evaluate_held_out(const ExperimentSpec &spec, const ExperimentSummary &S
 {
     HeldOut H;
     H.episodes = spec.worlds_episodes;
-    H.worlds = held_out_worlds(spec.target);
     const bool use_table = opt.use_table;
+    for (const HeldOutWorld &w : held_out_worlds(spec.target)) {
+        try {
+            if (!w.family) {
+                SimRunner probe(worlds, w.scenario, spec.seed, use_table);
+            }
+            H.worlds.push_back(w);
+        } catch (const UserError &e) {
+            H.skipped.push_back(w.label + ": " + e.what());
+        }
+    }
     WorldRunnerFactory make = [&worlds, use_table](const Scenario &sc, uint64_t seed) -> std::unique_ptr<EpisodeRunner> {
         return std::make_unique<SimRunner>(worlds, sc, seed, use_table);
     };
@@ -1101,6 +1110,9 @@ std::string worlds_md(const ExperimentSpec &spec, const HeldOut &H)
             o << "| " << c.label << " | " << (w.family ? "family " : "") << w.world << " | "
               << pct_interval(w.arrival) << " | " << num_interval(w.tau_c, 2) << " | " << num_interval(w.R) << " |\n";
         }
+    }
+    for (const std::string &why : H.skipped) {
+        o << "\nNot evaluated: " << why << "\n";
     }
     o << "\nArrival held out, mean (cross-environment matrix):\n\n| condition |";
     for (const HeldOutWorld &w : H.worlds) {

@@ -85,6 +85,8 @@ Recommendation recommend(const ExperimentSummary &S, const std::vector<HeldOutWo
 struct HeldOut {
     uint32_t episodes = 0;                  /* per policy and world */
     std::vector<HeldOutWorld> worlds;       /* the columns */
+    std::vector<std::string> skipped;       /* "NAME: why": named environments the robot
+                                               cannot start in (e.g. a larger body) */
     std::vector<ConditionWorlds> conditions;
     Recommendation recommended;             /* valid for a distribution target */
 };
