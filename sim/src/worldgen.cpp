@@ -228,8 +228,9 @@ void top_destination(Ctx &c, Environment &env) {
 
 // Scatter circles and boxes over [x0, x1] x [y0, y1] until they cover `coverage` of that
 // area or `tries` draws were made. An obstacle is kept only when it overlaps no other
-// obstacle, keeps 2 robot radii from start zones, the destination and every keep-out
-// shape, and the grid still connects every start zone to the destination.
+// obstacle, keeps 2 robot radii plus (1 - difficulty) x 0.6 m (times the size scale)
+// from start zones, the destination and every keep-out shape (easy worlds leave room to
+// start and to arrive), and the grid still connects every start zone to the destination.
 void scatter(Ctx &c, Environment &env, PassGrid &grid, double x0, double y0, double x1, double y1,
              double coverage, int tries, const std::vector<Shape> &keepout) {
     std::vector<Shape> placed = env.obstacle_shapes();
@@ -252,12 +253,13 @@ void scatter(Ctx &c, Environment &env, PassGrid &grid, double x0, double y0, dou
             s = shape_of(bo);
             area = bo.w_m * bo.h_m;
         }
-        bool bad = shape_distance(s, dest) < 2 * c.radius;
+        const double room = 2 * c.radius + (1.0 - c.d) * 0.6 * c.s;
+        bool bad = shape_distance(s, dest) < room;
         for (const StartZone &z : env.start_zones)
-            if (!bad && shape_distance(s, make_box(z.x_m + z.w_m / 2, z.y_m + z.h_m / 2, z.w_m, z.h_m, 0)) < 2 * c.radius)
+            if (!bad && shape_distance(s, make_box(z.x_m + z.w_m / 2, z.y_m + z.h_m / 2, z.w_m, z.h_m, 0)) < room)
                 bad = true;
         for (const Shape &k : keepout)
-            if (!bad && shape_distance(s, k) < 2 * c.radius) bad = true;
+            if (!bad && shape_distance(s, k) < room) bad = true;
         for (const Shape &o : placed)
             if (!bad && norm(o.c - s.c) < o.r + s.r && shape_distance(o, s) <= 0.0) bad = true;
         if (bad) continue;
@@ -271,23 +273,27 @@ void scatter(Ctx &c, Environment &env, PassGrid &grid, double x0, double y0, dou
     }
 }
 
+// The builders' grid is 0.075 m stricter than the final check: the symmetry applied
+// afterwards shifts the cells by up to cell/2 along each axis (< 0.071 m), and a free path
+// on this grid then stays free on that one.
 PassGrid grid_for(const Ctx &c, const Environment &env) {
-    PassGrid g(env.width_m, env.height_m, c.radius + kCell / 2, kCell);
+    PassGrid g(env.width_m, env.height_m, c.radius + kCell / 2 + 0.75 * kCell, kCell);
     for (const Shape &s : env.obstacle_shapes()) g.add(s, +1);
     return g;
 }
 
 // ---- the families ---------------------------------------------------------------------
 
-// clutter: circles and boxes anywhere in the arena; difficulty -> covered fraction
-// 0.05 .. 0.40 (data/envs/dense.toml covers about 0.13 of its arena).
+// clutter: circles and boxes anywhere in the arena; difficulty d -> covered fraction
+// 0.04 + 0.36 d^1.5 (0.04, 0.085, 0.17, 0.27, 0.40 at d = 0, 0.25, 0.5, 0.75, 1;
+// data/envs/dense.toml covers 0.12 of its arena).
 void build_clutter(Ctx &c, Environment &env) {
     env.width_m = c.uni(8, 14) * c.s;
     env.height_m = c.uni(8, 14) * c.s;
     bottom_zones(c, env, 1 + c.pick(3));
     top_destination(c, env);
     PassGrid grid = grid_for(c, env);
-    scatter(c, env, grid, 0, 0, env.width_m, env.height_m, 0.05 + 0.35 * c.d, 6000, {});
+    scatter(c, env, grid, 0, 0, env.width_m, env.height_m, 0.04 + 0.36 * c.d * std::sqrt(c.d), 6000, {});
 }
 
 // gaps: 1-4 walls across the arena, each with one gap of 2.75 (difficulty 1) to 7.25

@@ -450,7 +450,7 @@ int main(int argc, char **argv) {
     CLI::App *run = app.add_subcommand("run", "simulate a policy and print the episode's figures");
     run->add_option("--policy", ro.policy, "policy file (default: the probabilistic policy tuned for the robot)")->check(CLI::ExistingFile);
     run->add_option("--robot", ro.robot, "robot profile name or file")->capture_default_str();
-    run->add_option("--env", ro.env, "environment name or file")->capture_default_str();
+    run->add_option("--env", ro.env, "environment name, file, or world spec gen:FAMILY:SEED[:DIFFICULTY[:ROBOT]] (docs/sim.md)")->capture_default_str();
     run->add_option("--sectors", ro.sectors, "sonar sectors 1..360 (default: the profile's)")->check(CLI::Range(1, 360));
     run->add_option("--sensor-noise", ro.ps, "p_s in [0, 1] (default: the profile's typical)")->check(qnav::cli::finite_range(0.0, 1.0));
     run->add_option("--actuation-noise", ro.pa, "p_a in [0, 1] (default: the profile's typical)")->check(qnav::cli::finite_range(0.0, 1.0));
@@ -470,14 +470,14 @@ int main(int argc, char **argv) {
 
     std::string de_env = "dense", de_robot = "pioneer3dx", de_out;
     CLI::App *draw = app.add_subcommand("draw-env", "draw an environment (like the paper's Fig. 6) to SVG");
-    draw->add_option("--env", de_env, "environment name or file")->capture_default_str();
+    draw->add_option("--env", de_env, "environment name, file, or world spec gen:FAMILY:SEED[:DIFFICULTY[:ROBOT]] (docs/sim.md)")->capture_default_str();
     draw->add_option("--robot", de_robot, "robot whose size sets the direct lines' clearance")->capture_default_str();
     draw->add_option("--out", de_out, "SVG file")->required();
 
     GenOpts go;
     CLI::App *gen = app.add_subcommand("gen-env", "write a generated environment file (a world family, or the old density form)");
     gen->add_option("--family", go.family, std::string("world family: ") + qnav_sim_world_families() + " (docs/sim.md)");
-    gen->add_option("--difficulty", go.difficulty, "with --family: difficulty in [0, 1], at most 3 decimals")->capture_default_str();
+    CLI::Option *g_difficulty = gen->add_option("--difficulty", go.difficulty, "with --family: difficulty in [0, 1], at most 3 decimals")->capture_default_str();
     gen->add_option("--density", go.density, "without --family: fraction of the obstacle band covered, 0..0.5 (default 0.2)")->check(qnav::cli::finite_range(0.0, 0.5));
     gen->add_option("--seed", go.seed, "generator seed")->capture_default_str();
     gen->add_option("--robot", go.robot, "robot that must fit through (default: tekbot with --family, else pioneer3dx)");
@@ -487,7 +487,7 @@ int main(int argc, char **argv) {
     BenchOpts bo;
     CLI::App *bench = app.add_subcommand("bench", "episodes per second per core, time split");
     bench->add_option("--robot", bo.robot, "robot profile")->capture_default_str();
-    bench->add_option("--env", bo.env, "environment")->capture_default_str();
+    bench->add_option("--env", bo.env, "environment name, file, or world spec gen:...")->capture_default_str();
     bench->add_option("--sectors", bo.sectors, "sonar sectors")->check(CLI::Range(1, 360))->capture_default_str();
     bench->add_option("--hidden", bo.hidden, "hidden units of the random network")->check(CLI::Range(1, QNAV_MAX_HIDDEN))->capture_default_str();
     bench->add_option("--policy", bo.policy, "policy file, or 'prob' for the hand-tuned policy (default: a random network)")
@@ -504,7 +504,11 @@ int main(int argc, char **argv) {
     try {
         if (*run) return cmd_run(ro);
         if (*draw) return cmd_draw_env(de_env, de_robot, de_out);
-        if (*gen) return cmd_gen_env(go);
+        if (*gen) {
+            if (g_difficulty->count() > 0 && go.family.empty())
+                throw SimError(QNAV_SIM_E_PARAM, "--difficulty: only with --family (the density form takes --density)");
+            return cmd_gen_env(go);
+        }
         if (*bench) return cmd_bench(bo);
     } catch (const SimError &e) {
         // a bad robot, environment or policy file, or an impossible parameter

@@ -48,35 +48,35 @@ static double zone_clearance(const qnav::Environment &env) {
 
 static void test_every_family_is_passable_for_both_robots_over_many_seeds(void **state) {
     (void)state;
-    const int seeds = 6;
+    // 10 seeds per family and robot, the difficulty cycling through 0, 0.35, 0.7 and 1.
+    const char *const difficulties[] = {"0", "0.35", "0.7", "1"};
     for (const char *robot_name : kRobots) {
         qnav_sim_robot_t *robot = load_robot(robot_name);
         qnav_sim_robot_info_t ri;
         qnav_sim_robot_info(robot, &ri);
         for (const char *family : kFamilies)
-            for (const char *difficulty : kDifficulties)
-                for (int seed = 0; seed < seeds; ++seed) {
-                    const std::string spec = spec_of(family, seed * 7919 + 11, difficulty, robot_name);
-                    char err[QNAV_SIM_ERRLEN] = "";
-                    qnav_sim_env_t *env = nullptr;
-                    if (qnav_sim_env_load(spec.c_str(), &env, err, sizeof err) != QNAV_SIM_OK)
-                        fail_msg("%s: %s", spec.c_str(), err);
-                    const qnav::Environment &e = env->env;
-                    // The library's own check, as every simulation makes it.
-                    qnav_sim_config_t cfg;
-                    qnav_sim_config_default(&cfg);
-                    qnav_sim_t *sim = nullptr;
-                    if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK)
-                        fail_msg("%s: %s", spec.c_str(), err);
-                    // A stricter one: 5 cm cells, a disc 2 cm wider than the body.
-                    if (qnav::passable_path_m(e, ri.radius_m + 0.02, 0.05) <= 0)
-                        fail_msg("%s: walled in on a 5 cm grid", spec.c_str());
-                    if (zone_clearance(e) < ri.radius_m) fail_msg("%s: start zone closer than the body radius", spec.c_str());
-                    assert_true(e.episode_limit_s >= 30.0);
-                    assert_true(e.circles.size() + e.boxes.size() > 0);
-                    qnav_sim_destroy(sim);
-                    qnav_sim_env_free(env);
-                }
+            for (int seed = 0; seed < 10; ++seed) {
+                const std::string spec = spec_of(family, seed * 7919 + 11, difficulties[seed % 4], robot_name);
+                char err[QNAV_SIM_ERRLEN] = "";
+                qnav_sim_env_t *env = nullptr;
+                if (qnav_sim_env_load(spec.c_str(), &env, err, sizeof err) != QNAV_SIM_OK)
+                    fail_msg("%s: %s", spec.c_str(), err);
+                const qnav::Environment &e = env->env;
+                // The library's own check, as every simulation makes it.
+                qnav_sim_config_t cfg;
+                qnav_sim_config_default(&cfg);
+                qnav_sim_t *sim = nullptr;
+                if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK)
+                    fail_msg("%s: %s", spec.c_str(), err);
+                // A stricter one: 5 cm cells, a disc 2 cm wider than the body.
+                if (qnav::passable_path_m(e, ri.radius_m + 0.02, 0.05) <= 0)
+                    fail_msg("%s: walled in on a 5 cm grid", spec.c_str());
+                if (zone_clearance(e) < ri.radius_m) fail_msg("%s: start zone closer than the body radius", spec.c_str());
+                assert_true(e.episode_limit_s >= 30.0);
+                assert_true(e.circles.size() + e.boxes.size() > 0);
+                qnav_sim_destroy(sim);
+                qnav_sim_env_free(env);
+            }
         qnav_sim_robot_free(robot);
     }
 }
@@ -236,6 +236,8 @@ static void test_gen_env_writes_the_world_the_spec_loads_and_refuses_bad_names(v
     assert_string_equal(out.c_str(), "world spec 'gen:maze:1:0.5:tekbot': unknown family 'maze' (families: clutter, gaps, corridor, pocket, rooms)\n");
     assert_int_equal(run_tool("gen-env --family gaps --density 0.2 --out " + std::string(dir) + "/x.toml", &out), 2);
     assert_string_equal(out.c_str(), "--density: not with --family (use --difficulty)\n");
+    assert_int_equal(run_tool("gen-env --difficulty 0.2 --out " + std::string(dir) + "/x.toml", &out), 2);
+    assert_string_equal(out.c_str(), "--difficulty: only with --family (the density form takes --density)\n");
     assert_int_equal(run_tool("gen-env --family gaps --name 'a\"\nb' --out " + std::string(dir) + "/x.toml", &out), 2);
     assert_string_equal(out.c_str(), "--name: must not contain control characters (newline, tab, ...)\n");
     assert_int_equal(access((std::string(dir) + "/x.toml").c_str(), F_OK), -1);
