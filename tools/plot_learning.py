@@ -38,7 +38,12 @@ def main(argv):
     read_csv(os.path.join(exp, "curves.csv"), add)
 
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.6), dpi=110, layout="constrained")
-    colors = {"direct": "tab:red", "probabilistic": "tab:gray", "vfh": "tab:brown"}
+    # the references, one row each in simevo's table (summary.json "references")
+    references = summary.get("references") or [
+        {"label": "probabilistic", "plot_name": "probabilistic (held out)", "plot_style": "--", "plot_color": "tab:gray"},
+        {"label": "vfh", "plot_name": "VFH+ (held out)", "plot_style": ":", "plot_color": "tab:brown"}]
+    colors = {"direct": "tab:red"}
+    colors.update({r["label"]: r["plot_color"] for r in references})
     palette = ["tab:blue", "tab:green", "tab:purple", "tab:orange"]
     conds = {c["label"]: c for c in summary["conditions"]}
     transfer = [k for k in curves if k.startswith("transfer-")]
@@ -61,9 +66,9 @@ def main(argv):
             ax.plot(c["episode"], [v * scale for v in c[m_key]], color=colors[k], lw=1.8, label=label)
             ax.fill_between(c["episode"], [v * scale for v in c[lo_key]], [v * scale for v in c[hi_key]],
                             color=colors[k], alpha=0.2, lw=0)
-        for ref_label, ls in (("probabilistic", "--"), ("vfh", ":")):
+        for r in references:
+            ref_label, ls, name = r["label"], r["plot_style"], r["plot_name"]
             p = conds.get(ref_label)
-            name = "probabilistic (held out)" if ref_label == "probabilistic" else "VFH+ (held out)"
             if p and ref == "final_mean" and p["final_mean"] is not None:
                 mean = p["final_mean"]
                 ci = p["final_ci95"] or 0.0

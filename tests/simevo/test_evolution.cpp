@@ -14,15 +14,20 @@ extern "C" {
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <set>
 #include <cstring>
 #include <string>
 #include <vector>
 
 #include "evolution.h"
+#include "experiment.h"
 #include "fake_runner.h"
+#include "heldout.h"
 #include "rng.h"
 #include "spec.h"
 #include "stats.h"
+#include "worlds.h"
 
 using namespace qnav;
 
@@ -414,6 +419,229 @@ static void test_spec_errors_name_file_line_and_problem(void **state)
     }
 }
 
+
+static const char *kDistSpec = R"(name = "d"
+[distribution.mix]
+seeds = [100, 199]
+sectors = [8, 32]
+noise = [0.0, 0.1]
+families = [
+  { family = "clutter", weight = 3, difficulty = [0.2, 0.6] },
+  { family = "gaps", weight = 1 },
+  { environment = "dense", weight = 1 },
+]
+[distribution.easy]
+families = [ { family = "clutter", difficulty = [0.0, 0.3] } ]
+[target]
+distribution = "mix"
+sectors = 16
+episodes = 100
+[[source]]
+label = "easy"
+distribution = "easy"
+[[source]]
+label = "open"
+environment = "open"
+)";
+
+static void test_spec_distribution_parses_and_sources_name_their_own(void **state)
+{
+    (void)state;
+    const ExperimentSpec s = parse_experiment(kDistSpec, "x.toml");
+    assert_non_null(s.target.distribution.get());
+    const Distribution &d = *s.target.distribution;
+    assert_int_equal(d.families.size(), 3);
+    assert_string_equal(d.families[0].family.c_str(), "clutter");
+    assert_true(d.families[0].weight == 3.0 && d.families[0].difficulty_hi == 0.6);
+    assert_string_equal(d.families[2].environment.c_str(), "dense");
+    assert_int_equal(d.seed_lo, 100);
+    assert_int_equal(d.seed_hi, 199);
+    assert_true(d.noise_drawn && d.noise_hi == 0.1);
+    assert_string_equal(s.sources[0].scenario.distribution->name.c_str(), "easy"); // transfer between distributions
+    assert_null(s.sources[1].scenario.distribution.get());                         // environment replaces it
+    assert_true(s.target.describe().rfind("distribution=mix{families=clutter:w3:d0.2", 0) == 0);
+    assert_true(s.target.describe().find("env:dense:w1;seeds=100-199;sectors=8,32;noise=0-0.1") != std::string::npos);
+    // without a distribution the description (task fingerprints) is what it always was
+    assert_true(s.sources[1].scenario.describe().rfind("environment=open robot=tekbot", 0) == 0);
+}
+
+static void test_spec_distribution_errors_name_the_line(void **state)
+{
+    (void)state;
+    const std::string head = "name = \"t\"\n[distribution.a]\n";
+    assert_string_equal(parse_error(head + "families = []\n").c_str(),
+                        "x.toml:3: distribution.a: families: expected a non-empty array of { family = ... } tables");
+    assert_string_equal(parse_error(head + "families = [ { family = \"x\", environment = \"dense\" } ]\n").c_str(),
+                        "x.toml:3: distribution.a.families: give exactly one of 'family' and 'environment'");
+    assert_string_equal(parse_error(head + "families = [ { family = \"x\", difficulty = [0.5, 0.2] } ]\n").c_str(),
+                        "x.toml:3: difficulty: low is above high");
+    assert_string_equal(parse_error(head + "families = [ { family = \"x\" } ]\nseeds = [0, 1000000]\n").c_str(),
+                        "x.toml:4: seeds: 1e+06 is outside [0, 999999]");
+    assert_string_equal(parse_error(head + "families = [ { family = \"x\" } ]\n[target]\ndistribution = \"b\"\n").c_str(),
+                        "x.toml:5: distribution: no [distribution.b] in this file (known: a)");
+    assert_true(
+        parse_error(head + "families = [ { family = \"x\" } ]\n[target]\nenvironment = \"dense\"\ndistribution = \"a\"\n")
+            .find("give either 'environment' or 'distribution', not both") != std::string::npos);
+}
+
+static void test_world_draws_are_deterministic_weighted_and_inside_their_ranges(void **state)
+{
+    (void)state;
+    const ExperimentSpec s = parse_experiment(kDistSpec, "x.toml");
+    int count[3] = {0, 0, 0};
+    int sectors8 = 0;
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) {
+        const uint64_t seed = mix_seed(77, static_cast<uint64_t>(i));
+        const WorldDraw w = draw_world(s.target, seed);
+        const WorldDraw again = draw_world(s.target, seed);
+        assert_string_equal(w.scenario.describe().c_str(), again.scenario.describe().c_str());
+        assert_true(w.start_seed == again.start_seed && w.start_seed != seed);
+        assert_null(w.scenario.distribution.get());
+        ++count[w.family];
+        assert_true(w.scenario.sectors == 8 || w.scenario.sectors == 32);
+        sectors8 += w.scenario.sectors == 8;
+        assert_true(w.scenario.sensor_noise >= 0.0 && w.scenario.sensor_noise <= 0.1);
+        assert_true(w.scenario.sensor_noise == w.scenario.actuation_noise);
+        if (w.family == 2) {
+            assert_string_equal(w.scenario.environment.c_str(), "dense");
+            continue;
+        }
+        assert_true(w.world_seed >= 100 && w.world_seed <= 199);
+        unsigned long long ws = 0;
+        double diff = -1;
+        char fam[32] = {0}, robot[32] = {0};
+        assert_int_equal(std::sscanf(w.scenario.environment.c_str(), "gen:%31[a-z]:%llu:%lf:%31s", fam, &ws, &diff, robot), 4);
+        assert_true(ws == w.world_seed);
+        assert_string_equal(robot, "tekbot");
+        if (w.family == 0) {
+            assert_string_equal(fam, "clutter");
+            assert_true(diff >= 0.2 - 1e-9 && diff <= 0.6 + 1e-9);
+        } else {
+            assert_string_equal(fam, "gaps");
+            assert_true(diff >= 0.0 && diff <= 1.0);
+        }
+    }
+    // weights 3 : 1 : 1 -> 60 %, 20 %, 20 % (5 standard errors: 0.017)
+    assert_true(std::fabs(count[0] / double(n) - 0.6) < 0.017);
+    assert_true(std::fabs(count[1] / double(n) - 0.2) < 0.015);
+    assert_true(std::fabs(count[2] / double(n) - 0.2) < 0.015);
+    assert_true(std::fabs(sectors8 / double(n) - 0.5) < 0.02);
+}
+
+static void test_no_training_world_is_ever_in_a_held_out_set(void **state)
+{
+    (void)state;
+    ExperimentSpec s = parse_experiment(kDistSpec, "x.toml");
+    // the widest training range a file may give
+    auto wide = std::make_shared<Distribution>(*s.target.distribution);
+    wide->seed_lo = 0;
+    wide->seed_hi = kValidationSeedBase - 1;
+    wide->families.pop_back(); // generated families only: a fixed environment has no seed
+    Scenario train = s.target;
+    train.distribution = wide;
+    std::set<std::string> training;
+    for (uint64_t i = 0; i < 5000; ++i) {
+        const WorldDraw w = draw_world(train, mix_seed(1, i));
+        assert_true(w.world_seed < kValidationSeedBase);
+        training.insert(w.scenario.environment);
+    }
+    Scenario validation = validation_scenario(train);
+    Scenario test = train;
+    test.worlds = WorldSet::Test;
+    std::set<std::string> val;
+    for (uint64_t i = 0; i < 5000; ++i) {
+        const WorldDraw v = draw_world(validation, mix_seed(1, i)); // the same episode seeds
+        const WorldDraw t = draw_world(test, mix_seed(1, i));
+        assert_true(v.world_seed >= kValidationSeedBase && v.world_seed < kTestSeedBase);
+        assert_true(t.world_seed >= kTestSeedBase && t.world_seed < kTestSeedBase + kHeldOutSeedSpan);
+        assert_true(training.count(v.scenario.environment) == 0);
+        assert_true(training.count(t.scenario.environment) == 0);
+        val.insert(v.scenario.environment);
+    }
+    for (uint64_t i = 0; i < 5000; ++i) {
+        assert_true(val.count(draw_world(test, mix_seed(2, i)).scenario.environment) == 0);
+    }
+    // held-out worlds of a summary: every family's test worlds
+    for (const HeldOutWorld &h : held_out_worlds(s.target)) {
+        if (h.family) {
+            assert_true(h.scenario.worlds == WorldSet::Test);
+        }
+    }
+}
+
+/* A fake that scores a policy by its weights and a world "bias" read from the world's
+ * seed range: training worlds favour networks whose first weight is high, held-out
+ * (validation) worlds the opposite, so choosing on training scores picks the wrong one. */
+class WorldBiasedRunner : public FakeRunner {
+public:
+    explicit WorldBiasedRunner(const Scenario &s)
+    {
+        unsigned long long seed = 0;
+        held_out_ = std::sscanf(s.environment.c_str(), "gen:%*[a-z]:%llu", &seed) == 1 && seed >= kValidationSeedBase;
+    }
+    EpisodeOutcome run(const qnav_policy_t &policy, uint64_t) override
+    {
+        const double w0 = *qnav_net_weight(const_cast<qnav_net_t *>(&policy.u.net), 0) / 256.0;
+        EpisodeOutcome o;
+        o.R = held_out_ ? -w0 : w0;
+        o.reached = o.R > 0;
+        return o;
+    }
+
+private:
+    bool held_out_ = false;
+};
+
+static void test_recommended_policy_is_chosen_on_validation_not_training(void **state)
+{
+    (void)state;
+    // two runs' best policies: run 1 wins on training (its R there), run 2 on validation
+    ExperimentSummary S;
+    ConditionSummary c;
+    c.kind = ConditionKind::Direct;
+    c.label = "direct";
+    c.online_per_run = {5.0, -5.0};        // training: run 1 far ahead
+    c.final_per_run = {-1.0, 1.0};         // validation R
+    c.arrival_per_run = {0.1, 0.9};        // validation arrival
+    S.conditions.push_back(c);
+    ConditionSummary p;
+    p.kind = ConditionKind::Probabilistic;
+    p.label = "probabilistic";
+    p.final_per_run = {9.0};
+    p.arrival_per_run = {1.0};             // a reference is never recommended
+    S.conditions.push_back(p);
+    HeldOutWorld w;
+    w.label = "clutter";
+    w.family = true;
+    std::vector<WorldRow> rows = {{"direct", 1, "clutter", 10, 2.0, 0.5, 3, 0, 0.0},
+                                  {"direct", 2, "clutter", 10, 5.0, 0.5, 7, 4, 0.2}};
+    const Recommendation r = recommend(S, {w}, rows, 40);
+    assert_true(r.valid);
+    assert_string_equal(r.condition.c_str(), "direct");
+    assert_int_equal(r.run, 2);
+    assert_true(r.validation_arrival == 0.9);
+    assert_int_equal(r.test.size(), 1);
+    assert_true(std::fabs(r.test[0].arrival.mean - 0.7) < 1e-12); // its own test row
+    assert_true(std::fabs(r.test[0].tau_c.mean - 0.4) < 1e-12);
+    // and the runner view: the same two networks, training vs validation worlds disagree
+    ExperimentSpec s = parse_experiment(kDistSpec, "x.toml");
+    qnav_policy_t a{}, b{};
+    a.kind = b.kind = QNAV_POLICY_NET;
+    a.u.net.hidden = b.u.net.hidden = 2;
+    a.u.net.inputs = b.u.net.inputs = QNAV_NET_INPUTS_PAPER;
+    *qnav_net_weight(&a.u.net, 0) = 256;
+    *qnav_net_weight(&b.u.net, 0) = -256;
+    auto make = [](const Scenario &sc, uint64_t) -> std::unique_ptr<EpisodeRunner> {
+        return std::make_unique<WorldBiasedRunner>(sc);
+    };
+    s.target.distribution = std::make_shared<Distribution>(*s.sources[0].scenario.distribution);
+    DistributionRunner train(s.target, 1, make);
+    DistributionRunner val(validation_scenario(s.target), 1, make);
+    assert_true(train.run(a, 5).R > train.run(b, 5).R);
+    assert_true(val.run(a, 5).R < val.run(b, 5).R);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -435,6 +663,11 @@ int main(void)
         cmocka_unit_test(test_spec_controller_reading_reaches_every_scenario_and_bad_names_fail),
         cmocka_unit_test(test_spec_checkpoints_parse_and_presets_shrink_their_evaluation),
         cmocka_unit_test(test_spec_errors_name_file_line_and_problem),
+        cmocka_unit_test(test_spec_distribution_parses_and_sources_name_their_own),
+        cmocka_unit_test(test_spec_distribution_errors_name_the_line),
+        cmocka_unit_test(test_world_draws_are_deterministic_weighted_and_inside_their_ranges),
+        cmocka_unit_test(test_no_training_world_is_ever_in_a_held_out_set),
+        cmocka_unit_test(test_recommended_policy_is_chosen_on_validation_not_training),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

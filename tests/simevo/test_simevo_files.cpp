@@ -380,6 +380,30 @@ static pid_t spawn(const std::vector<std::string> &args, const std::string &err_
     return pid;
 }
 
+/* spawn with stdout to out_path as well. */
+static pid_t spawn_out(const std::vector<std::string> &args, const std::string &err_path, const std::string &out_path)
+{
+    const pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        const int fd = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        dup2(fd, 1);
+        std::vector<std::string> a = args;
+        const int efd = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        dup2(efd, 2);
+        std::vector<char *> argv;
+        argv.push_back(const_cast<char *>(SIMEVO_EXE));
+        for (const auto &x : a) {
+            argv.push_back(const_cast<char *>(x.c_str()));
+        }
+        argv.push_back(nullptr);
+        setenv("QNAV_DATA_DIR", SIMEVO_SOURCE_DIR "/data", 1);
+        execv(SIMEVO_EXE, argv.data());
+        _exit(127);
+    }
+    return pid;
+}
+
 static int wait_exit(pid_t pid)
 {
     int st = 0;
@@ -581,6 +605,39 @@ static void test_table_mode_and_network_mode_give_identical_results(void **state
     collect(join_path(root, "network"), "", fn);
     assert_true(ft.size() > 10);
     assert_true(ft == fn);
+}
+
+/* `simevo run generalist --preset quick`, shrunk: it writes recommended.policy (a copy of
+ * one run's best policy, the one its summary names), and prints its test arrival in every
+ * world family and every named environment, one line each with recovery ticks. */
+static void test_generalist_quick_run_writes_the_recommended_policy_and_its_test_lines(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::string out = join_path(root, "out.txt");
+    const std::vector<std::string> args = {"run", SIMEVO_SOURCE_DIR "/experiments/generalist.toml", "--preset", "quick",
+                                           "--runs", "1", "--episodes", "48", "--source-episodes", "24",
+                                           "--eval-episodes", "4", "--no-plot", "--no-progress", "-j", "2",
+                                           "--out", root};
+    assert_int_equal(wait_exit(spawn_out(args, join_path(root, "err"), out)), 0);
+    const std::string dir = join_path(root, "generalist");
+    const std::string rec = slurp(join_path(dir, "recommended.policy"));
+    const std::string json = slurp(join_path(dir, "summary.json"));
+    const std::size_t at = json.find("\"recommended\": {\"condition\": \"");
+    assert_true(at != std::string::npos);
+    const std::size_t c0 = at + std::strlen("\"recommended\": {\"condition\": \"");
+    const std::string condition = json.substr(c0, json.find('"', c0) - c0);
+    assert_true(condition == "direct" || condition == "transfer-easy");
+    assert_true(rec == slurp(join_path(join_path(join_path(dir, "run-001"), condition), "best.policy")));
+    const std::string text = slurp(out);
+    assert_non_null(std::strstr(text.c_str(), "generalist: recommended policy "));
+    for (const char *w : {"family clutter:", "family gaps:", "family corridor:", "family pocket:", "family rooms:",
+                          "environment cluttered:", "environment dense:", "environment open:", "environment single:"}) {
+        const std::size_t line = text.find(std::string("generalist: test ") + w);
+        assert_true(line != std::string::npos);
+        assert_true(text.find("recovery ticks", line) < text.find('\n', line));
+    }
+    assert_non_null(std::strstr(slurp(join_path(dir, "summary.md")).c_str(), "## Recommended policy"));
 }
 
 static std::string run_for_error(const std::vector<std::string> &args, int &status)
@@ -1070,6 +1127,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_sweep_shares_merge_to_the_member_experiment_run_directly_with_its_variation),
         cmocka_unit_test(test_slurm_sweep_writes_each_members_scripts_and_one_submit_for_all),
         cmocka_unit_test(test_sweep_file_problems_are_one_line_with_file_and_line),
+        cmocka_unit_test(test_generalist_quick_run_writes_the_recommended_policy_and_its_test_lines),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

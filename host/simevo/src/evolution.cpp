@@ -41,6 +41,28 @@ const char *evolution_params_problem(const EvolutionParams &p)
     return "";
 }
 
+const char *init_kind_name(InitKind k)
+{
+    switch (k) {
+    case InitKind::Cauchy:
+        return "cauchy";
+    case InitKind::Uniform:
+        return "uniform";
+    }
+    return "cauchy";
+}
+
+const char *world_sets_name(EvolutionParams::WorldSets w)
+{
+    switch (w) {
+    case EvolutionParams::WorldSets::PerStep:
+        return "per-step";
+    case EvolutionParams::WorldSets::PerGeneration:
+        return "per-generation";
+    }
+    return "per-step";
+}
+
 namespace {
 qnav_q8_8_t to_q8_8_saturated(double raw)
 {
@@ -100,9 +122,15 @@ Evolution::Evolution(const EvolutionParams &params, uint64_t seed)
         qnav_net_t &net = m.policy.u.net;
         const uint16_t n = weight_count(net);
         for (uint16_t k = 0; k < n; ++k) {
-            const double x = params_.init == InitKind::Cauchy
-                                 ? rng_.cauchy_clipped(params_.init_scale, params_.mutation_clip)
-                                 : (2.0 * rng_.uniform01() - 1.0) * params_.init_scale;
+            double x = 0.0;
+            switch (params_.init) {
+            case InitKind::Cauchy:
+                x = rng_.cauchy_clipped(params_.init_scale, params_.mutation_clip);
+                break;
+            case InitKind::Uniform:
+                x = (2.0 * rng_.uniform01() - 1.0) * params_.init_scale;
+                break;
+            }
             *qnav_net_weight(&net, k) = to_q8_8_saturated(x * QNAV_Q8_8_ONE);
         }
     }

@@ -67,7 +67,17 @@ struct EvolutionParams {
                                         fitness; docs/simevo.md, "Deviations") */
     InitKind init = InitKind::Cauchy;
     double init_scale = 1.0;       /* see InitKind, weight units */
+    /* Which steps meet the same k episodes (worlds and start points): PerStep = each step
+     * its own k, shared by the candidate and its re-evaluated parent (paired acceptance);
+     * PerGeneration = every block of `population` steps the same k (one world set per
+     * generation). docs/simevo.md, "Distributions of worlds". */
+    enum class WorldSets { PerStep, PerGeneration } world_sets = WorldSets::PerStep;
 };
+
+/* "cauchy", "uniform" (experiment files and task settings spell them so). */
+const char *init_kind_name(InitKind k);
+/* "per-step", "per-generation". */
+const char *world_sets_name(EvolutionParams::WorldSets w);
 
 /* Returns "" when p is valid, else "FIELD: problem". */
 const char *evolution_params_problem(const EvolutionParams &p);

@@ -25,12 +25,14 @@
 #include <unistd.h>
 
 #include "files.h"
+#include "heldout.h"
 #include "qnav/terminal.hpp"
 #include "qnav/ctrl.h"
 #include "qnav/policy_io.h"
 #include "rng.h"
 #include "sim_runner.h"
 #include "stats.h"
+#include "worlds.h"
 
 namespace qnav {
 
@@ -38,12 +40,6 @@ namespace {
 
 uint64_t label_hash(const std::string &s) { return fnv1a64(s.data(), s.size()); }
 
-std::string run_dir(const std::string &exp_dir, uint32_t run)
-{
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "run-%03u", run + 1);
-    return join_path(exp_dir, buf);
-}
 
 /* ---- progress -------------------------------------------------------------------- */
 
@@ -200,6 +196,13 @@ std::string json_str(const std::string &s)
 
 } // namespace
 
+std::string run_dir(const std::string &exp_dir, uint32_t run)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "run-%03u", run + 1);
+    return join_path(exp_dir, buf);
+}
+
 /* ---- plan ------------------------------------------------------------------------ */
 
 std::vector<uint64_t> checkpoint_grid(const ExperimentSpec &spec)
@@ -283,10 +286,10 @@ std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &e
 /* ---- conditions ------------------------------------------------------------------ */
 
 const ConditionDecl kConditions[4] = {
-    {ConditionKind::Transfer, "transfer-", true},
-    {ConditionKind::Direct, "direct", true},
-    {ConditionKind::Probabilistic, "probabilistic", false},
-    {ConditionKind::Vfh, kVfhController, false},
+    {ConditionKind::Transfer, "transfer-", true, nullptr},
+    {ConditionKind::Direct, "direct", true, nullptr},
+    {ConditionKind::Probabilistic, kReferences[0].label, false, &kReferences[0]},
+    {ConditionKind::Vfh, kReferences[1].label, false, &kReferences[1]},
 };
 
 const ConditionDecl &condition_decl(ConditionKind kind)
@@ -307,7 +310,15 @@ const ConditionDecl &condition_decl(ConditionKind kind)
 std::string condition_label(ConditionKind kind, const std::string &source)
 {
     const ConditionDecl &d = condition_decl(kind);
-    return kind == ConditionKind::Transfer ? std::string(d.label) + source : std::string(d.label);
+    switch (kind) {
+    case ConditionKind::Transfer:
+        return std::string(d.label) + source;
+    case ConditionKind::Direct:
+    case ConditionKind::Probabilistic:
+    case ConditionKind::Vfh:
+        break;
+    }
+    return d.label;
 }
 
 /* ---- pool ------------------------------------------------------------------------ */
@@ -457,8 +468,6 @@ void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, uns
 
 /* ---- summary --------------------------------------------------------------------- */
 
-namespace {
-
 Interval t_interval(const std::vector<double> &x, double lo_bound, double hi_bound)
 {
     Interval v;
@@ -476,6 +485,8 @@ Interval wilson_interval(double successes, double n)
     wilson_ci95(successes, n, &v.lo, &v.hi);
     return v;
 }
+
+namespace {
 
 /* One target run's held-out figures: R, arrival fraction, recovery ticks per episode. */
 void add_eval(ConditionSummary &c, const std::vector<EpisodeOutcome> &ev, uint64_t &reached, uint64_t &evals)
@@ -622,8 +633,8 @@ ConditionSummary summarize_condition(const ExperimentSpec &spec, const std::vect
     return c;
 }
 
-/* A reference (kind Probabilistic: eval.csv, Vfh: eval-vfh.csv of the reference task):
- * one policy or controller, so its CIs are over episodes. */
+/* A reference (its row's STEM.csv in the reference task's folder): one policy or
+ * controller, so its CIs are over episodes. */
 ConditionSummary summarize_reference(const std::vector<TaskDef> &tasks, ConditionKind kind)
 {
     ConditionSummary prob;
@@ -634,8 +645,7 @@ ConditionSummary summarize_reference(const std::vector<TaskDef> &tasks, Conditio
             continue;
         }
         double reached = 0;
-        const auto ev =
-            read_eval(join_path(t.dir, kind == ConditionKind::Vfh ? std::string(kVfhEvalStem) + ".csv" : "eval.csv"));
+        const auto ev = read_eval(join_path(t.dir, std::string(condition_decl(kind).reference->eval_stem) + ".csv"));
         for (const auto &o : ev) {
             prob.final_per_run.push_back(o.R);
             prob.arrival_per_run.push_back(o.reached ? 1.0 : 0.0);
@@ -698,8 +708,10 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
         S.conditions.push_back(summarize_condition(spec, tasks, kl.second, kl.first, S, steps, steps_per_bin));
     }
     const std::size_t first_reference = S.conditions.size();
-    for (ConditionKind r : {ConditionKind::Probabilistic, ConditionKind::Vfh}) {
-        S.conditions.push_back(summarize_reference(tasks, r));
+    for (const ConditionDecl &d : kConditions) {
+        if (d.reference != nullptr) {
+            S.conditions.push_back(summarize_reference(tasks, d.kind));
+        }
     }
 
     const ConditionSummary &direct = S.conditions[labels.size() - 1];
@@ -744,7 +756,72 @@ ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDe
 
 /* ---- outputs --------------------------------------------------------------------- */
 
+Scenario picture_scenario(const Scenario &target)
+{
+    if (!target.distribution) {
+        return target;
+    }
+    Scenario s = target;
+    s.distribution.reset();
+    s.environment.clear();
+    for (const FamilySpec &f : target.distribution->families) {
+        if (!f.environment.empty()) {
+            s.environment = f.environment;
+            break;
+        }
+    }
+    if (s.environment.empty()) {
+        const std::vector<std::string> named = named_environments();
+        if (named.empty()) {
+            throw UserError("data/envs: no named environment to draw the episodes in");
+        }
+        s.environment = named.front();
+    }
+    return s;
+}
+
 namespace {
+
+/* The held-out worlds of a finished experiment: every best policy and reference driven in
+ * them (worlds.csv), their figures, and for a distribution target the recommended policy
+ * (written to recommended.policy). */
+HeldOut evaluate_held_out(const ExperimentSpec &spec, const ExperimentSummary &S, const std::string &exp_dir,
+                          SimWorlds &worlds, const RunOptions &opt)
+{
+    HeldOut H;
+    H.episodes = spec.worlds_episodes;
+    const bool use_table = opt.use_table;
+    for (const HeldOutWorld &w : held_out_worlds(spec.target)) {
+        try {
+            if (!w.family) {
+                SimRunner probe(worlds, w.scenario, spec.seed, use_table);
+            }
+            H.worlds.push_back(w);
+        } catch (const UserError &e) {
+            H.skipped.push_back(w.label + ": " + e.what());
+        }
+    }
+    WorldRunnerFactory make = [&worlds, use_table](const Scenario &sc, uint64_t seed) -> std::unique_ptr<EpisodeRunner> {
+        return std::make_unique<SimRunner>(worlds, sc, seed, use_table);
+    };
+    const std::vector<WorldRow> rows = evaluate_held_out_worlds(spec, S, exp_dir, H.worlds, make, opt.jobs);
+    write_file_atomic(join_path(exp_dir, "worlds.csv"), world_rows_csv(rows));
+    H.conditions = summarize_worlds(S, H.worlds, rows);
+    if (spec.target.distribution) {
+        H.recommended = recommend(S, H.worlds, rows, spec.eval_episodes);
+        if (H.recommended.valid) {
+            const std::string from = join_path(join_path(run_dir(exp_dir, H.recommended.run - 1), H.recommended.condition),
+                                               "best.policy");
+            std::string text;
+            if (!read_file(from, text)) {
+                throw UserError(from + ": cannot read (" + std::strerror(errno) + ")");
+            }
+            write_file_atomic(recommended_policy_path(exp_dir), text);
+        }
+    }
+    return H;
+}
+
 
 std::string curves_csv(const ExperimentSummary &S)
 {
@@ -836,8 +913,10 @@ std::string episodes_csv(const ExperimentSummary &S, const std::string &exp_dir,
         for (uint32_t i = 0; i < std::min(kPictureEpisodes, eval_episodes); ++i) {
             std::vector<qnav_sim_sample_t> trace;
             const uint64_t seed = mix_seed(eval_base, i);
-            const EpisodeOutcome out = c.kind == ConditionKind::Vfh ? runner.run_controller_traced(kVfhController, seed, &trace)
-                                                                    : runner.run_traced(policy, seed, &trace);
+            const ReferenceDecl *ref = condition_decl(c.kind).reference;
+            const EpisodeOutcome out = ref != nullptr && ref->controller != nullptr
+                                           ? runner.run_controller_traced(ref->controller, seed, &trace)
+                                           : runner.run_traced(policy, seed, &trace);
             for (const qnav_sim_sample_t &smp : trace) {
                 char b[256];
                 std::snprintf(b, sizeof b, ",%u,%u,%.4f,%.4f,%d,%d,%.4f,%d,%u\n", i, smp.tick, smp.x_m, smp.y_m,
@@ -849,8 +928,48 @@ std::string episodes_csv(const ExperimentSummary &S, const std::string &exp_dir,
     return o.str();
 }
 
+/* The held-out worlds and the recommended policy as JSON members (",\n  ..."). */
+std::string worlds_json(const HeldOut &H)
+{
+    std::ostringstream o;
+    o << ",\n  \"held_out_worlds\": {\"episodes\": " << H.episodes << ", \"seed\": " << kHeldOutWorldsSeed
+      << ", \"worlds\": [";
+    for (std::size_t i = 0; i < H.worlds.size(); ++i) {
+        o << (i ? ", " : "") << "{\"label\": " << json_str(H.worlds[i].label)
+          << ", \"family\": " << (H.worlds[i].family ? "true" : "false") << "}";
+    }
+    o << "],\n    \"conditions\": [";
+    for (std::size_t i = 0; i < H.conditions.size(); ++i) {
+        const ConditionWorlds &c = H.conditions[i];
+        o << (i ? "," : "") << "\n      {\"label\": " << json_str(c.label) << ", \"worlds\": [";
+        for (std::size_t j = 0; j < c.cells.size(); ++j) {
+            const WorldCell &w = c.cells[j];
+            o << (j ? ", " : "") << "{\"world\": " << json_str(w.world) << ", \"runs\": " << w.runs
+              << ", \"episodes\": " << w.episodes << ", \"arrival\": " << json_interval(w.arrival)
+              << ", \"tau_c\": " << json_interval(w.tau_c) << ", \"R\": " << json_interval(w.R) << "}";
+        }
+        o << "]}";
+    }
+    o << "\n    ]}";
+    if (H.recommended.valid) {
+        const Recommendation &r = H.recommended;
+        o << ",\n  \"recommended\": {\"condition\": " << json_str(r.condition) << ", \"run\": " << r.run
+          << ", \"validation_arrival\": " << json_num(r.validation_arrival)
+          << ", \"validation_R\": " << json_num(r.validation_R)
+          << ", \"validation_episodes\": " << r.validation_episodes << ", \"test\": [";
+        for (std::size_t j = 0; j < r.test.size(); ++j) {
+            const WorldCell &w = r.test[j];
+            o << (j ? ", " : "") << "{\"world\": " << json_str(w.world) << ", \"episodes\": " << w.episodes
+              << ", \"arrival\": " << json_interval(w.arrival) << ", \"tau_c\": " << json_interval(w.tau_c)
+              << ", \"R\": " << json_interval(w.R) << "}";
+        }
+        o << "]}";
+    }
+    return o.str();
+}
+
 std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt,
-                         const std::string &env_file, double robot_radius_m)
+                         const std::string &env_file, double robot_radius_m, const HeldOut &H)
 {
     std::ostringstream o;
     o << "{\n  \"name\": " << json_str(spec.name) << ",\n  \"title\": " << json_str(spec.title)
@@ -898,7 +1017,13 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
           << ", \"online_p\": " << json_num(c.online.valid ? c.online.p : std::nan("")) << "}"
           << (i + 1 < S.comparisons.size() ? "," : "") << "\n";
     }
-    o << "  ]\n}\n";
+    o << "  ],\n  \"references\": [";
+    for (std::size_t i = 0; i < kReferenceCount; ++i) {
+        const ReferenceDecl &r = kReferences[i];
+        o << (i ? ", " : "") << "{\"label\": " << json_str(r.label) << ", \"plot_name\": " << json_str(r.plot_name)
+          << ", \"plot_style\": " << json_str(r.plot_style) << ", \"plot_color\": " << json_str(r.plot_color) << "}";
+    }
+    o << "]" << worlds_json(H) << "\n}\n";
     return o.str();
 }
 
@@ -967,7 +1092,65 @@ std::string checkpoint_tables_md(const ExperimentSummary &S)
     return o.str();
 }
 
-std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt, bool plots)
+/* The held-out worlds: per world and condition arrival, recovery ticks, R (95% CIs), the
+ * arrival matrix, and the recommended policy. */
+std::string worlds_md(const ExperimentSpec &spec, const HeldOut &H)
+{
+    std::ostringstream o;
+    o << "## Held-out worlds\n\n"
+      << "Each evolved condition's best policy of every run and the references, " << H.episodes
+      << " episodes in the test worlds of every world family (new seeds from " << kTestSeedBase
+      << ", difficulty drawn in [0, 1], never trained on) and in every named environment of data/envs/ "
+         "(new start points), with the target's robot, sectors and noise; the same episodes in every experiment. "
+         "Evolved: 95% CI over runs; references: over episodes (arrival: Wilson).\n\n"
+      << "| condition | world | arrival (95% CI) | recovery ticks per episode (95% CI) | R (95% CI) |\n"
+      << "|---|---|---|---|---|\n";
+    for (const ConditionWorlds &c : H.conditions) {
+        for (const WorldCell &w : c.cells) {
+            o << "| " << c.label << " | " << (w.family ? "family " : "") << w.world << " | "
+              << pct_interval(w.arrival) << " | " << num_interval(w.tau_c, 2) << " | " << num_interval(w.R) << " |\n";
+        }
+    }
+    for (const std::string &why : H.skipped) {
+        o << "\nNot evaluated: " << why << "\n";
+    }
+    o << "\nArrival held out, mean (cross-environment matrix):\n\n| condition |";
+    for (const HeldOutWorld &w : H.worlds) {
+        o << " " << w.label << " |";
+    }
+    o << "\n|---|";
+    for (std::size_t i = 0; i < H.worlds.size(); ++i) {
+        o << "---|";
+    }
+    o << "\n";
+    for (const ConditionWorlds &c : H.conditions) {
+        o << "| " << c.label << " |";
+        for (const WorldCell &w : c.cells) {
+            o << " " << fmt(100.0 * w.arrival.mean, 0) << "% |";
+        }
+        o << "\n";
+    }
+    o << "\n";
+    if (H.recommended.valid) {
+        const Recommendation &r = H.recommended;
+        o << "## Recommended policy\n\n`recommended.policy` = " << r.condition << " run " << r.run
+          << ": of every run's best policy of every evolved condition, the highest arrival in the "
+          << r.validation_episodes << " validation episodes (worlds seeded from " << kValidationSeedBase
+          << ", disjoint from training and test; never training scores): " << fmt(100.0 * r.validation_arrival, 0)
+          << "%, R " << fmt(r.validation_R) << ". Its test figures (95% CI over its episodes):\n\n"
+          << "| world | arrival (95% CI) | recovery ticks per episode (95% CI) | R (95% CI) |\n|---|---|---|---|\n";
+        for (const WorldCell &w : r.test) {
+            o << "| " << (w.family ? "family " : "") << w.world << " | " << pct_interval(w.arrival) << " | "
+              << num_interval(w.tau_c, 2) << " | " << num_interval(w.R) << " |\n";
+        }
+        o << "\n";
+    }
+    (void)spec;
+    return o.str();
+}
+
+std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt, bool plots,
+                       const HeldOut &H)
 {
     std::ostringstream o;
     o << "# " << spec.name << (spec.figure.empty() ? "" : " (paper " + spec.figure + ")") << "\n\n"
@@ -979,6 +1162,12 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
       << fmt(spec.evolution.epsilon, 2) << ", " << spec.evolution.hidden << " hidden units; final performance = each run's best policy over "
       << spec.eval_episodes << " held-out episodes (the same set for every run and condition).\n\n"
       << "Target: " << spec.target.describe() << "\n\n";
+    if (spec.target.distribution) {
+        o << "The target is a distribution of worlds: its held-out episodes (final performance, checkpoints, the "
+             "references) run in its validation worlds (world seeds from "
+          << kValidationSeedBase << ", never trained on; docs/simevo.md \"Held-out worlds\"); the episode pictures in `"
+          << picture_scenario(spec.target).environment << "`.\n\n";
+    }
     for (const SourceSpec &s : spec.sources) {
         o << "Source `" << s.label << "`: "
           << (s.policy_file.empty() ? s.scenario.describe() + ", " + std::to_string(s.episodes) + " episodes"
@@ -1017,6 +1206,7 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
          "which the candidates' mean curve has covered 90% of its rise from its first to its last bin. "
          "The probabilistic policy's p-value is a one-sample t-test of the runs against its held-out mean.\n\n";
     o << checkpoint_tables_md(S);
+    o << worlds_md(spec, H);
     if (plots) {
         o << "![learning curves](learning.png)\n\n![policy quality](policy.png)\n\n"
           << "![held-out episodes of the best policies](episodes.png)\n\n";
@@ -1120,18 +1310,19 @@ void write_best_policies(const ExperimentSummary &S, const std::string &exp_dir)
 /* Everything after the runs but summary.md: curves, quality map, summary.json, episode
  * traces and the plots (STATUS says when plots are missing). Throws UserError. */
 void write_outputs(const ExperimentSpec &spec, const ExperimentSummary &S, const std::vector<TaskDef> &tasks,
-                   const std::string &exp_dir, SimWorlds &worlds, SimRunner &target_runner, const RunOptions &opt)
+                   const std::string &exp_dir, SimWorlds &worlds, SimRunner &target_runner, const RunOptions &opt,
+                   const HeldOut &H)
 {
     const std::string status_path = join_path(exp_dir, "STATUS");
     write_file_atomic(join_path(exp_dir, "curves.csv"), curves_csv(S));
     write_file_atomic(join_path(exp_dir, "quality.csv"), quality_csv(S, exp_dir, target_runner.ctrl_config(),
                                                                    target_runner.probabilistic_policy()));
     qnav_sim_env_info_t env_info;
-    qnav_sim_env_info(worlds.env(spec.target.environment), &env_info);
+    qnav_sim_env_info(worlds.env(picture_scenario(spec.target).environment), &env_info);
     qnav_sim_robot_info_t robot_info;
     qnav_sim_robot_info(worlds.robot(spec.target.robot), &robot_info);
     write_file_atomic(join_path(exp_dir, "summary.json"),
-                      summary_json(spec, S, opt, env_info.source, robot_info.radius_m));
+                      summary_json(spec, S, opt, env_info.source, robot_info.radius_m, H));
     write_best_policies(S, exp_dir);
     const uint64_t eval_base = tasks.back().eval_seed_base; // the probabilistic task's: the held-out set
     write_file_atomic(join_path(exp_dir, "episodes.csv"),
@@ -1186,7 +1377,7 @@ void probe_inputs(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks,
     std::set<std::string> probed;
     for (const TaskDef &t : tasks) {
         if (probed.insert(t.scenario.describe()).second) {
-            SimRunner probe(worlds, t.scenario, t.context_seed, use_table);
+            probe_scenario(worlds, t.scenario, t.context_seed, use_table);
         }
     }
     for (const SourceSpec &s : spec.sources) {
@@ -1226,10 +1417,11 @@ void finish_experiment(const ExperimentSpec &spec, const std::vector<TaskDef> &t
 {
     const std::string exp_dir = join_path(opt.out_dir, spec.name);
     SimWorlds worlds;
-    SimRunner target_runner(worlds, spec.target, spec.seed, opt.use_table);
+    SimRunner target_runner(worlds, picture_scenario(spec.target), spec.seed, opt.use_table);
     const ExperimentSummary S = summarize(spec, tasks);
-    write_outputs(spec, S, tasks, exp_dir, worlds, target_runner, opt);
-    write_file_atomic(join_path(exp_dir, "summary.md"), summary_md(spec, S, opt, opt.plots));
+    const HeldOut H = evaluate_held_out(spec, S, exp_dir, worlds, opt);
+    write_outputs(spec, S, tasks, exp_dir, worlds, target_runner, opt, H);
+    write_file_atomic(join_path(exp_dir, "summary.md"), summary_md(spec, S, opt, opt.plots, H));
     write_file_atomic(join_path(exp_dir, "STATUS"), "complete\n");
 }
 

@@ -59,6 +59,13 @@ void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, uns
 struct Interval {
     double mean = 0, lo = 0, hi = 0;
 };
+/* Mean of x with its Student-t 95% CI, clipped to [lo_bound, hi_bound]. */
+Interval t_interval(const std::vector<double> &x, double lo_bound, double hi_bound);
+/* successes / n with its Wilson score 95% CI. */
+Interval wilson_interval(double successes, double n);
+
+/* A run's folder: exp_dir/run-NNN (run 0-based, NNN 1-based). */
+std::string run_dir(const std::string &exp_dir, uint32_t run);
 
 /* Held-out performance of a condition's best members at one checkpoint, per run. */
 struct CheckpointSummary {
@@ -84,6 +91,7 @@ struct ConditionDecl {
     ConditionKind kind;
     const char *label;   /* the label, or its prefix for Transfer */
     bool evolved;        /* has runs, learning curves and checkpoints */
+    const ReferenceDecl *reference; /* a reference's row of kReferences (task.h), or null */
 };
 extern const ConditionDecl kConditions[4];
 const ConditionDecl &condition_decl(ConditionKind kind);
@@ -151,6 +159,11 @@ struct ExperimentSummary {
 };
 
 ExperimentSummary summarize(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks);
+
+/* The situation an experiment's pictures (episodes.csv, quality.csv) are made in: the
+ * target, or for a distribution target its first fixed environment, else the first named
+ * environment of data/envs/. Throws UserError. */
+Scenario picture_scenario(const Scenario &target);
 
 /* Path quality over (distance level, dtheta) of each named policy, as libqnav computes it
  * (qnav_ctrl_quality): the quality.csv that tools/plot_policy.py draws. Throws UserError. */

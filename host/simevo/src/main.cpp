@@ -26,6 +26,7 @@
 #include "cluster.h"
 #include "experiment.h"
 #include "files.h"
+#include "heldout.h"
 #include "qnav/policy_io.h"
 #include "sim_runner.h"
 #include "stats.h"
@@ -156,8 +157,13 @@ std::vector<RunItem> load_run_specs(const std::vector<std::string> &names, const
     std::vector<std::pair<std::string, RunArgs>> paths;
     for (const auto &n : names) {
         if (n == "all") {
+            // the paper's experiments (a file that names the figure it reproduces); the
+            // others (generalist) run by name
             for (const auto &k : list_experiments(experiments_dir)) {
-                paths.emplace_back(join_path(experiments_dir, k + ".toml"), args);
+                const std::string path = join_path(experiments_dir, k + ".toml");
+                if (!load_experiment(path).figure.empty()) {
+                    paths.emplace_back(path, args);
+                }
             }
         } else {
             add_run_paths(resolve_experiment(n, experiments_dir), args, experiments_dir, paths, sweeps);
@@ -170,9 +176,9 @@ std::vector<RunItem> load_run_specs(const std::vector<std::string> &names, const
     SimWorlds probe_worlds;
     for (const RunItem &it : items) {
         const ExperimentSpec &s = it.spec;
-        SimRunner target(probe_worlds, s.target, s.seed, true);
+        probe_scenario(probe_worlds, s.target, s.seed, true);
         for (const auto &src : s.sources) {
-            SimRunner source(probe_worlds, src.scenario, s.seed, true);
+            probe_scenario(probe_worlds, src.scenario, s.seed, true);
             if (!src.policy_file.empty()) {
                 (void)read_policy_file(src.policy_file);
             }
@@ -192,6 +198,7 @@ void set_run_options(RunOptions &opt, const RunArgs &args, const std::string &ex
 }
 
 int summarize_sweep(const std::string &dir, const std::string &record_path, const RunOptions &opt, bool &started);
+void print_recommendation(const ExperimentSpec &s, const std::string &dir);
 
 /* `simevo summarize DIR`: the experiment's spec from DIR/run.txt, every task finished, then
  * the same outputs as a local run. Returns the exit status. */
@@ -232,6 +239,7 @@ int summarize_folder(const std::string &dir_arg, RunOptions opt, bool &started)
     }
     finish_experiment(spec, tasks, opt);
     std::printf("%s: merged %zu tasks; summary %s/summary.md\n", spec.name.c_str(), tasks.size(), dir.c_str());
+    print_recommendation(spec, join_path(opt.out_dir, spec.name));
     return 0;
 }
 
@@ -279,6 +287,21 @@ void print_transfer_arrival(const ExperimentSpec &s, const std::string &dir)
                     s.name.c_str(), best_policy_copy(dir, c.label).c_str(), c.best_run + 1,
                     100.0 * c.arrival_per_run[static_cast<std::size_t>(c.best_run)], s.eval_episodes,
                     100.0 * c.arrival.mean);
+    }
+}
+
+/* A distribution target's recommended policy and its test figures, one line per world
+ * (nothing for other experiments). */
+void print_recommendation(const ExperimentSpec &s, const std::string &dir)
+{
+    if (!s.target.distribution) {
+        return;
+    }
+    const ExperimentSummary S = summarize(s, plan_tasks(s, dir));
+    const std::vector<HeldOutWorld> worlds = held_out_worlds(s.target);
+    const Recommendation r = recommend(S, worlds, read_world_rows(join_path(dir, "worlds.csv")), s.eval_episodes);
+    for (const std::string &line : recommendation_lines(s.name, r, dir)) {
+        std::printf("%s\n", line.c_str());
     }
 }
 
@@ -381,7 +404,7 @@ int main(int argc, char **argv)
     bool no_plot = false, no_progress = false;
     std::string share_text;
     int stage = 0;
-    run->add_option("experiment", names, "experiment name(s), a .toml path, a sweep file, or 'all'")->required();
+    run->add_option("experiment", names, "experiment name(s), a .toml path, a sweep file, or 'all' (the paper's five; generalist by name)")->required();
     add_run_args(run, run_args);
     run->add_option("--out", opt.out_dir, "output folder; results go to OUT/<experiment>")->capture_default_str();
     run->add_option("-j,--jobs", opt.jobs, "worker threads (0 = all cores)")->capture_default_str();
@@ -515,6 +538,7 @@ int main(int argc, char **argv)
                         std::printf("%s: plot %s/learning.png\n", s.name.c_str(), dir.c_str());
                     }
                     print_transfer_arrival(s, dir);
+                    print_recommendation(s, dir);
                 } else {
                     run_share(s, opt, share, t0);
                 }

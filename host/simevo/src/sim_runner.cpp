@@ -4,6 +4,7 @@
 #include "sim_runner.h"
 
 #include "qnav/nav.h"
+#include "worlds.h"
 
 #include <cstring>
 
@@ -52,12 +53,54 @@ const qnav_sim_env_t *SimWorlds::env(const std::string &spec)
     return load_once(envs_, spec, "environment", qnav_sim_env_load);
 }
 
+std::shared_ptr<const qnav_sim_env_t> SimWorlds::generated(const std::string &spec)
+{
+    {
+        std::lock_guard<std::mutex> lock(mu_);
+        auto it = generated_.find(spec);
+        if (it != generated_.end()) {
+            return it->second;
+        }
+    }
+    // made outside the lock: other threads go on with their worlds meanwhile
+    char err[QNAV_SIM_ERRLEN] = {0};
+    qnav_sim_env_t *h = nullptr;
+    if (qnav_sim_env_load(spec.c_str(), &h, err, sizeof err) != QNAV_SIM_OK) {
+        throw UserError("environment '" + spec + "': " + err);
+    }
+    std::shared_ptr<const qnav_sim_env_t> env(h, [](const qnav_sim_env_t *e) {
+        qnav_sim_env_free(const_cast<qnav_sim_env_t *>(e));
+    });
+    std::lock_guard<std::mutex> lock(mu_);
+    auto ins = generated_.emplace(spec, env);
+    if (ins.second) {
+        generated_order_.push_back(spec);
+        if (generated_order_.size() > kGeneratedKept) {
+            generated_.erase(generated_order_.front());
+            generated_order_.pop_front();
+        }
+    }
+    return ins.first->second;
+}
+
 SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t context_seed,
                      bool use_table)
     : use_table_(use_table)
 {
     const qnav_sim_robot_t *robot = worlds.robot(scenario.robot);
-    const qnav_sim_env_t *env = worlds.env(scenario.environment);
+    if (scenario.distribution) {
+        throw UserError("simulator (" + scenario.describe() + "): a distribution runs through DistributionRunner");
+    }
+    // a generated world is shared through its own cache (up to a million of them in a
+    // training range: the context copies what it needs, so one may be dropped later)
+    std::shared_ptr<const qnav_sim_env_t> generated;
+    const qnav_sim_env_t *env = nullptr;
+    if (scenario.environment.compare(0, 4, "gen:") == 0) {
+        generated = worlds.generated(scenario.environment);
+        env = generated.get();
+    } else {
+        env = worlds.env(scenario.environment);
+    }
     qnav_sim_config_t cfg;
     qnav_sim_config_default(&cfg);
     cfg.n_sectors = static_cast<uint16_t>(scenario.sectors);
@@ -178,6 +221,32 @@ EpisodeOutcome SimRunner::run_controller_traced(const char *controller, uint64_t
     const qnav_sim_status_t s =
         qnav_sim_run_episode_nav(sim_, &nav, episode_seed, &res, trace ? +append_sample : nullptr, trace);
     return outcome(s, res);
+}
+
+void probe_scenario(SimWorlds &worlds, const Scenario &scenario, uint64_t context_seed, bool use_table)
+{
+    if (!scenario.distribution) {
+        SimRunner probe(worlds, scenario, context_seed, use_table);
+        return;
+    }
+    const Distribution &d = *scenario.distribution;
+    std::vector<uint32_t> sectors = d.sectors;
+    if (sectors.empty()) {
+        sectors.push_back(scenario.sectors);
+    }
+    for (const FamilySpec &f : d.families) {
+        Scenario s = scenario;
+        s.distribution.reset();
+        s.environment = f.family.empty() ? f.environment : family_env_spec(f.family, d.seed_lo, f.difficulty_lo, s.robot);
+        for (uint32_t n : sectors) {
+            s.sectors = n;
+            try {
+                SimRunner probe(worlds, s, context_seed, use_table);
+            } catch (const UserError &e) {
+                throw UserError("distribution " + d.name + ", " + f.label() + ": " + e.what());
+            }
+        }
+    }
 }
 
 } // namespace qnav

@@ -9,6 +9,7 @@
 #ifndef QNAV_SIMEVO_SIM_RUNNER_H
 #define QNAV_SIMEVO_SIM_RUNNER_H
 
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -31,11 +32,17 @@ public:
     /* Load (once) what the scenario names. Throws UserError with the sim's message. */
     const qnav_sim_robot_t *robot(const std::string &spec);
     const qnav_sim_env_t *env(const std::string &spec);
+    /* A generated world ("gen:..."), made once and kept while at most kGeneratedKept are
+     * (the oldest dropped first; a caller's reference keeps its own alive). */
+    std::shared_ptr<const qnav_sim_env_t> generated(const std::string &spec);
+    static constexpr std::size_t kGeneratedKept = 8192;
 
 private:
     std::mutex mu_;
     std::map<std::string, qnav_sim_robot_t *> robots_;
     std::map<std::string, qnav_sim_env_t *> envs_;
+    std::map<std::string, std::shared_ptr<const qnav_sim_env_t>> generated_;
+    std::deque<std::string> generated_order_; /* oldest first */
 };
 
 class SimRunner : public EpisodeRunner {
@@ -83,6 +90,11 @@ private:
     CompiledTable tables_[2];
     unsigned least_recent_ = 0; /* index into tables_ to overwrite next */
 };
+
+/* Check that every world a scenario can meet loads and runs: the scenario itself, or for
+ * a distribution each component (a family at its lowest training seed and difficulty) with
+ * each sector count. Throws UserError with the simulator's message. */
+void probe_scenario(SimWorlds &worlds, const Scenario &scenario, uint64_t context_seed, bool use_table);
 
 } // namespace qnav
 

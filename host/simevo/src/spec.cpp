@@ -34,11 +34,57 @@ bool controller_reading_parse(const std::string &name, ControllerReading *out)
     return false;
 }
 
+const char *world_set_name(WorldSet w)
+{
+    switch (w) {
+    case WorldSet::Training:
+        return "training";
+    case WorldSet::Validation:
+        return "validation";
+    case WorldSet::Test:
+        return "test";
+    }
+    return "training";
+}
+
+std::string FamilySpec::label() const { return family.empty() ? "env:" + environment : family; }
+
+std::string Distribution::describe() const
+{
+    std::ostringstream o;
+    o.precision(17);
+    o << name << "{families=";
+    for (std::size_t i = 0; i < families.size(); ++i) {
+        const FamilySpec &f = families[i];
+        o << (i ? "," : "") << f.label() << ":w" << f.weight;
+        if (!f.family.empty()) {
+            o << ":d" << f.difficulty_lo << "-" << f.difficulty_hi;
+        }
+    }
+    o << ";seeds=" << seed_lo << "-" << seed_hi;
+    if (!sectors.empty()) {
+        o << ";sectors=";
+        for (std::size_t i = 0; i < sectors.size(); ++i) {
+            o << (i ? "," : "") << sectors[i];
+        }
+    }
+    if (noise_drawn) {
+        o << ";noise=" << noise_lo << "-" << noise_hi;
+    }
+    o << "}";
+    return o.str();
+}
+
 std::string Scenario::describe() const
 {
     std::ostringstream o;
     o.precision(17);
-    o << "environment=" << environment << " robot=" << robot << " sectors=" << sectors
+    if (distribution) {
+        o << "distribution=" << distribution->describe() << " worlds=" << world_set_name(worlds);
+    } else {
+        o << "environment=" << environment;
+    }
+    o << " robot=" << robot << " sectors=" << sectors
       << " sensor_noise=" << sensor_noise << " actuation_noise=" << actuation_noise
       << " episode_limit_s=" << episode_limit_s
       << " fitness=" << qnav_sim_fitness_rule_name(fitness)
@@ -134,15 +180,54 @@ public:
         return v;
     }
 
-    /* Scenario keys shared by [target] and [[source]]. Returns true if key was one. */
+    /* A [lo, hi] pair of numbers within [min, max], lo <= hi. */
+    std::pair<double, double> range(const toml::node &n, const std::string &key, double min, double max) const
+    {
+        const toml::array *a = n.as_array();
+        if (a == nullptr || a->size() != 2) {
+            fail(n, key + ": expected [low, high]");
+        }
+        const double lo = number(*a->get(0), key, min, max);
+        const double hi = number(*a->get(1), key, min, max);
+        if (lo > hi) {
+            fail(n, key + ": low is above high");
+        }
+        return {lo, hi};
+    }
+
+    /* Scenario keys shared by [target] and [[source]]. Returns true if key was one.
+     * environment and distribution exclude each other (the last one given wins over an
+     * inherited one; both in one table is an error). */
     bool scenario_key(Scenario &s, const std::string &k, const toml::node &v,
                       bool &noise_set, bool &split_noise_set) const
     {
         if (k == "environment") {
+            if (s.distribution && distribution_set_) {
+                fail(v, "environment: give either 'environment' or 'distribution', not both");
+            }
             s.environment = str(v, k);
+            s.distribution.reset();
+            environment_set_ = true;
             if (s.environment.empty()) {
                 fail(v, "environment: must not be empty");
             }
+        } else if (k == "distribution") {
+            if (environment_set_) {
+                fail(v, "distribution: give either 'environment' or 'distribution', not both");
+            }
+            const std::string d = str(v, k);
+            if (distributions_ == nullptr || distributions_->count(d) == 0) {
+                std::string known;
+                if (distributions_ != nullptr) {
+                    for (auto &kv : *distributions_) {
+                        known += (known.empty() ? "" : ", ") + kv.first;
+                    }
+                }
+                fail(v, "distribution: no [distribution." + d + "] in this file" +
+                            (known.empty() ? "" : " (known: " + known + ")"));
+            }
+            s.distribution = distributions_->at(d);
+            distribution_set_ = true;
         } else if (k == "robot") {
             s.robot = str(v, k);
             if (s.robot.empty()) {
@@ -171,9 +256,15 @@ public:
     }
 
     const std::string &name() const { return name_; }
+    /* The distributions scenario_key resolves names in. */
+    void set_distributions(const std::map<std::string, std::shared_ptr<const Distribution>> *d) { distributions_ = d; }
+    /* Start a new scenario table (environment / distribution given in it: none yet). */
+    void begin_scenario() const { environment_set_ = distribution_set_ = false; }
 
 private:
     std::string name_;
+    const std::map<std::string, std::shared_ptr<const Distribution>> *distributions_ = nullptr;
+    mutable bool environment_set_ = false, distribution_set_ = false;
 };
 
 } // namespace
@@ -227,7 +318,7 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
         const toml::table &t = p.table(*n, "evolution");
         p.only_keys(t, {"population", "epsilon", "hidden", "inputs", "mutation_scale", "mutation_clip",
                         "episodes_per_candidate", "reevaluate_parent", "init", "init_scale",
-                        "fitness", "controller"},
+                        "fitness", "controller", "world_sets"},
                     "evolution");
         EvolutionParams &e = spec.evolution;
         if (auto *v = t.get("population")) {
@@ -260,12 +351,28 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
         }
         if (auto *v = t.get("init")) {
             const std::string s = p.str(*v, "init");
-            if (s == "cauchy") {
-                e.init = InitKind::Cauchy;
-            } else if (s == "uniform") {
-                e.init = InitKind::Uniform;
-            } else {
+            bool known = false;
+            for (InitKind k : {InitKind::Cauchy, InitKind::Uniform}) {
+                if (s == init_kind_name(k)) {
+                    e.init = k;
+                    known = true;
+                }
+            }
+            if (!known) {
                 p.fail(*v, "init: '" + s + "' is not one of cauchy, uniform");
+            }
+        }
+        if (auto *v = t.get("world_sets")) {
+            const std::string s = p.str(*v, "world_sets");
+            bool known = false;
+            for (auto w : {EvolutionParams::WorldSets::PerStep, EvolutionParams::WorldSets::PerGeneration}) {
+                if (s == world_sets_name(w)) {
+                    e.world_sets = w;
+                    known = true;
+                }
+            }
+            if (!known) {
+                p.fail(*v, "world_sets: '" + s + "' is not one of per-step, per-generation");
             }
         }
         if (auto *v = t.get("init_scale")) {
@@ -288,6 +395,94 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
     }
 }
 
+/* One entry of a distribution's families array. Throws UserError. */
+FamilySpec parse_family(const Parser &p, const toml::node &n, const std::string &where)
+{
+    const toml::table *t = n.as_table();
+    if (t == nullptr) {
+        p.fail(n, where + ": expected { family = \"NAME\", weight = W, difficulty = [LO, HI] } or "
+                          "{ environment = \"NAME\", weight = W }");
+    }
+    p.only_keys(*t, {"family", "environment", "weight", "difficulty"}, where);
+    FamilySpec f;
+    if (auto *v = t->get("family")) {
+        f.family = p.str(*v, "family");
+        if (!valid_name(f.family)) {
+            p.fail(*v, "family: use 1-64 characters a-z, 0-9, '-', '_'");
+        }
+    }
+    if (auto *v = t->get("environment")) {
+        f.environment = p.str(*v, "environment");
+        if (f.environment.empty() || f.environment.find(':') != std::string::npos) {
+            p.fail(*v, "environment: a name in data/envs or a file (a generated world is a 'family')");
+        }
+    }
+    if (f.family.empty() == f.environment.empty()) {
+        p.fail(n, where + ": give exactly one of 'family' and 'environment'");
+    }
+    if (auto *v = t->get("weight")) {
+        f.weight = p.number(*v, "weight", 1e-9, 1e9);
+    }
+    if (auto *v = t->get("difficulty")) {
+        if (!f.environment.empty()) {
+            p.fail(*v, "difficulty: only a generated family has one");
+        }
+        const auto r = p.range(*v, "difficulty", 0.0, 1.0);
+        f.difficulty_lo = r.first;
+        f.difficulty_hi = r.second;
+    }
+    return f;
+}
+
+/* [distribution.NAME]: training distributions that [target] and [[source]] name. Throws UserError. */
+void parse_distributions(const Parser &p, const toml::table &root, ExperimentSpec &spec)
+{
+    const toml::node *n = root.get("distribution");
+    if (n == nullptr) {
+        return;
+    }
+    for (auto &&[k, v] : p.table(*n, "distribution")) {
+        auto d = std::make_shared<Distribution>();
+        d->name = std::string(k.str());
+        const std::string where = "distribution." + d->name;
+        if (!valid_name(d->name)) {
+            p.fail(v, where + ": use 1-64 characters a-z, 0-9, '-', '_' in the name");
+        }
+        const toml::table &t = p.table(v, where);
+        p.only_keys(t, {"families", "seeds", "sectors", "noise"}, where);
+        const toml::node *fam = t.get("families");
+        if (fam == nullptr || !fam->is_array() || fam->as_array()->empty()) {
+            p.fail(fam ? *fam : v, where + ": families: expected a non-empty array of { family = ... } tables");
+        }
+        for (auto &&el : *fam->as_array()) {
+            d->families.push_back(parse_family(p, el, where + ".families"));
+        }
+        if (auto *s = t.get("seeds")) {
+            const auto r = p.range(*s, "seeds", 0.0, static_cast<double>(kValidationSeedBase - 1));
+            if (!s->as_array()->get(0)->is_integer() || !s->as_array()->get(1)->is_integer()) {
+                p.fail(*s, "seeds: expected two integers [low, high]");
+            }
+            d->seed_lo = static_cast<uint64_t>(r.first);
+            d->seed_hi = static_cast<uint64_t>(r.second);
+        }
+        if (auto *s = t.get("sectors")) {
+            if (!s->is_array() || s->as_array()->empty()) {
+                p.fail(*s, "sectors: expected a non-empty array of sector counts");
+            }
+            for (auto &&el : *s->as_array()) {
+                d->sectors.push_back(static_cast<uint32_t>(p.integer(el, "sectors", 1, QNAV_MAX_SECTORS)));
+            }
+        }
+        if (auto *s = t.get("noise")) {
+            const auto r = p.range(*s, "noise", 0.0, 1.0);
+            d->noise_drawn = true;
+            d->noise_lo = r.first;
+            d->noise_hi = r.second;
+        }
+        spec.distributions[d->name] = d;
+    }
+}
+
 /* [target]: the situation transfer and direct evolution share. Throws UserError. */
 void parse_target(const Parser &p, const toml::table &root, ExperimentSpec &spec)
 {
@@ -297,6 +492,7 @@ void parse_target(const Parser &p, const toml::table &root, ExperimentSpec &spec
     {
         const toml::table &t = p.table(*root.get("target"), "target");
         bool ns = false, ss = false;
+        p.begin_scenario();
         for (auto &&[k, v] : t) {
             const std::string key(k.str());
             if (p.scenario_key(spec.target, key, v, ns, ss)) {
@@ -325,6 +521,7 @@ void parse_sources(const Parser &p, const toml::table &root, ExperimentSpec &spe
             s.scenario = spec.target;
             s.episodes = spec.target_episodes;
             bool ns = false, ss = false;
+            p.begin_scenario();
             bool has_label = false;
             for (auto &&[k, v] : t) {
                 const std::string key(k.str());
@@ -368,7 +565,7 @@ void parse_evaluation(const Parser &p, const toml::table &root, ExperimentSpec &
     if (auto *n = root.get("evaluation")) {
         const toml::table &t = p.table(*n, "evaluation");
         p.only_keys(t, {"episodes", "seed", "checkpoints", "checkpoint_every", "checkpoint_episodes",
-                        "arrival_threshold"},
+                        "arrival_threshold", "worlds_episodes"},
                     "evaluation");
         if (auto *v = t.get("episodes")) {
             spec.eval_episodes = static_cast<uint32_t>(p.integer(*v, "episodes", 1, 1000000));
@@ -388,6 +585,9 @@ void parse_evaluation(const Parser &p, const toml::table &root, ExperimentSpec &
         if (auto *v = t.get("arrival_threshold")) {
             spec.arrival_threshold = p.number(*v, "arrival_threshold", 0.0, 100.0) / 100.0;
         }
+        if (auto *v = t.get("worlds_episodes")) {
+            spec.worlds_episodes = static_cast<uint32_t>(p.integer(*v, "worlds_episodes", 1, 1000000));
+        }
     }
 }
 
@@ -403,7 +603,7 @@ void parse_presets(const Parser &p, const toml::table &root, ExperimentSpec &spe
             }
             const toml::table &t = p.table(v, "preset." + pname);
             p.only_keys(t, {"runs", "episodes", "source_episodes", "eval_episodes", "curve_bin",
-                            "checkpoint_episodes"},
+                            "checkpoint_episodes", "worlds_episodes"},
                         "preset." + pname);
             Preset pr;
             if (auto *x = t.get("runs")) {
@@ -426,6 +626,9 @@ void parse_presets(const Parser &p, const toml::table &root, ExperimentSpec &spe
                 pr.checkpoint_episodes =
                     static_cast<uint32_t>(p.integer(*x, "checkpoint_episodes", 1, 1000000));
             }
+            if (auto *x = t.get("worlds_episodes")) {
+                pr.worlds_episodes = static_cast<uint32_t>(p.integer(*x, "worlds_episodes", 1, 1000000));
+            }
             spec.presets[pname] = pr;
         }
     }
@@ -446,9 +649,11 @@ ExperimentSpec parse_experiment(const std::string &text, const std::string &name
     ExperimentSpec spec;
     spec.file = name;
     p.only_keys(root, {"name", "title", "figure", "runs", "seed", "curve_bin", "evolution",
-                       "target", "source", "evaluation", "preset"},
+                       "target", "source", "evaluation", "preset", "distribution"},
                 "");
     parse_header(p, root, spec);
+    parse_distributions(p, root, spec);
+    p.set_distributions(&spec.distributions);
     parse_evolution(p, root, spec);
     parse_target(p, root, spec);
     parse_sources(p, root, spec);
@@ -499,6 +704,9 @@ void apply_preset(ExperimentSpec &spec, const std::string &preset)
     }
     if (p.checkpoint_episodes) {
         spec.checkpoint_episodes = *p.checkpoint_episodes;
+    }
+    if (p.worlds_episodes) {
+        spec.worlds_episodes = *p.worlds_episodes;
     }
 }
 

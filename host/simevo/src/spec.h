@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -38,6 +39,46 @@ const char *controller_reading_name(ControllerReading c);
 /* Parses a name; false when it is not one. */
 bool controller_reading_parse(const std::string &name, ControllerReading *out);
 
+/* Which worlds of a distribution an episode is drawn from. Training worlds come from the
+ * distribution's seed range (below kValidationSeedBase), validation worlds from
+ * [kValidationSeedBase, kTestSeedBase), test worlds from [kTestSeedBase, kTestSeedBase +
+ * kHeldOutSeedSpan): disjoint by construction (docs/simevo.md, "Held-out worlds"). */
+enum class WorldSet { Training, Validation, Test };
+constexpr uint64_t kValidationSeedBase = 1000000;
+constexpr uint64_t kTestSeedBase = 2000000;
+constexpr uint64_t kHeldOutSeedSpan = 1000000;
+/* "training", "validation", "test". */
+const char *world_set_name(WorldSet w);
+
+/* One component of a distribution of worlds: a family of the simulator's world generator
+ * (environment "gen:FAMILY:SEED:DIFFICULTY:ROBOT", a new world per seed) or one fixed
+ * environment (only the start point varies). */
+struct FamilySpec {
+    std::string family;        /* generator family, or "" for a fixed environment */
+    std::string environment;   /* fixed environment (name or file), or "" for a family */
+    double weight = 1.0;       /* relative probability, > 0 */
+    double difficulty_lo = 0.0, difficulty_hi = 1.0; /* drawn uniformly, in [0, 1] */
+
+    /* "clutter" or "env:dense": the family's label in summaries. */
+    std::string label() const;
+};
+
+/* A training distribution: each episode draws a component by weight, a world seed from
+ * the set's range, a difficulty, and optionally a sector count and a noise level. */
+struct Distribution {
+    std::string name;                   /* [distribution.NAME] */
+    std::vector<FamilySpec> families;   /* at least one */
+    uint64_t seed_lo = 0, seed_hi = kValidationSeedBase - 1; /* training world seeds,
+                                           inclusive, below kValidationSeedBase */
+    std::vector<uint32_t> sectors;      /* one drawn per episode; empty = the scenario's */
+    bool noise_drawn = false;           /* p drawn uniformly in [noise_lo, noise_hi] for
+                                           sensor and actuation alike, per episode */
+    double noise_lo = 0.0, noise_hi = 0.0;
+
+    /* Canonical one-line description (part of task fingerprints). */
+    std::string describe() const;
+};
+
 /* The situation a policy is evolved or evaluated in. */
 struct Scenario {
     std::string environment = "dense"; /* sim environment: name or file */
@@ -50,6 +91,10 @@ struct Scenario {
                                            set for every scenario from [evolution] fitness */
     ControllerReading controller = ControllerReading::Body; /* set for every scenario from
                                            [evolution] controller */
+    /* Set: every episode is drawn from this distribution (environment unused) out of the
+     * worlds of `worlds`; the episode seed fixes the world and the start point. */
+    std::shared_ptr<const Distribution> distribution;
+    WorldSet worlds = WorldSet::Training;
 
     /* Canonical one-line description (also part of task fingerprints). */
     std::string describe() const;
@@ -70,6 +115,7 @@ struct Preset {
     std::optional<uint32_t> eval_episodes;
     std::optional<uint32_t> curve_bin;
     std::optional<uint32_t> checkpoint_episodes;
+    std::optional<uint32_t> worlds_episodes;
 };
 
 struct ExperimentSpec {
@@ -96,6 +142,10 @@ struct ExperimentSpec {
     uint32_t checkpoint_episodes = 20;
     double arrival_threshold = 0.8; /* fraction; the file gives percent */
     std::map<std::string, Preset> presets;
+    std::map<std::string, std::shared_ptr<const Distribution>> distributions; /* by name */
+    /* Held-out worlds ([evaluation] worlds_episodes): episodes per best policy in each
+     * family's test worlds and each named environment (summary "Held-out worlds"). */
+    uint32_t worlds_episodes = 20;
 };
 
 /* An identifier of an experiment, source or sweep: 1-64 characters a-z, 0-9, '-', '_'. */

@@ -18,6 +18,7 @@
 #include "files.h"
 #include "qnav/policy_io.h"
 #include "rng.h"
+#include "worlds.h"
 
 namespace qnav {
 
@@ -358,13 +359,24 @@ qnav_policy_t load_source_policy(const std::string &path)
     return p;
 }
 
+const char *task_kind_name(TaskKind k)
+{
+    switch (k) {
+    case TaskKind::Evolve:
+        return "evolve";
+    case TaskKind::EvalProbabilistic:
+        return "eval-probabilistic+vfh"; /* kept as written before the reference table */
+    }
+    return "evolve";
+}
+
 std::string task_settings_text(const TaskDef &t, const std::string &source_fingerprint)
 {
     std::ostringstream o;
     o.precision(17);
     const EvolutionParams &e = t.evolution;
     o << "# simevo task settings; a resumed task must match them exactly\n"
-      << "kind=" << (t.kind == TaskKind::Evolve ? "evolve" : "eval-probabilistic+vfh") << "\n"
+      << "kind=" << task_kind_name(t.kind) << "\n"
       << "label=" << t.label << "\nrun=" << t.run << "\n"
       << "scenario=" << t.scenario.describe() << "\n"
       << "context_seed=" << t.context_seed << "\n";
@@ -374,9 +386,12 @@ std::string task_settings_text(const TaskDef &t, const std::string &source_finge
           << " hidden=" << e.hidden << " mutation_scale=" << e.mutation_scale
           << " mutation_clip=" << e.mutation_clip << " episodes_per_candidate=" << e.episodes_per_candidate
           << " reevaluate_parent=" << (e.reevaluate_parent ? 1 : 0)
-          << " init=" << (e.init == InitKind::Cauchy ? "cauchy" : "uniform")
+          << " init=" << init_kind_name(e.init)
           << " init_scale=" << e.init_scale
           << (e.inputs != QNAV_NET_INPUTS_PAPER ? " inputs=" + std::to_string(e.inputs) : std::string())
+          /* the default is left out, so fingerprints from before world sets still match */
+          << (e.world_sets != EvolutionParams::WorldSets::PerStep ? std::string(" world_sets=") + world_sets_name(e.world_sets)
+                                                                  : std::string())
           << "\n"
           << "evolution_seed=" << t.evolution_seed << "\n"
           << "episode_seed_base=" << t.episode_seed_base << "\n"
@@ -401,10 +416,18 @@ uint64_t task_steps(const TaskDef &t)
     return std::max<uint64_t>(1, (t.episodes + k - 1) / k);
 }
 
+EpisodeOutcome run_reference(EpisodeRunner &runner, const ReferenceDecl &r, uint64_t episode_seed)
+{
+    if (r.controller != nullptr) {
+        return runner.run_controller(r.controller, episode_seed);
+    }
+    return runner.run(runner.probabilistic_policy(), episode_seed);
+}
+
 uint64_t task_total_episodes(const TaskDef &t)
 {
     if (t.kind != TaskKind::Evolve) {
-        return 2u * static_cast<uint64_t>(t.eval_episodes); /* probabilistic and VFH+ */
+        return kReferenceCount * static_cast<uint64_t>(t.eval_episodes); /* every reference */
     }
     return task_steps(t) * t.evolution.episodes_per_candidate +
            static_cast<uint64_t>(t.checkpoints.size()) * t.checkpoint_episodes + t.eval_episodes;
@@ -531,12 +554,24 @@ std::size_t replay_journal(const TaskDef &t, const std::string &journal_path, Ev
         return true;
     });
 }
+/* Which k episodes step `step` runs: its own (paired with its parent), or its generation's. */
+uint64_t step_episode_set(const EvolutionParams &e, uint64_t step)
+{
+    switch (e.world_sets) {
+    case EvolutionParams::WorldSets::PerStep:
+        return step;
+    case EvolutionParams::WorldSets::PerGeneration:
+        return step / e.population;
+    }
+    return step;
+}
+
 /* Resume (replay) and continue an evolution to its budget, journaling each step and
  * evaluating the checkpoints. Returns false when stopped. */
-bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, const std::string &journal_path,
-            const TaskObserver &obs, const std::atomic<bool> &stop)
+bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, EpisodeRunner &held_out_runner,
+            const std::string &journal_path, const TaskObserver &obs, const std::atomic<bool> &stop)
 {
-    CheckpointLog checkpoints(t, runner, obs);
+    CheckpointLog checkpoints(t, held_out_runner, obs);
     const std::size_t keep = replay_journal(t, journal_path, evo, checkpoints, obs);
     const int fd = open_journal_at(journal_path, keep, kJournalHeader);
     FdGuard guard{fd};
@@ -549,12 +584,14 @@ bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, const std::
             return false;
         }
         const Candidate c = evo.propose();
-        const StepOutcome o = run_k(runner, c.policy, t.episode_seed_base, c.episode, k);
+        const uint64_t episode_set = step_episode_set(t.evolution, c.episode);
+        const StepOutcome o = run_k(runner, c.policy, t.episode_seed_base, episode_set, k);
         const bool has_parent = t.evolution.reevaluate_parent && c.parent >= 0;
         StepOutcome po;
         char parent_r[40] = "";
         if (has_parent) {
-            po = run_k(runner, evo.members()[static_cast<std::size_t>(c.parent)].policy, t.episode_seed_base, c.episode, k);
+            po = run_k(runner, evo.members()[static_cast<std::size_t>(c.parent)].policy, t.episode_seed_base,
+                       episode_set, k);
             std::snprintf(parent_r, sizeof parent_r, "%.17g", po.o.R);
         }
         evo.accept(c, o.o, has_parent ? &po.o : nullptr);
@@ -573,6 +610,14 @@ bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, const std::
     }
 
     return true;
+}
+/* The runner of a scenario: make's, or over a distribution's worlds. */
+std::unique_ptr<EpisodeRunner> make_runner(const RunnerFactory &make, const Scenario &sc, uint64_t seed)
+{
+    if (sc.distribution) {
+        return std::make_unique<DistributionRunner>(sc, seed, make);
+    }
+    return make(sc, seed);
 }
 } // namespace
 
@@ -612,18 +657,25 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
         return true;
     }
 
-    std::unique_ptr<EpisodeRunner> runner = make(t.scenario, t.context_seed);
+    // Held-out episodes of a distribution run in its validation worlds; of one environment,
+    // at new start points of it (the same runner, as before distributions existed).
+    std::unique_ptr<EpisodeRunner> held_out_owner;
+    std::unique_ptr<EpisodeRunner> runner;
+    if (t.kind == TaskKind::EvalProbabilistic || !t.scenario.distribution) {
+        runner = make_runner(make, validation_scenario(t.scenario), t.context_seed);
+    } else {
+        runner = make_runner(make, t.scenario, t.context_seed);
+        held_out_owner = make_runner(make, validation_scenario(t.scenario), t.context_seed);
+    }
+    EpisodeRunner &held_out = held_out_owner ? *held_out_owner : *runner;
 
     if (t.kind == TaskKind::EvalProbabilistic) {
-        // the references on the same held-out episodes: the hand-tuned probabilistic
-        // policy (eval.csv) and VFH+ (eval-vfh.csv), one task so shares stay as they were
-        const qnav_policy_t prob = runner->probabilistic_policy();
-        if (!run_eval(*runner, prob, t, obs, stop)) {
-            return false;
-        }
-        if (!run_eval_episodes([&](uint64_t seed) { return runner->run_controller(kVfhController, seed); },
-                               kVfhEvalStem, t, obs, stop)) {
-            return false;
+        // every reference on the same held-out episodes, one task so shares stay as they were
+        for (const ReferenceDecl &r : kReferences) {
+            if (!run_eval_episodes([&](uint64_t seed) { return run_reference(*runner, r, seed); }, r.eval_stem, t,
+                                   obs, stop)) {
+                return false;
+            }
         }
         write_file_atomic(done_path, "complete\n");
         return true;
@@ -632,7 +684,7 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
     Evolution evo = source_policy_path.empty()
                         ? Evolution(t.evolution, t.evolution_seed)
                         : Evolution(t.evolution, t.evolution_seed, source);
-    if (!evolve(t, evo, *runner, journal_path, obs, stop)) {
+    if (!evolve(t, evo, *runner, held_out, journal_path, obs, stop)) {
         return false;
     }
     const int32_t b = evo.best_index();
@@ -645,7 +697,7 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
         throw UserError(err);
     }
     if (t.eval_episodes > 0) {
-        if (!run_eval(*runner, best, t, obs, stop)) {
+        if (!run_eval(held_out, best, t, obs, stop)) {
             return false;
         }
     }

@@ -31,11 +31,39 @@
 namespace qnav {
 
 enum class TaskKind { Evolve, EvalProbabilistic };
+/* The kind as task.txt spells it ("evolve", "eval-probabilistic+vfh"). */
+const char *task_kind_name(TaskKind k);
 
 /* The second reference the EvalProbabilistic task runs: libqnav's controller of this name
  * (VFH+), journaled as <task dir>/kVfhEvalStem.csv. One home for both names. */
 constexpr const char *kVfhController = "vfh";
 constexpr const char *kVfhEvalStem = "eval-vfh";
+
+/* The references every experiment compares against, one row each: what a reference is,
+ * how it is evaluated and how it is plotted. The reference task (EvalProbabilistic) runs
+ * every row on the held-out episodes in this order; summaries, pictures, held-out worlds
+ * and tools/plot_learning.py (through summary.json "references") read the same rows. A new
+ * reference is a row here and its ConditionKind (experiment.h), whose switch the compiler
+ * checks (docs/simevo.md, "References"). */
+struct ReferenceDecl {
+    const char *label;      /* condition label in every output, e.g. "vfh" */
+    const char *controller; /* libqnav controller (qnav/nav.h) it runs without a policy, or
+                               nullptr: the robot's probabilistic policy through the
+                               path-quality controller */
+    const char *eval_stem;  /* its held-out episodes: <reference task dir>/STEM.csv */
+    const char *plot_name;  /* legend text */
+    const char *plot_style; /* matplotlib line style of its held-out band */
+    const char *plot_color; /* matplotlib colour */
+};
+constexpr ReferenceDecl kReferences[] = {
+    {"probabilistic", nullptr, "eval", "probabilistic (held out)", "--", "tab:gray"},
+    {kVfhController, kVfhController, kVfhEvalStem, "VFH+ (held out)", ":", "tab:brown"},
+};
+constexpr std::size_t kReferenceCount = sizeof kReferences / sizeof kReferences[0];
+
+/* One episode of reference r on runner: its controller, or the runner's probabilistic
+ * policy. */
+EpisodeOutcome run_reference(EpisodeRunner &runner, const ReferenceDecl &r, uint64_t episode_seed);
 
 struct TaskDef {
     TaskKind kind = TaskKind::Evolve;
