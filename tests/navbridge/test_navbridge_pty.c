@@ -529,6 +529,13 @@ static void test_bad_options_and_files_fail_with_one_line(void **state)
     const char *route[] = {EXE, "--device", "/dev/null", "--waypoints", "1:2,3", NULL};
     const char *at[] = {EXE, "--device", "/dev/null", "--goal-at", "1:2,3:4", NULL};
     const char *radius[] = {EXE, "--device", "/dev/null", "--goal-radius", "0", NULL};
+    /* two goals at once: refused, not the last one silently followed */
+    const char *both[] = {EXE, "--device", "/dev/null", "--goal", "30", "--waypoints", "1:2",
+                          NULL};
+    const char *goal_at[] = {EXE, "--device", "/dev/null", "--goal-at", "1:2", "--goal", "30",
+                             NULL};
+    const char *twice[] = {EXE, "--device", "/dev/null", "--goal-at", "1:2", "--goal-at",
+                           "3:4", NULL};
     (void)state;
     snprintf(bad_policy, sizeof bad_policy, "%s/bad.policy", g_dir);
     f = fopen(bad_policy, "w");
@@ -546,6 +553,9 @@ static void test_bad_options_and_files_fail_with_one_line(void **state)
     expect_refusal(route, "--waypoints 1:2,3");
     expect_refusal(at, "--goal-at 1:2,3:4");
     expect_refusal(radius, "--goal-radius 0");
+    expect_refusal(both, "--goal, --goal-at, --waypoints: give one of them, once");
+    expect_refusal(goal_at, "--goal, --goal-at, --waypoints: give one of them, once");
+    expect_refusal(twice, "--goal, --goal-at, --waypoints: give one of them, once");
 }
 
 /* Short unknown options are named as such (it used to say "--?: missing its value"), a
