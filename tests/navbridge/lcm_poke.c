@@ -5,9 +5,10 @@
  * (the board echoes the goal it drives to in every scan, so a goal navbridge obeyed shows
  * there within a tick or two).
  *
- * usage: lcm_poke URL goal CHANNEL GOAL_ID BEARING_CDEG
- *        lcm_poke URL route CHANNEL X:Y RADIUS_M
- *        lcm_poke URL scans N
+ * usage: lcm_poke URL ACTION...   each ACTION one of, done in order:
+ *          goal CHANNEL GOAL_ID BEARING_CDEG     publish a goal_t
+ *          route CHANNEL X:Y RADIUS_M            publish a one-point waypoints_t
+ *          scans N                               wait for N QNAV_SCAN messages
  * Exit 0 on success; 1 when the bus or N scans could not be had (scans waits for events,
  * with a last-resort limit of 600 s so a broken run ends); 2 for bad usage.
  */
@@ -61,10 +62,10 @@ static int wait_scans(lcm_t *lcm, int n)
 int main(int argc, char **argv)
 {
     lcm_t *lcm;
-    int rc = 2;
-    if (argc < 3) {
-        fprintf(stderr, "usage: lcm_poke URL goal CHANNEL ID CDEG | route CHANNEL X:Y R | "
-                        "scans N\n");
+    int k = 2, rc = 0;
+    if (argc < 4) {
+        fprintf(stderr, "usage: lcm_poke URL ACTION... (goal CHANNEL ID CDEG | route CHANNEL "
+                        "X:Y R | scans N)\n");
         return 2;
     }
     lcm = lcm_create(argv[1]);
@@ -72,26 +73,36 @@ int main(int argc, char **argv)
         fprintf(stderr, "lcm_poke: %s: cannot join the LCM bus\n", argv[1]);
         return 1;
     }
-    if (strcmp(argv[2], "goal") == 0 && argc == 6) {
-        qnav_goal_t g;
-        memset(&g, 0, sizeof g);
-        g.goal_id = atoi(argv[4]);
-        g.bearing_cdeg = (int16_t)atoi(argv[5]);
-        rc = qnav_goal_t_publish(lcm, argv[3], &g) == 0 ? 0 : 1;
-    } else if (strcmp(argv[2], "route") == 0 && argc == 6) {
-        qnav_waypoints_t w;
-        memset(&w, 0, sizeof w);
-        w.route_id = 7;
-        w.n = 1;
-        if (sscanf(argv[4], "%lf:%lf", &w.x_m[0], &w.y_m[0]) == 2) {
-            w.radius_m = atof(argv[5]);
-            rc = qnav_waypoints_t_publish(lcm, argv[3], &w) == 0 ? 0 : 1;
+    /* the actions in order, in one process: a loaded machine starts processes slowly */
+    while (rc == 0 && k < argc) {
+        if (strcmp(argv[k], "goal") == 0 && k + 3 < argc) {
+            qnav_goal_t g;
+            memset(&g, 0, sizeof g);
+            g.goal_id = atoi(argv[k + 2]);
+            g.bearing_cdeg = (int16_t)atoi(argv[k + 3]);
+            rc = qnav_goal_t_publish(lcm, argv[k + 1], &g) == 0 ? 0 : 1;
+            k += 4;
+        } else if (strcmp(argv[k], "route") == 0 && k + 3 < argc) {
+            qnav_waypoints_t w;
+            memset(&w, 0, sizeof w);
+            w.route_id = 7;
+            w.n = 1;
+            if (sscanf(argv[k + 2], "%lf:%lf", &w.x_m[0], &w.y_m[0]) != 2) {
+                rc = 2;
+                break;
+            }
+            w.radius_m = atof(argv[k + 3]);
+            rc = qnav_waypoints_t_publish(lcm, argv[k + 1], &w) == 0 ? 0 : 1;
+            k += 4;
+        } else if (strcmp(argv[k], "scans") == 0 && k + 1 < argc) {
+            rc = wait_scans(lcm, atoi(argv[k + 1]));
+            k += 2;
+        } else {
+            rc = 2;
         }
-    } else if (strcmp(argv[2], "scans") == 0 && argc == 4) {
-        rc = wait_scans(lcm, atoi(argv[3]));
     }
     if (rc == 2) {
-        fprintf(stderr, "lcm_poke: %s: bad usage\n", argv[2]);
+        fprintf(stderr, "lcm_poke: %s: bad usage\n", argv[k < argc ? k : argc - 1]);
     }
     lcm_destroy(lcm);
     return rc;
