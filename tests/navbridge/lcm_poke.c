@@ -45,15 +45,16 @@ static void on_scan(const lcm_recv_buf_t *rbuf, const char *channel, const qnav_
 static int wait_scans(lcm_t *lcm, int n)
 {
     scan_tally_t t;
-    int idle_s = 0;
+    int idle_s = 0, r = 0;
+    qnav_scan_t_subscription_t *sub;
     memset(&t, 0, sizeof t);
-    qnav_scan_t_subscribe(lcm, "QNAV_SCAN", on_scan, &t);
-    while (t.seen < n && idle_s < 600) {
-        int r = lcm_handle_timeout(lcm, 1000);
-        if (r < 0) {
-            return 1;
-        }
+    sub = qnav_scan_t_subscribe(lcm, "QNAV_SCAN", on_scan, &t);
+    while (sub != NULL && t.seen < n && idle_s < 600 && r >= 0) {
+        r = lcm_handle_timeout(lcm, 1000);
         idle_s += r == 0;
+    }
+    if (sub != NULL) {
+        qnav_scan_t_unsubscribe(lcm, sub);
     }
     printf("scans %d with_goal %d max_goal_id %d\n", t.seen, t.with_goal, t.max_goal_id);
     return t.seen >= n ? 0 : 1;
