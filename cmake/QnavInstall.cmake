@@ -7,7 +7,8 @@
 #   PREFIX/lib/cmake/qnav/      qnavConfig.cmake: find_package(qnav CONFIG) -> qnav::ctrl,
 #                               qnav::link, qnav::policyio, qnav::sim
 #   PREFIX/lib/pkgconfig/       qnav.pc
-#   PREFIX/share/qnav/          data/ (robots, environments), experiments/, tools/ (plot
+#   PREFIX/share/qnav/          data/ (robots, environments), experiments/, sweeps/,
+#                               boards/tekbot-avr.elf (with avr-gcc), tools/ (plot
 #                               scripts, qnav_log.py), python/qnav/ (generated LCM types),
 #                               java/ (LCM types jar), firmware/ (sources for add_subdirectory() in a
 #                               firmware project), cmake/ (toolchain files), VERSION
@@ -67,6 +68,11 @@ endforeach()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/ DESTINATION ${QNAV_SHARE_INSTALL_DIR}/data)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/experiments/
         DESTINATION ${QNAV_SHARE_INSTALL_DIR}/experiments)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/sweeps/ DESTINATION ${QNAV_SHARE_INSTALL_DIR}/sweeps)
+if(TARGET tekbot_avr_elf)
+  # the TekBot image for qnav-simavr-board (host builds with avr-gcc make it)
+  install(FILES ${QNAV_TEKBOT_AVR_ELF} DESTINATION ${QNAV_SHARE_INSTALL_DIR}/boards)
+endif()
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/tools/plot_learning.py ${PROJECT_SOURCE_DIR}/tools/plot_policy.py
                  ${PROJECT_SOURCE_DIR}/tools/plot_episodes.py ${PROJECT_SOURCE_DIR}/tools/policy_saturation.py
                  ${PROJECT_SOURCE_DIR}/tools/qnav_log.py

@@ -82,13 +82,15 @@ def decode(path, events, types):
     """{channel: [(log_utime, message)]} for the qnav channels; other channels are skipped."""
     out = {}
     for k, (utime, channel, data) in enumerate(events):
-        cls = types.get(channel)
+        # navbridge --lcm-goals takes goals on QNAV_GOAL_<token> (docs/hil.md): goal_t too
+        base = "QNAV_GOAL" if channel.startswith("QNAV_GOAL_") else channel
+        cls = types.get(base)
         if cls is None:
             continue
         try:
             msg = cls.decode(data)
         except (ValueError, struct.error) as e:
-            raise LogError(f"{path}: event {k} on {channel}: not a {CHANNELS[channel]} ({e})") from e
+            raise LogError(f"{path}: event {k} on {channel}: not a {CHANNELS[base]} ({e})") from e
         out.setdefault(channel, []).append((utime, msg))
     if not out:
         raise LogError(f"{path}: no qnav channel in this log")

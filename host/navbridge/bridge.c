@@ -3,10 +3,13 @@
  * that stops the robot when the board goes quiet, and the onboard policy upload. No I/O of
  * its own: bytes leave through the write callback, messages through LCM and the log.
  */
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* getrandom */
 #include "bridge.h"
 
+#include <errno.h>
 #include <string.h>
+#include <sys/random.h>
+#include <sys/types.h>
 #include <time.h>
 
 #include <math.h>
@@ -634,23 +637,64 @@ static void on_lcm_waypoints(const lcm_recv_buf_t *rbuf, const char *channel,
     }
 }
 
-void qnav_bridge_subscribe(qnav_bridge_t *b)
+int qnav_bridge_token_make(char *hex, size_t len)
 {
-    if (b->lcm != NULL) {
-        b->goal_sub = qnav_goal_t_subscribe(b->lcm, QNAV_CH_GOAL, on_lcm_goal, b);
-        b->route_sub =
-            qnav_waypoints_t_subscribe(b->lcm, QNAV_CH_WAYPOINTS, on_lcm_waypoints, b);
+    static const char digits[] = "0123456789abcdef";
+    uint8_t raw[QNAV_BRIDGE_TOKEN_HEX / 2];
+    size_t got = 0, k;
+    if (len < QNAV_BRIDGE_TOKEN_HEX + 1) {
+        return -1;
     }
+    while (got < sizeof raw) {
+        ssize_t n = getrandom(raw + got, sizeof raw - got, 0);
+        if (n < 0 && errno == EINTR) {
+            continue;
+        }
+        if (n <= 0) {
+            return -1;
+        }
+        got += (size_t)n;
+    }
+    for (k = 0; k < sizeof raw; ++k) {
+        hex[2 * k] = digits[raw[k] >> 4];
+        hex[2 * k + 1] = digits[raw[k] & 15u];
+    }
+    hex[QNAV_BRIDGE_TOKEN_HEX] = '\0';
+    return 0;
+}
+
+int qnav_bridge_subscribe(qnav_bridge_t *b, const char *token)
+{
+    size_t k, n = token != NULL ? strlen(token) : 0;
+    if (b->lcm == NULL || n == 0 || n > QNAV_BRIDGE_TOKEN_MAX) {
+        return -1;
+    }
+    /* only letters and digits: the channel is also an LCM subscription regex */
+    for (k = 0; k < n; ++k) {
+        char c = token[k];
+        if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'))) {
+            return -1;
+        }
+    }
+    snprintf(b->goal_channel, sizeof b->goal_channel, "%s_%s", QNAV_CH_GOAL, token);
+    snprintf(b->route_channel, sizeof b->route_channel, "%s_%s", QNAV_CH_WAYPOINTS, token);
+    b->goal_sub = qnav_goal_t_subscribe(b->lcm, b->goal_channel, on_lcm_goal, b);
+    b->route_sub = qnav_waypoints_t_subscribe(b->lcm, b->route_channel, on_lcm_waypoints, b);
+    return b->goal_sub != NULL && b->route_sub != NULL ? 0 : -1;
 }
 
 void qnav_bridge_unsubscribe(qnav_bridge_t *b)
 {
     if (b->lcm != NULL && b->goal_sub != NULL) {
         qnav_goal_t_unsubscribe(b->lcm, b->goal_sub);
+    }
+    if (b->lcm != NULL && b->route_sub != NULL) {
         qnav_waypoints_t_unsubscribe(b->lcm, b->route_sub);
     }
     b->goal_sub = NULL;
     b->route_sub = NULL;
+    b->goal_channel[0] = '\0';
+    b->route_channel[0] = '\0';
 }
 
 void qnav_bridge_poll(qnav_bridge_t *b, int64_t now_ms)

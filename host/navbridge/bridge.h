@@ -39,6 +39,15 @@ extern "C" {
 #define QNAV_CH_WAYPOINTS "QNAV_WAYPOINTS"
 #define QNAV_CH_ODOMETRY "QNAV_ODOMETRY"
 
+/* Goals and routes from LCM are taken only on these channels followed by the run's token
+ * (QNAV_GOAL_<token>, QNAV_WAYPOINTS_<token>), and only when the operator asked for it
+ * (navbridge --lcm-goals). Plain QNAV_GOAL and QNAV_WAYPOINTS are never obeyed: anyone
+ * who can put a datagram on the bus can publish there (docs/hil.md, "Who may move the
+ * robot"). */
+#define QNAV_BRIDGE_TOKEN_HEX 32      /* hex digits of a run token made by navbridge (128 bits) */
+#define QNAV_BRIDGE_TOKEN_MAX 40      /* longest token qnav_bridge_subscribe takes, characters */
+#define QNAV_BRIDGE_CHANNEL_MAX 64    /* LCM's channel name limit (63) plus the terminator */
+
 /* Most waypoints in a route (waypoints_t). */
 #define QNAV_BRIDGE_MAX_WAYPOINTS 16
 
@@ -165,6 +174,8 @@ typedef struct {
 
     qnav_goal_t_subscription_t *goal_sub;         /* qnav_bridge_subscribe's */
     qnav_waypoints_t_subscription_t *route_sub;
+    char goal_channel[QNAV_BRIDGE_CHANNEL_MAX];   /* QNAV_GOAL_<token> ("" not subscribed) */
+    char route_channel[QNAV_BRIDGE_CHANNEL_MAX];  /* QNAV_WAYPOINTS_<token> */
 
     uint64_t rx_bytes;
     FILE *diag;                   /* one-line notices (upload result, link lost), or NULL */
@@ -191,9 +202,15 @@ void qnav_bridge_on_goal(qnav_bridge_t *b, const qnav_goal_t *goal, int64_t now_
 int qnav_bridge_on_waypoints(qnav_bridge_t *b, const qnav_waypoints_t *w, int64_t now_ms,
                              char *err, size_t errlen);
 
-/* Subscribe b to QNAV_GOAL and QNAV_WAYPOINTS on its LCM (a refused route is reported
- * on b->diag). */
-void qnav_bridge_subscribe(qnav_bridge_t *b);
+/* A fresh run token: QNAV_BRIDGE_TOKEN_HEX lower-case hex digits of the kernel's random
+ * source and a terminator into hex (len >= QNAV_BRIDGE_TOKEN_HEX + 1). 0, or -1 when no
+ * random bytes could be had. */
+int qnav_bridge_token_make(char *hex, size_t len);
+
+/* Take goals and routes from b's LCM on QNAV_GOAL_<token> and QNAV_WAYPOINTS_<token> (a
+ * refused route is reported on b->diag). token: 1..QNAV_BRIDGE_TOKEN_MAX characters of
+ * [0-9a-zA-Z]. 0, or -1 (nothing subscribed) for a bad token or no LCM. */
+int qnav_bridge_subscribe(qnav_bridge_t *b, const char *token);
 void qnav_bridge_unsubscribe(qnav_bridge_t *b);
 
 /* Periodic work (call at least every 20 ms): heartbeats, watchdog, status, upload. */

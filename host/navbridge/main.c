@@ -56,6 +56,7 @@ static void usage(FILE *f)
             "                 [--policy FILE] [--upload] [--timeout-ms N] [--log FILE]\n"
             "                 [--goal DEG[:METRES] | --goal-at X:Y | --waypoints X:Y,...]\n"
             "                 [--goal-radius M] [--controller NAME] [--robot NAME|FILE]\n"
+            "                 [--lcm-goals]\n"
             "       navbridge --replay LOG [--policy FILE] [--controller NAME] [--robot NAME|FILE]\n"
             "  --device PATH      serial port to the board (or the SIL robot's pty)\n"
             "  --baud N           serial rate, default 57600\n"
@@ -69,13 +70,18 @@ static void usage(FILE *f)
             "  --timeout-ms N     stop the robot after N ms without scans/heartbeats (300)\n"
             "  --log FILE         also write every published message to an LCM log\n"
             "  --goal DEG[:M]     start with a goal: bearing in the board's heading frame,\n"
-            "                     degrees CCW, optional distance in metres (QNAV_GOAL later\n"
-            "                     messages replace it)\n"
+            "                     degrees CCW, optional distance in metres\n"
             "  --goal-at X:Y      start with a position goal: metres in the board's odometry\n"
             "                     frame (origin and x axis = its pose at start-up)\n"
-            "  --waypoints X:Y,.. start with a route of up to 16 such points (QNAV_WAYPOINTS\n"
-            "                     messages replace it); the next is sent when the board's\n"
-            "                     pose is within --goal-radius M (0.3) of the current one\n"
+            "  --waypoints X:Y,.. start with a route of up to 16 such points; the next is\n"
+            "                     sent when the board's pose is within --goal-radius M (0.3)\n"
+            "                     of the current one (at most one of --goal, --goal-at,\n"
+            "                     --waypoints)\n"
+            "  --lcm-goals        also take goals and routes from LCM, on the channels\n"
+            "                     QNAV_GOAL_<token> and QNAV_WAYPOINTS_<token> printed at\n"
+            "                     start (a new random token each run); without it navbridge\n"
+            "                     takes goals only from its command line and does not listen\n"
+            "                     on LCM at all (docs/hil.md, \"Who may move the robot\")\n"
             "  --replay LOG       re-run LOG's scans, compare with its commands, exit\n"
             "  --help, --version  this text; the version\n");
 }
@@ -174,13 +180,14 @@ int main(int argc, char **argv)
         {"goal-radius", required_argument, NULL, 'G'},
         {"controller", required_argument, NULL, 'c'},
         {"robot", required_argument, NULL, 'R'},
+        {"lcm-goals", no_argument, NULL, 'L'},
         {NULL, 0, NULL, 0}};
     static robot_check_t robot_check;
     const char *robot_spec = NULL;
     const char *device = NULL, *lcm_url = NULL, *policy_path = NULL, *log_path = NULL;
     const char *replay_path = NULL;
     long baud = 57600, timeout_ms = 300;
-    int have_goal = 0, have_route = 0;
+    int have_goal = 0, have_route = 0, goal_options = 0, lcm_goals = 0;
     double goal_radius = 0.3;
     qnav_waypoints_t route;
     qnav_goal_t start_goal;
@@ -211,6 +218,7 @@ int main(int argc, char **argv)
         case 'R': robot_spec = optarg; break;
         case 'r': replay_path = optarg; break;
         case 'U': cfg.upload = 1; break;
+        case 'L': lcm_goals = 1; break;
         case 'b':
             if (parse_long(optarg, 1, LONG_MAX, &baud) != 0 || !qnav_serial_baud_ok(baud)) {
                 fprintf(stderr, "navbridge: --baud %s: unsupported rate (" QNAV_SERIAL_RATES ")\n",
@@ -255,6 +263,7 @@ int main(int argc, char **argv)
             start_goal.bearing_cdeg = (int16_t)(deg >= 180.0 ? -18000 : (int)(deg * 100.0));
             start_goal.distance_mm = (int32_t)(dist * 1000.0);
             have_goal = 1;
+            goal_options++;
             break;
         }
         case 'A':
@@ -266,6 +275,7 @@ int main(int argc, char **argv)
                 return 2;
             }
             have_route = 1;
+            goal_options++;
             break;
         case 'G': {
             char *end = NULL;
@@ -296,6 +306,11 @@ int main(int argc, char **argv)
     }
     if (optind < argc) {
         fprintf(stderr, "navbridge: %s: unexpected argument (see --help)\n", argv[optind]);
+        return 2;
+    }
+    if (goal_options > 1) {
+        fprintf(stderr, "navbridge: --goal, --goal-at, --waypoints: give one of them, once "
+                        "(the robot would silently follow only the last)\n");
         return 2;
     }
     cfg.timeout_ms = (uint32_t)timeout_ms;
@@ -369,7 +384,20 @@ int main(int argc, char **argv)
 
     qnav_bridge_init(&bridge, &cfg, lcm, log, write_serial, &fd, mono_ms());
     bridge.diag = stderr;
-    qnav_bridge_subscribe(&bridge);
+    if (lcm_goals) {
+        char token[QNAV_BRIDGE_TOKEN_HEX + 1];
+        if (qnav_bridge_token_make(token, sizeof token) != 0 ||
+            qnav_bridge_subscribe(&bridge, token) != 0) {
+            fprintf(stderr, "navbridge: --lcm-goals: cannot make a run token and subscribe "
+                            "to it: %s\n", strerror(errno));
+            exit_code = 1;
+        } else {
+            /* the operator's tools publish here; a goal on any other channel is ignored */
+            printf("navbridge: goals from LCM for this run only: qnav.goal_t on %s, "
+                   "qnav.waypoints_t on %s\n", bridge.goal_channel, bridge.route_channel);
+            fflush(stdout);
+        }
+    }
     if (have_goal) {
         start_goal.utime = qnav_bridge_utime();
         qnav_bridge_on_goal(&bridge, &start_goal, mono_ms());
@@ -384,9 +412,11 @@ int main(int argc, char **argv)
             cfg.mode == QNAV_LINK_MODE_OFFBOARD ? "offboard" : "onboard", device, baud,
             timeout_ms);
 
-    while (!g_stop_signal) {
+    while (exit_code == 0 && !g_stop_signal) {
         struct pollfd p[2];
-        int lfd = lcm_get_fileno(lcm);
+        /* without --lcm-goals LCM is only written to: asking udpm for its file descriptor
+         * would open its receive socket (bound to every address: docs/hil.md) */
+        int lfd = lcm_goals ? lcm_get_fileno(lcm) : -1;
         int n;
         p[0].fd = fd;
         p[0].events = POLLIN;

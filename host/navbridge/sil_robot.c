@@ -459,6 +459,12 @@ int main(int argc, char **argv)
         return rc == 1 ? 0 : rc;
     }
     rc = start(&r, &o, &robot, &env, &slave);
+    if (rc == 0) {
+        /* the destination line is out before the link exists, so a caller that waits for
+         * the link (or for "link on") finds it already written (issue 20's race) */
+        print_destination(&r, env);
+        fflush(stdout);
+    }
     if (rc == 0 && o.link != NULL) {
         if (qnav_ptylink_make(o.link, slave, err, sizeof err) != 0) {
             fprintf(stderr, "qnav-sil-robot: %s\n", err);
@@ -476,7 +482,6 @@ int main(int argc, char **argv)
         }
     }
     if (rc == 0) {
-        print_destination(&r, env);
         printf("qnav-sil-robot: link on %s%s%s\n", slave, o.link ? " = " : "",
                o.link ? o.link : "");
         fflush(stdout);

@@ -482,7 +482,8 @@ static void test_route_from_lcm_advances_within_the_radius_and_stops_at_its_end(
     qnav_bridge_config_default(&cfg);
     cfg.mode = QNAV_LINK_MODE_ONBOARD;
     qnav_bridge_init(&b, &cfg, lcm, NULL, bridge_write, NULL, g.sim.now_ms);
-    qnav_bridge_subscribe(&b);
+    assert_int_equal(qnav_bridge_subscribe(&b, "run1"), 0);
+    assert_string_equal(b.route_channel, "QNAV_WAYPOINTS_run1");
     sub = qnav_odometry_t_subscribe(lcm, QNAV_CH_ODOMETRY, on_odometry, NULL);
     memset(&w, 0, sizeof w);
     w.route_id = 4;
@@ -492,8 +493,18 @@ static void test_route_from_lcm_advances_within_the_radius_and_stops_at_its_end(
     w.y_m[1] = 1.0;
     w.y_m[2] = 1.0;
     w.radius_m = 0.2;
+    /* strays: the plain channel and another run's token move nothing */
     assert_int_equal(qnav_waypoints_t_publish(lcm, QNAV_CH_WAYPOINTS, &w), 0);
-    assert_true(lcm_handle_timeout(lcm, 100) > 0);
+    assert_int_equal(qnav_waypoints_t_publish(lcm, "QNAV_WAYPOINTS_run2", &w), 0);
+    while (lcm_handle_timeout(lcm, 0) > 0) {
+    }
+    run_with_bridge(&b, 300);
+    assert_int_equal(g.bot.have_goal, 0);
+    assert_int_equal(b.route_n, 0);
+    assert_int_equal(qnav_waypoints_t_publish(lcm, "QNAV_WAYPOINTS_run1", &w), 0);
+    while (lcm_handle_timeout(lcm, 0) > 0) { /* the bridge's own telemetry, then the route */
+    }
+    assert_int_equal(b.route_n, 3);
     run_with_bridge(&b, 500);
     assert_int_equal(g.bot.goal.kind, QNAV_LINK_GOAL_POSITION);
     assert_int_equal(g.bot.goal.x_mm, 1000);
@@ -527,6 +538,34 @@ static void test_route_from_lcm_advances_within_the_radius_and_stops_at_its_end(
     assert_int_equal(g_last_waypoint, 3);
     qnav_odometry_t_unsubscribe(lcm, sub);
     qnav_bridge_unsubscribe(&b);
+    lcm_destroy(lcm);
+}
+
+static void test_bridge_takes_lcm_goals_only_on_a_token_of_letters_and_digits(void **state)
+{
+    static qnav_bridge_t b;
+    qnav_bridge_config_t cfg;
+    char tok[QNAV_BRIDGE_TOKEN_HEX + 1], again[QNAV_BRIDGE_TOKEN_HEX + 1];
+    lcm_t *lcm = lcm_create("memq://");
+    (void)state;
+    assert_non_null(lcm);
+    qnav_bridge_config_default(&cfg);
+    qnav_bridge_init(&b, &cfg, lcm, NULL, bridge_write, NULL, 0);
+    assert_int_equal(qnav_bridge_subscribe(&b, NULL), -1);
+    assert_int_equal(qnav_bridge_subscribe(&b, ""), -1);
+    assert_int_equal(qnav_bridge_subscribe(&b, ".*"), -1); /* a regex would take any */
+    assert_int_equal(qnav_bridge_subscribe(&b, "0123456789abcdef0123456789abcdef012345678"),
+                     -1);
+    assert_null(b.goal_sub);
+    assert_int_equal(qnav_bridge_token_make(tok, sizeof tok), 0);
+    assert_int_equal(qnav_bridge_token_make(again, sizeof again), 0);
+    assert_int_equal(strlen(tok), QNAV_BRIDGE_TOKEN_HEX);
+    assert_string_not_equal(tok, again);
+    assert_int_equal(qnav_bridge_subscribe(&b, tok), 0);
+    assert_int_equal(strncmp(b.goal_channel, "QNAV_GOAL_", 10), 0);
+    assert_string_equal(b.goal_channel + 10, tok);
+    qnav_bridge_unsubscribe(&b);
+    assert_string_equal(b.goal_channel, "");
     lcm_destroy(lcm);
 }
 
@@ -622,6 +661,7 @@ int main(void)
         cmocka_unit_test(test_position_goal_bearing_comes_from_the_pose),
         cmocka_unit_test(test_board_and_bridge_drive_together_in_both_modes),
         cmocka_unit_test(test_route_from_lcm_advances_within_the_radius_and_stops_at_its_end),
+        cmocka_unit_test(test_bridge_takes_lcm_goals_only_on_a_token_of_letters_and_digits),
         cmocka_unit_test(test_route_with_a_bad_radius_is_refused_naming_the_field),
         cmocka_unit_test(test_bridge_reports_no_answer_when_the_board_never_acks_an_upload),
     };

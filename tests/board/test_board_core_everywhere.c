@@ -82,11 +82,11 @@ static void trial(const char *const *robot, const char *link, const char *const 
     snprintf(nb_err, sizeof nb_err, "%s/%s-nb.err", g_dir, tag);
     pr = qnav_test_spawn(robot, r_out, r_err);
     assert_true(pr > 0);
-    assert_int_equal(qnav_test_wait_path(link, 20000), 0);
+    assert_int_equal(qnav_test_wait_path(link, QNAV_TEST_WAIT_MS), 0);
     pn = qnav_test_spawn(bridge, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(pr), 0);
-    assert_int_equal(wait_exit_within(pn, 40000), 1); /* link lost */
+    assert_int_equal(wait_exit_within(pn, QNAV_TEST_WAIT_MS), 1); /* link lost */
 }
 
 /* One power cycle of the simavr board (EEPROM file ee, optional power cut after `cut`

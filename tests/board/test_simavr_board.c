@@ -75,7 +75,7 @@ static int wait_decisions(const char *path, int n)
 {
     int waited;
     for (waited = 0; count_decisions(path) < n; waited += 50) {
-        if (waited > 60000) {
+        if (waited > QNAV_TEST_WAIT_MS) {
             return -1;
         }
         usleep(50000);
@@ -190,10 +190,10 @@ static void run_robot_trial(const char *elf, const char *robot)
     assert_int_equal(qnav_policy_write(policy, &p, "simavr test", perr, sizeof perr), 0);
     pb = qnav_test_spawn(board, sa_out, sa_err);
     assert_true(pb > 0);
-    assert_int_equal(qnav_test_wait_text(sa_out, "with USART0 on", 20000), 0);
+    assert_int_equal(qnav_test_wait_text(sa_out, "with USART0 on", QNAV_TEST_WAIT_MS), 0);
     pn = qnav_test_spawn(bridge, nb_out, nb_err);
     assert_true(pn > 0);
-    if (qnav_test_wait_text(nb_err, "policy upload: ok", 40000) != 0) {
+    if (qnav_test_wait_text(nb_err, "policy upload: ok", QNAV_TEST_WAIT_MS) != 0) {
         if (read_text(nb_err, text, sizeof text) > 0) {
             print_message("navbridge said:\n%s", text);
         }
@@ -206,7 +206,7 @@ static void run_robot_trial(const char *elf, const char *robot)
     assert_int_equal(wait_decisions(log, i + 30), 0);
     assert_int_equal(kill(pb, SIGTERM), 0);
     assert_int_equal(qnav_test_wait_exit(pb), 0);
-    assert_int_equal(wait_exit_within(pn, 40000), 1); /* simavr's pty closed: link lost */
+    assert_int_equal(wait_exit_within(pn, QNAV_TEST_WAIT_MS), 1); /* simavr's pty closed: link lost */
     assert_true(read_text(sa_out, text, sizeof text) > 0);
     assert_non_null(strstr(text, "simulated s (signal)"));
     assert_true(read_text(nb_err, text, sizeof text) > 0);
@@ -346,10 +346,10 @@ static void test_two_simavr_boards_get_their_own_ptys(void **state)
     snprintf(e2, sizeof e2, "%s/b2.err", g_dir);
     p1 = qnav_test_spawn(b1, o1, e1);
     assert_true(p1 > 0);
-    assert_int_equal(qnav_test_wait_text(o1, "with USART0 on", 20000), 0);
+    assert_int_equal(qnav_test_wait_text(o1, "with USART0 on", QNAV_TEST_WAIT_MS), 0);
     p2 = qnav_test_spawn(b2, o2, e2);
     assert_true(p2 > 0);
-    assert_int_equal(qnav_test_wait_text(o2, "with USART0 on", 20000), 0);
+    assert_int_equal(qnav_test_wait_text(o2, "with USART0 on", QNAV_TEST_WAIT_MS), 0);
     n1 = readlink(l1, t1, sizeof t1 - 1);
     n2 = readlink(l2, t2, sizeof t2 - 1);
     assert_true(n1 > 0 && n2 > 0);

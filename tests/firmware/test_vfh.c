@@ -188,7 +188,12 @@ static void test_table_selects_controllers_by_name(void **state)
     assert_int_equal(qnav_ctrl_init(&direct, &cfg, &p), QNAV_OK);
     qnav_nav_step(&nav, &in, &a);
     qnav_ctrl_step(&direct, &in, &b, NULL);
-    assert_memory_equal(&a, &b, sizeof a);
+    /* field by field: the struct's padding byte is whatever the stack held (a memcmp
+     * failed 1 run in 3 under stress-check) */
+    assert_int_equal(a.heading_deg, b.heading_deg);
+    assert_int_equal(a.speed, b.speed);
+    assert_int_equal(a.quality, b.quality);
+    assert_int_equal(a.flags, b.flags);
     assert_non_null(qnav_nav_paths(&nav));
 
     /* "vfh" takes no policy and has no path-quality controller inside */

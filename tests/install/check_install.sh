@@ -25,6 +25,13 @@ install)
              share/qnav/firmware/CMakeLists.txt share/qnav/cmake/toolchain-avr-atmega128.cmake; do
         [ -e "$prefix/$f" ] || fail "$f not installed"
     done
+    for f in bin/qnav-spy share/qnav/python/qnav/goal_t.py share/qnav/java/qnav_lcmtypes.jar \
+             share/qnav/sweeps/open-to-dense-noise.toml; do
+        [ -e "$prefix/$f" ] || fail "$f not installed"
+    done
+    if [ -e "$build/firmware/boards/tekbot-avr.elf" ]; then
+        [ -e "$prefix/share/qnav/boards/tekbot-avr.elf" ] || fail "tekbot-avr.elf not installed"
+    fi
     ;;
 programs)
     prefix=$2 work=$3
@@ -39,6 +46,9 @@ programs)
     grep -q "env only-installed" "$work/sim.out" || fail "qnav-sim did not read the installed data"
     n=$("$p/bin/simevo" list | wc -l)
     [ "$n" -eq "$(ls "$p/share/qnav/experiments" | grep -c '\.toml$')" ] || fail "simevo list: $n experiments"
+    # docs/simevo.md's sweep line from elsewhere: sweeps/ comes from the share folder
+    "$p/bin/simevo" slurm sweeps/open-to-dense-noise.toml --out "$work/sweep" > "$work/sweep.out"
+    grep -q "experiments; submit them all with" "$work/sweep.out" || fail "simevo did not find the installed sweep"
     "$p/bin/simevo" quality prob --out "$work/quality" > "$work/quality.out"
     head -c 8 "$work/quality/policy.png" | od -An -c | grep -q 'P   N   G' || fail "no policy.png from the installed plot script"
     v=$(cat "$p/share/qnav/VERSION")

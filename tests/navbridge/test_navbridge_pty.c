@@ -196,8 +196,8 @@ static void test_offboard_commands_equal_libqnav_and_replay_identically(void **s
     }
     /* SIGTERM: a stop reaches the board, then a clean exit */
     kill(fb.pid, SIGTERM);
-    assert_int_equal(wait_stop(&fb, 2000), 0);
-    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, 3000), 0);
+    assert_int_equal(wait_stop(&fb, QNAV_TEST_WAIT_MS), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, QNAV_TEST_WAIT_MS), 0);
     fakeboard_close(&fb);
 
     {
@@ -267,7 +267,7 @@ static void test_corrupted_and_replayed_scans_are_not_answered(void **state)
     seq = fb.tx.next_seq;
     assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_SCAN, p, n), 0);
     assert_int_equal(wait_command_for(&fb, seq, &c), 0);
-    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGINT, 3000), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGINT, QNAV_TEST_WAIT_MS), 0);
     fakeboard_close(&fb);
 }
 
@@ -291,12 +291,12 @@ static void test_watchdog_stops_robot_within_its_timeout(void **state)
     }
     t_last = fakeboard_ms();
     /* scans stop: a stop must come after about 300 ms (tolerant bounds: loaded machine) */
-    assert_int_equal(wait_stop(&fb, 3000), 0);
+    assert_int_equal(wait_stop(&fb, QNAV_TEST_WAIT_MS), 0);
     elapsed = fakeboard_ms() - t_last;
     print_message("watchdog stop after %lld ms (timeout 300 ms)\n", (long long)elapsed);
     assert_true(elapsed >= 250);
     assert_true(elapsed <= 1300);
-    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, 3000), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, QNAV_TEST_WAIT_MS), 0);
     fakeboard_close(&fb);
 }
 
@@ -320,12 +320,12 @@ static void test_onboard_watchdog_stops_robot_when_heartbeats_stop(void **state)
         t_last = fakeboard_ms(); /* the watchdog runs from the last heartbeat */
         assert_int_not_equal(wait_stop(&fb, 50), 0);
     }
-    assert_int_equal(wait_stop(&fb, 3000), 0);
+    assert_int_equal(wait_stop(&fb, QNAV_TEST_WAIT_MS), 0);
     elapsed = fakeboard_ms() - t_last;
     print_message("onboard watchdog stop after %lld ms (timeout 300 ms)\n", (long long)elapsed);
     assert_true(elapsed >= 250);
     assert_true(elapsed <= 1300);
-    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, 3000), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, QNAV_TEST_WAIT_MS), 0);
     fakeboard_close(&fb);
 }
 
@@ -346,8 +346,8 @@ static void check_signal_stops_robot_before_exit(int sig, const char *said)
     assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_SCAN, p, n), 0);
     assert_int_equal(wait_command_for(&fb, seq, &c), 0);
     kill(fb.pid, sig);
-    assert_int_equal(wait_stop(&fb, 2000), 0);
-    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, 3000), 0);
+    assert_int_equal(wait_stop(&fb, QNAV_TEST_WAIT_MS), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, QNAV_TEST_WAIT_MS), 0);
     assert_true(read_text(fb.stderr_path, text, sizeof text) > 0);
     assert_non_null(strstr(text, said));
     fakeboard_close(&fb);
@@ -430,8 +430,9 @@ static void test_onboard_upload_delivers_the_policy_file_to_the_board(void **sta
     assert_int_equal(got.u.net.hidden, file_policy.u.net.hidden);
     assert_memory_equal(got.u.net.w_theta, file_policy.u.net.w_theta,
                         sizeof got.u.net.w_theta);
-    usleep(100000); /* let the bridge read the ack */
-    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, 3000), 0);
+    /* the bridge has read the ack when it says so */
+    assert_int_equal(qnav_test_wait_text(fb.stderr_path, "policy upload: ok", QNAV_TEST_WAIT_MS), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, QNAV_TEST_WAIT_MS), 0);
     assert_true(read_text(fb.stderr_path, text, sizeof text) > 0);
     assert_non_null(strstr(text, "policy upload: ok"));
     fakeboard_close(&fb);
@@ -452,7 +453,7 @@ static void test_start_goal_is_relayed_to_the_board(void **state)
     assert_int_equal(g.goal_id, 1);
     assert_int_equal(g.bearing_cdeg, -3050);
     assert_int_equal(g.distance_mm, 4000);
-    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, 3000), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, QNAV_TEST_WAIT_MS), 0);
     fakeboard_close(&fb);
 }
 
@@ -492,7 +493,7 @@ static void check_refuses_board_of_protocol(uint8_t version)
         p[12] = version;
     }
     assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_HEARTBEAT, p, (uint16_t)n), 0);
-    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, 3000), 1);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, QNAV_TEST_WAIT_MS), 1);
     assert_true(read_text(fb.stderr_path, text, sizeof text) > 0);
     snprintf(want, sizeof want, "the board speaks link protocol %u, this navbridge speaks %u",
              (unsigned)version, (unsigned)QNAV_LINK_PROTOCOL_VERSION);
@@ -529,6 +530,13 @@ static void test_bad_options_and_files_fail_with_one_line(void **state)
     const char *route[] = {EXE, "--device", "/dev/null", "--waypoints", "1:2,3", NULL};
     const char *at[] = {EXE, "--device", "/dev/null", "--goal-at", "1:2,3:4", NULL};
     const char *radius[] = {EXE, "--device", "/dev/null", "--goal-radius", "0", NULL};
+    /* two goals at once: refused, not the last one silently followed */
+    const char *both[] = {EXE, "--device", "/dev/null", "--goal", "30", "--waypoints", "1:2",
+                          NULL};
+    const char *goal_at[] = {EXE, "--device", "/dev/null", "--goal-at", "1:2", "--goal", "30",
+                             NULL};
+    const char *twice[] = {EXE, "--device", "/dev/null", "--goal-at", "1:2", "--goal-at",
+                           "3:4", NULL};
     (void)state;
     snprintf(bad_policy, sizeof bad_policy, "%s/bad.policy", g_dir);
     f = fopen(bad_policy, "w");
@@ -546,6 +554,9 @@ static void test_bad_options_and_files_fail_with_one_line(void **state)
     expect_refusal(route, "--waypoints 1:2,3");
     expect_refusal(at, "--goal-at 1:2,3:4");
     expect_refusal(radius, "--goal-radius 0");
+    expect_refusal(both, "--goal, --goal-at, --waypoints: give one of them, once");
+    expect_refusal(goal_at, "--goal, --goal-at, --waypoints: give one of them, once");
+    expect_refusal(twice, "--goal, --goal-at, --waypoints: give one of them, once");
 }
 
 /* Short unknown options are named as such (it used to say "--?: missing its value"), a

@@ -5,6 +5,7 @@
 #define _DEFAULT_SOURCE
 #include "test_proc.h"
 
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,13 +15,27 @@
 
 pid_t qnav_test_spawn(const char *const *argv, const char *out, const char *err)
 {
-    pid_t pid = fork();
-    if (pid == 0) {
-        if (freopen(out, "w", stdout) == NULL || freopen(err, "w", stderr) == NULL) {
-            _exit(126);
+    /* the files are emptied here, before the child exists: a caller that then waits for a
+     * line in them never reads what an earlier child wrote to the same path */
+    int fo = open(out, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    int fe = open(err, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    pid_t pid = -1;
+    if (fo >= 0 && fe >= 0) {
+        fflush(NULL);
+        pid = fork();
+        if (pid == 0) {
+            if (dup2(fo, STDOUT_FILENO) < 0 || dup2(fe, STDERR_FILENO) < 0) {
+                _exit(126);
+            }
+            execv(argv[0], (char *const *)argv);
+            _exit(127);
         }
-        execv(argv[0], (char *const *)argv);
-        _exit(127);
+    }
+    if (fo >= 0) {
+        close(fo);
+    }
+    if (fe >= 0) {
+        close(fe);
     }
     return pid;
 }

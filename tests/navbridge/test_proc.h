@@ -9,8 +9,13 @@
 #include <stddef.h>
 #include <sys/types.h>
 
+/* The limit of every wait for an event in these tests (a line printed, a process's exit),
+ * ms: far above any normal run (a few seconds idle), so a loaded machine makes a test
+ * slower, not red; it only ends a run that is broken. */
+#define QNAV_TEST_WAIT_MS 120000
+
 /* Run argv (argv[0] a path, null-terminated) with stdout and stderr sent to the files
- * out and err. Returns the child's pid, or -1. */
+ * out and err, both emptied before the child starts. Returns the child's pid, or -1. */
 pid_t qnav_test_spawn(const char *const *argv, const char *out, const char *err);
 
 /* Wait for pid: its exit status, 256 + signal number if a signal ended it, -1 on error. */

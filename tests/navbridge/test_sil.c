@@ -64,7 +64,8 @@ static void count_channels(const char *path, int *scan, int *cmd, int *qual, int
 }
 
 /* The destination the SIL robot printed, as navbridge --goal-at's value (odometry frame);
- * the robot prints it before making its link. */
+ * the robot prints it before it makes its link and says "link on", which the callers wait
+ * for. */
 static void destination_of(const char *sil_out, char *goal, size_t len)
 {
     char text[2048];
@@ -112,13 +113,13 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     snprintf(nb_err, sizeof nb_err, "%s/nb.err", g_dir);
     ps = qnav_test_spawn(sil, sil_out, sil_err);
     assert_true(ps > 0);
-    assert_int_equal(qnav_test_wait_path(link, 4000), 0);
+    assert_int_equal(qnav_test_wait_text(sil_out, "link on", QNAV_TEST_WAIT_MS), 0);
     destination_of(sil_out, goal, sizeof goal);
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0); /* 0: destination reached */
     /* the robot's end closes the pty: navbridge sees the hang-up and leaves with 1 */
-    assert_int_equal(wait_exit_within(pn, 3000), 1);
+    assert_int_equal(wait_exit_within(pn, QNAV_TEST_WAIT_MS), 1);
     assert_true(read_text(nb_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "device hung up: link lost"));
     assert_true(read_text(sil_out, text, sizeof text) > 0);
@@ -218,12 +219,12 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     assert_int_equal(qnav_policy_write(pol, &p, "sil onboard test", perr, sizeof perr), 0);
     ps = qnav_test_spawn(sil, sil_out, sil_err);
     assert_true(ps > 0);
-    assert_int_equal(qnav_test_wait_path(link, 4000), 0);
+    assert_int_equal(qnav_test_wait_text(sil_out, "link on", QNAV_TEST_WAIT_MS), 0);
     destination_of(sil_out, goal, sizeof goal);
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
     assert_int_equal(qnav_test_wait_exit(ps), 0);
-    assert_int_equal(wait_exit_within(pn, 3000), 1);
+    assert_int_equal(wait_exit_within(pn, QNAV_TEST_WAIT_MS), 1);
     assert_true(read_text(nb_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "policy upload: ok"));
     /* the board's heartbeat says which policy runs: first its own, then the upload */
@@ -369,6 +370,7 @@ static void nvm_trial(const char *nvm, const char *pol, int upload, char *text, 
                         "onboard", "--goal-at", goal, upload ? "--policy" : NULL, pol,
                         "--upload", NULL};
     pid_t ps, pn;
+    int rc;
     snprintf(link, sizeof link, "%s/link-nvm", g_dir);
     snprintf(s_out, sizeof s_out, "%s/sil-nvm.out", g_dir);
     snprintf(s_err, sizeof s_err, "%s/sil-nvm.err", g_dir);
@@ -376,12 +378,15 @@ static void nvm_trial(const char *nvm, const char *pol, int upload, char *text, 
     snprintf(nb_err, sizeof nb_err, "%s/nb-nvm.err", g_dir);
     ps = qnav_test_spawn(sil, s_out, s_err);
     assert_true(ps > 0);
-    assert_int_equal(qnav_test_wait_path(link, 4000), 0);
+    assert_int_equal(qnav_test_wait_text(s_out, "link on", QNAV_TEST_WAIT_MS), 0);
     destination_of(s_out, goal, sizeof goal);
     pn = qnav_test_spawn(nb, nb_out, nb_err);
     assert_true(pn > 0);
-    assert_int_equal(qnav_test_wait_exit(ps), 0);
-    assert_int_equal(wait_exit_within(pn, 3000), 1);
+    rc = qnav_test_wait_exit(ps);
+    assert_int_equal(wait_exit_within(pn, QNAV_TEST_WAIT_MS), 1);
+    assert_true(read_text(s_out, text, cap) > 0);
+    print_message("%s", text);
+    assert_int_equal(rc, 0);
     assert_true(read_text(nb_err, text, cap) > 0);
 }
 
@@ -428,7 +433,7 @@ static void test_sil_robot_leaves_a_file_that_replaced_its_link(void **state)
     snprintf(err, sizeof err, "%s/replaced.err", g_dir);
     ps = qnav_test_spawn(sil, out, err);
     assert_true(ps > 0);
-    assert_int_equal(qnav_test_wait_text(out, "link on", 10000), 0);
+    assert_int_equal(qnav_test_wait_text(out, "link on", QNAV_TEST_WAIT_MS), 0);
     assert_int_equal(unlink(path), 0);
     assert_int_equal(qnav_test_write_text(path, "mine now\n"), 0);
     assert_int_equal(kill(ps, SIGTERM), 0);
@@ -451,7 +456,7 @@ static void test_sil_robot_replaces_stale_pty_link_and_removes_it_at_exit(void *
     assert_int_equal(symlink("/dev/pts/999999", path), 0);
     ps = qnav_test_spawn(sil, out, err);
     assert_true(ps > 0);
-    assert_int_equal(qnav_test_wait_text(out, "link on", 10000), 0);
+    assert_int_equal(qnav_test_wait_text(out, "link on", QNAV_TEST_WAIT_MS), 0);
     n = readlink(path, target, sizeof target - 1);
     assert_true(n > 9);
     target[n] = '\0';

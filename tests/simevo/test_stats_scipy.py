@@ -16,7 +16,7 @@ REL = 1e-9
 
 def run(lines):
     out = subprocess.run([CLI], input="\n".join(lines) + "\n", capture_output=True, text=True,
-                         check=True, timeout=60).stdout
+                         check=True, timeout=300).stdout
     return [list(map(float, row.split())) for row in out.strip().splitlines()]
 
 

@@ -24,8 +24,8 @@ EXPECTED = [("empty", 1), ("straight", 11), ("loop", 3), ("loop", 21), ("loop", 
 
 
 def icount(*args):
-    return subprocess.run([TOOL, "--nm", NM, "--timeout", "120", *args],
-                          capture_output=True, text=True, timeout=200)
+    return subprocess.run([TOOL, "--nm", NM, "--timeout", "600", *args],
+                          capture_output=True, text=True, timeout=900)
 
 
 def results(stdout):
@@ -114,7 +114,7 @@ class RunFailures(unittest.TestCase):
 
     def test_a_run_past_the_timeout_is_a_run_failure(self):
         r = subprocess.run([TOOL, "--nm", NM, "--timeout", "0.001", REGIONS],
-                           capture_output=True, text=True, timeout=200)
+                           capture_output=True, text=True, timeout=900)
         assert_one_line_error(self, r, 1, REGIONS, "no exit within 0.001 s")
 
 

@@ -17,7 +17,7 @@ GOOD = "M\ttarget=avr\tmode=network\tH=12\tN=32\tpolicy=e12-a\tset=evolved\tscan
 
 def run(*args, stdin=None):
     return subprocess.run([sys.executable, REPORT, *args], input=stdin, capture_output=True,
-                          text=True, timeout=60)
+                          text=True, timeout=300)
 
 
 def with_file(text, *args):

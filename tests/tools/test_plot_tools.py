@@ -31,7 +31,7 @@ def quality_csv(folder):
 
 def run_script(name, *args):
     return subprocess.run([sys.executable, os.path.join(TOOLS, name), *args],
-                          capture_output=True, text=True, timeout=100)
+                          capture_output=True, text=True, timeout=600)
 
 
 class PlotFormatByName(unittest.TestCase):

@@ -18,7 +18,7 @@ ENV = os.environ
 
 
 def run_tool(*args):
-    return subprocess.run([sys.executable, TOOL, *args], capture_output=True, text=True, timeout=120)
+    return subprocess.run([sys.executable, TOOL, *args], capture_output=True, text=True, timeout=600)
 
 
 def rows(path):
@@ -84,7 +84,7 @@ class RecordedTrial(unittest.TestCase):
             raise unittest.SkipTest("`unshare -n` is not permitted: no private network namespace "
                                     "for a udpm:// trial (DESIGN.md section 7)")
         r = subprocess.run([ENV["UNSHARE_EXE"], "-n", "/bin/sh", ENV["UDPM_SCRIPT"], ENV["NAVBRIDGE_EXE"],
-                            ENV["SIL_EXE"], d], capture_output=True, text=True, timeout=200)
+                            ENV["SIL_EXE"], d], capture_output=True, text=True, timeout=900)
         if r.returncode == 10:
             raise unittest.SkipTest("cannot configure loopback multicast in the namespace")
         with open(os.path.join(d, "rc.txt")) as f:
@@ -102,7 +102,7 @@ class RecordedTrial(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         scans = rows(os.path.join(out, "qnav_scan.csv"))
         replay = subprocess.run([ENV["NAVBRIDGE_EXE"], "--replay", self.log], capture_output=True,
-                                text=True, timeout=60)
+                                text=True, timeout=300)
         self.assertEqual(replay.returncode, 0, replay.stderr)
         first = replay.stdout.split("replay: ")[1]
         self.assertEqual(int(first.split()[0]), len(scans))  # "N scans"

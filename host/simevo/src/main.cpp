@@ -58,10 +58,23 @@ std::vector<std::string> list_experiments(const std::string &dir)
     return names;
 }
 
+/* A relative file path that does not exist from the working folder is taken from the folder
+ * that holds the experiments folder: qnav's share folder when installed (sweeps/ and
+ * experiments/extra/ are installed there), the source tree otherwise. So
+ * `simevo run sweeps/open-to-dense-noise.toml` works from any folder. */
+std::string resolve_file_argument(const std::string &arg, const std::string &experiments_dir)
+{
+    if (arg.empty() || arg[0] == '/' || file_exists(arg)) {
+        return arg;
+    }
+    const std::string shared = join_path(experiments_dir + "/..", arg);
+    return file_exists(shared) ? shared : arg;
+}
+
 std::string resolve_experiment(const std::string &arg, const std::string &dir)
 {
     if (arg.find('/') != std::string::npos || (arg.size() > 5 && arg.compare(arg.size() - 5, 5, ".toml") == 0)) {
-        return arg;
+        return resolve_file_argument(arg, dir);
     }
     const std::string path = join_path(dir, arg + ".toml");
     if (!file_exists(path)) {
