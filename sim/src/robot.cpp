@@ -108,25 +108,4 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
     return p;
 }
 
-// Metres (or m/s, m/s^2) to the controller's integer millimetres, saturated.
-static std::uint16_t to_mm(double m) {
-    return static_cast<std::uint16_t>(std::min(65535.0, std::round(m * 1000.0)));
-}
-
-void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl_config_t *cfg) {
-    qnav_ctrl_config_default(cfg);
-    cfg->n_sectors = n_sectors ? n_sectors : p.default_sectors;
-    cfg->max_range_mm = to_mm(p.range_max_m);
-    cfg->body_radius_mm = to_mm(p.radius_m);
-    cfg->safety_mm = to_mm(p.safety_m);
-    cfg->sensor_offset_mm = to_mm(p.sonar_offset_m);
-    cfg->v_max_mm_s = to_mm(p.v_max_mps);
-    cfg->decel_mm_s2 = p.speed_guard ? to_mm(p.decel_mps2) : 0;
-    cfg->wedge_pct = p.wedge_pct;
-    cfg->wedge_near_mm = to_mm(p.wedge_near_m);
-    cfg->escape_stall_ticks = static_cast<std::uint8_t>(std::lround(p.escape_stall_s * 10.0));
-    cfg->escape_follow_mm = to_mm(p.escape_follow_m);
-    cfg->escape_follow_s = static_cast<std::uint8_t>(std::lround(p.escape_follow_s));
-}
-
 }  // namespace qnav

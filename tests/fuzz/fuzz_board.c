@@ -30,7 +30,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         g_sim.ranges_mm[k] = (qnav_mm_t)(600 + 300 * k);
     }
     qnav_tekbot_config_default(&cfg);
-    cfg.n_sectors = 8;
+    cfg.ctrl.n_sectors = 8;
     if (qnav_board_init(&g_bot, &cfg, &hal) != QNAV_BOARD_OK) {
         abort();
     }

@@ -25,7 +25,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memcpy(g_sim.nvm, data, size < SIM_HAL_NVM ? size : SIM_HAL_NVM);
     g_sim.n_ranges = 8;
     qnav_tekbot_config_default(&cfg);
-    cfg.n_sectors = 8;
+    cfg.ctrl.n_sectors = 8;
     if (qnav_board_init(&g_bot, &cfg, &hal) != QNAV_BOARD_OK) {
         abort(); /* a board that does not start because of its EEPROM */
     }

@@ -143,7 +143,7 @@ static void eeprom_with(const qnav_policy_t *pol)
     sim_hal_init(&sim, &hal);
     sim.n_ranges = 8;
     qnav_tekbot_config_default(&cfg);
-    cfg.n_sectors = 8;
+    cfg.ctrl.n_sectors = 8;
     if (qnav_board_init(&bot, &cfg, &hal) != QNAV_BOARD_OK) {
         exit(1);
     }
