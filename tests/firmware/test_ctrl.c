@@ -1038,26 +1038,15 @@ static void test_run_reduce_keeps_its_promises_on_any_row(void **state)
     }
 }
 
+static void reference_levels_wedge(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
+                                   unsigned pct, qnav_mm_t near_mm, uint8_t *lvl);
+
 /* The enlargement as first written: every obstacle sector lowers its own paths widened by
- * its level's gamma on both sides, one path at a time. */
+ * its level's gamma on both sides, one path at a time (the whole wedge). */
 static void reference_levels(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
                              uint8_t *lvl)
 {
-    for (unsigned p = 0; p < QNAV_PATHS; ++p) {
-        lvl[p] = QNAV_DIST_LEVELS - 1;
-    }
-    for (unsigned p = 0; p < QNAV_PATHS; ++p) {
-        uint16_t s = qnav_ctrl_sector_of_path(n, (uint16_t)p);
-        uint8_t level = qnav_ctrl_level(c, ranges[s]);
-        int gamma = c->clr.enlarge_deg[level];
-        if (level == QNAV_DIST_LEVELS - 1) {
-            continue;
-        }
-        for (int d = -gamma; d <= gamma; ++d) {
-            unsigned q = (unsigned)(((int)p + d + 720) % 360);
-            lvl[q] = lvl[q] < level ? lvl[q] : level;
-        }
-    }
+    reference_levels_wedge(c, ranges, n, 100u, 0u, lvl);
 }
 
 /* The step paints each piece only where no neighbour already covers it at a level no

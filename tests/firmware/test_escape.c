@@ -35,6 +35,19 @@ static void wall_ahead(qnav_mm_t *r, qnav_mm_t near_mm)
     r[N - 1] = near_mm;
 }
 
+/* A controller of policy p with the given stall time facing a wall near_mm ahead, the
+ * destination range_mm away straight behind it; in reads r. */
+static void facing_wall(qnav_ctrl_t *c, const qnav_policy_t *p, uint8_t stall_ticks,
+                        qnav_mm_t *r, qnav_mm_t near_mm, qnav_mm_t range_mm,
+                        qnav_ctrl_input_t *in)
+{
+    init_ctrl(c, p, stall_ticks);
+    memset(in, 0, sizeof *in);
+    wall_ahead(r, near_mm);
+    in->ranges_mm = r;
+    in->goal_range_mm = range_mm;
+}
+
 /* One tick: the previous output's memory comes back in, as every caller must do. */
 static void tick(const qnav_ctrl_t *c, qnav_ctrl_input_t *in, qnav_ctrl_output_t *out)
 {
@@ -55,12 +68,7 @@ static void test_follows_after_a_stall_and_leaves_when_nearer(void **state)
     qnav_ctrl_input_t in;
     qnav_ctrl_output_t out;
     qnav_policy_prob_default(&p);
-    init_ctrl(&c, &p, 20);
-    memset(&in, 0, sizeof in);
-    wall_ahead(r, 300);
-    in.ranges_mm = r;
-    in.goal_bearing_cdeg = 0;
-    in.goal_range_mm = 3000;
+    facing_wall(&c, &p, 20, r, 300, 3000, &in);
     for (unsigned t = 0; t < 20; ++t) {
         tick(&c, &in, &out);
         assert_int_equal(out.escape.side, 0);
@@ -98,11 +106,7 @@ static void test_progress_never_follows(void **state)
     qnav_ctrl_input_t in;
     qnav_ctrl_output_t out;
     qnav_policy_prob_default(&p);
-    init_ctrl(&c, &p, 20);
-    memset(&in, 0, sizeof in);
-    wall_ahead(r, 300);
-    in.ranges_mm = r;
-    in.goal_range_mm = 9000;
+    facing_wall(&c, &p, 20, r, 300, 9000, &in);
     for (unsigned t = 0; t < 200; ++t) {
         tick(&c, &in, &out);
         assert_int_equal(out.escape.side, 0);
@@ -123,11 +127,7 @@ static void test_a_long_follow_tries_the_other_side(void **state)
     int8_t first;
     unsigned t;
     qnav_policy_prob_default(&p);
-    init_ctrl(&c, &p, 20);
-    memset(&in, 0, sizeof in);
-    wall_ahead(r, 300);
-    in.ranges_mm = r;
-    in.goal_range_mm = 3000;
+    facing_wall(&c, &p, 20, r, 300, 3000, &in);
     for (t = 0; t < 21; ++t) {
         tick(&c, &in, &out);
     }
@@ -164,12 +164,8 @@ static void test_a_policy_of_zeros_does_not_freeze(void **state)
     unsigned moving = 0;
     qnav_policy_net_zero(&p, 4);
     p.u.net.b_out = (qnav_q8_8_t)-32768;
-    init_ctrl(&c, &p, 20);
     init_ctrl(&off, &p, 0);
-    memset(&in, 0, sizeof in);
-    wall_ahead(r, 400);
-    in.ranges_mm = r;
-    in.goal_range_mm = 3000;
+    facing_wall(&c, &p, 20, r, 400, 3000, &in);
     in_off = in;
     for (unsigned t = 0; t < 60; ++t) {
         tick(&c, &in, &out);
@@ -194,10 +190,7 @@ static void test_no_range_no_escape(void **state)
     qnav_ctrl_input_t in;
     qnav_ctrl_output_t out;
     qnav_policy_prob_default(&p);
-    init_ctrl(&c, &p, 20);
-    memset(&in, 0, sizeof in);
-    wall_ahead(r, 300);
-    in.ranges_mm = r;
+    facing_wall(&c, &p, 20, r, 300, 0, &in);
     for (unsigned t = 0; t < 100; ++t) {
         tick(&c, &in, &out);
         assert_int_equal(out.escape.side, 0);
