@@ -469,18 +469,20 @@ static void test_spec_distribution_errors_name_the_line(void **state)
 {
     (void)state;
     const std::string head = "name = \"t\"\n[distribution.a]\n";
+    assert_string_equal(parse_error(head + "families = [ { family = \"nosuch\" } ]\n").c_str(),
+                        "x.toml:3: family: 'nosuch' is not one of clutter, gaps, corridor, pocket, rooms");
     assert_string_equal(parse_error(head + "families = []\n").c_str(),
                         "x.toml:3: distribution.a: families: expected a non-empty array of { family = ... } tables");
-    assert_string_equal(parse_error(head + "families = [ { family = \"x\", environment = \"dense\" } ]\n").c_str(),
+    assert_string_equal(parse_error(head + "families = [ { family = \"gaps\", environment = \"dense\" } ]\n").c_str(),
                         "x.toml:3: distribution.a.families: give exactly one of 'family' and 'environment'");
-    assert_string_equal(parse_error(head + "families = [ { family = \"x\", difficulty = [0.5, 0.2] } ]\n").c_str(),
+    assert_string_equal(parse_error(head + "families = [ { family = \"gaps\", difficulty = [0.5, 0.2] } ]\n").c_str(),
                         "x.toml:3: difficulty: low is above high");
-    assert_string_equal(parse_error(head + "families = [ { family = \"x\" } ]\nseeds = [0, 1000000]\n").c_str(),
+    assert_string_equal(parse_error(head + "families = [ { family = \"gaps\" } ]\nseeds = [0, 1000000]\n").c_str(),
                         "x.toml:4: seeds: 1e+06 is outside [0, 999999]");
-    assert_string_equal(parse_error(head + "families = [ { family = \"x\" } ]\n[target]\ndistribution = \"b\"\n").c_str(),
+    assert_string_equal(parse_error(head + "families = [ { family = \"gaps\" } ]\n[target]\ndistribution = \"b\"\n").c_str(),
                         "x.toml:5: distribution: no [distribution.b] in this file (known: a)");
     assert_true(
-        parse_error(head + "families = [ { family = \"x\" } ]\n[target]\nenvironment = \"dense\"\ndistribution = \"a\"\n")
+        parse_error(head + "families = [ { family = \"gaps\" } ]\n[target]\nenvironment = \"dense\"\ndistribution = \"a\"\n")
             .find("give either 'environment' or 'distribution', not both") != std::string::npos);
 }
 

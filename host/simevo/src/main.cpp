@@ -189,9 +189,17 @@ std::vector<RunItem> load_run_specs(const std::vector<std::string> &names, const
     SimWorlds probe_worlds;
     for (const RunItem &it : items) {
         const ExperimentSpec &s = it.spec;
-        probe_scenario(probe_worlds, s.target, s.seed, true);
+        try {
+            probe_scenario(probe_worlds, s.target, s.seed, true);
+        } catch (const UserError &e) {
+            throw UserError(s.file + ": [target]: " + e.what());
+        }
         for (const auto &src : s.sources) {
-            probe_scenario(probe_worlds, src.scenario, s.seed, true);
+            try {
+                probe_scenario(probe_worlds, src.scenario, s.seed, true);
+            } catch (const UserError &e) {
+                throw UserError(s.file + ": [[source]] " + src.label + ": " + e.what());
+            }
             if (!src.policy_file.empty()) {
                 (void)read_policy_file(src.policy_file);
             }

@@ -3,6 +3,9 @@
  */
 #include "spec.h"
 #include "files.h"
+#include "worlds.h"
+
+#include <algorithm>
 
 #include <cmath>
 #include <set>
@@ -407,8 +410,9 @@ FamilySpec parse_family(const Parser &p, const toml::node &n, const std::string 
     FamilySpec f;
     if (auto *v = t->get("family")) {
         f.family = p.str(*v, "family");
-        if (!valid_name(f.family)) {
-            p.fail(*v, "family: use 1-64 characters a-z, 0-9, '-', '_'");
+        const std::vector<std::string> known = world_families();
+        if (std::find(known.begin(), known.end(), f.family) == known.end()) {
+            p.fail(*v, "family: '" + f.family + "' is not one of " + qnav_sim_world_families());
         }
     }
     if (auto *v = t->get("environment")) {
