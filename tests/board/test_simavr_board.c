@@ -125,7 +125,7 @@ static unsigned compare_with_simulator(const char *log_path, const char *robot,
             for (k = 0; k < 64u && c.stop_reason == 0 && c.scan_seq >= 0 &&
                         (uint16_t)c.policy_crc == qnav_link_policy_crc(p); ++k) {
                 qnav_mm_t ranges[QNAV_MAX_SECTORS];
-                qnav_ctrl_input_t in;
+                qnav_ctrl_input_t in = {0};
                 qnav_ctrl_output_t out;
                 int i;
                 if (seqs[k] != c.scan_seq) {

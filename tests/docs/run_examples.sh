@@ -33,7 +33,7 @@ done
 fail() { echo "run_examples.sh: $*" >&2; for f in "$work"/*.err; do echo "--- $f"; tail -n 5 "$f"; done >&2; exit 1; }
 r=$work/runs
 [ "$(grep -c '^exit 0$' "$work/status.txt")" -eq 4 ] || fail "a block failed: $(tr '\n' ' ' < "$work/status.txt")"
-[ "$(grep -c ' Fig\. ' "$work/readme.out")" -eq "$(ls "$src/experiments" | grep -c '\.toml$')" ] || fail "simevo list"
+[ "$(grep -c ' Fig\. ' "$work/readme.out")" -eq "$(grep -l '^figure = ' "$src"/experiments/*.toml | wc -l)" ] || fail "simevo list"
 [ -s "$r/q/open-to-dense/summary.md" ] || fail "no summary.md from simevo run"
 head -c 4 "$r/q/open-to-dense/learning.png" | grep -q PNG || fail "no learning.png"
 head -c 5 "$r/episode.svg" | grep -q '<?xml' && grep -q '</svg>' "$r/episode.svg" || fail "no complete episode.svg"
