@@ -313,6 +313,72 @@ static void naive_comparison(void)
 }
 
 
+/* What the escape memory (docs/architecture.md, "Leaving dead ends") adds to a step: the
+ * probabilistic policy on every 32-sector scan, the step without a distance (escape off)
+ * against the same step while following a boundary (the skirt search every tick) and on
+ * the tick a stall begins a follow (side choice + skirt search). */
+static void escape_cost(void)
+{
+    qnav_mm_t *r = qnav_bench_scratch_ranges();
+    qnav_ctrl_t *c = qnav_bench_scratch_ctrl();
+    qnav_policy_t *p = qnav_bench_scratch_policy();
+    qnav_ctrl_config_t cfg;
+    uint32_t follow_max = 0, enter_max = 0, follow_sum = 0;
+    uint8_t n = 0;
+    uint16_t s;
+    qnav_policy_prob_default(p);
+    qnav_bench_config(&cfg, 32u);
+    if (qnav_ctrl_init(c, &cfg, p) != QNAV_OK) {
+        PUT("escape: init failed\n");
+        return;
+    }
+    for (s = 0; s < qnav_bench_scan_count(); ++s) {
+        qnav_ctrl_input_t in = {0};
+        qnav_ctrl_output_t out;
+        uint8_t type, k;
+        uint32_t off, follow, enter;
+        if (qnav_bench_load_scan(s, r, &in.goal_bearing_cdeg, &type, &k) != 32u) {
+            continue;
+        }
+        in.ranges_mm = r;
+        in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
+        timer_start();
+        qnav_ctrl_step(c, &in, &out, 0);
+        off = timer_stop() - overhead;
+        in.goal_range_mm = 3000u;
+        in.escape.best_mm = 2000u;
+        in.escape.hit_mm = 2000u;
+        in.escape.side = 1;
+        in.escape.last_side = 1;
+        timer_start();
+        qnav_ctrl_step(c, &in, &out, 0);
+        follow = timer_stop() - overhead;
+        in.escape.side = 0;
+        in.escape.last_side = 0;
+        in.escape.ticks = (uint16_t)(cfg.escape_stall_ticks - 1u);
+        timer_start();
+        qnav_ctrl_step(c, &in, &out, 0);
+        enter = timer_stop() - overhead;
+        follow = follow > off ? follow - off : 0u;
+        enter = enter > off ? enter - off : 0u;
+        follow_sum += follow;
+        follow_max = follow > follow_max ? follow : follow_max;
+        enter_max = enter > enter_max ? enter : enter_max;
+        ++n;
+    }
+    PUT("escape memory on the ");
+    qnav_target_put_u32(n);
+    PUT(" 32-sector scans, probabilistic policy: following adds mean ");
+    put_cycles(follow_sum / n);
+    PUT(", max ");
+    qnav_target_put_u32(follow_max);
+    PUT(" cycles; the tick a follow begins adds max ");
+    qnav_target_put_u32(enter_max);
+    PUT(" cycles; sizeof(qnav_escape_t) ");
+    qnav_target_put_u32(sizeof(qnav_escape_t));
+    PUT(" bytes\n");
+}
+
 /* VFH+ (qnav/vfh.h), the second controller, on every 32-sector scan through its own step
  * (free text: the M lines are the path-quality controller's). */
 static void vfh_comparison(void)
@@ -432,6 +498,7 @@ int main(void)
     init_times();
     naive_comparison();
     vfh_comparison();
+    escape_cost();
 #endif
     if (bad != 0u) {
         PUT("MISMATCH count ");
