@@ -597,7 +597,6 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     uint32_t speed;
     qnav_q1_15_t quality;
     qnav_q1_15_t cap;
-    qnav_escape_t esc;
     uint16_t goal;
 
     if (out == 0) {
@@ -611,8 +610,8 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     best.dtheta = 0;
     best.heading = 0;
     flags = qnav_clearance_levels(&ctrl->clr, in->ranges_mm, lvl);
-    goal = qnav_escape_goal(&ctrl->clr, lvl, in, &esc);
-    out->escape = esc;
+    /* the memory goes straight to the output (no copy on the stack: the ATmega128's RAM) */
+    goal = qnav_escape_goal(&ctrl->clr, lvl, in, &out->escape);
     qnav_run_start(&it, lvl, goal, qnav_whole_deg(in->prev_heading_cdeg));
     /* the keys land in qualities[] and are turned into qualities below */
     paths_best(ctrl, &it, &best, qualities);
@@ -628,7 +627,7 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
         out->speed = 0;
         out->quality = 0;
         out->flags = (uint8_t)(flags | QNAV_FLAG_NO_PATH);
-        qnav_escape_keep_moving(&ctrl->clr, lvl, &esc, goal, out);
+        qnav_escape_keep_moving(&ctrl->clr, lvl, &out->escape, goal, out);
         return;
     }
     speed = ((uint32_t)quality * ctrl->speed_scale) >> 15;
@@ -646,7 +645,7 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     out->speed = (qnav_q1_15_t)speed;
     out->quality = quality;
     out->flags = flags;
-    qnav_escape_keep_moving(&ctrl->clr, lvl, &esc, goal, out);
+    qnav_escape_keep_moving(&ctrl->clr, lvl, &out->escape, goal, out);
 }
 
 const char *qnav_status_str(qnav_status_t status)
