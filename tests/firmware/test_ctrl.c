@@ -1041,6 +1041,16 @@ static void test_run_reduce_keeps_its_promises_on_any_row(void **state)
 static void reference_levels_wedge(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
                                    unsigned pct, qnav_mm_t near_mm, uint8_t *lvl);
 
+/* The first path whose levels differ (the arrays are known to differ). */
+static unsigned first_difference(const uint8_t *got, const uint8_t *want)
+{
+    unsigned q = 0;
+    while (got[q] == want[q]) {
+        ++q;
+    }
+    return q;
+}
+
 /* The enlargement as first written: every obstacle sector lowers its own paths widened by
  * its level's gamma on both sides, one path at a time (the whole wedge). */
 static void reference_levels(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
@@ -1093,10 +1103,7 @@ static void test_path_levels_equal_painting_every_sector(void **state)
         assert_int_equal(qnav_ctrl_path_levels(&c, ranges, got) & QNAV_FLAG_NOT_READY, 0);
         reference_levels(&c, ranges, n, want);
         if (memcmp(got, want, sizeof got) != 0) {
-            unsigned q = 0;
-            while (got[q] == want[q]) {
-                ++q;
-            }
+            unsigned q = first_difference(got, want);
             fail_msg("scan %u (N = %u, kind %u): path %u level %u, painting everything %u", k,
                      n, (k / 19u) % 6u, q, got[q], want[q]);
         }
@@ -1173,10 +1180,7 @@ static void test_wedge_placement_equals_its_definition(void **state)
         assert_int_equal(qnav_ctrl_path_levels(&c, ranges, got) & QNAV_FLAG_NOT_READY, 0);
         reference_levels_wedge(&c, ranges, n, pct, near_mm, want);
         if (memcmp(got, want, sizeof got) != 0) {
-            unsigned q = 0;
-            while (got[q] == want[q]) {
-                ++q;
-            }
+            unsigned q = first_difference(got, want);
             fail_msg("scan %u (N = %u, pct %u, near %u): path %u level %u, definition %u", k, n,
                      pct, near_mm, q, got[q], want[q]);
         }

@@ -35,17 +35,24 @@ static void wall_ahead(qnav_mm_t *r, qnav_mm_t near_mm)
     r[N - 1] = near_mm;
 }
 
-/* A controller of policy p with the given stall time facing a wall near_mm ahead, the
- * destination range_mm away straight behind it; in reads r. */
-static void facing_wall(qnav_ctrl_t *c, const qnav_policy_t *p, uint8_t stall_ticks,
-                        qnav_mm_t *r, qnav_mm_t near_mm, qnav_mm_t range_mm,
-                        qnav_ctrl_input_t *in)
+/* One scripted robot: its policy, controller, scan, input and last output. */
+typedef struct {
+    qnav_policy_t p;
+    qnav_ctrl_t c;
+    qnav_mm_t r[N];
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+} bot_t;
+
+/* A controller of policy b->p with the given stall time facing a wall near_mm ahead, the
+ * destination range_mm away straight behind it. */
+static void facing_wall(bot_t *b, uint8_t stall_ticks, qnav_mm_t near_mm, qnav_mm_t range_mm)
 {
-    init_ctrl(c, p, stall_ticks);
-    memset(in, 0, sizeof *in);
-    wall_ahead(r, near_mm);
-    in->ranges_mm = r;
-    in->goal_range_mm = range_mm;
+    init_ctrl(&b->c, &b->p, stall_ticks);
+    memset(&b->in, 0, sizeof b->in);
+    wall_ahead(b->r, near_mm);
+    b->in.ranges_mm = b->r;
+    b->in.goal_range_mm = range_mm;
 }
 
 /* One tick: the previous output's memory comes back in, as every caller must do. */
@@ -62,55 +69,47 @@ static void tick(const qnav_ctrl_t *c, qnav_ctrl_input_t *in, qnav_ctrl_output_t
 static void test_follows_after_a_stall_and_leaves_when_nearer(void **state)
 {
     (void)state;
-    qnav_policy_t p;
-    qnav_ctrl_t c;
-    qnav_mm_t r[N];
-    qnav_ctrl_input_t in;
-    qnav_ctrl_output_t out;
-    qnav_policy_prob_default(&p);
-    facing_wall(&c, &p, 20, r, 300, 3000, &in);
+    bot_t b;
+    qnav_policy_prob_default(&b.p);
+    facing_wall(&b, 20, 300, 3000);
     for (unsigned t = 0; t < 20; ++t) {
-        tick(&c, &in, &out);
-        assert_int_equal(out.escape.side, 0);
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, 0);
     }
-    tick(&c, &in, &out);
-    assert_int_not_equal(out.escape.side, 0);
-    assert_int_equal(out.escape.hit_mm, 3000);
+    tick(&b.c, &b.in, &b.out);
+    assert_int_not_equal(b.out.escape.side, 0);
+    assert_int_equal(b.out.escape.hit_mm, 3000);
     for (unsigned t = 0; t < 10; ++t) {
-        tick(&c, &in, &out);
-        assert_int_not_equal(out.escape.side, 0);
+        tick(&b.c, &b.in, &b.out);
+        assert_int_not_equal(b.out.escape.side, 0);
         /* along the wall, never into it: well away from straight ahead */
-        assert_true(out.heading_deg >= 30 || out.heading_deg <= -30);
-        assert_true(out.speed > 0);
+        assert_true(b.out.heading_deg >= 30 || b.out.heading_deg <= -30);
+        assert_true(b.out.speed > 0);
     }
     /* nearer by less than the progress step: still following */
-    in.goal_range_mm = 2950;
-    wall_ahead(r, MAX_MM);
-    tick(&c, &in, &out);
-    assert_int_not_equal(out.escape.side, 0);
+    b.in.goal_range_mm = 2950;
+    wall_ahead(b.r, MAX_MM);
+    tick(&b.c, &b.in, &b.out);
+    assert_int_not_equal(b.out.escape.side, 0);
     /* nearer than ever and the way free: back to the destination */
-    in.goal_range_mm = 2500;
-    tick(&c, &in, &out);
-    assert_int_equal(out.escape.side, 0);
-    assert_int_equal(out.escape.best_mm, 2500);
-    assert_true(out.heading_deg <= 5 && out.heading_deg >= -5);
+    b.in.goal_range_mm = 2500;
+    tick(&b.c, &b.in, &b.out);
+    assert_int_equal(b.out.escape.side, 0);
+    assert_int_equal(b.out.escape.best_mm, 2500);
+    assert_true(b.out.heading_deg <= 5 && b.out.heading_deg >= -5);
 }
 
 /* Progress resets the stall count: a robot that keeps getting nearer never follows. */
 static void test_progress_never_follows(void **state)
 {
     (void)state;
-    qnav_policy_t p;
-    qnav_ctrl_t c;
-    qnav_mm_t r[N];
-    qnav_ctrl_input_t in;
-    qnav_ctrl_output_t out;
-    qnav_policy_prob_default(&p);
-    facing_wall(&c, &p, 20, r, 300, 9000, &in);
+    bot_t b;
+    qnav_policy_prob_default(&b.p);
+    facing_wall(&b, 20, 300, 9000);
     for (unsigned t = 0; t < 200; ++t) {
-        tick(&c, &in, &out);
-        assert_int_equal(out.escape.side, 0);
-        in.goal_range_mm = (qnav_mm_t)(in.goal_range_mm - 40u); /* 0.4 m/s */
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, 0);
+        b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm - 40u); /* 0.4 m/s */
     }
 }
 
@@ -119,33 +118,29 @@ static void test_progress_never_follows(void **state)
 static void test_a_long_follow_tries_the_other_side(void **state)
 {
     (void)state;
-    qnav_policy_t p;
-    qnav_ctrl_t c;
-    qnav_mm_t r[N];
-    qnav_ctrl_input_t in;
-    qnav_ctrl_output_t out;
+    bot_t b;
     int8_t first;
     unsigned t;
-    qnav_policy_prob_default(&p);
-    facing_wall(&c, &p, 20, r, 300, 3000, &in);
+    qnav_policy_prob_default(&b.p);
+    facing_wall(&b, 20, 300, 3000);
     for (t = 0; t < 21; ++t) {
-        tick(&c, &in, &out);
+        tick(&b.c, &b.in, &b.out);
     }
-    first = out.escape.side;
+    first = b.out.escape.side;
     assert_int_not_equal(first, 0);
     for (t = 0; t < 199; ++t) {
-        tick(&c, &in, &out);
-        assert_int_equal(out.escape.side, first);
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, first);
     }
-    tick(&c, &in, &out);
-    assert_int_equal(out.escape.side, -first);
-    assert_int_equal(out.escape.tries, 1);
+    tick(&b.c, &b.in, &b.out);
+    assert_int_equal(b.out.escape.side, -first);
+    assert_int_equal(b.out.escape.tries, 1);
     for (t = 0; t < 399; ++t) {
-        tick(&c, &in, &out);
-        assert_int_equal(out.escape.side, -first);
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, -first);
     }
-    tick(&c, &in, &out);
-    assert_int_equal(out.escape.side, first);
+    tick(&b.c, &b.in, &b.out);
+    assert_int_equal(b.out.escape.side, first);
 }
 
 /* No policy freezes: a network whose quality is 0 on every path stands still (NO_PATH)
@@ -154,28 +149,24 @@ static void test_a_long_follow_tries_the_other_side(void **state)
 static void test_a_policy_of_zeros_does_not_freeze(void **state)
 {
     (void)state;
-    qnav_policy_t p;
-    qnav_ctrl_t c;
+    bot_t b;
     qnav_ctrl_t off;
-    qnav_mm_t r[N];
-    qnav_ctrl_input_t in;
     qnav_ctrl_input_t in_off;
-    qnav_ctrl_output_t out;
     unsigned moving = 0;
-    qnav_policy_net_zero(&p, 4);
-    p.u.net.b_out = (qnav_q8_8_t)-32768;
-    init_ctrl(&off, &p, 0);
-    facing_wall(&c, &p, 20, r, 400, 3000, &in);
-    in_off = in;
+    qnav_policy_net_zero(&b.p, 4);
+    b.p.u.net.b_out = (qnav_q8_8_t)-32768;
+    init_ctrl(&off, &b.p, 0);
+    facing_wall(&b, 20, 400, 3000);
+    in_off = b.in;
     for (unsigned t = 0; t < 60; ++t) {
-        tick(&c, &in, &out);
-        if (out.speed > 0) {
+        tick(&b.c, &b.in, &b.out);
+        if (b.out.speed > 0) {
             ++moving;
-            assert_int_equal(out.flags & QNAV_FLAG_NO_PATH, 0);
+            assert_int_equal(b.out.flags & QNAV_FLAG_NO_PATH, 0);
         }
-        tick(&off, &in_off, &out);
-        assert_int_equal(out.speed, 0);
-        assert_int_not_equal(out.flags & QNAV_FLAG_NO_PATH, 0);
+        tick(&off, &in_off, &b.out);
+        assert_int_equal(b.out.speed, 0);
+        assert_int_not_equal(b.out.flags & QNAV_FLAG_NO_PATH, 0);
     }
     assert_true(moving >= 30);
 }
@@ -184,17 +175,13 @@ static void test_a_policy_of_zeros_does_not_freeze(void **state)
 static void test_no_range_no_escape(void **state)
 {
     (void)state;
-    qnav_policy_t p;
-    qnav_ctrl_t c;
-    qnav_mm_t r[N];
-    qnav_ctrl_input_t in;
-    qnav_ctrl_output_t out;
-    qnav_policy_prob_default(&p);
-    facing_wall(&c, &p, 20, r, 300, 0, &in);
+    bot_t b;
+    qnav_policy_prob_default(&b.p);
+    facing_wall(&b, 20, 300, 0);
     for (unsigned t = 0; t < 100; ++t) {
-        tick(&c, &in, &out);
-        assert_int_equal(out.escape.side, 0);
-        assert_int_equal(out.escape.best_mm, 0);
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, 0);
+        assert_int_equal(b.out.escape.best_mm, 0);
     }
 }
 
