@@ -466,6 +466,24 @@ static void on_pose(qnav_bridge_t *b, const qnav_link_frame_t *f)
     PUBLISH(b, QNAV_CH_ODOMETRY, qnav_odometry_t, &o);
 }
 
+static void send_upload(qnav_bridge_t *b);
+
+static const char *ack_str(int8_t status)
+{
+    switch (status) {
+    case QNAV_LINK_ACK_BAD_LENGTH:
+        return "chunks missing";
+    case QNAV_LINK_ACK_BAD_CRC:
+        return "CRC differs";
+    case QNAV_LINK_ACK_BAD_POLICY:
+        return "not a policy this board reads";
+    case QNAV_LINK_ACK_REJECTED:
+        return "the controller refused it";
+    default:
+        return "unknown status";
+    }
+}
+
 static void on_ack(qnav_bridge_t *b, const qnav_link_frame_t *f)
 {
     qnav_link_policy_ack_t a;
@@ -475,12 +493,25 @@ static void on_ack(qnav_bridge_t *b, const qnav_link_frame_t *f)
     }
     b->last_upload_status = a.status;
     b->upload_state = QNAV_BRIDGE_UPLOAD_DONE;
+    if ((a.status == QNAV_LINK_ACK_BAD_LENGTH || a.status == QNAV_LINK_ACK_BAD_CRC) &&
+        b->upload_tries < QNAV_BRIDGE_UPLOAD_TRIES) {
+        /* damaged on the way (a frame lost or corrupted on the line, or dropped while the
+         * board was busy): the policy itself was fine, so it is sent again */
+        if (b->diag != NULL) {
+            fprintf(b->diag, "navbridge: policy upload: the board got it damaged (%s); "
+                             "sending it again (try %d of %d)\n",
+                    ack_str(a.status),
+                    b->upload_tries + 1, QNAV_BRIDGE_UPLOAD_TRIES);
+        }
+        send_upload(b);
+        return;
+    }
     if (b->diag != NULL) {
         if (a.status == QNAV_LINK_ACK_OK) {
             fprintf(b->diag, "navbridge: policy upload: ok (crc 0x%04x)\n", a.crc);
         } else {
-            fprintf(b->diag, "navbridge: policy upload: refused by the board (status %d)\n",
-                    a.status);
+            fprintf(b->diag, "navbridge: policy upload: refused by the board (status %d: %s)\n",
+                    a.status, ack_str(a.status));
         }
     }
 }
@@ -738,7 +769,7 @@ void qnav_bridge_poll(qnav_bridge_t *b, int64_t now_ms)
         /* the board's answer is awaited QNAV_BRIDGE_UPLOAD_WAIT_MS, or the watchdog's time
          * when that is longer (a slow link, or simavr slower than real time on a loaded
          * machine) */
-        if (b->upload_tries < 3) {
+        if (b->upload_tries < QNAV_BRIDGE_UPLOAD_TRIES) {
             send_upload(b);
         } else {
             b->upload_state = QNAV_BRIDGE_UPLOAD_DONE;

@@ -61,8 +61,13 @@ extern "C" {
 
 /* link_status_t.last_upload_status besides the board's QNAV_LINK_ACK_* answers. */
 #define QNAV_BRIDGE_UPLOAD_NONE_YET 1
-#define QNAV_BRIDGE_UPLOAD_NO_ANSWER (-5) /* three tries, QNAV_BRIDGE_UPLOAD_WAIT_MS apart,
-                                              never acked */
+#define QNAV_BRIDGE_UPLOAD_NO_ANSWER (-5) /* QNAV_BRIDGE_UPLOAD_TRIES tries,
+                                              QNAV_BRIDGE_UPLOAD_WAIT_MS apart, never acked */
+
+/* An upload is sent at most this many times: again when no answer came, or when the board
+ * answered that it arrived damaged (QNAV_LINK_ACK_BAD_LENGTH / _BAD_CRC). A policy the board
+ * refuses (_BAD_POLICY / _REJECTED) is not sent again. */
+#define QNAV_BRIDGE_UPLOAD_TRIES 3
 
 /* How long a policy upload's answer is awaited before the upload is sent again. The board
  * answers after initialising the new controller (a 2-input network's init evaluates every
