@@ -94,10 +94,15 @@ void load(Loaded &l, const std::string &robot, const std::string &env) {
 }
 
 void make_sim(Loaded &l, int sectors, double ps, double pa, std::uint64_t seed,
-              qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS) {
+              qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS, double limit_factor = 1.0) {
     char err[QNAV_SIM_ERRLEN] = "";
     qnav_sim_config_t cfg;
     qnav_sim_config_default(&cfg);
+    if (limit_factor != 1.0) {
+        qnav_sim_env_info_t ei;
+        qnav_sim_env_info(l.env, &ei);
+        cfg.episode_limit_s = limit_factor * ei.episode_limit_s;
+    }
     cfg.fitness = fitness;
     cfg.n_sectors = static_cast<std::uint16_t>(sectors);
     cfg.sensor_noise = ps;
@@ -182,6 +187,7 @@ struct RunOpts {
     double ps = -1, pa = -1;
     std::uint64_t seed = 1, episode = 0;
     unsigned episodes = 1;
+    double limit_factor = 1.0;  // times the environment's episode time limit
     bool table = false;
     std::string controller = "body";  // a name in libqnav's controller table (qnav/nav.h)
     long svg_tick = -1;
@@ -198,7 +204,7 @@ int cmd_run(const RunOpts &o) {
     if (qnav_sim_fitness_rule_parse(o.fitness.c_str(), &rule) != QNAV_SIM_OK)
         throw SimError(QNAV_SIM_E_PARAM, "--fitness: '" + o.fitness + "' is not one of " +
                                              qnav_sim_fitness_rule_names());
-    make_sim(l, o.sectors, ps, pa, o.seed, rule);
+    make_sim(l, o.sectors, ps, pa, o.seed, rule, o.limit_factor);
     qnav::Simulation &sim = *l.sim->sim;
     const qnav_policy_t pol = read_policy(o.policy, l.robot);
     std::vector<qnav_qkey_t> tbuf;
@@ -486,6 +492,9 @@ int main(int argc, char **argv) {
                     "rank by pre-activation; literal: the paper's per-sector reading (ablation); "
                     "vfh: VFH+ (Ulrich & Borenstein 1998), no policy")
         ->capture_default_str();
+    run->add_option("--limit-factor", ro.limit_factor,
+                    "episode time limit as a multiple of the environment's (2: judge escapes at twice it)")
+        ->check(qnav::cli::finite_range(0.1, 100.0))->capture_default_str();
     run->add_option("--svg", ro.svg, "write the first episode's picture here");
     run->add_option("--trace", ro.trace, "write the first episode's trajectory here (CSV, one row per tick)");
     run->add_option("--svg-tick", ro.svg_tick, "tick whose sonar sectors are drawn (default 0; past the end: the last tick)")->check(CLI::NonNegativeNumber);

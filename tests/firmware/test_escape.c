@@ -63,9 +63,19 @@ static void tick(const qnav_ctrl_t *c, qnav_ctrl_input_t *in, qnav_ctrl_output_t
     in->prev_heading_cdeg = (qnav_cdeg_t)(out->heading_deg * 100);
 }
 
+/* How far the robot's centre can go toward a reading near_mm away (the controller's
+ * default body): the reading from the centre, less body radius and safety distance. */
+static qnav_mm_t free_mm(qnav_mm_t near_mm)
+{
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_config_default(&cfg);
+    return (qnav_mm_t)(near_mm + cfg.sensor_offset_mm - cfg.body_radius_mm - cfg.safety_mm);
+}
+
 /* Facing a wall with the destination behind it and no progress: the robot goes for the
  * destination until the stall time is up, then follows the wall (turns well off the
- * destination's bearing); once nearer than ever with the way free it goes back to it. */
+ * destination's bearing). It leaves by DistBug's rule: once the free way toward the
+ * destination ends nearer to it, by a step, than it did at the hit point. */
 static void test_follows_after_a_stall_and_leaves_when_nearer(void **state)
 {
     (void)state;
@@ -78,7 +88,8 @@ static void test_follows_after_a_stall_and_leaves_when_nearer(void **state)
     }
     tick(&b.c, &b.in, &b.out);
     assert_int_not_equal(b.out.escape.side, 0);
-    assert_int_equal(b.out.escape.hit_mm, 3000);
+    /* the hit point: the free way toward the destination ended 3000 - free_mm(300) from it */
+    assert_int_equal(b.out.escape.hit_mm, 3000 - free_mm(300));
     for (unsigned t = 0; t < 10; ++t) {
         tick(&b.c, &b.in, &b.out);
         assert_int_not_equal(b.out.escape.side, 0);
@@ -86,16 +97,21 @@ static void test_follows_after_a_stall_and_leaves_when_nearer(void **state)
         assert_true(b.out.heading_deg >= 30 || b.out.heading_deg <= -30);
         assert_true(b.out.speed > 0);
     }
-    /* nearer by less than the progress step: still following */
+    /* nearer by less than the progress step, the wall as near: still following */
     b.in.goal_range_mm = 2950;
-    wall_ahead(b.r, MAX_MM);
     tick(&b.c, &b.in, &b.out);
     assert_int_not_equal(b.out.escape.side, 0);
-    /* nearer than ever and the way free: back to the destination */
-    b.in.goal_range_mm = 2500;
+    /* much nearer, but the wall still blocks the way: still following */
+    b.in.goal_range_mm = 2000;
+    tick(&b.c, &b.in, &b.out);
+    assert_int_not_equal(b.out.escape.side, 0);
+    /* as far as at the hit, but the way toward the destination open to the sonar's range:
+     * it ends far nearer than at the hit point, so the robot goes back to the destination */
+    b.in.goal_range_mm = 3000;
+    wall_ahead(b.r, MAX_MM);
     tick(&b.c, &b.in, &b.out);
     assert_int_equal(b.out.escape.side, 0);
-    assert_int_equal(b.out.escape.best_mm, 2500);
+    assert_int_equal(b.out.escape.best_mm, 3000);
     assert_true(b.out.heading_deg <= 5 && b.out.heading_deg >= -5);
 }
 
