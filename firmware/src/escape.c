@@ -10,6 +10,9 @@
 
 /* Crawl speed while following a boundary whose policy would stand still: 1/4 of v_max. */
 #define QNAV_ESCAPE_CRAWL ((qnav_q1_15_t)8192)
+/* A stall this many margins (r + d_s) nearer to the destination than where the last
+ * follow ended is at another obstacle: its side is chosen afresh. */
+#define QNAV_ESCAPE_NEW_MARGINS 4u
 /* Longest follow, in ticks, however many tries were given up (about 109 s). */
 #define QNAV_ESCAPE_MAX_FOLLOW 1092u
 
@@ -139,6 +142,7 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
         if ((uint32_t)rest_mm(c, in, goal, range) + progress <= e->hit_mm &&
             !blocked(c, lvl, (int16_t)goal)) {
             e->side = 0;
+            e->hit_mm = range; /* where this follow ended: a stall far nearer is a new obstacle */
             e->best_mm = range;
             e->ticks = 0u;
             e->tries = 0u;
@@ -161,6 +165,9 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
     }
     if (++e->ticks < c->esc_stall_ticks) {
         return goal;
+    }
+    if ((uint32_t)e->best_mm + QNAV_ESCAPE_NEW_MARGINS * c->margin_mm < e->hit_mm) {
+        e->last_side = 0; /* far nearer than where the last follow ended: another obstacle */
     }
     e->side = e->last_side != 0 ? e->last_side : choose_side(c, lvl, goal);
     e->last_side = e->side;

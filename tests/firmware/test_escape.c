@@ -159,6 +159,54 @@ static void test_a_long_follow_tries_the_other_side(void **state)
     assert_int_equal(b.out.escape.side, first);
 }
 
+/* A wall ahead and to the left (sectors 0, 1 and 2): the nearest free way round is on the
+ * right, so a fresh choice follows it on the left (side -1). */
+static void wall_ahead_left(qnav_mm_t *r, qnav_mm_t near_mm)
+{
+    wall_ahead(r, near_mm);
+    r[N - 1] = MAX_MM;
+    r[2] = near_mm;
+}
+
+/* From a follow on side +1 that has just ended, range_mm away: the ticks of a new stall at
+ * a wall ahead and to the left. Returns the side the robot then follows. */
+static int8_t side_of_next_stall(qnav_mm_t range_mm)
+{
+    bot_t b;
+    unsigned t;
+    qnav_policy_prob_default(&b.p);
+    facing_wall(&b, 20, 300, 3000);
+    for (t = 0; t < 21; ++t) {
+        tick(&b.c, &b.in, &b.out);
+    }
+    assert_int_equal(b.out.escape.side, 1); /* a symmetric wall: counter-clockwise */
+    wall_ahead(b.r, MAX_MM);                /* the way opens: the follow ends at 3000 */
+    tick(&b.c, &b.in, &b.out);
+    assert_int_equal(b.out.escape.side, 0);
+    wall_ahead_left(b.r, 300);
+    b.in.goal_range_mm = range_mm;
+    for (t = 0; t < 21; ++t) {
+        tick(&b.c, &b.in, &b.out);
+    }
+    assert_int_not_equal(b.out.escape.side, 0);
+    return b.out.escape.side;
+}
+
+/* A new stall near where the last follow ended keeps its side (no shuttling between two
+ * sides of one obstacle); one more than 4 (r + d_s) nearer is at another obstacle and
+ * chooses afresh (an S-corridor's next wall). */
+static void test_a_new_obstacle_chooses_its_side_afresh(void **state)
+{
+    qnav_ctrl_config_t cfg;
+    qnav_mm_t margin;
+    (void)state;
+    qnav_ctrl_config_default(&cfg);
+    margin = (qnav_mm_t)(cfg.body_radius_mm + cfg.safety_mm);
+    assert_int_equal(side_of_next_stall(2950), 1);
+    assert_int_equal(side_of_next_stall((qnav_mm_t)(3000 - 4 * margin + 10)), 1);
+    assert_int_equal(side_of_next_stall((qnav_mm_t)(3000 - 4 * margin - 10)), -1);
+}
+
 /* No policy freezes: a network whose quality is 0 on every path stands still (NO_PATH)
  * until the stall time is up, then crawls along the boundary. Without an escape it stands
  * still for ever. */
@@ -207,6 +255,7 @@ int main(void)
         cmocka_unit_test(test_follows_after_a_stall_and_leaves_when_nearer),
         cmocka_unit_test(test_progress_never_follows),
         cmocka_unit_test(test_a_long_follow_tries_the_other_side),
+        cmocka_unit_test(test_a_new_obstacle_chooses_its_side_afresh),
         cmocka_unit_test(test_a_policy_of_zeros_does_not_freeze),
         cmocka_unit_test(test_no_range_no_escape),
     };

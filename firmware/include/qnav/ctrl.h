@@ -112,12 +112,16 @@ typedef struct {
 typedef struct {
     uint16_t best_mm;   /* nearest the robot came to the destination while going to it, mm;
                            0: not yet */
-    uint16_t hit_mm;    /* best_mm when the current boundary follow began, mm */
+    uint16_t hit_mm;    /* following: how near the destination the free way toward it
+                           ended when this follow began (best_mm less the sonar's free
+                           distance that way), mm; going: the range where the last follow
+                           ended, mm */
     uint16_t ticks;     /* going: ticks without progress; following: ticks on this side */
     int8_t side;        /* 0: going to the destination; +1: following a boundary on the
                            right (going round it counter-clockwise); -1: on the left */
-    int8_t last_side;   /* the side of the last follow (a new stall follows it again, so
-                           the robot does not shuttle between two sides); 0: none yet */
+    int8_t last_side;   /* the side of the last follow (a new stall near where it ended
+                           follows it again, so the robot does not shuttle between two
+                           sides; one 4 (r + d_s) nearer chooses afresh); 0: none yet */
     uint8_t tries;      /* follows given up for the other side since the last progress */
 } qnav_escape_t;
 
