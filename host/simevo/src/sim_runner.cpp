@@ -108,6 +108,12 @@ SimRunner::SimRunner(SimWorlds &worlds, const Scenario &scenario, uint64_t conte
     cfg.actuation_noise = scenario.actuation_noise;
     cfg.seed = context_seed;
     cfg.episode_limit_s = scenario.episode_limit_s;
+    if (scenario.limit_factor != 1.0) {
+        qnav_sim_env_info_t ei;
+        qnav_sim_env_info(env, &ei);
+        cfg.episode_limit_s =
+            scenario.limit_factor * (scenario.episode_limit_s > 0 ? scenario.episode_limit_s : ei.episode_limit_s);
+    }
     cfg.fitness = scenario.fitness;
     char err[QNAV_SIM_ERRLEN] = {0};
     if (qnav_sim_create(robot, env, &cfg, &sim_, err, sizeof err) != QNAV_SIM_OK) {

@@ -89,8 +89,11 @@ std::string Scenario::describe() const
     }
     o << " robot=" << robot << " sectors=" << sectors
       << " sensor_noise=" << sensor_noise << " actuation_noise=" << actuation_noise
-      << " episode_limit_s=" << episode_limit_s
-      << " fitness=" << qnav_sim_fitness_rule_name(fitness)
+      << " episode_limit_s=" << episode_limit_s;
+    if (limit_factor != 1.0) {
+        o << " limit_factor=" << limit_factor; /* absent at 1: old fingerprints unchanged */
+    }
+    o << " fitness=" << qnav_sim_fitness_rule_name(fitness)
       << " controller=" << controller_reading_name(controller);
     return o.str();
 }

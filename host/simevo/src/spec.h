@@ -87,6 +87,8 @@ struct Scenario {
     double sensor_noise = 0.0;          /* p_s, fraction (0.05 = 5 %) */
     double actuation_noise = 0.0;       /* p_a, fraction */
     double episode_limit_s = 0.0;       /* s; 0 = the environment's limit */
+    double limit_factor = 1.0;          /* the limit above (or each world's) times this:
+                                           held-out worlds judged at twice the limit */
     qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS; /* how R is computed;
                                            set for every scenario from [evolution] fitness */
     ControllerReading controller = ControllerReading::Body; /* set for every scenario from

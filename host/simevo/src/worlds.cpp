@@ -200,6 +200,17 @@ std::vector<HeldOutWorld> held_out_worlds(const Scenario &target)
         w.scenario.worlds = WorldSet::Test;
         v.push_back(w);
     }
+    if (target.distribution) {
+        /* escapes take time (issue 18): a distribution's families again at twice each
+         * world's limit */
+        const std::size_t families = v.size();
+        for (std::size_t i = 0; i < families; ++i) {
+            HeldOutWorld w = v[i];
+            w.label += kTwiceLimitSuffix;
+            w.scenario.limit_factor = 2.0;
+            v.push_back(w);
+        }
+    }
     for (const std::string &e : named_environments()) {
         HeldOutWorld w;
         w.label = e;

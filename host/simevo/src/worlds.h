@@ -79,7 +79,11 @@ struct HeldOutWorld {
                             [0, 1]; environment: that environment. Robot, sectors, noise,
                             fitness and controller are the target's. */
 };
-/* Every family's test worlds, then every named environment, for target's robot. */
+/* Label suffix of a family's test worlds judged at twice each world's time limit. */
+inline constexpr const char *kTwiceLimitSuffix = "@2x";
+/* Every family's test worlds, then (a distribution target) every family's test worlds at
+ * twice each world's time limit ("clutter@2x"), then every named environment, for
+ * target's robot. */
 std::vector<HeldOutWorld> held_out_worlds(const Scenario &target);
 
 /* A scenario's held-out version: a distribution's validation worlds (the scenario itself
