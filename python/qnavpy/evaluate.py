@@ -70,11 +70,13 @@ def evaluate(policies, episodes=50, *, world="dense", robot="tekbot", sectors=0,
 
     Raises QnavError with simevo's line for a bad world, robot, policy or option."""
     pols = _as_policies(policies, inputs)
-    episodes = int(episodes)
-    if not 1 <= episodes <= 1000000:
-        raise QnavError(f"--episodes: {episodes} not in [1 - 1000000]")
-    if not (isinstance(noise, (int, float)) and 0.0 <= noise <= 1.0):
-        raise QnavError(f"--noise: {noise} not in [0 - 1]")
+    # the checks simevo's command line makes, with its words
+    if not (isinstance(episodes, (int, np.integer)) and 1 <= episodes <= 1000000):
+        raise QnavError(f"--episodes: Value {episodes} not in range 1 to 1000000")
+    if not (isinstance(sectors, (int, np.integer)) and 0 <= sectors <= 360):
+        raise QnavError(f"--sectors: Value {sectors} not in range 0 to 360")
+    if not (isinstance(noise, (int, float, np.floating)) and 0.0 <= noise <= 1.0):
+        raise QnavError(f"--noise: expected a number in [0, 1], got '{noise}'")
     n = len(pols)
     kind = np.zeros(n, dtype=np.int32)
     hidden = np.zeros(n, dtype=np.int32)

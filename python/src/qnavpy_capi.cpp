@@ -546,7 +546,7 @@ int qpy_evaluate(const char *robot, const char *world, int32_t sectors, double n
             throw qnav::UserError(std::string("--fitness: '") + fitness + "' is not one of " +
                                   qnav_sim_fitness_rule_names());
         if (sectors < 0 || sectors > QNAV_MAX_SECTORS)
-            throw qnav::UserError("--sectors: " + std::to_string(sectors) + " not in [0 - 360]");
+            throw qnav::UserError("--sectors: Value " + std::to_string(sectors) + " not in range 0 to 360");
         // the context simevo eval makes (scenario_from with one noise level)
         qnav::Scenario sc;
         sc.fitness = rule;
