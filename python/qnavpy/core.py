@@ -73,6 +73,18 @@ class World:
         self.dest = (dx, dy)
         self.n_obstacles, self.n_start_zones = int(n_obst), int(n_zones)
 
+    @classmethod
+    def generated(cls, family, seed, difficulty=None, robot=None):
+        """The generated world of ``family`` (one of :func:`world_families`) with this seed,
+        difficulty in [0, 1] (default 0.5) made passable for ``robot`` (default tekbot):
+        ``World("gen:FAMILY:SEED[:DIFFICULTY[:ROBOT]]")``. The same arguments give the same world."""
+        spec = f"gen:{family}:{seed}"
+        if difficulty is not None or robot is not None:
+            spec += f":{0.5 if difficulty is None else difficulty}"
+        if robot is not None:
+            spec += f":{getattr(robot, 'spec', robot)}"
+        return cls(spec)
+
     def __repr__(self):
         return f"World({self.name!r}, {self.width_m} x {self.height_m} m, {self.n_obstacles} obstacles)"
 

@@ -231,6 +231,34 @@ class ControllersEqualSharedVectors(unittest.TestCase):
         self.assertGreater(len(np.unique(keys[saturated])), 10)  # the keys still tell them apart
 
 
+class PolicyMapShowsWhatDecides(unittest.TestCase):
+    def test_simevo_quality_writes_the_preactivation_the_controller_ranks_by(self):
+        # a network whose quality reads 1.0 almost everywhere (issue 21's flat policy.png)
+        policy = qnavpy.Policy.network(np.r_[np.tile([-20.0, 30.0, 5.0, 40.0], 4), 10.0])
+        keys, qualities, rank = qnavpy.Controller(policy).grid()
+        with tempfile.TemporaryDirectory() as work:
+            path = os.path.join(work, "sat.policy")
+            policy.write(path)
+            st, _, err = run_tool(SIMEVO, "quality", path, "--out", work)
+            self.assertEqual(st, 0, err)
+            with open(os.path.join(work, "quality.csv")) as f:
+                header = f.readline().strip().split(",")
+                rows = [dict(zip(header, line.strip().split(","))) for line in f]
+        self.assertEqual(header, ["policy", "level", "distance_m", "dtheta_deg", "quality", "rank", "key"])
+        net = [r for r in rows if r["policy"] != "probabilistic"]
+        self.assertEqual(len(net), 32 * 181)
+        k = keys.astype(np.int64)
+        z = np.where(np.abs(k) < 16384, k / 2048.0, np.sign(k) * (8.0 + (np.abs(k) - 16384) / 128.0))
+        for r in net:
+            lvl, dt = int(r["level"]), int(r["dtheta_deg"])
+            self.assertEqual(r["rank"], "preact")
+            self.assertEqual(r["key"], "%.6f" % z[lvl, dt])
+            self.assertEqual(r["quality"], "%.6f" % (qualities[lvl, dt] / 32768.0))
+        flat = [r for r in net if r["quality"] == "0.999969"]
+        self.assertGreater(len(flat), 1000)
+        self.assertGreater(len({r["key"] for r in flat}), 100)
+
+
 class BadInputRaisesTheToolsLine(unittest.TestCase):
     def assert_same_line(self, call, tool_args, program):
         st, _, err = run_tool(*tool_args)
@@ -290,6 +318,13 @@ class Policies(unittest.TestCase):
             st, out, err = run_tool(os.path.join(os.path.dirname(QNAV_SIM), "..", "host", "policyio",
                                                  "qnav-policy"), "check", path)
             self.assertEqual(st, 0, err)
+
+    def test_a_generated_world_is_named_by_its_full_spec_and_repeats(self):
+        a = qnavpy.World.generated("rooms", 12, 0.25, "tekbot")
+        self.assertEqual(a.name, "gen:rooms:12:0.25:tekbot")
+        b = qnavpy.World("gen:rooms:12:0.25")
+        self.assertEqual((b.name, b.n_obstacles, b.dest), (a.name, a.n_obstacles, a.dest))
+        self.assertIn("rooms", qnavpy.world_families())
 
     def test_weights_round_half_away_from_zero_as_evolution_does(self):
         p = qnavpy.Policy.network([0.5 / 256, -0.5 / 256, 1.5 / 256, -1.5 / 256, 200.0])
