@@ -108,20 +108,28 @@ class SteppedEpisodeEqualsQnavSimRun(unittest.TestCase):
 
     def test_python_controller_deciding_from_observations_is_the_c_step(self):
         # the controller stepped on each observation from Python, its decision given back
-        # as (heading, speed): every decision must equal the one qnav-sim run made
-        rows, line = qnav_sim_trace(self.work, "--seed", "4", "--controller", "vfh")
-        env = qnavpy.Env(seed=4, controller="vfh")
-        ctrl = qnavpy.Controller(controller="vfh", env=env)
+        # as (heading, speed): every decision must equal the one qnav-sim run made (VFH+
+        # with its histogram; the path-quality controller leaving a U-pocket with its
+        # escape memory)
+        cases = [("vfh", "dense", "pioneer3dx", 4, 0), ("body", "gen:pocket:2", "tekbot", 6, 3)]
+        for name, world, robot, seed, episode in cases:
+            with self.subTest(controller=name, world=world):
+                rows, line = qnav_sim_trace(self.work, "--seed", str(seed), "--controller", name, "--env", world,
+                                            "--robot", robot, "--episode", str(episode))
+                env = qnavpy.Env(world, robot, seed=seed, controller=name)
+                ctrl = qnavpy.Controller(controller=name, env=env)
+                flags = []
 
-        def decide(obs):
-            d = ctrl.decide(obs)
-            return d.heading_deg, d.speed
+                def decide(obs):
+                    d = ctrl.decide(obs)
+                    flags.append(d.flags)
+                    return d.heading_deg, d.speed
 
-        env.reset(seed=0)
-        ctrl.reset()
-        mine, _, _, result = stepped_rows(env, 0, decide)
-        self.assertEqual(mine, rows)
-        self.assertEqual(episode_line(0, result), line)
+                ctrl.reset()
+                mine, _, _, result = stepped_rows(env, episode, decide)
+                self.assertEqual(mine, rows)
+                self.assertEqual(episode_line(episode, result), line)
+                self.assertEqual(len(flags), len(rows) - 1)
 
     def test_run_episode_in_c_equals_the_stepped_episode(self):
         env = qnavpy.Env("dense", "tekbot", seed=2)
