@@ -15,11 +15,17 @@ Everything runs in the same C code as the command-line tools; errors raise
 
 import os as _os
 
-# Installed (share/qnav/python/qnavpy): the robots and environments are in share/qnav/data.
-# In a build tree the library knows its source tree's data/ folder.
-_data = _os.path.join(_os.path.dirname(_os.path.abspath(__file__)), "..", "..", "data")
-if not _os.environ.get("QNAV_DATA_DIR") and _os.path.isdir(_os.path.join(_data, "robots")):
-    _os.environ["QNAV_DATA_DIR"] = _os.path.normpath(_data)
+# Installed, the robots and environments are in PREFIX/share/qnav/data (_install.py says
+# where from here); in a build tree there is no _install.py and the library knows its
+# source tree's data/ folder. QNAV_DATA_DIR, when set, wins as for every qnav program.
+try:
+    from ._install import DATA_FROM_PACKAGE as _DATA_FROM_PACKAGE
+except ImportError:
+    _DATA_FROM_PACKAGE = None
+if _DATA_FROM_PACKAGE and not _os.environ.get("QNAV_DATA_DIR"):
+    _data = _os.path.join(_os.path.dirname(_os.path.abspath(__file__)), _DATA_FROM_PACKAGE)
+    if _os.path.isdir(_os.path.join(_data, "robots")):
+        _os.environ["QNAV_DATA_DIR"] = _os.path.normpath(_data)
 
 from ._lib import QnavError, version  # noqa: E402
 from .core import Controller, Decision, Policy, Robot, World, controller_names, world_families  # noqa: E402
