@@ -1,5 +1,5 @@
 #!/bin/sh
-# The README's, docs/hil.md's and docs/cluster.md's example blocks, run verbatim (docs.examples_run_verbatim):
+# The README's, docs/hil.md's, docs/cluster.md's and docs/python.md's example blocks, run verbatim (docs.examples_run_verbatim):
 # each block marked `<!-- doc-example: NAME ... -->` is extracted, written to WORK/NAME.sh
 # and run with sh in WORK (a fresh folder) with the installed tree PREFIX/bin on PATH and
 # no QNAV_* variables, inside a private network namespace (loopback up, multicast routed to
@@ -22,7 +22,7 @@ extract() { # FILE NAME -> the fenced block after the marker
         inside { print }' "$1"
 }
 for pair in "$src/README.md readme" "$src/docs/hil.md hil-sil" "$src/docs/cluster.md cluster-parallel" \
-            "$src/docs/cluster.md cluster-sweep"; do
+            "$src/docs/cluster.md cluster-sweep" "$src/README.md readme-python" "$src/docs/python.md python-quick"; do
     set -- $pair
     extract "$1" "$2" > "$work/$2.sh"
     [ -s "$work/$2.sh" ] || { echo "run_examples.sh: no block '$2' in $1" >&2; exit 1; }
@@ -32,7 +32,7 @@ done
 
 fail() { echo "run_examples.sh: $*" >&2; for f in "$work"/*.err; do echo "--- $f"; tail -n 5 "$f"; done >&2; exit 1; }
 r=$work/runs
-[ "$(grep -c '^exit 0$' "$work/status.txt")" -eq 4 ] || fail "a block failed: $(tr '\n' ' ' < "$work/status.txt")"
+[ "$(grep -c '^exit 0$' "$work/status.txt")" -eq 6 ] || fail "a block failed: $(tr '\n' ' ' < "$work/status.txt")"
 [ "$(grep -c ' Fig\. ' "$work/readme.out")" -eq "$(grep -l '^figure = ' "$src"/experiments/*.toml | wc -l)" ] || fail "simevo list"
 [ -s "$r/q/open-to-dense/summary.md" ] || fail "no summary.md from simevo run"
 head -c 4 "$r/q/open-to-dense/learning.png" | grep -q PNG || fail "no learning.png"
@@ -49,4 +49,14 @@ grep -q '^complete$' "$r/gp/open-to-dense/STATUS" || fail "cluster.md's merged e
 grep -q '^runs/sw/noise: merged 2 experiments$' "$work/cluster-sweep.out" || fail "cluster.md's sweep was not merged"
 grep -q '^identical$' "$work/cluster-sweep.out" || fail "cluster.md's sweep member differs from the experiment run directly"
 grep -q '^vary = noise=0.05$' "$r/sw/open-to-dense.noise-0.05/run.txt" || fail "the sweep member's run.txt has no variation"
-echo "run_examples.sh: README, docs/hil.md and docs/cluster.md examples ran verbatim"
+# qnavpy: evaluate's mean R is simevo eval's (README), the quick start's too (docs/python.md)
+py_r=$(sed -n 's/^mean R \([-0-9.]*\)$/\1/p' "$work/readme-python.out")
+[ -n "$py_r" ] && [ "$py_r" = "$(sed -n 's/^episodes 20  mean R \([-0-9.]*\) .*/\1/p' "$work/readme-python.out")" ] \
+    || fail "the README's qnavpy.evaluate differs from simevo eval"
+grep -q '^stepped: [0-9]* ticks, reached True R [-0-9.]*$' "$work/python-quick.out" || fail "python.md's stepped episode"
+[ "$(sed -n 's/^evaluate: mean R \([-0-9.]*\),.*/\1/p' "$work/python-quick.out")" = \
+  "$(sed -n 's/^episodes 20  mean R \([-0-9.]*\) .*/\1/p' "$work/python-quick.out")" ] \
+    || fail "python.md's evaluate differs from simevo eval"
+head -c 4 "$r/py/trajectory.png" | grep -q PNG || fail "python.md's example drew no trajectory.png"
+[ -s "$r/py/best.policy" ] || fail "python.md's example wrote no best.policy"
+echo "run_examples.sh: README, docs/hil.md, docs/cluster.md and docs/python.md examples ran verbatim"

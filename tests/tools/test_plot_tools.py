@@ -86,6 +86,38 @@ class CommandLine(unittest.TestCase):
             self.assertEqual(r.stderr.strip(), f"plot_policy.py: {d}/quality.csv: No such file or directory")
 
 
+class PolicyPictureShowsWhatDecides(unittest.TestCase):
+    """Issue 21: a saturated network's quality is 0.999969 in every cell, so policy.png was
+    flat; the controller ranks by the output's pre-activation, and the picture now shows it."""
+
+    def saturated_csv(self, folder, rank="preact"):
+        path = os.path.join(folder, "quality.csv")
+        with open(path, "w") as f:
+            f.write("policy,level,distance_m,dtheta_deg,quality,rank,key\n")
+            for lvl in range(4):
+                for dt in range(181):
+                    f.write(f"net,{lvl},{lvl * 0.5:.1f},{dt},0.999969,{rank},{20.0 + lvl - dt / 10:.6f}\n")
+        return path
+
+    def test_a_saturated_network_is_drawn_by_its_preactivation(self):
+        import plot_policy  # TOOLS is on sys.path
+        with tempfile.TemporaryDirectory() as d:
+            fig = plot_policy.draw(plot_policy.read_quality(self.saturated_csv(d)))
+            drawn = fig.axes[0].images[0].get_array()
+            self.assertEqual(drawn.shape, (4, 181))
+            self.assertAlmostEqual(float(drawn[3, 0]), 23.0)
+            self.assertAlmostEqual(float(drawn[0, 180]), 2.0)
+            self.assertIn("pre-activation", fig.axes[1].get_ylabel())
+
+    def test_an_unknown_rank_is_one_line_naming_the_row(self):
+        with tempfile.TemporaryDirectory() as d:
+            self.saturated_csv(d, rank="bogus")
+            r = run_script("plot_policy.py", d, os.path.join(d, "p.png"))
+            self.assertEqual(r.returncode, 1)
+            self.assertEqual(r.stderr.strip(),
+                             f"plot_policy.py: {d}/quality.csv:2: rank 'bogus' is not preact or quality")
+
+
 class WithoutMatplotlib(unittest.TestCase):
     """Issue 20: run by a python3 that lacks matplotlib (here: -S, no site-packages), each
     plot script printed a traceback; now one line naming the interpreter and exit 1."""

@@ -1259,22 +1259,42 @@ void run_plot(const RunOptions &opt, const std::string &script, const std::strin
     }
 }
 
+namespace {
+/* What a rank key stands for in real units: the output pre-activation z for
+ * QNAV_RANK_PREACT (Q5.11 below the knee |z| = 8, 1/128 per key step beyond it;
+ * docs/qformats.md), the quality for QNAV_RANK_QUALITY. */
+double key_value(qnav_qkey_t key, qnav_rank_t rank)
+{
+    if (rank == QNAV_RANK_QUALITY) {
+        return key / 32768.0;
+    }
+    const int32_t a = key < 0 ? -static_cast<int32_t>(key) : key;
+    const double z = a < 16384 ? a / 2048.0 : 8.0 + (a - 16384) / 128.0;
+    return key < 0 ? -z : z;
+}
+} // namespace
+
 std::string quality_table_csv(const std::vector<std::pair<std::string, qnav_policy_t>> &policies,
                               const qnav_ctrl_config_t &ccfg)
 {
     std::ostringstream o;
-    o << "policy,level,distance_m,dtheta_deg,quality\n";
+    // quality: what sets the speed; key: what the argmax ranks paths by (issue 21: a
+    // saturated network's quality is flat where its pre-activation still decides)
+    o << "policy,level,distance_m,dtheta_deg,quality,rank,key\n";
     for (auto &pp : policies) {
         qnav_ctrl_t ctrl;
         if (qnav_ctrl_init(&ctrl, &ccfg, &pp.second) != QNAV_OK) {
             throw UserError("quality map: the controller refused policy " + pp.first);
         }
+        const qnav_rank_t rank = qnav_ctrl_rank(&ctrl);
         for (uint32_t level = 0; level < QNAV_DIST_LEVELS; ++level) {
             const double dist = static_cast<double>(level) / (QNAV_DIST_LEVELS - 1) * ccfg.max_range_mm / 1000.0;
             for (uint32_t dt = 0; dt <= QNAV_DTHETA_MAX; ++dt) {
+                const qnav_qkey_t k = qnav_ctrl_key(&ctrl, static_cast<uint8_t>(level), static_cast<uint8_t>(dt));
                 const qnav_q1_15_t q = qnav_ctrl_quality(&ctrl, static_cast<uint8_t>(level), static_cast<uint8_t>(dt));
                 char b[200];
-                std::snprintf(b, sizeof b, "%s,%u,%.4f,%u,%.6f\n", pp.first.c_str(), level, dist, dt, q / 32768.0);
+                std::snprintf(b, sizeof b, "%s,%u,%.4f,%u,%.6f,%s,%.6f\n", pp.first.c_str(), level, dist, dt,
+                              q / 32768.0, rank == QNAV_RANK_PREACT ? "preact" : "quality", key_value(k, rank));
                 o << b;
             }
         }
