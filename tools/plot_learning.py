@@ -7,8 +7,9 @@ Reads EXPERIMENT_DIR/curves.csv and summary.json (written by `simevo run`) and d
 condition, the mean over runs with its 95% confidence band of (left) the population's best
 fitness, (middle) the R of the candidates (binned) and (right) the fraction of the
 candidates' episodes that reached the destination (binned); the two references, the
-probabilistic policy (dashed) and VFH+ (dotted), are horizontal bands (their held-out mean
-and 95% CI). Writes EXPERIMENT_DIR/learning.png
+probabilistic policy (dashed) and VFH+ (dotted), are horizontal bands (their mean and 95%
+CI on the held-out episodes). The legends and the arrival panel's title say which line is
+the candidates' (training episodes) and which a reference's (held-out episodes). Writes EXPERIMENT_DIR/learning.png
 unless OUT.png is given. Needs matplotlib only.
 """
 import os
@@ -19,25 +20,16 @@ from plotcommon import import_pyplot, parse_args, read_csv, read_json, run, save
 plt = import_pyplot("plot_learning.py")
 
 
-def main(argv):
-    args = parse_args(argv, "plot_learning.py", "learning.png")
-    if args is None:
-        return 2
-    exp, out = args
-    keys = ("mean", "ci_low", "ci_high", "best_mean", "best_ci_low", "best_ci_high",
-            "arrival_mean", "arrival_ci_low", "arrival_ci_high")
-    summary = read_json(os.path.join(exp, "summary.json"))
-    curves = {}
+KEYS = ("mean", "ci_low", "ci_high", "best_mean", "best_ci_low", "best_ci_high",
+        "arrival_mean", "arrival_ci_low", "arrival_ci_high")
 
-    def add(row):
-        c = curves.setdefault(row["condition"], {k: [] for k in ("episode",) + keys})
-        c["episode"].append(int(row["episode"]))
-        for k in keys:
-            c[k].append(float(row[k]) if row[k] != "null" else float("nan"))
 
-    read_csv(os.path.join(exp, "curves.csv"), add)
-
-    fig, axes = plt.subplots(1, 3, figsize=(16, 4.6), dpi=110, layout="constrained")
+def draw(summary, curves):
+    """The figure of summary.json and curves.csv's columns ({condition: {column: [values]}}).
+    The curves are the candidates' during evolution; the horizontal lines are the references
+    on the held-out episodes. Each panel says which is which in its legend, the arrival panel
+    also in its title, since its two kinds of arrival are read against each other."""
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.9), dpi=110, layout="constrained")
     # the references, one row each in simevo's table (summary.json "references")
     references = summary.get("references") or [
         {"label": "probabilistic", "plot_name": "probabilistic (held out)", "plot_style": "--", "plot_color": "tab:gray"},
@@ -51,23 +43,30 @@ def main(argv):
         colors[k] = palette[i % len(palette)]
     per_candidate = summary.get("episodes_per_candidate", 1)
     panels = (
-        (axes[0], "best", "population's best fitness R (mean over runs)", "final_mean", 1.0),
+        (axes[0], "best", "population's best fitness R (mean over runs)", "final_mean", 1.0,
+         "best fitness during evolution", "R on held-out episodes"),
         (axes[1], "", f"candidates' R ({summary['curve_bin']}-episode bins, k = {per_candidate}, mean over runs)",
-         "final_mean", 1.0),
-        (axes[2], "arrival", "candidates' episodes that arrived (%, binned, mean over runs)", "arrival", 100.0),
+         "final_mean", 1.0, "candidates' R during evolution", "R on held-out episodes"),
+        (axes[2], "arrival", "episodes that arrived (%)", "arrival", 100.0,
+         "arrival: candidates' training episodes (curves, binned, mean over runs)\n"
+         "vs. the references on held-out episodes (horizontal lines)", "arrival on held-out episodes"),
     )
-    for ax, prefix, ylabel, ref, scale in panels:
-        m_key, lo_key, hi_key = (prefix + "_mean", prefix + "_ci_low", prefix + "_ci_high") if prefix else keys[:3]
+    for ax, prefix, ylabel, ref, scale, title, ref_what in panels:
+        m_key, lo_key, hi_key = (prefix + "_mean", prefix + "_ci_low", prefix + "_ci_high") if prefix else KEYS[:3]
         for k in transfer + ["direct"]:
             if k not in curves:
                 continue
             c = curves[k]
             label = k.replace("transfer-", "transfer from ") if k != "direct" else "direct (random population)"
+            if prefix == "arrival":
+                label += ": candidates"
             ax.plot(c["episode"], [v * scale for v in c[m_key]], color=colors[k], lw=1.8, label=label)
             ax.fill_between(c["episode"], [v * scale for v in c[lo_key]], [v * scale for v in c[hi_key]],
                             color=colors[k], alpha=0.2, lw=0)
         for r in references:
-            ref_label, ls, name = r["label"], r["plot_style"], r["plot_name"]
+            ref_label, ls = r["label"], r["plot_style"]
+            # the table's plot name ends in "(held out)"; the legend says on what
+            name = r["plot_name"].replace(" (held out)", "") + ": " + ref_what
             p = conds.get(ref_label)
             if p and ref == "final_mean" and p["final_mean"] is not None:
                 mean = p["final_mean"]
@@ -78,15 +77,35 @@ def main(argv):
                 a = p["arrival"]
                 ax.axhline(100 * a["mean"], color=colors[ref_label], ls=ls, lw=1.5, label=name)
                 ax.axhspan(100 * a["ci95_low"], 100 * a["ci95_high"], color=colors[ref_label], alpha=0.15, lw=0)
+        ax.set_title(title, fontsize=9)
         ax.set_xlabel("episode in the target situation")
         ax.set_ylabel(ylabel, fontsize=9)
         ax.grid(alpha=0.3)
     axes[2].set_ylim(-2, 102)
-    axes[0].legend(fontsize=8, loc="lower right")
+    axes[0].legend(fontsize=7, loc="lower right")
+    axes[2].legend(fontsize=7, loc="lower right")
     fig_ref = f" ({summary['figure']})" if summary.get("figure") else ""
     fig.suptitle(f"{summary['title'] or summary['name']}{fig_ref}: "
                  f"{summary['runs']} runs, preset {summary['preset']}; bands: 95% CI", fontsize=10)
-    save(fig, out)
+    return fig
+
+
+def main(argv):
+    args = parse_args(argv, "plot_learning.py", "learning.png")
+    if args is None:
+        return 2
+    exp, out = args
+    summary = read_json(os.path.join(exp, "summary.json"))
+    curves = {}
+
+    def add(row):
+        c = curves.setdefault(row["condition"], {k: [] for k in ("episode",) + KEYS})
+        c["episode"].append(int(row["episode"]))
+        for k in KEYS:
+            c[k].append(float(row[k]) if row[k] != "null" else float("nan"))
+
+    read_csv(os.path.join(exp, "curves.csv"), add)
+    save(draw(summary, curves), out)
     return 0
 
 

@@ -132,10 +132,26 @@ def write_csv(folder, decoded):
     return written
 
 
+def span(values, least_m=1.0, margin=0.08):
+    """Axis limits around values: a margin on each side, and at least least_m wide so that
+    a robot that hardly moved is not drawn at a microscopic scale."""
+    lo, hi = min(values), max(values)
+    half = max(hi - lo, least_m) * (0.5 + margin)
+    mid = (lo + hi) / 2
+    return mid - half, mid + half
+
+
 def plot(out, decoded):
     plt = plotcommon.import_pyplot("qnav_log.py")  # one line, not a traceback, without matplotlib
 
-    fig, (ax_xy, ax_cmd, ax_link) = plt.subplots(1, 3, figsize=(13, 4), dpi=110, layout="constrained")
+    # The trajectory gets the left half at equal scale in x and y (a route is often long and
+    # narrow: fitted into a third of a wide strip it became a sliver); the time series share
+    # the right half.
+    fig = plt.figure(figsize=(13, 6.5), dpi=110, layout="constrained")
+    grid = fig.add_gridspec(2, 2, width_ratios=[1, 1.1])
+    ax_xy = fig.add_subplot(grid[:, 0])
+    ax_cmd = fig.add_subplot(grid[0, 1])
+    ax_link = fig.add_subplot(grid[1, 1], sharex=ax_cmd)
     t0 = min(rows[0][0] for rows in decoded.values())
     poses = decoded.get("QNAV_POSE", [])
     if poses:
@@ -145,10 +161,15 @@ def plot(out, decoded):
         ax_xy.plot(xs[0], ys[0], "go", label="start")
         ax_xy.plot(xs[-1], ys[-1], "r^" if poses[-1][1].reached else "rx",
                    label="reached" if poses[-1][1].reached else "end")
-        ax_xy.legend(fontsize=7)
+        ax_xy.legend(fontsize=8, loc="best")
+        ax_xy.set_xlim(*span(xs))
+        ax_xy.set_ylim(*span(ys))
+        ax_xy.grid(alpha=0.3)
     else:
         ax_xy.text(0.5, 0.5, "no QNAV_POSE in this log", ha="center", transform=ax_xy.transAxes)
-    ax_xy.set(title="trajectory", xlabel="x (m)", ylabel="y (m)", aspect="equal")
+    # equal scale; the limits (not the box) grow to fill the panel
+    ax_xy.set_aspect("equal", adjustable="datalim")
+    ax_xy.set(title="trajectory (world frame)", xlabel="x (m)", ylabel="y (m)")
     cmds = decoded.get("QNAV_COMMAND", [])
     if cmds:
         ts = [(u - t0) / 1e6 for u, _ in cmds]
@@ -160,7 +181,9 @@ def plot(out, decoded):
         stops = [t for t, (_, m) in zip(ts, cmds) if m.stop_reason != 0]
         if stops:
             ax_cmd.plot(stops, [0] * len(stops), "rx", label="stop")
-        ax_cmd.legend(fontsize=7, loc="upper left")
+        # one legend for both y axes, on the twin (drawn above the heading's axes)
+        handles = ax_cmd.get_legend_handles_labels()[0] + ax_sp.get_legend_handles_labels()[0]
+        ax_sp.legend(handles=handles, fontsize=7, loc="lower left", framealpha=0.9)
     ax_cmd.set(title="commands", xlabel="time (s)", ylabel="heading (deg)")
     status = decoded.get("QNAV_LINK_STATUS", [])
     if status:

@@ -10,7 +10,8 @@
  * work, 1 after). Also the defects of issue 11: temporary files never follow a planted
  * symlink, a plot script dies with simevo, zero episodes and NaN noise are refused, noise
  * above the simulator's 1 in a file fails at its line before any output, the progress
- * line fits the terminal, unknown options and subcommands are named. Sweeps (issue 12): a
+ * line fits the terminal (at 80 columns with every best R), unknown options and subcommands
+ * are named. Sweeps (issue 12): a
  * sweep's shares merge to the files of its member experiment run directly with the same
  * --vary, `simevo slurm` writes each member's scripts and one submit.sh for all, and bad
  * sweep files fail at their line.
@@ -19,6 +20,8 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+
+#include <regex> /* before cmocka.h, whose fail() macro it would meet */
 
 extern "C" {
 #include <cmocka.h>
@@ -39,6 +42,7 @@ extern "C" {
 #include <map>
 #include <string>
 #include <thread>
+#include <vector>
 #include <pty.h>
 #include <sys/file.h>
 #include <sys/ioctl.h>
@@ -1037,14 +1041,13 @@ static void test_sweep_file_problems_are_one_line_with_file_and_line(void **stat
     assert_true(file_exists(join_path(out, "tiny.sectors-100/run.txt")));
 }
 
-/* On a 40-column terminal every progress redraw fits in 39 columns (a longer line wraps,
- * and each redraw then scrolls a line instead of replacing it). */
-static void test_progress_line_is_cut_to_the_terminal_width(void **state)
+/* The progress redraws of simevo running tiny.toml on a terminal of the given width: the
+ * pieces between "\r" and "\n", without the erase-line escape. */
+static std::vector<std::string> progress_redraws(unsigned short columns)
 {
-    (void)state;
     const std::string root = make_tmp_dir();
     struct winsize ws {};
-    ws.ws_col = 40;
+    ws.ws_col = columns;
     ws.ws_row = 24;
     int master = -1, slave = -1;
     assert_int_equal(openpty(&master, &slave, nullptr, nullptr, &ws), 0);
@@ -1077,7 +1080,7 @@ static void test_progress_line_is_cut_to_the_terminal_width(void **state)
     }
     close(master);
     assert_int_equal(wait_exit(pid), 0);
-    std::size_t pieces = 0, longest = 0;
+    std::vector<std::string> pieces;
     std::size_t start = 0;
     for (std::size_t i = 0; i <= text.size(); ++i) {
         if (i == text.size() || text[i] == '\r' || text[i] == '\n') {
@@ -1085,20 +1088,61 @@ static void test_progress_line_is_cut_to_the_terminal_width(void **state)
             if (piece.rfind("\033[K", 0) == 0) {
                 piece.erase(0, 3);
             }
-            std::size_t chars = 0;
-            for (char c : piece) {
-                chars += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
-            }
-            if (chars > 0) {
-                ++pieces;
-                longest = std::max(longest, chars);
+            if (!piece.empty()) {
+                pieces.push_back(piece);
             }
             start = i + 1;
         }
     }
-    print_message("%zu progress redraws, the longest %zu columns\n", pieces, longest);
-    assert_true(pieces >= 1);
-    assert_int_equal(longest, 39); /* cut (the whole line is longer), never more */
+    return pieces;
+}
+
+static std::size_t columns_of(const std::string &s)
+{
+    std::size_t chars = 0;
+    for (char c : s) {
+        chars += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+    }
+    return chars;
+}
+
+/* On a 40-column terminal every progress redraw fits in 39 columns (a longer line wraps,
+ * and each redraw then scrolls a line instead of replacing it). */
+static void test_progress_line_is_cut_to_the_terminal_width(void **state)
+{
+    (void)state;
+    std::size_t longest = 0;
+    const std::vector<std::string> pieces = progress_redraws(40);
+    for (const std::string &p : pieces) {
+        longest = std::max(longest, columns_of(p));
+    }
+    print_message("%zu progress redraws, the longest %zu columns\n", pieces.size(), longest);
+    assert_true(pieces.size() >= 1);
+    assert_int_equal(longest, 39); /* cut (even the shortest form is longer), never more */
+}
+
+/* Issue 21: at 80 columns the line was cut inside "best R:", so no condition's best R was
+ * ever seen. Now the name, counts and rate give way first: the last redraw fits in 79
+ * columns and shows the best R of each of tiny.toml's three conditions (its label, full or
+ * abbreviated as "s-open", and a number). */
+static void test_progress_line_at_80_columns_shows_every_best_r(void **state)
+{
+    (void)state;
+    const std::vector<std::string> pieces = progress_redraws(80);
+    assert_true(pieces.size() >= 1);
+    for (const std::string &p : pieces) {
+        assert_true(columns_of(p) <= 79);
+    }
+    const std::string &last = pieces.back();
+    print_message("last redraw: %s\n", last.c_str());
+    assert_true(std::regex_search(last, std::regex("(^| )(best )?R: ")));
+    for (const char *label : {"direct", "(source|s)-open", "(transfer|t)-open"}) {
+        const std::regex value(std::string(" ") + label + " -?[0-9]+\\.[0-9]+( |$)");
+        if (!std::regex_search(last, value)) {
+            fail_msg("no best R of %s in \"%s\"", label, last.c_str());
+        }
+    }
+    assert_true(last.find("100") != std::string::npos); /* the percentage is kept */
 }
 
 int main(int argc, char **argv)
@@ -1124,6 +1168,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_program_refuses_zero_episodes_and_impossible_noise),
         cmocka_unit_test(test_experiment_file_problems_are_found_before_any_output),
         cmocka_unit_test(test_progress_line_is_cut_to_the_terminal_width),
+        cmocka_unit_test(test_progress_line_at_80_columns_shows_every_best_r),
         cmocka_unit_test(test_sweep_shares_merge_to_the_member_experiment_run_directly_with_its_variation),
         cmocka_unit_test(test_slurm_sweep_writes_each_members_scripts_and_one_submit_for_all),
         cmocka_unit_test(test_sweep_file_problems_are_one_line_with_file_and_line),

@@ -1,7 +1,9 @@
 """The plot scripts (tools/plot_policy.py, tools/plot_learning.py through tools/plotcommon.py):
 argparse command line (--help, --version, bad usage exits 2), the plot written in the format
-its file name asks for, and temporary files created exclusively so that a symlink planted
-beside the output is never followed."""
+its file name asks for, temporary files created exclusively so that a symlink planted
+beside the output is never followed, and what the pictures tell a reader (issue 21):
+policy.png by what decides, learning.png's curves and references named, episodes.png with
+a legend and axes in metres."""
 import os
 import subprocess
 import sys
@@ -116,6 +118,57 @@ class PolicyPictureShowsWhatDecides(unittest.TestCase):
             self.assertEqual(r.returncode, 1)
             self.assertEqual(r.stderr.strip(),
                              f"plot_policy.py: {d}/quality.csv:2: rank 'bogus' is not preact or quality")
+
+
+def tiny_summary():
+    return {"title": "t", "name": "t", "figure": None, "runs": 2, "preset": "quick", "curve_bin": 10,
+            "episodes_per_candidate": 3, "robot_radius_m": 0.1,
+            "conditions": [{"label": "probabilistic", "final_mean": 0.5, "final_ci95": 0.1,
+                            "arrival": {"mean": 0.9, "ci95_low": 0.8, "ci95_high": 0.95}}]}
+
+
+class LearningPictureSaysWhatIsHeldOut(unittest.TestCase):
+    """Issue 21: the arrival panel drew the candidates' (training) arrival and the references'
+    held-out arrival side by side without a word; now its legend and title say which is which."""
+
+    def test_arrival_panel_names_candidates_and_held_out_references(self):
+        import plot_learning
+        col = {k: [0.4, 0.6] for k in plot_learning.KEYS}
+        col["episode"] = [10, 20]
+        fig = plot_learning.draw(tiny_summary(), {"direct": col, "transfer-open": dict(col)})
+        arrival = fig.axes[2]
+        labels = [t.get_text() for t in arrival.get_legend().get_texts()]
+        self.assertIn("direct (random population): candidates", labels)
+        self.assertIn("transfer from open: candidates", labels)
+        self.assertIn("probabilistic: arrival on held-out episodes", labels)
+        self.assertIn("held-out", arrival.get_title())
+        self.assertIn("training", arrival.get_title())
+        self.assertEqual(arrival.get_ylabel(), "episodes that arrived (%)")
+        plt.close(fig)
+
+
+class EpisodesPictureHasLegendAndScale(unittest.TestCase):
+    """Issue 21: episodes.png had neither a legend nor a scale."""
+
+    def test_legend_names_every_mark_and_axes_are_in_metres(self):
+        import plot_episodes
+        env = {"arena": {"width_m": 4.0, "height_m": 3.0}, "destination": {"x_m": 3, "y_m": 2, "radius_m": 0.3}}
+        ep = {"x": [0.5, 1.0, 1.5], "y": [0.5, 1.0, 1.2], "recovering": [False, True, False],
+              "collided": [False, True, False], "R": 1.0, "reached": False, "tau_c": 3}
+        fig = plot_episodes.draw(tiny_summary(), env, {"direct": {0: ep, 1: ep}, "vfh": {0: ep}})
+        legends = [a.get_legend() for a in fig.axes if a.get_legend() is not None]
+        self.assertEqual(len(legends), 1)
+        labels = [t.get_text() for t in legends[0].get_texts()]
+        for want in ("obstacle", "destination", "path", "path while recovering from a collision", "collision",
+                     "start", "robot at the end", "start zone"):
+            self.assertIn(want, labels)
+        panels = [a for a in fig.axes if a.get_title()]
+        self.assertEqual(len(panels), 3)
+        self.assertEqual([a.get_ylabel() for a in panels], ["y (m)", "", "y (m)"])
+        # the lowest panel of each column names x; column 2 ends in row 1
+        self.assertEqual([a.get_xlabel() for a in panels], ["", "x (m)", "x (m)"])
+        self.assertGreater(len(panels[0].get_xticks()), 1)  # a scale, not bare panels
+        plt.close(fig)
 
 
 class WithoutMatplotlib(unittest.TestCase):
