@@ -90,20 +90,19 @@ static int8_t choose_side(const qnav_clearance_t *c, const uint8_t *lvl, uint16_
     return 1;
 }
 
-/* How near the destination (range_mm away) the free way toward it ends: range less how far
- * the robot's centre can go toward it before its margin reaches the reading of the sector
- * that looks that way (0: the destination is in plain view). The whole sector's reading,
- * not the path's painted level: with readings placed on the central part of their wedge
- * (wedge_pct) the paths between sector centres are left clear at long range. */
+/* How near the destination (range_mm away) the clear way toward it ends: range less how
+ * far the robot's centre can go toward it before its margin reaches the reading of the
+ * sector that looks that way (0: the destination is in plain view). The whole sector's
+ * reading, not the path's painted level: with readings placed on the central part of their
+ * wedge (wedge_pct) the paths between sector centres are left clear at long range. */
 static uint16_t rest_mm(const qnav_clearance_t *c, const qnav_ctrl_input_t *in, uint16_t goal,
                         uint16_t range_mm)
 {
-    uint16_t k = (uint16_t)(((uint32_t)goal * c->n_sectors + QNAV_PATHS / 2u) / QNAV_PATHS);
-    uint32_t r = in->ranges_mm[k < c->n_sectors ? k : 0u];
-    uint32_t free;
+    uint32_t r = in->ranges_mm[qnav_ctrl_sector_of_path(c->n_sectors, goal)];
+    uint32_t clear_mm;
     r = (r < c->max_range_mm ? r : c->max_range_mm) + c->sensor_offset_mm;
-    free = r > c->margin_mm ? r - c->margin_mm : 0u;
-    return (uint16_t)(range_mm > free ? range_mm - free : 0u);
+    clear_mm = r > c->margin_mm ? r - c->margin_mm : 0u;
+    return (uint16_t)(range_mm > clear_mm ? range_mm - clear_mm : 0u);
 }
 
 static uint16_t follow_limit(const qnav_clearance_t *c, uint8_t tries)
@@ -137,7 +136,7 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
         return goal;
     }
     if (e->side != 0) {
-        /* DistBug's leave rule (Kamon & Rivlin 1997): leave when the free way toward the
+        /* DistBug's leave rule (Kamon & Rivlin 1997): leave when the clear way toward the
          * destination ends nearer to it, by a step, than it did at the hit point */
         if ((uint32_t)rest_mm(c, in, goal, range) + progress <= e->hit_mm &&
             !blocked(c, lvl, (int16_t)goal)) {

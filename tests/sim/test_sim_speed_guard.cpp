@@ -82,7 +82,7 @@ static GuardRun drive_at_wall(const char *robot, bool guard) {
     while (!st.done) {
         qnav_sim_scan_t s;
         assert_int_equal(qnav_sim_scan(t.sim, &s), QNAV_SIM_OK);
-        const qnav_ctrl_input_t in = {s.ranges_mm, s.goal_bearing_cdeg, s.prev_heading_cdeg};
+        const qnav_ctrl_input_t in = {s.ranges_mm, s.goal_bearing_cdeg, s.prev_heading_cdeg, 0, {}}; // range 0: no escape
         qnav_ctrl_output_t out;
         qnav_nav_step(nav, &in, &out);
         if (out.flags & QNAV_FLAG_SPEED_GUARD) ++run.guard_ticks;
@@ -153,7 +153,7 @@ static int count_guard(const char *env, uint16_t sectors) {
             while (!st.done) {
                 qnav_sim_scan_t s;
                 qnav_sim_scan(t.sim, &s);
-                const qnav_ctrl_input_t in = {s.ranges_mm, s.goal_bearing_cdeg, s.prev_heading_cdeg};
+                const qnav_ctrl_input_t in = {s.ranges_mm, s.goal_bearing_cdeg, s.prev_heading_cdeg, 0, {}}; // range 0: no escape
                 qnav_ctrl_output_t out;
                 qnav_nav_step(nav, &in, &out);
                 ++ticks;

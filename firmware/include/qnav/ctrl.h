@@ -112,8 +112,8 @@ typedef struct {
 typedef struct {
     uint16_t best_mm;   /* nearest the robot came to the destination while going to it, mm;
                            0: not yet */
-    uint16_t hit_mm;    /* following: how near the destination the free way toward it
-                           ended when this follow began (best_mm less the sonar's free
+    uint16_t hit_mm;    /* following: how near the destination the clear way toward it
+                           ended when this follow began (best_mm less the sonar's clear
                            distance that way), mm; going: the range where the last follow
                            ended, mm */
     uint16_t ticks;     /* going: ticks without progress; following: ticks on this side */
