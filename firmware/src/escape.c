@@ -15,6 +15,10 @@
 #define QNAV_ESCAPE_NEW_MARGINS 4u
 /* Longest follow, in ticks, however many tries were given up (about 109 s). */
 #define QNAV_ESCAPE_MAX_FOLLOW 1092u
+/* A lost boundary is approached until a path clears its nearest reading by this many levels. */
+#define QNAV_ESCAPE_SKIRT_STEP 3u
+/* Nearer the boundary than half the follow level: this many degrees more away per level. */
+#define QNAV_ESCAPE_AWAY_DEG 10
 
 qnav_status_t qnav_escape_setup(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
 {
@@ -47,30 +51,41 @@ static uint8_t blocked(const qnav_clearance_t *c, const uint8_t *lvl, int16_t p)
 
 /*
  * The free path that skirts the boundary on side s (+1: obstacle on the right, the robot
- * goes round it counter-clockwise; -1: mirrored), from the previous heading h. ref points
- * at the side (h - 90 s). When ref is blocked, the first free path turning away from the
- * side; when it is free (the boundary fell away: a corner), the free path next to the
- * first blocked one turning toward the side, within half a turn; with no boundary there,
- * 45 degrees toward the side, to find it again. Everything blocked: turn round.
+ * goes round it counter-clockwise; -1: mirrored). Reference: the nearest reading on that
+ * side (the lowest level from straight ahead round to straight behind), so the choice
+ * moves with the boundary, not with the last command. From it, turning away from the
+ * side, the first path whose level clears the follow level, or the nearest reading by a
+ * step when that is farther (the boundary was lost: turn back toward it).
  */
-static uint16_t skirt(const qnav_clearance_t *c, const uint8_t *lvl, int16_t h, int8_t s)
+static uint16_t skirt(const qnav_clearance_t *c, const uint8_t *lvl, int8_t s)
 {
-    int16_t ref = (int16_t)(h - 90 * s);
+    int16_t w = (int16_t)(-90 * s);
+    uint8_t lw = 255u;
+    uint8_t need;
     int16_t k;
-    if (blocked(c, lvl, ref)) {
-        for (k = 1; k < (int16_t)QNAV_PATHS; ++k) {
-            if (!blocked(c, lvl, (int16_t)(ref + s * k))) {
-                return wrap((int16_t)(ref + s * k));
-            }
-        }
-        return wrap((int16_t)(h + 180));
-    }
-    for (k = 1; k <= (int16_t)QNAV_DTHETA_MAX; ++k) {
-        if (blocked(c, lvl, (int16_t)(ref - s * k))) {
-            return wrap((int16_t)(ref - s * k + s));
+    for (k = 1; k < (int16_t)QNAV_DTHETA_MAX; ++k) {
+        uint8_t l = lvl[wrap((int16_t)(-s * k))];
+        if (l < lw) {
+            lw = l;
+            w = (int16_t)(-s * k);
         }
     }
-    return wrap((int16_t)(ref + 45 * s));
+    need = (uint8_t)(lw + QNAV_ESCAPE_SKIRT_STEP);
+    if (need < c->esc_free_level) {
+        need = c->esc_free_level;
+    }
+    if (need > QNAV_DIST_LEVELS - 1u) {
+        need = QNAV_DIST_LEVELS - 1u;
+    }
+    for (k = 1; k < (int16_t)QNAV_PATHS; ++k) {
+        if (lvl[wrap((int16_t)(w + s * k))] >= need) {
+            /* nearer than half the follow level: a little more away from the boundary */
+            uint8_t half = (uint8_t)(c->esc_free_level / 2u);
+            int16_t off = lw < half ? (int16_t)((half - lw) * QNAV_ESCAPE_AWAY_DEG) : 0;
+            return wrap((int16_t)(w + s * (k + off)));
+        }
+    }
+    return wrap(180);
 }
 
 /* The side to follow: the one whose nearest free path to the goal is the nearer turn
@@ -124,6 +139,13 @@ void qnav_escape_clear(qnav_escape_t *e)
     e->tries = 0u;
 }
 
+static void start_follow(qnav_escape_t *e, int8_t side)
+{
+    e->side = side;
+    e->last_side = side;
+    e->ticks = 0u;
+}
+
 uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
                           const qnav_ctrl_input_t *in, qnav_escape_t *e)
 {
@@ -148,14 +170,12 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
             return goal;
         }
         if (++e->ticks >= follow_limit(c, e->tries)) {
-            e->side = (int8_t)-e->side; /* give this side up: the other, for longer */
-            e->last_side = e->side;
-            e->ticks = 0u;
+            start_follow(e, (int8_t)-e->side); /* give this side up: the other, for longer */
             if (e->tries < 255u) {
                 ++e->tries;
             }
         }
-        return skirt(c, lvl, (int16_t)qnav_whole_deg(in->prev_heading_cdeg), e->side);
+        return skirt(c, lvl, e->side);
     }
     if (e->best_mm == 0u || (uint32_t)range + progress <= e->best_mm) {
         e->best_mm = range;
@@ -168,11 +188,9 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
     if ((uint32_t)e->best_mm + QNAV_ESCAPE_NEW_MARGINS * c->margin_mm < e->hit_mm) {
         e->last_side = 0; /* far nearer than where the last follow ended: another obstacle */
     }
-    e->side = e->last_side != 0 ? e->last_side : choose_side(c, lvl, goal);
-    e->last_side = e->side;
+    start_follow(e, e->last_side != 0 ? e->last_side : choose_side(c, lvl, goal));
     e->hit_mm = rest_mm(c, in, goal, e->best_mm);
-    e->ticks = 0u;
-    return skirt(c, lvl, (int16_t)goal, e->side);
+    return skirt(c, lvl, e->side);
 }
 
 void qnav_escape_keep_moving(const qnav_clearance_t *c, const uint8_t *lvl,

@@ -5,8 +5,8 @@
  * whose gap lies off the straight line. While the robot makes progress toward the
  * destination nothing changes. When it has made none for escape_stall_ticks, it follows
  * the boundary in front of it on one side: the policy is given, instead of the
- * destination's bearing, the bearing of the free path that skirts the obstacle (the first
- * free path next to the blocked ones on that side; a stall far nearer than where the last
+ * destination's bearing, the bearing of the free path that skirts the obstacle (from the
+ * nearest reading on that side, turning away from it, the first free path; a stall far nearer than where the last
  * follow ended is at another obstacle and chooses its side afresh). It goes back to the
  * destination once the clear way toward it, read from the sonar sector that looks that
  * way, ends a step nearer to it than at the hit point (DistBug's leave rule); a follow that

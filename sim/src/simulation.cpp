@@ -175,6 +175,7 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     l_m_ = 0;
     wheel_l_ = wheel_r_ = 0;
     cmd_heading_deg_ = cmd_speed_ = 0;
+    escape_side_ = 0;
     have_prev_ = false;
     target_heading_ = heading_;
     target_speed_ = 0;
@@ -469,6 +470,7 @@ qnav_sim_sample_t Simulation::sample() const {
     s.cmd_speed = cmd_speed_;
     s.recovering = recovery_left_ > 0;
     s.collided = collided_this_tick_;
+    s.escape_side = escape_side_;
     return s;
 }
 
@@ -530,6 +532,7 @@ qnav_sim_result_t Simulation::run_episode_with(StepFn step, void *self, std::uin
         if (out.flags & QNAV_FLAG_NOT_READY)
             throw SimError(QNAV_SIM_E_PARAM, "controller: not initialised (qnav_ctrl_init failed or was not called)");
         command(out.heading_deg, QNAV_Q1_15_TO_REAL(out.speed));
+        escape_side_ = out.escape.side;
         advance();
         if (trace) {
             const qnav_sim_sample_t s = sample();

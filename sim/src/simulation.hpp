@@ -118,6 +118,7 @@ private:
     double clearance_m_ = 0;            // centre to nearest surface after the last step, m
     bool body_stale_ = false;           // Box2D body not moved since free steps
     double cmd_heading_deg_ = 0, cmd_speed_ = 0;  // last command, as given
+    std::int8_t escape_side_ = 0;                 // the last step's escape side
     double sensed_heading_ = 0;   // heading (with sensor noise) of the current scan, rad
     double prev_world_rad_ = 0;   // last command's heading in the world, rad
     bool have_prev_ = false;      // a command was given since reset

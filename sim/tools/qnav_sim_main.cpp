@@ -229,7 +229,7 @@ int cmd_run(const RunOpts &o) {
         qnav::EpisodePicture pic;
         const bool want_pic = e == 0 && !o.svg.empty();
         const bool want_trace = e == 0 && !o.trace.empty();
-        std::string csv = "tick,x_m,y_m,heading_rad,speed_mps,cmd_heading_deg,cmd_speed,recovering,collided\n";
+        std::string csv = "tick,x_m,y_m,heading_rad,speed_mps,cmd_heading_deg,cmd_speed,recovering,collided,escape_side\n";
         // Every sample of the episode: the trajectory row, the path, and the sonar at the
         // chosen tick (or the last one before the episode ended).
         bool have_last = false;
@@ -240,9 +240,9 @@ int cmd_run(const RunOpts &o) {
             last_heading = smp.heading_rad;
             if (want_trace) {
                 char line[256];
-                std::snprintf(line, sizeof line, "%u,%.6f,%.6f,%.6f,%.4f,%d,%.4f,%d,%d\n", smp.tick,
+                std::snprintf(line, sizeof line, "%u,%.6f,%.6f,%.6f,%.4f,%d,%.4f,%d,%d,%d\n", smp.tick,
                               smp.x_m, smp.y_m, smp.heading_rad, smp.speed_mps, smp.cmd_heading_deg,
-                              smp.cmd_speed, smp.recovering ? 1 : 0, smp.collided ? 1 : 0);
+                              smp.cmd_speed, smp.recovering ? 1 : 0, smp.collided ? 1 : 0, smp.escape_side);
                 csv += line;
             }
             if (!want_pic) return;

@@ -159,6 +159,49 @@ static void test_a_long_follow_tries_the_other_side(void **state)
     assert_int_equal(b.out.escape.side, first);
 }
 
+/* Following a wall on the right (side +1), the destination behind it: the bearing it
+ * skirts by is found from the wall itself, so the decision is the same whatever the
+ * previous command was (a search from 90 degrees off the previous command swung with the
+ * policy's own choice and dithered at doorways), and it runs along the wall: past its
+ * readings, not back. */
+static void test_the_follow_bearing_comes_from_the_boundary(void **state)
+{
+    static const qnav_cdeg_t prev[] = {0, 9000, -4000, 17000, -13000};
+    bot_t b;
+    qnav_escape_t following;
+    qnav_deg_t first = 0;
+    unsigned t;
+    (void)state;
+    qnav_policy_prob_default(&b.p);
+    facing_wall(&b, 20, 300, 3000);
+    for (t = 0; t < 21; ++t) {
+        tick(&b.c, &b.in, &b.out);
+    }
+    assert_int_equal(b.out.escape.side, 1); /* a symmetric wall: obstacle on the right */
+    following = b.out.escape;
+    for (t = 0; t < N; ++t) {
+        b.r[t] = MAX_MM;
+    }
+    b.r[N / 4 * 3 - 1] = 300; /* sectors at -112.5, -90 and -67.5 degrees: a wall 300 mm */
+    b.r[N / 4 * 3] = 300;     /* to the right, the destination behind it */
+    b.r[N / 4 * 3 + 1] = 300;
+    b.in.goal_bearing_cdeg = -9000;
+    for (t = 0; t < sizeof prev / sizeof prev[0]; ++t) {
+        b.in.escape = following;
+        b.in.prev_heading_cdeg = prev[t];
+        qnav_ctrl_step(&b.c, &b.in, &b.out, NULL);
+        assert_int_equal(b.out.escape.side, 1);
+        if (t == 0) {
+            first = b.out.heading_deg;
+        }
+        assert_int_equal(b.out.heading_deg, first);
+    }
+    /* the wall's readings block the paths to about -41 degrees (-67.5 plus its part of the
+     * wedge and the enlargement asin((r + d_s) / 420 mm)): past them, not back */
+    assert_true(first >= -40 && first <= 60);
+    assert_true(b.out.speed > 0);
+}
+
 /* A wall ahead and to the left (sectors 0, 1 and 2): the nearest free way round is on the
  * right, so a fresh choice follows it on the left (side -1). */
 static void wall_ahead_left(qnav_mm_t *r, qnav_mm_t near_mm)
@@ -255,6 +298,7 @@ int main(void)
         cmocka_unit_test(test_follows_after_a_stall_and_leaves_when_nearer),
         cmocka_unit_test(test_progress_never_follows),
         cmocka_unit_test(test_a_long_follow_tries_the_other_side),
+        cmocka_unit_test(test_the_follow_bearing_comes_from_the_boundary),
         cmocka_unit_test(test_a_new_obstacle_chooses_its_side_afresh),
         cmocka_unit_test(test_a_policy_of_zeros_does_not_freeze),
         cmocka_unit_test(test_no_range_no_escape),

@@ -36,12 +36,15 @@ def tool_line(stderr, program):
 
 
 def qnav_sim_trace(work, *args):
-    """qnav-sim run's trajectory rows and its episode line."""
+    """qnav-sim run's trajectory rows, without the controller's escape side (the controller's
+    memory, not the episode's: the decisions it led to are in the rows), and its episode line."""
     path = os.path.join(work, "trace.csv")
     st, out, err = run_tool(QNAV_SIM, "run", "--trace", path, *args)
     assert st == 0, err
     with open(path) as f:
-        rows = f.read().splitlines()[1:]
+        lines = f.read().splitlines()
+    assert lines[0].endswith(",escape_side"), lines[0]
+    rows = [line.rsplit(",", 1)[0] for line in lines[1:]]
     episode = next(line for line in out.splitlines() if line.startswith("episode "))
     return rows, episode
 

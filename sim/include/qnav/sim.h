@@ -234,6 +234,8 @@ typedef struct {
     double cmd_speed;          /* commanded speed fraction of v_max, [0, 1] */
     bool recovering;           /* in a collision recovery manoeuvre */
     bool collided;             /* a new collision started this tick */
+    int8_t escape_side;        /* the controller's escape after this tick's step: 0 none,
+                                  +1 / -1 following a boundary on the right / left */
 } qnav_sim_sample_t;
 
 /* Called once per sample; user is passed through. */
