@@ -137,6 +137,7 @@ void qnav_escape_clear(qnav_escape_t *e)
     e->side = 0;
     e->last_side = 0;
     e->tries = 0u;
+    e->stall_mm = 0u;
 }
 
 static void start_follow(qnav_escape_t *e, int8_t side)
@@ -185,9 +186,13 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
     if (++e->ticks < c->esc_stall_ticks) {
         return goal;
     }
-    if ((uint32_t)e->best_mm + QNAV_ESCAPE_NEW_MARGINS * c->margin_mm < e->hit_mm) {
+    if (e->stall_mm != 0u && (uint32_t)e->best_mm + progress > e->stall_mm && e->last_side != 0) {
+        e->last_side = (int8_t)-e->last_side; /* no nearer than when the last follow began:
+                                                 it led back here, go the other way round */
+    } else if ((uint32_t)e->best_mm + QNAV_ESCAPE_NEW_MARGINS * c->margin_mm < e->hit_mm) {
         e->last_side = 0; /* far nearer than where the last follow ended: another obstacle */
     }
+    e->stall_mm = e->best_mm;
     start_follow(e, e->last_side != 0 ? e->last_side : choose_side(c, lvl, goal));
     e->hit_mm = rest_mm(c, in, goal, e->best_mm);
     return skirt(c, lvl, e->side);

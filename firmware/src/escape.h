@@ -6,14 +6,16 @@
  * destination nothing changes. When it has made none for escape_stall_ticks, it follows
  * the boundary in front of it on one side: the policy is given, instead of the
  * destination's bearing, the bearing of the free path that skirts the obstacle (from the
- * nearest reading on that side, turning away from it, the first free path; a stall far nearer than where the last
- * follow ended is at another obstacle and chooses its side afresh). It goes back to the
+ * nearest reading on that side, turning away from it, the first free path; a stall far
+ * nearer than where the last follow ended is at another obstacle and chooses its side
+ * afresh; one no nearer than where the last follow began means that follow led back
+ * here, and it goes the other way round). It goes back to the
  * destination once the clear way toward it, read from the sonar sector that looks that
  * way, ends a step nearer to it than at the hit point (DistBug's leave rule); a follow that
  * lasts too long is given up for the other side, each try twice as long. While following, a step whose policy would stand still crawls along the
  * boundary or turns in place, so no policy freezes.
  *
- * The memory (qnav_escape_t, 9 bytes) is the caller's: it comes in with the step's input
+ * The memory (qnav_escape_t, 11 bytes) is the caller's: it comes in with the step's input
  * and goes out with its output; the step itself keeps nothing.
  */
 #ifndef QNAV_ESCAPE_H

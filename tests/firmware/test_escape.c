@@ -211,9 +211,10 @@ static void wall_ahead_left(qnav_mm_t *r, qnav_mm_t near_mm)
     r[2] = near_mm;
 }
 
-/* From a follow on side +1 that has just ended, range_mm away: the ticks of a new stall at
- * a wall ahead and to the left. Returns the side the robot then follows. */
-static int8_t side_of_next_stall(qnav_mm_t range_mm)
+/* A follow on side +1 that began 3000 mm from the destination and ended end_mm from it,
+ * then the ticks of a new stall range_mm away at a wall ahead and to the left. Returns the
+ * side the robot then follows. */
+static int8_t side_of_next_stall(qnav_mm_t end_mm, qnav_mm_t range_mm)
 {
     bot_t b;
     unsigned t;
@@ -223,7 +224,8 @@ static int8_t side_of_next_stall(qnav_mm_t range_mm)
         tick(&b.c, &b.in, &b.out);
     }
     assert_int_equal(b.out.escape.side, 1); /* a symmetric wall: counter-clockwise */
-    wall_ahead(b.r, MAX_MM);                /* the way opens: the follow ends at 3000 */
+    wall_ahead(b.r, MAX_MM);                /* the way opens: the follow ends at end_mm */
+    b.in.goal_range_mm = end_mm;
     tick(&b.c, &b.in, &b.out);
     assert_int_equal(b.out.escape.side, 0);
     wall_ahead_left(b.r, 300);
@@ -235,9 +237,11 @@ static int8_t side_of_next_stall(qnav_mm_t range_mm)
     return b.out.escape.side;
 }
 
-/* A new stall near where the last follow ended keeps its side (no shuttling between two
- * sides of one obstacle); one more than 4 (r + d_s) nearer is at another obstacle and
- * chooses afresh (an S-corridor's next wall). */
+/* A new stall near where the last follow ended, and nearer than where it began, keeps its
+ * side (no shuttling between two sides of one obstacle); one more than 4 (r + d_s) nearer
+ * than where it ended is at another obstacle and chooses afresh (an S-corridor's next
+ * wall); one no nearer than where the last follow began means that follow led back to it
+ * (round a room, back to the same wall): the other way round. */
 static void test_a_new_obstacle_chooses_its_side_afresh(void **state)
 {
     qnav_ctrl_config_t cfg;
@@ -245,9 +249,13 @@ static void test_a_new_obstacle_chooses_its_side_afresh(void **state)
     (void)state;
     qnav_ctrl_config_default(&cfg);
     margin = (qnav_mm_t)(cfg.body_radius_mm + cfg.safety_mm);
-    assert_int_equal(side_of_next_stall(2950), 1);
-    assert_int_equal(side_of_next_stall((qnav_mm_t)(3000 - 4 * margin + 10)), 1);
-    assert_int_equal(side_of_next_stall((qnav_mm_t)(3000 - 4 * margin - 10)), -1);
+    assert_int_equal(side_of_next_stall(2500, 2450), 1);
+    assert_int_equal(side_of_next_stall(2500, (qnav_mm_t)(2500 - 4 * margin + 10)), 1);
+    assert_int_equal(side_of_next_stall(2500, (qnav_mm_t)(2500 - 4 * margin - 10)), -1);
+    /* the follow left farther away (3400) and the robot stalls where it stalled before */
+    assert_int_equal(side_of_next_stall(3400, 3000), -1);
+    assert_int_equal(side_of_next_stall(3400, (qnav_mm_t)(3000 - margin / 2u + 1u)), -1);
+    assert_int_equal(side_of_next_stall(3400, (qnav_mm_t)(3000 - margin / 2u - 1u)), 1);
 }
 
 /* No policy freezes: a network whose quality is 0 on every path stands still (NO_PATH)
