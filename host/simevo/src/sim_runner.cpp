@@ -160,24 +160,33 @@ EpisodeOutcome SimRunner::outcome(qnav_sim_status_t s, const qnav_sim_result_t &
 
 SimRunner::~SimRunner() { qnav_sim_destroy(sim_); }
 
-const qnav_qkey_t *SimRunner::table_for(const qnav_ctrl_t &ctrl, const qnav_policy_t &policy)
+const qnav_ctrl_t &SimRunner::controller_for(const qnav_policy_t &policy)
 {
     for (unsigned i = 0; i < 2; ++i) {
-        if (tables_[i].valid && std::memcmp(&tables_[i].policy, &policy, sizeof policy) == 0) {
+        if (compiled_[i].valid && std::memcmp(&compiled_[i].policy, &policy, sizeof policy) == 0) {
             least_recent_ = 1 - i;
-            return tables_[i].table.data();
+            return compiled_[i].ctrl;
         }
     }
-    CompiledTable &t = tables_[least_recent_];
-    least_recent_ = 1 - least_recent_;
-    t.valid = false;
-    t.table.resize(QNAV_QTABLE_ENTRIES);
-    if (qnav_ctrl_build_table(&ctrl, t.table.data()) != QNAV_OK) {
-        return nullptr;
+    Compiled &c = compiled_[least_recent_];
+    c.valid = false;
+    const qnav_status_t st = qnav_ctrl_init(&c.ctrl, &ctrl_cfg_, &policy);
+    if (st != QNAV_OK) {
+        throw UserError("controller: qnav_ctrl_init refused the policy (status " +
+                        std::to_string(static_cast<int>(st)) + ")");
     }
-    t.policy = policy;
-    t.valid = true;
-    return t.table.data();
+    /* a 3-input network has no table (its key depends on the previous heading too) */
+    if (use_table_ && policy.kind == QNAV_POLICY_NET && policy.u.net.inputs == QNAV_NET_INPUTS_PAPER) {
+        c.table.resize(QNAV_QTABLE_ENTRIES);
+        if (qnav_ctrl_build_table(&c.ctrl, c.table.data()) != QNAV_OK ||
+            qnav_ctrl_init_table(&c.ctrl, &ctrl_cfg_, c.table.data(), qnav_ctrl_rank(&c.ctrl)) != QNAV_OK) {
+            throw UserError("controller: could not compile the policy into a quality table");
+        }
+    }
+    c.policy = policy;
+    c.valid = true;
+    least_recent_ = 1 - least_recent_;
+    return c.ctrl;
 }
 
 EpisodeOutcome SimRunner::run(const qnav_policy_t &policy, uint64_t episode_seed)
@@ -188,19 +197,7 @@ EpisodeOutcome SimRunner::run(const qnav_policy_t &policy, uint64_t episode_seed
 EpisodeOutcome SimRunner::run_traced(const qnav_policy_t &policy, uint64_t episode_seed,
                                      std::vector<qnav_sim_sample_t> *trace)
 {
-    qnav_ctrl_t ctrl;
-    qnav_status_t st = qnav_ctrl_init(&ctrl, &ctrl_cfg_, &policy);
-    if (st != QNAV_OK) {
-        throw UserError("controller: qnav_ctrl_init refused the policy (status " +
-                        std::to_string(static_cast<int>(st)) + ")");
-    }
-    /* a 3-input network has no table (its key depends on the previous heading too) */
-    if (use_table_ && policy.kind == QNAV_POLICY_NET && policy.u.net.inputs == QNAV_NET_INPUTS_PAPER) {
-        const qnav_qkey_t *table = table_for(ctrl, policy);
-        if (!table || qnav_ctrl_init_table(&ctrl, &ctrl_cfg_, table, qnav_ctrl_rank(&ctrl)) != QNAV_OK) {
-            throw UserError("controller: could not compile the policy into a quality table");
-        }
-    }
+    const qnav_ctrl_t &ctrl = controller_for(policy);
     qnav_sim_result_t res;
     const qnav_sim_status_t s = qnav_sim_run_episode(sim_, &ctrl, episode_seed, &res,
                                                      trace ? +append_sample : nullptr, trace);

@@ -73,22 +73,25 @@ public:
 private:
     /* An episode's figures from the simulator's status and result; UserError on failure. */
     EpisodeOutcome outcome(qnav_sim_status_t s, const qnav_sim_result_t &res) const;
-    /* policy's quality table, compiled by ctrl (initialised with policy), or null when it
-     * cannot be. The last two are kept: an evolution step runs a new candidate and then,
-     * mostly, the same best member as its parent, whose table need not be built again. */
-    const qnav_qkey_t *table_for(const qnav_ctrl_t &ctrl, const qnav_policy_t &policy);
+    /* A controller initialised with policy (in table mode when this runner uses tables and
+     * the policy has one), built once per policy: a candidate's k episodes, and the next
+     * step's parent, reuse it instead of evaluating the network over every (level, dtheta)
+     * pair again (issue 19). The last two are kept: an evolution step runs a new candidate
+     * and then, mostly, the same best member as its parent. Throws UserError. */
+    const qnav_ctrl_t &controller_for(const qnav_policy_t &policy);
 
-    struct CompiledTable {
+    struct Compiled {
         qnav_policy_t policy{};
-        std::vector<qnav_qkey_t> table;
+        std::vector<qnav_qkey_t> table; /* the table ctrl reads in table mode */
+        qnav_ctrl_t ctrl{};
         bool valid = false;
     };
     qnav_sim_t *sim_ = nullptr;
     qnav_ctrl_config_t ctrl_cfg_{};
     qnav_policy_t prob_{};
     bool use_table_;
-    CompiledTable tables_[2];
-    unsigned least_recent_ = 0; /* index into tables_ to overwrite next */
+    Compiled compiled_[2];
+    unsigned least_recent_ = 0; /* index into compiled_ to overwrite next */
 };
 
 /* Check that every world a scenario can meet loads and runs: the scenario itself, or for
