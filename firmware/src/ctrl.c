@@ -423,6 +423,16 @@ void qnav_row_shape_next(qnav_row_scan_t *sc, uint8_t d, qnav_qkey_t key)
     sc->prev = key;
 }
 
+/* Narrow r (its dtheta a..b) to dtheta a..e. */
+static void keep_dtheta(qnav_run_t *r, uint8_t a, uint8_t b, uint8_t e)
+{
+    if (r->dir < 0) {
+        r->first = (uint16_t)(r->first + (uint8_t)(b - e));
+        r->dtheta0 = e;
+    }
+    r->count = (uint8_t)((uint8_t)(e - a) + 1u);
+}
+
 /*
  * Every key of the run is at most the row's top, so a top below the best (or equal, with
  * every dtheta of the run larger than the best's: the tie is lost) rules the run out. A run
@@ -435,16 +445,6 @@ void qnav_row_shape_next(qnav_row_scan_t *sc, uint8_t d, qnav_qkey_t key)
  * exception is the run straight after it on the other side starting at the same dtheta
  * (equal keys, equal dtheta: the turn decides), which "fresh" recognises.
  */
-/* Narrow r (its dtheta a..b) to dtheta a..e. */
-static void keep_dtheta(qnav_run_t *r, uint8_t a, uint8_t b, uint8_t e)
-{
-    if (r->dir < 0) {
-        r->first = (uint16_t)(r->first + (uint8_t)(b - e));
-        r->dtheta0 = e;
-    }
-    r->count = (uint8_t)((uint8_t)(e - a) + 1u);
-}
-
 uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t *best,
                         qnav_run_iter_t *it)
 {
