@@ -29,6 +29,7 @@
 
 #include "bridge.h"
 #include "qnav/cli.h"
+#include "qnav/clock.h"
 #include "qnav/policy_io.h"
 #include "qnav_goal_t.h"
 #include "replay.h"
@@ -40,13 +41,6 @@ static volatile sig_atomic_t g_stop_signal = 0;
 static void on_signal(int sig)
 {
     g_stop_signal = sig;
-}
-
-static int64_t mono_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
 }
 
 static void usage(FILE *f)
@@ -382,7 +376,7 @@ int main(int argc, char **argv)
     sigaction(SIGHUP, &sa, NULL); /* a dropped ssh session: stop the robot too */
     signal(SIGPIPE, SIG_IGN);
 
-    qnav_bridge_init(&bridge, &cfg, lcm, log, write_serial, &fd, mono_ms());
+    qnav_bridge_init(&bridge, &cfg, lcm, log, write_serial, &fd, qnav_mono_ms());
     bridge.diag = stderr;
     if (lcm_goals) {
         char token[QNAV_BRIDGE_TOKEN_HEX + 1];
@@ -400,13 +394,13 @@ int main(int argc, char **argv)
     }
     if (have_goal) {
         start_goal.utime = qnav_bridge_utime();
-        qnav_bridge_on_goal(&bridge, &start_goal, mono_ms());
+        qnav_bridge_on_goal(&bridge, &start_goal, qnav_mono_ms());
     }
     if (have_route) {
         route.utime = qnav_bridge_utime();
         route.route_id = 1;
         route.radius_m = goal_radius;
-        (void)qnav_bridge_on_waypoints(&bridge, &route, mono_ms(), err, sizeof err);
+        (void)qnav_bridge_on_waypoints(&bridge, &route, qnav_mono_ms(), err, sizeof err);
     }
     fprintf(stderr, "navbridge: %s mode on %s at %ld baud, watchdog %ld ms\n",
             cfg.mode == QNAV_LINK_MODE_OFFBOARD ? "offboard" : "onboard", device, baud,
@@ -434,7 +428,7 @@ int main(int argc, char **argv)
             uint8_t buf[512];
             ssize_t r = read(fd, buf, sizeof buf);
             if (r > 0) {
-                qnav_bridge_on_bytes(&bridge, buf, (size_t)r, mono_ms());
+                qnav_bridge_on_bytes(&bridge, buf, (size_t)r, qnav_mono_ms());
             } else if (r == 0 || (errno != EAGAIN && errno != EINTR)) {
                 /* end of file on a serial port: unplugged adapter, or the SIL robot or
                  * simavr board (pty master) has gone */
@@ -446,7 +440,7 @@ int main(int argc, char **argv)
             }
         }
         if (n > 0 && (p[1].revents & POLLIN)) {
-            bridge.now_ms = mono_ms();
+            bridge.now_ms = qnav_mono_ms();
             lcm_handle_timeout(lcm, 0);
         }
         if (bridge.config_refused) {
@@ -463,10 +457,10 @@ int main(int argc, char **argv)
             exit_code = 1; /* docs/cli.md: a failure at run time */
             break;
         }
-        qnav_bridge_poll(&bridge, mono_ms());
+        qnav_bridge_poll(&bridge, qnav_mono_ms());
     }
     /* stop the robot before leaving, whatever made us leave */
-    qnav_bridge_shutdown(&bridge, mono_ms());
+    qnav_bridge_shutdown(&bridge, qnav_mono_ms());
     if (!hung_up) {
         tcdrain(fd);
     }

@@ -18,15 +18,9 @@
 
 #include <lcm/eventlog.h>
 
+#include "qnav/clock.h"
 #include "qnav_scan_t.h"
 #include "serial.h"
-
-static int64_t mono_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
-}
 
 static double wrap_rad(double a)
 {
@@ -41,7 +35,7 @@ static double wrap_rad(double a)
 
 static uint32_t hal_millis(void *ctx)
 {
-    return (uint32_t)(mono_ms() - ((sil_hal_t *)ctx)->start_ms);
+    return (uint32_t)(qnav_mono_ms() - ((sil_hal_t *)ctx)->start_ms);
 }
 
 static uint16_t hal_sonar(void *ctx, qnav_mm_t *ranges, uint16_t max)
@@ -185,7 +179,7 @@ int sil_hal_init(sil_hal_t *s, qnav_board_hal_t *hal, char *err, size_t errlen)
 {
     memset(s->nvm, 0xFF, sizeof s->nvm);
     s->rx_n = s->rx_i = 0;
-    s->start_ms = mono_ms();
+    s->start_ms = qnav_mono_ms();
     if (s->nvm_path != NULL) {
         FILE *f = fopen(s->nvm_path, "rb");
         if (f != NULL) {

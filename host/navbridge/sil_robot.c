@@ -28,9 +28,10 @@
 #include "ptylink.h"
 #include "qnav/board.h"
 #include "qnav/cli.h"
+#include "qnav/clock.h"
 #include "qnav/sim.h"
-#include "robot_board.h"
 #include "qnav_pose_t.h"
+#include "robot_board.h"
 #include "sil_hal.h"
 
 static volatile sig_atomic_t g_quit = 0;
@@ -38,13 +39,6 @@ static volatile sig_atomic_t g_quit = 0;
 static void on_signal(int sig)
 {
     g_quit = sig;
-}
-
-static int64_t mono_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
 }
 
 static int64_t utime_now(void)
@@ -228,11 +222,11 @@ static int open_pty(char **slave)
 /* Receive for up to wait_ms, handing every byte to the board core. */
 static void pump(qnav_board_t *bot, sil_hal_t *hal, int wait_ms)
 {
-    int64_t until = mono_ms() + wait_ms;
+    int64_t until = qnav_mono_ms() + wait_ms;
     do {
-        (void)sil_hal_wait_rx(hal, (int)(until - mono_ms()));
+        (void)sil_hal_wait_rx(hal, (int)(until - qnav_mono_ms()));
         qnav_board_receive(bot);
-    } while (!g_quit && mono_ms() < until);
+    } while (!g_quit && qnav_mono_ms() < until);
 }
 
 static void publish_true_pose(lcm_t *lcm, qnav_sim_t *sim)
@@ -267,7 +261,7 @@ typedef struct {
  * paced), the simulator step with the core's drive. */
 static void run_tick(robot_t *r, const options_t *o)
 {
-    int64_t tick_start = mono_ms();
+    int64_t tick_start = qnav_mono_ms();
     uint32_t cmds = qnav_board_stats(&r->bot)->commands;
     uint16_t seq;
     int answered = 0;
@@ -276,7 +270,7 @@ static void run_tick(robot_t *r, const options_t *o)
     seq = qnav_board_stats(&r->bot)->last_scan_seq;
     if (r->bot.mode == QNAV_LINK_MODE_OFFBOARD) {
         /* the answer to this scan: the core drives with it from the next tick on */
-        while (!g_quit && mono_ms() - tick_start < (int64_t)o->reply_ms && !answered) {
+        while (!g_quit && qnav_mono_ms() - tick_start < (int64_t)o->reply_ms && !answered) {
             pump(&r->bot, &r->hal, 5);
             answered = qnav_board_stats(&r->bot)->commands != cmds &&
                        qnav_board_stats(&r->bot)->last_command_seq == seq;
@@ -298,7 +292,7 @@ static void run_tick(robot_t *r, const options_t *o)
     }
     r->ticks++;
     if (!o->lockstep) {
-        int64_t left = tick_start + (int64_t)o->tick_ms - mono_ms();
+        int64_t left = tick_start + (int64_t)o->tick_ms - qnav_mono_ms();
         if (left > 0) {
             pump(&r->bot, &r->hal, (int)left);
         }
@@ -388,8 +382,8 @@ static int start(robot_t *r, const options_t *o, qnav_sim_robot_t **robot,
  * failed) when none came or it speaks another protocol. */
 static int wait_bridge(robot_t *r, const options_t *o, const char *slave)
 {
-    int64_t t0 = mono_ms();
-    while (!g_quit && r->bot.mode == 0 && mono_ms() - t0 < (int64_t)(o->wait_s * 1000.0)) {
+    int64_t t0 = qnav_mono_ms();
+    while (!g_quit && r->bot.mode == 0 && qnav_mono_ms() - t0 < (int64_t)(o->wait_s * 1000.0)) {
         pump(&r->bot, &r->hal, 50);
         if (qnav_board_stats(&r->bot)->peer_refused > 0u) {
             fprintf(stderr, "qnav-sil-robot: navbridge on %s speaks link protocol %u, this "

@@ -35,6 +35,7 @@
 
 #include "ptylink.h"
 #include "qnav/cli.h"
+#include "qnav/clock.h"
 #include "qnav/link.h"
 #include "robot_board.h"
 
@@ -52,13 +53,6 @@ const char *__asan_default_options(void)
 static void on_signal(int sig)
 {
     g_quit = sig;
-}
-
-static int64_t mono_us(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
 /* USART0 on a pseudo-terminal, served from the simulation loop itself. Not simavr's
@@ -497,7 +491,7 @@ int main(int argc, char **argv)
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
 
-    t0 = mono_us();
+    t0 = qnav_mono_us();
     while (!g_quit && state != cpu_Done && state != cpu_Crashed) {
         uint64_t sim_us = avr->cycle / (fw.frequency / 1000000u);
         uint64_t step = sim_us / 500000u; /* a new scene every 0.5 s */
@@ -535,7 +529,7 @@ int main(int argc, char **argv)
             break;
         }
         uart_service(&uart, avr->cycle);
-        ahead = (int64_t)sim_us - (mono_us() - t0);
+        ahead = (int64_t)sim_us - (qnav_mono_us() - t0);
         if (ahead > 2000) {
             usleep((useconds_t)ahead);
         }
