@@ -138,13 +138,66 @@ void qnav_escape_clear(qnav_escape_t *e)
     e->last_side = 0;
     e->tries = 0u;
     e->stall_mm = 0u;
+    e->near_mm = 0u;
+    e->loop_mm = 0u;
+    e->loop_deg2 = 0u;
+    e->loop = QNAV_ESCAPE_LOOP_NONE;
 }
 
-static void start_follow(qnav_escape_t *e, int8_t side)
+static uint16_t diff_mm(uint16_t a, uint16_t b)
+{
+    return (uint16_t)(a > b ? a - b : b - a);
+}
+
+/*
+ * Has this follow gone round its obstacle (an island: a box in a room)? Without a position,
+ * a place on the boundary is known by the destination's range and bearing there (the robot
+ * passes it again heading the same way): marked escape_stall_ticks into the follow, left
+ * once the range differs by 2 (r + d_s), back when it is within (r + d_s) and the bearing
+ * within 30 degrees. Returns 1 when the robot, having gone round, is as near the
+ * destination as it came on the way round (Bug1's leave point).
+ */
+static uint8_t gone_round(const qnav_clearance_t *c, qnav_escape_t *e, uint16_t range,
+                          uint16_t bearing)
+{
+    uint8_t b2 = (uint8_t)(bearing / 2u);
+    uint8_t d2 = (uint8_t)(b2 > e->loop_deg2 ? b2 - e->loop_deg2 : e->loop_deg2 - b2);
+    if (d2 > 90u) {
+        d2 = (uint8_t)(180u - d2);
+    }
+    if (range < e->near_mm) {
+        e->near_mm = range;
+    }
+    switch (e->loop) {
+    case QNAV_ESCAPE_LOOP_NONE:
+        if (e->ticks >= c->esc_stall_ticks) {
+            e->loop_mm = range;
+            e->loop_deg2 = b2;
+            e->loop = QNAV_ESCAPE_LOOP_MARKED;
+        }
+        return 0u;
+    case QNAV_ESCAPE_LOOP_MARKED:
+        if (diff_mm(range, e->loop_mm) > 2u * c->margin_mm) {
+            e->loop = QNAV_ESCAPE_LOOP_AWAY;
+        }
+        return 0u;
+    case QNAV_ESCAPE_LOOP_AWAY:
+        if (diff_mm(range, e->loop_mm) <= c->margin_mm && d2 <= 15u) {
+            e->loop = QNAV_ESCAPE_LOOP_ROUND;
+        }
+        return 0u;
+    default:
+        return (uint8_t)((uint32_t)range <= (uint32_t)e->near_mm + c->margin_mm / 2u);
+    }
+}
+
+static void start_follow(qnav_escape_t *e, int8_t side, uint16_t range)
 {
     e->side = side;
     e->last_side = side;
     e->ticks = 0u;
+    e->near_mm = range;
+    e->loop = QNAV_ESCAPE_LOOP_NONE;
 }
 
 uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
@@ -161,8 +214,13 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
     if (e->side != 0) {
         /* DistBug's leave rule (Kamon & Rivlin 1997): leave when the clear way toward the
          * destination ends nearer to it, by a step, than it did at the hit point */
-        if ((uint32_t)rest_mm(c, in, goal, range) + progress <= e->hit_mm &&
-            !blocked(c, lvl, (int16_t)goal)) {
+        uint8_t round = gone_round(c, e, range, goal);
+        if (round != 0u || ((uint32_t)rest_mm(c, in, goal, range) + progress <= e->hit_mm &&
+                            !blocked(c, lvl, (int16_t)goal))) {
+            if (round != 0u) {
+                e->last_side = 0; /* gone round an island: the next stall chooses afresh */
+                e->stall_mm = 0u;
+            }
             e->side = 0;
             e->hit_mm = range; /* where this follow ended: a stall far nearer is a new obstacle */
             e->best_mm = range;
@@ -171,7 +229,7 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
             return goal;
         }
         if (++e->ticks >= follow_limit(c, e->tries)) {
-            start_follow(e, (int8_t)-e->side); /* give this side up: the other, for longer */
+            start_follow(e, (int8_t)-e->side, range); /* give this side up: the other, for longer */
             if (e->tries < 255u) {
                 ++e->tries;
             }
@@ -193,7 +251,7 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
         e->last_side = 0; /* far nearer than where the last follow ended: another obstacle */
     }
     e->stall_mm = e->best_mm;
-    start_follow(e, e->last_side != 0 ? e->last_side : choose_side(c, lvl, goal));
+    start_follow(e, e->last_side != 0 ? e->last_side : choose_side(c, lvl, goal), range);
     e->hit_mm = rest_mm(c, in, goal, e->best_mm);
     return skirt(c, lvl, e->side);
 }

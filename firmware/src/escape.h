@@ -9,13 +9,16 @@
  * nearest reading on that side, turning away from it, the first free path; a stall far
  * nearer than where the last follow ended is at another obstacle and chooses its side
  * afresh; one no nearer than where the last follow began means that follow led back
- * here, and it goes the other way round). It goes back to the
+ * here, and it goes the other way round). A follow that comes back to a place it marked
+ * (the destination's range and bearing as they were there) has gone round an island; it
+ * leaves where it is again as near the destination as it came on the way round (Bug1).
+ * It goes back to the
  * destination once the clear way toward it, read from the sonar sector that looks that
  * way, ends a step nearer to it than at the hit point (DistBug's leave rule); a follow that
  * lasts too long is given up for the other side, each try twice as long. While following, a step whose policy would stand still crawls along the
  * boundary or turns in place, so no policy freezes.
  *
- * The memory (qnav_escape_t, 11 bytes) is the caller's: it comes in with the step's input
+ * The memory (qnav_escape_t, 17 bytes) is the caller's: it comes in with the step's input
  * and goes out with its output; the step itself keeps nothing.
  */
 #ifndef QNAV_ESCAPE_H

@@ -202,6 +202,55 @@ static void test_the_follow_bearing_comes_from_the_boundary(void **state)
     assert_true(b.out.speed > 0);
 }
 
+/* Following round an island (a box in a room, the way to the destination beyond it never
+ * opening): back at the place marked early in the follow (the destination's range and
+ * bearing as they were), the robot has gone round, and it leaves once it is again as
+ * near the destination as it came on the way round (Bug1), choosing the next side afresh.
+ * Passing the mark's range with a bearing 30 degrees or more off is not being back. Returns the side at
+ * the end; back_cdeg: the bearing when the range returns to the mark's. */
+static int8_t round_an_island(qnav_cdeg_t back_cdeg)
+{
+    bot_t b;
+    unsigned t;
+    qnav_policy_prob_default(&b.p);
+    facing_wall(&b, 20, 300, 3000);
+    for (t = 0; t < 21; ++t) {
+        tick(&b.c, &b.in, &b.out);
+    }
+    assert_int_not_equal(b.out.escape.side, 0);
+    b.in.goal_range_mm = 3200; /* the mark, 20 ticks into the follow */
+    for (t = 0; t < 21; ++t) {
+        tick(&b.c, &b.in, &b.out);
+    }
+    b.in.goal_range_mm = 3600; /* away from it */
+    tick(&b.c, &b.in, &b.out);
+    b.in.goal_range_mm = 2960; /* the nearest the way round comes (the wall still ahead:
+                                  DistBug's rule does not leave) */
+    tick(&b.c, &b.in, &b.out);
+    assert_int_not_equal(b.out.escape.side, 0);
+    b.in.goal_range_mm = 3200; /* back at the mark's range */
+    b.in.goal_bearing_cdeg = back_cdeg;
+    tick(&b.c, &b.in, &b.out);
+    b.in.goal_bearing_cdeg = 0;
+    b.in.goal_range_mm = 3400; /* on round, away from the mark again */
+    tick(&b.c, &b.in, &b.out);
+    assert_int_not_equal(b.out.escape.side, 0);
+    b.in.goal_range_mm = 3000; /* within (r + d_s) / 2 of the nearest */
+    tick(&b.c, &b.in, &b.out);
+    if (b.out.escape.side == 0) {
+        assert_int_equal(b.out.escape.last_side, 0); /* the next stall chooses afresh */
+    }
+    return b.out.escape.side;
+}
+
+static void test_round_an_island_leaves_at_its_nearest_place(void **state)
+{
+    (void)state;
+    assert_int_equal(round_an_island(0), 0);
+    /* 32 degrees off the mark's bearing (still into the wall): not back at the mark */
+    assert_int_not_equal(round_an_island(3200), 0);
+}
+
 /* A wall ahead and to the left (sectors 0, 1 and 2): the nearest free way round is on the
  * right, so a fresh choice follows it on the left (side -1). */
 static void wall_ahead_left(qnav_mm_t *r, qnav_mm_t near_mm)
@@ -307,6 +356,7 @@ int main(void)
         cmocka_unit_test(test_progress_never_follows),
         cmocka_unit_test(test_a_long_follow_tries_the_other_side),
         cmocka_unit_test(test_the_follow_bearing_comes_from_the_boundary),
+        cmocka_unit_test(test_round_an_island_leaves_at_its_nearest_place),
         cmocka_unit_test(test_a_new_obstacle_chooses_its_side_afresh),
         cmocka_unit_test(test_a_policy_of_zeros_does_not_freeze),
         cmocka_unit_test(test_no_range_no_escape),

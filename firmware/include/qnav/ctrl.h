@@ -126,7 +126,20 @@ typedef struct {
     uint16_t stall_mm;  /* nearest the robot had come to the destination when the last
                            follow began, mm (a new stall no nearer means that follow led
                            back: the other side); 0: none yet */
+    uint16_t near_mm;   /* following: nearest the robot came to the destination on this
+                           side, mm */
+    uint16_t loop_mm;   /* following: the destination's range at the loop mark (taken
+                           escape_stall_ticks into the follow), mm */
+    uint8_t loop_deg2;  /* following: the destination's bearing at the mark, 2 deg units */
+    uint8_t loop;       /* following: QNAV_ESCAPE_LOOP_* (a follow back at its mark has
+                           gone round its obstacle) */
 } qnav_escape_t;
+
+/* qnav_escape_t.loop: no mark yet; marked; left the mark; back at it (round once). */
+#define QNAV_ESCAPE_LOOP_NONE 0u
+#define QNAV_ESCAPE_LOOP_MARKED 1u
+#define QNAV_ESCAPE_LOOP_AWAY 2u
+#define QNAV_ESCAPE_LOOP_ROUND 3u
 
 /* One control tick's input. */
 typedef struct {
