@@ -63,6 +63,19 @@ static void tick(const qnav_ctrl_t *c, qnav_ctrl_input_t *in, qnav_ctrl_output_t
     in->prev_heading_cdeg = (qnav_cdeg_t)(out->heading_deg * 100);
 }
 
+/* A controller of the default probabilistic policy facing a wall 300 mm ahead, the
+ * destination 3000 mm away beyond it, ticked until it has stalled and follows the wall. */
+static void following_a_wall(bot_t *b)
+{
+    unsigned t;
+    qnav_policy_prob_default(&b->p);
+    facing_wall(b, 20, 300, 3000);
+    for (t = 0; t < 21; ++t) {
+        tick(&b->c, &b->in, &b->out);
+    }
+    assert_int_not_equal(b->out.escape.side, 0);
+}
+
 /* How far the robot's centre can go toward a reading near_mm away (the controller's
  * default body): the reading from the centre, less body radius and safety distance. */
 static qnav_mm_t free_mm(qnav_mm_t near_mm)
@@ -137,11 +150,7 @@ static void test_a_long_follow_tries_the_other_side(void **state)
     bot_t b;
     int8_t first;
     unsigned t;
-    qnav_policy_prob_default(&b.p);
-    facing_wall(&b, 20, 300, 3000);
-    for (t = 0; t < 21; ++t) {
-        tick(&b.c, &b.in, &b.out);
-    }
+    following_a_wall(&b);
     first = b.out.escape.side;
     assert_int_not_equal(first, 0);
     for (t = 0; t < 199; ++t) {
@@ -172,11 +181,7 @@ static void test_the_follow_bearing_comes_from_the_boundary(void **state)
     qnav_deg_t first = 0;
     unsigned t;
     (void)state;
-    qnav_policy_prob_default(&b.p);
-    facing_wall(&b, 20, 300, 3000);
-    for (t = 0; t < 21; ++t) {
-        tick(&b.c, &b.in, &b.out);
-    }
+    following_a_wall(&b);
     assert_int_equal(b.out.escape.side, 1); /* a symmetric wall: obstacle on the right */
     following = b.out.escape;
     for (t = 0; t < N; ++t) {
@@ -212,11 +217,7 @@ static int8_t round_an_island(qnav_cdeg_t back_cdeg)
 {
     bot_t b;
     unsigned t;
-    qnav_policy_prob_default(&b.p);
-    facing_wall(&b, 20, 300, 3000);
-    for (t = 0; t < 21; ++t) {
-        tick(&b.c, &b.in, &b.out);
-    }
+    following_a_wall(&b);
     assert_int_not_equal(b.out.escape.side, 0);
     b.in.goal_range_mm = 3200; /* the mark, 20 ticks into the follow */
     for (t = 0; t < 21; ++t) {
@@ -267,11 +268,7 @@ static int8_t side_of_next_stall(qnav_mm_t end_mm, qnav_mm_t range_mm)
 {
     bot_t b;
     unsigned t;
-    qnav_policy_prob_default(&b.p);
-    facing_wall(&b, 20, 300, 3000);
-    for (t = 0; t < 21; ++t) {
-        tick(&b.c, &b.in, &b.out);
-    }
+    following_a_wall(&b);
     assert_int_equal(b.out.escape.side, 1); /* a symmetric wall: counter-clockwise */
     wall_ahead(b.r, MAX_MM);                /* the way opens: the follow ends at end_mm */
     b.in.goal_range_mm = end_mm;
