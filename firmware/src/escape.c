@@ -161,10 +161,7 @@ static uint8_t gone_round(const qnav_clearance_t *c, qnav_escape_t *e, uint16_t 
                           uint16_t bearing)
 {
     uint8_t b2 = (uint8_t)(bearing / 2u);
-    uint8_t d2 = (uint8_t)(b2 > e->loop_deg2 ? b2 - e->loop_deg2 : e->loop_deg2 - b2);
-    if (d2 > 90u) {
-        d2 = (uint8_t)(180u - d2);
-    }
+    uint8_t off_deg = qnav_angle_dist_deg((uint16_t)(2u * b2), (uint16_t)(2u * e->loop_deg2));
     if (range < e->near_mm) {
         e->near_mm = range;
     }
@@ -182,7 +179,7 @@ static uint8_t gone_round(const qnav_clearance_t *c, qnav_escape_t *e, uint16_t 
         }
         return 0u;
     case QNAV_ESCAPE_LOOP_AWAY:
-        if (diff_mm(range, e->loop_mm) <= c->margin_mm && d2 <= 15u) {
+        if (diff_mm(range, e->loop_mm) <= c->margin_mm && off_deg <= 30u) {
             e->loop = QNAV_ESCAPE_LOOP_ROUND;
         }
         return 0u;
