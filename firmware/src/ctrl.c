@@ -32,6 +32,7 @@ void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg)
     cfg->escape_stall_ticks = 20u;
     cfg->escape_follow_mm = 500u;
     cfg->escape_follow_s = 20u;
+    cfg->keep_pct = 0u;
 }
 
 void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg)
@@ -44,6 +45,7 @@ void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg)
     cfg->decel_mm_s2 = 0u;
     cfg->rank = (uint8_t)QNAV_RANK_QUALITY;
     cfg->wedge_pct = 100u;
+    cfg->keep_pct = 0u;
 }
 
 static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg)
@@ -70,6 +72,9 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     if (cfg->rank != (uint8_t)QNAV_RANK_QUALITY && cfg->rank != (uint8_t)QNAV_RANK_PREACT) {
         return QNAV_E_RANK;
     }
+    if (cfg->keep_pct > 100u) {
+        return QNAV_E_KEEP;
+    }
     q_full = (uint32_t)cfg->full_speed_quality;
     ctrl->full_speed_quality = cfg->full_speed_quality;
     ctrl->speed_scale = ((uint32_t)32768u * 32768u + q_full / 2u) / q_full;
@@ -79,6 +84,7 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     ctrl->inputs = 0u;
     ctrl->out_bias_z = 0;
     ctrl->rank = cfg->rank;
+    ctrl->keep_pct = cfg->keep_pct;
     return QNAV_OK;
 }
 
@@ -586,6 +592,26 @@ uint8_t qnav_ctrl_path_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges_m
     return qnav_clearance_levels(&ctrl->clr, ranges_mm, lvl);
 }
 
+/*
+ * Holding the heading (keep_pct): the path on the previous tick's heading replaces the best
+ * while its quality is at least (100 - keep_pct) % of the best's. Keys are qualities here
+ * (QNAV_RANK_QUALITY), so the margin is a fraction of a probability.
+ */
+static void keep_heading(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uint16_t goal,
+                         uint16_t prev, qnav_best_t *best)
+{
+    uint8_t dtheta = qnav_angle_dist_deg(prev, goal);
+    qnav_qkey_t key = key_at(ctrl, lvl[prev], dtheta);
+    if (key <= 0) {
+        return; /* no way that way */
+    }
+    if ((uint32_t)key * 100u >= (uint32_t)best->key * (uint32_t)(100u - ctrl->keep_pct)) {
+        best->key = key;
+        best->dtheta = dtheta;
+        best->heading = (qnav_deg_t)(prev <= 180u ? (int16_t)prev : (int16_t)prev - 360);
+    }
+}
+
 void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
                     qnav_ctrl_output_t *out, qnav_q1_15_t *qualities)
 {
@@ -621,6 +647,9 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
         }
     }
 
+    if (ctrl->keep_pct != 0u && ctrl->rank == (uint8_t)QNAV_RANK_QUALITY) {
+        keep_heading(ctrl, lvl, goal, qnav_whole_deg(in->prev_heading_cdeg), &best);
+    }
     quality = key_quality(ctrl, best.key);
     if (quality <= 0) {
         out->heading_deg = 0;
@@ -679,6 +708,8 @@ const char *qnav_status_str(qnav_status_t status)
         return "no controller of that name";
     case QNAV_E_WEDGE:
         return "wedge_pct above 100";
+    case QNAV_E_KEEP:
+        return "keep_pct above 100";
     }
     return "unknown status";
 }

@@ -61,9 +61,10 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
 
     if (root.get("probabilistic")) {
         const toml::table &prob = r.table(root, "probabilistic");
-        r.only_keys(prob, {"k_goal", "k_safe"});
+        r.only_keys(prob, {"k_goal", "k_safe", "keep"});
         p.prob_k_goal = r.number(prob, "k_goal", 1.0 / 256.0, 64.0);
         p.prob_k_safe = r.number(prob, "k_safe", 1.0 / 256.0, 64.0);
+        if (prob.get("keep")) p.prob_keep = r.number(prob, "keep", 0.0, 1.0);
     }
 
     const toml::table &cl = r.table(root, "clearance");

@@ -60,6 +60,7 @@ struct RobotProfile {
     // the probabilistic policy hand-tuned for this robot (paper §3.2); 0 = libqnav default
     double prob_k_goal = 0.0;               // P_goal steepness, (0, 64]
     double prob_k_safe = 0.0;               // P_safe steepness, (0, 64]
+    double prob_keep = 0.0;                 // holding the heading: margin of quality, [0, 1]
 };
 
 // Parse a profile (TOML text); name is used in error messages. Throws SimError.

@@ -26,6 +26,7 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->escape_stall_ticks = static_cast<std::uint8_t>(std::lround(p.escape_stall_s * 10.0));
     cfg->escape_follow_mm = to_mm(p.escape_follow_m);
     cfg->escape_follow_s = static_cast<std::uint8_t>(std::lround(p.escape_follow_s));
+    cfg->keep_pct = static_cast<std::uint8_t>(std::lround(p.prob_keep * 100.0));
 }
 
 }  // namespace qnav

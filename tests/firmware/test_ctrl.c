@@ -117,6 +117,9 @@ static void test_init_rejects_bad_configuration(void **state)
     qnav_ctrl_config_default(&cfg);
     cfg.rank = 7;
     assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_E_RANK);
+    qnav_ctrl_config_default(&cfg);
+    cfg.keep_pct = 101;
+    assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_E_KEEP);
 }
 
 static void test_init_rejects_bad_policies(void **state)
@@ -270,6 +273,69 @@ static void test_ctrl_turns_away_from_near_obstacle(void **state)
     assert_true(out.heading_deg == 12 || out.heading_deg == -12);
     assert_int_equal(out.heading_deg, 12); /* tie goes counter-clockwise */
     assert_true(out.speed > 0);
+}
+
+/* --- holding the heading (keep_pct) --- */
+
+static void init_keep(qnav_ctrl_t *c, uint8_t keep, uint8_t rank, const qnav_policy_t *p)
+{
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_config_default(&cfg);
+    qnav_ctrl_config_literal(&cfg);
+    cfg.n_sectors = 16;
+    cfg.max_range_mm = 5000;
+    cfg.keep_pct = keep;
+    cfg.rank = rank;
+    assert_int_equal(qnav_ctrl_init(c, &cfg, p), QNAV_OK);
+}
+
+static qnav_deg_t heading_with_prev(const qnav_ctrl_t *c, const qnav_mm_t *ranges,
+                                    qnav_cdeg_t prev_cdeg)
+{
+    qnav_ctrl_output_t out;
+    qnav_ctrl_input_t in = {ranges, 0};
+    in.prev_heading_cdeg = prev_cdeg;
+    qnav_ctrl_step(c, &in, &out, NULL);
+    return out.heading_deg;
+}
+
+static void test_holding_keeps_the_previous_of_two_equal_ways(void **state)
+{
+    (void)state;
+    qnav_ctrl_t c;
+    qnav_policy_t p;
+    qnav_mm_t ranges[16];
+    qnav_policy_prob_default(&p);
+    fill(ranges, 16, 5000);
+    ranges[0] = 150; /* wall straight ahead, goal straight ahead: 12 and -12 are equal */
+    init_keep(&c, 0, QNAV_RANK_QUALITY, &p);
+    assert_int_equal(heading_with_prev(&c, ranges, -1200), 12); /* off: the tie-break */
+    init_keep(&c, 15, QNAV_RANK_QUALITY, &p);
+    assert_int_equal(heading_with_prev(&c, ranges, -1200), -12); /* held */
+    assert_int_equal(heading_with_prev(&c, ranges, 1200), 12);
+    /* the previous heading into the wall is no way: not held */
+    assert_int_equal(heading_with_prev(&c, ranges, 0), 12);
+    /* one far off the goal is worse by more than the margin: not held, held with a wide one */
+    assert_int_equal(heading_with_prev(&c, ranges, -9000), 12);
+    init_keep(&c, 100, QNAV_RANK_QUALITY, &p);
+    assert_int_equal(heading_with_prev(&c, ranges, -9000), -90);
+}
+
+static void test_holding_leaves_preactivation_keys_alone(void **state)
+{
+    (void)state;
+    qnav_ctrl_t off;
+    qnav_ctrl_t on;
+    qnav_policy_t p;
+    qnav_mm_t ranges[32];
+    for (int k = 0; k < 200; ++k) {
+        random_net(&p, 12, 1024);
+        random_scan(ranges, 16, 5000);
+        init_keep(&off, 0, QNAV_RANK_PREACT, &p);
+        init_keep(&on, 50, QNAV_RANK_PREACT, &p);
+        qnav_cdeg_t prev = (qnav_cdeg_t)rng_range(-17999, 18000);
+        assert_int_equal(heading_with_prev(&on, ranges, prev), heading_with_prev(&off, ranges, prev));
+    }
 }
 
 static void test_ctrl_prefers_goal_over_far_obstacle(void **state)
@@ -1267,6 +1333,8 @@ int main(void)
         cmocka_unit_test(test_level_maps_zero_and_max_range_to_the_ends),
         cmocka_unit_test(test_ctrl_drives_at_goal_in_open_space),
         cmocka_unit_test(test_ctrl_turns_away_from_near_obstacle),
+        cmocka_unit_test(test_holding_keeps_the_previous_of_two_equal_ways),
+        cmocka_unit_test(test_holding_leaves_preactivation_keys_alone),
         cmocka_unit_test(test_ctrl_prefers_goal_over_far_obstacle),
         cmocka_unit_test(test_speed_is_linear_in_quality_up_to_full),
         cmocka_unit_test(test_equal_qualities_choose_the_goal_direction),

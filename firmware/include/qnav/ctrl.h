@@ -40,7 +40,8 @@ typedef enum {
     QNAV_E_NO_TABLE = -10,    /* this policy cannot be compiled into a 2-D table (3 inputs) */
     QNAV_E_VFH_PARAM = -11,   /* a VFH+ parameter out of range (qnav/vfh.h) */
     QNAV_E_NAME = -12,        /* no controller of that name (qnav/nav.h) */
-    QNAV_E_WEDGE = -13        /* wedge_pct above 100 */
+    QNAV_E_WEDGE = -13,       /* wedge_pct above 100 */
+    QNAV_E_KEEP = -15         /* keep_pct above 100 */
 } qnav_status_t;
 
 /* One line of text for a status ("ok", "n_sectors outside 1..360", ...); never null. */
@@ -104,6 +105,14 @@ typedef struct {
     uint8_t escape_follow_s;          /* longest first follow of one side before trying
                                          the other, s (each later try twice as long, at
                                          most 109 s); default 20 */
+    uint8_t keep_pct;                 /* holding the heading: the previous tick's heading
+                                         (prev_heading_cdeg) is kept while its quality is
+                                         at least (100 - keep_pct) % of the best path's, so
+                                         two nearly equal ways round an obstacle do not
+                                         alternate tick by tick (docs/architecture.md,
+                                         "Holding the heading"). Applies when keys are
+                                         qualities (QNAV_RANK_QUALITY: the probabilistic
+                                         policy, its tables); 0..100, default 0 (off) */
 } qnav_ctrl_config_t;
 
 /* The escape memory: what the robot remembers between ticks to leave dead ends
@@ -215,6 +224,7 @@ typedef struct {
     uint8_t hidden;
     uint8_t inputs;                   /* network inputs, 2 or 3 */
     uint8_t rank;                     /* qnav_rank_t of the keys (table: as given at init) */
+    uint8_t keep_pct;                 /* qnav_ctrl_config_t.keep_pct; 0 under QNAV_RANK_PREACT */
     qnav_clearance_t clr;             /* levels, enlargement, speed guard */
     uint32_t speed_scale;             /* speed = min(MAX, (quality * scale) >> 15) */
     qnav_q1_15_t full_speed_quality;

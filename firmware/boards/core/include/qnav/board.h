@@ -86,6 +86,7 @@ typedef struct {
     X(12, escape_stall_ticks, ctrl.escape_stall_ticks)                                      \
     X(13, escape_follow_mm, ctrl.escape_follow_mm)                                          \
     X(14, escape_follow_s, ctrl.escape_follow_s)                                            \
+    X(15, keep_pct, ctrl.keep_pct)                                                          \
     X(32, tick_ms, tick_ms)                                                                 \
     X(33, track_mm, track_mm)                                                               \
     X(34, um_per_count, um_per_count)

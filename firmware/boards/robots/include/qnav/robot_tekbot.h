@@ -33,6 +33,7 @@
         .ctrl.escape_stall_ticks = 20, \
         .ctrl.escape_follow_mm = 500, \
         .ctrl.escape_follow_s = 20, \
+        .ctrl.keep_pct = 15, \
         .tick_ms = 100, \
         .track_mm = 180, \
         .um_per_count = 6872, \
