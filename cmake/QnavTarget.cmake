@@ -19,8 +19,11 @@ endif()
 
 function(qnav_add_target_program name)
   cmake_parse_arguments(T "" "" "SOURCES" ${ARGN})
-  add_executable(${name} ${T_SOURCES} ${PROJECT_SOURCE_DIR}/tests/target/target_io.c)
-  target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/target)
+  # tests/target beside this file, not PROJECT_SOURCE_DIR: a small project of its own
+  # (tests/firmware/switches) uses it too
+  get_filename_component(io_dir ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/../tests/target ABSOLUTE)
+  add_executable(${name} ${T_SOURCES} ${io_dir}/target_io.c)
+  target_include_directories(${name} PRIVATE ${io_dir})
   target_link_libraries(${name} PRIVATE qnav::ctrl)
   target_compile_options(${name} PRIVATE ${QNAV_TARGET_WARNINGS})
   set_target_properties(${name} PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)

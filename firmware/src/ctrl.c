@@ -3,7 +3,9 @@
  * (clearance.c), gives each of the 360 paths a rank key through its policy kind's
  * evaluation (policy_<kind>.c) or a compiled table, picks the best path and maps its
  * quality to a speed under the speed guard. The kind is dispatched by exhaustive switches
- * here and nowhere else. Integer arithmetic only; every format and bound is in
+ * here and nowhere else; a kind left out of the build (QNAV_WITH_<KIND> 0) keeps its case
+ * with an empty body under #if, never reached: qnav_policy_validate() refuses the kind, so
+ * no controller holds it. Integer arithmetic only; every format and bound is in
  * docs/qformats.md.
  */
 #include "qnav/ctrl.h"
@@ -104,6 +106,8 @@ static qnav_status_t policy_status(qnav_policy_status_t st)
         return QNAV_E_INPUTS;
     case QNAV_POLICY_E_PROB_PARAM:
         return QNAV_E_PROB_PARAM;
+    case QNAV_POLICY_E_KIND_DISABLED:
+        return QNAV_E_KIND_DISABLED;
     }
     return QNAV_E_POLICY_KIND;
 }
@@ -121,16 +125,32 @@ qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
     }
     switch ((qnav_policy_kind_t)policy->kind) {
     case QNAV_POLICY_PROB:
+#if QNAV_WITH_PROB
         ctrl->rank = (uint8_t)QNAV_RANK_QUALITY; /* a product of probabilities: no saturation */
         qnav_prob_eval_init(ctrl, &policy->u.prob);
+#endif
         break;
     case QNAV_POLICY_NET:
+#if QNAV_WITH_NETWORK
         qnav_net_eval_init(ctrl, &policy->u.net);
+#endif
         break;
     }
     ctrl->kind = policy->kind;
     ctrl->magic = QNAV_CTRL_MAGIC;
     return QNAV_OK;
+}
+
+/* The controller's compiled table, or null. Without table mode (QNAV_WITH_TABLE 0) never
+ * one, so the compiler leaves the table's paths out of the step. */
+static inline const qnav_qkey_t *table_of(const qnav_ctrl_t *ctrl)
+{
+#if QNAV_WITH_TABLE
+    return ctrl->table;
+#else
+    (void)ctrl;
+    return 0;
+#endif
 }
 
 /* The shape of every row of the table (init time: one read per entry). */
@@ -161,6 +181,9 @@ qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *
     if (rank != QNAV_RANK_QUALITY && rank != QNAV_RANK_PREACT) {
         return QNAV_E_RANK;
     }
+    if (!QNAV_WITH_TABLE) {
+        return QNAV_E_KIND_DISABLED;
+    }
     ctrl->table = table;
     ctrl->rank = (uint8_t)rank;
     table_shapes(ctrl);
@@ -169,25 +192,52 @@ qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *
     return QNAV_OK;
 }
 
-/* A key back to the quality under the controller's rank. */
+#if QNAV_WITH_PREACT_KEYS
+/* A function of its own (gcc inlines a static one into the four callers of key_quality:
+ * 1 KB more AVR flash). */
+qnav_q1_15_t qnav_preact_key_quality(qnav_qkey_t key)
+{
+    int32_t z = key;
+    if (z >= QNAV_KEY_KNEE) {
+        z = QNAV_KEY_KNEE + (z - QNAV_KEY_KNEE) * 16;
+    } else if (z < -QNAV_KEY_KNEE) {
+        z = -QNAV_KEY_KNEE + (z + QNAV_KEY_KNEE) * 16;
+    }
+    return qnav_sigmoid_q5_11(qnav_sat16(z));
+}
+#endif
+
+/* A key back to the quality under the controller's rank. Only networks and their tables
+ * rank by pre-activation: a build with neither has no sigmoid table to read. */
 static qnav_q1_15_t key_quality(const qnav_ctrl_t *ctrl, qnav_qkey_t key)
 {
-    if (ctrl->rank != (uint8_t)QNAV_RANK_PREACT) {
-        return (qnav_q1_15_t)(key < 0 ? 0 : key);
+#if QNAV_WITH_PREACT_KEYS
+    if (ctrl->rank == (uint8_t)QNAV_RANK_PREACT) {
+        return qnav_preact_key_quality(key);
     }
-    return qnav_net_eval_key_quality(key);
+#else
+    (void)ctrl;
+#endif
+    return (qnav_q1_15_t)(key < 0 ? 0 : key);
 }
 
 static qnav_qkey_t key_at(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
 {
-    if (ctrl->table != 0) {
-        return QNAV_FLASH_READ_I16(&ctrl->table[(uint16_t)level * QNAV_TABLE_STRIDE + dtheta]);
+    const qnav_qkey_t *table = table_of(ctrl);
+    if (table != 0) {
+        return QNAV_FLASH_READ_I16(&table[(uint16_t)level * QNAV_TABLE_STRIDE + dtheta]);
     }
     switch ((qnav_policy_kind_t)ctrl->kind) {
     case QNAV_POLICY_PROB:
+#if QNAV_WITH_PROB
         return qnav_prob_eval_key(ctrl, level, dtheta);
+#endif
+        break;
     case QNAV_POLICY_NET:
+#if QNAV_WITH_NETWORK
         return qnav_net_eval_key(ctrl, level, dtheta);
+#endif
+        break;
     }
     return QNAV_KEY_NONE + 1;
 }
@@ -520,26 +570,29 @@ static void eval_table_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_be
 qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_qkey_t *table)
 {
     uint16_t level;
-    uint16_t dtheta;
     if (ctrl == 0 || table == 0) {
         return QNAV_E_NULL;
     }
-    if (ctrl->magic != QNAV_CTRL_MAGIC || ctrl->table != 0) {
+    if (!QNAV_WITH_TABLE) {
+        return QNAV_E_KIND_DISABLED;
+    }
+    if (ctrl->magic != QNAV_CTRL_MAGIC || table_of(ctrl) != 0) {
         return QNAV_E_POLICY_KIND;
     }
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
-        qnav_qkey_t *row = &table[level * QNAV_TABLE_STRIDE];
         switch ((qnav_policy_kind_t)ctrl->kind) {
         case QNAV_POLICY_PROB:
-            for (dtheta = 0; dtheta <= QNAV_DTHETA_MAX; ++dtheta) {
-                row[dtheta] = qnav_prob_eval_key(ctrl, (uint8_t)level, (uint8_t)dtheta);
-            }
+#if QNAV_WITH_PROB
+            qnav_prob_eval_row(ctrl, (uint8_t)level, &table[level * QNAV_TABLE_STRIDE]);
+#endif
             break;
         case QNAV_POLICY_NET:
+#if QNAV_WITH_NETWORK
             if (ctrl->inputs != QNAV_NET_INPUTS_PAPER) {
                 return QNAV_E_NO_TABLE;
             }
-            qnav_net_eval_row(ctrl, (uint8_t)level, row);
+            qnav_net_eval_row(ctrl, (uint8_t)level, &table[level * QNAV_TABLE_STRIDE]);
+#endif
             break;
         }
     }
@@ -566,7 +619,7 @@ static void paths_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t
                        qnav_qkey_t *keys)
 {
     qnav_run_t r;
-    if (ctrl->table != 0) {
+    if (table_of(ctrl) != 0) {
         while (qnav_run_next(it, &r)) {
             if (keys != 0 || qnav_run_reduce(ctrl->p.net.in.row, &r, best, it) != QNAV_RUN_DONE) {
                 eval_table_run(ctrl, &r, best, keys);
@@ -576,10 +629,14 @@ static void paths_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t
     }
     switch ((qnav_policy_kind_t)ctrl->kind) {
     case QNAV_POLICY_PROB:
+#if QNAV_WITH_PROB
         qnav_prob_eval_paths(ctrl, it, best, keys);
+#endif
         break;
     case QNAV_POLICY_NET:
+#if QNAV_WITH_NETWORK
         qnav_net_eval_paths(ctrl, it, best, keys);
+#endif
         break;
     }
 }
@@ -708,6 +765,9 @@ const char *qnav_status_str(qnav_status_t status)
         return "no controller of that name";
     case QNAV_E_WEDGE:
         return "wedge_pct above 100";
+    case QNAV_E_KIND_DISABLED:
+        return "policy kind, table mode or controller left out of this build (a QNAV_WITH_* "
+               "switch is 0)";
     case QNAV_E_KEEP:
         return "keep_pct above 100";
     }

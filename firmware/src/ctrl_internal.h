@@ -31,6 +31,39 @@ static inline int16_t qnav_sat16(int32_t v)
     return (int16_t)v;
 }
 
+/* Knee of the companded pre-activation key: |z| below 8 keeps Q5.11 resolution. */
+#define QNAV_KEY_KNEE 16384
+
+/*
+ * The companded pre-activation key of acc (units of 2^-15): what a network ranks by under
+ * QNAV_RANK_PREACT, and what such a network's compiled table holds.
+ * @par Scaling and overflow: a = round(acc / 16) is Q5.11; |a| < 16384 (|z| < 8) is kept,
+ * beyond the knee every 16 Q5.11 steps are one key step (1/128 in z), saturated to
+ * +-32767, so the key is monotone in acc and -32768 stays free. |acc| < 2^27.
+ */
+static inline qnav_qkey_t qnav_preact_key(int32_t acc)
+{
+    int32_t a = (acc + 8) >> 4;
+    if (a >= QNAV_KEY_KNEE) {
+        a = QNAV_KEY_KNEE + ((a - QNAV_KEY_KNEE) >> 4);
+        return (qnav_qkey_t)(a > 32767 ? 32767 : a);
+    }
+    if (a < -QNAV_KEY_KNEE) {
+        a = -QNAV_KEY_KNEE + ((a + QNAV_KEY_KNEE) >> 4);
+        return (qnav_qkey_t)(a < -32767 ? -32767 : a);
+    }
+    return (qnav_qkey_t)a;
+}
+
+/* Whether this build has pre-activation keys: networks make them, tables of networks hold
+ * them. Turning one back into a quality reads the sigmoid table, so src/sigmoid_lut.c is
+ * built exactly then (firmware/CMakeLists.txt says the same). */
+#define QNAV_WITH_PREACT_KEYS (QNAV_WITH_NETWORK || QNAV_WITH_TABLE)
+
+/* A pre-activation key back to the quality (ctrl.c; with QNAV_WITH_PREACT_KEYS only):
+ * expand to Q5.11 (saturating at +-16) and take the sigmoid. */
+qnav_q1_15_t qnav_preact_key_quality(qnav_qkey_t key);
+
 /*
  * A run: consecutive paths of one distance level along which dtheta moves one way. Within
  * a run each hidden unit's pre-activation is monotone, which is what lets the network step
@@ -175,6 +208,8 @@ qnav_qkey_t qnav_prob_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t d
 /* Every run of it into best; keys (may be null) receives every path's key. */
 void qnav_prob_eval_paths(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best,
                           qnav_qkey_t *keys);
+/* One table row (dtheta 0..180 at level). */
+void qnav_prob_eval_row(const qnav_ctrl_t *ctrl, uint8_t level, qnav_qkey_t *row);
 
 /* ---- policy_net.c: the evolved network (paper §3.3; 3 inputs: §5) ------------------- */
 
@@ -188,7 +223,5 @@ void qnav_net_eval_paths(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best
                          qnav_qkey_t *keys);
 /* One table row (dtheta 0..180 at level) by the same additions as the step. */
 void qnav_net_eval_row(const qnav_ctrl_t *ctrl, uint8_t level, qnav_qkey_t *row);
-/* The quality a pre-activation key stands for. */
-qnav_q1_15_t qnav_net_eval_key_quality(qnav_qkey_t key);
 
 #endif /* QNAV_CTRL_INTERNAL_H */

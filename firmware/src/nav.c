@@ -23,6 +23,16 @@ static void paths_step(qnav_nav_t *nav, const qnav_ctrl_input_t *in, qnav_ctrl_o
     qnav_ctrl_step(&nav->u.paths, in, out, 0);
 }
 
+/* What a controller that is not ready commands. */
+static void stop(qnav_ctrl_output_t *out)
+{
+    out->heading_deg = 0;
+    out->speed = 0;
+    out->quality = 0;
+    out->flags = QNAV_FLAG_NOT_READY;
+}
+
+#if QNAV_WITH_VFH
 static qnav_status_t vfh_init(qnav_nav_t *nav, const qnav_ctrl_config_t *cfg,
                               const qnav_policy_t *policy)
 {
@@ -42,6 +52,32 @@ static void vfh_step(qnav_nav_t *nav, const qnav_ctrl_input_t *in, qnav_ctrl_out
 {
     qnav_vfh_step(&nav->u.vfh.vfh, &nav->u.vfh.state, in, out);
 }
+#else
+/* VFH+ left out of this build (QNAV_WITH_VFH 0): the row keeps its name, so that a board
+ * configured for it learns why it has no controller, and its init refuses. */
+static qnav_status_t vfh_init(qnav_nav_t *nav, const qnav_ctrl_config_t *cfg,
+                              const qnav_policy_t *policy)
+{
+    (void)nav;
+    (void)cfg;
+    (void)policy;
+    return QNAV_E_KIND_DISABLED;
+}
+
+static void vfh_reset(qnav_nav_t *nav)
+{
+    (void)nav;
+}
+
+static void vfh_step(qnav_nav_t *nav, const qnav_ctrl_input_t *in, qnav_ctrl_output_t *out)
+{
+    (void)nav;
+    (void)in;
+    if (out != 0) {
+        stop(out);
+    }
+}
+#endif
 
 static const qnav_nav_method_t methods[] = {
     {"body", 1u, 0, body_init, paths_reset, paths_step},
@@ -144,10 +180,7 @@ void qnav_nav_step(qnav_nav_t *nav, const qnav_ctrl_input_t *in, qnav_ctrl_outpu
         return;
     }
     if (nav == 0 || nav->method == 0) {
-        out->heading_deg = 0;
-        out->speed = 0;
-        out->quality = 0;
-        out->flags = QNAV_FLAG_NOT_READY;
+        stop(out);
         return;
     }
     nav->method->step(nav, in, out);

@@ -1,7 +1,8 @@
 /*
  * Policy helpers: the hand-tuned probabilistic defaults, an all-zero network, the flat
  * weight order that policy files, the link and evolution use to address a network's
- * weights, and the one validation of a policy that every reader and qnav_ctrl_init use.
+ * weights, and the one validation of a policy that every reader and qnav_ctrl_init use
+ * (which also refuses a kind that the build's QNAV_WITH_* switches left out).
  */
 #include "qnav/policy.h"
 
@@ -113,11 +114,12 @@ qnav_policy_status_t qnav_policy_validate(const qnav_policy_t *policy)
     if (policy == 0) {
         return QNAV_POLICY_E_NULL;
     }
+    /* a kind this build left out is refused here, so no controller ever holds it */
     switch ((qnav_policy_kind_t)policy->kind) {
     case QNAV_POLICY_PROB:
-        return prob_params(&policy->u.prob);
+        return QNAV_WITH_PROB ? prob_params(&policy->u.prob) : QNAV_POLICY_E_KIND_DISABLED;
     case QNAV_POLICY_NET:
-        return net_shape(&policy->u.net);
+        return QNAV_WITH_NETWORK ? net_shape(&policy->u.net) : QNAV_POLICY_E_KIND_DISABLED;
     }
     return QNAV_POLICY_E_KIND;
 }
@@ -137,6 +139,8 @@ const char *qnav_policy_status_str(qnav_policy_status_t status)
         return "network inputs neither 2 nor 3";
     case QNAV_POLICY_E_PROB_PARAM:
         return "probabilistic k_goal or k_safe outside (0, 64]";
+    case QNAV_POLICY_E_KIND_DISABLED:
+        return "policy kind left out of this build (QNAV_WITH_NETWORK or QNAV_WITH_PROB is 0)";
     }
     return "unknown policy status";
 }

@@ -12,8 +12,9 @@
 #include "ctrl_internal.h"
 #include "sigmoid_lut.h"
 
-/* Knee of the companded key: |z| below 8 keeps Q5.11 resolution. */
-#define QNAV_KEY_KNEE 16384
+#if !QNAV_WITH_NETWORK
+#error "policy_net.c is left out of the build when QNAV_WITH_NETWORK is 0 (qnav/qnav_config.h)"
+#endif
 
 /* Divide by a positive divisor, rounding halves away from zero. */
 static int32_t div_round(int32_t num, int32_t den)
@@ -49,42 +50,10 @@ static inline qnav_q1_15_t net_output(int32_t acc)
     return qnav_sigmoid_q5_11(qnav_sat16((acc + 8) >> 4));
 }
 
-/*
- * The companded pre-activation key of acc (units of 2^-15).
- * @par Scaling and overflow: a = round(acc / 16) is Q5.11; |a| < 16384 (|z| < 8) is kept,
- * beyond the knee every 16 Q5.11 steps are one key step (1/128 in z), saturated to
- * +-32767, so the key is monotone in acc and -32768 stays free. |acc| < 2^27.
- */
-static inline qnav_qkey_t preact_key(int32_t acc)
-{
-    int32_t a = (acc + 8) >> 4;
-    if (a >= QNAV_KEY_KNEE) {
-        a = QNAV_KEY_KNEE + ((a - QNAV_KEY_KNEE) >> 4);
-        return (qnav_qkey_t)(a > 32767 ? 32767 : a);
-    }
-    if (a < -QNAV_KEY_KNEE) {
-        a = -QNAV_KEY_KNEE + ((a + QNAV_KEY_KNEE) >> 4);
-        return (qnav_qkey_t)(a < -32767 ? -32767 : a);
-    }
-    return (qnav_qkey_t)a;
-}
-
 /* The network's key for an output accumulator, under the controller's rank. */
 static inline qnav_qkey_t net_key_of(const qnav_ctrl_t *ctrl, int32_t acc)
 {
-    return ctrl->rank == (uint8_t)QNAV_RANK_PREACT ? preact_key(acc) : net_output(acc);
-}
-
-/* A key back to the quality: expand to Q5.11 (saturating at +-16) and take the sigmoid. */
-qnav_q1_15_t qnav_net_eval_key_quality(qnav_qkey_t key)
-{
-    int32_t z = key;
-    if (z >= QNAV_KEY_KNEE) {
-        z = QNAV_KEY_KNEE + (z - QNAV_KEY_KNEE) * 16;
-    } else if (z < -QNAV_KEY_KNEE) {
-        z = -QNAV_KEY_KNEE + (z + QNAV_KEY_KNEE) * 16;
-    }
-    return qnav_sigmoid_q5_11(qnav_sat16(z));
+    return ctrl->rank == (uint8_t)QNAV_RANK_PREACT ? qnav_preact_key(acc) : net_output(acc);
 }
 
 /* a * b for a small unsigned b (the low 32 bits, which is the product: |a * b| < 2^31

@@ -5,6 +5,10 @@
  */
 #include "ctrl_internal.h"
 
+#if !QNAV_WITH_PROB
+#error "policy_prob.c is left out of the build when QNAV_WITH_PROB is 0 (qnav/qnav_config.h)"
+#endif
+
 /*
  * e^-u for u in Q16.16 (u >= 0), result in units of 2^-15 in [0, 32768] (1.0 included).
  * Range reduction by ln 2, then 9 terms of the series in Q0.16; error at most 2 LSB.
@@ -52,6 +56,14 @@ qnav_qkey_t qnav_prob_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t d
 {
     uint32_t q = (uint32_t)ctrl->p.prob.goal[dtheta] * (uint32_t)ctrl->p.prob.safe[level];
     return (qnav_q1_15_t)((q + 16384u) >> 15);
+}
+
+void qnav_prob_eval_row(const qnav_ctrl_t *ctrl, uint8_t level, qnav_qkey_t *row)
+{
+    uint16_t d;
+    for (d = 0; d <= QNAV_DTHETA_MAX; ++d) {
+        row[d] = qnav_prob_eval_key(ctrl, level, (uint8_t)d);
+    }
 }
 
 static void eval_run_all(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *best,

@@ -10,6 +10,10 @@
 #include "ctrl_internal.h"
 #include "escape.h"
 
+#if !QNAV_WITH_VFH
+#error "vfh.c is left out of the build when QNAV_WITH_VFH is 0 (qnav/qnav_config.h)"
+#endif
+
 #define QNAV_VFH_MAGIC 0x5646u
 
 void qnav_vfh_config_default(qnav_vfh_config_t *cfg)

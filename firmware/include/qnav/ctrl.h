@@ -41,6 +41,8 @@ typedef enum {
     QNAV_E_VFH_PARAM = -11,   /* a VFH+ parameter out of range (qnav/vfh.h) */
     QNAV_E_NAME = -12,        /* no controller of that name (qnav/nav.h) */
     QNAV_E_WEDGE = -13,       /* wedge_pct above 100 */
+    QNAV_E_KIND_DISABLED = -14, /* a policy kind, table mode or controller left out of
+                                  this build (a QNAV_WITH_* switch at 0, qnav/qnav_config.h) */
     QNAV_E_KEEP = -15         /* keep_pct above 100 */
 } qnav_status_t;
 
@@ -263,7 +265,8 @@ void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg);
  * Check cfg and policy and derive the step's parameters into ctrl.
  * Returns QNAV_OK, or QNAV_E_NULL, QNAV_E_SECTORS, QNAV_E_RANGE, QNAV_E_SPEED, QNAV_E_RANK,
  * QNAV_E_POLICY_KIND, QNAV_E_HIDDEN, QNAV_E_INPUTS, QNAV_E_PROB_PARAM (the policy is
- * checked by qnav_policy_validate()); on error ctrl is left not ready
+ * checked by qnav_policy_validate()), QNAV_E_KIND_DISABLED (its kind is left out of this
+ * build); on error ctrl is left not ready
  * (a step then commands a stop). The policy is not referenced after init returns.
  */
 QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
@@ -275,7 +278,7 @@ QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctr
  * tool) and does no multiplies per path. rank says what the keys are (qnav_ctrl_rank() of
  * the controller that built it); cfg->rank is not used. With QNAV_TABLES_IN_FLASH the table
  * must be in program memory. The table must outlive ctrl. Same statuses as
- * qnav_ctrl_init().
+ * qnav_ctrl_init(); QNAV_E_KIND_DISABLED without table mode (QNAV_WITH_TABLE 0).
  */
 QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
                                    const qnav_qkey_t *table, qnav_rank_t rank);
@@ -314,8 +317,9 @@ qnav_q1_15_t qnav_ctrl_key_quality(const qnav_ctrl_t *ctrl, qnav_qkey_t key);
  * Compile the controller's policy into a key table of QNAV_QTABLE_ENTRIES entries
  * (caller's buffer, in RAM), for qnav_ctrl_init_table(..., qnav_ctrl_rank(ctrl)).
  * Returns QNAV_OK, QNAV_E_NULL, QNAV_E_POLICY_KIND when ctrl is not initialised with a
- * policy, or QNAV_E_NO_TABLE for a 3-input network (its key depends on dprev too: a 3-D
- * table of 32 x 181 x 181 keys, 371 KB, does not fit a small board).
+ * policy, QNAV_E_NO_TABLE for a 3-input network (its key depends on dprev too: a 3-D
+ * table of 32 x 181 x 181 keys, 371 KB, does not fit a small board), or
+ * QNAV_E_KIND_DISABLED without table mode (QNAV_WITH_TABLE 0).
  */
 QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_qkey_t *table);
 

@@ -10,6 +10,8 @@
  *   "body"    the path-quality controller (paper §3, body-aware clearance), with a policy
  *   "literal" the same with qnav_ctrl_config_literal() (the paper read literally)
  *   "vfh"     VFH+ (Ulrich & Borenstein 1998), no policy
+ * Every row is there in every build; a controller or policy kind that the build's
+ * QNAV_WITH_* switches left out is refused at init with QNAV_E_KIND_DISABLED.
  */
 #ifndef QNAV_NAV_H
 #define QNAV_NAV_H
@@ -61,7 +63,8 @@ const qnav_nav_method_t *qnav_nav_find(const char *name);
 
 /* Initialise nav as method from cfg (and policy when the method uses one), then reset it.
  * Returns the method's status (QNAV_E_NULL for a null nav, cfg or method; QNAV_E_NULL for
- * a null policy when the method uses one); on error nav is not ready and steps stop. */
+ * a null policy when the method uses one; QNAV_E_KIND_DISABLED for a controller or policy
+ * kind left out of this build); on error nav is not ready and steps stop. */
 QNAV_CHECK_RESULT qnav_status_t qnav_nav_init(qnav_nav_t *nav, const qnav_nav_method_t *method,
                                               const qnav_ctrl_config_t *cfg,
                                               const qnav_policy_t *policy);

@@ -33,7 +33,9 @@ typedef enum {
     QNAV_POLICY_E_KIND = -2,       /* kind is not a qnav_policy_kind_t */
     QNAV_POLICY_E_HIDDEN = -3,     /* network: hidden outside 1..QNAV_MAX_HIDDEN */
     QNAV_POLICY_E_INPUTS = -4,     /* network: inputs not 2 or 3 */
-    QNAV_POLICY_E_PROB_PARAM = -5  /* probabilistic: k_goal or k_safe outside (0, 64] */
+    QNAV_POLICY_E_PROB_PARAM = -5, /* probabilistic: k_goal or k_safe outside (0, 64] */
+    QNAV_POLICY_E_KIND_DISABLED = -6 /* kind left out of this build (QNAV_WITH_NETWORK or
+                                        QNAV_WITH_PROB 0, qnav/qnav_config.h) */
 } qnav_policy_status_t;
 
 /* Largest probabilistic parameter, 64.0 in Q8.8. */
@@ -109,7 +111,7 @@ uint16_t qnav_net_weight_count(const qnav_net_t *net);
 /*
  * The one check of a policy: kind, shape and parameter ranges (what qnav_ctrl_init, the
  * policy reader, the link and the tools accept). Returns QNAV_POLICY_OK or a
- * qnav_policy_status_t error.
+ * qnav_policy_status_t error; QNAV_POLICY_E_KIND_DISABLED for a kind this build left out.
  */
 QNAV_CHECK_RESULT qnav_policy_status_t qnav_policy_validate(const qnav_policy_t *policy);
 

@@ -52,6 +52,44 @@
 #endif
 #endif
 
+/*
+ * Feature switches: 1 compiles a kind into libqnav, 0 leaves its code out of a firmware
+ * that does not use it (flash per configuration: docs/performance.md). The API stays the
+ * same: a policy, table or controller of a left-out kind is refused with
+ * QNAV_E_KIND_DISABLED (qnav_policy_validate: QNAV_POLICY_E_KIND_DISABLED), and
+ * qnav_vfh_* are not in the library. The CMake options of the same names (ON/OFF) leave
+ * the sources out and pass these; a build without CMake leaves out the files named here
+ * (they stop with #error when compiled with their switch at 0).
+ *   QNAV_WITH_NETWORK  the evolved network policy: src/policy_net.c
+ *   QNAV_WITH_PROB     the probabilistic policy: src/policy_prob.c
+ *   QNAV_WITH_TABLE    table mode, compiled key tables (qnav_ctrl_init_table, _build_table)
+ *   QNAV_WITH_VFH      the VFH+ controller: src/vfh.c (the nav table's "vfh" row refuses)
+ * src/sigmoid_lut.c (8 KB) is needed with QNAV_WITH_NETWORK or QNAV_WITH_TABLE: a table of
+ * pre-activation keys turns its chosen key into a quality through the sigmoid.
+ * The switches change no struct layout.
+ */
+#ifndef QNAV_WITH_NETWORK
+#define QNAV_WITH_NETWORK 1
+#endif
+#ifndef QNAV_WITH_PROB
+#define QNAV_WITH_PROB 1
+#endif
+#ifndef QNAV_WITH_TABLE
+#define QNAV_WITH_TABLE 1
+#endif
+#ifndef QNAV_WITH_VFH
+#define QNAV_WITH_VFH 1
+#endif
+
+#if (QNAV_WITH_NETWORK != 0 && QNAV_WITH_NETWORK != 1) ||                                    \
+    (QNAV_WITH_PROB != 0 && QNAV_WITH_PROB != 1) ||                                          \
+    (QNAV_WITH_TABLE != 0 && QNAV_WITH_TABLE != 1) || (QNAV_WITH_VFH != 0 && QNAV_WITH_VFH != 1)
+#error "QNAV_WITH_NETWORK, QNAV_WITH_PROB, QNAV_WITH_TABLE and QNAV_WITH_VFH must be 0 or 1"
+#endif
+#if !QNAV_WITH_NETWORK && !QNAV_WITH_PROB && !QNAV_WITH_TABLE && !QNAV_WITH_VFH
+#error "every QNAV_WITH_* switch is 0: libqnav would have no controller left"
+#endif
+
 #if QNAV_DIST_LEVELS < 2 || QNAV_DIST_LEVELS > 256
 #error "QNAV_DIST_LEVELS must be in 2..256"
 #endif

@@ -146,6 +146,7 @@ int qnav_policy_check(const qnav_policy_t *policy, char *err, size_t errlen)
         }
         return -1;
     case QNAV_POLICY_E_NULL:
+    case QNAV_POLICY_E_KIND_DISABLED:
         break;
     }
     set_err(err, errlen, "%s", qnav_policy_status_str(st));
