@@ -62,6 +62,49 @@ void check_sources_finished(const std::vector<TaskDef> &tasks, const std::vector
     }
 }
 
+enum class TaskState { Pending, Running, Done, Failed };
+
+/* The first pending task whose source task is done, or tasks.size() when none is ready
+ * yet; any_pending says whether any task is pending at all. */
+std::size_t next_ready_task(const std::vector<TaskDef> &tasks, const std::vector<TaskState> &state, bool &any_pending)
+{
+    std::size_t pick = tasks.size();
+    any_pending = false;
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+        if (state[i] != TaskState::Pending) {
+            continue;
+        }
+        any_pending = true;
+        const int src = tasks[i].source_task;
+        if (src < 0 || state[static_cast<std::size_t>(src)] == TaskState::Done) {
+            pick = i;
+            break;
+        }
+    }
+    return pick;
+}
+
+/* Task t, seeded from its source task's best policy or its source policy file, run while
+ * its lock is held. Returns whether it finished; error holds why it failed, if it threw. */
+bool run_locked_task(const std::vector<TaskDef> &tasks, const TaskDef &t, const RunnerFactory &make,
+                     const TaskObserver &obs, const std::atomic<bool> &stop, std::string &error)
+{
+    std::string source_path;
+    if (t.source_task >= 0) {
+        source_path = join_path(tasks[static_cast<std::size_t>(t.source_task)].dir, "best.policy");
+    } else if (!t.source_policy_file.empty()) {
+        source_path = t.source_policy_file;
+    }
+    bool ok = false;
+    try {
+        const TaskLock lock(t.dir);
+        ok = run_task(t, source_path, make, obs, stop);
+    } catch (const std::exception &e) {
+        error = e.what();
+    }
+    return ok;
+}
+
 } // namespace
 
 void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, unsigned jobs,
@@ -80,10 +123,9 @@ void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, uns
     obs.episodes_done = [&prog](uint64_t n, bool replayed) { prog.add(n, replayed); };
     obs.best = [&prog](const std::string &label, double r) { prog.best(label, r); };
 
-    enum State { Pending, Running, Done, Failed };
-    std::vector<State> state(tasks.size(), Pending);
+    std::vector<TaskState> state(tasks.size(), TaskState::Pending);
     for (std::size_t i = 0; i < tasks.size(); ++i) {
-        state[i] = selected[i] ? Pending : Done; // another share's (checked above)
+        state[i] = selected[i] ? TaskState::Pending : TaskState::Done; // another share's (checked above)
     }
     std::mutex mu;
     std::condition_variable cv;
@@ -96,19 +138,8 @@ void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, uns
             if (stop.load()) {
                 return;
             }
-            std::size_t pick = tasks.size();
             bool any_pending = false;
-            for (std::size_t i = 0; i < tasks.size(); ++i) {
-                if (state[i] != Pending) {
-                    continue;
-                }
-                any_pending = true;
-                const int src = tasks[i].source_task;
-                if (src < 0 || state[static_cast<std::size_t>(src)] == Done) {
-                    pick = i;
-                    break;
-                }
-            }
+            const std::size_t pick = next_ready_task(tasks, state, any_pending);
             if (!any_pending) {
                 return;
             }
@@ -116,25 +147,12 @@ void run_tasks(const std::vector<TaskDef> &tasks, const RunnerFactory &make, uns
                 cv.wait(l);
                 continue;
             }
-            state[pick] = Running;
+            state[pick] = TaskState::Running;
             l.unlock();
-            const TaskDef &t = tasks[pick];
-            std::string source_path;
-            if (t.source_task >= 0) {
-                source_path = join_path(tasks[static_cast<std::size_t>(t.source_task)].dir, "best.policy");
-            } else if (!t.source_policy_file.empty()) {
-                source_path = t.source_policy_file;
-            }
-            bool ok = false;
             std::string error;
-            try {
-                const TaskLock lock(t.dir);
-                ok = run_task(t, source_path, make, obs, stop);
-            } catch (const std::exception &e) {
-                error = e.what();
-            }
+            const bool ok = run_locked_task(tasks, tasks[pick], make, obs, stop, error);
             l.lock();
-            state[pick] = ok ? Done : Failed;
+            state[pick] = ok ? TaskState::Done : TaskState::Failed;
             if (!ok) {
                 if (first_error.empty() && !error.empty()) {
                     first_error = error;
