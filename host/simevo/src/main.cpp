@@ -404,6 +404,340 @@ Scenario scenario_from(const std::string &env, const std::string &robot, uint32_
     return s;
 }
 
+/* ---- subcommands: each one's options (add_*_command) and its work (*_command) ---------- */
+
+/* `simevo run`'s options. */
+struct RunCommand {
+    std::vector<std::string> names;
+    RunOptions opt;
+    RunArgs run_args;
+    bool no_plot = false, no_progress = false;
+    std::string share_text;
+    int stage = 0;
+};
+
+CLI::App *add_run_command(CLI::App &app, RunCommand &c)
+{
+    auto *run = app.add_subcommand("run", "run named experiments (resumes an interrupted run in the same --out)");
+    run->add_option("experiment", c.names, "experiment name(s), a .toml path, a sweep file, or 'all' (the paper's five; generalist by name)")->required();
+    add_run_args(run, c.run_args);
+    run->add_option("--out", c.opt.out_dir, "output folder; results go to OUT/<experiment>")->capture_default_str();
+    run->add_option("-j,--jobs", c.opt.jobs, "worker threads (0 = all cores)")->capture_default_str();
+    run->add_option("--tools-dir", c.opt.tools_dir, "folder with plot_learning.py and plot_policy.py")->capture_default_str();
+    run->add_option("--tasks", c.share_text,
+                    "run only the I-th of N shares of the tasks (I/N); no summary: 'simevo summarize' merges "
+                    "(docs/cluster.md)");
+    run->add_option("--stage", c.stage, "with --tasks: share out only stage 1 (no dependency) or stage 2 (transfers "
+                                        "from an evolved source)")->check(CLI::Range(1, 2));
+    run->add_flag("--no-plot", c.no_plot, "skip the PNG plots");
+    run->add_flag("--no-progress", c.no_progress, "no progress line even on a terminal");
+    return run;
+}
+
+/* One experiment of `simevo run` to its end, and what to take from it. */
+void run_whole(const ExperimentSpec &s, const RunOptions &opt, std::chrono::steady_clock::time_point t0)
+{
+    const std::string dir = run_experiment(s, opt);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("%s: complete in %.1f s; summary %s/summary.md\n", s.name.c_str(), secs, dir.c_str());
+    if (opt.plots) {
+        std::printf("%s: plot %s/learning.png\n", s.name.c_str(), dir.c_str());
+    }
+    print_transfer_arrival(s, dir);
+    print_recommendation(s, dir);
+}
+
+/* `simevo run NAME...`: every experiment named, whole or one share of its tasks. */
+int run_command(RunCommand &c, const std::string &experiments_dir, bool &started)
+{
+    if (c.stage != 0 && c.share_text.empty()) {
+        c.share_text = "1/1";
+    }
+    const Share share = c.share_text.empty() ? Share{} : parse_share(c.share_text, c.stage);
+    std::vector<Sweep> sweeps;
+    const auto items = load_run_specs(c.names, experiments_dir, c.run_args, sweeps);
+    c.opt.plots = !c.no_plot;
+    c.opt.progress = c.no_progress ? 0 : -1;
+    started = true;
+    for (const Sweep &sw : sweeps) {
+        (void)write_sweep_record(c.opt.out_dir, sw);
+    }
+    for (const RunItem &it : items) {
+        const ExperimentSpec &s = it.spec;
+        set_run_options(c.opt, it.args, it.file);
+        const auto t0 = std::chrono::steady_clock::now();
+        if (c.share_text.empty()) {
+            run_whole(s, c.opt, t0);
+        } else {
+            run_share(s, c.opt, share, t0);
+        }
+        std::fflush(stdout);
+    }
+    return 0;
+}
+
+/* `simevo summarize`'s options. */
+struct SummarizeCommand {
+    std::string summ_dir;
+    RunOptions opt;
+    bool no_plot = false;
+};
+
+CLI::App *add_summarize_command(CLI::App &app, SummarizeCommand &c)
+{
+    auto *summ = app.add_subcommand("summarize", "merge the finished tasks of an experiment folder into its summary");
+    summ->add_option("folder", c.summ_dir, "experiment or sweep folder (OUT/<experiment>, OUT/<sweep>)")->required();
+    summ->add_option("--tools-dir", c.opt.tools_dir, "folder with the plot scripts")->capture_default_str();
+    summ->add_flag("--no-plot", c.no_plot, "skip the PNG plots");
+    return summ;
+}
+
+int summarize_command(SummarizeCommand &c, bool &started)
+{
+    c.opt.plots = !c.no_plot;
+    return summarize_folder(c.summ_dir, c.opt, started);
+}
+
+/* `simevo slurm`'s options. */
+struct SlurmCommand {
+    std::string slurm_name;
+    RunArgs run_args;
+    RunOptions opt;
+    SlurmOptions so;
+    bool no_plot = false, submit = false;
+};
+
+CLI::App *add_slurm_command(CLI::App &app, SlurmCommand &c)
+{
+    auto *slurm = app.add_subcommand("slurm", "write (and with --submit submit) Slurm job arrays for an experiment");
+    slurm->add_option("experiment", c.slurm_name, "experiment name, .toml path or sweep file")->required();
+    add_run_args(slurm, c.run_args);
+    slurm->add_option("--out", c.opt.out_dir, "output folder (shared by every node); results go to OUT/<experiment>")->capture_default_str();
+    slurm->add_option("--partition", c.so.partition, "Slurm partition (default: the cluster's)");
+    slurm->add_option("--time", c.so.time, "time limit per array task, e.g. 2:00:00 (default: the partition's)");
+    slurm->add_option("--array-limit", c.so.array_limit, "at most this many array tasks at once (0 = no limit)")->capture_default_str();
+    slurm->add_option("--tasks-per-job", c.so.tasks_per_job, "simevo tasks per array task")->capture_default_str()->check(CLI::Range(1u, 1000000u));
+    slurm->add_option("-j,--jobs", c.so.jobs, "threads per array task (--cpus-per-task)")->capture_default_str()->check(CLI::Range(1u, 1024u));
+    slurm->add_option("--tools-dir", c.opt.tools_dir, "folder with the plot scripts, for the summarize job")->capture_default_str();
+    slurm->add_flag("--no-plot", c.no_plot, "the summarize job skips the PNG plots");
+    slurm->add_flag("--submit", c.submit, "submit the arrays with sbatch now");
+    return slurm;
+}
+
+int slurm_command(const SlurmCommand &c, const std::string &experiments_dir, bool &started)
+{
+    std::vector<Sweep> sweeps;
+    const auto items = load_run_specs({c.slurm_name}, experiments_dir, c.run_args, sweeps);
+    check_slurm_options(c.so, c.opt.out_dir);
+    started = true;
+    return write_slurm_all(items, sweeps, c.opt, c.so, !c.no_plot, c.submit);
+}
+
+/* `simevo list`: every experiment file with its figure and title. */
+int list_command(const std::string &experiments_dir)
+{
+    for (const auto &n : list_experiments(experiments_dir)) {
+        const ExperimentSpec s = load_experiment(join_path(experiments_dir, n + ".toml"));
+        std::printf("%-20s %-8s %s\n", n.c_str(), s.figure.c_str(), s.title.c_str());
+    }
+    return 0;
+}
+
+/* `simevo evolve`'s options: one evolution, optionally seeded from a policy file (transfer). */
+struct EvolveCommand {
+    std::string env = "dense", robot = "tekbot", from, out_dir = "runs/evolve";
+    uint32_t sectors = 0;
+    double noise = 0, sensor_noise = -1, actuation_noise = -1;
+    uint64_t ev_episodes = 1000, ev_seed = 1;
+    uint32_t ev_eval = 50;
+    std::string fitness;
+    EvolutionParams ep;
+};
+
+CLI::App *add_evolve_command(CLI::App &app, EvolveCommand &c)
+{
+    auto *evolve = app.add_subcommand("evolve", "evolve one population in one situation (transfer with --from)");
+    evolve->add_option("--env", c.env, "environment name or file")->capture_default_str();
+    evolve->add_option("--robot", c.robot, "robot profile name or file")->capture_default_str();
+    evolve->add_option("--sectors", c.sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
+    evolve->add_option("--noise", c.noise, "sensor and actuation noise level p (0.05 = 5%)")->check(qnav::cli::finite_range(0.0, 1.0));
+    evolve->add_option("--sensor-noise", c.sensor_noise, "sensor noise only")->check(qnav::cli::finite_range(0.0, 1.0));
+    evolve->add_option("--actuation-noise", c.actuation_noise, "actuation noise only")->check(qnav::cli::finite_range(0.0, 1.0));
+    evolve->add_option("--from", c.from, "policy file to seed the population from (transfer)");
+    evolve->add_option("--episodes", c.ev_episodes, "episodes")->capture_default_str()->check(CLI::Range(uint64_t(1), uint64_t(100000000)));
+    evolve->add_option("--eval-episodes", c.ev_eval, "held-out evaluation episodes of the best")->capture_default_str()->check(CLI::Range(1u, 1000000u));
+    evolve->add_option("--seed", c.ev_seed, "seed")->capture_default_str();
+    evolve->add_option("--fitness", c.fitness, "fitness rule: progress (default) or paper");
+    evolve->add_option("--population", c.ep.population, "population size")->capture_default_str();
+    evolve->add_option("--epsilon", c.ep.epsilon, "probability of mutating a random member")->capture_default_str();
+    evolve->add_option("--hidden", c.ep.hidden, "hidden units of random networks")->capture_default_str();
+    evolve->add_option("--mutation-scale", c.ep.mutation_scale, "Cauchy scale, weight units")->capture_default_str();
+    evolve->add_option("--mutation-clip", c.ep.mutation_clip, "Cauchy clip, weight units")->capture_default_str();
+    evolve->add_option("--per-candidate", c.ep.episodes_per_candidate, "episodes averaged per fitness value")->capture_default_str();
+    evolve->add_flag("--reevaluate-parent", c.ep.reevaluate_parent, "also re-run the parent each step (noisy fitness)");
+    evolve->add_option("--out", c.out_dir, "output folder")->capture_default_str();
+    return evolve;
+}
+
+/* The one task `simevo evolve` runs: its seeds all follow from --seed. Throws UserError. */
+TaskDef evolve_task(const EvolveCommand &c)
+{
+    TaskDef t;
+    t.label = c.from.empty() ? "direct" : "transfer";
+    t.dir = c.out_dir;
+    t.scenario = scenario_from(c.env, c.robot, c.sectors, c.noise, c.sensor_noise, c.actuation_noise, c.fitness);
+    t.context_seed = c.ev_seed;
+    t.episodes = c.ev_episodes;
+    t.evolution = c.ep;
+    t.evolution_seed = mix_seed(c.ev_seed, 1);
+    t.episode_seed_base = mix_seed(c.ev_seed, 2);
+    t.eval_episodes = c.ev_eval;
+    t.eval_seed_base = mix_seed(c.ev_seed, 3);
+    t.source_policy_file = c.from;
+    return t;
+}
+
+int evolve_command(const EvolveCommand &c, bool &started)
+{
+    if (const char *p = evolution_params_problem(c.ep); *p) {
+        throw UserError(std::string("--") + p);
+    }
+    const TaskDef t = evolve_task(c);
+    SimWorlds worlds;
+    RunnerFactory make = [&worlds](const Scenario &sc, uint64_t s) -> std::unique_ptr<EpisodeRunner> {
+        return std::make_unique<SimRunner>(worlds, sc, s, true);
+    };
+    if (!c.from.empty()) {
+        (void)read_policy_file(c.from); // a bad --from is bad input, found now
+    }
+    {
+        SimRunner probe(worlds, t.scenario, t.context_seed, true); // bad env/robot: now
+    }
+    started = true;
+    run_tasks({t}, make, 1, ::isatty(2) != 0, "evolve");
+    std::printf("best policy %s/best.policy; episodes %s/episodes.csv; held-out %s/eval.csv\n",
+                c.out_dir.c_str(), c.out_dir.c_str(), c.out_dir.c_str());
+    return 0;
+}
+
+/* `simevo eval`'s options: a policy over held-out episodes. */
+struct EvalCommand {
+    std::string policy_arg;
+    std::string e_env = "dense", e_robot = "tekbot";
+    uint32_t e_sectors = 0, e_episodes = 50;
+    double e_noise = 0;
+    uint64_t e_seed = 1;
+    std::string fitness;
+};
+
+CLI::App *add_eval_command(CLI::App &app, EvalCommand &c)
+{
+    auto *eval = app.add_subcommand("eval", "evaluate a policy file ('prob' = the probabilistic policy) over episodes");
+    eval->add_option("policy", c.policy_arg, "policy file, or 'prob'")->required();
+    eval->add_option("--env", c.e_env, "environment")->capture_default_str();
+    eval->add_option("--robot", c.e_robot, "robot profile")->capture_default_str();
+    eval->add_option("--sectors", c.e_sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
+    eval->add_option("--noise", c.e_noise, "noise level p")->check(qnav::cli::finite_range(0.0, 1.0));
+    eval->add_option("--episodes", c.e_episodes, "episodes")->capture_default_str()->check(CLI::Range(1u, 1000000u));
+    eval->add_option("--seed", c.e_seed, "seed")->capture_default_str();
+    eval->add_option("--fitness", c.fitness, "fitness rule: progress (default) or paper");
+    return eval;
+}
+
+int eval_command(const EvalCommand &c, bool &started)
+{
+    SimWorlds worlds;
+    SimRunner runner(worlds, scenario_from(c.e_env, c.e_robot, c.e_sectors, c.e_noise, -1, -1, c.fitness), c.e_seed, true);
+    qnav_policy_t p;
+    if (c.policy_arg == "prob") {
+        p = runner.probabilistic_policy();
+    } else {
+        p = read_policy_file(c.policy_arg);
+    }
+    started = true;
+    std::vector<double> R, tau;
+    uint32_t reached = 0;
+    for (uint32_t i = 0; i < c.e_episodes; ++i) {
+        const EpisodeOutcome o = runner.run(p, mix_seed(c.e_seed, i));
+        R.push_back(o.R);
+        reached += o.reached;
+        tau.push_back(o.tau_c);
+    }
+    double lo = 0, hi = 0;
+    wilson_ci95(reached, c.e_episodes, &lo, &hi);
+    std::printf("episodes %u  mean R %.3f ± %.3f (95%% CI)  sd %.3f  reached %.0f%% (95%% CI %.0f-%.0f%%)  "
+                "mean tau_c %.1f ± %.1f ticks\n",
+                c.e_episodes, mean_of(R), ci95_half_width(R), sd_of(R), 100.0 * reached / std::max(1u, c.e_episodes),
+                100.0 * lo, 100.0 * hi, mean_of(tau), ci95_half_width(tau));
+    return 0;
+}
+
+/* `simevo quality`'s options: Figs. 2-3 for any policy files. */
+struct QualityCommand {
+    std::vector<std::string> q_policies;
+    std::string q_out = "runs/quality";
+    uint32_t q_range = 5000;
+    std::string q_robot = "tekbot";
+    RunOptions opt;
+};
+
+CLI::App *add_quality_command(CLI::App &app, QualityCommand &c)
+{
+    auto *quality = app.add_subcommand("quality", "plot path quality over (dtheta, distance) of policy files (paper Figs. 2-3)");
+    quality->add_option("policy", c.q_policies, "policy files, or 'prob' (the robot's tuned probabilistic policy)")->required();
+    quality->add_option("--robot", c.q_robot, "robot profile whose probabilistic policy 'prob' means")->capture_default_str();
+    quality->add_option("--out", c.q_out, "folder for quality.csv and policy.png")->capture_default_str();
+    quality->add_option("--range-mm", c.q_range, "sonar maximum range for the distance axis, mm")
+        ->capture_default_str()->check(CLI::Range(1, 65535));
+    quality->add_option("--tools-dir", c.opt.tools_dir, "folder with plot_policy.py")->capture_default_str();
+    return quality;
+}
+
+/* A policy's name in quality.csv: the last two path components (run folders all hold
+ * "best.policy"), made unique among those named so far with a number when needed. */
+std::string quality_label(const std::string &arg, const std::vector<std::pair<std::string, qnav_policy_t>> &policies)
+{
+    std::string label = condition_label(ConditionKind::Probabilistic);
+    if (arg != "prob") {
+        const std::size_t last = arg.find_last_of('/');
+        const std::size_t prev = last == std::string::npos || last == 0 ? std::string::npos
+                                                                        : arg.find_last_of('/', last - 1);
+        label = prev == std::string::npos ? arg : arg.substr(prev + 1);
+    }
+    for (const auto &q : policies) {
+        if (q.first == label) {
+            label += " #" + std::to_string(policies.size() + 1);
+            break;
+        }
+    }
+    std::replace(label.begin(), label.end(), ',', ' ');
+    return label;
+}
+
+int quality_command(const QualityCommand &c, bool &started)
+{
+    std::vector<std::pair<std::string, qnav_policy_t>> policies;
+    for (const auto &arg : c.q_policies) {
+        qnav_policy_t p;
+        if (arg == "prob") {
+            SimWorlds worlds;
+            qnav_sim_robot_prob_policy(worlds.robot(c.q_robot), &p);
+        } else {
+            p = read_policy_file(arg);
+        }
+        policies.emplace_back(quality_label(arg, policies), p);
+    }
+    qnav_ctrl_config_t ccfg;
+    qnav_ctrl_config_default(&ccfg);
+    ccfg.max_range_mm = static_cast<qnav_mm_t>(c.q_range);
+    started = true;
+    make_dirs(c.q_out);
+    write_file_atomic(join_path(c.q_out, "quality.csv"), quality_table_csv(policies, ccfg));
+    run_plot(c.opt, "plot_policy.py", c.q_out);
+    std::printf("plot %s/policy.png\n", c.q_out.c_str());
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char **argv)
@@ -415,109 +749,22 @@ int main(int argc, char **argv)
         resource_dir("QNAV_EXPERIMENTS_DIR", "experiments", std::string(QNAV_SOURCE_DIR) + "/experiments");
     app.add_option("--experiments", experiments_dir, "folder of experiment files")->capture_default_str();
 
-    // run
-    auto *run = app.add_subcommand("run", "run named experiments (resumes an interrupted run in the same --out)");
-    std::vector<std::string> names;
-    RunOptions opt;
-    opt.tools_dir = resource_dir("QNAV_TOOLS_DIR", "tools", std::string(QNAV_SOURCE_DIR) + "/tools");
-    RunArgs run_args;
-    std::string fitness;
-    bool no_plot = false, no_progress = false;
-    std::string share_text;
-    int stage = 0;
-    run->add_option("experiment", names, "experiment name(s), a .toml path, a sweep file, or 'all' (the paper's five; generalist by name)")->required();
-    add_run_args(run, run_args);
-    run->add_option("--out", opt.out_dir, "output folder; results go to OUT/<experiment>")->capture_default_str();
-    run->add_option("-j,--jobs", opt.jobs, "worker threads (0 = all cores)")->capture_default_str();
-    run->add_option("--tools-dir", opt.tools_dir, "folder with plot_learning.py and plot_policy.py")->capture_default_str();
-    run->add_option("--tasks", share_text,
-                    "run only the I-th of N shares of the tasks (I/N); no summary: 'simevo summarize' merges "
-                    "(docs/cluster.md)");
-    run->add_option("--stage", stage, "with --tasks: share out only stage 1 (no dependency) or stage 2 (transfers "
-                                      "from an evolved source)")->check(CLI::Range(1, 2));
-    run->add_flag("--no-plot", no_plot, "skip the PNG plots");
-    run->add_flag("--no-progress", no_progress, "no progress line even on a terminal");
-
-    auto *summ = app.add_subcommand("summarize", "merge the finished tasks of an experiment folder into its summary");
-    std::string summ_dir;
-    summ->add_option("folder", summ_dir, "experiment or sweep folder (OUT/<experiment>, OUT/<sweep>)")->required();
-    summ->add_option("--tools-dir", opt.tools_dir, "folder with the plot scripts")->capture_default_str();
-    summ->add_flag("--no-plot", no_plot, "skip the PNG plots");
-
-    auto *slurm = app.add_subcommand("slurm", "write (and with --submit submit) Slurm job arrays for an experiment");
-    std::string slurm_name;
-    SlurmOptions so;
-    bool submit = false;
-    slurm->add_option("experiment", slurm_name, "experiment name, .toml path or sweep file")->required();
-    add_run_args(slurm, run_args);
-    slurm->add_option("--out", opt.out_dir, "output folder (shared by every node); results go to OUT/<experiment>")->capture_default_str();
-    slurm->add_option("--partition", so.partition, "Slurm partition (default: the cluster's)");
-    slurm->add_option("--time", so.time, "time limit per array task, e.g. 2:00:00 (default: the partition's)");
-    slurm->add_option("--array-limit", so.array_limit, "at most this many array tasks at once (0 = no limit)")->capture_default_str();
-    slurm->add_option("--tasks-per-job", so.tasks_per_job, "simevo tasks per array task")->capture_default_str()->check(CLI::Range(1u, 1000000u));
-    slurm->add_option("-j,--jobs", so.jobs, "threads per array task (--cpus-per-task)")->capture_default_str()->check(CLI::Range(1u, 1024u));
-    slurm->add_option("--tools-dir", opt.tools_dir, "folder with the plot scripts, for the summarize job")->capture_default_str();
-    slurm->add_flag("--no-plot", no_plot, "the summarize job skips the PNG plots");
-    slurm->add_flag("--submit", submit, "submit the arrays with sbatch now");
-
-    auto *lst = app.add_subcommand("list", "list the experiment files");
-
-    // evolve: one evolution, optionally seeded from a policy file (transfer)
-    auto *evolve = app.add_subcommand("evolve", "evolve one population in one situation (transfer with --from)");
-    std::string env = "dense", robot = "tekbot", from, out_dir = "runs/evolve";
-    uint32_t sectors = 0;
-    double noise = 0, sensor_noise = -1, actuation_noise = -1;
-    uint64_t ev_episodes = 1000, ev_seed = 1;
-    uint32_t ev_eval = 50;
-    EvolutionParams ep;
-    evolve->add_option("--env", env, "environment name or file")->capture_default_str();
-    evolve->add_option("--robot", robot, "robot profile name or file")->capture_default_str();
-    evolve->add_option("--sectors", sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
-    evolve->add_option("--noise", noise, "sensor and actuation noise level p (0.05 = 5%)")->check(qnav::cli::finite_range(0.0, 1.0));
-    evolve->add_option("--sensor-noise", sensor_noise, "sensor noise only")->check(qnav::cli::finite_range(0.0, 1.0));
-    evolve->add_option("--actuation-noise", actuation_noise, "actuation noise only")->check(qnav::cli::finite_range(0.0, 1.0));
-    evolve->add_option("--from", from, "policy file to seed the population from (transfer)");
-    evolve->add_option("--episodes", ev_episodes, "episodes")->capture_default_str()->check(CLI::Range(uint64_t(1), uint64_t(100000000)));
-    evolve->add_option("--eval-episodes", ev_eval, "held-out evaluation episodes of the best")->capture_default_str()->check(CLI::Range(1u, 1000000u));
-    evolve->add_option("--seed", ev_seed, "seed")->capture_default_str();
-    evolve->add_option("--fitness", fitness, "fitness rule: progress (default) or paper");
-    evolve->add_option("--population", ep.population, "population size")->capture_default_str();
-    evolve->add_option("--epsilon", ep.epsilon, "probability of mutating a random member")->capture_default_str();
-    evolve->add_option("--hidden", ep.hidden, "hidden units of random networks")->capture_default_str();
-    evolve->add_option("--mutation-scale", ep.mutation_scale, "Cauchy scale, weight units")->capture_default_str();
-    evolve->add_option("--mutation-clip", ep.mutation_clip, "Cauchy clip, weight units")->capture_default_str();
-    evolve->add_option("--per-candidate", ep.episodes_per_candidate, "episodes averaged per fitness value")->capture_default_str();
-    evolve->add_flag("--reevaluate-parent", ep.reevaluate_parent, "also re-run the parent each step (noisy fitness)");
-    evolve->add_option("--out", out_dir, "output folder")->capture_default_str();
-
-    // eval: a policy over held-out episodes
-    auto *eval = app.add_subcommand("eval", "evaluate a policy file ('prob' = the probabilistic policy) over episodes");
-    std::string policy_arg;
-    std::string e_env = "dense", e_robot = "tekbot";
-    uint32_t e_sectors = 0, e_episodes = 50;
-    double e_noise = 0;
-    uint64_t e_seed = 1;
-    eval->add_option("policy", policy_arg, "policy file, or 'prob'")->required();
-    eval->add_option("--env", e_env, "environment")->capture_default_str();
-    eval->add_option("--robot", e_robot, "robot profile")->capture_default_str();
-    eval->add_option("--sectors", e_sectors, "sonar sectors (0 = robot default)")->check(CLI::Range(0, 360));
-    eval->add_option("--noise", e_noise, "noise level p")->check(qnav::cli::finite_range(0.0, 1.0));
-    eval->add_option("--episodes", e_episodes, "episodes")->capture_default_str()->check(CLI::Range(1u, 1000000u));
-    eval->add_option("--seed", e_seed, "seed")->capture_default_str();
-    eval->add_option("--fitness", fitness, "fitness rule: progress (default) or paper");
-
-    // quality: Figs. 2-3 for any policy files
-    auto *quality = app.add_subcommand("quality", "plot path quality over (dtheta, distance) of policy files (paper Figs. 2-3)");
-    std::vector<std::string> q_policies;
-    std::string q_out = "runs/quality";
-    uint32_t q_range = 5000;
-    std::string q_robot = "tekbot";
-    quality->add_option("policy", q_policies, "policy files, or 'prob' (the robot's tuned probabilistic policy)")->required();
-    quality->add_option("--robot", q_robot, "robot profile whose probabilistic policy 'prob' means")->capture_default_str();
-    quality->add_option("--out", q_out, "folder for quality.csv and policy.png")->capture_default_str();
-    quality->add_option("--range-mm", q_range, "sonar maximum range for the distance axis, mm")
-        ->capture_default_str()->check(CLI::Range(1, 65535));
-    quality->add_option("--tools-dir", opt.tools_dir, "folder with plot_policy.py")->capture_default_str();
+    // every subcommand that plots finds the scripts here unless told otherwise
+    const std::string tools_dir = resource_dir("QNAV_TOOLS_DIR", "tools", std::string(QNAV_SOURCE_DIR) + "/tools");
+    RunCommand run_c;
+    SummarizeCommand summ_c;
+    SlurmCommand slurm_c;
+    QualityCommand quality_c;
+    run_c.opt.tools_dir = summ_c.opt.tools_dir = slurm_c.opt.tools_dir = quality_c.opt.tools_dir = tools_dir;
+    EvolveCommand evolve_c;
+    EvalCommand eval_c;
+    CLI::App *run = add_run_command(app, run_c);
+    CLI::App *summ = add_summarize_command(app, summ_c);
+    CLI::App *slurm = add_slurm_command(app, slurm_c);
+    CLI::App *lst = app.add_subcommand("list", "list the experiment files");
+    CLI::App *evolve = add_evolve_command(app, evolve_c);
+    CLI::App *eval = add_eval_command(app, eval_c);
+    CLI::App *quality = add_quality_command(app, quality_c);
 
     if (const int status = qnav::cli::parse(app, argc, argv, "simevo"); status >= 0) {
         return status;
@@ -528,151 +775,25 @@ int main(int argc, char **argv)
     bool started = false;
     try {
         if (*lst) {
-            for (const auto &n : list_experiments(experiments_dir)) {
-                const ExperimentSpec s = load_experiment(join_path(experiments_dir, n + ".toml"));
-                std::printf("%-20s %-8s %s\n", n.c_str(), s.figure.c_str(), s.title.c_str());
-            }
-            return 0;
+            return list_command(experiments_dir);
         }
         if (*run) {
-            if (stage != 0 && share_text.empty()) {
-                share_text = "1/1";
-            }
-            const Share share = share_text.empty() ? Share{} : parse_share(share_text, stage);
-            std::vector<Sweep> sweeps;
-            const auto items = load_run_specs(names, experiments_dir, run_args, sweeps);
-            opt.plots = !no_plot;
-            opt.progress = no_progress ? 0 : -1;
-            started = true;
-            for (const Sweep &sw : sweeps) {
-                (void)write_sweep_record(opt.out_dir, sw);
-            }
-            for (const RunItem &it : items) {
-                const ExperimentSpec &s = it.spec;
-                set_run_options(opt, it.args, it.file);
-                const auto t0 = std::chrono::steady_clock::now();
-                if (share_text.empty()) {
-                    const std::string dir = run_experiment(s, opt);
-                    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-                    std::printf("%s: complete in %.1f s; summary %s/summary.md\n", s.name.c_str(), secs, dir.c_str());
-                    if (opt.plots) {
-                        std::printf("%s: plot %s/learning.png\n", s.name.c_str(), dir.c_str());
-                    }
-                    print_transfer_arrival(s, dir);
-                    print_recommendation(s, dir);
-                } else {
-                    run_share(s, opt, share, t0);
-                }
-                std::fflush(stdout);
-            }
-            return 0;
+            return run_command(run_c, experiments_dir, started);
         }
         if (*summ) {
-            opt.plots = !no_plot;
-            return summarize_folder(summ_dir, opt, started);
+            return summarize_command(summ_c, started);
         }
         if (*slurm) {
-            std::vector<Sweep> sweeps;
-            const auto items = load_run_specs({slurm_name}, experiments_dir, run_args, sweeps);
-            check_slurm_options(so, opt.out_dir);
-            started = true;
-            return write_slurm_all(items, sweeps, opt, so, !no_plot, submit);
+            return slurm_command(slurm_c, experiments_dir, started);
         }
         if (*evolve) {
-            if (const char *p = evolution_params_problem(ep); *p) {
-                throw UserError(std::string("--") + p);
-            }
-            TaskDef t;
-            t.label = from.empty() ? "direct" : "transfer";
-            t.dir = out_dir;
-            t.scenario = scenario_from(env, robot, sectors, noise, sensor_noise, actuation_noise, fitness);
-            t.context_seed = ev_seed;
-            t.episodes = ev_episodes;
-            t.evolution = ep;
-            t.evolution_seed = mix_seed(ev_seed, 1);
-            t.episode_seed_base = mix_seed(ev_seed, 2);
-            t.eval_episodes = ev_eval;
-            t.eval_seed_base = mix_seed(ev_seed, 3);
-            t.source_policy_file = from;
-            SimWorlds worlds;
-            RunnerFactory make = [&worlds](const Scenario &sc, uint64_t s) -> std::unique_ptr<EpisodeRunner> {
-                return std::make_unique<SimRunner>(worlds, sc, s, true);
-            };
-            if (!from.empty()) {
-                (void)read_policy_file(from); // a bad --from is bad input, found now
-            }
-            {
-                SimRunner probe(worlds, t.scenario, t.context_seed, true); // bad env/robot: now
-            }
-            started = true;
-            run_tasks({t}, make, 1, ::isatty(2) != 0, "evolve");
-            std::printf("best policy %s/best.policy; episodes %s/episodes.csv; held-out %s/eval.csv\n",
-                        out_dir.c_str(), out_dir.c_str(), out_dir.c_str());
-            return 0;
+            return evolve_command(evolve_c, started);
         }
         if (*quality) {
-            std::vector<std::pair<std::string, qnav_policy_t>> policies;
-            for (const auto &arg : q_policies) {
-                qnav_policy_t p;
-                if (arg == "prob") {
-                    SimWorlds worlds;
-                    qnav_sim_robot_prob_policy(worlds.robot(q_robot), &p);
-                } else {
-                    p = read_policy_file(arg);
-                }
-                // Label: the last two path components (run folders all hold "best.policy"),
-                // made unique with a number when needed.
-                std::string label = condition_label(ConditionKind::Probabilistic);
-                if (arg != "prob") {
-                    const std::size_t last = arg.find_last_of('/');
-                    const std::size_t prev = last == std::string::npos || last == 0 ? std::string::npos
-                                                                                    : arg.find_last_of('/', last - 1);
-                    label = prev == std::string::npos ? arg : arg.substr(prev + 1);
-                }
-                for (const auto &q : policies) {
-                    if (q.first == label) {
-                        label += " #" + std::to_string(policies.size() + 1);
-                        break;
-                    }
-                }
-                std::replace(label.begin(), label.end(), ',', ' ');
-                policies.emplace_back(label, p);
-            }
-            qnav_ctrl_config_t ccfg;
-            qnav_ctrl_config_default(&ccfg);
-            ccfg.max_range_mm = static_cast<qnav_mm_t>(q_range);
-            started = true;
-            make_dirs(q_out);
-            write_file_atomic(join_path(q_out, "quality.csv"), quality_table_csv(policies, ccfg));
-            run_plot(opt, "plot_policy.py", q_out);
-            std::printf("plot %s/policy.png\n", q_out.c_str());
-            return 0;
+            return quality_command(quality_c, started);
         }
         if (*eval) {
-            SimWorlds worlds;
-            SimRunner runner(worlds, scenario_from(e_env, e_robot, e_sectors, e_noise, -1, -1, fitness), e_seed, true);
-            qnav_policy_t p;
-            if (policy_arg == "prob") {
-                p = runner.probabilistic_policy();
-            } else {
-                p = read_policy_file(policy_arg);
-            }
-            started = true;
-            std::vector<double> R, tau;
-            uint32_t reached = 0;
-            for (uint32_t i = 0; i < e_episodes; ++i) {
-                const EpisodeOutcome o = runner.run(p, mix_seed(e_seed, i));
-                R.push_back(o.R);
-                reached += o.reached;
-                tau.push_back(o.tau_c);
-            }
-            double lo = 0, hi = 0;
-            wilson_ci95(reached, e_episodes, &lo, &hi);
-            std::printf("episodes %u  mean R %.3f ± %.3f (95%% CI)  sd %.3f  reached %.0f%% (95%% CI %.0f-%.0f%%)  "
-                        "mean tau_c %.1f ± %.1f ticks\n",
-                        e_episodes, mean_of(R), ci95_half_width(R), sd_of(R), 100.0 * reached / std::max(1u, e_episodes),
-                        100.0 * lo, 100.0 * hi, mean_of(tau), ci95_half_width(tau));
-            return 0;
+            return eval_command(eval_c, started);
         }
     } catch (const UserError &e) {
         std::fprintf(stderr, "simevo: %s\n", e.what());

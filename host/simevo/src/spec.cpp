@@ -317,6 +317,26 @@ void parse_header(const Parser &p, const toml::table &root, ExperimentSpec &spec
     }
 }
 
+/* [evolution]'s fitness rule and controller reading: set on the target, which every source
+ * inherits. Throws UserError. */
+void parse_scenario_rules(const Parser &p, const toml::table &t, ExperimentSpec &spec)
+{
+    if (auto *v = t.get("fitness")) {
+        // Every scenario (target, and the sources that inherit from it) uses this rule.
+        const std::string s = p.str(*v, "fitness");
+        if (qnav_sim_fitness_rule_parse(s.c_str(), &spec.target.fitness) != QNAV_SIM_OK) {
+            p.fail(*v, "fitness: '" + s + "' is not one of " + qnav_sim_fitness_rule_names());
+        }
+    }
+    if (auto *v = t.get("controller")) {
+        // Like fitness: one reading for the target and every source.
+        const std::string s = p.str(*v, "controller");
+        if (!controller_reading_parse(s, &spec.target.controller)) {
+            p.fail(*v, "controller: '" + s + "' is not one of body, literal");
+        }
+    }
+}
+
 /* [evolution]: the algorithm's settings, the fitness rule and the controller reading. Throws UserError. */
 void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &spec)
 {
@@ -384,20 +404,7 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
         if (auto *v = t.get("init_scale")) {
             e.init_scale = p.number(*v, "init_scale", 1e-6, 128.0);
         }
-        if (auto *v = t.get("fitness")) {
-            // Every scenario (target, and the sources that inherit from it) uses this rule.
-            const std::string s = p.str(*v, "fitness");
-            if (qnav_sim_fitness_rule_parse(s.c_str(), &spec.target.fitness) != QNAV_SIM_OK) {
-                p.fail(*v, "fitness: '" + s + "' is not one of " + qnav_sim_fitness_rule_names());
-            }
-        }
-        if (auto *v = t.get("controller")) {
-            // Like fitness: one reading for the target and every source.
-            const std::string s = p.str(*v, "controller");
-            if (!controller_reading_parse(s, &spec.target.controller)) {
-                p.fail(*v, "controller: '" + s + "' is not one of body, literal");
-            }
-        }
+        parse_scenario_rules(p, t, spec);
     }
 }
 

@@ -611,6 +611,22 @@ bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, EpisodeRunn
 
     return true;
 }
+/* The population's best member written to best_path, its comment naming the task, run,
+ * episodes and fitness. Returns that policy. Throws UserError. */
+qnav_policy_t write_best_policy(const TaskDef &t, const Evolution &evo, const std::string &best_path)
+{
+    const int32_t b = evo.best_index();
+    const qnav_policy_t best = evo.members()[static_cast<std::size_t>(b)].policy;
+    char comment[200];
+    std::snprintf(comment, sizeof comment, "simevo %s run %u: best after %" PRIu64 " episodes, R = %.6f",
+                  t.label.c_str(), t.run + 1, t.episodes, evo.members()[static_cast<std::size_t>(b)].fitness);
+    char err[QNAV_POLICY_IO_ERRLEN] = {0};
+    if (qnav_policy_write(best_path.c_str(), &best, comment, err, sizeof err) != 0) {
+        throw UserError(err);
+    }
+    return best;
+}
+
 /* The runner of a scenario: make's, or over a distribution's worlds. */
 std::unique_ptr<EpisodeRunner> make_runner(const RunnerFactory &make, const Scenario &sc, uint64_t seed)
 {
@@ -687,15 +703,7 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
     if (!evolve(t, evo, *runner, held_out, journal_path, obs, stop)) {
         return false;
     }
-    const int32_t b = evo.best_index();
-    const qnav_policy_t best = evo.members()[static_cast<std::size_t>(b)].policy;
-    char comment[200];
-    std::snprintf(comment, sizeof comment, "simevo %s run %u: best after %" PRIu64 " episodes, R = %.6f",
-                  t.label.c_str(), t.run + 1, t.episodes, evo.members()[static_cast<std::size_t>(b)].fitness);
-    char err[QNAV_POLICY_IO_ERRLEN] = {0};
-    if (qnav_policy_write(best_path.c_str(), &best, comment, err, sizeof err) != 0) {
-        throw UserError(err);
-    }
+    const qnav_policy_t best = write_best_policy(t, evo, best_path);
     if (t.eval_episodes > 0) {
         if (!run_eval(held_out, best, t, obs, stop)) {
             return false;
