@@ -92,7 +92,8 @@ void mutate_network(qnav_net_t &net, Rng &rng, double scale, double clip)
 uint32_t policy_fingerprint(const qnav_policy_t &policy)
 {
     uint64_t h = fnv1a64(&policy.kind, 1);
-    if (policy.kind == QNAV_POLICY_NET) {
+    switch (static_cast<qnav_policy_kind_t>(policy.kind)) {
+    case QNAV_POLICY_NET: {
         qnav_net_t net = policy.u.net;
         h = fnv1a64(&net.hidden, 1, h);
         if (net.inputs != QNAV_NET_INPUTS_PAPER) {
@@ -105,9 +106,13 @@ uint32_t policy_fingerprint(const qnav_policy_t &policy)
                                         static_cast<unsigned char>((w >> 8) & 0xff)};
             h = fnv1a64(b, 2, h);
         }
-    } else {
+        break;
+    }
+    case QNAV_POLICY_PROB: {
         const int16_t p[2] = {policy.u.prob.k_goal, policy.u.prob.k_safe};
         h = fnv1a64(p, sizeof p, h);
+        break;
+    }
     }
     return static_cast<uint32_t>(h ^ (h >> 32));
 }
