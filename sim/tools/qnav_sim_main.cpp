@@ -332,8 +332,8 @@ struct GenOpts {
 // quotes and backslashes).
 void check_env_name(const std::string &name) {
     if (name.empty()) throw SimError(QNAV_SIM_E_PARAM, "--name: must not be empty");
-    for (unsigned char ch : name)
-        if (ch < 0x20 || ch == 0x7f)
+    for (const char c : name)
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
             throw SimError(QNAV_SIM_E_PARAM, "--name: must not contain control characters (newline, tab, ...)");
 }
 
@@ -448,7 +448,7 @@ int cmd_bench(const BenchOpts &o) {
                 what.c_str(),
                 o.mode.c_str(), o.episodes, o.ps, o.pa);
     std::printf("episodes/s per core: %.1f   (%.0f ticks/s, %.1f ticks/episode, %.2f us/tick, mean R %.3f)\n",
-                o.episodes / wall, ticks / wall, static_cast<double>(ticks) / o.episodes,
+                o.episodes / wall, static_cast<double>(ticks) / wall, static_cast<double>(ticks) / o.episodes,
                 1e6 * wall / static_cast<double>(ticks), sum_r / o.episodes);
     std::printf("time split (profiled pass, %.3f s): physics %.1f%%  sonar %.1f%%  controller %.1f%%  "
                 "other %.1f%%\n",

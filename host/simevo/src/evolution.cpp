@@ -167,7 +167,7 @@ int32_t Evolution::best_index() const
 {
     int32_t best = -1;
     for (uint32_t i = 0; i < pop_.size(); ++i) {
-        if (pop_[i].evaluated && (best < 0 || pop_[i].fitness > pop_[best].fitness)) {
+        if (pop_[i].evaluated && (best < 0 || pop_[i].fitness > pop_[static_cast<std::size_t>(best)].fitness)) {
             best = static_cast<int32_t>(i);
         }
     }
@@ -181,7 +181,7 @@ int32_t Evolution::worst_index() const
         if (!pop_[i].evaluated) {
             return static_cast<int32_t>(i);
         }
-        if (worst < 0 || pop_[i].fitness < pop_[worst].fitness) {
+        if (worst < 0 || pop_[i].fitness < pop_[static_cast<std::size_t>(worst)].fitness) {
             worst = static_cast<int32_t>(i);
         }
     }
@@ -194,14 +194,14 @@ Candidate Evolution::propose()
     c.episode = episode_;
     if (episode_ < init_order_.size()) {
         c.slot = static_cast<int32_t>(init_order_[episode_]);
-        c.policy = pop_[c.slot].policy;
+        c.policy = pop_[init_order_[episode_]].policy;
     } else {
         // Fig. 4 step 1: both draws every time, so the stream does not depend on ε.
         const double u = rng_.uniform01();
         const uint32_t pick = rng_.below(static_cast<uint32_t>(pop_.size()));
         c.explored = u < params_.epsilon;
         c.parent = c.explored ? static_cast<int32_t>(pick) : best_index();
-        c.policy = pop_[c.parent].policy;
+        c.policy = pop_[static_cast<std::size_t>(c.parent)].policy;
         mutate_network(c.policy.u.net, rng_, params_.mutation_scale, params_.mutation_clip);
         c.slot = -1; // decided in accept(): the worst member at that time
     }
@@ -220,11 +220,11 @@ void Evolution::accept(const Candidate &c, const EpisodeOutcome &out, const Epis
         p.fitness = (p.fitness * p.evaluations + parent_out->R) / (p.evaluations + 1);
         ++p.evaluations;
     }
-    const int32_t slot = c.slot >= 0 ? c.slot : worst_index();
-    pop_[slot].policy = c.policy;
-    pop_[slot].fitness = out.R;
-    pop_[slot].evaluations = 1;
-    pop_[slot].evaluated = true;
+    Member &m = pop_[static_cast<std::size_t>(c.slot >= 0 ? c.slot : worst_index())];
+    m.policy = c.policy;
+    m.fitness = out.R;
+    m.evaluations = 1;
+    m.evaluated = true;
     best_so_far_ = pop_[static_cast<std::size_t>(best_index())].fitness;
     ++episode_;
 }
