@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "error.hpp"
-#include "rng.hpp"
+#include "qnav/rng.hpp"
 #include "tomlread.hpp"
 
 namespace qnav {
@@ -264,8 +264,7 @@ Environment generate_environment(double density, std::uint64_t seed, double clea
     env.episode_limit_s = 40;
     env.start_zones = {{0.6, 0.6, 2.0, 1.0}, {4.0, 0.6, 2.0, 1.0}, {7.4, 0.6, 2.0, 1.0}};
     env.zone_lines = {0, 0, 0};
-    SimRng rng;
-    rng.seed(seed, 0x67656e, 0);
+    Rng rng = Rng::stream(seed, 0x67656e, 0);
     // Obstacles live in the band y in [2.2, 8.2]; keep the destination area free.
     const double band_lo = 2.2, band_hi = 8.2;
     const double band_area = env.width_m * (band_hi - band_lo);
@@ -273,7 +272,7 @@ Environment generate_environment(double density, std::uint64_t seed, double clea
     std::vector<Shape> placed;  // env's obstacles so far
     const double target = std::clamp(density, 0.0, 0.5) * band_area;
     for (int attempt = 0; attempt < 4000 && covered < target; ++attempt) {
-        const bool circle = rng.uniform() < 0.5;
+        const bool circle = rng.uniform01() < 0.5;
         const double x = rng.uniform(0.3, env.width_m - 0.3);
         const double y = rng.uniform(band_lo, band_hi);
         Environment trial = env;

@@ -11,7 +11,7 @@
 
 #include "capi_internal.hpp"
 #include "error.hpp"
-#include "rng.hpp"
+#include "qnav/rng.hpp"
 #include "tomlread.hpp"
 
 namespace qnav {
@@ -176,14 +176,14 @@ private:
 // ---- what every builder shares --------------------------------------------------------
 
 struct Ctx {
-    SimRng &rng;
+    Rng &rng;
     double radius;  // robot body radius, m
     double diam;    // robot diameter, m
     double s;       // size scale of the arena for bigger robots (1 for a TekBot)
     double d;       // difficulty in [0, 1]
     WorldNotes notes;
     double uni(double lo, double hi) { return rng.uniform(lo, hi); }
-    int pick(int n) { return std::min(n - 1, static_cast<int>(rng.uniform() * n)); }
+    int pick(int n) { return std::min(n - 1, static_cast<int>(rng.uniform01() * n)); }
     // A width of k robot diameters, jittered by +-0.25 diameter.
     double widths(double k) { return diam * (k + uni(-0.25, 0.25)); }
 };
@@ -239,7 +239,7 @@ void scatter(Ctx &c, Environment &env, PassGrid &grid, double x0, double y0, dou
     const Shape dest = make_circle(env.dest_x_m, env.dest_y_m, env.dest_radius_m);
     double covered = 0;
     for (int t = 0; t < tries && covered < target; ++t) {
-        const bool circle = c.rng.uniform() < 0.5;
+        const bool circle = c.rng.uniform01() < 0.5;
         const double x = c.uni(x0, x1), y = c.uni(y0, y1);
         Shape s;
         double area;
@@ -315,7 +315,7 @@ void build_gaps(Ctx &c, Environment &env) {
     const int walls = std::clamp(1 + static_cast<int>(c.d * 2.5 + c.uni(0, 1.5)), 1,
                                  std::max(1, static_cast<int>((hi - lo) / (1.6 * c.s))));
     const double thick = c.uni(0.1, 0.25) * c.s;
-    double side = c.rng.uniform() < 0.5 ? -1 : 1;
+    double side = c.rng.uniform01() < 0.5 ? -1 : 1;
     for (int k = 0; k < walls; ++k) {
         const double y = lo + (hi - lo) * (k + 0.5 + c.uni(-0.2, 0.2)) / walls;
         const double f = (y - zone_centre(env.start_zones[0]).y) / (env.dest_y_m - zone_centre(env.start_zones[0]).y);
@@ -340,7 +340,7 @@ void build_serpentine(Ctx &c, Environment &env) {
     const double cw = c.widths(3.0 + 4.0 * (1.0 - c.d));
     const int baffles = 2 + static_cast<int>(c.d * 3 + c.uni(0, 1.5));
     const double thick = 0.15 * c.s;
-    const double tilt = c.rng.uniform() < 0.5 ? 0.0 : c.uni(8, 20) * kPi / 180.0;
+    const double tilt = c.rng.uniform01() < 0.5 ? 0.0 : c.uni(8, 20) * kPi / 180.0;
     env.width_m = c.uni(6, 11) * c.s;
     const double span = env.width_m - cw;                    // baffle length
     const double rise = std::tan(tilt) * span;               // height a tilted baffle climbs
@@ -379,7 +379,7 @@ void build_maze(Ctx &c, Environment &env) {
     std::vector<char> wallc(cell_index(nx * ny));
     auto at = [&](int i, int j) -> char & { return wallc[cell_index(j * nx + i)]; };
     const double p = 0.40 + 0.08 * c.d;
-    for (char &w : wallc) w = c.rng.uniform() < p;
+    for (char &w : wallc) w = c.rng.uniform01() < p;
     for (int gen = 0; gen < 12; ++gen) {
         std::vector<char> next(wallc.size());
         for (int j = 0; j < ny; ++j)
@@ -397,8 +397,8 @@ void build_maze(Ctx &c, Environment &env) {
     int i = si, j = sj;
     at(i, j) = 0;
     while (i != gi || j != gj) {
-        if (c.rng.uniform() < 0.6) {
-            if (i != gi && (j == gj || c.rng.uniform() < 0.5))
+        if (c.rng.uniform01() < 0.6) {
+            if (i != gi && (j == gj || c.rng.uniform01() < 0.5))
                 i += gi > i ? 1 : -1;
             else
                 j += gj > j ? 1 : -1;
@@ -429,7 +429,7 @@ void build_maze(Ctx &c, Environment &env) {
 }
 
 void build_corridor(Ctx &c, Environment &env) {
-    if (c.rng.uniform() < 0.5)
+    if (c.rng.uniform01() < 0.5)
         build_serpentine(c, env);
     else
         build_maze(c, env);
@@ -556,9 +556,9 @@ void build_rooms(Ctx &c, Environment &env) {
         for (int i = 0; i < nx; ++i) {
             const std::size_t r = cell_index(j * nx + i);
             if (i + 1 < nx)
-                segment({(i + 1) * rw, j * rh}, {(i + 1) * rw, (j + 1) * rh}, door_v[r] || c.rng.uniform() < extra);
+                segment({(i + 1) * rw, j * rh}, {(i + 1) * rw, (j + 1) * rh}, door_v[r] || c.rng.uniform01() < extra);
             if (j + 1 < ny)
-                segment({i * rw, (j + 1) * rh}, {(i + 1) * rw, (j + 1) * rh}, door_h[r] || c.rng.uniform() < extra);
+                segment({i * rw, (j + 1) * rh}, {(i + 1) * rw, (j + 1) * rh}, door_h[r] || c.rng.uniform01() < extra);
         }
     const int si = c.pick(nx), gi = c.pick(nx);
     const double margin = c.radius + thick / 2 + 0.2;
@@ -738,8 +738,7 @@ Environment generate_world(const WorldSpec &w, const RobotProfile &robot, WorldN
         throw SimError(QNAV_SIM_E_PARAM, fail_spec(name, "difficulty outside [0, 1]"));
     const double diam = 2 * robot.radius_m;
     for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
-        SimRng rng;
-        rng.seed(w.seed, fam->stream, static_cast<std::uint64_t>(attempt));
+        Rng rng = Rng::stream(w.seed, fam->stream, static_cast<std::uint64_t>(attempt));
         Ctx c{rng, robot.radius_m, diam, std::max(1.0, std::sqrt(diam / 0.24)), w.difficulty_milli / 1000.0, {}};
         Environment env;
         env.name = name;

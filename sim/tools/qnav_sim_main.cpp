@@ -28,7 +28,7 @@
 #include "qnav/nav.h"
 #include "qnav/sim.h"
 #include "robot_board.h"
-#include "rng.hpp"
+#include "qnav/rng.hpp"
 #include "svg.hpp"
 #include "worldgen.hpp"
 #ifdef QNAV_SIM_HAVE_POLICYIO
@@ -378,8 +378,7 @@ struct BenchOpts {
 qnav_policy_t random_network(int hidden, std::uint64_t seed, std::uint64_t which) {
     qnav_policy_t pol;
     qnav_policy_net_zero(&pol, static_cast<std::uint8_t>(hidden));
-    qnav::SimRng rng;
-    rng.seed(seed, 0xbe7c, which);
+    qnav::Rng rng = qnav::Rng::stream(seed, 0xbe7c, which);
     for (std::uint16_t k = 0; k < QNAV_NET_WEIGHTS(pol.u.net.hidden); ++k)
         *qnav_net_weight(&pol.u.net, k) =
             static_cast<qnav_q8_8_t>(std::lround(rng.uniform(-4.0, 4.0) * 256.0));

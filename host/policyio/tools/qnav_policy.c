@@ -18,6 +18,7 @@
 #include "qnav/ctrl.h"
 #include "qnav/cli.h"
 #include "qnav/policy_io.h"
+#include "qnav/rng.h"
 
 #define EXIT_FAILED 1    /* a write or the machine failed */
 #define EXIT_BAD_INPUT 2 /* the policy file given is not a good one */
@@ -170,20 +171,11 @@ static int cmd_show(int argc, char **argv)
 
 /* ---- new ----------------------------------------------------------------------------- */
 
-/* SplitMix64: a tiny generator whose sequence is the same on every machine. */
-static uint64_t splitmix64(uint64_t *state)
-{
-    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-/* Uniform raw Q8.8 weight in -512..512 (+-2.0), without modulo bias worth noting
- * (2^64 / 1025 leaves a bias below 1e-16). */
+/* Uniform raw Q8.8 weight in -512..512 (+-2.0) from the splitmix64 sequence of --seed
+ * (qnav/rng.h), without modulo bias worth noting (2^64 / 1025 leaves a bias below 1e-16). */
 static qnav_q8_8_t random_weight(uint64_t *state)
 {
-    return (qnav_q8_8_t)((int32_t)(splitmix64(state) % 1025u) - 512);
+    return (qnav_q8_8_t)((int32_t)(qnav_splitmix64(state) % 1025u) - 512);
 }
 
 /* A seeded random network and the command that makes it again, as its "source". */
