@@ -137,10 +137,13 @@ static void put_line(const qnav_bench_hooks_t *h, uint8_t mode, uint8_t set, uin
     put_field(h->sep, "target=", h->target);
     put_field(h->sep, "mode=", mode_names[mode]);
     put_field(h->sep, "H=", "");
-    if (policy.kind == QNAV_POLICY_NET) {
+    switch ((qnav_policy_kind_t)policy.kind) {
+    case QNAV_POLICY_NET:
         qnav_target_put_u32(policy.u.net.hidden);
-    } else {
+        break;
+    case QNAV_POLICY_PROB:
         qnav_target_put("-");
+        break;
     }
     put_field(h->sep, "N=", "");
     qnav_target_put_u32(n);

@@ -294,12 +294,12 @@ static void write_policies(const char *dir)
         const policy_entry_t *e = &policies[i];
         fprintf(o.f, "    /* %s */\n", e->provenance);
         fprintf(o.f, "    {\"%s\", %s, %u, {.kind = ", e->id, set_macros[e->set], (unsigned)e->group);
-        if (e->policy.kind == QNAV_POLICY_PROB) {
+        switch ((qnav_policy_kind_t)e->policy.kind) {
+        case QNAV_POLICY_PROB:
             fprintf(o.f, "QNAV_POLICY_PROB, .u = {.prob = {%d, %d}}}},\n",
                     (int)e->policy.u.prob.k_goal, (int)e->policy.u.prob.k_safe);
-            continue;
-        }
-        {
+            break;
+        case QNAV_POLICY_NET: {
             const qnav_net_t *n = &e->policy.u.net;
             fprintf(o.f, "QNAV_POLICY_NET, .u = {.net = {\n        .hidden = %u, .inputs = %u,\n",
                     (unsigned)n->hidden, (unsigned)n->inputs);
@@ -311,6 +311,8 @@ static void write_policies(const char *dir)
             put_weights(o.f, "b_hidden", n->b_hidden, n->hidden);
             put_weights(o.f, "w_out", n->w_out, n->hidden);
             fprintf(o.f, "        .b_out = %d}}}},\n", (int)n->b_out);
+            break;
+        }
         }
     }
     fputs("};\n\n#endif /* QNAV_BENCH_POLICIES_H */\n", o.f);

@@ -46,12 +46,35 @@ int guarded(char *err, size_t errlen, F &&f) {
     }
 }
 
+// Whether Python's integer names a policy kind (qnav_policy_kind_name knows every one), so
+// that it may be switched on as a qnav_policy_kind_t.
+bool known_kind(int32_t kind) {
+    return kind >= 0 && kind <= UINT8_MAX && qnav_policy_kind_name(static_cast<uint8_t>(kind)) != nullptr;
+}
+
+// The number of weights a policy of this shape has (0 for no kind).
+int32_t weight_count(int32_t kind, int32_t hidden, int32_t inputs) {
+    if (!known_kind(kind)) return 0;
+    switch (static_cast<qnav_policy_kind_t>(kind)) {
+    case QNAV_POLICY_PROB:
+        return 2;
+    case QNAV_POLICY_NET:
+        return static_cast<int32_t>(QNAV_NET_WEIGHTS_IN(static_cast<uint32_t>(hidden), static_cast<uint32_t>(inputs)));
+    }
+    return 0;
+}
+
 // The policy (kind, hidden, inputs, weights) as libqnav's struct; false with a message
 // when the shape is not one (the policy files' and libqnav's own check decide).
 bool to_policy(int32_t kind, int32_t hidden, int32_t inputs, const int16_t *w, int32_t nw,
                qnav_policy_t *p, std::string *why) {
     std::memset(p, 0, sizeof *p);
-    if (kind == QNAV_POLICY_PROB) {
+    if (!known_kind(kind)) {
+        *why = std::string("policy: ") + qnav_policy_status_str(QNAV_POLICY_E_KIND);
+        return false;
+    }
+    switch (static_cast<qnav_policy_kind_t>(kind)) {
+    case QNAV_POLICY_PROB:
         if (nw != 2) {
             *why = "policy: a probabilistic policy has 2 parameters (k_goal, k_safe), not " + std::to_string(nw);
             return false;
@@ -59,7 +82,8 @@ bool to_policy(int32_t kind, int32_t hidden, int32_t inputs, const int16_t *w, i
         p->kind = QNAV_POLICY_PROB;
         p->u.prob.k_goal = w[0];
         p->u.prob.k_safe = w[1];
-    } else if (kind == QNAV_POLICY_NET) {
+        break;
+    case QNAV_POLICY_NET: {
         if (hidden < 1 || hidden > QNAV_MAX_HIDDEN || (inputs != 2 && inputs != 3)) {
             *why = std::string("policy: ") + qnav_policy_status_str(hidden < 1 || hidden > QNAV_MAX_HIDDEN
                                                                         ? QNAV_POLICY_E_HIDDEN
@@ -74,9 +98,8 @@ bool to_policy(int32_t kind, int32_t hidden, int32_t inputs, const int16_t *w, i
             return false;
         }
         for (uint16_t k = 0; k < n; ++k) *qnav_net_weight(&p->u.net, k) = w[k];
-    } else {
-        *why = std::string("policy: ") + qnav_policy_status_str(QNAV_POLICY_E_KIND);
-        return false;
+        break;
+    }
     }
     const qnav_policy_status_t st = qnav_policy_validate(p);
     if (st != QNAV_POLICY_OK) {
@@ -563,11 +586,7 @@ int qpy_evaluate(const char *robot, const char *world, int32_t sectors, double n
                 if (kind[p] == QPY_KIND_ROBOT_PROB) {
                     pols[p] = probe.probabilistic_policy();
                 } else if (!to_policy(kind[p], hidden[p], inputs[p], w + p * QPY_MAX_WEIGHTS,
-                                      kind[p] == QNAV_POLICY_PROB ? 2
-                                                                  : static_cast<int32_t>(QNAV_NET_WEIGHTS_IN(
-                                                                        static_cast<uint32_t>(hidden[p]),
-                                                                        static_cast<uint32_t>(inputs[p]))),
-                                      &pols[p], &why)) {
+                                      weight_count(kind[p], hidden[p], inputs[p]), &pols[p], &why)) {
                     throw qnav::UserError("policy " + std::to_string(p) + ": " + why);
                 }
             }

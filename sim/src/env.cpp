@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "error.hpp"
-#include "rng.hpp"
+#include "qnav/rng.hpp"
 #include "tomlread.hpp"
 
 namespace qnav {
@@ -167,7 +167,7 @@ void check_clearance(const Environment &env, double clearance_m) {
     if (walled >= 0) {
         char buf[64];
         std::snprintf(buf, sizeof buf, "%.3f", clearance_m);
-        const int line = static_cast<std::size_t>(walled) < env.zone_lines.size() ? env.zone_lines[walled] : 0;
+        const int line = static_cast<std::size_t>(walled) < env.zone_lines.size() ? env.zone_lines[cell_index(walled)] : 0;
         throw SimError(QNAV_SIM_E_WORLD, line_prefix(env.source.empty() ? env.name : env.source, line) +
                                              "start zone is walled in: no path to the destination for a "
                                              "robot of radius " + buf + " m");
@@ -182,11 +182,11 @@ int first_walled_in_zone(const Environment &env, double clearance_m, double cell
     const int nx = static_cast<int>(std::ceil(env.width_m / cell_m));
     const int ny = static_cast<int>(std::ceil(env.height_m / cell_m));
     const std::vector<Shape> obs = env.obstacle_shapes();
-    std::vector<char> free(static_cast<std::size_t>(nx) * ny, 0);
+    std::vector<char> free(cell_index(nx * ny), 0);
     for (int j = 0; j < ny; ++j) {
         for (int i = 0; i < nx; ++i) {
             const Vec2 p{(i + 0.5) * cell_m, (j + 0.5) * cell_m};
-            free[static_cast<std::size_t>(j) * nx + i] = p.x >= clearance_m && p.y >= clearance_m &&
+            free[cell_index(j * nx + i)] = p.x >= clearance_m && p.y >= clearance_m &&
                                                          p.x <= env.width_m - clearance_m &&
                                                          p.y <= env.height_m - clearance_m;
         }
@@ -202,7 +202,7 @@ int first_walled_in_zone(const Environment &env, double clearance_m, double cell
         Vec2 q;
         for (int j = j0; j <= j1; ++j)
             for (int i = i0; i <= i1; ++i) {
-                char &f = free[static_cast<std::size_t>(j) * nx + i];
+                char &f = free[cell_index(j * nx + i)];
                 if (f && nearest_point(s, {(i + 0.5) * cell_m, (j + 0.5) * cell_m}, &q) < clearance_m) f = 0;
             }
     }
@@ -219,13 +219,13 @@ int first_walled_in_zone(const Environment &env, double clearance_m, double cell
         for (int i = 0; i < nx; ++i) {
             const double dx = (i + 0.5) * cell_m - env.dest_x_m, dy = (j + 0.5) * cell_m - env.dest_y_m;
             const int k = j * nx + i;
-            if (free[k] && dx * dx + dy * dy <= env.dest_radius_m * env.dest_radius_m) {
-                seen[k] = 1;
+            if (free[cell_index(k)] && dx * dx + dy * dy <= env.dest_radius_m * env.dest_radius_m) {
+                seen[cell_index(k)] = 1;
                 q.push_back(k);
             }
         }
-    if (q.empty() && free[goal]) {
-        seen[goal] = 1;
+    if (q.empty() && free[cell_index(goal)]) {
+        seen[cell_index(goal)] = 1;
         q.push_back(goal);
     }
     while (!q.empty()) {
@@ -237,15 +237,15 @@ int first_walled_in_zone(const Environment &env, double clearance_m, double cell
             const int a = i + di[d], b = j + dj[d];
             if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
             const int m = b * nx + a;
-            if (free[m] && !seen[m]) {
-                seen[m] = 1;
+            if (free[cell_index(m)] && !seen[cell_index(m)]) {
+                seen[cell_index(m)] = 1;
                 q.push_back(m);
             }
         }
     }
     for (std::size_t z = 0; z < env.start_zones.size(); ++z) {
         const StartZone &sz = env.start_zones[z];
-        if (!seen[cell(sz.x_m + sz.w_m / 2, sz.y_m + sz.h_m / 2)]) return static_cast<int>(z);
+        if (!seen[cell_index(cell(sz.x_m + sz.w_m / 2, sz.y_m + sz.h_m / 2))]) return static_cast<int>(z);
     }
     return -1;
 }
@@ -264,8 +264,7 @@ Environment generate_environment(double density, std::uint64_t seed, double clea
     env.episode_limit_s = 40;
     env.start_zones = {{0.6, 0.6, 2.0, 1.0}, {4.0, 0.6, 2.0, 1.0}, {7.4, 0.6, 2.0, 1.0}};
     env.zone_lines = {0, 0, 0};
-    SimRng rng;
-    rng.seed(seed, 0x67656e, 0);
+    Rng rng = Rng::stream(seed, 0x67656e, 0);
     // Obstacles live in the band y in [2.2, 8.2]; keep the destination area free.
     const double band_lo = 2.2, band_hi = 8.2;
     const double band_area = env.width_m * (band_hi - band_lo);
@@ -273,7 +272,7 @@ Environment generate_environment(double density, std::uint64_t seed, double clea
     std::vector<Shape> placed;  // env's obstacles so far
     const double target = std::clamp(density, 0.0, 0.5) * band_area;
     for (int attempt = 0; attempt < 4000 && covered < target; ++attempt) {
-        const bool circle = rng.uniform() < 0.5;
+        const bool circle = rng.uniform01() < 0.5;
         const double x = rng.uniform(0.3, env.width_m - 0.3);
         const double y = rng.uniform(band_lo, band_hi);
         Environment trial = env;
@@ -313,7 +312,8 @@ std::string environment_to_toml(const Environment &env) {
     os.precision(6);
     os << "# qnav environment (format: docs/sim.md). Units: metres, degrees, seconds.\n";
     os << "name = \"";
-    for (const unsigned char ch : env.name) {  // a TOML basic string: escape what ends it
+    for (const char c : env.name) {  // a TOML basic string: escape what ends it
+        const auto ch = static_cast<unsigned char>(c);
         if (ch == '"' || ch == '\\') {
             os << '\\' << ch;
         } else if (ch < 0x20 || ch == 0x7f) {

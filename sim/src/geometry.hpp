@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 #include <limits>
 
 namespace qnav {
@@ -19,6 +20,11 @@ inline double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
 inline double norm(Vec2 a) { return std::sqrt(dot(a, a)); }
 // a rotated by the angle whose cosine and sine are c and s.
 inline Vec2 rotate(Vec2 a, double c, double s) { return {c * a.x - s * a.y, s * a.x + c * a.y}; }
+
+// Grids (passability, sonar cells, maze and room layouts) number their cells
+// k = j * nx + i with int coordinates, so that a neighbour one step outside the grid is a
+// plain comparison; a cell inside its grid (k >= 0) indexes the grid's vectors through this.
+inline std::size_t cell_index(int k) { return static_cast<std::size_t>(k); }
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();

@@ -136,14 +136,14 @@ void Simulation::build_world() {
 }
 
 void Simulation::reset(std::uint64_t episode_seed) {
-    rng_start_.seed(cfg_.seed, episode_seed, 1);
-    rng_sensor_.seed(cfg_.seed, episode_seed, 2);
-    rng_act_.seed(cfg_.seed, episode_seed, 3);
+    rng_start_ = Rng::stream(cfg_.seed, episode_seed, 1);
+    rng_sensor_ = Rng::stream(cfg_.seed, episode_seed, 2);
+    rng_act_ = Rng::stream(cfg_.seed, episode_seed, 3);
     // Start zone weighted by area (equal weights when all are points or lines).
     double total = 0;
     for (const auto &z : env_.start_zones) total += z.w_m * z.h_m;
     std::size_t zi = 0;
-    const double pick = rng_start_.uniform();
+    const double pick = rng_start_.uniform01();
     if (total > 0) {
         double acc = 0;
         for (zi = 0; zi + 1 < env_.start_zones.size(); ++zi) {
@@ -155,8 +155,8 @@ void Simulation::reset(std::uint64_t episode_seed) {
                       static_cast<std::size_t>(pick * static_cast<double>(env_.start_zones.size())));
     }
     const StartZone &z = env_.start_zones[zi];
-    const double x = z.x_m + rng_start_.uniform() * z.w_m;
-    const double y = z.y_m + rng_start_.uniform() * z.h_m;
+    const double x = z.x_m + rng_start_.uniform01() * z.w_m;
+    const double y = z.y_m + rng_start_.uniform01() * z.h_m;
     const double hd = rng_start_.uniform(-kPi, kPi);
     place(x, y, hd);
 }

@@ -12,7 +12,7 @@
 #include "env.hpp"
 #include "qnav/nav.h"
 #include "qnav/sim.h"
-#include "rng.hpp"
+#include "qnav/rng.hpp"
 #include "robot.hpp"
 #include "sonar.hpp"
 
@@ -103,7 +103,7 @@ private:
     std::unique_ptr<b2World> world_;
     b2Body *body_ = nullptr;
 
-    SimRng rng_start_, rng_sensor_, rng_act_;
+    Rng rng_start_, rng_sensor_, rng_act_;
     bool started_ = false, done_ = false, reached_ = false;
     std::uint32_t tick_ = 0, tau_c_ = 0, collisions_ = 0;
     std::uint32_t recovery_left_ = 0;

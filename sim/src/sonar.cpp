@@ -51,7 +51,7 @@ void SonarRing::build_grid() {
     cell_m_ = std::isfinite(reach_) && reach_ > 0 ? std::max(0.25, reach_ / 2) : 1e9;
     nx_ = std::max(1, std::min(4096, static_cast<int>(std::ceil(width_m_ / cell_m_))));
     ny_ = std::max(1, std::min(4096, static_cast<int>(std::ceil(height_m_ / cell_m_))));
-    std::vector<std::uint32_t> count(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
+    std::vector<std::uint32_t> count(cell_index(nx_ * ny_) + 1, 0);
     std::vector<std::uint32_t> cell_of(shapes_.size());
     large_.clear();
     for (std::uint32_t k = 0; k < shapes_.size(); ++k) {
@@ -61,7 +61,7 @@ void SonarRing::build_grid() {
         }
         int i0, i1, j0, j1;
         cell_range(shapes_[k].c, 0.0, &i0, &i1, &j0, &j1);
-        cell_of[k] = static_cast<std::uint32_t>(j0) * nx_ + i0;
+        cell_of[k] = static_cast<std::uint32_t>(j0 * nx_ + i0);
         ++count[cell_of[k] + 1];
     }
     for (std::size_t c = 1; c < count.size(); ++c) count[c] += count[c - 1];
@@ -191,8 +191,9 @@ void SonarRing::measure(Vec2 pos, double heading, double *dist) const {
     int gi0, gi1, gj0, gj1;
     cell_range(pos, reach_ + cell_m_, &gi0, &gi1, &gj0, &gj1);
     for (int j = gj0; j <= gj1; ++j) {
-        const std::size_t row = static_cast<std::size_t>(j) * nx_;
-        for (std::uint32_t e = cell_start_[row + gi0]; e < cell_start_[row + gi1 + 1]; ++e) consider(cell_shapes_[e]);
+        const int row = j * nx_;
+        for (std::uint32_t e = cell_start_[cell_index(row + gi0)]; e < cell_start_[cell_index(row + gi1 + 1)]; ++e)
+            consider(cell_shapes_[e]);
     }
     for (const std::uint32_t k : large_) consider(k);
     std::sort(near_.begin(), near_.end());

@@ -11,7 +11,7 @@
 
 #include "capi_internal.hpp"
 #include "error.hpp"
-#include "rng.hpp"
+#include "qnav/rng.hpp"
 #include "tomlread.hpp"
 
 namespace qnav {
@@ -34,7 +34,7 @@ public:
         : w_(w), h_(h), clear_(clearance), cell_(cell),
           nx_(std::max(1, static_cast<int>(std::ceil(w / cell)))),
           ny_(std::max(1, static_cast<int>(std::ceil(h / cell)))),
-          blocked_(static_cast<std::size_t>(nx_) * ny_, 0) {
+          blocked_(cell_index(nx_ * ny_), 0) {
         for (int j = 0; j < ny_; ++j)
             for (int i = 0; i < nx_; ++i) {
                 const double x = (i + 0.5) * cell_, y = (j + 0.5) * cell_;
@@ -75,17 +75,18 @@ public:
         for (const StartZone &z : env.start_zones) {
             const int k = cell_of(z.x_m + z.w_m / 2, z.y_m + z.h_m / 2);
             const int i = k % nx_, j = k / nx_;
-            if (i >= i0 && i <= i1 && j >= j0 && j <= j1) terminal[(j - j0) * w + (i - i0)] = 1;
+            if (i >= i0 && i <= i1 && j >= j0 && j <= j1) terminal[cell_index((j - j0) * w + (i - i0))] = 1;
         }
         for (int j = j0; j <= j1 && local_ok; ++j)
             for (int i = i0; i <= i1 && local_ok; ++i) {
-                const int k = (j - j0) * w + (i - i0);
+                const std::size_t k = cell_index((j - j0) * w + (i - i0));
                 const double dx = (i + 0.5) * cell_ - env.dest_x_m, dy = (j + 0.5) * cell_ - env.dest_y_m;
                 const bool term = terminal[k] || i == i0 || i == i1 || j == j0 || j == j1 || dx * dx + dy * dy <= r2;
                 if (!term || before[k] < 0) continue;
+                const std::size_t label = cell_index(before[k]);  // a component number: >= 0
                 if (after[k] < 0) local_ok = false;
-                else if (maps[before[k]] < 0) maps[before[k]] = after[k];
-                else if (maps[before[k]] != after[k]) local_ok = false;
+                else if (maps[label] < 0) maps[label] = after[k];
+                else if (maps[label] != after[k]) local_ok = false;
             }
         if (local_ok || path_m(env) >= 0) return true;
         add(s, -1);
@@ -100,8 +101,8 @@ public:
             for (int i = 0; i < nx_; ++i) {
                 const double dx = (i + 0.5) * cell_ - env.dest_x_m, dy = (j + 0.5) * cell_ - env.dest_y_m;
                 const int k = j * nx_ + i;
-                if (!blocked_[k] && dx * dx + dy * dy <= r2) {
-                    dist[k] = 0;
+                if (!blocked_[cell_index(k)] && dx * dx + dy * dy <= r2) {
+                    dist[cell_index(k)] = 0;
                     q.push_back(k);
                 }
             }
@@ -114,15 +115,15 @@ public:
                 const int a = i + di[d], b = j + dj[d];
                 if (a < 0 || b < 0 || a >= nx_ || b >= ny_) continue;
                 const int m = b * nx_ + a;
-                if (!blocked_[m] && dist[m] < 0) {
-                    dist[m] = dist[k] + 1;
+                if (!blocked_[cell_index(m)] && dist[cell_index(m)] < 0) {
+                    dist[cell_index(m)] = dist[cell_index(k)] + 1;
                     q.push_back(m);
                 }
             }
         }
         int worst = 0;
         for (const StartZone &z : env.start_zones) {
-            const int d = dist[cell_of(z.x_m + z.w_m / 2, z.y_m + z.h_m / 2)];
+            const int d = dist[cell_index(cell_of(z.x_m + z.w_m / 2, z.y_m + z.h_m / 2))];
             if (d < 0) return -1;
             worst = std::max(worst, d);
         }
@@ -130,18 +131,18 @@ public:
     }
 
 private:
-    int &at(int i, int j) { return blocked_[static_cast<std::size_t>(j) * nx_ + i]; }
+    int &at(int i, int j) { return blocked_[cell_index(j * nx_ + i)]; }
     // Components of the free cells of the window [i0, i1] x [j0, j1] (4-connected,
     // inside the window only); -1 for blocked cells.
     std::vector<int> local_labels(int i0, int i1, int j0, int j1) const {
         const int w = i1 - i0 + 1, h = j1 - j0 + 1;
-        std::vector<int> lab(static_cast<std::size_t>(w) * h, -1);
+        std::vector<int> lab(cell_index(w * h), -1);
         std::vector<int> stack;
         int next = 0;
         for (int start = 0; start < w * h; ++start) {
             const int si = start % w + i0, sj = start / w + j0;
-            if (lab[start] >= 0 || blocked_[static_cast<std::size_t>(sj) * nx_ + si]) continue;
-            lab[start] = next;
+            if (lab[cell_index(start)] >= 0 || blocked_[cell_index(sj * nx_ + si)]) continue;
+            lab[cell_index(start)] = next;
             stack.push_back(start);
             while (!stack.empty()) {
                 const int k = stack.back();
@@ -152,8 +153,8 @@ private:
                     const int x = a + da[d], y = b + db[d];
                     if (x < 0 || y < 0 || x >= w || y >= h) continue;
                     const int m = y * w + x;
-                    if (lab[m] < 0 && !blocked_[static_cast<std::size_t>(y + j0) * nx_ + (x + i0)]) {
-                        lab[m] = next;
+                    if (lab[cell_index(m)] < 0 && !blocked_[cell_index((y + j0) * nx_ + (x + i0))]) {
+                        lab[cell_index(m)] = next;
                         stack.push_back(m);
                     }
                 }
@@ -175,14 +176,14 @@ private:
 // ---- what every builder shares --------------------------------------------------------
 
 struct Ctx {
-    SimRng &rng;
+    Rng &rng;
     double radius;  // robot body radius, m
     double diam;    // robot diameter, m
     double s;       // size scale of the arena for bigger robots (1 for a TekBot)
     double d;       // difficulty in [0, 1]
     WorldNotes notes;
     double uni(double lo, double hi) { return rng.uniform(lo, hi); }
-    int pick(int n) { return std::min(n - 1, static_cast<int>(rng.uniform() * n)); }
+    int pick(int n) { return std::min(n - 1, static_cast<int>(rng.uniform01() * n)); }
     // A width of k robot diameters, jittered by +-0.25 diameter.
     double widths(double k) { return diam * (k + uni(-0.25, 0.25)); }
 };
@@ -238,7 +239,7 @@ void scatter(Ctx &c, Environment &env, PassGrid &grid, double x0, double y0, dou
     const Shape dest = make_circle(env.dest_x_m, env.dest_y_m, env.dest_radius_m);
     double covered = 0;
     for (int t = 0; t < tries && covered < target; ++t) {
-        const bool circle = c.rng.uniform() < 0.5;
+        const bool circle = c.rng.uniform01() < 0.5;
         const double x = c.uni(x0, x1), y = c.uni(y0, y1);
         Shape s;
         double area;
@@ -306,7 +307,7 @@ void build_gaps(Ctx &c, Environment &env) {
     top_destination(c, env);
     double zx = 0, ztop = 0;
     for (const StartZone &z : env.start_zones) {
-        zx += zone_centre(z).x / env.start_zones.size();
+        zx += zone_centre(z).x / static_cast<double>(env.start_zones.size());
         ztop = std::max(ztop, z.y_m + z.h_m);
     }
     const double lo = ztop + c.radius * 2 + 0.4 * c.s;
@@ -314,7 +315,7 @@ void build_gaps(Ctx &c, Environment &env) {
     const int walls = std::clamp(1 + static_cast<int>(c.d * 2.5 + c.uni(0, 1.5)), 1,
                                  std::max(1, static_cast<int>((hi - lo) / (1.6 * c.s))));
     const double thick = c.uni(0.1, 0.25) * c.s;
-    double side = c.rng.uniform() < 0.5 ? -1 : 1;
+    double side = c.rng.uniform01() < 0.5 ? -1 : 1;
     for (int k = 0; k < walls; ++k) {
         const double y = lo + (hi - lo) * (k + 0.5 + c.uni(-0.2, 0.2)) / walls;
         const double f = (y - zone_centre(env.start_zones[0]).y) / (env.dest_y_m - zone_centre(env.start_zones[0]).y);
@@ -339,7 +340,7 @@ void build_serpentine(Ctx &c, Environment &env) {
     const double cw = c.widths(3.0 + 4.0 * (1.0 - c.d));
     const int baffles = 2 + static_cast<int>(c.d * 3 + c.uni(0, 1.5));
     const double thick = 0.15 * c.s;
-    const double tilt = c.rng.uniform() < 0.5 ? 0.0 : c.uni(8, 20) * kPi / 180.0;
+    const double tilt = c.rng.uniform01() < 0.5 ? 0.0 : c.uni(8, 20) * kPi / 180.0;
     env.width_m = c.uni(6, 11) * c.s;
     const double span = env.width_m - cw;                    // baffle length
     const double rise = std::tan(tilt) * span;               // height a tilted baffle climbs
@@ -375,10 +376,10 @@ void build_maze(Ctx &c, Environment &env) {
     const int ny = std::max(5, static_cast<int>(c.uni(8, 13) * c.s / cell));
     env.width_m = nx * cell;
     env.height_m = ny * cell;
-    std::vector<char> wallc(static_cast<std::size_t>(nx) * ny);
-    auto at = [&](int i, int j) -> char & { return wallc[static_cast<std::size_t>(j) * nx + i]; };
+    std::vector<char> wallc(cell_index(nx * ny));
+    auto at = [&](int i, int j) -> char & { return wallc[cell_index(j * nx + i)]; };
     const double p = 0.40 + 0.08 * c.d;
-    for (char &w : wallc) w = c.rng.uniform() < p;
+    for (char &w : wallc) w = c.rng.uniform01() < p;
     for (int gen = 0; gen < 12; ++gen) {
         std::vector<char> next(wallc.size());
         for (int j = 0; j < ny; ++j)
@@ -387,7 +388,7 @@ void build_maze(Ctx &c, Environment &env) {
                 for (int b = j - 1; b <= j + 1; ++b)
                     for (int a = i - 1; a <= i + 1; ++a)
                         if ((a != i || b != j) && a >= 0 && b >= 0 && a < nx && b < ny) n += at(a, b);
-                next[static_cast<std::size_t>(j) * nx + i] = at(i, j) ? (n >= 1 && n <= 5) : (n == 3);
+                next[cell_index(j * nx + i)] = at(i, j) ? (n >= 1 && n <= 5) : (n == 3);
             }
         wallc.swap(next);
     }
@@ -396,8 +397,8 @@ void build_maze(Ctx &c, Environment &env) {
     int i = si, j = sj;
     at(i, j) = 0;
     while (i != gi || j != gj) {
-        if (c.rng.uniform() < 0.6) {
-            if (i != gi && (j == gj || c.rng.uniform() < 0.5))
+        if (c.rng.uniform01() < 0.6) {
+            if (i != gi && (j == gj || c.rng.uniform01() < 0.5))
                 i += gi > i ? 1 : -1;
             else
                 j += gj > j ? 1 : -1;
@@ -428,7 +429,7 @@ void build_maze(Ctx &c, Environment &env) {
 }
 
 void build_corridor(Ctx &c, Environment &env) {
-    if (c.rng.uniform() < 0.5)
+    if (c.rng.uniform01() < 0.5)
         build_serpentine(c, env);
     else
         build_maze(c, env);
@@ -517,25 +518,25 @@ void build_rooms(Ctx &c, Environment &env) {
     std::vector<char> door_v(static_cast<std::size_t>(rooms), 0), door_h(static_cast<std::size_t>(rooms), 0);
     std::vector<char> seen(static_cast<std::size_t>(rooms), 0);
     std::vector<int> stack{c.pick(rooms)};
-    seen[stack[0]] = 1;
+    seen[cell_index(stack[0])] = 1;
     while (!stack.empty()) {  // random depth-first spanning tree
         const int r = stack.back(), i = r % nx, j = r / nx;
         int opts[4], n = 0;
-        if (i + 1 < nx && !seen[r + 1]) opts[n++] = 0;
-        if (i > 0 && !seen[r - 1]) opts[n++] = 1;
-        if (j + 1 < ny && !seen[r + nx]) opts[n++] = 2;
-        if (j > 0 && !seen[r - nx]) opts[n++] = 3;
+        if (i + 1 < nx && !seen[cell_index(r + 1)]) opts[n++] = 0;
+        if (i > 0 && !seen[cell_index(r - 1)]) opts[n++] = 1;
+        if (j + 1 < ny && !seen[cell_index(r + nx)]) opts[n++] = 2;
+        if (j > 0 && !seen[cell_index(r - nx)]) opts[n++] = 3;
         if (n == 0) {
             stack.pop_back();
             continue;
         }
         const int o = opts[c.pick(n)];
         const int next = o == 0 ? r + 1 : o == 1 ? r - 1 : o == 2 ? r + nx : r - nx;
-        if (o == 0) door_v[r] = 1;
-        if (o == 1) door_v[r - 1] = 1;
-        if (o == 2) door_h[r] = 1;
-        if (o == 3) door_h[r - nx] = 1;
-        seen[next] = 1;
+        if (o == 0) door_v[cell_index(r)] = 1;
+        if (o == 1) door_v[cell_index(r - 1)] = 1;
+        if (o == 2) door_h[cell_index(r)] = 1;
+        if (o == 3) door_h[cell_index(r - nx)] = 1;
+        seen[cell_index(next)] = 1;
         stack.push_back(next);
     }
     const double extra = 0.5 * (1.0 - c.d);
@@ -553,11 +554,11 @@ void build_rooms(Ctx &c, Environment &env) {
     };
     for (int j = 0; j < ny; ++j)
         for (int i = 0; i < nx; ++i) {
-            const int r = j * nx + i;
+            const std::size_t r = cell_index(j * nx + i);
             if (i + 1 < nx)
-                segment({(i + 1) * rw, j * rh}, {(i + 1) * rw, (j + 1) * rh}, door_v[r] || c.rng.uniform() < extra);
+                segment({(i + 1) * rw, j * rh}, {(i + 1) * rw, (j + 1) * rh}, door_v[r] || c.rng.uniform01() < extra);
             if (j + 1 < ny)
-                segment({i * rw, (j + 1) * rh}, {(i + 1) * rw, (j + 1) * rh}, door_h[r] || c.rng.uniform() < extra);
+                segment({i * rw, (j + 1) * rh}, {(i + 1) * rw, (j + 1) * rh}, door_h[r] || c.rng.uniform01() < extra);
         }
     const int si = c.pick(nx), gi = c.pick(nx);
     const double margin = c.radius + thick / 2 + 0.2;
@@ -737,8 +738,7 @@ Environment generate_world(const WorldSpec &w, const RobotProfile &robot, WorldN
         throw SimError(QNAV_SIM_E_PARAM, fail_spec(name, "difficulty outside [0, 1]"));
     const double diam = 2 * robot.radius_m;
     for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
-        SimRng rng;
-        rng.seed(w.seed, fam->stream, static_cast<std::uint64_t>(attempt));
+        Rng rng = Rng::stream(w.seed, fam->stream, static_cast<std::uint64_t>(attempt));
         Ctx c{rng, robot.radius_m, diam, std::max(1.0, std::sqrt(diam / 0.24)), w.difficulty_milli / 1000.0, {}};
         Environment env;
         env.name = name;

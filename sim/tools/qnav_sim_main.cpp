@@ -28,7 +28,7 @@
 #include "qnav/nav.h"
 #include "qnav/sim.h"
 #include "robot_board.h"
-#include "rng.hpp"
+#include "qnav/rng.hpp"
 #include "svg.hpp"
 #include "worldgen.hpp"
 #ifdef QNAV_SIM_HAVE_POLICYIO
@@ -332,8 +332,8 @@ struct GenOpts {
 // quotes and backslashes).
 void check_env_name(const std::string &name) {
     if (name.empty()) throw SimError(QNAV_SIM_E_PARAM, "--name: must not be empty");
-    for (unsigned char ch : name)
-        if (ch < 0x20 || ch == 0x7f)
+    for (const char c : name)
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
             throw SimError(QNAV_SIM_E_PARAM, "--name: must not contain control characters (newline, tab, ...)");
 }
 
@@ -378,8 +378,7 @@ struct BenchOpts {
 qnav_policy_t random_network(int hidden, std::uint64_t seed, std::uint64_t which) {
     qnav_policy_t pol;
     qnav_policy_net_zero(&pol, static_cast<std::uint8_t>(hidden));
-    qnav::SimRng rng;
-    rng.seed(seed, 0xbe7c, which);
+    qnav::Rng rng = qnav::Rng::stream(seed, 0xbe7c, which);
     for (std::uint16_t k = 0; k < QNAV_NET_WEIGHTS(pol.u.net.hidden); ++k)
         *qnav_net_weight(&pol.u.net, k) =
             static_cast<qnav_q8_8_t>(std::lround(rng.uniform(-4.0, 4.0) * 256.0));
@@ -448,7 +447,7 @@ int cmd_bench(const BenchOpts &o) {
                 what.c_str(),
                 o.mode.c_str(), o.episodes, o.ps, o.pa);
     std::printf("episodes/s per core: %.1f   (%.0f ticks/s, %.1f ticks/episode, %.2f us/tick, mean R %.3f)\n",
-                o.episodes / wall, ticks / wall, static_cast<double>(ticks) / o.episodes,
+                o.episodes / wall, static_cast<double>(ticks) / wall, static_cast<double>(ticks) / o.episodes,
                 1e6 * wall / static_cast<double>(ticks), sum_r / o.episodes);
     std::printf("time split (profiled pass, %.3f s): physics %.1f%%  sonar %.1f%%  controller %.1f%%  "
                 "other %.1f%%\n",

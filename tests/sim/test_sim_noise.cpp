@@ -9,14 +9,13 @@
 #include <cmath>
 #include <vector>
 
-#include "rng.hpp"
+#include "qnav/rng.hpp"
 
 static const double kPiD = 3.14159265358979323846;
 
 static void test_normal_draws_have_unit_variance_and_gaussian_tails(void **state) {
     (void)state;
-    qnav::SimRng rng;
-    rng.seed(42, 0, 0);
+    qnav::Rng rng = qnav::Rng::stream(42, 0, 0);
     const int n = 200000;
     double sum = 0, sum2 = 0;
     int within1 = 0, beyond3 = 0;
@@ -36,11 +35,10 @@ static void test_normal_draws_have_unit_variance_and_gaussian_tails(void **state
 
 static void test_uniform_draws_fill_the_unit_interval_evenly(void **state) {
     (void)state;
-    qnav::SimRng rng;
-    rng.seed(1, 2, 3);
+    qnav::Rng rng = qnav::Rng::stream(1, 2, 3);
     int bins[10] = {0};
     for (int i = 0; i < 100000; ++i) {
-        const double u = rng.uniform();
+        const double u = rng.uniform01();
         assert_true(u >= 0.0 && u < 1.0);
         bins[(int)(u * 10)]++;
     }
@@ -49,10 +47,9 @@ static void test_uniform_draws_fill_the_unit_interval_evenly(void **state) {
 
 static void test_same_seeds_give_the_same_stream_and_different_streams_differ(void **state) {
     (void)state;
-    qnav::SimRng a, b, c;
-    a.seed(5, 9, 1);
-    b.seed(5, 9, 1);
-    c.seed(5, 9, 2);
+    qnav::Rng a = qnav::Rng::stream(5, 9, 1);
+    qnav::Rng b = qnav::Rng::stream(5, 9, 1);
+    qnav::Rng c = qnav::Rng::stream(5, 9, 2);
     int differ = 0;
     for (int i = 0; i < 100; ++i) {
         const uint64_t x = a.next_u64();

@@ -13,7 +13,7 @@
 
 #include "env.hpp"
 #include "geometry.hpp"
-#include "rng.hpp"
+#include "qnav/rng.hpp"
 #include "sonar.hpp"
 #include "worldgen.hpp"
 
@@ -189,8 +189,7 @@ static void test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment(
     std::vector<qnav::Shape> shapes = e.obstacle_shapes();
     std::vector<qnav::Shape> all = shapes;
     for (const auto &w : e.wall_shapes()) all.push_back(w);
-    qnav::SimRng rng;
-    rng.seed(7, 7, 7);
+    qnav::Rng rng = qnav::Rng::stream(7, 7, 7);
     // (sectors, cone deg): cone 0 = 360/N; wider cones overlap.
     const struct { unsigned n; double cone_deg; } cases[] = {
         {3, 0}, {8, 0}, {16, 0}, {32, 0}, {180, 0}, {8, 60}, {32, 30}, {180, 15}};
@@ -243,8 +242,7 @@ static void test_broad_phase_reads_bit_identical_to_testing_every_shape(void **s
         {"gen:clutter:4:1:tekbot", 2.62}, {"gen:rooms:3:1:pioneer3dx", 5.26}, {"gen:clutter:9:0.6:pioneer3dx", 5.26},
         {"gen:rooms:5:1:tekbot", 2.62}};
     const unsigned sectors[] = {1, 2, 3, 8, 16, 32, 180, 360};
-    qnav::SimRng rng;
-    rng.seed(19, 5, 0);
+    qnav::Rng rng = qnav::Rng::stream(19, 5, 0);
     long compared = 0, hits = 0;
     for (const auto &w : worlds) {
         const qnav::Environment e = qnav::load_world(w.spec);

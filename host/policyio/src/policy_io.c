@@ -567,34 +567,147 @@ static int line_end(parser_t *ps, size_t ntok)
     return 0;
 }
 
+/* The keys that belong to one kind of policy; the other kind names them in its error. */
+static int is_net_key(const parser_t *ps, const token_t *key)
+{
+    return (tok_is(key, "inputs") && ps->version >= 2) || tok_is(key, "hidden") ||
+           tok_is(key, "unit") || tok_is(key, "b_out");
+}
+
+static int is_prob_key(const token_t *key)
+{
+    return tok_is(key, "k_goal") || tok_is(key, "k_safe");
+}
+
+static int line_inputs(parser_t *ps, const token_t *tok, size_t ntok)
+{
+    char q[80];
+    long n = 0;
+    if (once(ps, &ps->inputs_line, "inputs") != 0 || want_values(ps, ntok, 1, "inputs") != 0) {
+        return -1;
+    }
+    if (ps->next_unit != 0) {
+        return fail(ps, "'inputs' after the first 'unit'");
+    }
+    quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
+    if (parse_int(&tok[1], &n) != 0 ||
+        (n != (long)QNAV_NET_INPUTS_PAPER && n != (long)QNAV_NET_INPUTS_PREV)) {
+        return fail(ps, "inputs '%s': a network has 2 or 3 inputs", q);
+    }
+    ps->pol.u.net.inputs = (uint8_t)n;
+    return 0;
+}
+
+static int line_hidden(parser_t *ps, const token_t *tok, size_t ntok)
+{
+    char q[80];
+    long h = 0;
+    if (once(ps, &ps->hidden_line, "hidden") != 0 || want_values(ps, ntok, 1, "hidden") != 0) {
+        return -1;
+    }
+    quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
+    if (parse_int(&tok[1], &h) != 0) {
+        return fail(ps, "hidden '%s' is not an integer", q);
+    }
+    if (h < 1 || h > QNAV_MAX_HIDDEN) {
+        return fail(ps, "hidden %s outside 1..%d", q, QNAV_MAX_HIDDEN);
+    }
+    ps->pol.u.net.hidden = (uint8_t)h;
+    return 0;
+}
+
+/* A key of a network policy file (q: the key, quoted for messages). */
+static int line_key_net(parser_t *ps, const token_t *tok, size_t ntok, const char *q)
+{
+    const token_t *key = &tok[0];
+    if (is_prob_key(key)) {
+        return fail(ps, "'%s' is not a key of kind network", q);
+    }
+    if (!is_net_key(ps, key)) {
+        return fail(ps, "unknown key '%s'", q);
+    }
+    if (tok_is(key, "inputs")) {
+        return line_inputs(ps, tok, ntok);
+    }
+    if (tok_is(key, "unit")) {
+        return line_unit(ps, tok, ntok);
+    }
+    if (tok_is(key, "b_out")) {
+        if (once(ps, &ps->b_out_line, "b_out") != 0 || want_values(ps, ntok, 1, "b_out") != 0) {
+            return -1;
+        }
+        return parse_q88(ps, &tok[1], "b_out: ", &ps->pol.u.net.b_out);
+    }
+    return line_hidden(ps, tok, ntok);
+}
+
+/* A key of a probabilistic policy file (q: the key, quoted for messages). */
+static int line_key_prob(parser_t *ps, const token_t *tok, size_t ntok, const char *q)
+{
+    const token_t *key = &tok[0];
+    int goal = tok_is(key, "k_goal");
+    qnav_q8_8_t v = 0;
+    if (is_net_key(ps, key)) {
+        return fail(ps, "'%s' is not a key of kind probabilistic", q);
+    }
+    if (!is_prob_key(key)) {
+        return fail(ps, "unknown key '%s'", q);
+    }
+    if (once(ps, goal ? &ps->k_goal_line : &ps->k_safe_line, q) != 0 ||
+        want_values(ps, ntok, 1, q) != 0) {
+        return -1;
+    }
+    if (parse_q88(ps, &tok[1], goal ? "k_goal: " : "k_safe: ", &v) != 0) {
+        return -1;
+    }
+    if (v <= 0 || v > K_RAW_MAX) {
+        return fail(ps, "%s %d outside (0, 64]: raw Q8.8 must be 1..%ld", q, (int)v, K_RAW_MAX);
+    }
+    if (goal) {
+        ps->pol.u.prob.k_goal = v;
+    } else {
+        ps->pol.u.prob.k_safe = v;
+    }
+    return 0;
+}
+
+/* The first key: the kind, which decides the keys that may follow. */
+static int line_kind(parser_t *ps, const token_t *tok, size_t ntok, const char *q)
+{
+    char v[80];
+    if (!tok_is(&tok[0], "kind")) {
+        return fail(ps, "expected 'kind' as the first key, found '%s'", q);
+    }
+    if (want_values(ps, ntok, 1, "kind") != 0) {
+        return -1;
+    }
+    if (qnav_policy_kind_from_name(tok[1].p, tok[1].n, &ps->pol.kind) != 0) {
+        quote_bytes(tok[1].p, tok[1].n, 40, v, sizeof v);
+        return fail(ps, "unknown kind '%s' (expected 'network' or 'probabilistic')", v);
+    }
+    switch ((qnav_policy_kind_t)ps->pol.kind) {
+    case QNAV_POLICY_NET:
+        ps->pol.u.net.inputs = QNAV_NET_INPUTS_PAPER; /* version 2 may say 3 */
+        break;
+    case QNAV_POLICY_PROB:
+        break;
+    }
+    ps->kind_line = ps->line;
+    return 0;
+}
+
 static int line_key(parser_t *ps, const char *body, size_t blen, const token_t *tok,
                     size_t ntok)
 {
     char q[80];
-    int net;
     const token_t *key = &tok[0];
     quote_bytes(key->p, key->n, 40, q, sizeof q);
     if (ps->end_line != 0) {
         return fail(ps, "content after 'end' (line %lu)", ps->end_line);
     }
     if (ps->kind_line == 0) {
-        if (!tok_is(key, "kind")) {
-            return fail(ps, "expected 'kind' as the first key, found '%s'", q);
-        }
-        if (want_values(ps, ntok, 1, "kind") != 0) {
-            return -1;
-        }
-        if (qnav_policy_kind_from_name(tok[1].p, tok[1].n, &ps->pol.kind) != 0) {
-            quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
-            return fail(ps, "unknown kind '%s' (expected 'network' or 'probabilistic')", q);
-        }
-        if (ps->pol.kind == (uint8_t)QNAV_POLICY_NET) {
-            ps->pol.u.net.inputs = QNAV_NET_INPUTS_PAPER; /* version 2 may say 3 */
-        }
-        ps->kind_line = ps->line;
-        return 0;
+        return line_kind(ps, tok, ntok, q);
     }
-    net = ps->pol.kind == (uint8_t)QNAV_POLICY_NET;
     if (tok_is(key, "kind")) {
         return once(ps, &ps->kind_line, "kind");
     }
@@ -615,82 +728,13 @@ static int line_key(parser_t *ps, const char *body, size_t blen, const token_t *
     if (tok_is(key, "end")) {
         return line_end(ps, ntok);
     }
-    if (tok_is(key, "inputs") && ps->version >= 2) {
-        long n = 0;
-        if (!net) {
-            return fail(ps, "'inputs' is not a key of kind probabilistic");
-        }
-        if (once(ps, &ps->inputs_line, "inputs") != 0 ||
-            want_values(ps, ntok, 1, "inputs") != 0) {
-            return -1;
-        }
-        if (ps->next_unit != 0) {
-            return fail(ps, "'inputs' after the first 'unit'");
-        }
-        quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
-        if (parse_int(&tok[1], &n) != 0 ||
-            (n != (long)QNAV_NET_INPUTS_PAPER && n != (long)QNAV_NET_INPUTS_PREV)) {
-            return fail(ps, "inputs '%s': a network has 2 or 3 inputs", q);
-        }
-        ps->pol.u.net.inputs = (uint8_t)n;
-        return 0;
+    switch ((qnav_policy_kind_t)ps->pol.kind) {
+    case QNAV_POLICY_NET:
+        return line_key_net(ps, tok, ntok, q);
+    case QNAV_POLICY_PROB:
+        return line_key_prob(ps, tok, ntok, q);
     }
-    if (tok_is(key, "hidden") || tok_is(key, "unit") || tok_is(key, "b_out")) {
-        if (!net) {
-            return fail(ps, "'%s' is not a key of kind probabilistic", q);
-        }
-        if (tok_is(key, "unit")) {
-            return line_unit(ps, tok, ntok);
-        }
-        if (tok_is(key, "b_out")) {
-            if (once(ps, &ps->b_out_line, "b_out") != 0 ||
-                want_values(ps, ntok, 1, "b_out") != 0) {
-                return -1;
-            }
-            return parse_q88(ps, &tok[1], "b_out: ", &ps->pol.u.net.b_out);
-        }
-        {
-            long h = 0;
-            if (once(ps, &ps->hidden_line, "hidden") != 0 ||
-                want_values(ps, ntok, 1, "hidden") != 0) {
-                return -1;
-            }
-            quote_bytes(tok[1].p, tok[1].n, 40, q, sizeof q);
-            if (parse_int(&tok[1], &h) != 0) {
-                return fail(ps, "hidden '%s' is not an integer", q);
-            }
-            if (h < 1 || h > QNAV_MAX_HIDDEN) {
-                return fail(ps, "hidden %s outside 1..%d", q, QNAV_MAX_HIDDEN);
-            }
-            ps->pol.u.net.hidden = (uint8_t)h;
-            return 0;
-        }
-    }
-    if (tok_is(key, "k_goal") || tok_is(key, "k_safe")) {
-        int goal = tok_is(key, "k_goal");
-        qnav_q8_8_t v = 0;
-        if (net) {
-            return fail(ps, "'%s' is not a key of kind network", q);
-        }
-        if (once(ps, goal ? &ps->k_goal_line : &ps->k_safe_line, q) != 0 ||
-            want_values(ps, ntok, 1, q) != 0) {
-            return -1;
-        }
-        if (parse_q88(ps, &tok[1], goal ? "k_goal: " : "k_safe: ", &v) != 0) {
-            return -1;
-        }
-        if (v <= 0 || v > K_RAW_MAX) {
-            return fail(ps, "%s %d outside (0, 64]: raw Q8.8 must be 1..%ld", q, (int)v,
-                        K_RAW_MAX);
-        }
-        if (goal) {
-            ps->pol.u.prob.k_goal = v;
-        } else {
-            ps->pol.u.prob.k_safe = v;
-        }
-        return 0;
-    }
-    return fail(ps, "unknown key '%s'", q);
+    return fail(ps, "unknown kind %u", (unsigned)ps->pol.kind); /* line_kind set a known one */
 }
 
 int qnav_policy_parse_meta(const char *text, size_t len, const char *name,
@@ -1036,11 +1080,15 @@ int qnav_policy_format(const qnav_policy_t *policy, const qnav_policy_meta_t *me
     }
     emit(&o, "kind %s\n", qnav_policy_kind_name(policy->kind));
     emit(&o, "qformat Q8.8\n");
-    if (policy->kind == (uint8_t)QNAV_POLICY_NET) {
+    switch ((qnav_policy_kind_t)policy->kind) {
+    case QNAV_POLICY_NET:
         emit(&o, "hidden %u\n", (unsigned)policy->u.net.hidden);
         if (qnav_policy_file_version(policy) >= 2) {
             emit(&o, "inputs %u\n", (unsigned)policy->u.net.inputs);
         }
+        break;
+    case QNAV_POLICY_PROB:
+        break;
     }
     for (i = 0; meta != NULL && i < meta->count; ++i) {
         emit(&o, "meta %s %s\n", meta->entry[i].name, meta->entry[i].value);

@@ -18,6 +18,7 @@
 #include "qnav/ctrl.h"
 #include "qnav/cli.h"
 #include "qnav/policy_io.h"
+#include "qnav/rng.h"
 
 #define EXIT_FAILED 1    /* a write or the machine failed */
 #define EXIT_BAD_INPUT 2 /* the policy file given is not a good one */
@@ -101,12 +102,49 @@ static void q88_text(int raw, char *out, size_t outlen)
     }
 }
 
+static void show_prob(const qnav_prob_params_t *pp)
+{
+    char a[32], b[32];
+    q88_text(pp->k_goal, a, sizeof a);
+    q88_text(pp->k_safe, b, sizeof b);
+    printf("kind: probabilistic\n");
+    printf("k_goal: %s  (P_goal = exp(-k_goal * dtheta / 180 deg))\n", a);
+    printf("k_safe: %s  (P_safe = 1 - exp(-k_safe * level / (levels - 1)))\n", b);
+}
+
+static void show_net(const qnav_net_t *n)
+{
+    char a[32], b[32], c[32], d[32];
+    size_t i;
+    printf("kind: network\nhidden: %u\ninputs: %u\n", (unsigned)n->hidden, (unsigned)n->inputs);
+    if (n->inputs == QNAV_NET_INPUTS_PREV) {
+        printf("%4s %14s %14s %14s %14s %14s\n", "unit", "w_theta", "w_dist", "w_prev",
+               "b_hidden", "w_out");
+    } else {
+        printf("%4s %14s %14s %14s %14s\n", "unit", "w_theta", "w_dist", "b_hidden", "w_out");
+    }
+    for (i = 0; i < n->hidden; ++i) {
+        q88_text(n->w_theta[i], a, sizeof a);
+        q88_text(n->w_dist[i], b, sizeof b);
+        q88_text(n->b_hidden[i], c, sizeof c);
+        q88_text(n->w_out[i], d, sizeof d);
+        if (n->inputs == QNAV_NET_INPUTS_PREV) {
+            char e[32];
+            q88_text(n->w_prev[i], e, sizeof e);
+            printf("%4zu %14s %14s %14s %14s %14s\n", i, a, b, e, c, d);
+        } else {
+            printf("%4zu %14s %14s %14s %14s\n", i, a, b, c, d);
+        }
+    }
+    q88_text(n->b_out, a, sizeof a);
+    printf("b_out: %s\n", a);
+}
+
 static int cmd_show(int argc, char **argv)
 {
     qnav_policy_t p;
     qnav_policy_meta_t meta;
     char err[QNAV_POLICY_IO_ERRLEN];
-    char a[32], b[32], c[32], d[32];
     size_t i;
     if (argc != 2) {
         return usage_error("show: expected exactly one FILE, got %d arguments", argc - 1);
@@ -119,56 +157,47 @@ static int cmd_show(int argc, char **argv)
     for (i = 0; i < meta.count; ++i) {
         printf("meta %s: %s\n", meta.entry[i].name, meta.entry[i].value);
     }
-    if (p.kind == (uint8_t)QNAV_POLICY_PROB) {
-        q88_text(p.u.prob.k_goal, a, sizeof a);
-        q88_text(p.u.prob.k_safe, b, sizeof b);
-        printf("kind: probabilistic\n");
-        printf("k_goal: %s  (P_goal = exp(-k_goal * dtheta / 180 deg))\n", a);
-        printf("k_safe: %s  (P_safe = 1 - exp(-k_safe * level / (levels - 1)))\n", b);
+    switch ((qnav_policy_kind_t)p.kind) {
+    case QNAV_POLICY_PROB:
+        show_prob(&p.u.prob);
+        return 0;
+    case QNAV_POLICY_NET:
+        show_net(&p.u.net);
         return 0;
     }
-    printf("kind: network\nhidden: %u\ninputs: %u\n", (unsigned)p.u.net.hidden,
-           (unsigned)p.u.net.inputs);
-    if (p.u.net.inputs == QNAV_NET_INPUTS_PREV) {
-        printf("%4s %14s %14s %14s %14s %14s\n", "unit", "w_theta", "w_dist", "w_prev",
-               "b_hidden", "w_out");
-    } else {
-        printf("%4s %14s %14s %14s %14s\n", "unit", "w_theta", "w_dist", "b_hidden", "w_out");
-    }
-    for (i = 0; i < p.u.net.hidden; ++i) {
-        q88_text(p.u.net.w_theta[i], a, sizeof a);
-        q88_text(p.u.net.w_dist[i], b, sizeof b);
-        q88_text(p.u.net.b_hidden[i], c, sizeof c);
-        q88_text(p.u.net.w_out[i], d, sizeof d);
-        if (p.u.net.inputs == QNAV_NET_INPUTS_PREV) {
-            char e[32];
-            q88_text(p.u.net.w_prev[i], e, sizeof e);
-            printf("%4zu %14s %14s %14s %14s %14s\n", i, a, b, e, c, d);
-        } else {
-            printf("%4zu %14s %14s %14s %14s\n", i, a, b, c, d);
-        }
-    }
-    q88_text(p.u.net.b_out, a, sizeof a);
-    printf("b_out: %s\n", a);
-    return 0;
+    fprintf(stderr, "%s: unknown policy kind %u\n", argv[1], (unsigned)p.kind);
+    return EXIT_BAD_INPUT;
 }
 
 /* ---- new ----------------------------------------------------------------------------- */
 
-/* SplitMix64: a tiny generator whose sequence is the same on every machine. */
-static uint64_t splitmix64(uint64_t *state)
-{
-    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-/* Uniform raw Q8.8 weight in -512..512 (+-2.0), without modulo bias worth noting
- * (2^64 / 1025 leaves a bias below 1e-16). */
+/* Uniform raw Q8.8 weight in -512..512 (+-2.0) from the splitmix64 sequence of --seed
+ * (qnav/rng.h), without modulo bias worth noting (2^64 / 1025 leaves a bias below 1e-16). */
 static qnav_q8_8_t random_weight(uint64_t *state)
 {
-    return (qnav_q8_8_t)((int32_t)(splitmix64(state) % 1025u) - 512);
+    return (qnav_q8_8_t)((int32_t)(qnav_splitmix64(state) % 1025u) - 512);
+}
+
+/* A seeded random network and the command that makes it again, as its "source". */
+static void new_network(qnav_policy_t *p, qnav_policy_meta_t *meta, uint8_t hidden,
+                        uint8_t inputs, uint64_t seed)
+{
+    char src[128];
+    uint64_t state = seed;
+    uint16_t k;
+    qnav_policy_net_zero_inputs(p, hidden, inputs);
+    for (k = 0; k < qnav_net_weight_count(&p->u.net); ++k) {
+        *qnav_net_weight(&p->u.net, k) = random_weight(&state);
+    }
+    if (inputs == QNAV_NET_INPUTS_PAPER) {
+        (void)snprintf(src, sizeof src, "qnav-policy new --kind network --hidden %u --seed %llu",
+                       (unsigned)hidden, (unsigned long long)seed);
+    } else {
+        (void)snprintf(src, sizeof src,
+                       "qnav-policy new --kind network --hidden %u --inputs 3 --seed %llu",
+                       (unsigned)hidden, (unsigned long long)seed);
+    }
+    (void)qnav_policy_meta_set(meta, "source", src, NULL, 0);
 }
 
 static int cmd_new(int argc, char **argv)
@@ -188,7 +217,6 @@ static int cmd_new(int argc, char **argv)
     qnav_policy_t p;
     qnav_policy_meta_t meta;
     char err[QNAV_POLICY_IO_ERRLEN];
-    char src[128];
     opterr = 0;
     optind = 1;
     while ((opt = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
@@ -229,33 +257,22 @@ static int cmd_new(int argc, char **argv)
     if (optind != argc - 1) {
         return usage_error("new: expected exactly one OUT file after the options");
     }
+    if (qnav_policy_kind_from_name(kind, strlen(kind), &p.kind) != 0) {
+        return usage_error("new: --kind '%s' must be 'probabilistic' or 'network'", kind);
+    }
     qnav_policy_meta_clear(&meta);
-    if (strcmp(kind, "probabilistic") == 0) {
+    switch ((qnav_policy_kind_t)p.kind) {
+    case QNAV_POLICY_PROB:
         if (have_hidden || have_seed) {
             return usage_error("new: --hidden, --inputs and --seed apply to --kind network only");
         }
         qnav_policy_prob_default(&p);
         (void)qnav_policy_meta_set(&meta, "source", "qnav-policy new --kind probabilistic",
                                    NULL, 0);
-    } else if (strcmp(kind, "network") == 0) {
-        uint64_t state = seed;
-        uint16_t k;
-        qnav_policy_net_zero_inputs(&p, (uint8_t)hidden, (uint8_t)inputs);
-        for (k = 0; k < qnav_net_weight_count(&p.u.net); ++k) {
-            *qnav_net_weight(&p.u.net, k) = random_weight(&state);
-        }
-        if (inputs == QNAV_NET_INPUTS_PAPER) {
-            (void)snprintf(src, sizeof src,
-                           "qnav-policy new --kind network --hidden %u --seed %llu",
-                           (unsigned)hidden, (unsigned long long)seed);
-        } else {
-            (void)snprintf(src, sizeof src,
-                           "qnav-policy new --kind network --hidden %u --inputs 3 --seed %llu",
-                           (unsigned)hidden, (unsigned long long)seed);
-        }
-        (void)qnav_policy_meta_set(&meta, "source", src, NULL, 0);
-    } else {
-        return usage_error("new: --kind '%s' must be 'probabilistic' or 'network'", kind);
+        break;
+    case QNAV_POLICY_NET:
+        new_network(&p, &meta, (uint8_t)hidden, (uint8_t)inputs, seed);
+        break;
     }
     if (qnav_policy_write_meta(argv[optind], &p, &meta, NULL, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
@@ -367,6 +384,39 @@ static void put_array(text_t *t, const char *field, const qnav_q8_8_t *v, unsign
 
 static int header_body(int argc, char **argv, const char *cmd);
 
+/* The policy itself as a qnav_policy_t initializer named `name`; -1 for an unknown kind. */
+static int put_policy(text_t *t, const qnav_policy_t *p, const char *name)
+{
+    const qnav_net_t *n = &p->u.net;
+    put(t, "#include \"qnav/policy.h\"\n\n");
+    switch ((qnav_policy_kind_t)p->kind) {
+    case QNAV_POLICY_NET:
+        put(t, "#if QNAV_MAX_HIDDEN < %u\n#error \"%s needs QNAV_MAX_HIDDEN >= %u\"\n#endif\n\n",
+            (unsigned)n->hidden, name, (unsigned)n->hidden);
+        put(t, "/* Network policy, %u hidden units, weights raw Q8.8 (value * 256). */\n",
+            (unsigned)n->hidden);
+        put(t, "static const qnav_policy_t %s = {\n", name);
+        put(t, "    .kind = (uint8_t)QNAV_POLICY_NET,\n    .u = {\n        .net = {\n");
+        put(t, "            .hidden = %u,\n", (unsigned)n->hidden);
+        put(t, "            .inputs = %u,\n", (unsigned)n->inputs);
+        put_array(t, "w_theta", n->w_theta, n->hidden, 0);
+        put_array(t, "w_dist", n->w_dist, n->hidden, 0);
+        put_array(t, "w_prev", n->w_prev, n->hidden, 0);
+        put_array(t, "b_hidden", n->b_hidden, n->hidden, 0);
+        put_array(t, "w_out", n->w_out, n->hidden, 0);
+        put(t, "            .b_out = %d\n        }\n    }\n};\n", (int)n->b_out);
+        return 0;
+    case QNAV_POLICY_PROB:
+        put(t, "/* Probabilistic navigation policy, parameters raw Q8.8 (value * 256). */\n");
+        put(t, "static const qnav_policy_t %s = {\n", name);
+        put(t, "    .kind = (uint8_t)QNAV_POLICY_PROB,\n    .u = {\n        .prob = {\n");
+        put(t, "            .k_goal = %d,\n            .k_safe = %d\n        }\n    }\n};\n",
+            (int)p->u.prob.k_goal, (int)p->u.prob.k_safe);
+        return 0;
+    }
+    return -1;
+}
+
 /* Write the header for "header" (argv from the subcommand on); full_argv is the whole
  * command line, recorded in the header as typed (before getopt_long permutes argv). */
 static int cmd_header(int argc, char **argv, int full_argc, char *const *full_argv)
@@ -452,12 +502,10 @@ static int header_body(int argc, char **argv, const char *cmd)
         fprintf(stderr, "%s\n", err);
         return EXIT_BAD_INPUT;
     }
-    if (strcmp(mode, "network") == 0 && p.kind != (uint8_t)QNAV_POLICY_NET) {
-        fprintf(stderr, "%s: kind is probabilistic but --mode network was asked for\n", in);
-        return EXIT_BAD_INPUT;
-    }
-    if (strcmp(mode, "probabilistic") == 0 && p.kind != (uint8_t)QNAV_POLICY_PROB) {
-        fprintf(stderr, "%s: kind is network but --mode probabilistic was asked for\n", in);
+    /* --mode network|probabilistic names a kind (table takes either) */
+    if (strcmp(mode, "table") != 0 && strcmp(mode, qnav_policy_kind_name(p.kind)) != 0) {
+        fprintf(stderr, "%s: kind is %s but --mode %s was asked for\n", in,
+                qnav_policy_kind_name(p.kind), mode);
         return EXIT_BAD_INPUT;
     }
     for (i = 0; name[i] != '\0'; ++i) {
@@ -524,30 +572,10 @@ static int header_body(int argc, char **argv, const char *cmd)
         }
         put(&t, "};\n");
         free(table);
-    } else if (p.kind == (uint8_t)QNAV_POLICY_NET) {
-        const qnav_net_t *n = &p.u.net;
-        put(&t, "#include \"qnav/policy.h\"\n\n");
-        put(&t, "#if QNAV_MAX_HIDDEN < %u\n#error \"%s needs QNAV_MAX_HIDDEN >= %u\"\n#endif\n\n",
-            (unsigned)n->hidden, name, (unsigned)n->hidden);
-        put(&t, "/* Network policy, %u hidden units, weights raw Q8.8 (value * 256). */\n",
-            (unsigned)n->hidden);
-        put(&t, "static const qnav_policy_t %s = {\n", name);
-        put(&t, "    .kind = (uint8_t)QNAV_POLICY_NET,\n    .u = {\n        .net = {\n");
-        put(&t, "            .hidden = %u,\n", (unsigned)n->hidden);
-        put(&t, "            .inputs = %u,\n", (unsigned)n->inputs);
-        put_array(&t, "w_theta", n->w_theta, n->hidden, 0);
-        put_array(&t, "w_dist", n->w_dist, n->hidden, 0);
-        put_array(&t, "w_prev", n->w_prev, n->hidden, 0);
-        put_array(&t, "b_hidden", n->b_hidden, n->hidden, 0);
-        put_array(&t, "w_out", n->w_out, n->hidden, 0);
-        put(&t, "            .b_out = %d\n        }\n    }\n};\n", (int)n->b_out);
-    } else {
-        put(&t, "#include \"qnav/policy.h\"\n\n");
-        put(&t, "/* Probabilistic navigation policy, parameters raw Q8.8 (value * 256). */\n");
-        put(&t, "static const qnav_policy_t %s = {\n", name);
-        put(&t, "    .kind = (uint8_t)QNAV_POLICY_PROB,\n    .u = {\n        .prob = {\n");
-        put(&t, "            .k_goal = %d,\n            .k_safe = %d\n        }\n    }\n};\n",
-            (int)p.u.prob.k_goal, (int)p.u.prob.k_safe);
+    } else if (put_policy(&t, &p, name) != 0) {
+        free(t.p);
+        fprintf(stderr, "%s: unknown policy kind %u\n", in, (unsigned)p.kind);
+        return EXIT_BAD_INPUT;
     }
     put(&t, "\n#endif /* QNAV_GENERATED_%s_H */\n", guard);
     if (t.failed) {

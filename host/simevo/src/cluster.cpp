@@ -64,7 +64,8 @@ void write_script(const std::string &path, const std::string &content)
 std::string shown(const std::string &v)
 {
     std::string o;
-    for (unsigned char c : v) {
+    for (const char ch : v) {
+        const auto c = static_cast<unsigned char>(ch);
         if (c == '\n') o += "\\n";
         else if (c == '\t') o += "\\t";
         else if (c < 0x20 || c == 0x7f) {
@@ -104,7 +105,8 @@ void check_slurm_options(const SlurmOptions &o, const std::string &out_dir)
         throw UserError("--time: '" + shown(o.time) +
                         "' is not a Slurm time limit (MINUTES, M:S, H:M:S, D-H, D-H:M, D-H:M:S or unlimited)");
     }
-    for (unsigned char c : out_dir) {
+    for (const char ch : out_dir) {
+        const auto c = static_cast<unsigned char>(ch);
         if (c < 0x20 || c == 0x7f || c == '"' || c == '\\') {
             throw UserError("--out: '" + shown(out_dir) +
                             "' holds a control character, '\"' or '\\' and cannot go on an #SBATCH line");

@@ -92,7 +92,8 @@ void mutate_network(qnav_net_t &net, Rng &rng, double scale, double clip)
 uint32_t policy_fingerprint(const qnav_policy_t &policy)
 {
     uint64_t h = fnv1a64(&policy.kind, 1);
-    if (policy.kind == QNAV_POLICY_NET) {
+    switch (static_cast<qnav_policy_kind_t>(policy.kind)) {
+    case QNAV_POLICY_NET: {
         qnav_net_t net = policy.u.net;
         h = fnv1a64(&net.hidden, 1, h);
         if (net.inputs != QNAV_NET_INPUTS_PAPER) {
@@ -105,9 +106,13 @@ uint32_t policy_fingerprint(const qnav_policy_t &policy)
                                         static_cast<unsigned char>((w >> 8) & 0xff)};
             h = fnv1a64(b, 2, h);
         }
-    } else {
+        break;
+    }
+    case QNAV_POLICY_PROB: {
         const int16_t p[2] = {policy.u.prob.k_goal, policy.u.prob.k_safe};
         h = fnv1a64(p, sizeof p, h);
+        break;
+    }
     }
     return static_cast<uint32_t>(h ^ (h >> 32));
 }
@@ -162,7 +167,7 @@ int32_t Evolution::best_index() const
 {
     int32_t best = -1;
     for (uint32_t i = 0; i < pop_.size(); ++i) {
-        if (pop_[i].evaluated && (best < 0 || pop_[i].fitness > pop_[best].fitness)) {
+        if (pop_[i].evaluated && (best < 0 || pop_[i].fitness > pop_[static_cast<std::size_t>(best)].fitness)) {
             best = static_cast<int32_t>(i);
         }
     }
@@ -176,7 +181,7 @@ int32_t Evolution::worst_index() const
         if (!pop_[i].evaluated) {
             return static_cast<int32_t>(i);
         }
-        if (worst < 0 || pop_[i].fitness < pop_[worst].fitness) {
+        if (worst < 0 || pop_[i].fitness < pop_[static_cast<std::size_t>(worst)].fitness) {
             worst = static_cast<int32_t>(i);
         }
     }
@@ -189,14 +194,14 @@ Candidate Evolution::propose()
     c.episode = episode_;
     if (episode_ < init_order_.size()) {
         c.slot = static_cast<int32_t>(init_order_[episode_]);
-        c.policy = pop_[c.slot].policy;
+        c.policy = pop_[init_order_[episode_]].policy;
     } else {
         // Fig. 4 step 1: both draws every time, so the stream does not depend on ε.
         const double u = rng_.uniform01();
         const uint32_t pick = rng_.below(static_cast<uint32_t>(pop_.size()));
         c.explored = u < params_.epsilon;
         c.parent = c.explored ? static_cast<int32_t>(pick) : best_index();
-        c.policy = pop_[c.parent].policy;
+        c.policy = pop_[static_cast<std::size_t>(c.parent)].policy;
         mutate_network(c.policy.u.net, rng_, params_.mutation_scale, params_.mutation_clip);
         c.slot = -1; // decided in accept(): the worst member at that time
     }
@@ -215,11 +220,11 @@ void Evolution::accept(const Candidate &c, const EpisodeOutcome &out, const Epis
         p.fitness = (p.fitness * p.evaluations + parent_out->R) / (p.evaluations + 1);
         ++p.evaluations;
     }
-    const int32_t slot = c.slot >= 0 ? c.slot : worst_index();
-    pop_[slot].policy = c.policy;
-    pop_[slot].fitness = out.R;
-    pop_[slot].evaluations = 1;
-    pop_[slot].evaluated = true;
+    Member &m = pop_[static_cast<std::size_t>(c.slot >= 0 ? c.slot : worst_index())];
+    m.policy = c.policy;
+    m.fitness = out.R;
+    m.evaluations = 1;
+    m.evaluated = true;
     best_so_far_ = pop_[static_cast<std::size_t>(best_index())].fitness;
     ++episode_;
 }

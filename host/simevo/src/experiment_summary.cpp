@@ -81,7 +81,7 @@ void add_checkpoints(ConditionSummary &c, const std::string &path, const std::ve
         }
     }
     c.to_threshold.push_back(first);
-    c.threshold_not_reached += std::isnan(first) ? 1 : 0;
+    c.threshold_not_reached += std::isnan(first) ? 1u : 0u;
 }
 
 /* One run's learning curves, binned: candidates' R, the population best, arrivals. */

@@ -160,6 +160,20 @@ EpisodeOutcome SimRunner::outcome(qnav_sim_status_t s, const qnav_sim_result_t &
 
 SimRunner::~SimRunner() { qnav_sim_destroy(sim_); }
 
+/* Whether a policy runs from a compiled quality table when tables are asked for: a
+ * 2-input network does; a 3-input network has none (its key depends on the previous heading
+ * too); the probabilistic policy runs as it is. */
+static bool has_table(const qnav_policy_t &policy)
+{
+    switch (static_cast<qnav_policy_kind_t>(policy.kind)) {
+    case QNAV_POLICY_NET:
+        return policy.u.net.inputs == QNAV_NET_INPUTS_PAPER;
+    case QNAV_POLICY_PROB:
+        return false;
+    }
+    return false;
+}
+
 const qnav_ctrl_t &SimRunner::controller_for(const qnav_policy_t &policy)
 {
     for (unsigned i = 0; i < 2; ++i) {
@@ -175,8 +189,7 @@ const qnav_ctrl_t &SimRunner::controller_for(const qnav_policy_t &policy)
         throw UserError("controller: qnav_ctrl_init refused the policy (status " +
                         std::to_string(static_cast<int>(st)) + ")");
     }
-    /* a 3-input network has no table (its key depends on the previous heading too) */
-    if (use_table_ && policy.kind == QNAV_POLICY_NET && policy.u.net.inputs == QNAV_NET_INPUTS_PAPER) {
+    if (use_table_ && has_table(policy)) {
         c.table.resize(QNAV_QTABLE_ENTRIES);
         if (qnav_ctrl_build_table(&c.ctrl, c.table.data()) != QNAV_OK ||
             qnav_ctrl_init_table(&c.ctrl, &ctrl_cfg_, c.table.data(), qnav_ctrl_rank(&c.ctrl)) != QNAV_OK) {

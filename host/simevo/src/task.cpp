@@ -349,7 +349,10 @@ qnav_policy_t read_policy_file(const std::string &path)
 qnav_policy_t load_source_policy(const std::string &path)
 {
     const qnav_policy_t p = read_policy_file(path);
-    if (p.kind != QNAV_POLICY_NET) {
+    switch (static_cast<qnav_policy_kind_t>(p.kind)) {
+    case QNAV_POLICY_NET:
+        break;
+    case QNAV_POLICY_PROB:
         throw UserError(path + ": incompatible policy: kind is not 'net' (a transfer seeds a "
                                "population of networks)");
     }
