@@ -704,7 +704,7 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
         }
     }
 
-    if (ctrl->keep_pct != 0u && ctrl->rank == (uint8_t)QNAV_RANK_QUALITY) {
+    if (ctrl->keep_pct != 0u && ctrl->rank == (uint8_t)QNAV_RANK_QUALITY && out->escape.side == 0) {
         keep_heading(ctrl, lvl, goal, qnav_whole_deg(in->prev_heading_cdeg), &best);
     }
     quality = key_quality(ctrl, best.key);
