@@ -652,7 +652,8 @@ uint8_t qnav_ctrl_path_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges_m
 /*
  * Holding the heading (keep_pct): the path on the previous tick's heading replaces the best
  * while its quality is at least (100 - keep_pct) % of the best's. Keys are qualities here
- * (QNAV_RANK_QUALITY), so the margin is a fraction of a probability.
+ * (QNAV_RANK_QUALITY), so the margin is a fraction of a probability; the step calls it only
+ * while going to the destination (a follow's skirt bearing comes from the boundary).
  */
 static void keep_heading(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uint16_t goal,
                          uint16_t prev, qnav_best_t *best)

@@ -108,8 +108,10 @@ typedef struct {
                                          the other, s (each later try twice as long, at
                                          most 109 s); default 20 */
     uint8_t keep_pct;                 /* holding the heading: the previous tick's heading
-                                         (prev_heading_cdeg) is kept while its quality is
-                                         at least (100 - keep_pct) % of the best path's, so
+                                         (prev_heading_cdeg) is kept, while going to the
+                                         destination (not while the escape follows a
+                                         boundary), as long as its quality is at least
+                                         (100 - keep_pct) % of the best path's, so
                                          two nearly equal ways round an obstacle do not
                                          alternate tick by tick (docs/architecture.md,
                                          "Holding the heading"). Applies when keys are
