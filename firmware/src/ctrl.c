@@ -735,6 +735,19 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     qnav_escape_keep_moving(&ctrl->clr, lvl, &out->escape, goal, out);
 }
 
+qnav_cdeg_t qnav_ctrl_prev_heading(qnav_deg_t last_heading_deg, qnav_cdeg_t last_goal_cdeg,
+                                   qnav_cdeg_t goal_cdeg)
+{
+    int32_t a = (int32_t)last_heading_deg * 100 + ((int32_t)goal_cdeg - last_goal_cdeg);
+    a %= 36000;
+    if (a < -18000) {
+        a += 36000;
+    } else if (a >= 18000) {
+        a -= 36000;
+    }
+    return (qnav_cdeg_t)a;
+}
+
 const char *qnav_status_str(qnav_status_t status)
 {
     switch (status) {

@@ -52,24 +52,6 @@ void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg
     bc->ready = bridge_ctrl_reinit(bc);
 }
 
-/* The previous decision seen from now. The scan has no compass heading, so the turn made
- * since is taken from how the goal's bearing moved (exact for a distant goal). */
-static qnav_cdeg_t prev_heading_cdeg(const qnav_bridge_ctrl_t *bc, int16_t goal_cdeg)
-{
-    int32_t a;
-    if (!bc->have_last) {
-        return 0;
-    }
-    a = (int32_t)bc->last_heading_deg * 100 + ((int32_t)goal_cdeg - bc->last_goal_cdeg);
-    a %= 36000;
-    if (a < -18000) {
-        a += 36000;
-    } else if (a >= 18000) {
-        a -= 36000;
-    }
-    return (qnav_cdeg_t)a;
-}
-
 void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
                            qnav_command_t *cmd, int16_t *qualities)
 {
@@ -94,7 +76,10 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
     }
     in.ranges_mm = ranges;
     in.goal_bearing_cdeg = scan->goal_bearing_cdeg;
-    in.prev_heading_cdeg = prev_heading_cdeg(bc, scan->goal_bearing_cdeg);
+    in.prev_heading_cdeg =
+        bc->have_last ? qnav_ctrl_prev_heading(bc->last_heading_deg, bc->last_goal_cdeg,
+                                               scan->goal_bearing_cdeg)
+                      : 0;
     if (qualities != NULL) {
         memset(qualities, 0, sizeof(int16_t) * QNAV_PATHS);
     }

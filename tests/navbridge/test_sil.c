@@ -201,7 +201,8 @@ static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(
     const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--mode",
                         "onboard", "--policy", pol, "--upload", "--log", log, "--goal-at",
                         goal, NULL};
-    const char *replay[] = {NAVBRIDGE_EXE, "--replay", log, "--policy", pol, NULL};
+    const char *replay[] = {NAVBRIDGE_EXE, "--replay", log, "--policy", pol, "--robot", "tekbot",
+                            NULL}; /* the board's robot: its controller configuration */
     qnav_policy_t p;
     pid_t ps, pn;
     int i;

@@ -46,6 +46,16 @@ typedef enum {
     QNAV_E_KEEP = -15         /* keep_pct above 100 */
 } qnav_status_t;
 
+/*
+ * The previous tick's heading seen in this tick's robot frame, for a caller without a
+ * compass: the turn made since is taken from how the destination's bearing moved (exact
+ * for a distant destination). last_heading_deg: the previous output's heading;
+ * last_goal_cdeg, goal_cdeg: the destination's bearing then and now. Board, bridge and
+ * replay compute it alike, so a replayed log decides as the board did.
+ */
+qnav_cdeg_t qnav_ctrl_prev_heading(qnav_deg_t last_heading_deg, qnav_cdeg_t last_goal_cdeg,
+                                   qnav_cdeg_t goal_cdeg);
+
 /* One line of text for a status ("ok", "n_sectors outside 1..360", ...); never null. */
 const char *qnav_status_str(qnav_status_t status);
 

@@ -486,19 +486,21 @@ void qnav_board_tick(qnav_board_t *bot)
     in.ranges_mm = bot->ranges;
     in.goal_bearing_cdeg = goal_bearing(bot, &dist_mm);
     /* the previous decision, seen from where the robot points now (3-input policies) */
-    in.prev_heading_cdeg = bot->have_decision
-                               ? qnav_board_wrap_cdeg((int32_t)bot->decided_cdeg -
-                                                      (int32_t)bot->pose.heading_cdeg)
-                               : 0;
+    in.prev_heading_cdeg = bot->have_decision ? qnav_ctrl_prev_heading(bot->decided_deg,
+                                                                       bot->decided_goal_cdeg,
+                                                                       in.goal_bearing_cdeg)
+                                              : 0;
     /* the distance to a position goal (0 for a bearing goal: no escape) and the memory */
     in.goal_range_mm = (qnav_mm_t)(dist_mm > 65535u ? 65535u : dist_mm);
     in.escape = bot->escape;
 
     decide(bot, now, &in, &out);
     bot->escape = out.escape;
-    bot->decided_cdeg =
-        qnav_board_wrap_cdeg((int32_t)bot->pose.heading_cdeg + 100 * (int32_t)out.heading_deg);
-    bot->have_decision = 1;
+    if (!(out.flags & QNAV_FLAG_NOT_READY)) {
+        bot->decided_deg = out.heading_deg;
+        bot->decided_goal_cdeg = in.goal_bearing_cdeg;
+        bot->have_decision = 1;
+    }
     moving = (uint8_t)(bot->link_ok && !bot->hold_stop && bot->have_goal && bot->mode != 0u &&
                        out.speed > 0);
     if (!moving) {

@@ -131,9 +131,11 @@ typedef struct {
     qnav_link_upload_t upload;
     qnav_nav_t nav;              /* the chosen controller (cfg.controller) and its state */
     qnav_policy_t policy;        /* the policy nav was made from (if it takes one) */
-    qnav_cdeg_t decided_cdeg;    /* last decision's heading in the world (compass), 0.01 deg:
-                                    the previous-decision input of 3-input policies */
-    uint8_t have_decision;       /* decided_cdeg is set */
+    qnav_deg_t decided_deg;      /* last decision's heading, robot frame then, degrees */
+    qnav_cdeg_t decided_goal_cdeg; /* the destination's bearing it saw: with it the previous
+                                    decision is seen from now (qnav_ctrl_prev_heading, as
+                                    navbridge and its replay compute it) */
+    uint8_t have_decision;       /* decided_deg is set */
     qnav_escape_t escape;        /* the controller's escape memory, carried from each tick's
                                     decision to the next; cleared with every new goal */
     uint16_t policy_crc;
