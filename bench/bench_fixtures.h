@@ -25,7 +25,15 @@
 #define QNAV_BENCH_ID_LEN 24u
 
 /* Which set a policy belongs to: the report keeps them apart. */
-enum { QNAV_BENCH_SET_EVOLVED = 0, QNAV_BENCH_SET_RANDOM, QNAV_BENCH_SET_PROB, QNAV_BENCH_SETS };
+enum {
+    QNAV_BENCH_SET_EVOLVED = 0,
+    QNAV_BENCH_SET_RANDOM,
+    QNAV_BENCH_SET_PROB,
+    QNAV_BENCH_SET_ADVERSARY, /* found by the adversarial search (bench/adversary.c) */
+    QNAV_BENCH_SETS
+};
+/* Their names in M lines and policy lists, in that order. */
+#define QNAV_BENCH_SET_NAMES {"evolved", "random", "prob", "adversary"}
 
 /* Scan types (the list). */
 enum {
@@ -35,8 +43,12 @@ enum {
     QNAV_BENCH_SCAN_CORRIDOR,  /* two walls 0.6 m either side, goal along the corridor */
     QNAV_BENCH_SCAN_DENSE,     /* qnav_sim's sonar in data/envs/dense.toml at fixed poses */
     QNAV_BENCH_SCAN_RANDOM,    /* i.i.d. ranges, about a fifth above the maximum */
+    QNAV_BENCH_SCAN_ADVERSARY, /* found by the adversarial search with the policy of its k */
     QNAV_BENCH_SCAN_TYPES
 };
+/* Their names in M lines, in that order. */
+#define QNAV_BENCH_SCAN_NAMES                                                              \
+    {"clear", "behind", "obstacle", "corridor", "dense", "random", "adversary"}
 
 /* One policy of the set. */
 typedef struct {

@@ -4,15 +4,20 @@
  */
 #include "bench_grid.h"
 
+/* The set the grid walks: the fixtures, or the adversarial set (bench/adversary/). */
+#if defined(QNAV_BENCH_ADVERSARY) && QNAV_BENCH_ADVERSARY
+#include "adversary/bench_policies.h"
+#include "adversary/bench_scans.h"
+#else
 #include "bench_policies.h"
 #include "bench_scans.h"
+#endif
 #include "target_io.h"
 
 static const char *const mode_names[QNAV_BENCH_MODES] = {"network", "probabilistic", "table",
                                                           "network3"};
-static const char *const set_names[QNAV_BENCH_SETS] = {"evolved", "random", "prob"};
-static const char *const scan_names[QNAV_BENCH_SCAN_TYPES] = {"clear", "behind", "obstacle",
-                                                              "corridor", "dense", "random"};
+static const char *const set_names[QNAV_BENCH_SETS] = QNAV_BENCH_SET_NAMES;
+static const char *const scan_names[QNAV_BENCH_SCAN_TYPES] = QNAV_BENCH_SCAN_NAMES;
 
 /* Scratch in RAM: one scan, one policy, one controller, the reference's qualities. */
 static qnav_mm_t ranges[QNAV_MAX_SECTORS];

@@ -5,6 +5,12 @@
  * (CLOCK_MONOTONIC). Tables are compiled into RAM for every 2-input network. Meaningful
  * only in an optimised build without sanitizers (preset host-release); the build flags
  * are printed. Exit status 1 on a heading mismatch.
+ *
+ * Built against libqnav with QNAV_BENCH_COUNT = 1 (qnav_bench_count over the fixtures,
+ * qnav_bench_count_adversary over the adversarial set, bench/adversary/) it measures no
+ * time: the value is the number of hidden-unit evaluations of the step
+ * (qnav_ctrl_count_evals), target "count", network mode only; tools/bench-proxy sets these
+ * counts beside the same steps' simavr cycles.
  */
 #define _POSIX_C_SOURCE 199309L
 #include <stdint.h>
@@ -20,6 +26,34 @@
 
 #define REPS 5
 #define MIN_BATCH_NS 50000.0
+
+#if QNAV_BENCH_COUNT
+#define TARGET "count"
+#define MODES QNAV_BENCH_MODE_BIT(QNAV_BENCH_NETWORK)
+
+static uint32_t measure(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
+                        qnav_ctrl_output_t *out, uint8_t mode)
+{
+    /* the grid's controller is its own scratch: counting through it changes no decision */
+    qnav_ctrl_t *c = (qnav_ctrl_t *)ctrl;
+    uint32_t evals = 0;
+    (void)mode;
+    qnav_ctrl_count_evals(c, &evals);
+    qnav_ctrl_step(c, in, out, 0);
+    qnav_ctrl_count_evals(c, 0);
+    return evals;
+}
+
+static void put_header(void)
+{
+    printf("qnav evaluation counts: values are hidden-unit evaluations per step\n");
+}
+
+#else
+#define TARGET "host"
+#define MODES                                                                              \
+    (uint8_t)(QNAV_BENCH_MODE_BIT(QNAV_BENCH_NETWORK) | QNAV_BENCH_MODE_BIT(QNAV_BENCH_PROB) | \
+              QNAV_BENCH_MODE_BIT(QNAV_BENCH_TABLE) | QNAV_BENCH_MODE_BIT(QNAV_BENCH_NETWORK3))
 
 static volatile int32_t sink;
 
@@ -69,18 +103,22 @@ static uint32_t measure(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     return (uint32_t)(per[REPS / 2] * 1000.0 + 0.5);
 }
 
+static void put_header(void)
+{
+    printf("qnav host benchmark: values are ps per step (ns x 1000), median of %d repetitions "
+           "of >= %.0f us\nbuild: %s\n", REPS, MIN_BATCH_NS / 1000.0, QNAV_BENCH_BUILD);
+    printf("sizeof(qnav_ctrl_t) %u bytes\n", (unsigned)sizeof(qnav_ctrl_t));
+}
+#endif
+
 int main(void)
 {
     qnav_bench_hooks_t hooks;
     uint16_t bad;
-    printf("qnav host benchmark: values are ps per step (ns x 1000), median of %d repetitions "
-           "of >= %.0f us\nbuild: %s\n", REPS, MIN_BATCH_NS / 1000.0, QNAV_BENCH_BUILD);
-    printf("sizeof(qnav_ctrl_t) %u bytes\n", (unsigned)sizeof(qnav_ctrl_t));
-    hooks.target = "host";
+    put_header();
+    hooks.target = TARGET;
     hooks.sep = '\t';
-    hooks.modes = (uint8_t)(QNAV_BENCH_MODE_BIT(QNAV_BENCH_NETWORK) | QNAV_BENCH_MODE_BIT(QNAV_BENCH_PROB) |
-                            QNAV_BENCH_MODE_BIT(QNAV_BENCH_TABLE) |
-                            QNAV_BENCH_MODE_BIT(QNAV_BENCH_NETWORK3));
+    hooks.modes = MODES;
     hooks.measure = measure;
     hooks.has_value = 1;
     hooks.table = qnav_bench_ram_table;

@@ -16,6 +16,19 @@
 #error "policy_net.c is left out of the build when QNAV_WITH_NETWORK is 0 (qnav/qnav_config.h)"
 #endif
 
+/* QNAV_BENCH_COUNT: n hidden-unit evaluations, into the caller's counter if it gave one. */
+#if QNAV_BENCH_COUNT
+#define QNAV_COUNT_EVALS(ctrl, n)                                                          \
+    do {                                                                                   \
+        if ((ctrl)->bench_evals != 0) {                                                    \
+            *(ctrl)->bench_evals += (uint32_t)(n);                                         \
+        }                                                                                  \
+    } while (0)
+#else
+#define QNAV_COUNT_EVALS(ctrl, n) ((void)0)
+#endif
+
+
 /* Divide by a positive divisor, rounding halves away from zero. */
 static int32_t div_round(int32_t num, int32_t den)
 {
@@ -94,6 +107,7 @@ static int32_t path_acc_prev(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dth
 {
     int32_t acc = ctrl->out_bias_z;
     uint8_t j;
+    QNAV_COUNT_EVALS(ctrl, ctrl->hidden);
     for (j = 0; j < ctrl->hidden; ++j) {
         const qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
         acc += unit_share(unit_base(u, level) + mul_u8(u->per_deg, dtheta) +
@@ -108,6 +122,7 @@ static inline qnav_qkey_t key_of_path(const qnav_ctrl_t *ctrl, uint8_t level, ui
 {
     int32_t acc = ctrl->out_bias_z;
     uint8_t j;
+    QNAV_COUNT_EVALS(ctrl, ctrl->hidden);
     /* dprev = 0: the third input's term is 0 */
     for (j = 0; j < ctrl->hidden; ++j) {
         const qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
@@ -141,6 +156,7 @@ static void eval_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *
         }
         uint8_t k;
         uint8_t j;
+        QNAV_COUNT_EVALS(ctrl, (uint16_t)n * ctrl->hidden);
         for (k = 0; k < n; ++k) {
             acc[k] = ctrl->out_bias_z;
         }
@@ -222,6 +238,9 @@ static void row_shapes(qnav_ctrl_t *ctrl)
 void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net)
 {
     uint8_t j;
+#if QNAV_BENCH_COUNT
+    ctrl->bench_evals = 0;
+#endif
     ctrl->hidden = net->hidden;
     ctrl->inputs = net->inputs;
     for (j = 0; j < net->hidden; ++j) {
@@ -266,6 +285,7 @@ static inline void two_sums(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_
     int32_t lo = 0;
     int32_t hi = 0;
     uint8_t j;
+    QNAV_COUNT_EVALS(ctrl, ctrl->hidden);
     for (j = 0; j < ctrl->hidden; ++j) {
         const qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
         int32_t base = unit_base(u, r->level);

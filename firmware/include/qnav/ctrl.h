@@ -258,7 +258,22 @@ typedef struct {
             } in;
         } net;
     } p;
+#if QNAV_BENCH_COUNT
+    uint32_t *bench_evals;            /* hidden-unit evaluations are added here (null: not
+                                         counted); qnav_ctrl_count_evals */
+#endif
 } qnav_ctrl_t;
+
+#if QNAV_BENCH_COUNT
+/* Benchmarks only (QNAV_BENCH_COUNT = 1): from now on each hidden-unit evaluation of this
+ * network controller (H per path evaluated) adds 1 to *evals; null stops counting. Call it
+ * after init, which forgets the counter. The counter is the caller's: libqnav keeps no
+ * state of its own. */
+static inline void qnav_ctrl_count_evals(qnav_ctrl_t *ctrl, uint32_t *evals)
+{
+    ctrl->bench_evals = evals;
+}
+#endif
 
 /* Number of entries of a quality table: QNAV_DIST_LEVELS * 181, row-major by level. */
 #define QNAV_QTABLE_ENTRIES ((uint16_t)(QNAV_DIST_LEVELS * (QNAV_DTHETA_MAX + 1)))

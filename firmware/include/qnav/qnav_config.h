@@ -90,6 +90,15 @@
 #error "every QNAV_WITH_* switch is 0: libqnav would have no controller left"
 #endif
 
+/* 1: a network controller counts its hidden-unit evaluations (one per unit and path it
+ * evaluates) into a counter its caller supplies (qnav_ctrl_count_evals): the deterministic
+ * cost measure of the adversarial benchmark (bench/README.md, "Adversarial search"), which
+ * tracks ATmega128 cycles. It adds a pointer to qnav_ctrl_t and an addition per path
+ * evaluated; 0 (default): neither. */
+#ifndef QNAV_BENCH_COUNT
+#define QNAV_BENCH_COUNT 0
+#endif
+
 #if QNAV_DIST_LEVELS < 2 || QNAV_DIST_LEVELS > 256
 #error "QNAV_DIST_LEVELS must be in 2..256"
 #endif
@@ -98,6 +107,9 @@
 #endif
 #if QNAV_DEFAULT_HIDDEN > QNAV_MAX_HIDDEN
 #error "QNAV_DEFAULT_HIDDEN must not exceed QNAV_MAX_HIDDEN"
+#endif
+#if QNAV_BENCH_COUNT != 0 && QNAV_BENCH_COUNT != 1
+#error "QNAV_BENCH_COUNT must be 0 or 1"
 #endif
 #if QNAV_TABLES_IN_FLASH && !defined(__AVR__)
 #error "QNAV_TABLES_IN_FLASH is for AVR targets only"
