@@ -650,8 +650,9 @@ static void keep(search_t *S, const target_t *t, const cand_t *c, unsigned n, in
         m = &S->set[S->n_set++];
         m->c = c[i];
         m->how = how;
-        snprintf(m->id, sizeof m->id, "adv-%c%u-n%u-%u", tag, (unsigned)t->hidden, (unsigned)t->n,
-                 k++);
+        /* bounded (H <= 32, N <= 360, k < 100) so the id always fits */
+        snprintf(m->id, sizeof m->id, "adv-%c%u-n%u-%u", tag, (unsigned)t->hidden % 100u,
+                 (unsigned)t->n % 1000u, k++ % 100u);
     }
 }
 

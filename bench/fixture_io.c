@@ -121,7 +121,7 @@ static void parse_entry(const char *path, unsigned lineno, const char *line, con
             qnav_fx_fail(2, "%s:%u: ID '%s' given twice", path, lineno, id);
         }
     }
-    snprintf(e->id, sizeof e->id, "%s", id);
+    memcpy(e->id, id, strlen(id) + 1u); /* qnav_fx_id_ok bounded it below QNAV_BENCH_ID_LEN */
     e->set = QNAV_BENCH_SETS;
     for (uint8_t s = 0; s < QNAV_BENCH_SETS; ++s) {
         if (strcmp(set, qnav_fx_set_names[s]) == 0) {
