@@ -26,13 +26,24 @@ static const uint16_t sin_deg_q15[91] QNAV_FLASH = {
 /* Control tick the speed guard allows for reacting, ms (DESIGN.md §4: 0.1 s). */
 #define QNAV_GUARD_REACTION_MS 100u
 
-/* The level of a range at most max_range_mm (inline for the step's sector loop). A range
- * below 65536 times a scale below 2^21 stays within 32 bits. (A 16 x 16 bit branch for
- * scales that fit 16 bits bought nothing: avr-gcc merges it into the same 32 x 16 bit
- * multiply.) */
+/*
+ * The level of a range (docs/qformats.md): (r * S + 2^15) >> 16, capped at L - 1. A range
+ * at or beyond the maximum is at the farthest level without a product (a sector that saw
+ * nothing). Below it, S fits 16 bits for every maximum range of at least L mm, so the
+ * product is a 16 x 16 bit one (avr-gcc: __umulhisi3, four MULs, instead of the 32 x 16
+ * bit __muluhisi3); maximum ranges below L mm add r * level_scale_hi, r < L - 1, within 16
+ * bits. Inline for the step's sector loop.
+ */
 static inline uint8_t level_of(const qnav_clearance_t *c, qnav_mm_t range_mm)
 {
-    uint32_t level = ((uint32_t)range_mm * c->level_scale + 32768u) >> 16;
+    uint32_t level;
+    if (range_mm >= c->max_range_mm) {
+        return QNAV_DIST_LEVELS - 1u;
+    }
+    level = ((uint32_t)range_mm * c->level_scale + 32768u) >> 16;
+    if (c->level_scale_hi != 0u) {
+        level += (uint16_t)(range_mm * c->level_scale_hi);
+    }
     return (uint8_t)(level > QNAV_DIST_LEVELS - 1u ? QNAV_DIST_LEVELS - 1u : level);
 }
 
@@ -163,8 +174,12 @@ qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t
     }
     c->n_sectors = cfg->n_sectors;
     c->max_range_mm = cfg->max_range_mm;
-    c->level_scale = ((uint32_t)(QNAV_DIST_LEVELS - 1) * 65536u + cfg->max_range_mm / 2u) /
-                     cfg->max_range_mm;
+    {
+        uint32_t scale = ((uint32_t)(QNAV_DIST_LEVELS - 1) * 65536u + cfg->max_range_mm / 2u) /
+                         cfg->max_range_mm;
+        c->level_scale = (uint16_t)(scale & 0xFFFFu);
+        c->level_scale_hi = (uint8_t)(scale >> 16);
+    }
     c->sector_paths = (uint16_t)(QNAV_PATHS / cfg->n_sectors);
     c->sector_span = (uint16_t)(c->sector_paths * cfg->n_sectors);
     if (cfg->wedge_pct > 100u) {
@@ -279,13 +294,12 @@ static void paint_piece_central(uint8_t *lvl, const qnav_clearance_t *c, uint16_
     paint(lvl, (uint16_t)lo, (uint16_t)(hi - lo), level);
 }
 
-/* The level of sector s's reading (clipped to the maximum range, flagged in *flags). */
+/* The level of sector s's reading (one beyond the maximum range flagged in *flags). */
 static inline uint8_t sector_level(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint16_t s,
                             uint8_t *flags)
 {
     qnav_mm_t r = ranges[s];
     if (r > c->max_range_mm) {
-        r = c->max_range_mm;
         *flags |= QNAV_FLAG_RANGE_CLIPPED;
     }
     return level_of(c, r);

@@ -40,7 +40,8 @@ qnav_q1_15_t qnav_clearance_turn_cap(const qnav_clearance_t *c, const uint8_t *l
  */
 uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint8_t *lvl);
 
-/* Level of a range already known to be at most max_range_mm. */
+/* The distance level of a range, mm (docs/qformats.md; at or beyond max_range_mm:
+ * QNAV_DIST_LEVELS - 1). */
 uint8_t qnav_clearance_level_of(const qnav_clearance_t *c, qnav_mm_t range_mm);
 
 #endif /* QNAV_CLEARANCE_H */
