@@ -116,21 +116,45 @@ static uint32_t isqrt32(uint32_t x)
 }
 
 /* Largest speed (Q1.15 of v_max) that stops within s_mm after one reaction tick:
- * v T + v^2 / (2 a) <= s, so v = sqrt((a T)^2 + 2 a s) - a T. */
-static qnav_q1_15_t stop_speed(uint32_t s_mm, uint32_t v_max_mm_s, uint32_t decel_mm_s2)
+ * v T + v^2 / (2 a) <= s, so v = sqrt((a T)^2 + 2 a s) - a T; for an s whose stop_speed()
+ * is below full speed, so that (a T)^2 + 2 a s fits 32 bits (a, v_max <= 65535; a T = a / 10
+ * exactly, a 16-bit division). */
+static qnav_q1_15_t stop_speed_within(uint32_t s_mm, uint32_t v_max_mm_s, uint32_t decel_mm_s2)
 {
-    uint32_t at = decel_mm_s2 * QNAV_GUARD_REACTION_MS / 1000u;
-    uint32_t at2 = at * at;
-    uint32_t v;
-    /* a <= 65535 and s <= 65535: 2 a s may pass 2^32; such a cap is above any v_max */
-    if (s_mm > (0xFFFFFFFFu - at2) / (2u * decel_mm_s2)) {
-        return QNAV_Q1_15_MAX;
-    }
-    v = isqrt32(at2 + 2u * decel_mm_s2 * s_mm) - at;
+    uint32_t at = (uint16_t)((uint16_t)decel_mm_s2 / (1000u / QNAV_GUARD_REACTION_MS));
+    uint32_t v = isqrt32(at * at + 2u * decel_mm_s2 * s_mm) - at;
     if (v >= v_max_mm_s) {
         return QNAV_Q1_15_MAX;
     }
     return (qnav_q1_15_t)((v * 32768u) / v_max_mm_s);
+}
+
+/* The same for any s_mm <= 65535: a <= 65535 and s <= 65535, so 2 a s may pass 2^32; such a
+ * cap is above any v_max. */
+static qnav_q1_15_t stop_speed(uint32_t s_mm, uint32_t v_max_mm_s, uint32_t decel_mm_s2)
+{
+    uint32_t at = decel_mm_s2 / (1000u / QNAV_GUARD_REACTION_MS);
+    if (s_mm > (0xFFFFFFFFu - at * at) / (2u * decel_mm_s2)) {
+        return QNAV_Q1_15_MAX;
+    }
+    return stop_speed_within(s_mm, v_max_mm_s, decel_mm_s2);
+}
+
+/* The clearance (mm) a path at level leaves for stopping: the nearest its obstacle can be,
+ * less the robot's radius and safety distance. */
+static uint32_t stop_room_mm(const qnav_clearance_t *c, uint8_t level)
+{
+    uint32_t d = level_distance_mm(c, level);
+    return d > c->margin_mm ? d - c->margin_mm : 0u;
+}
+
+/* The speed guard's cap at level, computed (at init for every level; the step's is below). */
+static qnav_q1_15_t level_cap(const qnav_clearance_t *c, uint8_t level)
+{
+    if (c->v_max_mm_s == 0u || c->decel_mm_s2 == 0u || level >= QNAV_DIST_LEVELS - 1u) {
+        return QNAV_Q1_15_MAX; /* no guard, or nothing seen within range */
+    }
+    return stop_speed(stop_room_mm(c, level), c->v_max_mm_s, c->decel_mm_s2);
 }
 
 void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
@@ -144,18 +168,32 @@ void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
         c->enlarge_deg[level] = enlarge_deg(margin, level_distance_mm(c, level));
     }
+    /* where the cap leaves 0, and from where on it is full speed (level L - 1 always is) */
+    c->guard_from_level = 0;
+    while (level_cap(c, c->guard_from_level) == 0) {
+        ++c->guard_from_level;
+    }
+    c->guard_full_level = QNAV_DIST_LEVELS - 1u;
+    while (c->guard_full_level > 0u &&
+           level_cap(c, (uint8_t)(c->guard_full_level - 1u)) == QNAV_Q1_15_MAX) {
+        --c->guard_full_level;
+    }
 }
 
-/* The speed guard's cap is made when asked for (once a step, for the chosen path's level)
- * rather than tabulated: 64 bytes of RAM for about 2 000 cycles on the ATmega128. */
+/* The cap is 0 below guard_from_level and full speed from guard_full_level on (both found
+ * at init from the cap itself), so only the levels between compute it: a binary search, a
+ * square root and two divisions, for one level on the TekBot's profile (2), six on the
+ * Pioneer's. A table of every level's cap would be 62 bytes of RAM. */
 qnav_q1_15_t qnav_clearance_speed_cap(const qnav_clearance_t *c, uint8_t level)
 {
-    uint32_t d;
-    if (c->v_max_mm_s == 0u || c->decel_mm_s2 == 0u || level >= QNAV_DIST_LEVELS - 1u) {
-        return QNAV_Q1_15_MAX; /* no guard, or nothing seen within range */
+    if (level >= c->guard_full_level) {
+        return QNAV_Q1_15_MAX;
     }
-    d = level_distance_mm(c, level);
-    return stop_speed(d > c->margin_mm ? d - c->margin_mm : 0u, c->v_max_mm_s, c->decel_mm_s2);
+    if (level < c->guard_from_level) {
+        return 0;
+    }
+    /* below full speed at init, so within stop_speed_within()'s range */
+    return stop_speed_within(stop_room_mm(c, level), c->v_max_mm_s, c->decel_mm_s2);
 }
 
 qnav_q1_15_t qnav_clearance_turn_cap(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t path)
@@ -195,7 +233,7 @@ qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t
     }
     c->wedge_near_level = qnav_clearance_level_of(
         c, cfg->wedge_near_mm < cfg->max_range_mm ? cfg->wedge_near_mm : cfg->max_range_mm);
-    c->first_sector_paths = (uint16_t)((QNAV_PATHS / 2u + cfg->n_sectors - 1u) / cfg->n_sectors);
+    c->first_sector_paths = (uint8_t)((QNAV_PATHS / 2u + cfg->n_sectors - 1u) / cfg->n_sectors);
     qnav_clearance_init(c, cfg);
     return QNAV_OK;
 }
