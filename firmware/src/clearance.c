@@ -219,7 +219,7 @@ qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t
         c->level_scale_hi = (uint8_t)(scale >> 16);
     }
     c->sector_paths = (uint16_t)(QNAV_PATHS / cfg->n_sectors);
-    c->sector_span = (uint16_t)(c->sector_paths * cfg->n_sectors);
+    c->sector_rem = (uint16_t)(QNAV_PATHS - c->sector_paths * cfg->n_sectors);
     if (cfg->wedge_pct > 100u) {
         return QNAV_E_WEDGE;
     }
@@ -332,22 +332,22 @@ static void paint_piece_central(uint8_t *lvl, const qnav_clearance_t *c, uint16_
     paint(lvl, (uint16_t)lo, (uint16_t)(hi - lo), level);
 }
 
-/* The level of sector s's reading (one beyond the maximum range flagged in *flags). */
-static inline uint8_t sector_level(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint16_t s,
-                            uint8_t *flags)
+/* The level of a sector's reading (one beyond the maximum range flagged in *flags). */
+static inline uint8_t sector_level(const qnav_clearance_t *c, qnav_mm_t range_mm, uint8_t *flags)
 {
-    qnav_mm_t r = ranges[s];
-    if (r > c->max_range_mm) {
+    if (range_mm > c->max_range_mm) {
         *flags |= QNAV_FLAG_RANGE_CLIPPED;
     }
-    return level_of(c, r);
+    return level_of(c, range_mm);
 }
 
 /* Every path at the farthest level. On AVR four bytes per iteration: avr-libc's memset
  * takes about 6 cycles a byte on the ATmega128, this loop under 3 (and GCC would turn the
- * loop back into a memset call); elsewhere the C library's memset, which stores words. */
+ * loop back into a memset call); out of line, because inlined into the sector loop it gets
+ * no pointer register with a displacement and costs 1 000 cycles more. Elsewhere the C
+ * library's memset, which stores words. */
 #if defined(__AVR__)
-__attribute__((optimize("no-tree-loop-distribute-patterns")))
+__attribute__((optimize("no-tree-loop-distribute-patterns"), noinline))
 static void fill_clear(uint8_t *lvl)
 {
     uint8_t *p = lvl;
@@ -368,47 +368,49 @@ static void fill_clear(uint8_t *lvl)
 #endif
 
 /* Sector lengths follow from path * N + 180 wrapping past 360: a sector whose first path
- * has phase p holds q = 360 / N paths, or q + 1 when p + q * N is still below 360; sector 0
- * is cut in two pieces, paths 0.. and the last ones before 360. Pieces are painted in path
- * order, each knowing its neighbours' levels (the piece before piece 0 holds path 359). */
+ * has phase p = path * N + 180 - 360 * sector (0 <= p < N) holds q = 360 / N paths, or q + 1
+ * when p < 360 - q * N; sector 0 is cut in two pieces, paths 0.. and the last ones before
+ * 360. Pieces are painted in path order, each knowing its neighbours' levels (the piece
+ * before piece 0 holds path 359). */
 uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint8_t *lvl)
 {
-    uint16_t path = 0;
-    uint16_t sector = 0;
-    uint16_t phase = QNAV_PATHS / 2u;
-    uint16_t count = c->first_sector_paths;
+    const qnav_mm_t *next_range = ranges + 1; /* the sector after the current piece's */
+    const qnav_mm_t *end = ranges + c->n_sectors;
+    uint16_t first = 0;                       /* the current piece: paths first..stop - 1 */
+    uint16_t stop = c->first_sector_paths;
+    uint16_t phase = (uint16_t)(stop * c->n_sectors - QNAV_PATHS / 2u); /* of the next sector */
     uint8_t flags = 0;
-    uint8_t level0 = sector_level(c, ranges, 0u, &flags);
+    uint8_t level0 = sector_level(c, ranges[0], &flags);
     /* path 359 lies in sector 0 (its last piece) when N <= 180, else in sector N - 1 */
-    uint8_t prev = c->n_sectors <= QNAV_DTHETA_MAX
-                       ? level0 : sector_level(c, ranges, (uint16_t)(c->n_sectors - 1u), &flags);
+    uint8_t prev = c->n_sectors <= QNAV_DTHETA_MAX ? level0 : sector_level(c, end[-1], &flags);
     uint8_t level = level0;
     fill_clear(lvl);
     for (;;) {
-        uint16_t n = count < QNAV_PATHS - path ? count : (uint16_t)(QNAV_PATHS - path);
-        uint16_t next_sector = (uint16_t)(sector + 1u == c->n_sectors ? 0u : sector + 1u);
-        uint8_t next;
-        if (path + n >= QNAV_PATHS || next_sector == 0u) {
-            next = level0; /* piece 0, or sector 0's last piece */
-        } else {
-            next = sector_level(c, ranges, next_sector, &flags);
-        }
+        /* after the last sector comes sector 0's last piece, after that piece 0 */
+        uint8_t next = next_range != end ? sector_level(c, *next_range++, &flags) : level0;
         if (level == QNAV_DIST_LEVELS - 1u) {
             /* nothing seen in this sector */
         } else if (c->wedge_shrink == 0u) {
-            paint_piece(lvl, c, path, n, level, prev, next);
+            paint_piece(lvl, c, first, (uint16_t)(stop - first), level, prev, next);
         } else {
             /* sector 0 is cut at path 0 (piece 0's left, its last piece's right) */
-            paint_piece_central(lvl, c, path, n, level, (uint8_t)(path != 0u),
-                                (uint8_t)(path + n < QNAV_PATHS));
+            paint_piece_central(lvl, c, first, (uint16_t)(stop - first), level,
+                                (uint8_t)(first != 0u), (uint8_t)(stop < QNAV_PATHS));
         }
-        path = (uint16_t)(path + n);
-        if (path >= QNAV_PATHS) {
+        if (stop >= QNAV_PATHS) {
             return flags;
         }
-        phase = (uint16_t)(phase + count * c->n_sectors - QNAV_PATHS);
-        count = (uint16_t)(c->sector_paths + (phase + c->sector_span < QNAV_PATHS ? 1u : 0u));
-        sector = next_sector;
+        first = stop;
+        stop = (uint16_t)(stop + c->sector_paths);
+        if (phase < c->sector_rem) {
+            ++stop;
+            phase = (uint16_t)(phase + c->n_sectors - c->sector_rem);
+        } else {
+            phase = (uint16_t)(phase - c->sector_rem);
+        }
+        if (stop > QNAV_PATHS) {
+            stop = QNAV_PATHS;
+        }
         prev = level;
         level = next;
     }

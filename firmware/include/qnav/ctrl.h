@@ -182,7 +182,7 @@ typedef struct {
     uint16_t level_scale;             /* distance level = (range * S + 2^15) >> 16, S =
                                          level_scale + 2^16 level_scale_hi */
     uint16_t sector_paths;            /* 360 / N: paths in a sector, or one more */
-    uint16_t sector_span;             /* sector_paths * N */
+    uint16_t sector_rem;              /* 360 - sector_paths * N */
     uint8_t enlarge_deg[QNAV_DIST_LEVELS];      /* obstacle enlargement gamma by level, deg */
     uint8_t first_sector_paths;       /* paths 0.. that lie in sector 0: ceil(180 / N) */
     uint8_t wedge_shrink;             /* paths a reading leaves free at each sector edge */
