@@ -238,8 +238,37 @@ qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t
     return QNAV_OK;
 }
 
-/* Lower lvl[p..p+k-1] to at most level (no wrap; a branch-free min the compiler can
- * vectorise on hosts). */
+/* Lower lvl[p..p+k-1] to at most level (no wrap; k <= 360). On AVR two bytes per
+ * iteration by hand, 8.5 cycles a byte against 11 from avr-gcc (checked by the shared
+ * vectors under simavr); elsewhere a branch-free min the compiler can vectorise. */
+#if defined(__AVR__)
+static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
+{
+    uint8_t *q = lvl + p;
+    uint8_t pairs = (uint8_t)(k >> 1);
+    if ((k & 1u) != 0u) {
+        *q = *q < level ? *q : level;
+        ++q;
+    }
+    if (pairs != 0u) {
+        __asm__ volatile("1: ld __tmp_reg__, %a0\n\t"
+                         "cp %2, __tmp_reg__\n\t"
+                         "brsh 2f\n\t"
+                         "mov __tmp_reg__, %2\n\t"
+                         "2: st %a0+, __tmp_reg__\n\t"
+                         "ld __tmp_reg__, %a0\n\t"
+                         "cp %2, __tmp_reg__\n\t"
+                         "brsh 3f\n\t"
+                         "mov __tmp_reg__, %2\n\t"
+                         "3: st %a0+, __tmp_reg__\n\t"
+                         "dec %1\n\t"
+                         "brne 1b\n\t"
+                         : "+z"(q), "+r"(pairs)
+                         : "r"(level)
+                         : "memory");
+    }
+}
+#else
 static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
 {
     uint8_t *q = lvl + p;
@@ -248,6 +277,7 @@ static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
         *q = *q < level ? *q : level;
     }
 }
+#endif
 
 /* Lower the level of the k paths from p on (wrapping past 359; k <= 360) to level. */
 static void paint(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
