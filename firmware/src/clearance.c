@@ -26,13 +26,24 @@ static const uint16_t sin_deg_q15[91] QNAV_FLASH = {
 /* Control tick the speed guard allows for reacting, ms (DESIGN.md §4: 0.1 s). */
 #define QNAV_GUARD_REACTION_MS 100u
 
-/* The level of a range at most max_range_mm (inline for the step's sector loop). A range
- * below 65536 times a scale below 2^21 stays within 32 bits. (A 16 x 16 bit branch for
- * scales that fit 16 bits bought nothing: avr-gcc merges it into the same 32 x 16 bit
- * multiply.) */
+/*
+ * The level of a range (docs/qformats.md): (r * S + 2^15) >> 16, capped at L - 1. A range
+ * at or beyond the maximum is at the farthest level without a product (a sector that saw
+ * nothing). Below it, S fits 16 bits for every maximum range of at least L mm, so the
+ * product is a 16 x 16 bit one (avr-gcc: __umulhisi3, four MULs, instead of the 32 x 16
+ * bit __muluhisi3); maximum ranges below L mm add r * level_scale_hi, r < L - 1, within 16
+ * bits. Inline for the step's sector loop.
+ */
 static inline uint8_t level_of(const qnav_clearance_t *c, qnav_mm_t range_mm)
 {
-    uint32_t level = ((uint32_t)range_mm * c->level_scale + 32768u) >> 16;
+    uint32_t level;
+    if (range_mm >= c->max_range_mm) {
+        return QNAV_DIST_LEVELS - 1u;
+    }
+    level = ((uint32_t)range_mm * c->level_scale + 32768u) >> 16;
+    if (c->level_scale_hi != 0u) {
+        level += (uint16_t)(range_mm * c->level_scale_hi);
+    }
     return (uint8_t)(level > QNAV_DIST_LEVELS - 1u ? QNAV_DIST_LEVELS - 1u : level);
 }
 
@@ -105,21 +116,45 @@ static uint32_t isqrt32(uint32_t x)
 }
 
 /* Largest speed (Q1.15 of v_max) that stops within s_mm after one reaction tick:
- * v T + v^2 / (2 a) <= s, so v = sqrt((a T)^2 + 2 a s) - a T. */
-static qnav_q1_15_t stop_speed(uint32_t s_mm, uint32_t v_max_mm_s, uint32_t decel_mm_s2)
+ * v T + v^2 / (2 a) <= s, so v = sqrt((a T)^2 + 2 a s) - a T; for an s whose stop_speed()
+ * is below full speed, so that (a T)^2 + 2 a s fits 32 bits (a, v_max <= 65535; a T = a / 10
+ * exactly, a 16-bit division). */
+static qnav_q1_15_t stop_speed_within(uint32_t s_mm, uint32_t v_max_mm_s, uint32_t decel_mm_s2)
 {
-    uint32_t at = decel_mm_s2 * QNAV_GUARD_REACTION_MS / 1000u;
-    uint32_t at2 = at * at;
-    uint32_t v;
-    /* a <= 65535 and s <= 65535: 2 a s may pass 2^32; such a cap is above any v_max */
-    if (s_mm > (0xFFFFFFFFu - at2) / (2u * decel_mm_s2)) {
-        return QNAV_Q1_15_MAX;
-    }
-    v = isqrt32(at2 + 2u * decel_mm_s2 * s_mm) - at;
+    uint32_t at = (uint16_t)((uint16_t)decel_mm_s2 / (1000u / QNAV_GUARD_REACTION_MS));
+    uint32_t v = isqrt32(at * at + 2u * decel_mm_s2 * s_mm) - at;
     if (v >= v_max_mm_s) {
         return QNAV_Q1_15_MAX;
     }
     return (qnav_q1_15_t)((v * 32768u) / v_max_mm_s);
+}
+
+/* The same for any s_mm <= 65535: a <= 65535 and s <= 65535, so 2 a s may pass 2^32; such a
+ * cap is above any v_max. */
+static qnav_q1_15_t stop_speed(uint32_t s_mm, uint32_t v_max_mm_s, uint32_t decel_mm_s2)
+{
+    uint32_t at = decel_mm_s2 / (1000u / QNAV_GUARD_REACTION_MS);
+    if (s_mm > (0xFFFFFFFFu - at * at) / (2u * decel_mm_s2)) {
+        return QNAV_Q1_15_MAX;
+    }
+    return stop_speed_within(s_mm, v_max_mm_s, decel_mm_s2);
+}
+
+/* The clearance (mm) a path at level leaves for stopping: the nearest its obstacle can be,
+ * less the robot's radius and safety distance. */
+static uint32_t stop_room_mm(const qnav_clearance_t *c, uint8_t level)
+{
+    uint32_t d = level_distance_mm(c, level);
+    return d > c->margin_mm ? d - c->margin_mm : 0u;
+}
+
+/* The speed guard's cap at level, computed (at init for every level; the step's is below). */
+static qnav_q1_15_t level_cap(const qnav_clearance_t *c, uint8_t level)
+{
+    if (c->v_max_mm_s == 0u || c->decel_mm_s2 == 0u || level >= QNAV_DIST_LEVELS - 1u) {
+        return QNAV_Q1_15_MAX; /* no guard, or nothing seen within range */
+    }
+    return stop_speed(stop_room_mm(c, level), c->v_max_mm_s, c->decel_mm_s2);
 }
 
 void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
@@ -133,18 +168,32 @@ void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
         c->enlarge_deg[level] = enlarge_deg(margin, level_distance_mm(c, level));
     }
+    /* where the cap leaves 0, and from where on it is full speed (level L - 1 always is) */
+    c->guard_from_level = 0;
+    while (level_cap(c, c->guard_from_level) == 0) {
+        ++c->guard_from_level;
+    }
+    c->guard_full_level = QNAV_DIST_LEVELS - 1u;
+    while (c->guard_full_level > 0u &&
+           level_cap(c, (uint8_t)(c->guard_full_level - 1u)) == QNAV_Q1_15_MAX) {
+        --c->guard_full_level;
+    }
 }
 
-/* The speed guard's cap is made when asked for (once a step, for the chosen path's level)
- * rather than tabulated: 64 bytes of RAM for about 2 000 cycles on the ATmega128. */
+/* The cap is 0 below guard_from_level and full speed from guard_full_level on (both found
+ * at init from the cap itself), so only the levels between compute it: a binary search, a
+ * square root and two divisions, for one level on the TekBot's profile (2), six on the
+ * Pioneer's. A table of every level's cap would be 62 bytes of RAM. */
 qnav_q1_15_t qnav_clearance_speed_cap(const qnav_clearance_t *c, uint8_t level)
 {
-    uint32_t d;
-    if (c->v_max_mm_s == 0u || c->decel_mm_s2 == 0u || level >= QNAV_DIST_LEVELS - 1u) {
-        return QNAV_Q1_15_MAX; /* no guard, or nothing seen within range */
+    if (level >= c->guard_full_level) {
+        return QNAV_Q1_15_MAX;
     }
-    d = level_distance_mm(c, level);
-    return stop_speed(d > c->margin_mm ? d - c->margin_mm : 0u, c->v_max_mm_s, c->decel_mm_s2);
+    if (level < c->guard_from_level) {
+        return 0;
+    }
+    /* below full speed at init, so within stop_speed_within()'s range */
+    return stop_speed_within(stop_room_mm(c, level), c->v_max_mm_s, c->decel_mm_s2);
 }
 
 qnav_q1_15_t qnav_clearance_turn_cap(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t path)
@@ -163,10 +212,14 @@ qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t
     }
     c->n_sectors = cfg->n_sectors;
     c->max_range_mm = cfg->max_range_mm;
-    c->level_scale = ((uint32_t)(QNAV_DIST_LEVELS - 1) * 65536u + cfg->max_range_mm / 2u) /
-                     cfg->max_range_mm;
+    {
+        uint32_t scale = ((uint32_t)(QNAV_DIST_LEVELS - 1) * 65536u + cfg->max_range_mm / 2u) /
+                         cfg->max_range_mm;
+        c->level_scale = (uint16_t)(scale & 0xFFFFu);
+        c->level_scale_hi = (uint8_t)(scale >> 16);
+    }
     c->sector_paths = (uint16_t)(QNAV_PATHS / cfg->n_sectors);
-    c->sector_span = (uint16_t)(c->sector_paths * cfg->n_sectors);
+    c->sector_rem = (uint16_t)(QNAV_PATHS - c->sector_paths * cfg->n_sectors);
     if (cfg->wedge_pct > 100u) {
         return QNAV_E_WEDGE;
     }
@@ -180,13 +233,42 @@ qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t
     }
     c->wedge_near_level = qnav_clearance_level_of(
         c, cfg->wedge_near_mm < cfg->max_range_mm ? cfg->wedge_near_mm : cfg->max_range_mm);
-    c->first_sector_paths = (uint16_t)((QNAV_PATHS / 2u + cfg->n_sectors - 1u) / cfg->n_sectors);
+    c->first_sector_paths = (uint8_t)((QNAV_PATHS / 2u + cfg->n_sectors - 1u) / cfg->n_sectors);
     qnav_clearance_init(c, cfg);
     return QNAV_OK;
 }
 
-/* Lower lvl[p..p+k-1] to at most level (no wrap; a branch-free min the compiler can
- * vectorise on hosts). */
+/* Lower lvl[p..p+k-1] to at most level (no wrap; k <= 360). On AVR two bytes per
+ * iteration by hand, 8.5 cycles a byte against 11 from avr-gcc (checked by the shared
+ * vectors under simavr); elsewhere a branch-free min the compiler can vectorise. */
+#if defined(__AVR__)
+static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
+{
+    uint8_t *q = lvl + p;
+    uint8_t pairs = (uint8_t)(k >> 1);
+    if ((k & 1u) != 0u) {
+        *q = *q < level ? *q : level;
+        ++q;
+    }
+    if (pairs != 0u) {
+        __asm__ volatile("1: ld __tmp_reg__, %a0\n\t"
+                         "cp %2, __tmp_reg__\n\t"
+                         "brsh 2f\n\t"
+                         "mov __tmp_reg__, %2\n\t"
+                         "2: st %a0+, __tmp_reg__\n\t"
+                         "ld __tmp_reg__, %a0\n\t"
+                         "cp %2, __tmp_reg__\n\t"
+                         "brsh 3f\n\t"
+                         "mov __tmp_reg__, %2\n\t"
+                         "3: st %a0+, __tmp_reg__\n\t"
+                         "dec %1\n\t"
+                         "brne 1b\n\t"
+                         : "+z"(q), "+r"(pairs)
+                         : "r"(level)
+                         : "memory");
+    }
+}
+#else
 static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
 {
     uint8_t *q = lvl + p;
@@ -195,6 +277,7 @@ static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
         *q = *q < level ? *q : level;
     }
 }
+#endif
 
 /* Lower the level of the k paths from p on (wrapping past 359; k <= 360) to level. */
 static void paint(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
@@ -279,23 +362,22 @@ static void paint_piece_central(uint8_t *lvl, const qnav_clearance_t *c, uint16_
     paint(lvl, (uint16_t)lo, (uint16_t)(hi - lo), level);
 }
 
-/* The level of sector s's reading (clipped to the maximum range, flagged in *flags). */
-static inline uint8_t sector_level(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint16_t s,
-                            uint8_t *flags)
+/* The level of a sector's reading (one beyond the maximum range flagged in *flags). */
+static inline uint8_t sector_level(const qnav_clearance_t *c, qnav_mm_t range_mm, uint8_t *flags)
 {
-    qnav_mm_t r = ranges[s];
-    if (r > c->max_range_mm) {
-        r = c->max_range_mm;
+    if (range_mm > c->max_range_mm) {
         *flags |= QNAV_FLAG_RANGE_CLIPPED;
     }
-    return level_of(c, r);
+    return level_of(c, range_mm);
 }
 
 /* Every path at the farthest level. On AVR four bytes per iteration: avr-libc's memset
  * takes about 6 cycles a byte on the ATmega128, this loop under 3 (and GCC would turn the
- * loop back into a memset call); elsewhere the C library's memset, which stores words. */
+ * loop back into a memset call); out of line, because inlined into the sector loop it gets
+ * no pointer register with a displacement and costs 1 000 cycles more. Elsewhere the C
+ * library's memset, which stores words. */
 #if defined(__AVR__)
-__attribute__((optimize("no-tree-loop-distribute-patterns")))
+__attribute__((optimize("no-tree-loop-distribute-patterns"), noinline))
 static void fill_clear(uint8_t *lvl)
 {
     uint8_t *p = lvl;
@@ -316,47 +398,49 @@ static void fill_clear(uint8_t *lvl)
 #endif
 
 /* Sector lengths follow from path * N + 180 wrapping past 360: a sector whose first path
- * has phase p holds q = 360 / N paths, or q + 1 when p + q * N is still below 360; sector 0
- * is cut in two pieces, paths 0.. and the last ones before 360. Pieces are painted in path
- * order, each knowing its neighbours' levels (the piece before piece 0 holds path 359). */
+ * has phase p = path * N + 180 - 360 * sector (0 <= p < N) holds q = 360 / N paths, or q + 1
+ * when p < 360 - q * N; sector 0 is cut in two pieces, paths 0.. and the last ones before
+ * 360. Pieces are painted in path order, each knowing its neighbours' levels (the piece
+ * before piece 0 holds path 359). */
 uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint8_t *lvl)
 {
-    uint16_t path = 0;
-    uint16_t sector = 0;
-    uint16_t phase = QNAV_PATHS / 2u;
-    uint16_t count = c->first_sector_paths;
+    const qnav_mm_t *next_range = ranges + 1; /* the sector after the current piece's */
+    const qnav_mm_t *end = ranges + c->n_sectors;
+    uint16_t first = 0;                       /* the current piece: paths first..stop - 1 */
+    uint16_t stop = c->first_sector_paths;
+    uint16_t phase = (uint16_t)(stop * c->n_sectors - QNAV_PATHS / 2u); /* of the next sector */
     uint8_t flags = 0;
-    uint8_t level0 = sector_level(c, ranges, 0u, &flags);
+    uint8_t level0 = sector_level(c, ranges[0], &flags);
     /* path 359 lies in sector 0 (its last piece) when N <= 180, else in sector N - 1 */
-    uint8_t prev = c->n_sectors <= QNAV_DTHETA_MAX
-                       ? level0 : sector_level(c, ranges, (uint16_t)(c->n_sectors - 1u), &flags);
+    uint8_t prev = c->n_sectors <= QNAV_DTHETA_MAX ? level0 : sector_level(c, end[-1], &flags);
     uint8_t level = level0;
     fill_clear(lvl);
     for (;;) {
-        uint16_t n = count < QNAV_PATHS - path ? count : (uint16_t)(QNAV_PATHS - path);
-        uint16_t next_sector = (uint16_t)(sector + 1u == c->n_sectors ? 0u : sector + 1u);
-        uint8_t next;
-        if (path + n >= QNAV_PATHS || next_sector == 0u) {
-            next = level0; /* piece 0, or sector 0's last piece */
-        } else {
-            next = sector_level(c, ranges, next_sector, &flags);
-        }
+        /* after the last sector comes sector 0's last piece, after that piece 0 */
+        uint8_t next = next_range != end ? sector_level(c, *next_range++, &flags) : level0;
         if (level == QNAV_DIST_LEVELS - 1u) {
             /* nothing seen in this sector */
         } else if (c->wedge_shrink == 0u) {
-            paint_piece(lvl, c, path, n, level, prev, next);
+            paint_piece(lvl, c, first, (uint16_t)(stop - first), level, prev, next);
         } else {
             /* sector 0 is cut at path 0 (piece 0's left, its last piece's right) */
-            paint_piece_central(lvl, c, path, n, level, (uint8_t)(path != 0u),
-                                (uint8_t)(path + n < QNAV_PATHS));
+            paint_piece_central(lvl, c, first, (uint16_t)(stop - first), level,
+                                (uint8_t)(first != 0u), (uint8_t)(stop < QNAV_PATHS));
         }
-        path = (uint16_t)(path + n);
-        if (path >= QNAV_PATHS) {
+        if (stop >= QNAV_PATHS) {
             return flags;
         }
-        phase = (uint16_t)(phase + count * c->n_sectors - QNAV_PATHS);
-        count = (uint16_t)(c->sector_paths + (phase + c->sector_span < QNAV_PATHS ? 1u : 0u));
-        sector = next_sector;
+        first = stop;
+        stop = (uint16_t)(stop + c->sector_paths);
+        if (phase < c->sector_rem) {
+            ++stop;
+            phase = (uint16_t)(phase + c->n_sectors - c->sector_rem);
+        } else {
+            phase = (uint16_t)(phase - c->sector_rem);
+        }
+        if (stop > QNAV_PATHS) {
+            stop = QNAV_PATHS;
+        }
         prev = level;
         level = next;
     }

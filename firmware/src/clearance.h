@@ -18,14 +18,16 @@
 QNAV_CHECK_RESULT qnav_status_t qnav_clearance_setup(qnav_clearance_t *c,
                                                      const qnav_ctrl_config_t *cfg);
 
-/* Fill c->enlarge_deg[] and the speed guard's parameters from cfg (init time; integer
- * only). */
+/* Fill c->enlarge_deg[] and the speed guard's parameters and levels from cfg (init time;
+ * integer only). */
 void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg);
 
 /* The speed guard's cap for a path at level: the largest speed (Q1.15 of v_max) that stops
  * within the level's clearance after one reaction tick (QNAV_Q1_15_MAX without a guard or
- * at the farthest level). @par Cost: a binary search over ranges, a square root and a
- * division (about 2 000 cycles on the ATmega128); the step asks once. */
+ * at the farthest level), the same as computing it for every step. @par Cost: two
+ * compares for levels whose cap is 0 or full speed; for the levels between them (found at
+ * init: one on the TekBot's profile, six on the Pioneer's) a binary search over ranges, a
+ * square root and two divisions, about 2 000 cycles on the ATmega128. */
 qnav_q1_15_t qnav_clearance_speed_cap(const qnav_clearance_t *c, uint8_t level);
 
 /* The speed guard while turning to path (0..359): the robot still moves along its present
@@ -40,7 +42,8 @@ qnav_q1_15_t qnav_clearance_turn_cap(const qnav_clearance_t *c, const uint8_t *l
  */
 uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint8_t *lvl);
 
-/* Level of a range already known to be at most max_range_mm. */
+/* The distance level of a range, mm (docs/qformats.md; at or beyond max_range_mm:
+ * QNAV_DIST_LEVELS - 1). */
 uint8_t qnav_clearance_level_of(const qnav_clearance_t *c, qnav_mm_t range_mm);
 
 #endif /* QNAV_CLEARANCE_H */

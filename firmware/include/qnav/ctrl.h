@@ -202,13 +202,17 @@ typedef struct {
 typedef struct {
     uint16_t n_sectors;
     qnav_mm_t max_range_mm;
-    uint32_t level_scale;             /* distance level = (range * scale + 2^15) >> 16 */
+    uint16_t level_scale;             /* distance level = (range * S + 2^15) >> 16, S =
+                                         level_scale + 2^16 level_scale_hi */
     uint16_t sector_paths;            /* 360 / N: paths in a sector, or one more */
-    uint16_t sector_span;             /* sector_paths * N */
-    uint16_t first_sector_paths;      /* paths 0.. that lie in sector 0: ceil(180 / N) */
+    uint16_t sector_rem;              /* 360 - sector_paths * N */
     uint8_t enlarge_deg[QNAV_DIST_LEVELS];      /* obstacle enlargement gamma by level, deg */
+    uint8_t first_sector_paths;       /* paths 0.. that lie in sector 0: ceil(180 / N) */
     uint8_t wedge_shrink;             /* paths a reading leaves free at each sector edge */
     uint8_t wedge_near_level;         /* readings below this level block their whole wedge */
+    uint8_t level_scale_hi;           /* 0 unless max_range_mm < QNAV_DIST_LEVELS */
+    uint8_t guard_from_level;         /* speed guard: levels below cap the speed at 0 */
+    uint8_t guard_full_level;         /* speed guard: levels from here on leave it uncapped */
     uint8_t esc_stall_ticks;          /* escape: ticks without progress; 0: off */
     uint8_t esc_free_level;           /* escape: lowest level of a free path */
     uint16_t esc_follow_ticks;        /* escape: first follow's length, ticks */

@@ -1,0 +1,206 @@
+/*
+ * Body-aware clearance (firmware/src/clearance.[ch]) against the computations the step made
+ * before they were made faster. The references below are clearance.c's own code as it
+ * stood at c6f786c, kept here so that the faster forms are checked to give the same values,
+ * not merely close ones. Built for 32, 64, 2 and 23 distance levels (tests/firmware).
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "clearance.h"
+#include "qnav/ctrl.h"
+
+/* ---- reference: the range-to-level mapping of c6f786c ----------------------------------- */
+
+/* The scale qnav_clearance_setup kept. */
+static uint32_t ref_scale(qnav_mm_t max_range_mm)
+{
+    return ((uint32_t)(QNAV_DIST_LEVELS - 1) * 65536u + max_range_mm / 2u) / max_range_mm;
+}
+
+/* level_of() of a range that its callers had clipped to the maximum range. */
+static uint8_t ref_level(qnav_mm_t max_range_mm, uint32_t range_mm)
+{
+    qnav_mm_t r = (qnav_mm_t)(range_mm < max_range_mm ? range_mm : max_range_mm);
+    uint32_t level = ((uint32_t)r * ref_scale(max_range_mm) + 32768u) >> 16;
+    return (uint8_t)(level > QNAV_DIST_LEVELS - 1u ? QNAV_DIST_LEVELS - 1u : level);
+}
+
+/* ---- reference: the speed guard's cap of c6f786c, computed for every step -------------- */
+
+#define REF_GUARD_REACTION_MS 100u
+
+/* level_floor_mm(): the smallest range at level or above, by a binary search. */
+static uint32_t ref_floor(qnav_mm_t max_range_mm, uint8_t level)
+{
+    uint32_t lo = 0;
+    uint32_t hi = max_range_mm;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2u;
+        if (ref_level(max_range_mm, mid) >= level) {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    return lo;
+}
+
+static uint32_t ref_isqrt32(uint32_t x)
+{
+    uint32_t r = 0;
+    uint32_t bit = (uint32_t)1 << 30;
+    while (bit > x) {
+        bit >>= 2;
+    }
+    while (bit != 0u) {
+        if (x >= r + bit) {
+            x -= r + bit;
+            r = (r >> 1) + bit;
+        } else {
+            r >>= 1;
+        }
+        bit >>= 2;
+    }
+    return r;
+}
+
+static qnav_q1_15_t ref_stop_speed(uint32_t s_mm, uint32_t v_max_mm_s, uint32_t decel_mm_s2)
+{
+    uint32_t at = decel_mm_s2 * REF_GUARD_REACTION_MS / 1000u;
+    uint32_t at2 = at * at;
+    uint32_t v;
+    if (s_mm > (0xFFFFFFFFu - at2) / (2u * decel_mm_s2)) {
+        return QNAV_Q1_15_MAX;
+    }
+    v = ref_isqrt32(at2 + 2u * decel_mm_s2 * s_mm) - at;
+    if (v >= v_max_mm_s) {
+        return QNAV_Q1_15_MAX;
+    }
+    return (qnav_q1_15_t)((v * 32768u) / v_max_mm_s);
+}
+
+/* qnav_clearance_speed_cap() with qnav_clearance_init()'s fields spelt out from cfg. */
+static qnav_q1_15_t ref_speed_cap(const qnav_ctrl_config_t *cfg, uint8_t level)
+{
+    uint32_t margin = (uint32_t)cfg->body_radius_mm + cfg->safety_mm;
+    uint32_t d;
+    margin = margin > 65535u ? 65535u : margin;
+    if (cfg->v_max_mm_s == 0u || cfg->decel_mm_s2 == 0u || level >= QNAV_DIST_LEVELS - 1u) {
+        return QNAV_Q1_15_MAX;
+    }
+    d = ref_floor(cfg->max_range_mm, level) + cfg->sensor_offset_mm;
+    d = d > 65535u ? 65535u : d;
+    return ref_stop_speed(d > margin ? d - margin : 0u, cfg->v_max_mm_s, cfg->decel_mm_s2);
+}
+
+/* ---- tests ------------------------------------------------------------------------------ */
+
+static void setup_range(qnav_clearance_t *c, qnav_mm_t max_range_mm)
+{
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_config_default(&cfg);
+    cfg.max_range_mm = max_range_mm;
+    assert_int_equal(qnav_clearance_setup(c, &cfg), QNAV_OK);
+}
+
+/* Besides every maximum range 1..300 mm (those below L mm have a scale beyond 16 bits):
+ * powers of two and their neighbours, the robots' sonars, the largest. */
+static const qnav_mm_t more_ranges_mm[] = {
+    1000, 1023, 1024, 1025, 2047, 2048, 2500, 3000, 4095, 5000, 8000, 12345, 16384,
+    32767, 32768, 40000, 65534, 65535,
+};
+
+static void check_every_range(qnav_mm_t max_mm)
+{
+    qnav_clearance_t c;
+    setup_range(&c, max_mm);
+    for (uint32_t r = 0; r <= 65535u; ++r) {
+        uint8_t got = qnav_clearance_level_of(&c, (qnav_mm_t)r);
+        uint8_t want = ref_level(max_mm, r);
+        if (got != want) {
+            fail_msg("max_range_mm %u, range %u: level %u, formula %u", (unsigned)max_mm,
+                     (unsigned)r, (unsigned)got, (unsigned)want);
+        }
+    }
+}
+
+/* The level depends on the configuration through max_range_mm only. */
+static void test_level_of_equals_the_formula_for_every_range(void **state)
+{
+    (void)state;
+    for (uint32_t m = 1; m <= 300u; ++m) {
+        check_every_range((qnav_mm_t)m);
+    }
+    for (size_t i = 0; i < sizeof more_ranges_mm / sizeof more_ranges_mm[0]; ++i) {
+        check_every_range(more_ranges_mm[i]);
+    }
+}
+
+/* Configurations around every branch of the cap: no guard (v_max or decel 0), caps of 0,
+ * of full speed, of 2 a s beyond 32 bits (decel 65535 at long range), and from one level
+ * between 0 and full speed (the TekBot) to all of them (braking at 1 mm/s^2). */
+static const qnav_mm_t guard_ranges_mm[] = {1, 5, 31, 32, 100, 2500, 5000, 65535};
+static const qnav_mm_t guard_offsets_mm[] = {0, 120, 65535};
+static const qnav_mm_t guard_radii_mm[][2] = {{0, 0}, {120, 50}, {260, 50}, {65535, 65535}};
+static const uint16_t guard_v_max_mm_s[] = {0, 1, 500, 1000, 65535};
+static const uint16_t guard_decel_mm_s2[] = {0, 1, 9, 100, 600, 2000, 65535};
+
+#define COUNT(a) (sizeof(a) / sizeof((a)[0]))
+
+static void check_caps(const qnav_ctrl_config_t *cfg, unsigned *between)
+{
+    qnav_clearance_t c;
+    assert_int_equal(qnav_clearance_setup(&c, cfg), QNAV_OK);
+    for (uint8_t level = 0; level < QNAV_DIST_LEVELS; ++level) {
+        qnav_q1_15_t want = ref_speed_cap(cfg, level);
+        qnav_q1_15_t got = qnav_clearance_speed_cap(&c, level);
+        if (got != want) {
+            fail_msg("range %u offset %u radius %u safety %u v_max %u decel %u level %u: cap "
+                     "%d, computed %d", (unsigned)cfg->max_range_mm,
+                     (unsigned)cfg->sensor_offset_mm, (unsigned)cfg->body_radius_mm,
+                     (unsigned)cfg->safety_mm, (unsigned)cfg->v_max_mm_s,
+                     (unsigned)cfg->decel_mm_s2, (unsigned)level, got, want);
+        }
+        *between += (unsigned)(want > 0 && want < QNAV_Q1_15_MAX);
+    }
+}
+
+static void test_speed_cap_equals_the_computation_for_every_level(void **state)
+{
+    (void)state;
+    unsigned between = 0;
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_config_default(&cfg);
+    for (size_t i = 0; i < COUNT(guard_ranges_mm); ++i) {
+        for (size_t j = 0; j < COUNT(guard_offsets_mm); ++j) {
+            for (size_t k = 0; k < COUNT(guard_radii_mm); ++k) {
+                for (size_t v = 0; v < COUNT(guard_v_max_mm_s); ++v) {
+                    for (size_t a = 0; a < COUNT(guard_decel_mm_s2); ++a) {
+                        cfg.max_range_mm = guard_ranges_mm[i];
+                        cfg.sensor_offset_mm = guard_offsets_mm[j];
+                        cfg.body_radius_mm = guard_radii_mm[k][0];
+                        cfg.safety_mm = guard_radii_mm[k][1];
+                        cfg.v_max_mm_s = guard_v_max_mm_s[v];
+                        cfg.decel_mm_s2 = guard_decel_mm_s2[a];
+                        check_caps(&cfg, &between);
+                    }
+                }
+            }
+        }
+    }
+    /* the levels that still compute their cap were reached too */
+    assert_true(between > 100u);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_level_of_equals_the_formula_for_every_range),
+        cmocka_unit_test(test_speed_cap_equals_the_computation_for_every_level),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
