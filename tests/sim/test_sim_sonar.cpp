@@ -242,14 +242,22 @@ static void test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment(
 
 // Generated worlds of every family that the broad phase serves (at least kBroadPhaseMin
 // shapes), for both robots: 54 to 309 shapes, arenas of 7 to 20 m.
-static std::vector<std::pair<std::string, double>> broad_phase_worlds() {
+struct BroadPhaseWorld {
+    std::string spec;
+    double reach_m;  // range_max + offset of the profile
+    qnav::Environment env;
+    std::vector<qnav::Shape> shapes;
+};
+static std::vector<BroadPhaseWorld> broad_phase_worlds() {
     const char *specs[] = {"gen:clutter:4:1:tekbot", "gen:clutter:5:1:pioneer3dx", "gen:clutter:9:0.6:pioneer3dx",
                            "gen:clutter:7:0.5:tekbot", "gen:rooms:3:1:pioneer3dx", "gen:rooms:5:1:tekbot",
                            "gen:corridor:7:1:tekbot", "gen:pocket:7:1:tekbot", "gen:pocket:4:1:pioneer3dx"};
-    std::vector<std::pair<std::string, double>> out;
+    std::vector<BroadPhaseWorld> out;
     for (const char *spec : specs) {
-        const bool pioneer = std::strstr(spec, "pioneer3dx") != nullptr;
-        out.push_back({spec, pioneer ? 5.26 : 2.62});  // range_max + offset of the profile
+        BroadPhaseWorld w{spec, std::strstr(spec, "pioneer3dx") ? 5.26 : 2.62, qnav::load_world(spec), {}};
+        w.shapes = w.env.obstacle_shapes();
+        assert_true(w.shapes.size() >= qnav::SonarRing::kBroadPhaseMin);  // the broad phase runs
+        out.push_back(std::move(w));
     }
     return out;
 }
@@ -270,22 +278,21 @@ static void test_broad_phase_reads_bit_identical_to_testing_every_shape(void **s
     qnav::SimRng rng;
     rng.seed(19, 5, 0);
     long compared = 0, hits = 0;
-    for (const auto &[spec, reach] : broad_phase_worlds()) {
-        const qnav::Environment e = qnav::load_world(spec);
-        const std::vector<qnav::Shape> shapes = e.obstacle_shapes();
-        assert_true(shapes.size() >= qnav::SonarRing::kBroadPhaseMin);  // the broad phase runs
+    for (const BroadPhaseWorld &w : broad_phase_worlds()) {
+        const qnav::Environment &e = w.env;
+        const double reach = w.reach_m;
         for (const auto &[n, poses] : sectors) {
-            qnav::SonarRing ring(shapes, e.width_m, e.height_m, static_cast<uint16_t>(n), reach);
+            qnav::SonarRing ring(w.shapes, e.width_m, e.height_m, static_cast<uint16_t>(n), reach);
             std::vector<double> fast(n), again(n), plain(n);
             for (int trial = 0; trial < poses; ++trial) {
-                const qnav::Vec2 p = random_pose(rng, e, shapes);
+                const qnav::Vec2 p = random_pose(rng, e, w.shapes);
                 const double h = rng.uniform(-3 * kPiD, 3 * kPiD);
                 ring.measure(p, h, fast.data());   // the cell's list made here...
                 ring.measure(p, h, again.data());  // ...and kept
                 ring.measure_plain(p, h, plain.data());
                 if (std::memcmp(fast.data(), plain.data(), n * sizeof(double)) != 0 ||
                     std::memcmp(again.data(), plain.data(), n * sizeof(double)) != 0)
-                    fail_msg("%s, %u sectors, pose (%.17g, %.17g, %.17g): broad phase differs", spec.c_str(), n, p.x, p.y, h);
+                    fail_msg("%s, %u sectors, pose (%.17g, %.17g, %.17g): broad phase differs", w.spec.c_str(), n, p.x, p.y, h);
                 for (unsigned k = 0; k < n; ++k) hits += plain[k] < reach;
                 compared += n;
             }
@@ -302,13 +309,13 @@ static void test_shapes_near_include_every_shape_within_the_distance(void **stat
     qnav::SimRng rng;
     rng.seed(19, 5, 1);
     long listed = 0, needed = 0;
-    for (const auto &[spec, reach] : broad_phase_worlds()) {
-        const qnav::Environment e = qnav::load_world(spec);
-        const std::vector<qnav::Shape> shapes = e.obstacle_shapes();
-        qnav::SonarRing ring(shapes, e.width_m, e.height_m, 16, reach);
+    for (const BroadPhaseWorld &w : broad_phase_worlds()) {
+        const std::vector<qnav::Shape> &shapes = w.shapes;
+        const double reach = w.reach_m;
+        qnav::SonarRing ring(shapes, w.env.width_m, w.env.height_m, 16, reach);
         std::vector<char> seen(shapes.size());
         for (int trial = 0; trial < 400; ++trial) {
-            const qnav::Vec2 p = random_pose(rng, e, shapes);
+            const qnav::Vec2 p = random_pose(rng, w.env, shapes);
             const double d = trial % 3 == 0 ? reach : rng.uniform(0.0, 1.2);
             std::fill(seen.begin(), seen.end(), 0);
             ring.for_shapes_near(p, d, [&](std::uint32_t k) {
@@ -320,7 +327,7 @@ static void test_shapes_near_include_every_shape_within_the_distance(void **stat
                 const double bound = shapes[k].r + d;
                 if (qnav::dot(dc, dc) > bound * bound) continue;
                 ++needed;
-                if (!seen[k]) fail_msg("%s: shape %zu within %.3f m of (%.17g, %.17g) not listed", spec.c_str(), k, d, p.x, p.y);
+                if (!seen[k]) fail_msg("%s: shape %zu within %.3f m of (%.17g, %.17g) not listed", w.spec.c_str(), k, d, p.x, p.y);
             }
         }
     }
