@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <deque>
 #include <sstream>
 
 #include "error.hpp"
@@ -147,7 +146,7 @@ Environment parse_environment(std::string_view text, const std::string &name) {
     return env;
 }
 
-void check_clearance(const Environment &env, double clearance_m) {
+void check_zone_clearance(const Environment &env, double clearance_m) {
     const std::vector<Shape> obs = env.obstacle_shapes();
     const std::vector<Shape> walls = env.wall_shapes();
     for (std::size_t z = 0; z < env.start_zones.size(); ++z) {
@@ -163,6 +162,11 @@ void check_clearance(const Environment &env, double clearance_m) {
         for (const Shape &s : walls)
             if (shape_distance(zs, s) < clearance_m) refuse("an arena wall");
     }
+}
+
+void check_clearance(const Environment &env, double clearance_m) {
+    if (clearance_m == env.clearance_checked_m) return;
+    check_zone_clearance(env, clearance_m);
     const int walled = first_walled_in_zone(env, clearance_m);
     if (walled >= 0) {
         char buf[64];
@@ -176,6 +180,63 @@ void check_clearance(const Environment &env, double clearance_m) {
 
 bool environment_connected(const Environment &env, double clearance_m, double cell_m) {
     return first_walled_in_zone(env, clearance_m, cell_m) < 0;
+}
+
+std::vector<int> zone_steps(const Environment &env, const std::vector<char> &free, int nx, int ny,
+                            double cell_m, bool from_goal_cell) {
+    // The grid framed by a border of blocked cells (no bounds to test while flooding);
+    // each cell holds its step count once reached, else what it is.
+    constexpr int kBlocked = -2, kFree = -1, kZone = -3;  // kZone: free and a zone's cell
+    const std::size_t w = cell_index(nx + 2);
+    auto at = [&](int i, int j) { return cell_index(j + 1) * w + cell_index(i + 1); };  // i, j >= 0
+    std::vector<int> steps(w * cell_index(ny + 2), kBlocked);
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i)
+            if (free[cell_index(j) * cell_index(nx) + cell_index(i)]) steps[at(i, j)] = kFree;
+    auto cell = [&](double x, double y) {
+        return at(std::clamp(static_cast<int>(x / cell_m), 0, nx - 1), std::clamp(static_cast<int>(y / cell_m), 0, ny - 1));
+    };
+    std::vector<std::size_t> zones;
+    int unreached = 0;  // zone cells not reached yet
+    for (const StartZone &z : env.start_zones) {
+        zones.push_back(cell(z.x_m + z.w_m / 2, z.y_m + z.h_m / 2));
+        if (steps[zones.back()] == kFree) {
+            steps[zones.back()] = kZone;
+            ++unreached;
+        }
+    }
+    std::vector<std::size_t> queue;  // breadth first: every cell once, in the order reached
+    queue.reserve(steps.size());
+    auto reach = [&](std::size_t k, int count) {
+        unreached -= steps[k] == kZone;
+        steps[k] = count;
+        queue.push_back(k);
+    };
+    auto open = [&](std::size_t k) { return steps[k] == kFree || steps[k] == kZone; };
+    // Sources: the free cells whose centre lies in the destination disc (only the cells
+    // of its bounding square, one more on each side, can).
+    const double r2 = env.dest_radius_m * env.dest_radius_m, around = env.dest_radius_m + cell_m;
+    const int i0 = std::max(0, static_cast<int>(std::floor((env.dest_x_m - around) / cell_m)));
+    const int i1 = std::min(nx - 1, static_cast<int>(std::floor((env.dest_x_m + around) / cell_m)));
+    const int j0 = std::max(0, static_cast<int>(std::floor((env.dest_y_m - around) / cell_m)));
+    const int j1 = std::min(ny - 1, static_cast<int>(std::floor((env.dest_y_m + around) / cell_m)));
+    for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) {
+            const double dx = (i + 0.5) * cell_m - env.dest_x_m, dy = (j + 0.5) * cell_m - env.dest_y_m;
+            if (open(at(i, j)) && dx * dx + dy * dy <= r2) reach(at(i, j), 0);
+        }
+    const std::size_t goal = cell(env.dest_x_m, env.dest_y_m);
+    if (queue.empty() && from_goal_cell && steps[goal] != kBlocked) reach(goal, 0);
+    // A cell's count is final when it is first reached: the flood stops once every
+    // zone's cell is. The border keeps k - 1 and k - w inside the grid.
+    for (std::size_t head = 0; head < queue.size() && unreached > 0; ++head) {
+        const std::size_t k = queue[head];
+        for (const std::size_t m : {k + 1, k - 1, k + w, k - w})
+            if (open(m)) reach(m, steps[k] + 1);
+    }
+    std::vector<int> out;
+    for (const std::size_t z : zones) out.push_back(steps[z] >= 0 ? steps[z] : -1);
+    return out;
 }
 
 int first_walled_in_zone(const Environment &env, double clearance_m, double cell_m) {
@@ -206,47 +267,9 @@ int first_walled_in_zone(const Environment &env, double clearance_m, double cell
                 if (f && nearest_point(s, {(i + 0.5) * cell_m, (j + 0.5) * cell_m}, &q) < clearance_m) f = 0;
             }
     }
-    auto cell = [&](double x, double y) {
-        const int i = std::clamp(static_cast<int>(x / cell_m), 0, nx - 1);
-        const int j = std::clamp(static_cast<int>(y / cell_m), 0, ny - 1);
-        return j * nx + i;
-    };
-    const int goal = cell(env.dest_x_m, env.dest_y_m);
-    // Flood from the destination's free neighbourhood (within its radius).
-    std::vector<char> seen(free.size(), 0);
-    std::deque<int> q;
-    for (int j = 0; j < ny; ++j)
-        for (int i = 0; i < nx; ++i) {
-            const double dx = (i + 0.5) * cell_m - env.dest_x_m, dy = (j + 0.5) * cell_m - env.dest_y_m;
-            const int k = j * nx + i;
-            if (free[cell_index(k)] && dx * dx + dy * dy <= env.dest_radius_m * env.dest_radius_m) {
-                seen[cell_index(k)] = 1;
-                q.push_back(k);
-            }
-        }
-    if (q.empty() && free[cell_index(goal)]) {
-        seen[cell_index(goal)] = 1;
-        q.push_back(goal);
-    }
-    while (!q.empty()) {
-        const int k = q.front();
-        q.pop_front();
-        const int i = k % nx, j = k / nx;
-        const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
-        for (int d = 0; d < 4; ++d) {
-            const int a = i + di[d], b = j + dj[d];
-            if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
-            const int m = b * nx + a;
-            if (free[cell_index(m)] && !seen[cell_index(m)]) {
-                seen[cell_index(m)] = 1;
-                q.push_back(m);
-            }
-        }
-    }
-    for (std::size_t z = 0; z < env.start_zones.size(); ++z) {
-        const StartZone &sz = env.start_zones[z];
-        if (!seen[cell_index(cell(sz.x_m + sz.w_m / 2, sz.y_m + sz.h_m / 2))]) return static_cast<int>(z);
-    }
+    const std::vector<int> steps = zone_steps(env, free, nx, ny, cell_m, true);
+    for (std::size_t z = 0; z < steps.size(); ++z)
+        if (steps[z] < 0) return static_cast<int>(z);
     return -1;
 }
 

@@ -33,6 +33,10 @@ struct Environment {
     std::vector<CircleObstacle> circles;
     std::vector<BoxObstacle> boxes;
     std::vector<int> zone_lines;  // source line of each start zone (for later messages)
+    // The robot radius (m) that check_clearance is known to pass for, or -1: the world
+    // generator checked it (clearance and a wider path than the walled-in check needs), so
+    // a context made for the same robot does not check again. Set only by generate_world.
+    double clearance_checked_m = -1;
 
     // Obstacles as shapes: circles first, then boxes (not the walls).
     std::vector<Shape> obstacle_shapes() const;
@@ -47,8 +51,11 @@ Environment parse_environment(std::string_view text, const std::string &name);
 
 // Check that every start zone keeps clearance_m (a robot's radius) from obstacles and
 // walls and that a robot of that radius can drive from it to the destination (not walled
-// in); throws SimError(QNAV_SIM_E_WORLD, "NAME:LINE: ...") otherwise.
+// in); throws SimError(QNAV_SIM_E_WORLD, "NAME:LINE: ...") otherwise. Returns at once
+// when clearance_m is env.clearance_checked_m.
 void check_clearance(const Environment &env, double clearance_m);
+// Its first half: every start zone keeps clearance_m from obstacles and walls.
+void check_zone_clearance(const Environment &env, double clearance_m);
 
 // A random dense environment: 10 m x 10 m arena, start zones along the bottom, the
 // destination at the top, obstacles covering about `density` (0..0.5) of the middle band,
@@ -65,5 +72,12 @@ bool environment_connected(const Environment &env, double clearance_m, double ce
 // The index of the first start zone that such a disc cannot leave for the destination,
 // or -1 when every zone is connected.
 int first_walled_in_zone(const Environment &env, double clearance_m, double cell_m = 0.1);
+
+// Steps between 4-neighbouring free cells (free[j * nx + i] != 0, cells cell_m wide from
+// the origin) from the free cells whose centre lies in the destination disc (or, when
+// there is none and from_goal_cell, from the destination's cell if free) to the centre
+// cell of each start zone: one count per zone, -1 where no path leads.
+std::vector<int> zone_steps(const Environment &env, const std::vector<char> &free, int nx, int ny,
+                            double cell_m, bool from_goal_cell);
 
 }  // namespace qnav

@@ -177,6 +177,37 @@ bool angular_span(const Shape &s, Vec2 p, double *lo, double *hi) {
     return true;
 }
 
+bool angular_span_from_nearest(const Shape &s, Vec2 p, Vec2 dq, double aq, double *lo, double *hi) {
+    if (s.kind == Shape::kCircle) {
+        // The nearest point lies straight towards the centre.
+        const Vec2 d = s.c - p;
+        const double d2 = dot(d, d), r2 = s.r * s.r;
+        if (d2 <= r2) return false;  // as angular_span
+        const double half = fast_atan2(s.r, std::sqrt(d2 - r2));
+        *lo = aq - half;
+        *hi = aq + half;
+        return true;
+    }
+    if (s.kind != Shape::kBox) {
+        double a, b;
+        if (!angular_span(s, p, &a, &b)) return false;
+        *lo = aq + wrap_pi(a - aq);  // near aq, as the other kinds give it
+        *hi = *lo + (b - a);
+        return true;
+    }
+    // The extreme vertices by cross products (seen from outside, every direction to the
+    // box lies within less than pi), then their angles from dq, which lies between them.
+    Vec2 dlo = s.v[0] - p, dhi = dlo;
+    for (int i = 1; i < s.n; ++i) {
+        const Vec2 d = s.v[i] - p;
+        if (cross(d, dlo) > 0) dlo = d;
+        if (cross(dhi, d) > 0) dhi = d;
+    }
+    *lo = aq + fast_atan2(cross(dq, dlo), dot(dq, dlo));
+    *hi = aq + fast_atan2(cross(dq, dhi), dot(dq, dhi));
+    return true;
+}
+
 double shape_distance(const Shape &a, const Shape &b) {
     // (Boxes take the polygon path here through their vertices.)
     if (a.kind == Shape::kCircle && b.kind == Shape::kCircle)

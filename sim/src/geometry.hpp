@@ -37,6 +37,13 @@ inline double wrap_pi(double a) {
     return a;
 }
 
+// floor(x) for |x| < 2^63, as std::floor, without a call into libm (x86-64 without
+// SSE4.1 has no rounding instruction).
+inline long floor_long(double x) {
+    const long k = static_cast<long>(x);
+    return k - (static_cast<double>(k) > x);
+}
+
 // atan2 to within 1e-5 rad (Abramowitz & Stegun 4.4.49 polynomial after reduction to
 // [-1, 1]); used where the sonar only needs to know which sectors an angle falls in.
 inline double fast_atan2(double y, double x) {
@@ -78,6 +85,11 @@ double ray_hit(const Shape &s, Vec2 p, Vec2 u);
 // Computed with fast_atan2 and widened by 1e-4 rad on each side (a superset is harmless:
 // callers only use it to decide which rays to test).
 bool angular_span(const Shape &s, Vec2 p, double *lo, double *hi);
+// The same extent, cheaper, for p outside the shape, from the direction dq of p's nearest
+// point of the shape and its angle aq = fast_atan2(dq.y, dq.x): [lo, hi] (rad, not
+// wrapped, not widened) within 3e-5 rad of the true extent. False where angular_span is
+// false for a circle or a segment.
+bool angular_span_from_nearest(const Shape &s, Vec2 p, Vec2 dq, double aq, double *lo, double *hi);
 // Smallest distance between two shapes (0 when they touch or overlap).
 double shape_distance(const Shape &a, const Shape &b);
 

@@ -279,17 +279,24 @@ bool Simulation::touching(Vec2 *contact) {
             best_q = feet[w];
         }
     }
-    for (const Shape &s : sonar_.shapes()) {
+    // Only the shapes near the robot (the sonar's broad phase), in any order: on a tie the
+    // lowest-numbered shape gives the contact point, as a scan of every shape in order
+    // would (and a wall before any shape).
+    const std::vector<Shape> &shapes = sonar_.shapes();
+    std::uint32_t best_k = UINT32_MAX;  // shape that gave best; UINT32_MAX: a wall
+    sonar_.for_shapes_near(pos_, far, [&](std::uint32_t k) {
+        const Shape &s = shapes[k];
         const Vec2 dc = s.c - pos_;
         const double bound = s.r + far;
-        if (dot(dc, dc) > bound * bound) continue;
+        if (dot(dc, dc) > bound * bound) return;
         Vec2 q;
         const double d = nearest_point(s, pos_, &q);
-        if (d < best) {
+        if (d < best || (d == best && best_k != UINT32_MAX && k < best_k)) {
             best = d;
             best_q = q;
+            best_k = k;
         }
-    }
+    });
     clearance_m_ = std::min(best, far);
     if (best <= lim) {
         *contact = best_q;

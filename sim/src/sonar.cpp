@@ -14,6 +14,7 @@ SonarRing::SonarRing(std::vector<Shape> shapes, double width_m, double height_m,
       height_m_(height_m),
       n_(n_sectors),
       width_(2.0 * kPi / n_sectors),
+      inv_width_(n_sectors / (2.0 * kPi)),
       reach_(reach_m) {
     boundary_.resize(n_);
     for (std::uint16_t j = 0; j < n_; ++j) {
@@ -32,43 +33,51 @@ SonarRing::SonarRing(std::vector<Shape> shapes, double width_m, double height_m,
     }
 }
 
-void SonarRing::cell_range(Vec2 c, double half, int *i0, int *i1, int *j0, int *j1) const {
-    auto idx = [&](double v, int n) {
-        const double k = std::floor(v / cell_m_);
-        return k < 0 ? 0 : k >= n ? n - 1 : static_cast<int>(k);
-    };
-    *i0 = idx(c.x - half, nx_);
-    *i1 = idx(c.x + half, nx_);
-    *j0 = idx(c.y - half, ny_);
-    *j1 = idx(c.y + half, ny_);
+void SonarRing::build_grid() {
+    cell_m_ = std::max(kCell_m, std::max(width_m_, height_m_) / kMaxCells);
+    nx_ = std::max(1, static_cast<int>(std::ceil(width_m_ / cell_m_)));
+    ny_ = std::max(1, static_cast<int>(std::ceil(height_m_ / cell_m_)));
+    first_.assign(cell_index(nx_) * cell_index(ny_), -1);
+    count_.assign(first_.size(), 0);
 }
 
-void SonarRing::build_grid() {
-    // Cells of half the reach. A shape no wider than a cell (bounding radius <= cell) is
-    // binned by its centre: it can matter only when its centre is within reach + cell of
-    // the robot, so a scan visits the cells under that square (at most 7 x 7). Wider
-    // shapes (long walls) are few and tested every scan.
-    cell_m_ = std::isfinite(reach_) && reach_ > 0 ? std::max(0.25, reach_ / 2) : 1e9;
-    nx_ = std::max(1, std::min(4096, static_cast<int>(std::ceil(width_m_ / cell_m_))));
-    ny_ = std::max(1, std::min(4096, static_cast<int>(std::ceil(height_m_ / cell_m_))));
-    std::vector<std::uint32_t> count(cell_index(nx_ * ny_) + 1, 0);
-    std::vector<std::uint32_t> cell_of(shapes_.size());
-    large_.clear();
+// Every shape whose bounding circle comes within reach of cell (i, j) grown by kSlack_m,
+// nearest first: a superset of the shapes that pass measure_plain's bounding test from
+// any position in the cell. Seen from a point p within rho of the cell's centre o, a
+// circle B(c, r) spans no more directions than B(c, r + rho) seen from o (the directions
+// from p to B(c, r) are those from o to B(c - (p - o), r), inside B(c, r + rho)).
+void SonarRing::build_cell(std::size_t cell, int i, int j) const {
+    const double x0 = i * cell_m_ - kSlack_m, x1 = (i + 1) * cell_m_ + kSlack_m;
+    const double y0 = j * cell_m_ - kSlack_m, y1 = (j + 1) * cell_m_ + kSlack_m;
+    const Vec2 o{0.5 * (x0 + x1), 0.5 * (y0 + y1)};
+    const double rho = 0.5 * std::hypot(x1 - x0, y1 - y0) + kSlack_m;
+    const std::size_t begin = candidates_.size();
     for (std::uint32_t k = 0; k < shapes_.size(); ++k) {
-        if (!(shapes_[k].r <= cell_m_)) {
-            large_.push_back(k);
-            continue;
-        }
-        int i0, i1, j0, j1;
-        cell_range(shapes_[k].c, 0.0, &i0, &i1, &j0, &j1);
-        cell_of[k] = static_cast<std::uint32_t>(j0 * nx_ + i0);
-        ++count[cell_of[k] + 1];
+        const Shape &s = shapes_[k];
+        const double dx = std::max({x0 - s.c.x, s.c.x - x1, 0.0});
+        const double dy = std::max({y0 - s.c.y, s.c.y - y1, 0.0});
+        const double lower = std::sqrt(dx * dx + dy * dy) - s.r;
+        if (!(lower <= reach_ + kSlack_m)) continue;
+        const Vec2 d = s.c - o;
+        const double dist = norm(d);
+        const double half = dist > s.r + rho ? std::asin((s.r + rho) / dist) * inv_width_ : static_cast<double>(n_);
+        candidates_.push_back({lower, s.c, s.r, std::atan2(d.y, d.x) * inv_width_, half, k});
     }
-    for (std::size_t c = 1; c < count.size(); ++c) count[c] += count[c - 1];
-    cell_start_ = count;
-    cell_shapes_.resize(count.back());
-    for (std::uint32_t k = 0; k < shapes_.size(); ++k)
-        if (shapes_[k].r <= cell_m_) cell_shapes_[count[cell_of[k]]++] = k;
+    std::sort(candidates_.begin() + static_cast<std::ptrdiff_t>(begin), candidates_.end(),
+              [](const Candidate &a, const Candidate &b) { return a.lower < b.lower || (a.lower == b.lower && a.k < b.k); });
+    first_[cell] = static_cast<std::int32_t>(begin);
+    count_[cell] = static_cast<std::uint32_t>(candidates_.size() - begin);
+}
+
+bool SonarRing::candidates_at(Vec2 pos, const Candidate **begin, const Candidate **end) const {
+    const double fx = pos.x / cell_m_, fy = pos.y / cell_m_;
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < nx_ && fy < ny_)) return false;  // NaN too
+    const int i = static_cast<int>(fx), j = static_cast<int>(fy);
+    const std::size_t cell = cell_index(j) * cell_index(nx_) + cell_index(i);
+    if (first_[cell] < 0) build_cell(cell, i, j);
+    *begin = candidates_.data() + first_[cell];
+    *end = *begin + count_[cell];
+    return true;
 }
 
 template <typename F>
@@ -137,13 +146,6 @@ void SonarRing::measure_wide(Vec2 pos, double heading, double *dist) const {
     }
 }
 
-std::uint16_t SonarRing::sector_of(double a) const {
-    long k = static_cast<long>(std::floor((a + 0.5 * width_) / width_));
-    // a is a difference of two wrapped angles, so k is within a few turns of 0..n-1.
-    while (k < 0) k += n_;
-    while (k >= static_cast<long>(n_)) k -= n_;
-    return static_cast<std::uint16_t>(k);
-}
 
 // The arena walls' readings (every sector starts from them).
 void SonarRing::measure_walls(Vec2 pos, double heading, double *dist) const {
@@ -173,84 +175,100 @@ void SonarRing::measure(Vec2 pos, double heading, double *dist) const {
         measure_wide(pos, heading, dist);
         return;
     }
-    if (shapes_.size() < kBroadPhaseMin) {
+    const Candidate *c, *end;
+    if (shapes_.size() < kBroadPhaseMin || !candidates_at(pos, &c, &end)) {
         measure_plain(pos, heading, dist);
         return;
     }
     measure_walls(pos, heading, dist);
     const double ch = std::cos(heading), sh = std::sin(heading);
-    // Broad phase: the shapes whose bounding circle comes within reach, nearest first.
-    near_.clear();
-    auto consider = [&](std::uint32_t k) {
-        const Shape &s = shapes_[k];
-        const Vec2 dc = s.c - pos;
-        const double bound = s.r + reach_;
-        const double d2 = dot(dc, dc);
-        if (d2 <= bound * bound) near_.push_back({std::max(0.0, std::sqrt(d2) - s.r), k});
-    };
-    int gi0, gi1, gj0, gj1;
-    cell_range(pos, reach_ + cell_m_, &gi0, &gi1, &gj0, &gj1);
-    for (int j = gj0; j <= gj1; ++j) {
-        const int row = j * nx_;
-        for (std::uint32_t e = cell_start_[cell_index(row + gi0)]; e < cell_start_[cell_index(row + gi1 + 1)]; ++e)
-            consider(cell_shapes_[e]);
-    }
-    for (const std::uint32_t k : large_) consider(k);
-    std::sort(near_.begin(), near_.end());
-    for (const auto &[lower, k] : near_) {
-        const Shape &s = shapes_[k];
-        const Vec2 dc = s.c - pos;
-        if (lower > 0.0 && n_ > 1) {
-            // Occlusion: every value this shape can give is >= lower; skip it when every
-            // sector its bounding circle may touch already reads no more. The circle spans
-            // +-asin(r / |dc|) <= +-(pi/2) r / |dc| about its centre; one more sector of
-            // margin on each side covers fast_atan2's error and the boundary rays.
-            const double dist_c = lower + s.r;
-            const double half = 0.5 * kPi * s.r / dist_c;
-            const double a = fast_atan2(dc.y, dc.x) - heading;
-            const long k0 = static_cast<long>(std::floor((a - half) / width_ + 0.5)) - 1;
-            const long k1 = static_cast<long>(std::floor((a + half) / width_ + 0.5)) + 1;
-            bool hidden = true;
-            if (k1 - k0 + 1 >= static_cast<long>(n_)) {
-                for (std::uint16_t kk = 0; kk < n_ && hidden; ++kk) hidden = lower >= dist[kk];
-            } else {
-                long kk = k0 % static_cast<long>(n_);
-                if (kk < 0) kk += n_;
-                for (long m = k0; m <= k1 && hidden; ++m) {
-                    hidden = lower >= dist[kk];
-                    kk = kk + 1 == static_cast<long>(n_) ? 0 : kk + 1;
-                }
-            }
-            if (hidden) continue;
+    if (end - c <= kShortList) {
+        // Few shapes: testing each is cheaper than deciding which to skip.
+        for (; c != end; ++c) {
+            const Vec2 dc = c->c - pos;
+            const double bound = c->r + reach_;
+            if (dot(dc, dc) <= bound * bound) apply_shape(shapes_[c->k], pos, heading, ch, sh, dist);
         }
-        apply_shape(s, pos, heading, ch, sh, dist);
+        return;
+    }
+    // The largest reading (kept exact: rescanned when the sector that held it falls), and
+    // about the smallest (the least nearest distance applied): a shape nearer than that
+    // cannot be hidden.
+    std::uint16_t top = 0;
+    double smallest = dist[0];
+    for (std::uint16_t k = 1; k < n_; ++k) {
+        if (dist[k] > dist[top]) top = k;
+        smallest = std::min(smallest, dist[k]);
+    }
+    double largest = dist[top];
+    const double heading_sectors = heading * inv_width_;
+    for (; c != end; ++c) {
+        if (c->lower - kSlack_m >= largest) break;  // this shape and every later one
+        // measure_plain's bounding test, on the same numbers
+        const Vec2 dc = c->c - pos;
+        const double bound = c->r + reach_;
+        const double d2 = dot(dc, dc);
+        if (d2 > bound * bound) continue;
+        const double lower = std::sqrt(d2) - c->r - kSlack_m;
+        if (lower > 0.0 && lower >= smallest && hidden(*c, heading_sectors, lower, dist)) continue;
+        smallest = std::min(smallest, apply_shape(shapes_[c->k], pos, heading, ch, sh, dist));
+        if (dist[top] < largest) {
+            top = static_cast<std::uint16_t>(std::max_element(dist, dist + n_) - dist);
+            largest = dist[top];
+        }
     }
 }
 
+// Occlusion: every value a shape can give from outside its bounding circle (its nearest
+// point, its boundary-ray hits) is at least lower; it changes nothing when every sector
+// its bounding circle may touch already reads no more. One more sector of margin on each
+// side of the circle's span covers the sector of its nearest point (found with
+// fast_atan2, 1e-5 rad), the boundary rays (each touches the sectors on both sides) and
+// the rounding here.
+bool SonarRing::hidden(const Candidate &c, double heading_sectors, double lower, const double *dist) const {
+    const double a = c.mid - heading_sectors + 0.5;
+    long k = floor_long(a - c.half) - 1;
+    const long count = floor_long(a + c.half) + 1 - k + 1;
+    if (count >= static_cast<long>(n_)) {
+        for (std::uint16_t kk = 0; kk < n_; ++kk)
+            if (lower < dist[kk]) return false;
+        return true;
+    }
+    while (k < 0) k += n_;
+    while (k >= static_cast<long>(n_)) k -= n_;
+    for (long m = 0; m < count; ++m) {
+        if (lower < dist[k]) return false;
+        k = k + 1 == static_cast<long>(n_) ? 0 : k + 1;
+    }
+    return true;
+}
+
 // One shape's readings: its nearest point's sector and its hits on the sector boundaries
-// it spans (narrow cones).
-void SonarRing::apply_shape(const Shape &s, Vec2 pos, double heading, double ch, double sh, double *dist) const {
+// it spans (narrow cones). Returns its nearest distance (kInf beyond reach).
+double SonarRing::apply_shape(const Shape &s, Vec2 pos, double heading, double ch, double sh, double *dist) const {
     const Vec2 dc = s.c - pos;
     Vec2 q;
     const double dn = nearest_point(s, pos, &q);
-    if (dn > reach_) return;
+    if (dn > reach_) return kInf;
     if (dn <= 0.0) {
         // Inside or touching: the sector facing the shape reads zero.
         const double a = fast_atan2(dc.y, dc.x) - heading;
         dist[sector_of(a)] = 0.0;
-        return;
+        return 0.0;
     }
     const Vec2 dq = q - pos;
-    const std::uint16_t ks = sector_of(fast_atan2(dq.y, dq.x) - heading);
+    const double aq = fast_atan2(dq.y, dq.x);
+    const std::uint16_t ks = sector_of(aq - heading);
     if (dn < dist[ks]) dist[ks] = dn;
-    if (n_ == 1) return;
+    if (n_ == 1) return dn;
     double lo, hi;
-    if (!angular_span(s, pos, &lo, &hi)) return;
-    // Boundary j sits at (j - 0.5) * width in the robot frame.
-    const double lo_r = wrap_pi(lo - heading);
-    const double span = hi - lo;
-    const long j0 = static_cast<long>(std::ceil(lo_r / width_ + 0.5));
-    const long j1 = static_cast<long>(std::floor((lo_r + span) / width_ + 0.5));
+    if (!angular_span_from_nearest(s, pos, dq, aq, &lo, &hi)) return dn;
+    // Boundary j sits at (j - 0.5) * width in the robot frame. A ray outside the shape's
+    // extent misses it (ray_hit gives kInf), so testing boundaries up to kSpanMargin_rad
+    // beyond it changes nothing; the margin covers the errors of the extent.
+    const double lo_r = lo - heading - kSpanMargin_rad, hi_r = hi - heading + kSpanMargin_rad;
+    const long j0 = -floor_long(-(lo_r / width_ + 0.5));  // ceil
+    const long j1 = std::min(floor_long(hi_r / width_ + 0.5), j0 + n_ - 1);
     long jj = j0;
     while (jj < 0) jj += n_;
     while (jj >= static_cast<long>(n_)) jj -= n_;
@@ -263,6 +281,7 @@ void SonarRing::apply_shape(const Shape &s, Vec2 pos, double heading, double ch,
         if (t < dist[right]) dist[right] = t;
         if (t < dist[left]) dist[left] = t;
     }
+    return dn;
 }
 
 void SonarRing::measure_plain(Vec2 pos, double heading, double *dist) const {

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <deque>
 #include <functional>
 
 #include "capi_internal.hpp"
@@ -94,38 +93,12 @@ public:
     }
     // Longest BFS distance (m) from the destination disc to a zone centre; -1 if one is cut off.
     double path_m(const Environment &env) const {
-        std::vector<int> dist(blocked_.size(), -1);
-        std::deque<int> q;
-        const double r2 = env.dest_radius_m * env.dest_radius_m;
-        for (int j = 0; j < ny_; ++j)
-            for (int i = 0; i < nx_; ++i) {
-                const double dx = (i + 0.5) * cell_ - env.dest_x_m, dy = (j + 0.5) * cell_ - env.dest_y_m;
-                const int k = j * nx_ + i;
-                if (!blocked_[cell_index(k)] && dx * dx + dy * dy <= r2) {
-                    dist[cell_index(k)] = 0;
-                    q.push_back(k);
-                }
-            }
-        while (!q.empty()) {
-            const int k = q.front();
-            q.pop_front();
-            const int i = k % nx_, j = k / nx_;
-            const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
-            for (int d = 0; d < 4; ++d) {
-                const int a = i + di[d], b = j + dj[d];
-                if (a < 0 || b < 0 || a >= nx_ || b >= ny_) continue;
-                const int m = b * nx_ + a;
-                if (!blocked_[cell_index(m)] && dist[cell_index(m)] < 0) {
-                    dist[cell_index(m)] = dist[cell_index(k)] + 1;
-                    q.push_back(m);
-                }
-            }
-        }
+        std::vector<char> free(blocked_.size());
+        for (std::size_t k = 0; k < free.size(); ++k) free[k] = blocked_[k] == 0;
         int worst = 0;
-        for (const StartZone &z : env.start_zones) {
-            const int d = dist[cell_index(cell_of(z.x_m + z.w_m / 2, z.y_m + z.h_m / 2))];
-            if (d < 0) return -1;
-            worst = std::max(worst, d);
+        for (const int steps : zone_steps(env, free, nx_, ny_, cell_, false)) {
+            if (steps < 0) return -1;
+            worst = std::max(worst, steps);
         }
         return worst * cell_;
     }
@@ -748,12 +721,15 @@ Environment generate_world(const WorldSpec &w, const RobotProfile &robot, WorldN
         Environment parsed;
         try {
             parsed = parse_environment(environment_to_toml(env), name);
-            check_clearance(parsed, robot.radius_m);
+            check_zone_clearance(parsed, robot.radius_m);
         } catch (const SimError &) {
             continue;  // a layout whose zone or destination came out blocked: draw again
         }
+        // A path for a disc wider than the robot: check_clearance's walled-in test (the
+        // robot's own radius blocks no more cells and floods from no fewer) passes too.
         const double path = passable_path_m(parsed, robot.radius_m + kCell / 2, kCell);
         if (path < 0) continue;
+        parsed.clearance_checked_m = robot.radius_m;
         // Time limit: twice the grid path at full speed plus 10 s, to 5 s, at least 30 s.
         parsed.episode_limit_s = std::max(30.0, 5.0 * std::ceil((2.0 * path / robot.v_max_mps + 10.0) / 5.0));
         if (notes) {

@@ -3,12 +3,16 @@
  * range (robot frame counter-clockwise, ranges from the body surface, clipped to the
  * profile's [min, max]); the destination bearing; and the analytic sonar against a
  * brute-force fan of fine rays at random poses in the dense environment; the broad phase
- * (grid + nearest-first occlusion) reads bit-identical to testing every shape, in
- * generated worlds of 54 to 309 obstacles.
+ * (per-cell lists, nearest first, stopped and culled by the readings) reads bit-identical
+ * to testing every shape, in generated worlds of 54 to 309 obstacles, and lists every
+ * shape near the robot for its contact test.
  */
 #include "sim_test_util.hpp"
 
 #include <cmath>
+#include <cstring>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "env.hpp"
@@ -235,36 +239,97 @@ static void test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment(
     qnav_sim_env_free(env);
 }
 
+// Generated worlds of every family that the broad phase serves (at least kBroadPhaseMin
+// shapes), for both robots: 54 to 309 shapes, arenas of 7 to 20 m.
+struct BroadPhaseWorld {
+    std::string spec;
+    double reach_m;  // range_max + offset of the profile
+    qnav::Environment env;
+    std::vector<qnav::Shape> shapes;
+};
+static std::vector<BroadPhaseWorld> broad_phase_worlds() {
+    const char *specs[] = {"gen:clutter:4:1:tekbot", "gen:clutter:5:1:pioneer3dx", "gen:clutter:9:0.6:pioneer3dx",
+                           "gen:clutter:7:0.5:tekbot", "gen:rooms:3:1:pioneer3dx", "gen:rooms:5:1:tekbot",
+                           "gen:corridor:7:1:tekbot", "gen:pocket:7:1:tekbot", "gen:pocket:4:1:pioneer3dx"};
+    std::vector<BroadPhaseWorld> out;
+    for (const char *spec : specs) {
+        BroadPhaseWorld w{spec, std::strstr(spec, "pioneer3dx") ? 5.26 : 2.62, qnav::load_world(spec), {}};
+        w.shapes = w.env.obstacle_shapes();
+        assert_true(w.shapes.size() >= qnav::SonarRing::kBroadPhaseMin);  // the broad phase runs
+        out.push_back(std::move(w));
+    }
+    return out;
+}
+
+// A pose anywhere in (or just outside) the arena, inside obstacles too (a robot pressed
+// into one), or close around a random shape, where tangents and ties are likeliest.
+static qnav::Vec2 random_pose(qnav::Rng &rng, const qnav::Environment &e, const std::vector<qnav::Shape> &shapes) {
+    if (rng.uniform01() < 0.5) return {rng.uniform(-0.1, e.width_m + 0.1), rng.uniform(-0.1, e.height_m + 0.1)};
+    const qnav::Shape &s = shapes[static_cast<std::size_t>(rng.uniform01() * shapes.size()) % shapes.size()];
+    const double a = rng.uniform(-kPiD, kPiD), d = s.r * rng.uniform(0.3, 1.6);
+    return {s.c.x + d * std::cos(a), s.c.y + d * std::sin(a)};
+}
+
 static void test_broad_phase_reads_bit_identical_to_testing_every_shape(void **state) {
     (void)state;
-    // 309 and 104 obstacles, rooms with furniture (TekBot and Pioneer reach).
-    const struct { const char *spec; double reach_m; } worlds[] = {
-        {"gen:clutter:4:1:tekbot", 2.62}, {"gen:rooms:3:1:pioneer3dx", 5.26}, {"gen:clutter:9:0.6:pioneer3dx", 5.26},
-        {"gen:rooms:5:1:tekbot", 2.62}};
-    const unsigned sectors[] = {1, 2, 3, 8, 16, 32, 180, 360};
+    // Few sectors most often read the largest value, where the walk stops: many poses there.
+    const struct { unsigned n; int poses; } sectors[] = {{1, 800}, {2, 300}, {3, 300}, {8, 600}, {16, 300}, {32, 200}, {180, 40}, {360, 40}};
     qnav::Rng rng = qnav::Rng::stream(19, 5, 0);
     long compared = 0, hits = 0;
-    for (const auto &w : worlds) {
-        const qnav::Environment e = qnav::load_world(w.spec);
-        assert_true(e.circles.size() + e.boxes.size() >= qnav::SonarRing::kBroadPhaseMin);  // the broad phase runs
-        for (unsigned n : sectors) {
-            qnav::SonarRing ring(e.obstacle_shapes(), e.width_m, e.height_m, static_cast<uint16_t>(n), w.reach_m);
-            std::vector<double> fast(n), plain(n);
-            for (int trial = 0; trial < 150; ++trial) {
-                // Anywhere in the arena, inside obstacles too (a robot pressed into one).
-                const qnav::Vec2 p{rng.uniform(0.0, e.width_m), rng.uniform(0.0, e.height_m)};
+    for (const BroadPhaseWorld &w : broad_phase_worlds()) {
+        const qnav::Environment &e = w.env;
+        const double reach = w.reach_m;
+        for (const auto &[n, poses] : sectors) {
+            qnav::SonarRing ring(w.shapes, e.width_m, e.height_m, static_cast<uint16_t>(n), reach);
+            std::vector<double> fast(n), again(n), plain(n);
+            for (int trial = 0; trial < poses; ++trial) {
+                const qnav::Vec2 p = random_pose(rng, e, w.shapes);
                 const double h = rng.uniform(-3 * kPiD, 3 * kPiD);
-                ring.measure(p, h, fast.data());
+                ring.measure(p, h, fast.data());   // the cell's list made here...
+                ring.measure(p, h, again.data());  // ...and kept
                 ring.measure_plain(p, h, plain.data());
-                if (std::memcmp(fast.data(), plain.data(), n * sizeof(double)) != 0)
-                    fail_msg("%s, %u sectors, pose (%.3f, %.3f, %.3f): broad phase differs", w.spec, n, p.x, p.y, h);
-                for (unsigned k = 0; k < n; ++k) hits += plain[k] < w.reach_m;
+                if (std::memcmp(fast.data(), plain.data(), n * sizeof(double)) != 0 ||
+                    std::memcmp(again.data(), plain.data(), n * sizeof(double)) != 0)
+                    fail_msg("%s, %u sectors, pose (%.17g, %.17g, %.17g): broad phase differs", w.spec.c_str(), n, p.x, p.y, h);
+                for (unsigned k = 0; k < n; ++k) hits += plain[k] < reach;
                 compared += n;
             }
         }
     }
-    assert_true(compared > 200000);
-    assert_true(hits > compared / 4);  // most readings are within reach (obstacle or wall)
+    assert_true(compared > 300000);
+    assert_true(hits > compared / 3);  // most readings are within reach (obstacle or wall)
+}
+
+// The robot's contact test takes its shapes from the same lists: every shape whose
+// bounding circle comes within d of the pose must be among them.
+static void test_shapes_near_include_every_shape_within_the_distance(void **state) {
+    (void)state;
+    qnav::Rng rng = qnav::Rng::stream(19, 5, 1);
+    long listed = 0, needed = 0;
+    for (const BroadPhaseWorld &w : broad_phase_worlds()) {
+        const std::vector<qnav::Shape> &shapes = w.shapes;
+        const double reach = w.reach_m;
+        qnav::SonarRing ring(shapes, w.env.width_m, w.env.height_m, 16, reach);
+        std::vector<char> seen(shapes.size());
+        for (int trial = 0; trial < 400; ++trial) {
+            const qnav::Vec2 p = random_pose(rng, w.env, shapes);
+            const double d = trial % 3 == 0 ? reach : rng.uniform(0.0, 1.2);
+            std::fill(seen.begin(), seen.end(), 0);
+            ring.for_shapes_near(p, d, [&](std::uint32_t k) {
+                seen[k] = 1;
+                ++listed;
+            });
+            for (std::size_t k = 0; k < shapes.size(); ++k) {
+                const qnav::Vec2 dc = shapes[k].c - p;
+                const double bound = shapes[k].r + d;
+                if (qnav::dot(dc, dc) > bound * bound) continue;
+                ++needed;
+                if (!seen[k]) fail_msg("%s: shape %zu within %.3f m of (%.17g, %.17g) not listed", w.spec.c_str(), k, d, p.x, p.y);
+            }
+        }
+    }
+    assert_true(needed > 10000);
+    assert_true(listed < 3 * needed);  // and the lists leave the far shapes out
 }
 
 int main(void) {
@@ -279,6 +344,7 @@ int main(void) {
         cmocka_unit_test(test_box_ray_hits_and_nearest_points_match_hand_geometry),
         cmocka_unit_test(test_analytic_sonar_matches_a_fine_ray_fan_in_the_dense_environment),
         cmocka_unit_test(test_broad_phase_reads_bit_identical_to_testing_every_shape),
+        cmocka_unit_test(test_shapes_near_include_every_shape_within_the_distance),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

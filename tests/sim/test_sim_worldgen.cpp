@@ -4,8 +4,9 @@
  * walled-in check at qnav_sim_create and by a stricter grid), the same spec gives a
  * byte-identical TOML, malformed specs give one line naming the field, gaps at difficulty 1
  * are 2.5-3 robot diameters wide, the U-pocket's opening faces the start (the straight
- * line from the start zone to the destination runs into its bottom), and `qnav-sim gen-env
- * --family` writes exactly the world that the spec loads.
+ * line from the start zone to the destination runs into its bottom), `qnav-sim gen-env
+ * --family` writes exactly the world that the spec loads, and the passability flood
+ * counts the shortest grid path to each zone.
  */
 #include "sim_test_util.hpp"
 
@@ -62,12 +63,16 @@ static void test_every_family_is_passable_for_both_robots_over_many_seeds(void *
                 if (qnav_sim_env_load(spec.c_str(), &env, err, sizeof err) != QNAV_SIM_OK)
                     fail_msg("%s: %s", spec.c_str(), err);
                 const qnav::Environment &e = env->env;
-                // The library's own check, as every simulation makes it.
+                // The library's own check, as every simulation makes it: the generator
+                // vouches for its robot's radius (a wider path), so the walled-in flood
+                // that qnav_sim_create skips for it must pass too.
                 qnav_sim_config_t cfg;
                 qnav_sim_config_default(&cfg);
                 qnav_sim_t *sim = nullptr;
                 if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK)
                     fail_msg("%s: %s", spec.c_str(), err);
+                assert_true(e.clearance_checked_m == ri.radius_m);
+                if (qnav::first_walled_in_zone(e, ri.radius_m) >= 0) fail_msg("%s: walled in for the body radius", spec.c_str());
                 // A stricter one: 5 cm cells, a disc 2 cm wider than the body.
                 if (qnav::passable_path_m(e, ri.radius_m + 0.02, 0.05) <= 0)
                     fail_msg("%s: walled in on a 5 cm grid", spec.c_str());
@@ -252,6 +257,36 @@ static void test_gen_env_writes_the_world_the_spec_loads_and_refuses_bad_names(v
     rmdir(dir);
 }
 
+// The passability flood on a hand-made 10 x 3 grid of 0.1 m cells: the destination's cell
+// is (9, 1), the zones' cells (0, 1) and (5, 1).
+static void test_zone_steps_count_the_shortest_grid_path_to_each_zone(void **state) {
+    (void)state;
+    qnav::Environment env;
+    env.width_m = 1.0;
+    env.height_m = 0.3;
+    env.dest_x_m = 0.95;
+    env.dest_y_m = 0.15;
+    env.dest_radius_m = 0.04;
+    env.start_zones = {{0.0, 0.1, 0.1, 0.1}, {0.5, 0.1, 0.1, 0.1}};
+    std::vector<char> free(30, 1);
+    assert_true((qnav::zone_steps(env, free, 10, 3, 0.1, false) == std::vector<int>{9, 4}));
+    // Column 7 closed but for its bottom cell: a detour of two steps.
+    free[1 * 10 + 7] = free[2 * 10 + 7] = 0;
+    assert_true((qnav::zone_steps(env, free, 10, 3, 0.1, false) == std::vector<int>{11, 6}));
+    // Closed: no path; a zone on a blocked cell has none either.
+    free[7] = 0;
+    assert_true((qnav::zone_steps(env, free, 10, 3, 0.1, false) == std::vector<int>{-1, -1}));
+    free[7] = 1;
+    free[1 * 10 + 5] = 0;
+    assert_true((qnav::zone_steps(env, free, 10, 3, 0.1, false) == std::vector<int>{11, -1}));
+    // No cell centre in the destination disc: only from_goal_cell floods from its cell.
+    free[1 * 10 + 5] = 1;
+    env.dest_x_m = 0.92;  // 3 cm from the centre of its cell (9, 1)
+    env.dest_radius_m = 0.01;
+    assert_true((qnav::zone_steps(env, free, 10, 3, 0.1, false) == std::vector<int>{-1, -1}));
+    assert_true((qnav::zone_steps(env, free, 10, 3, 0.1, true) == std::vector<int>{11, 6}));
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_every_family_is_passable_for_both_robots_over_many_seeds),
@@ -260,6 +295,7 @@ int main(void) {
         cmocka_unit_test(test_gaps_at_difficulty_one_are_two_and_a_half_to_three_diameters),
         cmocka_unit_test(test_u_pocket_faces_the_start),
         cmocka_unit_test(test_gen_env_writes_the_world_the_spec_loads_and_refuses_bad_names),
+        cmocka_unit_test(test_zone_steps_count_the_shortest_grid_path_to_each_zone),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
