@@ -379,6 +379,59 @@ static void escape_cost(void)
     PUT(" bytes\n");
 }
 
+/* What holding the heading (docs/architecture.md, "Holding the heading") adds to a step:
+ * the probabilistic policy on every 32-sector scan with keep_pct 0 against the TekBot
+ * profile's 15 (one key lookup of the previous heading's path, two products). A scan whose
+ * step got cheaper counts as 0. */
+static void keep_cost(void)
+{
+    qnav_mm_t *r = qnav_bench_scratch_ranges();
+    qnav_ctrl_t *c = qnav_bench_scratch_ctrl();
+    qnav_policy_t *p = qnav_bench_scratch_policy();
+    qnav_ctrl_config_t cfg;
+    uint32_t cost[2];
+    uint32_t add_max = 0, add_sum = 0;
+    uint8_t n = 0;
+    uint16_t s;
+    uint8_t keep;
+    qnav_policy_prob_default(p);
+    for (s = 0; s < qnav_bench_scan_count(); ++s) {
+        qnav_ctrl_input_t in = {0};
+        qnav_ctrl_output_t out;
+        uint8_t type, k;
+        for (keep = 0; keep < 2u; ++keep) {
+            qnav_bench_config(&cfg, 32u);
+            cfg.keep_pct = (uint8_t)(keep ? 15u : 0u);
+            if (qnav_ctrl_init(c, &cfg, p) != QNAV_OK) {
+                PUT("holding: init failed\n");
+                return;
+            }
+            if (qnav_bench_load_scan(s, r, &in.goal_bearing_cdeg, &type, &k) != 32u) {
+                break;
+            }
+            in.ranges_mm = r;
+            in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
+            timer_start();
+            qnav_ctrl_step(c, &in, &out, 0);
+            cost[keep] = timer_stop() - overhead;
+        }
+        if (keep < 2u) {
+            continue;
+        }
+        cost[1] = cost[1] > cost[0] ? cost[1] - cost[0] : 0u;
+        add_sum += cost[1];
+        add_max = cost[1] > add_max ? cost[1] : add_max;
+        ++n;
+    }
+    PUT("holding the heading (keep_pct 15) on the ");
+    qnav_target_put_u32(n);
+    PUT(" 32-sector scans, probabilistic policy: adds mean ");
+    put_cycles(add_sum / n);
+    PUT(", max ");
+    qnav_target_put_u32(add_max);
+    PUT(" cycles\n");
+}
+
 /* VFH+ (qnav/vfh.h), the second controller, on every 32-sector scan through its own step
  * (free text: the M lines are the path-quality controller's). */
 static void vfh_comparison(void)
@@ -499,6 +552,7 @@ int main(void)
     naive_comparison();
     vfh_comparison();
     escape_cost();
+    keep_cost();
 #endif
     if (bad != 0u) {
         PUT("MISMATCH count ");
