@@ -130,6 +130,7 @@ static const qnav_qkey_t *flash_table(uint8_t index, const qnav_policy_t *p, uin
 }
 #endif
 
+#if !QNAV_BENCH_TABLE_GROUP
 /* "<cycles> cycles (<ms> ms at 16 MHz)" */
 static void put_cycles(uint32_t cycles)
 {
@@ -149,11 +150,16 @@ static void put_cycles(uint32_t cycles)
     PUT(" ms at 16 MHz)");
 }
 
-#if !QNAV_BENCH_TABLE_GROUP
 /* ---- naive float network, for the ratio ---------------------------------------------- */
 
 static float w_theta_f[12], w_dist_f[12], b_hidden_f[12], w_out_f[12], b_out_f; /* H = 12 */
 static uint8_t hidden_f;
+
+/* avr-libc's expf is exp on a 32-bit double: the conversions are spelled out. */
+static float naive_expf(float x)
+{
+    return (float)exp((double)x);
+}
 
 static void naive_load(const qnav_policy_t *policy)
 {
@@ -191,9 +197,9 @@ __attribute__((noinline)) static int16_t naive_float_step(const qnav_mm_t *r, ui
         }
         for (j = 0; j < hidden_f; ++j) {
             float z = w_theta_f[j] * (dtheta / 180.0f) + w_dist_f[j] * (d / max_mm) + b_hidden_f[j];
-            acc += w_out_f[j] / (1.0f + expf(-z));
+            acc += w_out_f[j] / (1.0f + naive_expf(-z));
         }
-        q = 1.0f / (1.0f + expf(-acc));
+        q = 1.0f / (1.0f + naive_expf(-acc));
         if (q > best_q) {
             best_q = q;
             best = i;
@@ -297,6 +303,7 @@ static void naive_comparison(void)
         fixed += timer_stop() - overhead;
         ++scans;
     }
+    (void)naive_heading;
     PUT("naive float network (expf, 360 paths x H, per-sector ranges), ");
     qnav_target_put(id);
     PUT(", mean of ");

@@ -12,20 +12,22 @@ if(CMAKE_SYSTEM_PROCESSOR STREQUAL "avr")
   endif()
 endif()
 
-set(QNAV_TARGET_WARNINGS -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wdouble-promotion)
-if(QNAV_WERROR)
-  list(APPEND QNAV_TARGET_WARNINGS -Werror)
-endif()
-
 function(qnav_add_target_program name)
   cmake_parse_arguments(T "" "" "SOURCES" ${ARGN})
+  # The warnings are set here, not beside include_guard: a variable set at the first
+  # include lives in that directory's scope only, and every later includer (bench/) got
+  # none.
+  set(warnings -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wdouble-promotion)
+  if(QNAV_WERROR)
+    list(APPEND warnings -Werror)
+  endif()
   # tests/target beside this file, not PROJECT_SOURCE_DIR: a small project of its own
   # (tests/firmware/switches) uses it too
   get_filename_component(io_dir ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/../tests/target ABSOLUTE)
   add_executable(${name} ${T_SOURCES} ${io_dir}/target_io.c)
   target_include_directories(${name} PRIVATE ${io_dir})
   target_link_libraries(${name} PRIVATE qnav::ctrl)
-  target_compile_options(${name} PRIVATE ${QNAV_TARGET_WARNINGS})
+  target_compile_options(${name} PRIVATE ${warnings})
   set_target_properties(${name} PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
   if(CMAKE_SYSTEM_PROCESSOR STREQUAL "avr")
     # avr_mcu_section.h is not -Wpedantic clean: include it as a system header.
