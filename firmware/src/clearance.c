@@ -105,18 +105,19 @@ static uint8_t enlarge_deg(uint32_t margin_mm, uint32_t d_mm)
  * the level's floor widens each side by up to 5 degrees more than the reading does, which
  * closes gaps the robot fits through (docs/architecture.md, "The reading's own distance,
  * and braking that does not wait for a turn").
- * @par Cost: one 16 x 32 bit product per degree below the level's gamma (0-1 for most
- * levels; more only within a few decimetres); products stay below 2^31 as in enlarge_deg().
+ * @par Cost: one 16 x 16 bit product per degree below the level's gamma and one more
+ * (1-2 for most readings; more only within a few decimetres); products stay below 2^31 as
+ * in enlarge_deg().
  */
 static uint8_t reading_gamma(const qnav_clearance_t *c, qnav_mm_t range_mm, uint8_t level)
 {
     uint8_t g = c->enlarge_deg[level];
-    uint32_t d = (uint32_t)range_mm + c->sensor_offset_mm;
-    uint32_t need = (uint32_t)c->margin_mm * 32768u;
-    if (d > 65535u) {
-        d = 65535u;
+    uint32_t need = (uint32_t)c->margin_mm << 15;
+    uint16_t d = (uint16_t)(range_mm + c->sensor_offset_mm); /* 16 x 16 bit products below */
+    if (d < range_mm) {
+        d = 65535u; /* the sum passed 65535 */
     }
-    while (g > 0u && (uint32_t)QNAV_FLASH_READ_U16(&sin_deg_q15[g - 1u]) * d >= need) {
+    while (g > 0u && (uint32_t)QNAV_FLASH_READ_U16(&sin_deg_q15[g - 1u]) * (uint32_t)d >= need) {
         --g;
     }
     return g;
