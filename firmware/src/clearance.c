@@ -96,6 +96,33 @@ static uint8_t enlarge_deg(uint32_t margin_mm, uint32_t d_mm)
     return 90;
 }
 
+/*
+ * The enlargement of one reading: the smallest whole degree g with sin g >= margin / D, D the
+ * reading's own distance from the centre (range + sensor offset, at most 65535 mm), the same
+ * definition as enlarge_deg(). Its level's gamma (enlarge_deg[] at init, from the level's
+ * smallest range) is the largest the reading can have, so the search walks down from it: a
+ * level spans up to 161 mm of range (5 m sonar, 32 levels), and at 0.7-1.2 m from a Pioneer
+ * the level's floor widens each side by up to 5 degrees more than the reading does, which
+ * closes gaps the robot fits through (docs/architecture.md, "The reading's own distance,
+ * and braking that does not wait for a turn").
+ * @par Cost: one 16 x 16 bit product per degree below the level's gamma and one more
+ * (1-2 for most readings; more only within a few decimetres); products stay below 2^31 as
+ * in enlarge_deg().
+ */
+static uint8_t reading_gamma(const qnav_clearance_t *c, qnav_mm_t range_mm, uint8_t level)
+{
+    uint8_t g = c->enlarge_deg[level];
+    uint32_t need = (uint32_t)c->margin_mm << 15;
+    uint16_t d = (uint16_t)(range_mm + c->sensor_offset_mm); /* 16 x 16 bit products below */
+    if (d < range_mm) {
+        d = 65535u; /* the sum passed 65535 */
+    }
+    while (g > 0u && (uint32_t)QNAV_FLASH_READ_U16(&sin_deg_q15[g - 1u]) * (uint32_t)d >= need) {
+        --g;
+    }
+    return g;
+}
+
 static uint32_t isqrt32(uint32_t x)
 {
     uint32_t r = 0;
@@ -293,19 +320,20 @@ static void paint(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
 /*
  * Paint one piece (n paths from first on, all of one sector) at level, widened by its
  * gamma on both sides, except where a neighbouring piece already covers it at a level no
- * higher. gamma only shrinks as the level grows, so a left neighbour at a level <= this
- * one's covers this piece's left widening and as far as its own right widening reaches
- * (gamma_prev + gamma paths); a right neighbour at a strictly lower level covers this
- * piece's right widening back to where its own left widening starts (gamma_next + gamma
- * paths). Ties leave the overlap to the left piece's right widening, so each skipped path
- * is painted by a chain of neighbours ending in one that paints it (docs/architecture.md,
- * "Clearance that respects the body"). Walls of similar readings paint about n paths a
- * piece instead of n + 2 gamma.
+ * higher. gamma only shrinks as the reading grows, so a left neighbour at a level <= this
+ * one's whose gamma is no smaller (always, unless both readings share a level and the
+ * neighbour's is the farther) covers this piece's left widening and as far as its own
+ * right widening reaches (gamma_prev + gamma paths); a right neighbour at a strictly lower
+ * level (a nearer reading: gamma_next >= gamma) covers this piece's right widening back to
+ * where its own left widening starts (gamma_next + gamma paths). Ties leave the overlap to
+ * the left piece's right widening, so each skipped path is painted by a chain of
+ * neighbours ending in one that paints it (docs/architecture.md, "Clearance that respects
+ * the body"). Walls of similar readings paint about n paths a piece instead of
+ * n + 2 gamma.
  */
-static void paint_piece(uint8_t *lvl, const qnav_clearance_t *c, uint16_t first, uint16_t n,
-                        uint8_t level, uint8_t prev, uint8_t next)
+static void paint_piece(uint8_t *lvl, uint16_t first, uint16_t n, uint8_t level, uint8_t gamma,
+                        uint8_t prev, uint8_t prev_gamma, uint8_t next, uint8_t next_gamma)
 {
-    uint8_t gamma = c->enlarge_deg[level];
     uint16_t k = (uint16_t)(n + 2u * gamma);
     uint16_t skip_left = 0;
     uint16_t skip_right = 0;
@@ -314,11 +342,11 @@ static void paint_piece(uint8_t *lvl, const qnav_clearance_t *c, uint16_t first,
         paint(lvl, 0u, QNAV_PATHS, level); /* the whole circle */
         return;
     }
-    if (prev <= level) {
-        skip_left = (uint16_t)(c->enlarge_deg[prev] + gamma);
+    if (prev <= level && prev_gamma >= gamma) {
+        skip_left = (uint16_t)(prev_gamma + gamma);
     }
     if (next < level) {
-        skip_right = (uint16_t)(c->enlarge_deg[next] + gamma);
+        skip_right = (uint16_t)(next_gamma + gamma);
     }
     if (skip_left + skip_right >= k) {
         return;
@@ -338,9 +366,10 @@ static void paint_piece(uint8_t *lvl, const qnav_clearance_t *c, uint16_t first,
  * neighbour skipping above assumes pieces that reach their edges, so every piece paints.
  */
 static void paint_piece_central(uint8_t *lvl, const qnav_clearance_t *c, uint16_t first,
-                                uint16_t n, uint8_t level, uint8_t cut_left, uint8_t cut_right)
+                                uint16_t n, uint8_t level, uint8_t gamma8, uint8_t cut_left,
+                                uint8_t cut_right)
 {
-    int16_t gamma = (int16_t)c->enlarge_deg[level];
+    int16_t gamma = (int16_t)gamma8;
     int16_t shrink = level >= c->wedge_near_level ? (int16_t)c->wedge_shrink : 0;
     int16_t lo = (int16_t)((int16_t)first + (cut_left ? shrink : 0) - gamma);
     int16_t hi = (int16_t)((int16_t)(first + n) - (cut_right ? shrink : 0) + gamma);
@@ -369,6 +398,13 @@ static inline uint8_t sector_level(const qnav_clearance_t *c, qnav_mm_t range_mm
         *flags |= QNAV_FLAG_RANGE_CLIPPED;
     }
     return level_of(c, range_mm);
+}
+
+/* A sector's enlargement: its reading's own (reading_gamma); none for a sector that saw
+ * nothing within range, which is never painted. */
+static inline uint8_t gamma_of(const qnav_clearance_t *c, qnav_mm_t range_mm, uint8_t level)
+{
+    return level == QNAV_DIST_LEVELS - 1u ? 0u : reading_gamma(c, range_mm, level);
 }
 
 /* Every path at the farthest level. On AVR four bytes per iteration: avr-libc's memset
@@ -411,20 +447,34 @@ uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges
     uint16_t phase = (uint16_t)(stop * c->n_sectors - QNAV_PATHS / 2u); /* of the next sector */
     uint8_t flags = 0;
     uint8_t level0 = sector_level(c, ranges[0], &flags);
-    /* path 359 lies in sector 0 (its last piece) when N <= 180, else in sector N - 1 */
-    uint8_t prev = c->n_sectors <= QNAV_DTHETA_MAX ? level0 : sector_level(c, end[-1], &flags);
+    uint8_t gamma0 = gamma_of(c, ranges[0], level0);
     uint8_t level = level0;
+    uint8_t gamma = gamma0;
+    /* path 359 lies in sector 0 (its last piece) when N <= 180, else in sector N - 1 */
+    uint8_t prev = level0;
+    uint8_t prev_gamma = gamma0;
+    if (c->n_sectors > QNAV_DTHETA_MAX) {
+        prev = sector_level(c, end[-1], &flags);
+        prev_gamma = gamma_of(c, end[-1], prev);
+    }
     fill_clear(lvl);
     for (;;) {
         /* after the last sector comes sector 0's last piece, after that piece 0 */
-        uint8_t next = next_range != end ? sector_level(c, *next_range++, &flags) : level0;
+        uint8_t next = level0;
+        uint8_t next_gamma = gamma0;
+        if (next_range != end) {
+            next = sector_level(c, *next_range, &flags);
+            next_gamma = gamma_of(c, *next_range, next);
+            ++next_range;
+        }
         if (level == QNAV_DIST_LEVELS - 1u) {
             /* nothing seen in this sector */
         } else if (c->wedge_shrink == 0u) {
-            paint_piece(lvl, c, first, (uint16_t)(stop - first), level, prev, next);
+            paint_piece(lvl, first, (uint16_t)(stop - first), level, gamma, prev, prev_gamma,
+                        next, next_gamma);
         } else {
             /* sector 0 is cut at path 0 (piece 0's left, its last piece's right) */
-            paint_piece_central(lvl, c, first, (uint16_t)(stop - first), level,
+            paint_piece_central(lvl, c, first, (uint16_t)(stop - first), level, gamma,
                                 (uint8_t)(first != 0u), (uint8_t)(stop < QNAV_PATHS));
         }
         if (stop >= QNAV_PATHS) {
@@ -442,6 +492,8 @@ uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges
             stop = QNAV_PATHS;
         }
         prev = level;
+        prev_gamma = gamma;
         level = next;
+        gamma = next_gamma;
     }
 }

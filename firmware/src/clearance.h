@@ -6,7 +6,9 @@
  * centre (range + sensor offset); a path's level is the nearest reading whose enlarged arc covers it. With
  * r_robot = d_safe = 0 every gamma is 0 and a path sees exactly its own sector (the
  * paper's literal mapping). The speed guard caps the speed at what the path's clearance
- * can stop in. Everything per level is computed at init; the step only paints bytes.
+ * can stop in. Everything per level is computed at init; the step only paints bytes and
+ * lowers each reading's gamma from its level's (the level's smallest range) to the
+ * reading's own distance.
  */
 #ifndef QNAV_CLEARANCE_H
 #define QNAV_CLEARANCE_H

@@ -29,12 +29,18 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
 
     const toml::table &drive = r.table(root, "drive");
     r.only_keys(drive, {"v_max_mps", "accel_mps2", "decel_mps2", "turn_rate_max_dps",
-                        "heading_gain_per_s"});
+                        "heading_gain_per_s", "limits"});
     p.v_max_mps = r.number(drive, "v_max_mps", 0.01, 20.0);
     p.accel_mps2 = r.number(drive, "accel_mps2", 0.01, 100.0);
     p.decel_mps2 = r.number(drive, "decel_mps2", 0.01, 100.0);
     p.turn_rate_max_dps = r.number(drive, "turn_rate_max_dps", 1.0, 3600.0);
     p.heading_gain_per_s = r.number(drive, "heading_gain_per_s", 0.1, 100.0);
+    if (drive.get("limits")) {
+        const std::string limits = r.string(drive, "limits");
+        if (limits != "wheel" && limits != "body")
+            r.fail(*drive.get("limits"), "'limits' must be \"wheel\" or \"body\"");
+        p.body_limits = limits == "body";
+    }
 
     const toml::table &slip = r.table(root, "slip");
     r.only_keys(slip, {"turn", "lateral_s"});

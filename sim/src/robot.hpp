@@ -21,6 +21,10 @@ struct RobotProfile {
     double v_max_mps = 0.5;         // maximum wheel / forward speed, m/s
     double accel_mps2 = 1.0;        // wheel acceleration limit (speeding up), m/s^2
     double decel_mps2 = 1.0;        // wheel deceleration limit (slowing down), m/s^2
+    // where accel_mps2 / decel_mps2 act (docs/sim.md, "Drive model"): on each wheel, or on
+    // the body's forward speed and turn rate separately (the Pioneer's ARCOS servo:
+    // translational and rotational profiles, so braking does not wait for a turn)
+    bool body_limits = false;       // [drive] limits = "wheel" (false) or "body" (true)
     double turn_rate_max_dps = 180; // turn-rate limit of the heading controller, deg/s
     double heading_gain_per_s = 4;  // heading controller: turn rate = gain * error, 1/s
     // slip

@@ -336,8 +336,23 @@ void Simulation::drive_substep(double dt) {
             tl = v - om * b / 2;
             tr = v + om * b / 2;
         }
-        wheel_l_ = approach(wheel_l_, tl, robot_.accel_mps2, robot_.decel_mps2, dt);
-        wheel_r_ = approach(wheel_r_, tr, robot_.accel_mps2, robot_.decel_mps2, dt);
+        if (robot_.body_limits) {
+            // The limits act on the body (ARCOS: translational and rotational profiles):
+            // forward speed at accel/decel, turn rate at the rates the wheel limits give a
+            // turn in place (2 accel / b, 2 decel / b); the turn gets what the wheels have
+            // left beside the forward speed, so braking never waits for a turn.
+            const double v = approach(0.5 * (wheel_l_ + wheel_r_), 0.5 * (tl + tr),
+                                      robot_.accel_mps2, robot_.decel_mps2, dt);
+            double om = approach((wheel_r_ - wheel_l_) / b, (tr - tl) / b, 2 * robot_.accel_mps2 / b,
+                                 2 * robot_.decel_mps2 / b, dt);
+            const double room = std::max(0.0, vmax - std::fabs(v)) * 2 / b;
+            om = std::clamp(om, -room, room);
+            wheel_l_ = v - om * b / 2;
+            wheel_r_ = v + om * b / 2;
+        } else {
+            wheel_l_ = approach(wheel_l_, tl, robot_.accel_mps2, robot_.decel_mps2, dt);
+            wheel_r_ = approach(wheel_r_, tr, robot_.accel_mps2, robot_.decel_mps2, dt);
+        }
     }
     const double v = 0.5 * (wheel_l_ + wheel_r_);
     const double omega = (wheel_r_ - wheel_l_) / b;

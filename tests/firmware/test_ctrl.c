@@ -628,8 +628,9 @@ static void test_enlargement_blocks_paths_beside_a_near_obstacle(void **state)
     assert_int_equal(qnav_ctrl_path_levels(&c, ranges, lvl), 0);
     uint8_t near = qnav_ctrl_level(&c, 500);
     /* the body (0.17 m with the margin) hits it on every path within asin(0.17 / D) */
-    /* D from the centre: the range plus the default sensor offset (the body's rim, 120) */
-    double gamma = asin(170.0 / (level_floor(&c, near) + 120.0)) * 180.0 / M_PI;
+    /* D from the centre: the reading itself (not its level's floor) plus the default
+     * sensor offset (the body's rim, 120) */
+    double gamma = asin(170.0 / (500.0 + 120.0)) * 180.0 / M_PI;
     for (unsigned i = 0; i < QNAV_PATHS; ++i) {
         unsigned off = i <= 180 ? i : 360 - i;
         if (off + 1e-9 < gamma) {
@@ -659,28 +660,34 @@ static void test_enlargement_matches_asin_at_every_level(void **state)
     qnav_policy_prob_default(&p);
     init_body(&c, 360, 2500, 120, 50, 0, &p);
     for (unsigned level = 0; level + 1 < QNAV_DIST_LEVELS; ++level) {
-        unsigned d = level_floor(&c, level);
-        double ratio = 170.0 / (d + 120.0);
-        double g = ratio >= 1.0 ? 90.0 : asin(ratio) * 180.0 / M_PI;
-        unsigned blocked = 0;
-        fill(ranges, 360, 2500);
-        ranges[0] = (qnav_mm_t)d;
-        qnav_ctrl_path_levels(&c, ranges, lvl);
-        for (unsigned i = 0; i < QNAV_PATHS; ++i) {
-            blocked += lvl[i] == level;
-        }
-        /* whole degrees: gamma is the smallest g with sin g >= (r + d_s) / D */
-        unsigned expect = 1u + 2u * (unsigned)ceil(g - 1e-6);
-        if (blocked != expect && fabs(g - round(g)) > 0.01) {
-            fail_msg("level %u (D %u mm): %u paths blocked, expected %u (gamma %.3f)", level, d,
-                     blocked, expect, g);
+        /* the level's nearest and farthest readings: each is enlarged by its own distance */
+        unsigned ends[2] = {level_floor(&c, level), level_floor(&c, level + 1u) - 1u};
+        for (unsigned e = 0; e < 2u; ++e) {
+            unsigned d = ends[e];
+            double ratio = 170.0 / (d + 120.0);
+            double g = ratio >= 1.0 ? 90.0 : asin(ratio) * 180.0 / M_PI;
+            unsigned blocked = 0;
+            fill(ranges, 360, 2500);
+            ranges[0] = (qnav_mm_t)d;
+            qnav_ctrl_path_levels(&c, ranges, lvl);
+            for (unsigned i = 0; i < QNAV_PATHS; ++i) {
+                blocked += lvl[i] == level;
+            }
+            /* whole degrees: gamma is the smallest g with sin g >= (r + d_s) / D */
+            unsigned expect = 1u + 2u * (unsigned)ceil(g - 1e-6);
+            if (blocked != expect && fabs(g - round(g)) > 0.01) {
+                fail_msg("level %u (D %u mm): %u paths blocked, expected %u (gamma %.3f)", level,
+                         d, blocked, expect, g);
+            }
         }
     }
 }
 
 static void test_enlargement_lowers_collisions_with_sector_count_not_raises(void **state)
 {
-    /* the robot must see a near wall at 30 degrees beside its path whatever N is */
+    /* the robot must see a near obstacle 25 degrees beside its path whatever N is: 0.25 m
+     * from the sonar is 0.37 m from the centre and 0.156 m beside the straight path, within
+     * the body's 0.17 m (radius + safety distance) */
     (void)state;
     static const uint16_t sectors[] = {8, 16, 32, 64, 180, 360};
     qnav_policy_t p;
@@ -692,11 +699,15 @@ static void test_enlargement_lowers_collisions_with_sector_count_not_raises(void
         uint8_t lvl[QNAV_PATHS];
         init_body(&c, n, 2500, 120, 50, 0, &p);
         fill(ranges, n, 2500);
-        ranges[qnav_ctrl_sector_of_path(n, 30)] = 250; /* 0.25 m away at 30 degrees */
+        ranges[qnav_ctrl_sector_of_path(n, 25)] = 250; /* 0.25 m away at 25 degrees */
         qnav_ctrl_path_levels(&c, ranges, lvl);
-        assert_int_equal(lvl[30], qnav_ctrl_level(&c, 250));
-        /* gamma(0.25 m + 0.12 m) = 27 degrees (+ the wedge): the straight path is blocked too */
+        assert_int_equal(lvl[25], qnav_ctrl_level(&c, 250));
+        /* gamma(0.25 m + 0.12 m) = 28 degrees (+ the wedge): the straight path is blocked too */
         assert_int_equal(lvl[0], qnav_ctrl_level(&c, 250));
+        if (n == 360) {
+            /* a 1-degree reading is a point: 4 degrees the other way the body passes it */
+            assert_int_equal(lvl[356], QNAV_DIST_LEVELS - 1);
+        }
     }
 }
 
@@ -1107,6 +1118,33 @@ static void test_run_reduce_keeps_its_promises_on_any_row(void **state)
 static void reference_levels_wedge(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
                                    unsigned pct, qnav_mm_t near_mm, uint8_t *lvl);
 
+/* The enlargement of one reading as defined (clearance.h): the smallest whole degree g with
+ * sin g >= (r + d_s) / D, D the reading's own distance from the centre (range + sensor
+ * offset, at most 65535 mm), sin in units of 2^-15 as the library tabulates it; 90 when no
+ * degree below 90 suffices, 0 without a margin. Computed here from the configuration, not
+ * from the library's per-level table: the level's floor is not the reading. */
+static int reference_gamma(const qnav_ctrl_t *c, qnav_mm_t range_mm)
+{
+    unsigned long margin = (unsigned long)c->clr.margin_mm;
+    unsigned long d = (unsigned long)range_mm + c->clr.sensor_offset_mm;
+    if (margin == 0u) {
+        return 0;
+    }
+    if (d > 65535u) {
+        d = 65535u;
+    }
+    for (int g = 0; g < 90; ++g) {
+        long sq = lround(sin((double)g * M_PI / 180.0) * 32768.0);
+        if (sq > 32767) {
+            sq = 32767;
+        }
+        if ((unsigned long)sq * d >= margin * 32768u) {
+            return g;
+        }
+    }
+    return 90;
+}
+
 /* The first path whose levels differ (the arrays are known to differ). */
 static unsigned first_difference(const uint8_t *got, const uint8_t *want)
 {
@@ -1180,7 +1218,7 @@ static void test_path_levels_equal_painting_every_sector(void **state)
  * wedge_near_mm blocks its whole wedge; a farther one leaves shrink paths free at each edge
  * of its sector (shrink = (100 - pct)% of half the 360/N wedge, at most so many that the
  * middle path stays), so path p is placed when the paths shrink either side of it are still
- * in its sector; then each placed path is widened by its level's gamma. */
+ * in its sector; then each placed path is widened by its reading's gamma. */
 static void reference_levels_wedge(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
                                    unsigned pct, qnav_mm_t near_mm, uint8_t *lvl)
 {
@@ -1196,7 +1234,7 @@ static void reference_levels_wedge(const qnav_ctrl_t *c, const qnav_mm_t *ranges
     for (unsigned p = 0; p < QNAV_PATHS; ++p) {
         uint16_t s = qnav_ctrl_sector_of_path(n, (uint16_t)p);
         uint8_t level = qnav_ctrl_level(c, ranges[s]);
-        int gamma = c->clr.enlarge_deg[level];
+        int gamma = reference_gamma(c, ranges[s]);
         unsigned sh = level < near_level ? 0u : shrink;
         /* one sector: its only edge lies between paths 179 and 180 */
         unsigned from_edge = p < 180u ? 179u - p : p - 180u;

@@ -69,7 +69,10 @@ static void test_robot_never_sinks_into_a_circle_it_drives_at(void **state) {
         qnav_sim_advance(t.sim);
         qnav_sim_state(t.sim, &st);
         const double d = std::hypot(st.x_m - 5.0, st.y_m - 5.0);
-        assert_true(d >= 0.5 + 0.26 - 0.01);
+        // Box2D's contact solver lets a disc in by its slop: up to 5.6 mm head-on at full
+        // speed, 11.1 mm turning into the circle at 0.3 m/s with the Pioneer's body limits
+        // (docs/sim.md, "Drive model"); never by more than 15 mm.
+        assert_true(d >= 0.5 + 0.26 - 0.015);
         collisions = st.collisions;
     }
     // Head-on, it keeps coming back after each manoeuvre: several collisions.

@@ -1,7 +1,8 @@
 /*
  * The drive model: acceleration and deceleration limits of the Pioneer profile (0.3 and
- * 0.6 m/s^2, 1 m/s), the heading controller turning to a commanded heading, and slip
- * (a slipping robot turns less at speed and skids outwards).
+ * 0.6 m/s^2, 1 m/s), on the body (the Pioneer: braking does not wait for a turn) or on each
+ * wheel, the heading controller turning to a commanded heading, and slip (a slipping robot
+ * turns less at speed and skids outwards).
  */
 #include "sim_test_util.hpp"
 
@@ -104,11 +105,78 @@ static void test_slipping_robot_turns_less_at_speed_and_skids_outwards(void **st
     assert_true(lat_slip < lat_grip);
 }
 
+// Slowing to a tenth of full speed while turning 40 deg left (commanded afresh every tick,
+// so the turn never ends) from 0.5 m/s, for 6 ticks, on the Pioneer's profile with its
+// [drive] limits replaced: the speed at the end, the distance covered and the turn.
+static void brake_while_turning(const char *limits, double *speed, double *dist, double *turned) {
+    std::string text = read_text_file(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml");
+    const std::string key = "limits = \"body\"";
+    const size_t at = text.find(key);
+    assert_true(at != std::string::npos);
+    text.replace(at, key.size(), std::string("limits = \"") + limits + "\"");
+    char err[QNAV_SIM_ERRLEN];
+    TestSim t;
+    const std::string et = test_env_text("");
+    assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "r.toml", &t.robot, err, sizeof err), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_env_parse(et.data(), et.size(), "e.toml", &t.env, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_config_t cfg;
+    qnav_sim_config_default(&cfg);
+    assert_int_equal(qnav_sim_create(t.robot, t.env, &cfg, &t.sim, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_reset(t.sim, 1);
+    qnav_sim_place(t.sim, 1.0, 2.0, 0.0);
+    drive(t.sim, 0.0, 1.0, 40);                              // up to 1 m/s
+    const qnav_sim_state_t a = drive(t.sim, 0.0, 0.5, 10);  // and down to 0.5 m/s
+    assert_true(std::fabs(a.speed_mps - 0.5) < 1e-3);
+    qnav_sim_state_t b = a;
+    *dist = 0;
+    for (int i = 0; i < 6; ++i) {
+        const qnav_sim_state_t p = b;
+        b = drive(t.sim, 40.0, 0.1, 1);
+        *dist += std::hypot(b.x_m - p.x_m, b.y_m - p.y_m);
+    }
+    *speed = b.speed_mps;
+    *turned = (b.heading_rad - a.heading_rad) * 180.0 / kPiD;
+}
+
+static void test_body_limits_brake_at_decel_while_turning(void **state) {
+    (void)state;
+    double v_body, v_wheel, d_body, d_wheel, turn_body, turn_wheel;
+    brake_while_turning("body", &v_body, &d_body, &turn_body);
+    brake_while_turning("wheel", &v_wheel, &d_wheel, &turn_wheel);
+    print_message("body: %.4f m/s, %.3f m, %.1f deg; wheel: %.4f m/s, %.3f m, %.1f deg\n", v_body,
+                  d_body, turn_body, v_wheel, d_wheel, turn_wheel);
+    // body: 0.6 s at 0.6 m/s^2, whatever the turn does: 0.5 - 0.36 = 0.14 m/s (the 0.1 m/s
+    // asked for times the cosine of the heading error, 0.08-0.1, is not reached yet);
+    // travelled 0.1 s x (0.44 + 0.38 + ... + 0.14) = 0.174 m
+    assert_true(std::fabs(v_body - 0.14) < 0.01);
+    assert_true(std::fabs(d_body - 0.174) < 0.01);
+    assert_true(turn_body > 10.0);  // and it turns meanwhile
+    // wheel: the outer wheel stops slowing at the turn's share (0.4 m/s), only the inner one
+    // brakes, and the robot slows at half the rate: what the speed guard, which assumes
+    // decel, does not see
+    assert_true(v_wheel > v_body + 0.1);
+    assert_true(d_wheel > d_body + 0.03);
+}
+
+static void test_limits_key_is_checked(void **state) {
+    (void)state;
+    std::string text = read_text_file(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml");
+    const std::string key = "limits = \"body\"";
+    text.replace(text.find(key), key.size(), "limits = \"wheels\"");
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_robot_t *robot = nullptr;
+    assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "r.toml", &robot, err, sizeof err),
+                     QNAV_SIM_E_PARSE);
+    assert_non_null(std::strstr(err, "'limits' must be \"wheel\" or \"body\""));
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pioneer_speeds_up_at_0_3_and_slows_at_0_6_mps2_to_1_mps),
         cmocka_unit_test(test_heading_controller_turns_to_the_commanded_heading_and_stays),
         cmocka_unit_test(test_slipping_robot_turns_less_at_speed_and_skids_outwards),
+        cmocka_unit_test(test_body_limits_brake_at_decel_while_turning),
+        cmocka_unit_test(test_limits_key_is_checked),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
