@@ -9,7 +9,7 @@
  * and path. Three inputs: every path is evaluated (dprev breaks the runs' shape, and a
  * table would need a third dimension, docs/architecture.md).
  */
-#include "ctrl_internal.h"
+#include "policy_eval.h"
 #include "sigmoid_lut.h"
 
 #if !QNAV_WITH_NETWORK

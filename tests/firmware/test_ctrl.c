@@ -16,7 +16,7 @@
 #include "qnav/ctrl.h"
 #include "qnav/fixed_host.h"
 #include "reference.h"
-#include "ctrl_internal.h"
+#include "runs.h"
 #include "sigmoid_lut.h"
 
 #ifndef M_PI
