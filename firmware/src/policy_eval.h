@@ -1,7 +1,7 @@
 /*
- * What the step (ctrl.c) calls in each policy kind's evaluation
+ * What the step (ctrl.c, ctrl_plain.c) calls in each policy kind's evaluation
  * (policy_<kind>.c), private to libqnav: one prototype block per kind. Adding a kind means
- * one block here, one file, and a case in every switch of ctrl.c that
+ * one block here, one file, and a case in every switch of ctrl.c and ctrl_plain.c that
  * -Wswitch names (docs/architecture.md, "Adding a policy kind").
  */
 #ifndef QNAV_POLICY_EVAL_H
@@ -28,6 +28,10 @@ void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net);
 /* The key of one (level, dtheta); a 3-input network with the path on the previous
  * heading (dprev = 0). */
 qnav_qkey_t qnav_net_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta);
+/* The key of one path from its own inputs (dprev: its angular distance from the previous
+ * heading, read by a 3-input network only): what the plain step evaluates. */
+qnav_qkey_t qnav_net_eval_path_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta,
+                                   uint8_t dprev);
 /* Every path of it into best (best first when keys is null); keys as above. */
 void qnav_net_eval_paths(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best,
                          qnav_qkey_t *keys);
