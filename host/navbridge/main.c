@@ -142,13 +142,10 @@ static int check_board_config(void *user, const qnav_link_config_t *m, char *lin
 static int use_robot(const char *spec, robot_check_t *rc, qnav_bridge_config_t *cfg)
 {
     char err[QNAV_SIM_ERRLEN];
-    qnav_sim_robot_t *robot = NULL;
-    if (qnav_sim_robot_load(spec, &robot, err, sizeof err) != QNAV_SIM_OK) {
+    if (qnav_robot_board_load(spec, &rc->expected, err, sizeof err) != QNAV_SIM_OK) {
         fprintf(stderr, "navbridge: --robot: %s\n", err);
         return 2;
     }
-    qnav_robot_board_config(robot, &rc->expected);
-    qnav_sim_robot_free(robot);
     rc->name = spec;
     cfg->ctrl = rc->expected.ctrl;
     cfg->check_config = check_board_config;

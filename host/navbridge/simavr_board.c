@@ -431,13 +431,10 @@ static int parse_args(int argc, char **argv, options_t *o)
 static int load_robot(const char *spec, qnav_board_config_t *expected, int *sectors)
 {
     char rerr[QNAV_SIM_ERRLEN];
-    qnav_sim_robot_t *robot = NULL;
-    if (qnav_sim_robot_load(spec, &robot, rerr, sizeof rerr) != QNAV_SIM_OK) {
+    if (qnav_robot_board_load(spec, expected, rerr, sizeof rerr) != QNAV_SIM_OK) {
         fprintf(stderr, "qnav-simavr-board: --robot: %s\n", rerr);
         return 2;
     }
-    qnav_robot_board_config(robot, expected);
-    qnav_sim_robot_free(robot);
     *sectors = expected->ctrl.n_sectors > 16u ? 16 : (int)expected->ctrl.n_sectors;
     qnav_link_rx_init(&g_watch.rx);
     g_watch.expected = expected;
