@@ -1,6 +1,6 @@
 /*
  * The benchmark grid (bench_grid.h): walks the fixtures, checks each measured heading
- * against the every-path step of the same policy, prints the M lines.
+ * against the library's plain step (qnav_ctrl_step_plain), prints the M lines.
  */
 #include "bench_grid.h"
 
@@ -19,9 +19,8 @@ static const char *const mode_names[QNAV_BENCH_MODES] = {"network", "probabilist
 static const char *const set_names[QNAV_BENCH_SETS] = QNAV_BENCH_SET_NAMES;
 static const char *const scan_names[QNAV_BENCH_SCAN_TYPES] = QNAV_BENCH_SCAN_NAMES;
 
-/* Scratch in RAM: one scan, one policy, one controller, the reference's qualities. */
+/* Scratch in RAM: one scan, one policy, one controller. */
 static qnav_mm_t ranges[QNAV_MAX_SECTORS];
-static qnav_q1_15_t qualities[QNAV_PATHS];
 static qnav_policy_t policy;
 static qnav_ctrl_t ctrl;
 static char policy_id[QNAV_BENCH_ID_LEN];
@@ -183,7 +182,7 @@ static void put_mismatch(const qnav_bench_hooks_t *h, uint8_t mode, uint16_t n, 
     qnav_target_put_u32(k);
     qnav_target_put(": heading ");
     qnav_target_put_i32(got);
-    qnav_target_put(", every-path step ");
+    qnav_target_put(", plain step ");
     qnav_target_put_i32(want);
     qnav_target_put("\n");
 }
@@ -202,7 +201,8 @@ static qnav_status_t init_mode(uint8_t mode, uint16_t n, const qnav_qkey_t *tabl
 /* One policy in one mode over every scan; returns the mismatches. The controller is made
  * once per sector count (a network's init evaluates every row of keys: about 0.8 s on the
  * ATmega128 at H = 12, docs/performance.md), and each measured step is checked against
- * the same controller stepped with a qualities buffer, which evaluates every path. */
+ * the library's plain reference step (qnav_ctrl_step_plain: every path evaluated from its
+ * own inputs) on the same controller: heading, speed, quality and flags must be equal. */
 static uint16_t run_policy(const qnav_bench_hooks_t *h, uint8_t index, uint8_t mode, uint8_t set)
 {
     const qnav_qkey_t *table = 0;
@@ -233,12 +233,11 @@ static uint16_t run_policy(const qnav_bench_hooks_t *h, uint8_t index, uint8_t m
             }
             ready_n = n;
         }
-        /* the reference: every path evaluated */
-        qnav_ctrl_step(&ctrl, &in, &ref, qualities);
+        qnav_ctrl_step_plain(&ctrl, &in, &ref, 0);
         v = h->measure(&ctrl, &in, &out, mode);
         put_line(h, mode, set, n, type, k, v);
         if (out.heading_deg != ref.heading_deg || out.speed != ref.speed ||
-            out.flags != ref.flags) {
+            out.quality != ref.quality || out.flags != ref.flags) {
             put_mismatch(h, mode, n, type, k, out.heading_deg, ref.heading_deg);
             ++bad;
         }

@@ -2,9 +2,9 @@
  * The benchmark grid shared by the ATmega128, Cortex-M4 and host programs: every policy
  * of the set (bench/fixtures/bench_policies.h) in each mode it has, on every scan of every
  * sector count (bench_scans.h), through the public API only. Before each measured step the
- * same scan is stepped once with a qualities buffer (every path evaluated) by the
- * policy's own network or probabilistic controller; a measured heading that differs is
- * printed as a MISMATCH line. One line per measured step in the output protocol of
+ * same scan is stepped once by the library's plain reference step (qnav_ctrl_step_plain:
+ * every path evaluated) on the same controller; a measured decision (heading, speed,
+ * quality, flags) that differs is printed as a MISMATCH line. One line per measured step in the output protocol of
  * bench/README.md:
  *   M<TAB>target=T<TAB>mode=M<TAB>H=h<TAB>N=n<TAB>policy=ID<TAB>set=S<TAB>scan=TYPE:k<TAB>VALUE
  */

@@ -34,7 +34,12 @@ CHANNELS = {
     "QNAV_QUALITIES": "path_qualities_t",
     "QNAV_POSE": "pose_t",
     "QNAV_LINK_STATUS": "link_status_t",
+    "QNAV_WAYPOINTS": "waypoints_t",
+    "QNAV_ODOMETRY": "odometry_t",
 }
+# navbridge --lcm-goals takes goals and routes on QNAV_GOAL_<token> and
+# QNAV_WAYPOINTS_<token> (docs/hil.md): the same types as the plain channels
+TOKEN_CHANNELS = ("QNAV_GOAL", "QNAV_WAYPOINTS")
 
 
 class LogError(Exception):
@@ -82,8 +87,7 @@ def decode(path, events, types):
     """{channel: [(log_utime, message)]} for the qnav channels; other channels are skipped."""
     out = {}
     for k, (utime, channel, data) in enumerate(events):
-        # navbridge --lcm-goals takes goals on QNAV_GOAL_<token> (docs/hil.md): goal_t too
-        base = "QNAV_GOAL" if channel.startswith("QNAV_GOAL_") else channel
+        base = next((t for t in TOKEN_CHANNELS if channel.startswith(t + "_")), channel)
         cls = types.get(base)
         if cls is None:
             continue

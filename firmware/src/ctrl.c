@@ -10,8 +10,8 @@
  */
 #include "qnav/ctrl.h"
 #include "clearance.h"
-#include "ctrl_internal.h"
 #include "escape.h"
+#include "policy_eval.h"
 #include "qnav/flash.h"
 #include "sigmoid_lut.h"
 
@@ -141,18 +141,6 @@ qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
     return QNAV_OK;
 }
 
-/* The controller's compiled table, or null. Without table mode (QNAV_WITH_TABLE 0) never
- * one, so the compiler leaves the table's paths out of the step. */
-static inline const qnav_qkey_t *table_of(const qnav_ctrl_t *ctrl)
-{
-#if QNAV_WITH_TABLE
-    return ctrl->table;
-#else
-    (void)ctrl;
-    return 0;
-#endif
-}
-
 /* The shape of every row of the table (init time: one read per entry). */
 static void table_shapes(qnav_ctrl_t *ctrl)
 {
@@ -223,7 +211,7 @@ static qnav_q1_15_t key_quality(const qnav_ctrl_t *ctrl, qnav_qkey_t key)
 
 static qnav_qkey_t key_at(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
 {
-    const qnav_qkey_t *table = table_of(ctrl);
+    const qnav_qkey_t *table = qnav_table_of(ctrl);
     if (table != 0) {
         return QNAV_FLASH_READ_I16(&table[(uint16_t)level * QNAV_TABLE_STRIDE + dtheta]);
     }
@@ -299,271 +287,6 @@ uint16_t qnav_ctrl_sector_of_path(uint16_t n_sectors, uint16_t path_deg)
     return (uint16_t)(s % n_sectors);
 }
 
-uint16_t qnav_whole_deg(qnav_cdeg_t cdeg)
-{
-    int16_t d = (int16_t)(cdeg / 100);
-    int16_t rest = (int16_t)(cdeg - d * 100);
-    if (rest >= 50) {
-        ++d;
-    } else if (rest <= -50) {
-        --d;
-    }
-    while (d < 0) {
-        d = (int16_t)(d + QNAV_PATHS);
-    }
-    while (d >= (int16_t)QNAV_PATHS) {
-        d = (int16_t)(d - QNAV_PATHS);
-    }
-    return (uint16_t)d;
-}
-
-
-/* The first of the n bytes from q on that differs from level (q + n when none does). The
- * walk over the 360 levels is the step's longest loop: on AVR two bytes per iteration by
- * hand, 5.5 cycles a byte against 11 from avr-gcc (checked by the shared vectors under
- * simavr). */
-static inline const uint8_t *same_up(const uint8_t *q, uint8_t n, uint8_t level)
-{
-#if defined(__AVR__)
-    uint8_t pairs = (uint8_t)(n >> 1);
-    if ((n & 1u) != 0u) {
-        if (*q != level) {
-            return q;
-        }
-        ++q;
-    }
-    if (pairs != 0u) {
-        __asm__ volatile("1: ld __tmp_reg__, %a0+\n\t"
-                         "cp __tmp_reg__, %2\n\t"
-                         "brne 2f\n\t"
-                         "ld __tmp_reg__, %a0+\n\t"
-                         "cp __tmp_reg__, %2\n\t"
-                         "brne 2f\n\t"
-                         "dec %1\n\t"
-                         "brne 1b\n\t"
-                         "rjmp 3f\n\t"
-                         "2: sbiw %0, 1\n\t"
-                         "3:\n\t"
-                         : "+z"(q), "+r"(pairs)
-                         : "r"(level)
-                         : "memory");
-    }
-    return q;
-#else
-    const uint8_t *end = q + n;
-    while (q != end && *q == level) {
-        ++q;
-    }
-    return q;
-#endif
-}
-
-/* Walking down from q (whose byte is level), the lowest of q - n .. q such that every byte
- * from it to q is level. */
-static inline const uint8_t *same_down(const uint8_t *q, uint8_t n, uint8_t level)
-{
-#if defined(__AVR__)
-    uint8_t pairs = (uint8_t)(n >> 1);
-    if ((n & 1u) != 0u) {
-        if (q[-1] != level) {
-            return q;
-        }
-        --q;
-    }
-    if (pairs != 0u) {
-        __asm__ volatile("1: ld __tmp_reg__, -%a0\n\t"
-                         "cp __tmp_reg__, %2\n\t"
-                         "brne 2f\n\t"
-                         "ld __tmp_reg__, -%a0\n\t"
-                         "cp __tmp_reg__, %2\n\t"
-                         "brne 2f\n\t"
-                         "dec %1\n\t"
-                         "brne 1b\n\t"
-                         "rjmp 3f\n\t"
-                         "2: adiw %0, 1\n\t"
-                         "3:\n\t"
-                         : "+z"(q), "+r"(pairs)
-                         : "r"(level)
-                         : "memory");
-    }
-    return q;
-#else
-    uint8_t i;
-    for (i = 0; i < n && q[-1] == level; ++i) {
-        --q;
-    }
-    return q;
-#endif
-}
-
-/*
- * The next run into *r; 0 when all 360 paths have been handed out. Runs come outward
- * from the goal: of the two sides (counter-clockwise: paths goal + 0..180, dtheta rising
- * with the path; clockwise: goal - 1..179, dtheta falling with the path), the one whose
- * next path is nearer the goal gives the next run, so runs arrive by their smallest
- * dtheta. A run ends where the level changes, at the side's end and at the wrap from path
- * 359 to 0 (a run's paths are first..first + count - 1).
- */
-uint8_t qnav_run_next(qnav_run_iter_t *it, qnav_run_t *r)
-{
-    uint16_t p;
-    uint16_t limit;
-    uint8_t level;
-    uint8_t k;
-    if (it->up <= QNAV_DTHETA_MAX && (it->down >= QNAV_DTHETA_MAX || it->up <= it->down)) {
-        p = (uint16_t)(it->goal + it->up);
-        if (p >= QNAV_PATHS) {
-            p = (uint16_t)(p - QNAV_PATHS);
-        }
-        limit = (uint16_t)(QNAV_DTHETA_MAX + 1u - it->up);
-        if (limit > QNAV_PATHS - p) {
-            limit = (uint16_t)(QNAV_PATHS - p);
-        }
-        level = it->lvl[p];
-        k = (uint8_t)(same_up(it->lvl + p + 1, (uint8_t)(limit - 1u), level) - (it->lvl + p));
-        r->first = p;
-        r->dtheta0 = (uint8_t)it->up;
-        r->dir = 1;
-        it->up = (uint8_t)(it->up + k);
-    } else if (it->down < QNAV_DTHETA_MAX) {
-        p = (uint16_t)(it->goal >= it->down ? it->goal - it->down
-                                            : it->goal + QNAV_PATHS - it->down);
-        limit = (uint16_t)(QNAV_DTHETA_MAX - it->down);
-        if (limit > p + 1u) {
-            limit = (uint16_t)(p + 1u);
-        }
-        level = it->lvl[p];
-        k = (uint8_t)((it->lvl + p) - same_down(it->lvl + p, (uint8_t)(limit - 1u), level) + 1);
-        r->first = (uint16_t)(p + 1u - k);
-        r->dtheta0 = (uint8_t)((uint8_t)(it->down + k) - 1u);
-        r->dir = -1;
-        it->down = (uint8_t)(it->down + k);
-    } else {
-        return 0;
-    }
-    r->count = k;
-    r->level = level;
-    return 1;
-}
-
-/* Start it over the levels lvl with the goal and previous heading in whole degrees. */
-void qnav_run_start(qnav_run_iter_t *it, const uint8_t *lvl, uint16_t goal, uint16_t prev)
-{
-    uint8_t i;
-    it->lvl = lvl;
-    it->goal = goal;
-    it->prev = prev;
-    it->up = 0;
-    it->down = 1;
-    for (i = 0; i < sizeof it->settled; ++i) {
-        it->settled[i] = 0;
-    }
-    it->fresh = 0;
-    it->fresh_level = 0;
-    it->fresh_a = 0;
-}
-
-void qnav_row_shape_start(qnav_row_scan_t *sc, qnav_row_shape_t *s, qnav_qkey_t key0)
-{
-    sc->shape = s;
-    sc->prev = key0;
-    sc->last_rise = 0;
-    sc->rising = 0;
-    s->top = key0;
-    s->top_d = 0;
-    s->fall_d = 0;
-    s->peak_lo = QNAV_PEAK_NONE;
-    s->peak_hi = 0;
-}
-
-void qnav_row_shape_next(qnav_row_scan_t *sc, uint8_t d, qnav_qkey_t key)
-{
-    qnav_row_shape_t *s = sc->shape;
-    if (key > s->top) {
-        s->top = key;
-        s->top_d = d;
-    }
-    if (key > sc->prev) {
-        s->fall_d = d; /* the last rise so far ends here */
-        sc->last_rise = d;
-        sc->rising = 1;
-    } else if (key < sc->prev && sc->rising) {
-        /* a rise, equal keys, a fall: an interior peak last_rise..d - 1 */
-        if (s->peak_lo == QNAV_PEAK_NONE) {
-            s->peak_lo = sc->last_rise;
-            s->peak_hi = (uint8_t)(d - 1u);
-        } else {
-            s->peak_lo = QNAV_PEAK_MANY;
-        }
-        sc->rising = 0;
-    }
-    sc->prev = key;
-}
-
-/* Narrow r (its dtheta a..b) to dtheta a..e. */
-static void keep_dtheta(qnav_run_t *r, uint8_t a, uint8_t b, uint8_t e)
-{
-    if (r->dir < 0) {
-        r->first = (uint16_t)(r->first + (uint8_t)(b - e));
-        r->dtheta0 = e;
-    }
-    r->count = (uint8_t)((uint8_t)(e - a) + 1u);
-}
-
-/*
- * Every key of the run is at most the row's top, so a top below the best (or equal, with
- * every dtheta of the run larger than the best's: the tie is lost) rules the run out. A run
- * that holds the top's dtheta has its best there: the top is the largest key and top_d the
- * smallest dtheta with it. From fall_d on the keys never rise, so of the paths at or
- * beyond fall_d only the one nearest the goal can win (ties prefer the smaller dtheta).
- * Runs arrive by their smallest dtheta (qnav_run_next), so once a run of a level that lies
- * wholly beyond fall_d has had its first path offered, a later such run of that level
- * cannot win either: its keys are at most that path's, its dtheta larger. The one
- * exception is the run straight after it on the other side starting at the same dtheta
- * (equal keys, equal dtheta: the turn decides), which "fresh" recognises.
- */
-uint8_t qnav_run_reduce(const qnav_row_shape_t *row, qnav_run_t *r, qnav_best_t *best,
-                        qnav_run_iter_t *it)
-{
-    const qnav_row_shape_t *s = &row[r->level];
-    uint8_t a = qnav_run_dmin(r);
-    uint8_t b = (uint8_t)(a + (uint8_t)(r->count - 1u));
-    uint8_t byte = (uint8_t)(r->level >> 3);
-    uint8_t bit = (uint8_t)(1u << (r->level & 7u));
-    uint8_t mirror = (uint8_t)(it->fresh && it->fresh_level == r->level && it->fresh_a == a);
-    uint8_t e;
-    it->fresh = 0;
-    if (s->top < best->key || (s->top == best->key && a > best->dtheta)) {
-        return QNAV_RUN_DONE;
-    }
-    if (s->top_d >= a && s->top_d <= b) {
-        qnav_best_consider(best, s->top, qnav_run_path_at(r, s->top_d), s->top_d);
-        return QNAV_RUN_DONE;
-    }
-    if (a >= s->fall_d) {
-        if ((it->settled[byte] & bit) != 0u) {
-            if (!mirror) {
-                return QNAV_RUN_DONE;
-            }
-        } else {
-            it->settled[byte] = (uint8_t)(it->settled[byte] | bit);
-            it->fresh = 1;
-            it->fresh_level = r->level;
-            it->fresh_a = a;
-        }
-        keep_dtheta(r, a, b, a);
-        return QNAV_RUN_ALL;
-    }
-    e = b < s->fall_d ? b : s->fall_d;
-    keep_dtheta(r, a, b, e);
-    if (s->peak_lo == QNAV_PEAK_MANY) {
-        return QNAV_RUN_ALL; /* peaks somewhere: search */
-    }
-    if (s->peak_lo == QNAV_PEAK_NONE || !(a < s->peak_lo && s->peak_hi < e)) {
-        return QNAV_RUN_VALLEY; /* no interior peak inside a..e */
-    }
-    return QNAV_RUN_PEAK;
-}
 
 /* Table mode: read a run's row. Along the run the tie order prefers earlier paths when
  * dtheta rises and later ones when it falls, so only the run's winner is considered. */
@@ -597,7 +320,7 @@ qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_qkey_t *table)
     if (!QNAV_WITH_TABLE) {
         return QNAV_E_KIND_DISABLED;
     }
-    if (ctrl->magic != QNAV_CTRL_MAGIC || table_of(ctrl) != 0) {
+    if (ctrl->magic != QNAV_CTRL_MAGIC || qnav_table_of(ctrl) != 0) {
         return QNAV_E_POLICY_KIND;
     }
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
@@ -620,7 +343,7 @@ qnav_status_t qnav_ctrl_build_table(const qnav_ctrl_t *ctrl, qnav_qkey_t *table)
     return QNAV_OK;
 }
 
-static void stop_output(qnav_ctrl_output_t *out, uint8_t flags, qnav_q1_15_t *qualities)
+void qnav_ctrl_stop(qnav_ctrl_output_t *out, uint8_t flags, qnav_q1_15_t *qualities)
 {
     uint16_t i;
     out->heading_deg = 0;
@@ -640,7 +363,7 @@ static void paths_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t
                        qnav_qkey_t *keys)
 {
     qnav_run_t r;
-    if (table_of(ctrl) != 0) {
+    if (qnav_table_of(ctrl) != 0) {
         while (qnav_run_next(it, &r)) {
             if (keys != 0 || qnav_run_reduce(ctrl->p.net.in.row, &r, best, it) != QNAV_RUN_DONE) {
                 eval_table_run(ctrl, &r, best, keys);
@@ -676,7 +399,7 @@ uint8_t qnav_ctrl_path_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges_m
  * (QNAV_RANK_QUALITY), so the margin is a fraction of a probability; the step calls it only
  * while going to the destination (a follow's skirt bearing comes from the boundary).
  */
-static void keep_heading(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uint16_t goal,
+static inline void keep_heading(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uint16_t goal,
                          uint16_t prev, qnav_best_t *best)
 {
     uint8_t dtheta = qnav_angle_dist_deg(prev, goal);
@@ -687,49 +410,24 @@ static void keep_heading(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uint16_t g
     if ((uint32_t)key * 100u >= (uint32_t)best->key * (uint32_t)(100u - ctrl->keep_pct)) {
         best->key = key;
         best->dtheta = dtheta;
-        best->heading = (qnav_deg_t)(prev <= 180u ? (int16_t)prev : (int16_t)prev - 360);
+        best->heading = qnav_signed_deg(prev);
     }
 }
 
-void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
-                    qnav_ctrl_output_t *out, qnav_q1_15_t *qualities)
+/* qnav_ctrl_decide's body, inline in the fast step (a call there costs 40 cycles a tick on
+ * the ATmega128); the plain step calls it through qnav_ctrl_decide. */
+static inline void decide(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uint16_t goal,
+                          uint16_t prev, uint8_t flags, qnav_best_t *best,
+                          qnav_ctrl_output_t *out)
 {
-    uint8_t lvl[QNAV_PATHS];
-    qnav_run_iter_t it;
-    qnav_best_t best;
-    uint8_t flags;
     uint16_t path;
     uint32_t speed;
     qnav_q1_15_t quality;
     qnav_q1_15_t cap;
-    uint16_t goal;
-
-    if (out == 0) {
-        return;
-    }
-    if (ctrl == 0 || ctrl->magic != QNAV_CTRL_MAGIC || in == 0 || in->ranges_mm == 0) {
-        stop_output(out, QNAV_FLAG_NOT_READY, qualities);
-        return;
-    }
-    best.key = QNAV_KEY_NONE;
-    best.dtheta = 0;
-    best.heading = 0;
-    flags = qnav_clearance_levels(&ctrl->clr, in->ranges_mm, lvl);
-    /* the memory goes straight to the output (no copy on the stack: the ATmega128's RAM) */
-    goal = qnav_escape_goal(&ctrl->clr, lvl, in, &out->escape);
-    qnav_run_start(&it, lvl, goal, qnav_whole_deg(in->prev_heading_cdeg));
-    /* the keys land in qualities[] and are turned into qualities below */
-    paths_best(ctrl, &it, &best, qualities);
-    if (qualities != 0) {
-        for (path = 0; path < QNAV_PATHS; ++path) {
-            qualities[path] = key_quality(ctrl, qualities[path]);
-        }
-    }
-
     if (ctrl->keep_pct != 0u && ctrl->rank == (uint8_t)QNAV_RANK_QUALITY && out->escape.side == 0) {
-        keep_heading(ctrl, lvl, goal, qnav_whole_deg(in->prev_heading_cdeg), &best);
+        keep_heading(ctrl, lvl, goal, prev, best);
     }
-    quality = key_quality(ctrl, best.key);
+    quality = key_quality(ctrl, best->key);
     if (quality <= 0) {
         out->heading_deg = 0;
         out->speed = 0;
@@ -743,17 +441,63 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
         speed = QNAV_Q1_15_MAX;
         flags |= QNAV_FLAG_FULL_SPEED;
     }
-    path = (uint16_t)(best.heading < 0 ? best.heading + QNAV_PATHS : best.heading);
+    path = (uint16_t)(best->heading < 0 ? best->heading + QNAV_PATHS : best->heading);
     cap = qnav_clearance_turn_cap(&ctrl->clr, lvl, path);
     if (speed > (uint32_t)cap) {
         speed = (uint32_t)cap;
         flags |= QNAV_FLAG_SPEED_GUARD;
     }
-    out->heading_deg = best.heading;
+    out->heading_deg = best->heading;
     out->speed = (qnav_q1_15_t)speed;
     out->quality = quality;
     out->flags = flags;
     qnav_escape_keep_moving(&ctrl->clr, lvl, &out->escape, goal, out);
+}
+
+void qnav_ctrl_decide(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uint16_t goal,
+                      uint16_t prev, uint8_t flags, qnav_best_t *best,
+                      qnav_ctrl_output_t *out)
+{
+    decide(ctrl, lvl, goal, prev, flags, best, out);
+}
+
+/* The fast step: the runs settle most paths from their rows' shapes, the rest are searched
+ * (policy_<kind>.c); qnav_ctrl_step_plain (ctrl_plain.c) evaluates every path instead and
+ * must decide the same, bit for bit. */
+void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
+                    qnav_ctrl_output_t *out, qnav_q1_15_t *qualities)
+{
+    uint8_t lvl[QNAV_PATHS];
+    qnav_run_iter_t it;
+    qnav_best_t best;
+    uint8_t flags;
+    uint16_t path;
+    uint16_t goal;
+    uint16_t prev;
+
+    if (out == 0) {
+        return;
+    }
+    if (ctrl == 0 || ctrl->magic != QNAV_CTRL_MAGIC || in == 0 || in->ranges_mm == 0) {
+        qnav_ctrl_stop(out, QNAV_FLAG_NOT_READY, qualities);
+        return;
+    }
+    best.key = QNAV_KEY_NONE;
+    best.dtheta = 0;
+    best.heading = 0;
+    flags = qnav_clearance_levels(&ctrl->clr, in->ranges_mm, lvl);
+    /* the memory goes straight to the output (no copy on the stack: the ATmega128's RAM) */
+    goal = qnav_escape_goal(&ctrl->clr, lvl, in, &out->escape);
+    prev = qnav_whole_deg(in->prev_heading_cdeg);
+    qnav_run_start(&it, lvl, goal, prev);
+    /* the keys land in qualities[] and are turned into qualities below */
+    paths_best(ctrl, &it, &best, qualities);
+    if (qualities != 0) {
+        for (path = 0; path < QNAV_PATHS; ++path) {
+            qualities[path] = key_quality(ctrl, qualities[path]);
+        }
+    }
+    decide(ctrl, lvl, goal, prev, flags, &best, out);
 }
 
 qnav_cdeg_t qnav_ctrl_prev_heading(qnav_deg_t last_heading_deg, qnav_cdeg_t last_goal_cdeg,

@@ -260,7 +260,7 @@ void qnav_escape_keep_moving(const qnav_clearance_t *c, const uint8_t *lvl,
     if (e->side == 0 || out->speed >= QNAV_ESCAPE_CRAWL) {
         return;
     }
-    out->heading_deg = (qnav_deg_t)(goal <= 180u ? (int16_t)goal : (int16_t)goal - 360);
+    out->heading_deg = qnav_signed_deg(goal);
     out->flags = (uint8_t)(out->flags & (uint8_t)~QNAV_FLAG_NO_PATH);
     if (blocked(c, lvl, (int16_t)goal)) {
         out->speed = 0; /* turn in place toward it */

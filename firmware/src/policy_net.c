@@ -9,7 +9,7 @@
  * and path. Three inputs: every path is evaluated (dprev breaks the runs' shape, and a
  * table would need a third dimension, docs/architecture.md).
  */
-#include "ctrl_internal.h"
+#include "policy_eval.h"
 #include "sigmoid_lut.h"
 
 #if !QNAV_WITH_NETWORK
@@ -101,8 +101,9 @@ static inline int32_t unit_base(const qnav_ctrl_unit_t *u, uint8_t level)
     return u->bias_z + mul_u8(u->per_level, level);
 }
 
-/* The output accumulator of one path of a 3-input network. */
-static int32_t path_acc_prev(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta,
+/* The output accumulator of one path of a 3-input network (inline: the step calls it once
+ * per path, and a call there costs a 3-input step about 2 % on the ATmega128). */
+static inline int32_t path_acc_prev(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta,
                              uint8_t dprev)
 {
     int32_t acc = ctrl->out_bias_z;
@@ -134,6 +135,15 @@ static inline qnav_qkey_t key_of_path(const qnav_ctrl_t *ctrl, uint8_t level, ui
 qnav_qkey_t qnav_net_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
 {
     return key_of_path(ctrl, level, dtheta);
+}
+
+qnav_qkey_t qnav_net_eval_path_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta,
+                                   uint8_t dprev)
+{
+    if (ctrl->inputs == QNAV_NET_INPUTS_PREV) {
+        return net_key_of(ctrl, path_acc_prev(ctrl, level, dtheta, dprev));
+    }
+    return qnav_net_eval_key(ctrl, level, dtheta);
 }
 
 /* Paths evaluated together by eval_run: one unit at a time over all of them, so that its

@@ -3,7 +3,7 @@
  * P_safe(level), both exponentials tabulated at init so that a path costs one product.
  * Its key is the quality itself (a product of probabilities does not saturate).
  */
-#include "ctrl_internal.h"
+#include "policy_eval.h"
 
 #if !QNAV_WITH_PROB
 #error "policy_prob.c is left out of the build when QNAV_WITH_PROB is 0 (qnav/qnav_config.h)"

@@ -272,7 +272,7 @@ void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ct
         speed = cap;
         flags |= QNAV_FLAG_SPEED_GUARD;
     }
-    out->heading_deg = (qnav_deg_t)(c.dir <= 180u ? (int16_t)c.dir : (int16_t)c.dir - 360);
+    out->heading_deg = qnav_signed_deg(c.dir);
     out->speed = speed;
     out->flags = flags;
     out->escape = esc;

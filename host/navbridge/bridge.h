@@ -18,6 +18,7 @@
 #include <lcm/eventlog.h>
 
 #include "qnav/ctrl.h"
+#include "qnav/check.h"
 #include "qnav/nav.h"
 #include "qnav/link.h"
 #include "qnav_command_t.h"
@@ -204,18 +205,18 @@ void qnav_bridge_on_goal(qnav_bridge_t *b, const qnav_goal_t *goal, int64_t now_
  * once; the bridge advances when the board's pose is within radius_m. Returns 0, or -1
  * with "FIELD: problem" in err for a route it cannot take (n out of 0..16, radius <= 0,
  * a point that is not finite or beyond +-2000 km); n = 0 clears the goal. */
-int qnav_bridge_on_waypoints(qnav_bridge_t *b, const qnav_waypoints_t *w, int64_t now_ms,
+QNAV_CHECK_RESULT int qnav_bridge_on_waypoints(qnav_bridge_t *b, const qnav_waypoints_t *w, int64_t now_ms,
                              char *err, size_t errlen);
 
 /* A fresh run token: QNAV_BRIDGE_TOKEN_HEX lower-case hex digits of the kernel's random
  * source and a terminator into hex (len >= QNAV_BRIDGE_TOKEN_HEX + 1). 0, or -1 when no
  * random bytes could be had. */
-int qnav_bridge_token_make(char *hex, size_t len);
+QNAV_CHECK_RESULT int qnav_bridge_token_make(char *hex, size_t len);
 
 /* Take goals and routes from b's LCM on QNAV_GOAL_<token> and QNAV_WAYPOINTS_<token> (a
  * refused route is reported on b->diag). token: 1..QNAV_BRIDGE_TOKEN_MAX characters of
  * [0-9a-zA-Z]. 0, or -1 (nothing subscribed) for a bad token or no LCM. */
-int qnav_bridge_subscribe(qnav_bridge_t *b, const char *token);
+QNAV_CHECK_RESULT int qnav_bridge_subscribe(qnav_bridge_t *b, const char *token);
 void qnav_bridge_unsubscribe(qnav_bridge_t *b);
 
 /* Periodic work (call at least every 20 ms): heartbeats, watchdog, status, upload. */

@@ -324,7 +324,67 @@ static long eeprom_changed(avr_t *avr, const uint8_t *start)
     return n;
 }
 
-int main(int argc, char **argv)
+/* Everything the command line says. */
+typedef struct {
+    const char *robot_spec;
+    const char *eeprom_path;
+    const char *elf;
+    const char *link_path;
+    long cut_after;
+    double seconds;
+    double baud;
+} options_t;
+
+static void usage(void)
+{
+    printf("usage: qnav-simavr-board --elf IMAGE [--robot NAME|FILE] [--link PATH]\n"
+           "                         [--seconds S] [--baud N]\n"
+           "                         [--eeprom FILE [--power-cut-after N]]\n"
+           "  --elf FILE     the board's firmware image (tekbot-avr.elf, pioneer3dx-avr.elf)\n"
+           "  --robot R      the robot profile the image must be built for (tekbot): a\n"
+           "                 board reporting another configuration is refused\n"
+           "  --link PATH    also make PATH a symlink to the board's pty\n"
+           "  --seconds S    stop after S simulated seconds (0: run until a signal)\n"
+           "  --baud N       the firmware's line rate: bytes reach USART0 no faster\n"
+           "                 (57600, the TekBot's)\n"
+           "  --eeprom FILE  the EEPROM: loaded at start (absent: erased), saved at exit\n"
+           "  --power-cut-after N  stop dead once N EEPROM bytes have changed\n"
+           "  --help, --version  this text; the version\n");
+}
+
+/* The options with a number (--power-cut-after, --seconds, --baud) into o; 0, or 2 after
+ * one line. */
+static int parse_number(int c, const char *arg, options_t *o)
+{
+    char *end = NULL;
+    switch (c) {
+    case 'C':
+        o->cut_after = strtol(arg, &end, 10);
+        if (end == arg || *end != '\0' || o->cut_after < 1 || o->cut_after > WATCHED_BYTES) {
+            fprintf(stderr, "qnav-simavr-board: --power-cut-after %s: expected a number "
+                            "of EEPROM bytes in 1..%d\n", arg, WATCHED_BYTES);
+            return 2;
+        }
+        return 0;
+    case 's':
+        o->seconds = strtod(arg, &end);
+        if (end == arg || *end != '\0' || !(o->seconds >= 0.0)) {
+            fprintf(stderr, "qnav-simavr-board: --seconds %s: expected a number >= 0\n", arg);
+            return 2;
+        }
+        return 0;
+    default: /* 'b' */
+        o->baud = strtod(arg, &end);
+        if (end == arg || *end != '\0' || !(o->baud >= 300.0 && o->baud <= 2000000.0)) {
+            fprintf(stderr, "qnav-simavr-board: --baud %s: expected 300..2000000\n", arg);
+            return 2;
+        }
+        return 0;
+    }
+}
+
+/* The command line into o: -1 to go on, else the exit status. */
+static int parse_args(int argc, char **argv, options_t *o)
 {
     static const struct option opts[] = {
         {"elf", required_argument, NULL, 'e'},    {"link", required_argument, NULL, 'l'},
@@ -333,74 +393,25 @@ int main(int argc, char **argv)
         {"version", no_argument, NULL, 'V'},       {"eeprom", required_argument, NULL, 'E'},
         {"power-cut-after", required_argument, NULL, 'C'},
         {"robot", required_argument, NULL, 'r'},   {NULL, 0, NULL, 0}};
-    const char *robot_spec = "tekbot";
-    static qnav_board_config_t expected;
-    static sonar_scene_t scene;
-    int sectors, refused = 0;
-    const char *eeprom_path = NULL;
-    static uint8_t ee_start[EEPROM_BYTES];
-    long cut_after = 0, changed = 0;
-    const char *elf = NULL, *link_path = NULL;
-    double seconds = 0.0, baud = 57600.0;
-    elf_firmware_t fw;
-    avr_t *avr;
-    static board_uart_t uart;
-    int64_t t0;
-    uint64_t last_scene = (uint64_t)-1;
-    int c, k, state = cpu_Running;
-    char err[512];
-
+    int c;
+    memset(o, 0, sizeof *o);
+    o->robot_spec = "tekbot";
+    o->baud = 57600.0;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
         switch (c) {
-        case 'e': elf = optarg; break;
-        case 'E': eeprom_path = optarg; break;
-        case 'C': {
-            char *end = NULL;
-            cut_after = strtol(optarg, &end, 10);
-            if (end == optarg || *end != '\0' || cut_after < 1 || cut_after > WATCHED_BYTES) {
-                fprintf(stderr, "qnav-simavr-board: --power-cut-after %s: expected a number "
-                                "of EEPROM bytes in 1..%d\n", optarg, WATCHED_BYTES);
+        case 'e': o->elf = optarg; break;
+        case 'E': o->eeprom_path = optarg; break;
+        case 'l': o->link_path = optarg; break;
+        case 'r': o->robot_spec = optarg; break;
+        case 'C':
+        case 's':
+        case 'b':
+            if (parse_number(c, optarg, o) != 0) {
                 return 2;
             }
             break;
-        }
-        case 'l': link_path = optarg; break;
-        case 'r': robot_spec = optarg; break;
-        case 's': {
-            char *end = NULL;
-            seconds = strtod(optarg, &end);
-            if (end == optarg || *end != '\0' || !(seconds >= 0.0)) {
-                fprintf(stderr, "qnav-simavr-board: --seconds %s: expected a number >= 0\n",
-                        optarg);
-                return 2;
-            }
-            break;
-        }
-        case 'b': {
-            char *end = NULL;
-            baud = strtod(optarg, &end);
-            if (end == optarg || *end != '\0' || !(baud >= 300.0 && baud <= 2000000.0)) {
-                fprintf(stderr, "qnav-simavr-board: --baud %s: expected 300..2000000\n", optarg);
-                return 2;
-            }
-            break;
-        }
-        case 'h':
-            printf("usage: qnav-simavr-board --elf IMAGE [--robot NAME|FILE] [--link PATH]\n"
-                   "                         [--seconds S] [--baud N]\n"
-                   "                         [--eeprom FILE [--power-cut-after N]]\n"
-                   "  --elf FILE     the board's firmware image (tekbot-avr.elf, pioneer3dx-avr.elf)\n"
-                   "  --robot R      the robot profile the image must be built for (tekbot): a\n"
-                   "                 board reporting another configuration is refused\n"
-                   "  --link PATH    also make PATH a symlink to the board's pty\n"
-                   "  --seconds S    stop after S simulated seconds (0: run until a signal)\n"
-                   "  --baud N       the firmware's line rate: bytes reach USART0 no faster\n"
-                   "                 (57600, the TekBot's)\n"
-                   "  --eeprom FILE  the EEPROM: loaded at start (absent: erased), saved at exit\n"
-                   "  --power-cut-after N  stop dead once N EEPROM bytes have changed\n"
-                   "  --help, --version  this text; the version\n");
-            return 0;
+        case 'h': usage(); return 0;
         case 'V': fputs(QNAV_CLI_VERSION_LINE("qnav-simavr-board"), stdout); return 0;
         default:
             fprintf(stderr, "qnav-simavr-board: %s: unknown option or missing value\n",
@@ -408,140 +419,222 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (elf == NULL) {
+    if (o->elf == NULL) {
         fprintf(stderr, "qnav-simavr-board: --elf: required\n");
         return 2;
     }
-    {
-        char rerr[QNAV_SIM_ERRLEN];
-        qnav_sim_robot_t *robot = NULL;
-        if (qnav_sim_robot_load(robot_spec, &robot, rerr, sizeof rerr) != QNAV_SIM_OK) {
-            fprintf(stderr, "qnav-simavr-board: --robot: %s\n", rerr);
-            return 2;
-        }
-        qnav_robot_board_config(robot, &expected);
-        qnav_sim_robot_free(robot);
-        sectors = expected.ctrl.n_sectors > 16u ? 16 : (int)expected.ctrl.n_sectors;
-        qnav_link_rx_init(&g_watch.rx);
-        g_watch.expected = &expected;
+    return -1;
+}
+
+/* --robot's board configuration into expected, watched for in the board's CONFIG reports;
+ * the sonar sectors the scene feeds (at most 16) into *sectors. 0, or 2 after one line. */
+static int load_robot(const char *spec, qnav_board_config_t *expected, int *sectors)
+{
+    char rerr[QNAV_SIM_ERRLEN];
+    if (qnav_robot_board_load(spec, expected, rerr, sizeof rerr) != QNAV_SIM_OK) {
+        fprintf(stderr, "qnav-simavr-board: --robot: %s\n", rerr);
+        return 2;
     }
+    *sectors = expected->ctrl.n_sectors > 16u ? 16 : (int)expected->ctrl.n_sectors;
+    qnav_link_rx_init(&g_watch.rx);
+    g_watch.expected = expected;
+    return 0;
+}
+
+/* The MCU with the image loaded (ATmega128 at 16 MHz unless the image says otherwise);
+ * null after one line. */
+static avr_t *make_mcu(const char *elf, elf_firmware_t *fw)
+{
+    avr_t *avr;
     if (access(elf, R_OK) != 0) {
         fprintf(stderr, "qnav-simavr-board: %s: %s\n", elf, strerror(errno));
-        return 2;
+        return NULL;
     }
-    memset(&fw, 0, sizeof fw);
-    if (elf_read_firmware(elf, &fw) != 0) {
+    memset(fw, 0, sizeof *fw);
+    if (elf_read_firmware(elf, fw) != 0) {
         fprintf(stderr, "qnav-simavr-board: %s: not an AVR ELF image\n", elf);
-        return 2;
+        return NULL;
     }
-    if (fw.mmcu[0] == '\0') {
-        snprintf(fw.mmcu, sizeof fw.mmcu, "atmega128");
+    if (fw->mmcu[0] == '\0') {
+        snprintf(fw->mmcu, sizeof fw->mmcu, "atmega128");
     }
-    if (fw.frequency == 0) {
-        fw.frequency = 16000000;
+    if (fw->frequency == 0) {
+        fw->frequency = 16000000;
     }
-    avr = avr_make_mcu_by_name(fw.mmcu);
+    avr = avr_make_mcu_by_name(fw->mmcu);
     if (avr == NULL) {
-        fprintf(stderr, "qnav-simavr-board: %s: simavr does not know MCU '%s'\n", elf, fw.mmcu);
-        return 2;
+        fprintf(stderr, "qnav-simavr-board: %s: simavr does not know MCU '%s'\n", elf, fw->mmcu);
+        return NULL;
     }
     avr_init(avr);
-    avr_load_firmware(avr, &fw);
+    avr_load_firmware(avr, fw);
     avr->log = 0;
     avr->vcc = 5000;
     avr->avcc = 5000;
     avr->aref = 5000;
-    if (cut_after > 0 && eeprom_path == NULL) {
+    return avr;
+}
+
+/* --eeprom and --power-cut-after on the MCU; 0, or 2 after one line. */
+static int attach_eeprom(const options_t *o, avr_t *avr, const elf_firmware_t *fw,
+                         uint8_t *ee_start)
+{
+    if (o->cut_after > 0 && o->eeprom_path == NULL) {
         fprintf(stderr, "qnav-simavr-board: --power-cut-after: needs --eeprom FILE\n");
         return 2;
     }
-    if (eeprom_path != NULL) {
-        if (eeprom_load(avr, eeprom_path, ee_start) != 0) {
-            return 2;
-        }
+    if (o->eeprom_path != NULL && eeprom_load(avr, o->eeprom_path, ee_start) != 0) {
+        return 2;
     }
-    if (cut_after > 0) {
-        if (strcmp(fw.mmcu, "atmega128") != 0) {
+    if (o->cut_after > 0) {
+        if (strcmp(fw->mmcu, "atmega128") != 0) {
             fprintf(stderr, "qnav-simavr-board: --power-cut-after: knows the ATmega128's "
-                            "EEPROM only, not the %s's\n", fw.mmcu);
+                            "EEPROM only, not the %s's\n", fw->mmcu);
             return 2;
         }
         avr_register_io_write(avr, ATMEGA128_EECR, on_eecr_write, NULL);
     }
+    return 0;
+}
 
-    if (uart_open(avr, &uart, fw.frequency, (uint32_t)baud) != 0) {
+/* USART0 on a pty (and --link to it), the sonar ADCs and the multiplexer, the signals.
+ * 0, or the exit status after one line. */
+static int attach_io(const options_t *o, avr_t *avr, const elf_firmware_t *fw,
+                     board_uart_t *uart, sonar_scene_t *scene)
+{
+    char err[512];
+    int k;
+    if (uart_open(avr, uart, fw->frequency, (uint32_t)o->baud) != 0) {
         fprintf(stderr, "qnav-simavr-board: cannot put USART0 on a pseudo-terminal: %s\n",
                 strerror(errno));
         return 1;
     }
-    if (link_path != NULL &&
-        qnav_ptylink_make(link_path, uart.name, err, sizeof err) != 0) {
+    if (o->link_path != NULL && qnav_ptylink_make(o->link_path, uart->name, err, sizeof err) != 0) {
         fprintf(stderr, "qnav-simavr-board: %s\n", err);
         return 2;
     }
-    printf("qnav-simavr-board: %s (%s, %u Hz) with USART0 on %s%s%s\n", elf, fw.mmcu,
-           (unsigned)fw.frequency, uart.name, link_path ? " = " : "",
-           link_path ? link_path : "");
+    printf("qnav-simavr-board: %s (%s, %u Hz) with USART0 on %s%s%s\n", o->elf, fw->mmcu,
+           (unsigned)fw->frequency, uart->name, o->link_path ? " = " : "",
+           o->link_path ? o->link_path : "");
     fflush(stdout);
     for (k = 0; k < 8; ++k) {
-        scene.adc[k] = avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0 + k);
+        scene->adc[k] = avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0 + k);
     }
     avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ('B'), 2), on_mux_select,
-                            &scene);
+                            scene);
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
+    return 0;
+}
 
-    t0 = qnav_mono_us();
-    while (!g_quit && state != cpu_Done && state != cpu_Crashed) {
-        uint64_t sim_us = avr->cycle / (fw.frequency / 1000000u);
+/* The scene of 0.5 s step `step`: an obstacle that walks round the robot; the rest open at
+ * 2 m and beyond. */
+static void scene_at(sonar_scene_t *scene, uint64_t step, int sectors)
+{
+    int k;
+    for (k = 0; k < 16; ++k) {
+        scene->mm[k] = ((uint64_t)k == step % (uint64_t)sectors)
+                           ? 400u : 2000u + (uint32_t)(400 / sectors) * (uint32_t)(k % sectors);
+    }
+    scene_apply(scene);
+}
+
+/* What ended a run. */
+typedef struct {
+    int state;   /* simavr's cpu state */
+    int refused; /* the board's configuration differs from the robot's */
+} run_end_t;
+
+/* Run the MCU, held to the wall clock, until a signal, --seconds, a power cut, a refused
+ * board or the MCU's end. */
+static run_end_t run_board(const options_t *o, avr_t *avr, const elf_firmware_t *fw,
+                           board_uart_t *uart, sonar_scene_t *scene, int sectors,
+                           const uint8_t *ee_start)
+{
+    run_end_t end = {cpu_Running, 0};
+    uint64_t last_scene = (uint64_t)-1;
+    long changed = 0;
+    int64_t t0 = qnav_mono_us();
+    while (!g_quit && end.state != cpu_Done && end.state != cpu_Crashed) {
+        uint64_t sim_us = avr->cycle / (fw->frequency / 1000000u);
         uint64_t step = sim_us / 500000u; /* a new scene every 0.5 s */
         int64_t ahead;
+        int k;
         if (g_watch.refused) {
             fprintf(stderr, "qnav-simavr-board: board configuration differs from robot '%s': %s\n",
-                    robot_spec, g_watch.diff);
-            refused = 1;
+                    o->robot_spec, g_watch.diff);
+            end.refused = 1;
             break;
         }
         if (step != last_scene) {
-            /* an obstacle that walks round the robot; the rest open at 2 m and beyond */
-            for (k = 0; k < 16; ++k) {
-                scene.mm[k] = ((uint64_t)k == step % (uint64_t)sectors)
-                                  ? 400u : 2000u + (uint32_t)(400 / sectors) * (uint32_t)(k % sectors);
-            }
-            scene_apply(&scene);
+            scene_at(scene, step, sectors);
             last_scene = step;
         }
-        if (seconds > 0.0 && (double)sim_us >= seconds * 1e6) {
+        if (o->seconds > 0.0 && (double)sim_us >= o->seconds * 1e6) {
             break;
         }
-        for (k = 0; k < 2000 && state != cpu_Done && state != cpu_Crashed; ++k) {
-            state = avr_run(avr);
+        for (k = 0; k < 2000 && end.state != cpu_Done && end.state != cpu_Crashed; ++k) {
+            end.state = avr_run(avr);
             /* the instruction that wrote EECR wrote the byte: the cut comes right after it */
             if (g_eecr_written) {
                 g_eecr_written = 0;
-                if ((changed = eeprom_changed(avr, ee_start)) >= cut_after) {
+                if ((changed = eeprom_changed(avr, ee_start)) >= o->cut_after) {
                     break;
                 }
             }
         }
-        if (cut_after > 0 && changed >= cut_after) {
+        if (o->cut_after > 0 && changed >= o->cut_after) {
             printf("qnav-simavr-board: power cut after %ld changed EEPROM bytes\n", changed);
             break;
         }
-        uart_service(&uart, avr->cycle);
+        uart_service(uart, avr->cycle);
         ahead = (int64_t)sim_us - (qnav_mono_us() - t0);
         if (ahead > 2000) {
             usleep((useconds_t)ahead);
         }
     }
+    return end;
+}
+
+int main(int argc, char **argv)
+{
+    static options_t o;
+    static qnav_board_config_t expected;
+    static sonar_scene_t scene;
+    static uint8_t ee_start[EEPROM_BYTES];
+    static board_uart_t uart;
+    elf_firmware_t fw;
+    avr_t *avr;
+    run_end_t end;
+    int sectors = 0;
+    int rc = parse_args(argc, argv, &o);
+    if (rc >= 0) {
+        return rc;
+    }
+    if (load_robot(o.robot_spec, &expected, &sectors) != 0) {
+        return 2;
+    }
+    avr = make_mcu(o.elf, &fw);
+    if (avr == NULL) {
+        return 2;
+    }
+    rc = attach_eeprom(&o, avr, &fw, ee_start);
+    if (rc == 0) {
+        rc = attach_io(&o, avr, &fw, &uart, &scene);
+    }
+    if (rc != 0) {
+        return rc;
+    }
+    end = run_board(&o, avr, &fw, &uart, &scene, sectors, ee_start);
     printf("qnav-simavr-board: stopped after %.2f simulated s (%s)\n",
            (double)avr->cycle / (double)fw.frequency,
-           refused ? "refused" : state == cpu_Crashed ? "crashed" : (g_quit ? "signal" : "done"));
+           end.refused ? "refused" : end.state == cpu_Crashed ? "crashed"
+                                   : (g_quit ? "signal" : "done"));
     fflush(stdout);
-    if (eeprom_path != NULL && eeprom_save(avr, eeprom_path) != 0) {
-        state = cpu_Crashed;
+    if (o.eeprom_path != NULL && eeprom_save(avr, o.eeprom_path) != 0) {
+        end.state = cpu_Crashed;
     }
     /* only the link made here is removed, and only if it is still ours */
-    qnav_ptylink_remove(link_path, uart.name);
-    return state == cpu_Crashed || refused ? 1 : 0;
+    qnav_ptylink_remove(o.link_path, uart.name);
+    return end.state == cpu_Crashed || end.refused ? 1 : 0;
 }

@@ -19,6 +19,19 @@ void qnav_robot_board_config(const qnav_sim_robot_t *robot, qnav_board_config_t 
     cfg->um_per_count = (uint16_t)ri.um_per_count;
 }
 
+qnav_sim_status_t qnav_robot_board_load(const char *spec, qnav_board_config_t *cfg, char *err,
+                                        size_t errlen)
+{
+    qnav_sim_robot_t *robot = NULL;
+    qnav_sim_status_t st = qnav_sim_robot_load(spec, &robot, err, errlen);
+    if (st != QNAV_SIM_OK) {
+        return st;
+    }
+    qnav_robot_board_config(robot, cfg);
+    qnav_sim_robot_free(robot);
+    return QNAV_SIM_OK;
+}
+
 long qnav_robot_board_udeg_per_count(const qnav_board_config_t *cfg)
 {
     if (cfg->track_mm == 0u) {

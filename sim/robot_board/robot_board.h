@@ -26,6 +26,12 @@ extern "C" {
  * wheel_base_m, um_per_count = [odometry] um_per_count. */
 void qnav_robot_board_config(const qnav_sim_robot_t *robot, qnav_board_config_t *cfg);
 
+/* The same from a robot spec (a profile's path or name, as qnav_sim_robot_load takes it):
+ * QNAV_SIM_OK, or the loader's status with its message in err. */
+QNAV_CHECK_RESULT qnav_sim_status_t qnav_robot_board_load(const char *spec,
+                                                          qnav_board_config_t *cfg, char *err,
+                                                          size_t errlen);
+
 /* The heading change per differential encoder count (right minus left), micro-degrees:
  * um_per_count / track_mm radians. What a board's HAL integrates for its heading. */
 long qnav_robot_board_udeg_per_count(const qnav_board_config_t *cfg);

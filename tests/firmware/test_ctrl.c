@@ -16,7 +16,7 @@
 #include "qnav/ctrl.h"
 #include "qnav/fixed_host.h"
 #include "reference.h"
-#include "ctrl_internal.h"
+#include "runs.h"
 #include "sigmoid_lut.h"
 
 #ifndef M_PI
@@ -943,46 +943,109 @@ static void structured_scan(qnav_mm_t *ranges, uint16_t n, qnav_mm_t max_mm, uns
     *goal = (qnav_cdeg_t)g;
 }
 
-/* The step without qualities skips most evaluations (row shapes, settled levels, the run
- * search); with qualities it evaluates every path and picks the best by the same order.
- * Both must decide exactly the same, for nets from mild to saturated, both ranks, all
- * sector counts. */
-static void test_fast_step_equals_every_path_evaluation(void **state)
+/* A controller for the comparison with the plain step; k picks the kind (a 2-input network
+ * from mild to saturated, a 3-input one, the probabilistic policy with random parameters,
+ * table mode of a 2-input network), the rank (every third group of 32 the literal
+ * configuration: keys are qualities, long runs of equal keys), holding the heading
+ * (keep_pct 0..30) and a quick escape (stall after 3 ticks). */
+static void plain_case_init(qnav_ctrl_t *c, qnav_qkey_t *table, unsigned k, uint16_t n)
+{
+    static const int32_t scales[] = {128, 768, 4096, 32767};
+    qnav_ctrl_config_t cfg;
+    qnav_policy_t p;
+    qnav_ctrl_t direct;
+    uint8_t hidden = (uint8_t)rng_range(1, QNAV_MAX_HIDDEN);
+    qnav_ctrl_config_default(&cfg);
+    cfg.n_sectors = n;
+    cfg.max_range_mm = 4000;
+    if ((k / 32u) % 3u == 2u) {
+        qnav_ctrl_config_literal(&cfg);
+    }
+    cfg.keep_pct = (uint8_t)((k / 8u) % 4u * 10u);
+    cfg.escape_stall_ticks = 3u;
+    if (k % 4u == 2u) {
+        qnav_policy_prob_default(&p);
+        p.u.prob.k_goal = (qnav_q8_8_t)rng_range(1, 64 * 256);
+        p.u.prob.k_safe = (qnav_q8_8_t)rng_range(1, 64 * 256);
+    } else {
+        qnav_policy_net_zero_inputs(&p, hidden, k % 4u == 1u ? 3u : 2u);
+        for (uint16_t w = 0; w < qnav_net_weight_count(&p.u.net); ++w) {
+            int32_t s = scales[(k / 8u) % 4u];
+            *qnav_net_weight(&p.u.net, w) = (qnav_q8_8_t)rng_range(-s, s);
+        }
+    }
+    assert_int_equal(qnav_ctrl_init(c, &cfg, &p), QNAV_OK);
+    if (k % 4u == 3u) {
+        direct = *c;
+        assert_int_equal(qnav_ctrl_build_table(&direct, table), QNAV_OK);
+        assert_int_equal(qnav_ctrl_init_table(c, &cfg, table, qnav_ctrl_rank(&direct)), QNAV_OK);
+    }
+}
+
+/* The fast step (row shapes, settled levels, the run search; with qualities, every run
+ * evaluated) must decide exactly as the library's plain step, which evaluates every path
+ * from its own inputs: heading, speed, quality, flags, escape memory and all 360
+ * qualities, tick after tick (each step fed its own previous output), for every kind,
+ * both ranks, holding the heading, escapes, all sector counts. */
+static void test_fast_step_equals_plain_step(void **state)
 {
     (void)state;
     static const uint16_t sectors[] = {1, 5, 8, 16, 32, 64, 180, 360};
-    static const int32_t scales[] = {128, 768, 4096, 32767};
-    static qnav_q1_15_t q[QNAV_PATHS];
+    static qnav_qkey_t table[QNAV_QTABLE_ENTRIES];
+    static qnav_q1_15_t q_fast[QNAV_PATHS];
+    static qnav_q1_15_t q_plain[QNAV_PATHS];
     qnav_mm_t ranges[360];
     unsigned checked = 0;
-    for (unsigned k = 0; k < 6000; ++k) {
+    for (unsigned k = 0; k < 3000; ++k) {
         uint16_t n = sectors[k % 8u];
-        qnav_policy_t p;
         qnav_ctrl_t c;
-        qnav_ctrl_input_t in = {0};
+        qnav_ctrl_input_t in_fast = {0};
+        qnav_ctrl_input_t in_plain = {0};
         qnav_ctrl_output_t fast;
-        qnav_ctrl_output_t full;
+        qnav_ctrl_output_t plain;
         qnav_cdeg_t goal;
-        random_net(&p, (uint8_t)rng_range(1, QNAV_MAX_HIDDEN), scales[(k / 8u) % 4u]);
-        if ((k / 32u) % 3u == 2u) {
-            init_literal(&c, n, 4000, &p); /* quality rank: long runs of equal keys */
-        } else {
-            init_or_fail(&c, n, 4000, &p);
-        }
+        plain_case_init(&c, table, k, n);
         structured_scan(ranges, n, 4000, k / 96u, &goal);
-        in.ranges_mm = ranges;
-        in.goal_bearing_cdeg = goal;
-        in.prev_heading_cdeg = 0;
-        qnav_ctrl_step(&c, &in, &fast, NULL);
-        qnav_ctrl_step(&c, &in, &full, q);
-        if (fast.heading_deg != full.heading_deg || fast.speed != full.speed ||
-            fast.quality != full.quality || fast.flags != full.flags) {
-            fail_msg("scan %u (N = %u, kind %u): fast heading %d, every path %d", k, n,
-                     (k / 96u) % 5u, fast.heading_deg, full.heading_deg);
+        in_fast.ranges_mm = ranges;
+        in_fast.goal_bearing_cdeg = goal;
+        in_fast.prev_heading_cdeg = (qnav_cdeg_t)rng_range(-18000, 18000);
+        in_fast.goal_range_mm = (qnav_mm_t)rng_range(0, 6000);
+        in_plain = in_fast;
+        memset(&fast, 0, sizeof fast);
+        memset(&plain, 0, sizeof plain);
+        for (unsigned tick = 0; tick < 5u; ++tick) {
+            qnav_ctrl_step(&c, &in_fast, &fast, (k + tick) % 2u ? q_fast : NULL);
+            qnav_ctrl_step_plain(&c, &in_plain, &plain, (k + tick) % 2u ? q_plain : NULL);
+            if (memcmp(&fast, &plain, sizeof fast) != 0 ||
+                ((k + tick) % 2u && memcmp(q_fast, q_plain, sizeof q_fast) != 0)) {
+                fail_msg("case %u tick %u (N = %u, kind %u): fast heading %d, plain %d", k,
+                         tick, n, k % 4u, fast.heading_deg, plain.heading_deg);
+            }
+            in_fast.escape = fast.escape;
+            in_plain.escape = plain.escape;
+            in_fast.prev_heading_cdeg = (qnav_cdeg_t)(fast.heading_deg * 100);
+            in_plain.prev_heading_cdeg = (qnav_cdeg_t)(plain.heading_deg * 100);
+            ++checked;
         }
-        ++checked;
     }
-    assert_int_equal(checked, 6000);
+    assert_int_equal(checked, 15000);
+}
+
+/* Not ready (no controller, no scan) is the same stop from both steps. */
+static void test_plain_step_stops_when_not_ready(void **state)
+{
+    (void)state;
+    qnav_ctrl_t c;
+    qnav_ctrl_input_t in = {0};
+    qnav_ctrl_output_t out;
+    qnav_q1_15_t q[QNAV_PATHS];
+    memset(&c, 0, sizeof c);
+    memset(q, 0x55, sizeof q);
+    qnav_ctrl_step_plain(&c, &in, &out, q);
+    assert_int_equal(out.flags, QNAV_FLAG_NOT_READY);
+    assert_int_equal(out.speed, 0);
+    assert_int_equal(q[17], 0);
+    qnav_ctrl_step_plain(&c, &in, NULL, NULL); /* no output: nothing to write, no crash */
 }
 
 /* A row of keys with the features that break shortcuts: plateaus, single-path spikes and
@@ -1388,7 +1451,8 @@ int main(void)
         cmocka_unit_test(test_saturated_network_ranks_by_preactivation),
         cmocka_unit_test(test_preactivation_rank_agrees_with_float_network_on_saturated_nets),
         cmocka_unit_test(test_sigmoid_flat_ends_match_the_table),
-        cmocka_unit_test(test_fast_step_equals_every_path_evaluation),
+        cmocka_unit_test(test_fast_step_equals_plain_step),
+        cmocka_unit_test(test_plain_step_stops_when_not_ready),
         cmocka_unit_test(test_path_levels_equal_painting_every_sector),
         cmocka_unit_test(test_wedge_placement_equals_its_definition),
         cmocka_unit_test(test_run_reduce_keeps_its_promises_on_any_row),

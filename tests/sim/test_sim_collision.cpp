@@ -14,8 +14,9 @@ static void test_driving_into_a_wall_starts_a_ten_tick_recovery_counted_in_tau_c
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
-    qnav_sim_reset(t.sim, 1);
-    qnav_sim_place(t.sim, 5.0, 9.0, kPiD / 2);  // 0.74 m from the wall y = 10, facing it
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    // 0.74 m from the wall y = 10, facing it
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 9.0, kPiD / 2), QNAV_SIM_OK);
     qnav_sim_command_raw(t.sim, 0.0, 1.0);
     qnav_sim_state_t st;
     int ticks = 0;
@@ -57,8 +58,8 @@ static void test_robot_never_sinks_into_a_circle_it_drives_at(void **state) {
     TestSim t;
     make_test_sim(t, "pioneer3dx", test_env_text("[[circle]]\nx_m = 5.0\ny_m = 5.0\nr_m = 0.5\n"),
                   nullptr, 16, 0, 0);
-    qnav_sim_reset(t.sim, 1);
-    qnav_sim_place(t.sim, 2.0, 5.0, 0.0);
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 2.0, 5.0, 0.0), QNAV_SIM_OK);
     unsigned collisions = 0;
     qnav_sim_state_t st;
     qnav_sim_state(t.sim, &st);
@@ -87,8 +88,8 @@ static void test_robot_in_free_space_never_collides(void **state) {
     (void)state;
     TestSim t;
     make_test_sim(t, "tekbot", test_env_text(""), nullptr, 8, 0, 0);
-    qnav_sim_reset(t.sim, 1);
-    qnav_sim_place(t.sim, 5.0, 5.0, 0.0);
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
     qnav_sim_command_raw(t.sim, 20.0, 0.5);  // keeps turning left: drives in circles
     for (int i = 0; i < 100; ++i) qnav_sim_advance(t.sim);
     qnav_sim_result_t r;

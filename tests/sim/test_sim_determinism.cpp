@@ -56,7 +56,7 @@ static void rule_step(const qnav_sim_scan_t &s, double *heading_deg, double *spe
 }
 
 static void hash_episode(qnav_sim_t *sim, uint64_t seed, Fnv *f, qnav_sim_result_t *out) {
-    qnav_sim_reset(sim, seed);
+    assert_int_equal(qnav_sim_reset(sim, seed), QNAV_SIM_OK);
     qnav_sim_state_t st;
     qnav_sim_state(sim, &st);
     while (!st.done) {

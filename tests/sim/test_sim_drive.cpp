@@ -22,8 +22,8 @@ static void test_pioneer_speeds_up_at_0_3_and_slows_at_0_6_mps2_to_1_mps(void **
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
-    qnav_sim_reset(t.sim, 1);
-    qnav_sim_place(t.sim, 0.8, 5.0, 0.0);
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 0.8, 5.0, 0.0), QNAV_SIM_OK);
     qnav_sim_state_t st = drive(t.sim, 0.0, 1.0, 10);
     assert_true(std::fabs(st.speed_mps - 0.3) < 1e-3);  // 1 s at 0.3 m/s^2
     st = drive(t.sim, 0.0, 1.0, 30);
@@ -39,8 +39,8 @@ static void test_heading_controller_turns_to_the_commanded_heading_and_stays(voi
     (void)state;
     TestSim t;
     make_test_sim(t, "tekbot", test_env_text(""), nullptr, 8, 0, 0);
-    qnav_sim_reset(t.sim, 1);
-    qnav_sim_place(t.sim, 5.0, 5.0, 0.0);
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
     // Command a world heading of 90 deg, relative to the current heading every tick.
     qnav_sim_state_t st;
     qnav_sim_state(t.sim, &st);
@@ -74,8 +74,8 @@ static double turn_at_speed(const char *slip_turn, const char *slip_lateral, dou
     qnav_sim_config_t cfg;
     qnav_sim_config_default(&cfg);
     assert_int_equal(qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err), QNAV_SIM_OK);
-    qnav_sim_reset(sim, 1);
-    qnav_sim_place(sim, 2.0, 2.0, 0.0);
+    assert_int_equal(qnav_sim_reset(sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(sim, 2.0, 2.0, 0.0), QNAV_SIM_OK);
     drive(sim, 0.0, 1.0, 40);  // up to 1 m/s first
     qnav_sim_state_t a, b;
     qnav_sim_state(sim, &a);

@@ -103,7 +103,7 @@ static void test_robot_that_never_moves_scores_only_the_time_term_under_the_pape
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0, 1, QNAV_SIM_FITNESS_PAPER);
-    qnav_sim_reset(t.sim, 4);
+    assert_int_equal(qnav_sim_reset(t.sim, 4), QNAV_SIM_OK);
     qnav_sim_command_raw(t.sim, 0.0, 0.0);
     qnav_sim_state_t st;
     int n = 0;
@@ -128,7 +128,7 @@ static void test_robot_that_never_moves_scores_zero_under_the_progress_rule(void
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
-    qnav_sim_reset(t.sim, 4);
+    assert_int_equal(qnav_sim_reset(t.sim, 4), QNAV_SIM_OK);
     qnav_sim_command_raw(t.sim, 0.0, 0.0);
     qnav_sim_state_t st;
     do {
@@ -147,8 +147,9 @@ static void test_progress_is_measured_to_the_destination_edge(void **state) {
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
-    qnav_sim_reset(t.sim, 4);
-    qnav_sim_place(t.sim, 9.0, 1.0, kPiD / 2);  // 8 m below the destination centre
+    assert_int_equal(qnav_sim_reset(t.sim, 4), QNAV_SIM_OK);
+    // 8 m below the destination centre
+    assert_int_equal(qnav_sim_place(t.sim, 9.0, 1.0, kPiD / 2), QNAV_SIM_OK);
     qnav_sim_command_raw(t.sim, 0.0, 1.0);      // straight at it
     for (int i = 0; i < 30; ++i) qnav_sim_advance(t.sim);
     qnav_sim_state_t st;
@@ -166,8 +167,8 @@ static void test_beta_l_and_beta_tau_come_from_the_start_and_the_profile(void **
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
-    qnav_sim_reset(t.sim, 4);
-    qnav_sim_place(t.sim, 1.0, 1.0, 0.0);
+    assert_int_equal(qnav_sim_reset(t.sim, 4), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 1.0, 1.0, 0.0), QNAV_SIM_OK);
     qnav_sim_result_t r;
     qnav_sim_result(t.sim, &r);
     const double beta_l = std::sqrt(2.0) * 8.0 - 0.3;  // to the edge of the destination

@@ -72,11 +72,12 @@ static void test_sensor_noise_scales_range_by_p_and_bearing_by_p_pi(void **state
     const double p = 0.1;
     TestSim t;
     make_test_sim(t, "pioneer3dx", env_circle(), nullptr, 16, p, 0);
-    qnav_sim_reset(t.sim, 3);
+    assert_int_equal(qnav_sim_reset(t.sim, 3), QNAV_SIM_OK);
     const int n = 4000;
     double rs = 0, rs2 = 0, bs = 0, bs2 = 0;
     for (int i = 0; i < n; ++i) {
-        qnav_sim_place(t.sim, 5.0, 5.0, 0.0);  // each place draws a fresh scan
+        // each place draws a fresh scan
+        assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
         qnav_sim_scan_t s;
         qnav_sim_scan(t.sim, &s);
         const double r = s.ranges_mm[2], b = s.goal_bearing_cdeg;
@@ -99,11 +100,11 @@ static void test_zero_noise_gives_identical_scans(void **state) {
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", env_circle(), nullptr, 16, 0, 0);
-    qnav_sim_reset(t.sim, 3);
-    qnav_sim_place(t.sim, 5.0, 5.0, 0.0);
+    assert_int_equal(qnav_sim_reset(t.sim, 3), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
     qnav_sim_scan_t a, b;
     qnav_sim_scan(t.sim, &a);
-    qnav_sim_place(t.sim, 5.0, 5.0, 0.0);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
     qnav_sim_scan(t.sim, &b);
     assert_memory_equal(a.ranges_mm, b.ranges_mm, 16 * sizeof(qnav_mm_t));
     assert_int_equal(a.goal_bearing_cdeg, b.goal_bearing_cdeg);
@@ -111,8 +112,8 @@ static void test_zero_noise_gives_identical_scans(void **state) {
 
 // Final pose after driving straight ahead for 20 ticks from a fixed pose.
 static void drive_straight(qnav_sim_t *sim, uint64_t seed, double *y, double *heading) {
-    qnav_sim_reset(sim, seed);
-    qnav_sim_place(sim, 2.0, 5.0, 0.0);
+    assert_int_equal(qnav_sim_reset(sim, seed), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(sim, 2.0, 5.0, 0.0), QNAV_SIM_OK);
     qnav_sim_command_raw(sim, 0.0, 0.6);
     for (int i = 0; i < 20; ++i) qnav_sim_advance(sim);
     qnav_sim_state_t st;
@@ -148,8 +149,8 @@ static void test_sensor_noise_does_not_move_the_start(void **state) {
     make_test_sim(a, "pioneer3dx", "", "dense", 16, 0, 0, 9);
     make_test_sim(b, "pioneer3dx", "", "dense", 16, 0.1, 0.1, 9);
     for (uint64_t e = 0; e < 5; ++e) {
-        qnav_sim_reset(a.sim, e);
-        qnav_sim_reset(b.sim, e);
+        assert_int_equal(qnav_sim_reset(a.sim, e), QNAV_SIM_OK);
+        assert_int_equal(qnav_sim_reset(b.sim, e), QNAV_SIM_OK);
         qnav_sim_result_t ra, rb;
         qnav_sim_result(a.sim, &ra);
         qnav_sim_result(b.sim, &rb);

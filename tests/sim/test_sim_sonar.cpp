@@ -56,8 +56,8 @@ static void test_sector_without_perpendicular_foot_reads_its_nearest_edge_ray(vo
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 16, 0, 0);
-    qnav_sim_reset(t.sim, 1);
-    qnav_sim_place(t.sim, 5.0, 5.0, 0.0);
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
     qnav_sim_scan_t s;
     qnav_sim_scan(t.sim, &s);
     // Sector 1 spans 11.25..33.75 deg: its nearest wall point lies on the 11.25 deg edge.
@@ -70,8 +70,9 @@ static void test_turned_robot_sees_the_obstacle_clockwise_of_ahead(void **state)
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", env_with_circle_at_45(), nullptr, 16, 0, 0);
-    qnav_sim_reset(t.sim, 1);
-    qnav_sim_place(t.sim, 5.0, 5.0, kPiD / 2);  // facing +y: obstacle at -45 deg
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    // facing +y: obstacle at -45 deg
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, kPiD / 2), QNAV_SIM_OK);
     qnav_sim_scan_t s;
     qnav_sim_scan(t.sim, &s);
     assert_int_equal(s.ranges_mm[14], 1440);
@@ -82,9 +83,9 @@ static void test_ranges_clip_to_profile_min_and_max(void **state) {
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 4, 0, 0);
-    qnav_sim_reset(t.sim, 1);
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
     // 0.3 m from the wall x = 10: surface gap 0.04 m, below the 0.1 m minimum.
-    qnav_sim_place(t.sim, 9.7, 5.0, 0.0);
+    assert_int_equal(qnav_sim_place(t.sim, 9.7, 5.0, 0.0), QNAV_SIM_OK);
     qnav_sim_scan_t s;
     qnav_sim_scan(t.sim, &s);
     assert_int_equal(s.ranges_mm[0], 100);
@@ -96,15 +97,16 @@ static void test_goal_bearing_is_robot_relative_in_centidegrees(void **state) {
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", test_env_text(""), nullptr, 8, 0, 0);
-    qnav_sim_reset(t.sim, 1);
-    qnav_sim_place(t.sim, 5.0, 5.0, 0.0);  // destination (9, 9): 45 deg left
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    // destination (9, 9): 45 deg left
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
     qnav_sim_scan_t s;
     qnav_sim_scan(t.sim, &s);
     assert_int_equal(s.goal_bearing_cdeg, 4500);
-    qnav_sim_place(t.sim, 5.0, 5.0, kPiD / 2);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, kPiD / 2), QNAV_SIM_OK);
     qnav_sim_scan(t.sim, &s);
     assert_int_equal(s.goal_bearing_cdeg, -4500);
-    qnav_sim_place(t.sim, 5.0, 5.0, -3.0 * kPiD / 4);  // facing away
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, -3.0 * kPiD / 4), QNAV_SIM_OK);  // facing away
     qnav_sim_scan(t.sim, &s);
     assert_int_equal(s.goal_bearing_cdeg, -18000);
 }
@@ -113,8 +115,8 @@ static void test_one_sector_reads_the_nearest_obstacle_all_round(void **state) {
     (void)state;
     TestSim t;
     make_test_sim(t, "pioneer3dx", env_with_circle_at_45(), nullptr, 1, 0, 0);
-    qnav_sim_reset(t.sim, 1);
-    qnav_sim_place(t.sim, 5.0, 5.0, 1.0);
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 1.0), QNAV_SIM_OK);
     qnav_sim_scan_t s;
     qnav_sim_scan(t.sim, &s);
     assert_int_equal(s.ranges_mm[0], 1440);
@@ -143,8 +145,8 @@ static void test_wide_cone_sees_the_obstacle_from_every_overlapping_sector(void 
     qnav_sim_config_t cfg;
     qnav_sim_config_default(&cfg);  // 0 sectors: the profile's 32
     assert_int_equal(qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err), QNAV_SIM_OK);
-    qnav_sim_reset(sim, 1);
-    qnav_sim_place(sim, 5.0, 5.0, 0.0);
+    assert_int_equal(qnav_sim_reset(sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
     qnav_sim_scan_t s;
     qnav_sim_scan(sim, &s);
     assert_int_equal(s.n_sectors, 32);

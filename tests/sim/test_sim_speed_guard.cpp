@@ -146,7 +146,7 @@ static int count_guard(const char *env, uint16_t sectors) {
         if (qnav_nav_init_named(nav, "body", &cc, &pol) != QNAV_OK) return 1;
         unsigned long ticks = 0, guarded = 0, reached = 0, collisions = 0;
         for (uint64_t e = 0; e < 200; ++e) {
-            qnav_sim_reset(t.sim, e);
+            assert_int_equal(qnav_sim_reset(t.sim, e), QNAV_SIM_OK);
             qnav_nav_reset(nav);
             qnav_sim_state_t st;
             qnav_sim_state(t.sim, &st);

@@ -330,6 +330,18 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
                     qnav_ctrl_output_t *out, qnav_q1_15_t *qualities);
 
 /*
+ * The plain reference step: the same output as qnav_ctrl_step() (heading, speed, quality,
+ * flags, escape memory, qualities) for every input, bit for bit, by the obvious route:
+ * every path's key from its own inputs (level, dtheta, and dprev for a 3-input network),
+ * the best under the same total order, then the same command. No runs, row shapes or
+ * search: 360 policy evaluations a tick, so it is the reference the fast step is tested
+ * against and the place a reader starts, not what a robot runs. It lives in its own object
+ * (src/ctrl_plain.c): a firmware that does not call it does not link it.
+ */
+void qnav_ctrl_step_plain(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
+                          qnav_ctrl_output_t *out, qnav_q1_15_t *qualities);
+
+/*
  * The rank key the policy gives one (distance level, dtheta) pair: the single function
  * that both the network/probabilistic step and every compiled table evaluate (a 3-input
  * network: with the path on the previous heading, dprev = 0).

@@ -1224,7 +1224,12 @@ int qnav_policy_write_meta(const char *path, const qnav_policy_t *policy,
         set_err(err, errlen, "%s: out of memory", nm);
         return -1;
     }
-    (void)qnav_policy_format(policy, meta, comment, buf, (size_t)n + 1, NULL, 0);
+    if (qnav_policy_format(policy, meta, comment, buf, (size_t)n + 1, msg, sizeof msg) != n) {
+        set_err(err, errlen, "%s: the policy's text changed length while it was written: %s", nm,
+                msg);
+        free(buf);
+        return -1;
+    }
     rc = qnav_policy_io_write_atomic(path, buf, (size_t)n, err, errlen);
     free(buf);
     return rc;

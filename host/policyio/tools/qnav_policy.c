@@ -178,9 +178,10 @@ static qnav_q8_8_t random_weight(uint64_t *state)
     return (qnav_q8_8_t)((int32_t)(qnav_splitmix64(state) % 1025u) - 512);
 }
 
-/* A seeded random network and the command that makes it again, as its "source". */
-static void new_network(qnav_policy_t *p, qnav_policy_meta_t *meta, uint8_t hidden,
-                        uint8_t inputs, uint64_t seed)
+/* A seeded random network and the command that makes it again, as its "source"; 0, or
+ * -1 with err. */
+static int new_network(qnav_policy_t *p, qnav_policy_meta_t *meta, uint8_t hidden,
+                       uint8_t inputs, uint64_t seed, char *err, size_t errlen)
 {
     char src[128];
     uint64_t state = seed;
@@ -197,7 +198,7 @@ static void new_network(qnav_policy_t *p, qnav_policy_meta_t *meta, uint8_t hidd
                        "qnav-policy new --kind network --hidden %u --inputs 3 --seed %llu",
                        (unsigned)hidden, (unsigned long long)seed);
     }
-    (void)qnav_policy_meta_set(meta, "source", src, NULL, 0);
+    return qnav_policy_meta_set(meta, "source", src, err, errlen);
 }
 
 static int cmd_new(int argc, char **argv)
@@ -214,6 +215,7 @@ static int cmd_new(int argc, char **argv)
     int have_hidden = 0;
     int have_seed = 0;
     int opt;
+    int made = -1;
     qnav_policy_t p;
     qnav_policy_meta_t meta;
     char err[QNAV_POLICY_IO_ERRLEN];
@@ -267,14 +269,14 @@ static int cmd_new(int argc, char **argv)
             return usage_error("new: --hidden, --inputs and --seed apply to --kind network only");
         }
         qnav_policy_prob_default(&p);
-        (void)qnav_policy_meta_set(&meta, "source", "qnav-policy new --kind probabilistic",
-                                   NULL, 0);
+        made = qnav_policy_meta_set(&meta, "source", "qnav-policy new --kind probabilistic",
+                                    err, sizeof err);
         break;
     case QNAV_POLICY_NET:
-        new_network(&p, &meta, (uint8_t)hidden, (uint8_t)inputs, seed);
+        made = new_network(&p, &meta, (uint8_t)hidden, (uint8_t)inputs, seed, err, sizeof err);
         break;
     }
-    if (qnav_policy_write_meta(argv[optind], &p, &meta, NULL, err, sizeof err) != 0) {
+    if (made != 0 || qnav_policy_write_meta(argv[optind], &p, &meta, NULL, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
         return EXIT_FAILED;
     }

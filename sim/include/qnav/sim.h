@@ -12,6 +12,10 @@
  * qnav_sim_result) -> qnav_sim_destroy(). One context is used by one thread at a time;
  * different contexts may run in parallel. See docs/sim.md.
  *
+ * Statuses: as in libqnav, what can fail on its input (load, parse, create, an episode,
+ * reset, place) is QNAV_CHECK_RESULT; the per-tick calls (scan, command, advance, state,
+ * result) fail only when misused (null, before the first reset), like a step, and are not.
+ *
  * Frames and units: world frame x right, y up, metres; headings in the world frame are
  * radians counter-clockwise from +x. Robot-frame angles (scan, bearing, command) are
  * counter-clockwise positive, 0 = straight ahead, as in libqnav. Time is counted in
@@ -25,6 +29,7 @@
 #include <stdint.h>
 
 #include "qnav/ctrl.h"
+#include "qnav/check.h"
 #include "qnav/nav.h"
 
 #ifdef __cplusplus
@@ -68,10 +73,10 @@ typedef struct qnav_sim qnav_sim_t;
  * qnav_sim_robot_free), or QNAV_SIM_E_NULL / _IO / _PARSE / _NOMEM with *out = NULL and
  * "FILE:LINE: problem" in err.
  */
-qnav_sim_status_t qnav_sim_robot_load(const char *spec, qnav_sim_robot_t **out, char *err,
+QNAV_CHECK_RESULT qnav_sim_status_t qnav_sim_robot_load(const char *spec, qnav_sim_robot_t **out, char *err,
                                       size_t errlen);
 /* Same from TOML text in memory; name stands in for the file name in messages. */
-qnav_sim_status_t qnav_sim_robot_parse(const char *text, size_t len, const char *name,
+QNAV_CHECK_RESULT qnav_sim_status_t qnav_sim_robot_parse(const char *text, size_t len, const char *name,
                                        qnav_sim_robot_t **out, char *err, size_t errlen);
 void qnav_sim_robot_free(qnav_sim_robot_t *robot);
 
@@ -86,12 +91,12 @@ void qnav_sim_robot_free(qnav_sim_robot_t *robot);
  * name is the spec with every field spelled out ("gen:gaps:7:0.5:tekbot"). A malformed
  * spec is QNAV_SIM_E_PARAM with one line naming the field ("world spec 'gen:x:1': unknown
  * family 'x' (families: ...)"). */
-qnav_sim_status_t qnav_sim_env_load(const char *spec, qnav_sim_env_t **out, char *err,
+QNAV_CHECK_RESULT qnav_sim_status_t qnav_sim_env_load(const char *spec, qnav_sim_env_t **out, char *err,
                                     size_t errlen);
 /* The world families a "gen:" spec may name, comma-separated ("clutter, gaps, ..."); a
  * static string. */
 const char *qnav_sim_world_families(void);
-qnav_sim_status_t qnav_sim_env_parse(const char *text, size_t len, const char *name,
+QNAV_CHECK_RESULT qnav_sim_status_t qnav_sim_env_parse(const char *text, size_t len, const char *name,
                                      qnav_sim_env_t **out, char *err, size_t errlen);
 void qnav_sim_env_free(qnav_sim_env_t *env);
 
@@ -151,7 +156,7 @@ typedef enum {
 const char *qnav_sim_fitness_rule_name(qnav_sim_fitness_rule_t rule);
 /* The rule called name (as above). Returns QNAV_SIM_OK and *rule, QNAV_SIM_E_NULL, or
  * QNAV_SIM_E_PARAM for an unknown name (*rule unchanged). */
-qnav_sim_status_t qnav_sim_fitness_rule_parse(const char *name, qnav_sim_fitness_rule_t *rule);
+QNAV_CHECK_RESULT qnav_sim_status_t qnav_sim_fitness_rule_parse(const char *name, qnav_sim_fitness_rule_t *rule);
 /* The known rules' names, comma separated ("progress, paper"), for messages. */
 const char *qnav_sim_fitness_rule_names(void);
 
@@ -179,7 +184,7 @@ void qnav_sim_config_default(qnav_sim_config_t *cfg);
  * [0, 36000] s, fitness not a qnav_sim_fitness_rule_t) with a "FIELD: problem" line in err, QNAV_SIM_E_WORLD (a start zone closer
  * than the robot's radius to an obstacle or wall: "FILE:LINE: ...") or QNAV_SIM_E_NOMEM.
  */
-qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_env_t *env,
+QNAV_CHECK_RESULT qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_env_t *env,
                                   const qnav_sim_config_t *cfg, qnav_sim_t **out, char *err,
                                   size_t errlen);
 void qnav_sim_destroy(qnav_sim_t *sim);
@@ -249,7 +254,7 @@ typedef void (*qnav_sim_trace_fn)(void *user, const qnav_sim_sample_t *sample);
  * Returns QNAV_SIM_OK with *res, or QNAV_SIM_E_NULL / QNAV_SIM_E_PARAM (controller not
  * ready or not matching).
  */
-qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
+QNAV_CHECK_RESULT qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
                                        uint64_t episode_seed, qnav_sim_result_t *res,
                                        qnav_sim_trace_fn trace, void *user);
 
@@ -258,7 +263,7 @@ qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
  * "literal", "vfh", ...): qnav_nav_reset() first, then every tick qnav_nav_step(). nav must
  * be initialised for this context's sensors. Same statuses.
  */
-qnav_sim_status_t qnav_sim_run_episode_nav(qnav_sim_t *sim, qnav_nav_t *nav, uint64_t episode_seed,
+QNAV_CHECK_RESULT qnav_sim_status_t qnav_sim_run_episode_nav(qnav_sim_t *sim, qnav_nav_t *nav, uint64_t episode_seed,
                                            qnav_sim_result_t *res, qnav_sim_trace_fn trace,
                                            void *user);
 
@@ -303,12 +308,12 @@ typedef struct {
 
 /* Start a new episode: random start point in a random start zone (zones weighted by
  * area), random heading, robot at rest. Computes the first scan. */
-qnav_sim_status_t qnav_sim_reset(qnav_sim_t *sim, uint64_t episode_seed);
+QNAV_CHECK_RESULT qnav_sim_status_t qnav_sim_reset(qnav_sim_t *sim, uint64_t episode_seed);
 
 /* For tests and tools: move the robot of the current episode (reset first) to a pose
  * (world frame, m and rad) at rest, clear collisions and figures (the start becomes this
  * pose) and compute a new scan. QNAV_SIM_E_PARAM for a pose outside the arena. */
-qnav_sim_status_t qnav_sim_place(qnav_sim_t *sim, double x_m, double y_m, double heading_rad);
+QNAV_CHECK_RESULT qnav_sim_status_t qnav_sim_place(qnav_sim_t *sim, double x_m, double y_m, double heading_rad);
 
 /* Copy this tick's scan, every field (computed once per tick at reset/advance, so reading
  * it twice gives the same values; qnav_sim_command changes prev_heading_cdeg only from the

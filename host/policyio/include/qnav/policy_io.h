@@ -9,6 +9,7 @@
 
 #include <stddef.h>
 #include "qnav/policy.h"
+#include "qnav/check.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -21,17 +22,17 @@ extern "C" {
  * Read the policy file at path into *out. Returns 0 on success; on failure returns -1,
  * leaves *out untouched and writes "PATH:LINE: what is wrong" into err (errlen bytes).
  */
-int qnav_policy_read(const char *path, qnav_policy_t *out, char *err, size_t errlen);
+QNAV_CHECK_RESULT int qnav_policy_read(const char *path, qnav_policy_t *out, char *err, size_t errlen);
 
 /* Same, from a string in memory; name is used in error messages in place of a path. */
-int qnav_policy_parse(const char *text, size_t len, const char *name, qnav_policy_t *out,
+QNAV_CHECK_RESULT int qnav_policy_parse(const char *text, size_t len, const char *name, qnav_policy_t *out,
                       char *err, size_t errlen);
 
 /*
  * Write policy to path atomically (a temporary file renamed into place), so that a reader
  * never sees half a file. comment (may be null) becomes a '#' line. 0 or -1 with err.
  */
-int qnav_policy_write(const char *path, const qnav_policy_t *policy, const char *comment,
+QNAV_CHECK_RESULT int qnav_policy_write(const char *path, const qnav_policy_t *policy, const char *comment,
                       char *err, size_t errlen);
 
 /* ---- Additions: format limits, metadata, in-memory rendering, checks ---------------- */
@@ -69,7 +70,7 @@ void qnav_policy_meta_clear(qnav_policy_meta_t *meta);
 
 /* Add or replace an entry. 0, or -1 with a message in err when the name or value breaks
  * the rules above or the table is full. */
-int qnav_policy_meta_set(qnav_policy_meta_t *meta, const char *name, const char *value,
+QNAV_CHECK_RESULT int qnav_policy_meta_set(qnav_policy_meta_t *meta, const char *name, const char *value,
                          char *err, size_t errlen);
 
 /* The value of an entry, or null when there is none. */
@@ -77,14 +78,14 @@ const char *qnav_policy_meta_get(const qnav_policy_meta_t *meta, const char *nam
 
 /* qnav_policy_read / qnav_policy_parse that also keep the metadata lines (meta may be
  * null). On failure neither *out nor *meta is touched. */
-int qnav_policy_read_meta(const char *path, qnav_policy_t *out, qnav_policy_meta_t *meta,
+QNAV_CHECK_RESULT int qnav_policy_read_meta(const char *path, qnav_policy_t *out, qnav_policy_meta_t *meta,
                           char *err, size_t errlen);
-int qnav_policy_parse_meta(const char *text, size_t len, const char *name,
+QNAV_CHECK_RESULT int qnav_policy_parse_meta(const char *text, size_t len, const char *name,
                            qnav_policy_t *out, qnav_policy_meta_t *meta, char *err,
                            size_t errlen);
 
 /* qnav_policy_write with metadata lines (meta may be null). */
-int qnav_policy_write_meta(const char *path, const qnav_policy_t *policy,
+QNAV_CHECK_RESULT int qnav_policy_write_meta(const char *path, const qnav_policy_t *policy,
                            const qnav_policy_meta_t *meta, const char *comment, char *err,
                            size_t errlen);
 
@@ -93,13 +94,13 @@ int qnav_policy_write_meta(const char *path, const qnav_policy_t *policy,
  * snprintf: returns the length of the full text (without NUL), which is >= buflen when buf
  * was too small; or -1 with err when the policy, metadata or comment is invalid.
  */
-int qnav_policy_format(const qnav_policy_t *policy, const qnav_policy_meta_t *meta,
+QNAV_CHECK_RESULT int qnav_policy_format(const qnav_policy_t *policy, const qnav_policy_meta_t *meta,
                        const char *comment, char *buf, size_t buflen, char *err,
                        size_t errlen);
 
 /* Check a policy in memory against the rules of the format (which are those of
  * qnav_ctrl_init). 0, or -1 with "what is wrong" (no file prefix) in err. */
-int qnav_policy_check(const qnav_policy_t *policy, char *err, size_t errlen);
+QNAV_CHECK_RESULT int qnav_policy_check(const qnav_policy_t *policy, char *err, size_t errlen);
 
 /* 1 when a and b are the same policy (kind, shape and every weight in use), else 0. */
 int qnav_policy_equal(const qnav_policy_t *a, const qnav_policy_t *b);
@@ -108,14 +109,14 @@ int qnav_policy_equal(const qnav_policy_t *a, const qnav_policy_t *b);
 const char *qnav_policy_kind_name(uint8_t kind);
 
 /* The kind named by the len bytes at name: 0 with *kind, or -1 when no kind has that name. */
-int qnav_policy_kind_from_name(const char *name, size_t len, uint8_t *kind);
+QNAV_CHECK_RESULT int qnav_policy_kind_from_name(const char *name, size_t len, uint8_t *kind);
 
 /* The format version qnav_policy_format() writes for policy (1 or 2). */
 int qnav_policy_file_version(const qnav_policy_t *policy);
 
 /* Write len bytes to path atomically (temporary file in the same directory, fsync,
  * rename, fsync of the directory). 0, or -1 with "PATH: what failed" in err. */
-int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, char *err,
+QNAV_CHECK_RESULT int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, char *err,
                                 size_t errlen);
 
 #ifdef __cplusplus

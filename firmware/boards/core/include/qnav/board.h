@@ -25,6 +25,7 @@
 
 #include "qnav/board_hal.h"
 #include "qnav/ctrl.h"
+#include "qnav/check.h"
 #include "qnav/nav.h"
 #include "qnav/link.h"
 
@@ -172,7 +173,7 @@ void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t
 /* Check cfg and hal, start the link, load the newest whole policy from storage (the
  * built-in policy when there is none or it is corrupt), start the controller; the drive
  * is set to 0. Returns QNAV_BOARD_OK, _E_NULL, _E_CONFIG or _E_CTRL. */
-qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t *cfg,
+QNAV_CHECK_RESULT qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t *cfg,
                                     const qnav_board_hal_t *hal);
 
 /* Drain the UART (qnav_board_receive) and run a control tick when tick_ms has passed. */
