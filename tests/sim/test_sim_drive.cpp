@@ -122,8 +122,8 @@ static void brake_while_turning(const char *limits, double *speed, double *dist,
     qnav_sim_config_t cfg;
     qnav_sim_config_default(&cfg);
     assert_int_equal(qnav_sim_create(t.robot, t.env, &cfg, &t.sim, err, sizeof err), QNAV_SIM_OK);
-    qnav_sim_reset(t.sim, 1);
-    qnav_sim_place(t.sim, 1.0, 2.0, 0.0);
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 1.0, 2.0, 0.0), QNAV_SIM_OK);
     drive(t.sim, 0.0, 1.0, 40);                              // up to 1 m/s
     const qnav_sim_state_t a = drive(t.sim, 0.0, 0.5, 10);  // and down to 0.5 m/s
     assert_true(std::fabs(a.speed_mps - 0.5) < 1e-3);
