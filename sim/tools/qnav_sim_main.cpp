@@ -193,6 +193,85 @@ struct RunOpts {
     long svg_tick = -1;
 };
 
+// One episode's samples as they come: the trajectory rows (first episode, --trace), the
+// picture's path and the sonar at the chosen tick or the last one before the end (first
+// episode, --svg), and the heading change for the smoothness figure (every episode).
+struct EpisodeRecord {
+    const qnav::Simulation &sim;
+    bool want_pic, want_trace;
+    long svg_tick;
+    qnav::EpisodePicture pic;
+    std::string csv = "tick,x_m,y_m,heading_rad,speed_mps,cmd_heading_deg,cmd_speed,recovering,collided,escape_side\n";
+    bool have_last = false;
+    double last_heading = 0, turn_deg = 0;
+
+    EpisodeRecord(const qnav::Simulation &s, bool pic_wanted, bool trace_wanted, long tick)
+        : sim(s), want_pic(pic_wanted), want_trace(trace_wanted), svg_tick(tick) {}
+    void add(const qnav_sim_sample_t &smp) {
+        if (have_last) turn_deg += std::fabs(std::remainder(smp.heading_rad - last_heading, 2 * M_PI)) * 180.0 / M_PI;
+        have_last = true;
+        last_heading = smp.heading_rad;
+        if (want_trace) {
+            char line[256];
+            std::snprintf(line, sizeof line, "%u,%.6f,%.6f,%.6f,%.4f,%d,%.4f,%d,%d,%d\n", smp.tick, smp.x_m,
+                          smp.y_m, smp.heading_rad, smp.speed_mps, smp.cmd_heading_deg, smp.cmd_speed,
+                          smp.recovering ? 1 : 0, smp.collided ? 1 : 0, smp.escape_side);
+            csv += line;
+        }
+        if (!want_pic) return;
+        pic.path.push_back({smp.x_m, smp.y_m});
+        if (static_cast<long>(smp.tick) <= std::max(0L, svg_tick)) {
+            pic.sonar_tick = smp.tick;
+            pic.sonar_pos = {smp.x_m, smp.y_m};
+            pic.sonar_heading = smp.heading_rad;
+            pic.sonar_ranges_m.clear();
+            for (unsigned k = 0; k < sim.config().n_sectors; ++k) pic.sonar_ranges_m.push_back(sim.scan().ranges_mm[k] / 1000.0);
+        }
+    }
+};
+
+// The first episode's --trace and --svg files.
+void write_episode_files(const RunOpts &o, const qnav::Simulation &sim, const qnav_sim_robot_info_t &ri,
+                         EpisodeRecord &rec, std::uint64_t episode, const qnav_sim_result_t &r) {
+    if (rec.want_trace) {
+        write_output(o.trace, rec.csv);
+        std::printf("trajectory: %s\n", o.trace.c_str());
+    }
+    if (!rec.want_pic) return;
+    rec.pic.collisions = sim.collision_marks();
+    rec.pic.cone_rad = sim.sonar_cone_rad();
+    rec.pic.reached = r.reached;
+    char cap[256];
+    std::snprintf(cap, sizeof cap, "%s, %s, %u sectors, episode %llu: R %.2f, %s, sonar at tick %u", ri.name,
+                  sim.env().name.c_str(), sim.config().n_sectors, static_cast<unsigned long long>(episode), r.R,
+                  r.reached ? "reached" : "not reached", rec.pic.sonar_tick);
+    rec.pic.caption = cap;
+    write_output(o.svg, qnav::render_svg(sim.env(), ri.radius_m, &rec.pic));
+    std::printf("picture: %s\n", o.svg.c_str());
+}
+
+// What the episodes of one run add up to.
+struct RunTotals {
+    double sum_r = 0, path_m = 0, turn_deg = 0;
+    unsigned reached = 0;
+    unsigned long long tau_c = 0;
+
+    void add(const qnav_sim_result_t &r, double turn) {
+        sum_r += r.R;
+        reached += r.reached;
+        tau_c += r.tau_c;
+        path_m += r.l;
+        turn_deg += turn;
+    }
+    void print(unsigned episodes) const {
+        if (episodes <= 1) return;
+        std::printf("mean R %.3f over %u episodes, %u reached (%.1f%%)\n", sum_r / episodes, episodes, reached,
+                    100.0 * reached / episodes);
+        std::printf("recovery ticks %.2f per episode  path %.2f m per episode  heading change %.1f deg/m\n",
+                    static_cast<double>(tau_c) / episodes, path_m / episodes, path_m > 0 ? turn_deg / path_m : 0.0);
+    }
+};
+
 int cmd_run(const RunOpts &o) {
     Loaded l;
     load(l, o.robot, o.env);
@@ -220,74 +299,17 @@ int cmd_run(const RunOpts &o) {
                 qnav_sim_fitness_rule_name(rule),
                 !uses_policy ? "none" : o.policy.empty() ? "probabilistic (default)" : o.policy.c_str(),
                 o.table ? " (table mode)" : "");
-    double sum_r = 0;
-    unsigned reached = 0;
-    unsigned long long tau_c = 0;
-    double path_m = 0, turn_deg = 0;  // smoothness: heading change per metre driven
+    RunTotals totals;
     for (unsigned e = 0; e < o.episodes; ++e) {
         const std::uint64_t es = o.episode + e;
-        qnav::EpisodePicture pic;
-        const bool want_pic = e == 0 && !o.svg.empty();
-        const bool want_trace = e == 0 && !o.trace.empty();
-        std::string csv = "tick,x_m,y_m,heading_rad,speed_mps,cmd_heading_deg,cmd_speed,recovering,collided,escape_side\n";
-        // Every sample of the episode: the trajectory row, the path, and the sonar at the
-        // chosen tick (or the last one before the episode ended).
-        bool have_last = false;
-        double last_heading = 0;
-        auto grab = [&](const qnav_sim_sample_t &smp) {
-            if (have_last) turn_deg += std::fabs(std::remainder(smp.heading_rad - last_heading, 2 * M_PI)) * 180.0 / M_PI;
-            have_last = true;
-            last_heading = smp.heading_rad;
-            if (want_trace) {
-                char line[256];
-                std::snprintf(line, sizeof line, "%u,%.6f,%.6f,%.6f,%.4f,%d,%.4f,%d,%d,%d\n", smp.tick,
-                              smp.x_m, smp.y_m, smp.heading_rad, smp.speed_mps, smp.cmd_heading_deg,
-                              smp.cmd_speed, smp.recovering ? 1 : 0, smp.collided ? 1 : 0, smp.escape_side);
-                csv += line;
-            }
-            if (!want_pic) return;
-            pic.path.push_back({smp.x_m, smp.y_m});
-            if (static_cast<long>(smp.tick) <= std::max(0L, o.svg_tick)) {
-                pic.sonar_tick = smp.tick;
-                pic.sonar_pos = {smp.x_m, smp.y_m};
-                pic.sonar_heading = smp.heading_rad;
-                pic.sonar_ranges_m.clear();
-                for (unsigned k = 0; k < sim.config().n_sectors; ++k)
-                    pic.sonar_ranges_m.push_back(sim.scan().ranges_mm[k] / 1000.0);
-            }
-        };
-        auto trace = [](void *user, const qnav_sim_sample_t *smp) { (*static_cast<decltype(grab) *>(user))(*smp); };
-        const qnav_sim_result_t r = sim.run_episode(&nav, es, +trace, &grab);
+        EpisodeRecord rec(sim, e == 0 && !o.svg.empty(), e == 0 && !o.trace.empty(), o.svg_tick);
+        auto trace = [](void *user, const qnav_sim_sample_t *smp) { static_cast<EpisodeRecord *>(user)->add(*smp); };
+        const qnav_sim_result_t r = sim.run_episode(&nav, es, +trace, &rec);
         print_result(static_cast<unsigned long long>(es), r);
-        sum_r += r.R;
-        reached += r.reached;
-        tau_c += r.tau_c;
-        path_m += r.l;
-        if (want_trace) {
-            write_output(o.trace, csv);
-            std::printf("trajectory: %s\n", o.trace.c_str());
-        }
-        if (want_pic) {
-            pic.collisions = sim.collision_marks();
-            pic.cone_rad = sim.sonar_cone_rad();
-            pic.reached = r.reached;
-            char cap[256];
-            std::snprintf(cap, sizeof cap, "%s, %s, %u sectors, episode %llu: R %.2f, %s, sonar at tick %u",
-                          ri.name, sim.env().name.c_str(), sim.config().n_sectors,
-                          static_cast<unsigned long long>(es), r.R, r.reached ? "reached" : "not reached",
-                          pic.sonar_tick);
-            pic.caption = cap;
-            write_output(o.svg, qnav::render_svg(sim.env(), ri.radius_m, &pic));
-            std::printf("picture: %s\n", o.svg.c_str());
-        }
+        totals.add(r, rec.turn_deg);
+        write_episode_files(o, sim, ri, rec, es, r);
     }
-    if (o.episodes > 1) {
-        std::printf("mean R %.3f over %u episodes, %u reached (%.1f%%)\n", sum_r / o.episodes, o.episodes,
-                    reached, 100.0 * reached / o.episodes);
-        std::printf("recovery ticks %.2f per episode  path %.2f m per episode  heading change %.1f deg/m\n",
-                    static_cast<double>(tau_c) / o.episodes, path_m / o.episodes,
-                    path_m > 0 ? turn_deg / path_m : 0.0);
-    }
+    totals.print(o.episodes);
     return 0;
 }
 
@@ -468,35 +490,73 @@ int cmd_bench(const BenchOpts &o) {
 
 }  // namespace
 
+// The run subcommand's options, into o.
+static CLI::App *add_run(CLI::App &app, RunOpts &o) {
+    CLI::App *run = app.add_subcommand("run", "simulate a policy and print the episode's figures");
+    run->add_option("--policy", o.policy, "policy file (default: the probabilistic policy tuned for the robot)")->check(CLI::ExistingFile);
+    run->add_option("--robot", o.robot, "robot profile name or file")->capture_default_str();
+    run->add_option("--env", o.env, "environment name, file, or world spec gen:FAMILY:SEED[:DIFFICULTY[:ROBOT]] (docs/sim.md)")->capture_default_str();
+    run->add_option("--sectors", o.sectors, "sonar sectors 1..360 (default: the profile's)")->check(CLI::Range(1, 360));
+    run->add_option("--sensor-noise", o.ps, "p_s in [0, 1] (default: the profile's typical)")->check(qnav::cli::finite_range(0.0, 1.0));
+    run->add_option("--actuation-noise", o.pa, "p_a in [0, 1] (default: the profile's typical)")->check(qnav::cli::finite_range(0.0, 1.0));
+    run->add_option("--seed", o.seed, "context seed")->capture_default_str();
+    run->add_option("--fitness", o.fitness, "fitness rule: progress (default) or paper (Eq. 1-3 literally; docs/sim.md)")->capture_default_str();
+    run->add_option("--episode", o.episode, "first episode seed")->capture_default_str();
+    run->add_option("--episodes", o.episodes, "number of episodes")->check(CLI::Range(1u, 1000000u))->capture_default_str();
+    run->add_flag("--table", o.table, "run the controller in table mode");
+    run->add_option("--controller", o.controller,
+                    "body: obstacles enlarged by the robot's radius + safety distance, speed guard, "
+                    "rank by pre-activation; literal: the paper's per-sector reading (ablation); "
+                    "vfh: VFH+ (Ulrich & Borenstein 1998), no policy")
+        ->capture_default_str();
+    run->add_option("--limit-factor", o.limit_factor,
+                    "episode time limit as a multiple of the environment's (2: judge escapes at twice it)")
+        ->check(qnav::cli::finite_range(0.1, 100.0))->capture_default_str();
+    run->add_option("--svg", o.svg, "write the first episode's picture here");
+    run->add_option("--trace", o.trace, "write the first episode's trajectory here (CSV, one row per tick)");
+    run->add_option("--svg-tick", o.svg_tick, "tick whose sonar sectors are drawn (default 0; past the end: the last tick)")->check(CLI::NonNegativeNumber);
+    return run;
+}
+
+// The gen-env subcommand's options, into o; *difficulty: the --difficulty option.
+static CLI::App *add_gen_env(CLI::App &app, GenOpts &o, CLI::Option **difficulty) {
+    CLI::App *gen = app.add_subcommand("gen-env", "write a generated environment file (a world family, or the old density form)");
+    gen->add_option("--family", o.family, std::string("world family: ") + qnav_sim_world_families() + " (docs/sim.md)");
+    *difficulty = gen->add_option("--difficulty", o.difficulty, "with --family: difficulty in [0, 1], at most 3 decimals")->capture_default_str();
+    gen->add_option("--density", o.density, "without --family: fraction of the obstacle band covered, 0..0.5 (default 0.2)")->check(qnav::cli::finite_range(0.0, 0.5));
+    gen->add_option("--seed", o.seed, "generator seed")->capture_default_str();
+    gen->add_option("--robot", o.robot, "robot that must fit through (default: tekbot with --family, else pioneer3dx)");
+    gen->add_option("--name", o.name, "environment name (default: the world spec, or generated-d<density>-s<seed>)");
+    gen->add_option("--out", o.out, "TOML file to write")->required();
+    return gen;
+}
+
+// The bench subcommand's options, into o.
+static CLI::App *add_bench(CLI::App &app, BenchOpts &o) {
+    CLI::App *bench = app.add_subcommand("bench", "episodes per second per core, time split");
+    bench->add_option("--robot", o.robot, "robot profile")->capture_default_str();
+    bench->add_option("--env", o.env, "environment name, file, or world spec gen:...")->capture_default_str();
+    bench->add_option("--sectors", o.sectors, "sonar sectors")->check(CLI::Range(1, 360))->capture_default_str();
+    bench->add_option("--hidden", o.hidden, "hidden units of the random network")->check(CLI::Range(1, QNAV_MAX_HIDDEN))->capture_default_str();
+    bench->add_option("--policy", o.policy, "policy file, or 'prob' for the hand-tuned policy (default: a random network)")
+        ->check(CLI::ExistingFile | CLI::IsMember({"prob"}));
+    bench->add_flag("--fresh-network", o.fresh, "a new random network for every episode, as in evolution");
+    bench->add_flag("--reference", o.reference, "the straightforward way for comparison: a Box2D ray per degree, Box2D every tick");
+    bench->add_option("--episodes", o.episodes, "episodes per pass")->check(CLI::Range(1u, 10000000u))->capture_default_str();
+    bench->add_option("--mode", o.mode, "controller mode")->check(CLI::IsMember({"table", "network"}))->capture_default_str();
+    bench->add_option("--seed", o.seed, "context and network seed")->capture_default_str();
+    bench->add_option("--sensor-noise", o.ps, "p_s")->check(qnav::cli::finite_range(0.0, 1.0))->capture_default_str();
+    bench->add_option("--actuation-noise", o.pa, "p_a")->check(qnav::cli::finite_range(0.0, 1.0))->capture_default_str();
+    return bench;
+}
+
 int main(int argc, char **argv) {
     CLI::App app{"qnav-sim: Box2D simulator of TekBot-class and Pioneer 3-DX robots (docs/sim.md)"};
     app.require_subcommand(1);
     qnav::cli::add_version(app, "qnav-sim");
 
     RunOpts ro;
-    CLI::App *run = app.add_subcommand("run", "simulate a policy and print the episode's figures");
-    run->add_option("--policy", ro.policy, "policy file (default: the probabilistic policy tuned for the robot)")->check(CLI::ExistingFile);
-    run->add_option("--robot", ro.robot, "robot profile name or file")->capture_default_str();
-    run->add_option("--env", ro.env, "environment name, file, or world spec gen:FAMILY:SEED[:DIFFICULTY[:ROBOT]] (docs/sim.md)")->capture_default_str();
-    run->add_option("--sectors", ro.sectors, "sonar sectors 1..360 (default: the profile's)")->check(CLI::Range(1, 360));
-    run->add_option("--sensor-noise", ro.ps, "p_s in [0, 1] (default: the profile's typical)")->check(qnav::cli::finite_range(0.0, 1.0));
-    run->add_option("--actuation-noise", ro.pa, "p_a in [0, 1] (default: the profile's typical)")->check(qnav::cli::finite_range(0.0, 1.0));
-    run->add_option("--seed", ro.seed, "context seed")->capture_default_str();
-    run->add_option("--fitness", ro.fitness, "fitness rule: progress (default) or paper (Eq. 1-3 literally; docs/sim.md)")->capture_default_str();
-    run->add_option("--episode", ro.episode, "first episode seed")->capture_default_str();
-    run->add_option("--episodes", ro.episodes, "number of episodes")->check(CLI::Range(1u, 1000000u))->capture_default_str();
-    run->add_flag("--table", ro.table, "run the controller in table mode");
-    run->add_option("--controller", ro.controller,
-                    "body: obstacles enlarged by the robot's radius + safety distance, speed guard, "
-                    "rank by pre-activation; literal: the paper's per-sector reading (ablation); "
-                    "vfh: VFH+ (Ulrich & Borenstein 1998), no policy")
-        ->capture_default_str();
-    run->add_option("--limit-factor", ro.limit_factor,
-                    "episode time limit as a multiple of the environment's (2: judge escapes at twice it)")
-        ->check(qnav::cli::finite_range(0.1, 100.0))->capture_default_str();
-    run->add_option("--svg", ro.svg, "write the first episode's picture here");
-    run->add_option("--trace", ro.trace, "write the first episode's trajectory here (CSV, one row per tick)");
-    run->add_option("--svg-tick", ro.svg_tick, "tick whose sonar sectors are drawn (default 0; past the end: the last tick)")->check(CLI::NonNegativeNumber);
+    CLI::App *run = add_run(app, ro);
 
     std::string de_env = "dense", de_robot = "pioneer3dx", de_out;
     CLI::App *draw = app.add_subcommand("draw-env", "draw an environment (like the paper's Fig. 6) to SVG");
@@ -505,30 +565,11 @@ int main(int argc, char **argv) {
     draw->add_option("--out", de_out, "SVG file")->required();
 
     GenOpts go;
-    CLI::App *gen = app.add_subcommand("gen-env", "write a generated environment file (a world family, or the old density form)");
-    gen->add_option("--family", go.family, std::string("world family: ") + qnav_sim_world_families() + " (docs/sim.md)");
-    CLI::Option *g_difficulty = gen->add_option("--difficulty", go.difficulty, "with --family: difficulty in [0, 1], at most 3 decimals")->capture_default_str();
-    gen->add_option("--density", go.density, "without --family: fraction of the obstacle band covered, 0..0.5 (default 0.2)")->check(qnav::cli::finite_range(0.0, 0.5));
-    gen->add_option("--seed", go.seed, "generator seed")->capture_default_str();
-    gen->add_option("--robot", go.robot, "robot that must fit through (default: tekbot with --family, else pioneer3dx)");
-    gen->add_option("--name", go.name, "environment name (default: the world spec, or generated-d<density>-s<seed>)");
-    gen->add_option("--out", go.out, "TOML file to write")->required();
+    CLI::Option *g_difficulty = nullptr;
+    CLI::App *gen = add_gen_env(app, go, &g_difficulty);
 
     BenchOpts bo;
-    CLI::App *bench = app.add_subcommand("bench", "episodes per second per core, time split");
-    bench->add_option("--robot", bo.robot, "robot profile")->capture_default_str();
-    bench->add_option("--env", bo.env, "environment name, file, or world spec gen:...")->capture_default_str();
-    bench->add_option("--sectors", bo.sectors, "sonar sectors")->check(CLI::Range(1, 360))->capture_default_str();
-    bench->add_option("--hidden", bo.hidden, "hidden units of the random network")->check(CLI::Range(1, QNAV_MAX_HIDDEN))->capture_default_str();
-    bench->add_option("--policy", bo.policy, "policy file, or 'prob' for the hand-tuned policy (default: a random network)")
-        ->check(CLI::ExistingFile | CLI::IsMember({"prob"}));
-    bench->add_flag("--fresh-network", bo.fresh, "a new random network for every episode, as in evolution");
-    bench->add_flag("--reference", bo.reference, "the straightforward way for comparison: a Box2D ray per degree, Box2D every tick");
-    bench->add_option("--episodes", bo.episodes, "episodes per pass")->check(CLI::Range(1u, 10000000u))->capture_default_str();
-    bench->add_option("--mode", bo.mode, "controller mode")->check(CLI::IsMember({"table", "network"}))->capture_default_str();
-    bench->add_option("--seed", bo.seed, "context and network seed")->capture_default_str();
-    bench->add_option("--sensor-noise", bo.ps, "p_s")->check(qnav::cli::finite_range(0.0, 1.0))->capture_default_str();
-    bench->add_option("--actuation-noise", bo.pa, "p_a")->check(qnav::cli::finite_range(0.0, 1.0))->capture_default_str();
+    CLI::App *bench = add_bench(app, bo);
 
     std::string rh_robot = "tekbot", rh_out;
     CLI::App *rh = app.add_subcommand("robot-header", "write a robot's board configuration as a C header (for a firmware build)");
