@@ -452,31 +452,24 @@ static int cmd_header(int argc, char **argv, int full_argc, char *const *full_ar
     return rc;
 }
 
-static int header_body(int argc, char **argv, const char *cmd)
+/* header's options and operands: --mode, --name, IN, OUT.h. Returns 0, or the exit code
+ * after one line on stderr. */
+static int header_args(int argc, char **argv, const char **mode, const char **name,
+                       const char **in, const char **out)
 {
     static const struct option opts[] = {{"mode", required_argument, NULL, 'm'},
                                          {"name", required_argument, NULL, 'n'},
                                          {NULL, 0, NULL, 0}};
-    const char *mode = NULL;
-    const char *name = NULL;
-    const char *in;
-    const char *out;
     int opt;
-    int i;
-    qnav_policy_t p;
-    char err[QNAV_POLICY_IO_ERRLEN];
-    text_t t = {NULL, 0, 0, 0};
-    char guard[80];
-    int rc;
     opterr = 0;
     optind = 1;
     while ((opt = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
         switch (opt) {
         case 'm':
-            mode = optarg;
+            *mode = optarg;
             break;
         case 'n':
-            name = optarg;
+            *name = optarg;
             break;
         case ':':
             return usage_error("header: option '%s' needs a value", argv[optind - 1]);
@@ -484,21 +477,90 @@ static int header_body(int argc, char **argv, const char *cmd)
             return usage_error("header: unknown option '%s'", argv[optind - 1]);
         }
     }
-    if (mode == NULL || (strcmp(mode, "network") != 0 && strcmp(mode, "probabilistic") != 0 &&
-                         strcmp(mode, "table") != 0)) {
+    if (*mode == NULL || (strcmp(*mode, "network") != 0 && strcmp(*mode, "probabilistic") != 0 &&
+                          strcmp(*mode, "table") != 0)) {
         return usage_error("header: --mode must be network, probabilistic or table");
     }
-    if (name == NULL || !is_c_identifier(name)) {
+    if (*name == NULL || !is_c_identifier(*name)) {
         return usage_error("header: --name must be a C identifier (letters, digits, '_'; "
                            "not starting with a digit or '_'; not a keyword; <= 63 chars)");
     }
     if (optind != argc - 2) {
         return usage_error("header: expected IN and OUT.h after the options");
     }
-    in = argv[optind];
-    out = argv[optind + 1];
-    if (strcmp(in, out) == 0) {
+    *in = argv[optind];
+    *out = argv[optind + 1];
+    if (strcmp(*in, *out) == 0) {
         return usage_error("header: OUT.h must not be the policy file IN");
+    }
+    return 0;
+}
+
+/* Policy p (read from in) compiled into a quality table, as C text. Returns 0, or the exit
+ * code after one line on stderr. */
+static int put_table(text_t *t, const qnav_policy_t *p, const char *name, const char *in)
+{
+    qnav_ctrl_t ctrl;
+    qnav_ctrl_config_t cfg;
+    qnav_qkey_t *table = (qnav_qkey_t *)malloc(sizeof(qnav_qkey_t) * QNAV_QTABLE_ENTRIES);
+    unsigned level;
+    unsigned d;
+    qnav_status_t st = QNAV_E_NULL;
+    qnav_ctrl_config_default(&cfg);
+    if (table != NULL) {
+        st = qnav_ctrl_init(&ctrl, &cfg, p);
+    }
+    if (st == QNAV_OK) {
+        st = qnav_ctrl_build_table(&ctrl, table);
+    }
+    if (st != QNAV_OK) {
+        fprintf(stderr, "%s: cannot build the quality table: %s%s\n", in, qnav_status_str(st),
+                st == QNAV_E_NO_TABLE ? " (use --mode network: the board then evaluates "
+                                        "every path, docs/performance.md)"
+                                      : "");
+        free(table);
+        return EXIT_FAILED;
+    }
+    put(t, "#include \"qnav/ctrl.h\"\n#include \"qnav/flash.h\"\n\n");
+    put(t, "#if QNAV_DIST_LEVELS != %d || QNAV_DTHETA_MAX != %d\n", QNAV_DIST_LEVELS,
+        QNAV_DTHETA_MAX);
+    put(t, "#error \"%s was generated for QNAV_DIST_LEVELS %d: regenerate it with "
+           "qnav-policy header for this build\"\n#endif\n\n",
+        name, QNAV_DIST_LEVELS);
+    put(t, "/* Path rank keys (qnav_qkey_t of rank %s_RANK) by distance level (rows,\n"
+           " * 0..%d) and dtheta in degrees (columns, 0..%d); use with\n"
+           " * qnav_ctrl_init_table(&ctrl, &cfg, %s, %s_RANK). */\n",
+        name, QNAV_DIST_LEVELS - 1, QNAV_DTHETA_MAX, name, name);
+    put(t, "#define %s_RANK %s\n", name,
+        qnav_ctrl_rank(&ctrl) == QNAV_RANK_PREACT ? "QNAV_RANK_PREACT" : "QNAV_RANK_QUALITY");
+    put(t, "static QNAV_FLASH const qnav_qkey_t %s[QNAV_QTABLE_ENTRIES] = {\n", name);
+    for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
+        put(t, "    /* level %u */\n", level);
+        for (d = 0; d <= QNAV_DTHETA_MAX; ++d) {
+            int v = table[level * (QNAV_DTHETA_MAX + 1u) + d];
+            put(t, "%s%d,%s", d % 12u == 0 ? "    " : " ", v,
+                (d % 12u == 11u || d == QNAV_DTHETA_MAX) ? "\n" : "");
+        }
+    }
+    put(t, "};\n");
+    free(table);
+    return 0;
+}
+
+static int header_body(int argc, char **argv, const char *cmd)
+{
+    const char *mode = NULL;
+    const char *name = NULL;
+    const char *in = NULL;
+    const char *out = NULL;
+    int i;
+    qnav_policy_t p;
+    char err[QNAV_POLICY_IO_ERRLEN];
+    text_t t = {NULL, 0, 0, 0};
+    char guard[80];
+    int rc = header_args(argc, argv, &mode, &name, &in, &out);
+    if (rc != 0) {
+        return rc;
     }
     if (qnav_policy_read(in, &p, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
@@ -527,57 +589,15 @@ static int header_body(int argc, char **argv, const char *cmd)
     put(&t, " * Source: ");
     put_comment_safe(&t, in);
     put(&t, "\n * Command:%s\n */\n#ifndef QNAV_GENERATED_%s_H\n#define QNAV_GENERATED_%s_H\n\n", cmd, guard, guard);
-
     if (strcmp(mode, "table") == 0) {
-        qnav_ctrl_t ctrl;
-        qnav_ctrl_config_t cfg;
-        qnav_qkey_t *table = (qnav_qkey_t *)malloc(sizeof(qnav_qkey_t) * QNAV_QTABLE_ENTRIES);
-        unsigned level;
-        unsigned d;
-        qnav_status_t st = QNAV_E_NULL;
-        qnav_ctrl_config_default(&cfg);
-        if (table != NULL) {
-            st = qnav_ctrl_init(&ctrl, &cfg, &p);
-        }
-        if (st == QNAV_OK) {
-            st = qnav_ctrl_build_table(&ctrl, table);
-        }
-        if (st != QNAV_OK) {
-            fprintf(stderr, "%s: cannot build the quality table: %s%s\n", in, qnav_status_str(st),
-                    st == QNAV_E_NO_TABLE ? " (use --mode network: the board then evaluates "
-                                            "every path, docs/performance.md)"
-                                          : "");
-            free(table);
-            free(t.p);
-            return EXIT_FAILED;
-        }
-        put(&t, "#include \"qnav/ctrl.h\"\n#include \"qnav/flash.h\"\n\n");
-        put(&t, "#if QNAV_DIST_LEVELS != %d || QNAV_DTHETA_MAX != %d\n", QNAV_DIST_LEVELS,
-            QNAV_DTHETA_MAX);
-        put(&t, "#error \"%s was generated for QNAV_DIST_LEVELS %d: regenerate it with "
-                "qnav-policy header for this build\"\n#endif\n\n",
-            name, QNAV_DIST_LEVELS);
-        put(&t, "/* Path rank keys (qnav_qkey_t of rank %s_RANK) by distance level (rows,\n"
-                " * 0..%d) and dtheta in degrees (columns, 0..%d); use with\n"
-                " * qnav_ctrl_init_table(&ctrl, &cfg, %s, %s_RANK). */\n",
-            name, QNAV_DIST_LEVELS - 1, QNAV_DTHETA_MAX, name, name);
-        put(&t, "#define %s_RANK %s\n", name,
-            qnav_ctrl_rank(&ctrl) == QNAV_RANK_PREACT ? "QNAV_RANK_PREACT" : "QNAV_RANK_QUALITY");
-        put(&t, "static QNAV_FLASH const qnav_qkey_t %s[QNAV_QTABLE_ENTRIES] = {\n", name);
-        for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
-            put(&t, "    /* level %u */\n", level);
-            for (d = 0; d <= QNAV_DTHETA_MAX; ++d) {
-                int v = table[level * (QNAV_DTHETA_MAX + 1u) + d];
-                put(&t, "%s%d,%s", d % 12u == 0 ? "    " : " ", v,
-                    (d % 12u == 11u || d == QNAV_DTHETA_MAX) ? "\n" : "");
-            }
-        }
-        put(&t, "};\n");
-        free(table);
+        rc = put_table(&t, &p, name, in);
     } else if (put_policy(&t, &p, name) != 0) {
-        free(t.p);
         fprintf(stderr, "%s: unknown policy kind %u\n", in, (unsigned)p.kind);
-        return EXIT_BAD_INPUT;
+        rc = EXIT_BAD_INPUT;
+    }
+    if (rc != 0) {
+        free(t.p);
+        return rc;
     }
     put(&t, "\n#endif /* QNAV_GENERATED_%s_H */\n", guard);
     if (t.failed) {
