@@ -737,6 +737,90 @@ static int line_key(parser_t *ps, const char *body, size_t blen, const token_t *
     return fail(ps, "unknown kind %u", (unsigned)ps->pol.kind); /* line_kind set a known one */
 }
 
+/* The bytes of one line: no NUL, no lone carriage return, no control character but tab. */
+static int line_bytes(parser_t *ps, const char *s, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        unsigned char c = (unsigned char)s[i];
+        if (c == 0) {
+            return fail(ps, "NUL byte at column %zu", i + 1);
+        }
+        if (c == '\r') {
+            return fail(ps, "carriage return not followed by a line feed at column %zu", i + 1);
+        }
+        if ((c < 0x20 && c != '\t') || c == 0x7f) {
+            return fail(ps, "control character 0x%02X at column %zu", (unsigned)c, i + 1);
+        }
+    }
+    return 0;
+}
+
+/* The blank-separated tokens of buf[0..blen): their count, MAX_TOKENS + 1 when there are
+ * more than MAX_TOKENS (the first MAX_TOKENS are in tok). */
+static size_t split_tokens(const char *buf, size_t blen, token_t *tok)
+{
+    size_t ntok = 0;
+    size_t i = 0;
+    while (i < blen) {
+        while (i < blen && (buf[i] == ' ' || buf[i] == '\t')) {
+            i++;
+        }
+        if (i >= blen) {
+            break;
+        }
+        if (ntok == MAX_TOKENS) {
+            return MAX_TOKENS + 1u; /* more than any key takes: "too many" */
+        }
+        tok[ntok].p = buf + i;
+        while (i < blen && buf[i] != ' ' && buf[i] != '\t') {
+            i++;
+        }
+        tok[ntok].n = (size_t)((buf + i) - tok[ntok].p);
+        ntok++;
+    }
+    return ntok;
+}
+
+/* One line of the file: n bytes at s, without its line ending; ps->line is its number. */
+static int parse_line(parser_t *ps, const char *s, size_t n)
+{
+    char buf[QNAV_POLICY_LINE_MAX + 1];
+    token_t tok[MAX_TOKENS];
+    size_t ntok;
+    size_t blen = n;
+    if (n > QNAV_POLICY_LINE_MAX) {
+        return fail(ps, "line longer than %d bytes", QNAV_POLICY_LINE_MAX);
+    }
+    if (line_bytes(ps, s, n) != 0) {
+        return -1;
+    }
+    memcpy(buf, s, n);
+    buf[n] = '\0';
+    if (ps->line == 1 && n >= 3 && memcmp(buf, "\xEF\xBB\xBF", 3) == 0) {
+        return fail(ps, "byte order mark before 'qnav-policy': save without BOM");
+    }
+    /* comments: from '#' to the end of the line, on every line but the first */
+    if (ps->line > 1) {
+        char *hash = memchr(buf, '#', n);
+        if (hash != NULL) {
+            blen = (size_t)(hash - buf);
+        }
+    }
+    ntok = split_tokens(buf, blen, tok);
+    if (ntok > MAX_TOKENS) {
+        /* a meta value is free text; every other line is short */
+        if (!tok_is(&tok[0], "meta")) {
+            return fail(ps, "too many values on one line (more than %d tokens)", MAX_TOKENS);
+        }
+        ntok = MAX_TOKENS;
+    }
+    if (ps->line == 1) {
+        return line_magic(ps, tok, ntok);
+    }
+    return ntok > 0 ? line_key(ps, buf, blen, tok, ntok) : 0;
+}
+
 int qnav_policy_parse_meta(const char *text, size_t len, const char *name,
                            qnav_policy_t *out, qnav_policy_meta_t *meta, char *err,
                            size_t errlen)
@@ -769,14 +853,9 @@ int qnav_policy_parse_meta(const char *text, size_t len, const char *name,
         rc = fail(ps, "file larger than %ld bytes", QNAV_POLICY_FILE_MAX);
     }
     while (rc == 0 && pos < len) {
-        char buf[QNAV_POLICY_LINE_MAX + 1];
-        token_t tok[MAX_TOKENS];
-        size_t ntok = 0;
         size_t start = pos;
         size_t eol = pos;
         size_t n;
-        size_t i;
-        size_t blen;
         while (eol < len && text[eol] != '\n') {
             eol++;
         }
@@ -786,73 +865,7 @@ int qnav_policy_parse_meta(const char *text, size_t len, const char *name,
         if (n > 0 && eol < len && text[eol - 1] == '\r') {
             n--; /* CRLF line ending: accepted (docs/policy-format.md) */
         }
-        if (n > QNAV_POLICY_LINE_MAX) {
-            rc = fail(ps, "line longer than %d bytes", QNAV_POLICY_LINE_MAX);
-            break;
-        }
-        for (i = 0; i < n; ++i) {
-            unsigned char c = (unsigned char)text[start + i];
-            if (c == 0) {
-                rc = fail(ps, "NUL byte at column %zu", i + 1);
-            } else if (c == '\r') {
-                rc = fail(ps, "carriage return not followed by a line feed at column %zu",
-                          i + 1);
-            } else if ((c < 0x20 && c != '\t') || c == 0x7f) {
-                rc = fail(ps, "control character 0x%02X at column %zu", (unsigned)c, i + 1);
-            }
-            if (rc != 0) {
-                break;
-            }
-        }
-        if (rc != 0) {
-            break;
-        }
-        memcpy(buf, text + start, n);
-        buf[n] = '\0';
-        if (ps->line == 1 && n >= 3 && memcmp(buf, "\xEF\xBB\xBF", 3) == 0) {
-            rc = fail(ps, "byte order mark before 'qnav-policy': save without BOM");
-            break;
-        }
-        /* comments: from '#' to the end of the line, on every line but the first */
-        blen = n;
-        if (ps->line > 1) {
-            char *hash = memchr(buf, '#', n);
-            if (hash != NULL) {
-                blen = (size_t)(hash - buf);
-            }
-        }
-        for (i = 0; i < blen;) {
-            while (i < blen && (buf[i] == ' ' || buf[i] == '\t')) {
-                i++;
-            }
-            if (i >= blen) {
-                break;
-            }
-            if (ntok == MAX_TOKENS) {
-                ntok++; /* more than any key takes: counted as "too many" below */
-                break;
-            }
-            tok[ntok].p = buf + i;
-            while (i < blen && buf[i] != ' ' && buf[i] != '\t') {
-                i++;
-            }
-            tok[ntok].n = (size_t)((buf + i) - tok[ntok].p);
-            ntok++;
-        }
-        if (ntok > MAX_TOKENS) {
-            /* a meta value is free text; every other line is short */
-            if (!tok_is(&tok[0], "meta")) {
-                rc = fail(ps, "too many values on one line (more than %d tokens)",
-                          MAX_TOKENS);
-                break;
-            }
-            ntok = MAX_TOKENS;
-        }
-        if (ps->line == 1) {
-            rc = line_magic(ps, tok, ntok);
-        } else if (ntok > 0) {
-            rc = line_key(ps, buf, blen, tok, ntok);
-        }
+        rc = parse_line(ps, text + start, n);
     }
     if (rc == 0 && ps->end_line == 0) {
         rc = fail(ps, "truncated: no 'end' line");
