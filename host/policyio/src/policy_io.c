@@ -1124,15 +1124,54 @@ int qnav_policy_format(const qnav_policy_t *policy, const qnav_policy_meta_t *me
 
 /* ---- writing ------------------------------------------------------------------------- */
 
+/* All len bytes of data to fd, through short writes and interruptions. Returns 0, or -1
+ * with errno set. */
+static int write_all(int fd, const void *data, size_t len)
+{
+    size_t done = 0;
+    while (done < len) {
+        ssize_t w = write(fd, (const char *)data + done, len - done);
+        if (w < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            return -1;
+        }
+        done += (size_t)w;
+    }
+    return 0;
+}
+
+/* Make a rename durable: fsync the directory that holds path (pl bytes), named in dir
+ * (pl + 2 bytes of the caller's). Some file systems refuse fsync on a directory: not an
+ * error. */
+static void sync_dir(char *dir, const char *path, size_t pl)
+{
+    char *slash;
+    int fd;
+    memcpy(dir, path, pl + 1);
+    slash = strrchr(dir, '/');
+    if (slash == NULL) {
+        memcpy(dir, ".", 2);
+    } else if (slash == dir) {
+        dir[1] = '\0';
+    } else {
+        *slash = '\0';
+    }
+    fd = open(dir, O_RDONLY);
+    if (fd >= 0) {
+        (void)fsync(fd);
+        (void)close(fd);
+    }
+}
+
 int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, char *err,
                                 size_t errlen)
 {
     char *tmp;
     char *dir;
-    char *slash;
     size_t pl;
     int fd;
-    size_t done = 0;
     char nm[200];
     if (path == NULL || (data == NULL && len > 0)) {
         set_err(err, errlen, "(null): null argument");
@@ -1165,17 +1204,7 @@ int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, 
     if (fchmod(fd, 0644) != 0) {
         goto io_error;
     }
-    while (done < len) {
-        ssize_t w = write(fd, (const char *)data + done, len - done);
-        if (w < 0) {
-            if (errno == EINTR) {
-                continue;
-            }
-            goto io_error;
-        }
-        done += (size_t)w;
-    }
-    if (fsync(fd) != 0) {
+    if (write_all(fd, data, len) != 0 || fsync(fd) != 0) {
         goto io_error;
     }
     if (close(fd) != 0) {
@@ -1186,21 +1215,7 @@ int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, 
     if (rename(tmp, path) != 0) {
         goto io_error;
     }
-    /* make the rename itself durable: fsync the directory that holds the file */
-    memcpy(dir, path, pl + 1);
-    slash = strrchr(dir, '/');
-    if (slash == NULL) {
-        memcpy(dir, ".", 2);
-    } else if (slash == dir) {
-        dir[1] = '\0';
-    } else {
-        *slash = '\0';
-    }
-    fd = open(dir, O_RDONLY);
-    if (fd >= 0) {
-        (void)fsync(fd); /* some file systems refuse fsync on a directory: not an error */
-        (void)close(fd);
-    }
+    sync_dir(dir, path, pl);
     free(tmp);
     free(dir);
     return 0;
