@@ -21,80 +21,107 @@ typedef struct {
     qnav_command_t cmd;
 } pending_t;
 
+/* One replay: the controller, the scans waiting for their command, and what was found. */
+typedef struct {
+    pending_t pend[PENDING];
+    unsigned next;
+    int crc_noted;
+    qnav_bridge_ctrl_t bc;
+    qnav_replay_result_t *res;
+    FILE *out;
+} replay_t;
+
+/* A logged scan: run the controller on it and keep the command until the log's own. */
+static void on_scan(replay_t *r, const lcm_eventlog_event_t *ev)
+{
+    qnav_scan_t scan;
+    pending_t *p = &r->pend[r->next];
+    if (qnav_scan_t_decode(ev->data, 0, ev->datalen, &scan) < 0) {
+        r->res->bad_events++;
+        return;
+    }
+    r->res->scans++;
+    p->used = 1;
+    p->seq = scan.seq;
+    qnav_bridge_ctrl_step(&r->bc, &scan, &p->cmd, NULL);
+    r->next = (r->next + 1u) % PENDING;
+}
+
+/* The logged command c against the replayed one of its scan p (first 10 differences
+ * printed). */
+static void compare(replay_t *r, const qnav_command_t *c, const pending_t *p)
+{
+    r->res->compared++;
+    if (p->cmd.heading_deg == c->heading_deg && p->cmd.speed_q15 == c->speed_q15 &&
+        p->cmd.quality_q15 == c->quality_q15 && p->cmd.flags == c->flags) {
+        r->res->identical++;
+        return;
+    }
+    r->res->differ++;
+    if (r->out != NULL && r->res->differ <= 10u) {
+        fprintf(r->out,
+                "scan %d: logged heading %d speed %d quality %d flags %d,"
+                " replayed heading %d speed %d quality %d flags %d\n",
+                c->scan_seq, c->heading_deg, c->speed_q15, c->quality_q15, c->flags,
+                p->cmd.heading_deg, p->cmd.speed_q15, p->cmd.quality_q15, p->cmd.flags);
+    }
+}
+
+/* A logged command: compared with the newest pending scan of its sequence number, unless
+ * it is a stop or came from another policy. */
+static void on_command(replay_t *r, const lcm_eventlog_event_t *ev)
+{
+    qnav_command_t c;
+    unsigned k;
+    if (qnav_command_t_decode(ev->data, 0, ev->datalen, &c) < 0) {
+        r->res->bad_events++;
+    } else if (c.stop_reason != QNAV_STOP_NONE || c.scan_seq < 0) {
+        r->res->stops++;
+    } else if (c.policy_crc != 0 && (uint16_t)c.policy_crc != r->bc.policy_crc) {
+        r->res->other_policy++;
+        if (!r->crc_noted && r->out != NULL) {
+            fprintf(r->out, "note: some logged commands came from policy crc 0x%04x, "
+                            "replaying with 0x%04x: those are not compared\n",
+                    (unsigned)(uint16_t)c.policy_crc, (unsigned)r->bc.policy_crc);
+            r->crc_noted = 1;
+        }
+    } else {
+        for (k = 1; k <= PENDING; ++k) {
+            pending_t *p = &r->pend[(r->next + PENDING - k) % PENDING];
+            if (p->used && p->seq == c.scan_seq) {
+                compare(r, &c, p);
+                p->used = 0;
+                break;
+            }
+        }
+    }
+}
+
 int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg, const char *controller,
                     const qnav_policy_t *policy, qnav_replay_result_t *res, FILE *out,
                     char *err, size_t errlen)
 {
-    pending_t pend[PENDING];
-    qnav_scan_t scan;
-    qnav_bridge_ctrl_t bc;
+    replay_t r;
     lcm_eventlog_t *log;
     lcm_eventlog_event_t *ev;
-    unsigned next = 0, events = 0;
-    int crc_noted = 0;
+    unsigned events = 0;
 
     memset(res, 0, sizeof *res);
-    memset(pend, 0, sizeof pend);
+    memset(&r, 0, sizeof r);
+    r.res = res;
+    r.out = out;
     log = lcm_eventlog_create(path, "r");
     if (log == NULL) {
         snprintf(err, errlen, "%s: cannot open LCM log (%s)", path, strerror(errno));
         return -1;
     }
-    qnav_bridge_ctrl_init(&bc, cfg, controller, policy);
+    qnav_bridge_ctrl_init(&r.bc, cfg, controller, policy);
     while ((ev = lcm_eventlog_read_next_event(log)) != NULL) {
         events++;
         if (strcmp(ev->channel, QNAV_CH_SCAN) == 0) {
-            if (qnav_scan_t_decode(ev->data, 0, ev->datalen, &scan) < 0) {
-                res->bad_events++;
-            } else {
-                res->scans++;
-                pend[next].used = 1;
-                pend[next].seq = scan.seq;
-                qnav_bridge_ctrl_step(&bc, &scan, &pend[next].cmd, NULL);
-                next = (next + 1u) % PENDING;
-            }
+            on_scan(&r, ev);
         } else if (strcmp(ev->channel, QNAV_CH_COMMAND) == 0) {
-            qnav_command_t c;
-            if (qnav_command_t_decode(ev->data, 0, ev->datalen, &c) < 0) {
-                res->bad_events++;
-            } else if (c.stop_reason != QNAV_STOP_NONE || c.scan_seq < 0) {
-                res->stops++;
-            } else if (c.policy_crc != 0 && (uint16_t)c.policy_crc != bc.policy_crc) {
-                res->other_policy++;
-                if (!crc_noted && out != NULL) {
-                    fprintf(out, "note: some logged commands came from policy crc 0x%04x, "
-                                 "replaying with 0x%04x: those are not compared\n",
-                            (unsigned)(uint16_t)c.policy_crc, (unsigned)bc.policy_crc);
-                    crc_noted = 1;
-                }
-            } else {
-                /* newest pending scan with that sequence number */
-                unsigned k;
-                for (k = 1; k <= PENDING; ++k) {
-                    pending_t *p = &pend[(next + PENDING - k) % PENDING];
-                    if (!p->used || p->seq != c.scan_seq) {
-                        continue;
-                    }
-                    res->compared++;
-                    if (p->cmd.heading_deg == c.heading_deg &&
-                        p->cmd.speed_q15 == c.speed_q15 &&
-                        p->cmd.quality_q15 == c.quality_q15 && p->cmd.flags == c.flags) {
-                        res->identical++;
-                    } else {
-                        res->differ++;
-                        if (out != NULL && res->differ <= 10u) {
-                            fprintf(out,
-                                    "scan %d: logged heading %d speed %d quality %d flags %d,"
-                                    " replayed heading %d speed %d quality %d flags %d\n",
-                                    c.scan_seq, c.heading_deg, c.speed_q15, c.quality_q15,
-                                    c.flags, p->cmd.heading_deg, p->cmd.speed_q15,
-                                    p->cmd.quality_q15, p->cmd.flags);
-                        }
-                    }
-                    p->used = 0;
-                    break;
-                }
-            }
+            on_command(&r, ev);
         }
         lcm_eventlog_free_event(ev);
     }
