@@ -13,6 +13,11 @@
 /* A stall this many margins (r + d_s) nearer to the destination than where the last
  * follow ended is at another obstacle: its side is chosen afresh. */
 #define QNAV_ESCAPE_NEW_MARGINS 4u
+/* A side is given up once it has led this many margins (r + d_s) farther from the
+ * destination than where it began (twice as far for each try given up), while the
+ * side away from the boundary is open beyond QNAV_ESCAPE_OPEN_MARGINS. */
+#define QNAV_ESCAPE_AWAY_MARGINS 14u
+#define QNAV_ESCAPE_OPEN_MARGINS 9u
 /* Longest follow, in ticks, however many tries were given up (about 109 s). */
 #define QNAV_ESCAPE_MAX_FOLLOW 1092u
 /* A lost boundary is approached until a path clears its nearest reading by this many levels. */
@@ -142,6 +147,8 @@ void qnav_escape_clear(qnav_escape_t *e)
     e->loop_mm = 0u;
     e->loop_deg2 = 0u;
     e->loop = QNAV_ESCAPE_LOOP_NONE;
+    e->from_mm = 0u;
+    e->over_mm = 0u;
 }
 
 static uint16_t diff_mm(uint16_t a, uint16_t b)
@@ -195,6 +202,53 @@ static void start_follow(qnav_escape_t *e, int8_t side, uint16_t range)
     e->ticks = 0u;
     e->near_mm = range;
     e->loop = QNAV_ESCAPE_LOOP_NONE;
+    e->from_mm = range;
+    e->over_mm = 0u;
+}
+
+/*
+ * Has this side led away? Following a long wall the wrong way (its gap lies behind) takes
+ * the robot round the arena's corner, ever farther from the destination; a time limit
+ * alone lets it go on for the whole try. A side is given up once the robot is
+ * QNAV_ESCAPE_AWAY_MARGINS margins (doubled per try given up) farther from the
+ * destination than where the side began, but not while the side away from the boundary
+ * is closed within QNAV_ESCAPE_OPEN_MARGINS margins: in a corridor or a pocket the way
+ * out leads away from the destination first, and turning back there only returns to
+ * the dead end.
+ */
+static uint8_t led_away(const qnav_clearance_t *c, const qnav_ctrl_input_t *in,
+                        const qnav_escape_t *e, uint16_t range)
+{
+    uint16_t away_path = wrap((int16_t)(90 * e->side));
+    uint32_t open_mm = (uint32_t)in->ranges_mm[qnav_ctrl_sector_of_path(c->n_sectors, away_path)] +
+                       c->sensor_offset_mm;
+    uint8_t shift = e->tries < 6u ? e->tries : 6u;
+    uint32_t budget = ((uint32_t)QNAV_ESCAPE_AWAY_MARGINS * c->margin_mm) << shift;
+    if (open_mm < (uint32_t)QNAV_ESCAPE_OPEN_MARGINS * c->margin_mm) {
+        return 0u;
+    }
+    return (uint8_t)((uint32_t)range > (uint32_t)e->from_mm + budget);
+}
+
+/*
+ * Is this side's time up? Past follow_limit the follow goes on while the robot still gets
+ * nearer to the destination (by half a margin within escape_stall_ticks, as while going):
+ * a follow rounding the far end of a long wall toward the destination is not turned back
+ * at its last corner.
+ */
+static uint8_t time_up(const qnav_clearance_t *c, qnav_escape_t *e, uint16_t range)
+{
+    uint16_t limit = follow_limit(c, e->tries);
+    uint16_t progress = (uint16_t)(c->margin_mm / 2u);
+    if (++e->ticks < limit) {
+        return 0u;
+    }
+    if (e->over_mm == 0u || (uint32_t)range + progress <= e->over_mm) {
+        e->over_mm = range;
+        e->ticks = limit > c->esc_stall_ticks ? (uint16_t)(limit - c->esc_stall_ticks) : 0u;
+        return 0u;
+    }
+    return 1u;
 }
 
 uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
@@ -225,7 +279,7 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
             e->tries = 0u;
             return goal;
         }
-        if (++e->ticks >= follow_limit(c, e->tries)) {
+        if (time_up(c, e, range) != 0u || led_away(c, in, e, range) != 0u) {
             start_follow(e, (int8_t)-e->side, range); /* give this side up: the other, for longer */
             if (e->tries < 255u) {
                 ++e->tries;

@@ -15,10 +15,11 @@
  * It goes back to the
  * destination once the clear way toward it, read from the sonar sector that looks that
  * way, ends a step nearer to it than at the hit point (DistBug's leave rule); a follow that
- * lasts too long is given up for the other side, each try twice as long. While following, a step whose policy would stand still crawls along the
+ * lasts too long without getting nearer, or that leads far from the destination with open
+ * space on its other hand, is given up for the other side, each try twice as long or far. While following, a step whose policy would stand still crawls along the
  * boundary or turns in place, so no policy freezes.
  *
- * The memory (qnav_escape_t, 17 bytes) is the caller's: it comes in with the step's input
+ * The memory (qnav_escape_t, 21 bytes) is the caller's: it comes in with the step's input
  * and goes out with its output; the step itself keeps nothing.
  */
 #ifndef QNAV_ESCAPE_H

@@ -142,8 +142,17 @@ static void test_progress_never_follows(void **state)
     }
 }
 
-/* A follow that does not get nearer is given up for the other side after escape_follow_s,
- * and the next try lasts twice as long. */
+/* The controller's default margin (body radius and safety distance), mm. */
+static unsigned margin_mm(void)
+{
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_config_default(&cfg);
+    return (unsigned)(cfg.body_radius_mm + cfg.safety_mm);
+}
+
+/* A follow that does not get nearer is given up for the other side after escape_follow_s
+ * and one stall time more (the window in which it could still have got nearer), and the
+ * next try lasts twice as long. */
 static void test_a_long_follow_tries_the_other_side(void **state)
 {
     (void)state;
@@ -153,19 +162,93 @@ static void test_a_long_follow_tries_the_other_side(void **state)
     following_a_wall(&b);
     first = b.out.escape.side;
     assert_int_not_equal(first, 0);
-    for (t = 0; t < 199; ++t) {
+    for (t = 0; t < 219; ++t) {
         tick(&b.c, &b.in, &b.out);
         assert_int_equal(b.out.escape.side, first);
     }
     tick(&b.c, &b.in, &b.out);
     assert_int_equal(b.out.escape.side, -first);
     assert_int_equal(b.out.escape.tries, 1);
-    for (t = 0; t < 399; ++t) {
+    for (t = 0; t < 419; ++t) {
         tick(&b.c, &b.in, &b.out);
         assert_int_equal(b.out.escape.side, -first);
     }
     tick(&b.c, &b.in, &b.out);
     assert_int_equal(b.out.escape.side, first);
+}
+
+/* Past its time, a follow that still gets nearer to the destination (round the far end of
+ * a long wall) goes on; once it stops getting nearer, it is given up a stall time later. */
+static void test_a_follow_getting_nearer_outlasts_its_time(void **state)
+{
+    (void)state;
+    bot_t b;
+    int8_t first;
+    unsigned t;
+    qnav_policy_prob_default(&b.p);
+    facing_wall(&b, 20, 300, 9000); /* room to get nearer for 45 s */
+    for (t = 0; t < 21; ++t) {
+        tick(&b.c, &b.in, &b.out);
+    }
+    first = b.out.escape.side;
+    assert_int_not_equal(first, 0);
+    for (t = 0; t < 600; ++t) {
+        if (t >= 150u && t % 10u == 0u) { /* half a margin nearer a second */
+            b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm - (margin_mm() / 2u + 1u));
+        }
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, first);
+    }
+    for (t = 0; t < 19; ++t) {
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, first);
+    }
+    for (t = 0; t < 21 && b.out.escape.side == first; ++t) {
+        tick(&b.c, &b.in, &b.out);
+    }
+    assert_int_equal(b.out.escape.side, -first);
+}
+
+/* Following a wall with open space on the other hand, a side that leads 14 margins
+ * farther from the destination than where it began is given up before its time (the
+ * wrong way along a long wall); the next try may lead twice as far. In a corridor (the
+ * other hand closed) the same side is kept: there the way out leads away first. */
+static void test_a_follow_leading_away_is_given_up_early(void **state)
+{
+    (void)state;
+    bot_t b;
+    int8_t first;
+    unsigned t;
+    const unsigned step = margin_mm() / 2u;
+    following_a_wall(&b);
+    first = b.out.escape.side;
+    for (t = 0; t < 28; ++t) { /* 14 margins in half-margin steps: not beyond yet */
+        b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, first);
+    }
+    b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
+    tick(&b.c, &b.in, &b.out);
+    assert_int_equal(b.out.escape.side, -first);
+    assert_int_equal(b.out.escape.from_mm, b.in.goal_range_mm);
+    for (t = 0; t < 56; ++t) { /* the second try: 28 margins */
+        b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, -first);
+    }
+    b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
+    tick(&b.c, &b.in, &b.out);
+    assert_int_equal(b.out.escape.side, first);
+
+    following_a_wall(&b);
+    first = b.out.escape.side;
+    b.r[N / 4] = 400; /* a corridor: walls on both hands */
+    b.r[3 * N / 4] = 400;
+    for (t = 0; t < 150; ++t) {
+        b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, first);
+    }
 }
 
 /* Following a wall on the right (side +1), the destination behind it: the bearing it
@@ -352,6 +435,8 @@ int main(void)
         cmocka_unit_test(test_follows_after_a_stall_and_leaves_when_nearer),
         cmocka_unit_test(test_progress_never_follows),
         cmocka_unit_test(test_a_long_follow_tries_the_other_side),
+        cmocka_unit_test(test_a_follow_getting_nearer_outlasts_its_time),
+        cmocka_unit_test(test_a_follow_leading_away_is_given_up_early),
         cmocka_unit_test(test_the_follow_bearing_comes_from_the_boundary),
         cmocka_unit_test(test_round_an_island_leaves_at_its_nearest_place),
         cmocka_unit_test(test_a_new_obstacle_chooses_its_side_afresh),
