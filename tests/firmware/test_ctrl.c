@@ -520,7 +520,7 @@ static void test_argmax_matches_reference_on_random_scans(void **state)
         ref_path_qualities(&c, &p, &in, ref);
         /* networks rank by the pre-activation y: its bound, and the key's 1/128 steps
          * beyond |y| = 8; the probabilistic policy by its quality */
-        int net = p.kind == QNAV_POLICY_NET;
+        int net = ref_is_network(&p);
         double bound = net ? ref_preact_bound(&p) : ref_quality_bound(&p);
         double near = net ? 2.0 * bound + 1.0 / 128.0 : NEAR_TIE;
         unsigned rbest = ref_argmax(ref, ref_goal_deg(in.goal_bearing_cdeg));
