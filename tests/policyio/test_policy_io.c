@@ -550,6 +550,37 @@ static void test_every_bad_file_is_refused_with_its_expected_line_and_message(vo
     assert_int_equal(files, rows);
 }
 
+/* The list every message and the tool's help print names each kind once, from the kinds'
+ * own table, and a short buffer cuts it safely. */
+static void test_kind_list_names_every_kind_once(void **state)
+{
+    char buf[80];
+    char small[8];
+    char quoted[40];
+    unsigned k;
+    size_t named = 0;
+    size_t quotes = 0;
+    const char *c;
+    (void)state;
+    assert_ptr_equal(qnav_policy_kind_list(buf, sizeof buf, "'", ", ", " or "), buf);
+    for (k = 0; k < 256u; ++k) {
+        const char *n = qnav_policy_kind_name((uint8_t)k);
+        if (n != NULL) {
+            (void)snprintf(quoted, sizeof quoted, "'%s'", n);
+            assert_non_null(strstr(buf, quoted));
+            ++named;
+        }
+    }
+    for (c = buf; *c != '\0'; ++c) {
+        quotes += *c == '\'';
+    }
+    assert_true(named >= 2);
+    assert_int_equal(quotes, 2 * named);
+    assert_non_null(strstr(buf, " or "));
+    assert_int_equal(strlen(qnav_policy_kind_list(small, sizeof small, "", "|", "|")),
+                     sizeof small - 1);
+}
+
 static void test_every_status_has_its_own_text(void **state)
 {
     static const qnav_policy_io_status_t all[] = {
@@ -746,6 +777,7 @@ int main(void)
         cmocka_unit_test(test_reader_agrees_with_ctrl_init_on_every_probabilistic_parameter),
         cmocka_unit_test(test_every_bad_file_is_refused_with_its_expected_line_and_message),
         cmocka_unit_test(test_every_status_has_its_own_text),
+        cmocka_unit_test(test_kind_list_names_every_kind_once),
         cmocka_unit_test(test_missing_file_is_reported_with_its_name),
         cmocka_unit_test(test_oversized_file_is_refused),
         cmocka_unit_test(test_truncating_a_good_file_at_every_byte_never_crashes),

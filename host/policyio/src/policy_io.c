@@ -113,11 +113,14 @@ const char *qnav_policy_kind_name(uint8_t kind)
     return NULL;
 }
 
+/* Every kind, in the order names are listed. */
+static const qnav_policy_kind_t kinds[] = {QNAV_POLICY_PROB, QNAV_POLICY_NET};
+#define N_KINDS (sizeof kinds / sizeof kinds[0])
+
 qnav_policy_io_status_t qnav_policy_kind_from_name(const char *name, size_t len, uint8_t *kind)
 {
-    static const qnav_policy_kind_t kinds[] = {QNAV_POLICY_PROB, QNAV_POLICY_NET};
     size_t i;
-    for (i = 0; i < sizeof kinds / sizeof kinds[0]; ++i) {
+    for (i = 0; i < N_KINDS; ++i) {
         const char *n = qnav_policy_kind_name((uint8_t)kinds[i]);
         if (strlen(n) == len && memcmp(n, name, len) == 0) {
             *kind = (uint8_t)kinds[i];
@@ -125,6 +128,27 @@ qnav_policy_io_status_t qnav_policy_kind_from_name(const char *name, size_t len,
         }
     }
     return QNAV_POLICY_IO_E_NAME;
+}
+
+const char *qnav_policy_kind_list(char *buf, size_t len, const char *quote, const char *sep,
+                                  const char *last)
+{
+    size_t used = 0;
+    size_t i;
+    if (buf == NULL || len == 0) {
+        return buf;
+    }
+    buf[0] = '\0';
+    for (i = 0; i < N_KINDS && used < len; ++i) {
+        const char *between = i == 0 ? "" : (i + 1 == N_KINDS ? last : sep);
+        int n = snprintf(buf + used, len - used, "%s%s%s%s", between, quote,
+                         qnav_policy_kind_name((uint8_t)kinds[i]), quote);
+        if (n < 0) {
+            break;
+        }
+        used += (size_t)n;
+    }
+    return buf;
 }
 
 int qnav_policy_file_version(const qnav_policy_t *policy)
@@ -696,6 +720,7 @@ static int line_key_prob(parser_t *ps, const token_t *tok, size_t ntok, const ch
 static int line_kind(parser_t *ps, const token_t *tok, size_t ntok, const char *q)
 {
     char v[80];
+    char names[80];
     if (!tok_is(&tok[0], "kind")) {
         return fail(ps, "expected 'kind' as the first key, found '%s'", q);
     }
@@ -704,7 +729,8 @@ static int line_kind(parser_t *ps, const token_t *tok, size_t ntok, const char *
     }
     if (qnav_policy_kind_from_name(tok[1].p, tok[1].n, &ps->pol.kind) != 0) {
         quote_bytes(tok[1].p, tok[1].n, 40, v, sizeof v);
-        return fail(ps, "unknown kind '%s' (expected 'network' or 'probabilistic')", v);
+        return fail(ps, "unknown kind '%s' (expected %s)", v,
+                    qnav_policy_kind_list(names, sizeof names, "'", ", ", " or "));
     }
     switch ((qnav_policy_kind_t)ps->pol.kind) {
     case QNAV_POLICY_NET:

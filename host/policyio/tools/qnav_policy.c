@@ -24,12 +24,19 @@
 #define EXIT_BAD_INPUT 2 /* the policy file given is not a good one */
 #define EXIT_USAGE 2
 
-static const char *const usage_text =
-    "usage: qnav-policy check FILE\n"
-    "       qnav-policy show FILE\n"
-    "       qnav-policy new --kind probabilistic|network [--hidden H] [--inputs 2|3] [--seed S] OUT\n"
-    "       qnav-policy header --mode network|probabilistic|table --name NAME IN OUT.h\n"
-    "Policy files are described in docs/policy-format.md.\n";
+/* The usage text; the kinds it names are the policy kinds' own list. */
+static void usage(FILE *f)
+{
+    char kinds[80];
+    (void)qnav_policy_kind_list(kinds, sizeof kinds, "", "|", "|");
+    fprintf(f,
+            "usage: qnav-policy check FILE\n"
+            "       qnav-policy show FILE\n"
+            "       qnav-policy new --kind %s [--hidden H] [--inputs 2|3] [--seed S] OUT\n"
+            "       qnav-policy header --mode %s|table --name NAME IN OUT.h\n"
+            "Policy files are described in docs/policy-format.md.\n",
+            kinds, kinds);
+}
 
 #if defined(__GNUC__)
 #define QNAV_PRINTF_LIKE(f, a) __attribute__((format(printf, f, a)))
@@ -268,7 +275,9 @@ static int new_options(int argc, char **argv, new_options_t *o)
         }
     }
     if (o->kind == NULL) {
-        return usage_error("new: --kind probabilistic|network is required");
+        char kinds[80];
+        return usage_error("new: --kind %s is required",
+                           qnav_policy_kind_list(kinds, sizeof kinds, "", "|", "|"));
     }
     if (optind != argc - 1) {
         return usage_error("new: expected exactly one OUT file after the options");
@@ -288,7 +297,9 @@ static int cmd_new(int argc, char **argv)
         return rc;
     }
     if (qnav_policy_kind_from_name(o.kind, strlen(o.kind), &p.kind) != 0) {
-        return usage_error("new: --kind '%s' must be 'probabilistic' or 'network'", o.kind);
+        char kinds[80];
+        return usage_error("new: --kind '%s' must be %s", o.kind,
+                           qnav_policy_kind_list(kinds, sizeof kinds, "'", ", ", " or "));
     }
     qnav_policy_meta_clear(&meta);
     switch ((qnav_policy_kind_t)p.kind) {
@@ -481,6 +492,13 @@ static int cmd_header(int argc, char **argv, int full_argc, char *const *full_ar
     return rc;
 }
 
+/* 1 when --mode names a policy kind (the kind's own mode; "table" takes any). */
+static int mode_is_kind(const char *mode)
+{
+    uint8_t kind;
+    return qnav_policy_kind_from_name(mode, strlen(mode), &kind) == QNAV_POLICY_IO_OK;
+}
+
 /* header's options and operands: --mode, --name, IN, OUT.h. Returns 0, or the exit code
  * after one line on stderr. */
 static int header_args(int argc, char **argv, const char **mode, const char **name,
@@ -506,9 +524,10 @@ static int header_args(int argc, char **argv, const char **mode, const char **na
             return usage_error("header: unknown option '%s'", argv[optind - 1]);
         }
     }
-    if (*mode == NULL || (strcmp(*mode, "network") != 0 && strcmp(*mode, "probabilistic") != 0 &&
-                          strcmp(*mode, "table") != 0)) {
-        return usage_error("header: --mode must be network, probabilistic or table");
+    if (*mode == NULL || (!mode_is_kind(*mode) && strcmp(*mode, "table") != 0)) {
+        char kinds[80];
+        return usage_error("header: --mode must be %s or table",
+                           qnav_policy_kind_list(kinds, sizeof kinds, "", ", ", ", "));
     }
     if (*name == NULL || !is_c_identifier(*name)) {
         return usage_error("header: --name must be a C identifier (letters, digits, '_'; "
@@ -647,12 +666,12 @@ int main(int argc, char **argv)
 {
     const char *cmd;
     if (argc < 2) {
-        fputs(usage_text, stderr);
+        usage(stderr);
         return EXIT_USAGE;
     }
     cmd = argv[1];
     if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {
-        fputs(usage_text, stdout);
+        usage(stdout);
         return 0;
     }
     if (strcmp(cmd, "--version") == 0) {

@@ -128,6 +128,14 @@ int qnav_policy_equal(const qnav_policy_t *a, const qnav_policy_t *b);
 /* The file name of a policy kind ("probabilistic", "network"), or null for an unknown one. */
 const char *qnav_policy_kind_name(uint8_t kind);
 
+/* Every policy kind's file name, in the order of qnav_policy_kind_t, each between quote
+ * ("" for none), sep between two and last between the last two, into buf (len bytes,
+ * always NUL-terminated when len > 0, cut short if too small); returns buf. E.g. quote
+ * "'", sep ", ", last " or ": "'probabilistic' or 'network'". For help and messages, so
+ * that no list of kinds is kept beside the kinds' own. */
+const char *qnav_policy_kind_list(char *buf, size_t len, const char *quote, const char *sep,
+                                  const char *last);
+
 /* The kind named by the len bytes at name: _OK with *kind, or _E_NAME when no kind has
  * that name. */
 QNAV_CHECK_RESULT qnav_policy_io_status_t qnav_policy_kind_from_name(const char *name, size_t len, uint8_t *kind);
