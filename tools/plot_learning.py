@@ -6,9 +6,9 @@ Usage: plot_learning.py EXPERIMENT_DIR [OUT.png]
 Reads EXPERIMENT_DIR/curves.csv and summary.json (written by `simevo run`) and draws, per
 condition, the mean over runs with its 95% confidence band of (left) the population's best
 fitness, (middle) the R of the candidates (binned) and (right) the fraction of the
-candidates' episodes that reached the destination (binned); the two references, the
-probabilistic policy (dashed) and VFH+ (dotted), are horizontal bands (their mean and 95%
-CI on the held-out episodes). The legends and the arrival panel's title say which line is
+candidates' episodes that reached the destination (binned); the references (summary.json
+"references": simevo's reference table, e.g. the probabilistic policy dashed and VFH+
+dotted) are horizontal bands (their mean and 95% CI on the held-out episodes). The legends and the arrival panel's title say which line is
 the candidates' (training episodes) and which a reference's (held-out episodes). Writes EXPERIMENT_DIR/learning.png
 unless OUT.png is given. Needs matplotlib only.
 """
@@ -30,10 +30,9 @@ def draw(summary, curves):
     on the held-out episodes. Each panel says which is which in its legend, the arrival panel
     also in its title, since its two kinds of arrival are read against each other."""
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.9), dpi=110, layout="constrained")
-    # the references, one row each in simevo's table (summary.json "references")
-    references = summary.get("references") or [
-        {"label": "probabilistic", "plot_name": "probabilistic (held out)", "plot_style": "--", "plot_color": "tab:gray"},
-        {"label": "vfh", "plot_name": "VFH+ (held out)", "plot_style": ":", "plot_color": "tab:brown"}]
+    # the references, one row each in simevo's table (summary.json "references", written
+    # from kReferences in host/simevo/src/task.h): no list of them is kept here
+    references = summary.get("references", [])
     colors = {"direct": "tab:red"}
     colors.update({r["label"]: r["plot_color"] for r in references})
     palette = ["tab:blue", "tab:green", "tab:purple", "tab:orange"]

@@ -1,8 +1,8 @@
 /*
  * The controller table (qnav/nav.h): one row per controller, each a thin adapter from
- * the shared step signature to that controller's own init and step. Adding a controller
- * is one row here, one union member in qnav_nav_t, and its own header and source
- * (docs/architecture.md, "Adding a controller").
+ * the shared step signature to that controller's own init, step and sensor settings.
+ * Adding a controller is one row here, one union member in qnav_nav_t, and its own
+ * header and source (docs/architecture.md, "Adding a controller").
  */
 #include "qnav/nav.h"
 
@@ -21,6 +21,16 @@ static void paths_reset(qnav_nav_t *nav)
 static void paths_step(qnav_nav_t *nav, const qnav_ctrl_input_t *in, qnav_ctrl_output_t *out)
 {
     qnav_ctrl_step(&nav->u.paths, in, out, 0);
+}
+
+static const qnav_clearance_t *paths_sensors(const qnav_nav_t *nav)
+{
+    return &nav->u.paths.clr;
+}
+
+static const qnav_clearance_t *vfh_sensors(const qnav_nav_t *nav)
+{
+    return &nav->u.vfh.vfh.clr;
 }
 
 /* What a controller that is not ready commands. */
@@ -80,9 +90,9 @@ static void vfh_step(qnav_nav_t *nav, const qnav_ctrl_input_t *in, qnav_ctrl_out
 #endif
 
 static const qnav_nav_method_t methods[] = {
-    {"body", 1u, 0, body_init, paths_reset, paths_step},
-    {"literal", 1u, qnav_ctrl_config_literal, body_init, paths_reset, paths_step},
-    {"vfh", 0u, 0, vfh_init, vfh_reset, vfh_step},
+    {"body", 1u, 0, body_init, paths_reset, paths_step, paths_sensors},
+    {"literal", 1u, qnav_ctrl_config_literal, body_init, paths_reset, paths_step, paths_sensors},
+    {"vfh", 0u, 0, vfh_init, vfh_reset, vfh_step, vfh_sensors},
 };
 
 #define N_METHODS ((uint8_t)(sizeof methods / sizeof methods[0]))
@@ -195,7 +205,7 @@ void qnav_nav_sensors(const qnav_nav_t *nav, uint16_t *n_sectors, qnav_mm_t *max
 {
     const qnav_clearance_t *c = 0;
     if (nav != 0 && nav->method != 0) {
-        c = nav->method->step == paths_step ? &nav->u.paths.clr : &nav->u.vfh.vfh.clr;
+        c = nav->method->sensors(nav);
     }
     if (n_sectors != 0) {
         *n_sectors = c != 0 ? c->n_sectors : 0u;

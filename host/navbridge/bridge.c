@@ -48,7 +48,7 @@ void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg
     bc->cfg = *cfg;
     bc->policy = *policy;
     bc->policy_crc = qnav_bridge_policy_crc(policy);
-    bc->method = qnav_nav_find(controller != NULL ? controller : "body");
+    bc->method = qnav_nav_find(controller != NULL ? controller : QNAV_BRIDGE_DEFAULT_CONTROLLER);
     bc->ready = bridge_ctrl_reinit(bc);
 }
 
@@ -120,7 +120,7 @@ void qnav_bridge_config_default(qnav_bridge_config_t *cfg)
     cfg->timeout_ms = 300;
     cfg->heartbeat_ms = 100;
     cfg->status_ms = 500;
-    cfg->controller = "body";
+    cfg->controller = QNAV_BRIDGE_DEFAULT_CONTROLLER;
     qnav_ctrl_config_default(&cfg->ctrl);
     qnav_policy_prob_default(&cfg->policy);
 }

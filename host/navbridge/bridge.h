@@ -79,6 +79,9 @@ extern "C" {
 /* Writes bytes to the serial port; returns 0 or -1. */
 typedef int (*qnav_bridge_write_fn)(void *user, const uint8_t *bytes, size_t n);
 
+/* The controller navbridge runs when none is named: a row of qnav/nav.h's table. */
+#define QNAV_BRIDGE_DEFAULT_CONTROLLER "body"
+
 typedef struct {
     uint8_t mode;                 /* QNAV_LINK_MODE_OFFBOARD or _ONBOARD */
     uint32_t timeout_ms;          /* watchdog: stop after this long without scans
@@ -86,8 +89,8 @@ typedef struct {
     uint32_t heartbeat_ms;        /* bridge heartbeat period, ms (100) */
     uint32_t status_ms;           /* link status publish period, ms (500) */
     qnav_ctrl_config_t ctrl;      /* n_sectors is taken from each scan */
-    const char *controller;       /* a name in libqnav's controller table: "body" (default),
-                                     "literal", "vfh" (qnav/nav.h) */
+    const char *controller;       /* a name in libqnav's controller table (qnav/nav.h);
+                                     null: QNAV_BRIDGE_DEFAULT_CONTROLLER */
     qnav_policy_t policy;         /* offboard: drives the robot; onboard: qualities shown */
     int upload;                   /* onboard: upload policy to the board */
     /* --robot: checks each CONFIG report of the board against the robot's profile; 0 when
@@ -111,7 +114,7 @@ typedef struct {
     int16_t last_goal_cdeg;       /* the goal bearing it saw */
 } qnav_bridge_ctrl_t;
 
-/* controller: a name of the table in qnav/nav.h (null: "body"). */
+/* controller: a name of the table in qnav/nav.h (null: QNAV_BRIDGE_DEFAULT_CONTROLLER). */
 void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg,
                            const char *controller, const qnav_policy_t *policy);
 /* Run the controller on an LCM scan; fills cmd (integer and float fields, source BRIDGE)

@@ -43,6 +43,19 @@ static void on_signal(int sig)
     g_stop_signal = sig;
 }
 
+/* The controllers of libqnav's table (qnav/nav.h), ", " between them, the default marked
+ * when mark_default: the list is the table's, never a copy. */
+static void print_controllers(FILE *f, int mark_default)
+{
+    uint8_t i;
+    for (i = 0; i < qnav_nav_count(); ++i) {
+        const char *name = qnav_nav_method_at(i)->name;
+        fprintf(f, "%s%s%s", i > 0 ? ", " : "", name,
+                mark_default && strcmp(name, QNAV_BRIDGE_DEFAULT_CONTROLLER) == 0 ? " (default)"
+                                                                                  : "");
+    }
+}
+
 static void usage(FILE *f)
 {
     fprintf(f,
@@ -57,7 +70,10 @@ static void usage(FILE *f)
             "  --lcm-url URL      LCM provider URL, default LCM's own default\n"
             "  --mode M           offboard (bridge runs libqnav, default) or onboard\n"
             "  --policy FILE      policy file; default: hand-tuned probabilistic policy\n"
-            "  --controller NAME  offboard controller: body (default), literal, vfh\n"
+            "  --controller NAME  offboard controller: ");
+    print_controllers(f, 1);
+    fprintf(f,
+            "\n"
             "  --robot NAME|FILE  robot profile (data/robots): the controller runs its\n"
             "                     configuration, and a board reporting another is refused\n"
             "  --upload           onboard: upload --policy to the board at start\n"
@@ -226,8 +242,9 @@ static int parse_value(int c, const char *arg, options_t *o)
     switch (c) {
     case 'c':
         if (qnav_nav_find(arg) == NULL) {
-            fprintf(stderr, "navbridge: --controller %s: no such controller (body, literal, vfh)\n",
-                    arg);
+            fprintf(stderr, "navbridge: --controller %s: no such controller (", arg);
+            print_controllers(stderr, 0);
+            fprintf(stderr, ")\n");
             return 2;
         }
         o->cfg.controller = arg;

@@ -23,7 +23,7 @@ def world_families():
 
 
 def controller_names():
-    """The controllers of libqnav's table (qnav/nav.h): ``body``, ``literal``, ``vfh``."""
+    """The controllers of libqnav's table (qnav/nav.h), in its order, e.g. ``body``."""
     return [f.strip() for f in lib.qpy_controller_names().decode().split(",")]
 
 
@@ -98,6 +98,11 @@ def _q8_8(values):
     return np.clip(r, -32768, 32767).astype(np.int16)
 
 
+# The policy kinds, one row each: the name qnavpy spells and libqnav's code for it
+# (qnav_policy_kind_t through qnavpy_capi.h). A new kind is a row here.
+_KIND_CODES = {"prob": _lib.KIND_PROB, "net": _lib.KIND_NET}
+
+
 class Policy:
     """A navigation policy as libqnav holds it.
 
@@ -108,8 +113,8 @@ class Policy:
     """
 
     def __init__(self, kind, raw, hidden=0, inputs=2):
-        if kind not in ("prob", "net"):
-            raise QnavError(f"policy: kind '{kind}' is not 'prob' or 'net'")
+        if kind not in _KIND_CODES:
+            raise QnavError(f"policy: kind '{kind}' is not " + " or ".join(f"'{k}'" for k in _KIND_CODES))
         self.kind = kind
         self.raw = np.array(raw, dtype=np.int16).reshape(-1)
         self.hidden = int(hidden) if kind == "net" else 0
@@ -119,7 +124,7 @@ class Policy:
 
     @property
     def _kind_code(self):
-        return _lib.KIND_PROB if self.kind == "prob" else _lib.KIND_NET
+        return _KIND_CODES[self.kind]
 
     @property
     def weights(self):
@@ -151,7 +156,10 @@ class Policy:
         w = np.zeros(_lib.MAX_WEIGHTS, dtype=np.int16)
         call(lib.qpy_policy_read, encode(path), kind.ctypes.data, hidden.ctypes.data, inputs.ctypes.data,
              w.ctypes.data, nw.ctypes.data)
-        return cls("prob" if kind[0] == _lib.KIND_PROB else "net", w[:nw[0]], int(hidden[0]), int(inputs[0]))
+        names = [name for name, code in _KIND_CODES.items() if code == kind[0]]
+        if not names:
+            raise QnavError(f"{path}: policy kind {int(kind[0])} unknown to qnavpy")
+        return cls(names[0], w[:nw[0]], int(hidden[0]), int(inputs[0]))
 
     def write(self, path, comment=None):
         """Write the policy file at path (the format simevo writes)."""

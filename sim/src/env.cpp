@@ -33,13 +33,27 @@ static std::string line_prefix(const std::string &name, int line) {
     return name + ":" + std::to_string(line) + ": ";
 }
 
-Environment parse_environment(std::string_view text, const std::string &name) {
-    TomlReader r(text, name);
+// The [[key]] tables of the root, or null when there are none (an error when required).
+static const toml::array *array_of_tables(const TomlReader &r, const char *key, bool required) {
+    const toml::table &root = r.root();
+    const toml::node *n = root.get(key);
+    if (!n) {
+        if (required) r.fail(root, std::string("missing [[") + key + "]] (at least one)");
+        return nullptr;
+    }
+    const toml::array *a = n->as_array();
+    if (!a || !a->is_array_of_tables())
+        r.fail(*n, std::string("'") + key + "' must be written as [[" + key + "]] tables");
+    return a;
+}
+
+static int source_line(const toml::table &t) { return static_cast<int>(t.source().begin.line); }
+
+// name, episode limit, [arena] and [destination].
+static void parse_environment_frame(const TomlReader &r, Environment &env) {
     const toml::table &root = r.root();
     r.only_keys(root, {"name", "episode_limit_s", "arena", "destination", "start_zone",
                        "circle", "box"});
-    Environment env;
-    env.source = name;
     env.name = r.string(root, "name");
     if (env.name.empty()) r.fail(root, "'name' must not be empty");
     env.episode_limit_s = r.number(root, "episode_limit_s", 0.1, 36000.0);
@@ -54,39 +68,33 @@ Environment parse_environment(std::string_view text, const std::string &name) {
     env.dest_x_m = r.number(dest, "x_m", 0.0, env.width_m);
     env.dest_y_m = r.number(dest, "y_m", 0.0, env.height_m);
     env.dest_radius_m = r.number(dest, "radius_m", 0.01, 100.0);
+}
 
-    auto array_of_tables = [&](const char *key, bool required) -> const toml::array * {
-        const toml::node *n = root.get(key);
-        if (!n) {
-            if (required) r.fail(root, std::string("missing [[") + key + "]] (at least one)");
-            return nullptr;
-        }
-        const toml::array *a = n->as_array();
-        if (!a || !a->is_array_of_tables())
-            r.fail(*n, std::string("'") + key + "' must be written as [[" + key + "]] tables");
-        return a;
-    };
-
-    std::vector<int> circle_lines, box_lines;
-    if (const toml::array *zones = array_of_tables("start_zone", true)) {
-        for (const toml::node &n : *zones) {
-            const toml::table &t = *n.as_table();
-            r.only_keys(t, {"x_m", "y_m", "w_m", "h_m"});
-            StartZone z;
-            z.x_m = r.number(t, "x_m", -1e6, 1e6);
-            z.y_m = r.number(t, "y_m", -1e6, 1e6);
-            z.w_m = r.number(t, "w_m", 0.0, 1e6);
-            z.h_m = r.number(t, "h_m", 0.0, 1e6);
-            const int line = static_cast<int>(t.source().begin.line);
-            if (z.x_m < 0 || z.y_m < 0 || z.x_m + z.w_m > env.width_m ||
-                z.y_m + z.h_m > env.height_m)
-                throw SimError(QNAV_SIM_E_WORLD,
-                               line_prefix(name, line) + "start zone leaves the arena");
-            env.start_zones.push_back(z);
-            env.zone_lines.push_back(line);
-        }
+// [[start_zone]]: each inside the arena; their lines go to env.zone_lines.
+static void parse_start_zones(const TomlReader &r, Environment &env) {
+    const toml::array *zones = array_of_tables(r, "start_zone", true);
+    if (!zones) return;
+    for (const toml::node &n : *zones) {
+        const toml::table &t = *n.as_table();
+        r.only_keys(t, {"x_m", "y_m", "w_m", "h_m"});
+        StartZone z;
+        z.x_m = r.number(t, "x_m", -1e6, 1e6);
+        z.y_m = r.number(t, "y_m", -1e6, 1e6);
+        z.w_m = r.number(t, "w_m", 0.0, 1e6);
+        z.h_m = r.number(t, "h_m", 0.0, 1e6);
+        const int line = source_line(t);
+        if (z.x_m < 0 || z.y_m < 0 || z.x_m + z.w_m > env.width_m ||
+            z.y_m + z.h_m > env.height_m)
+            throw SimError(QNAV_SIM_E_WORLD, line_prefix(r.name(), line) + "start zone leaves the arena");
+        env.start_zones.push_back(z);
+        env.zone_lines.push_back(line);
     }
-    if (const toml::array *cs = array_of_tables("circle", false)) {
+}
+
+// [[circle]] then [[box]]; returns each obstacle's line in obstacle_shapes() order.
+static std::vector<int> parse_obstacles(const TomlReader &r, Environment &env) {
+    std::vector<int> circle_lines, box_lines;
+    if (const toml::array *cs = array_of_tables(r, "circle", false)) {
         for (const toml::node &n : *cs) {
             const toml::table &t = *n.as_table();
             r.only_keys(t, {"x_m", "y_m", "r_m"});
@@ -95,10 +103,10 @@ Environment parse_environment(std::string_view text, const std::string &name) {
             c.y_m = r.number(t, "y_m", -1e6, 1e6);
             c.r_m = r.number(t, "r_m", 0.001, 1e6);
             env.circles.push_back(c);
-            circle_lines.push_back(static_cast<int>(t.source().begin.line));
+            circle_lines.push_back(source_line(t));
         }
     }
-    if (const toml::array *bs = array_of_tables("box", false)) {
+    if (const toml::array *bs = array_of_tables(r, "box", false)) {
         for (const toml::node &n : *bs) {
             const toml::table &t = *n.as_table();
             r.only_keys(t, {"x_m", "y_m", "w_m", "h_m", "angle_deg"});
@@ -109,14 +117,20 @@ Environment parse_environment(std::string_view text, const std::string &name) {
             b.h_m = r.number(t, "h_m", 0.001, 1e6);
             b.angle_deg = r.number(t, "angle_deg", -360.0, 360.0, true, 0.0);
             env.boxes.push_back(b);
-            box_lines.push_back(static_cast<int>(t.source().begin.line));
+            box_lines.push_back(source_line(t));
         }
     }
+    circle_lines.insert(circle_lines.end(), box_lines.begin(), box_lines.end());
+    return circle_lines;
+}
 
-    // World consistency: start zones and the destination must be free.
+// World consistency: start zones and the destination must be free. An obstacle wholly
+// outside the walls is a typo that would silently do nothing; one that touches the
+// destination's disc makes "reached" partly unreachable.
+static void check_environment_world(const TomlReader &r, const Environment &env,
+                                    const std::vector<int> &obs_lines) {
+    const std::string &name = r.name();
     const std::vector<Shape> obs = env.obstacle_shapes();
-    std::vector<int> obs_lines = circle_lines;
-    obs_lines.insert(obs_lines.end(), box_lines.begin(), box_lines.end());
     const Shape dest_shape = make_circle(env.dest_x_m, env.dest_y_m, env.dest_radius_m);
     for (std::size_t z = 0; z < env.start_zones.size(); ++z) {
         const Shape zs = zone_shape(env.start_zones[z]);
@@ -131,8 +145,6 @@ Environment parse_environment(std::string_view text, const std::string &name) {
             throw SimError(QNAV_SIM_E_WORLD, line_prefix(name, env.zone_lines[z]) +
                                                  "start zone overlaps the destination");
     }
-    // An obstacle wholly outside the walls is a typo that would silently do nothing; one
-    // that touches the destination's disc makes "reached" partly unreachable.
     const Shape arena_shape = make_box(env.width_m / 2, env.height_m / 2, env.width_m, env.height_m, 0.0);
     for (std::size_t k = 0; k < obs.size(); ++k) {
         if (shape_distance(obs[k], arena_shape) > 0.0)
@@ -141,8 +153,18 @@ Environment parse_environment(std::string_view text, const std::string &name) {
         if (shape_distance(obs[k], dest_shape) <= 0.0)
             throw SimError(QNAV_SIM_E_WORLD, line_prefix(name, obs_lines[k]) +
                                                  "obstacle overlaps the destination (" +
-                                                 r.where(dest) + ")");
+                                                 r.where(r.table(r.root(), "destination")) + ")");
     }
+}
+
+Environment parse_environment(std::string_view text, const std::string &name) {
+    TomlReader r(text, name);
+    Environment env;
+    env.source = name;
+    parse_environment_frame(r, env);
+    parse_start_zones(r, env);
+    const std::vector<int> obs_lines = parse_obstacles(r, env);
+    check_environment_world(r, env, obs_lines);
     return env;
 }
 

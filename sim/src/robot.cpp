@@ -10,15 +10,9 @@
 
 namespace qnav {
 
-RobotProfile parse_robot_profile(std::string_view text, const std::string &name) {
-    TomlReader r(text, name);
+// [body], [drive] and [slip]: the robot's size and how it moves.
+static void parse_motion(const TomlReader &r, RobotProfile &p) {
     const toml::table &root = r.root();
-    r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery", "probabilistic",
-                      "clearance", "odometry", "control", "escape"});
-    RobotProfile p;
-    p.name = r.string(root, "name");
-    if (p.name.empty()) r.fail(root, "'name' must not be empty");
-
     const toml::table &body = r.table(root, "body");
     r.only_keys(body, {"radius_m", "mass_kg", "wheel_base_m"});
     p.radius_m = r.number(body, "radius_m", 0.01, 2.0);
@@ -46,7 +40,11 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
     r.only_keys(slip, {"turn", "lateral_s"});
     p.slip_turn = r.number(slip, "turn", 0.0, 0.9);
     p.slip_lateral_s = r.number(slip, "lateral_s", 0.0, 1.0);
+}
 
+// [sonar], then the optional [noise] and [probabilistic].
+static void parse_sensing(const TomlReader &r, RobotProfile &p) {
+    const toml::table &root = r.root();
     const toml::table &sonar = r.table(root, "sonar");
     r.only_keys(sonar, {"range_min_m", "range_max_m", "offset_m", "default_sectors", "cone_deg"});
     p.range_min_m = r.number(sonar, "range_min_m", 0.0, 10.0);
@@ -72,7 +70,11 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
         p.prob_k_safe = r.number(prob, "k_safe", 1.0 / 256.0, 64.0);
         if (prob.get("keep")) p.prob_keep = r.number(prob, "keep", 0.0, 1.0);
     }
+}
 
+// [clearance], [odometry] and [control]: what the controller and the board are given.
+static void parse_controller_settings(const TomlReader &r, RobotProfile &p) {
+    const toml::table &root = r.root();
     const toml::table &cl = r.table(root, "clearance");
     r.only_keys(cl, {"safety_m", "speed_guard", "wedge_pct", "wedge_near_m"});
     p.safety_m = r.number(cl, "safety_m", 0.0, 10.0);
@@ -94,7 +96,11 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
     if (p.tick_ms != static_cast<std::uint32_t>(QNAV_SIM_TICK_S * 1000.0 + 0.5))
         r.fail(*ctl.get("tick_ms"), "'tick_ms' must be 100: the simulator's tick is fixed "
                                     "(QNAV_SIM_TICK_S, DESIGN.md section 4)");
+}
 
+// The optional [escape] and [recovery]: what the robot does when stuck or in collision.
+static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
+    const toml::table &root = r.root();
     if (root.get("escape")) {
         const toml::table &es = r.table(root, "escape");
         r.only_keys(es, {"stall_s", "follow_m", "follow_s"});
@@ -112,6 +118,20 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
         r.fail(*rec.get("back_ticks"), "'back_ticks' exceeds 'ticks'");
     p.recovery_back_speed_mps = r.number(rec, "back_speed_mps", 0.0, p.v_max_mps);
     p.recovery_turn_deg = r.number(rec, "turn_deg", 0.0, 360.0);
+}
+
+RobotProfile parse_robot_profile(std::string_view text, const std::string &name) {
+    TomlReader r(text, name);
+    const toml::table &root = r.root();
+    r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery", "probabilistic",
+                      "clearance", "odometry", "control", "escape"});
+    RobotProfile p;
+    p.name = r.string(root, "name");
+    if (p.name.empty()) r.fail(root, "'name' must not be empty");
+    parse_motion(r, p);
+    parse_sensing(r, p);
+    parse_controller_settings(r, p);
+    parse_escape_and_recovery(r, p);
     return p;
 }
 

@@ -305,66 +305,63 @@ bool Simulation::touching(Vec2 *contact) {
     return false;
 }
 
-void Simulation::drive_substep(double dt) {
+// The fixed manoeuvre sets the wheels directly: back away, then turn in place.
+void Simulation::recovery_wheels() {
     const double b = robot_.wheel_base_m, vmax = robot_.v_max_mps;
-    if (recovery_left_ > 0) {
-        // The fixed manoeuvre sets the wheels directly: back away, then turn in place.
-        const std::uint32_t phase = robot_.recovery_ticks - recovery_left_;
-        if (phase < robot_.recovery_back_ticks) {
-            wheel_l_ = wheel_r_ = recovery_back_sign_ * robot_.recovery_back_speed_mps;
-        } else {
-            const std::uint32_t turn_ticks = robot_.recovery_ticks - robot_.recovery_back_ticks;
-            const double omega = recovery_turn_sign_ * robot_.recovery_turn_deg * kPi / 180.0 /
-                                 (turn_ticks * QNAV_SIM_TICK_S);
-            wheel_l_ = std::clamp(-omega * b / 2, -vmax, vmax);
-            wheel_r_ = -wheel_l_;
-        }
+    const std::uint32_t phase = robot_.recovery_ticks - recovery_left_;
+    if (phase < robot_.recovery_back_ticks) {
+        wheel_l_ = wheel_r_ = recovery_back_sign_ * robot_.recovery_back_speed_mps;
     } else {
-        // Heading controller: turn rate proportional to the heading error, forward speed
-        // reduced by cos(error) (no driving while facing away), then per-wheel
-        // acceleration limits.
-        const double e = wrap_pi(target_heading_ - heading_);
-        const double wmax = robot_.turn_rate_max_dps * kPi / 180.0;
-        const double omega_d = std::clamp(robot_.heading_gain_per_s * e, -wmax, wmax);
-        const double v_d = target_speed_ * vmax * std::max(0.0, std::cos(e));
-        double tl = v_d - omega_d * b / 2, tr = v_d + omega_d * b / 2;
-        const double over = std::max(std::fabs(tl), std::fabs(tr)) / vmax;
-        if (over > 1.0) {
-            // Keep the turn, give up forward speed.
-            const double om = std::clamp(omega_d, -2 * vmax / b, 2 * vmax / b);
-            const double v = std::clamp(v_d, -(vmax - std::fabs(om) * b / 2), vmax - std::fabs(om) * b / 2);
-            tl = v - om * b / 2;
-            tr = v + om * b / 2;
-        }
-        if (robot_.body_limits) {
-            // The limits act on the body (ARCOS: translational and rotational profiles):
-            // forward speed at accel/decel, turn rate at the rates the wheel limits give a
-            // turn in place (2 accel / b, 2 decel / b); the turn gets what the wheels have
-            // left beside the forward speed, so braking never waits for a turn.
-            const double v = approach(0.5 * (wheel_l_ + wheel_r_), 0.5 * (tl + tr),
-                                      robot_.accel_mps2, robot_.decel_mps2, dt);
-            double om = approach((wheel_r_ - wheel_l_) / b, (tr - tl) / b, 2 * robot_.accel_mps2 / b,
-                                 2 * robot_.decel_mps2 / b, dt);
-            const double room = std::max(0.0, vmax - std::fabs(v)) * 2 / b;
-            om = std::clamp(om, -room, room);
-            wheel_l_ = v - om * b / 2;
-            wheel_r_ = v + om * b / 2;
-        } else {
-            wheel_l_ = approach(wheel_l_, tl, robot_.accel_mps2, robot_.decel_mps2, dt);
-            wheel_r_ = approach(wheel_r_, tr, robot_.accel_mps2, robot_.decel_mps2, dt);
-        }
+        const std::uint32_t turn_ticks = robot_.recovery_ticks - robot_.recovery_back_ticks;
+        const double omega = recovery_turn_sign_ * robot_.recovery_turn_deg * kPi / 180.0 /
+                             (turn_ticks * QNAV_SIM_TICK_S);
+        wheel_l_ = std::clamp(-omega * b / 2, -vmax, vmax);
+        wheel_r_ = -wheel_l_;
     }
-    const double v = 0.5 * (wheel_l_ + wheel_r_);
-    const double omega = (wheel_r_ - wheel_l_) / b;
-    // Slip: turning loses some of its rate at speed, and the body skids outwards.
-    const double omega_a = omega * (1.0 - robot_.slip_turn * std::min(1.0, std::fabs(v) / vmax));
-    const double v_lat = -robot_.slip_lateral_s * v * omega_a;
-    const double ch = std::cos(heading_), sh = std::sin(heading_);
-    vel_ = {v * ch - v_lat * sh, v * sh + v_lat * ch};
-    // Box2D only where a contact is possible this step: far from every obstacle the disc
-    // moves freely and its motion is integrated here exactly as Box2D would (no forces:
-    // position += dt * velocity, angle += dt * turn rate). Box2D's step costs about a
-    // microsecond, most of it in its internal timers.
+}
+
+// Heading controller: turn rate proportional to the heading error, forward speed
+// reduced by cos(error) (no driving while facing away), then per-wheel acceleration
+// limits.
+void Simulation::heading_wheels(double dt) {
+    const double b = robot_.wheel_base_m, vmax = robot_.v_max_mps;
+    const double e = wrap_pi(target_heading_ - heading_);
+    const double wmax = robot_.turn_rate_max_dps * kPi / 180.0;
+    const double omega_d = std::clamp(robot_.heading_gain_per_s * e, -wmax, wmax);
+    const double v_d = target_speed_ * vmax * std::max(0.0, std::cos(e));
+    double tl = v_d - omega_d * b / 2, tr = v_d + omega_d * b / 2;
+    const double over = std::max(std::fabs(tl), std::fabs(tr)) / vmax;
+    if (over > 1.0) {
+        // Keep the turn, give up forward speed.
+        const double om = std::clamp(omega_d, -2 * vmax / b, 2 * vmax / b);
+        const double v = std::clamp(v_d, -(vmax - std::fabs(om) * b / 2), vmax - std::fabs(om) * b / 2);
+        tl = v - om * b / 2;
+        tr = v + om * b / 2;
+    }
+    if (robot_.body_limits) {
+        // The limits act on the body (ARCOS: translational and rotational profiles):
+        // forward speed at accel/decel, turn rate at the rates the wheel limits give a
+        // turn in place (2 accel / b, 2 decel / b); the turn gets what the wheels have
+        // left beside the forward speed, so braking never waits for a turn.
+        const double v = approach(0.5 * (wheel_l_ + wheel_r_), 0.5 * (tl + tr),
+                                  robot_.accel_mps2, robot_.decel_mps2, dt);
+        double om = approach((wheel_r_ - wheel_l_) / b, (tr - tl) / b, 2 * robot_.accel_mps2 / b,
+                             2 * robot_.decel_mps2 / b, dt);
+        const double room = std::max(0.0, vmax - std::fabs(v)) * 2 / b;
+        om = std::clamp(om, -room, room);
+        wheel_l_ = v - om * b / 2;
+        wheel_r_ = v + om * b / 2;
+    } else {
+        wheel_l_ = approach(wheel_l_, tl, robot_.accel_mps2, robot_.decel_mps2, dt);
+        wheel_r_ = approach(wheel_r_, tr, robot_.accel_mps2, robot_.decel_mps2, dt);
+    }
+}
+
+// Box2D only where a contact is possible this step: far from every obstacle the disc
+// moves freely and its motion is integrated here exactly as Box2D would (no forces:
+// position += dt * velocity, angle += dt * turn rate). Box2D's step costs about a
+// microsecond, most of it in its internal timers.
+void Simulation::move_body(double omega_a, double v_lat, double dt) {
     const double reach = robot_.radius_m + (robot_.v_max_mps + std::fabs(v_lat)) * dt * 1.5 + 0.05;
     if (clearance_m_ > reach && !reference_) {
         pos_ = pos_ + dt * vel_;
@@ -385,6 +382,22 @@ void Simulation::drive_substep(double dt) {
     heading_ = wrap_pi(body_->GetAngle());
     const b2Vec2 bv = body_->GetLinearVelocity();
     vel_ = {bv.x, bv.y};
+}
+
+void Simulation::drive_substep(double dt) {
+    if (recovery_left_ > 0)
+        recovery_wheels();
+    else
+        heading_wheels(dt);
+    const double vmax = robot_.v_max_mps;
+    const double v = 0.5 * (wheel_l_ + wheel_r_);
+    const double omega = (wheel_r_ - wheel_l_) / robot_.wheel_base_m;
+    // Slip: turning loses some of its rate at speed, and the body skids outwards.
+    const double omega_a = omega * (1.0 - robot_.slip_turn * std::min(1.0, std::fabs(v) / vmax));
+    const double v_lat = -robot_.slip_lateral_s * v * omega_a;
+    const double ch = std::cos(heading_), sh = std::sin(heading_);
+    vel_ = {v * ch - v_lat * sh, v * sh + v_lat * ch};
+    move_body(omega_a, v_lat, dt);
 }
 
 void Simulation::start_recovery(Vec2 contact) {

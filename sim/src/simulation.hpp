@@ -90,6 +90,9 @@ private:
     void build_world();
     void compute_scan();
     void drive_substep(double dt);
+    void recovery_wheels();
+    void heading_wheels(double dt);
+    void move_body(double omega_a, double v_lat, double dt);
     bool touching(Vec2 *contact);
     void start_recovery(Vec2 contact);
 

@@ -21,15 +21,8 @@ struct Mapper {
     double y(double ym) const { return kMargin + (h_m - ym) * kScale; }
 };
 
-}  // namespace
-
-std::string render_svg(const Environment &env, double robot_r, const EpisodePicture *ep) {
-    const Mapper m{env.height_m};
-    const double wpx = env.width_m * kScale + 2 * kMargin;
-    const double hpx = env.height_m * kScale + 2 * kMargin + (ep && !ep->caption.empty() ? 24 : 0);
-    std::ostringstream o;
-    o.setf(std::ios::fixed);
-    o.precision(2);
+// Header, background and arena; the start zones (yellow).
+void draw_arena(std::ostream &o, const Mapper &m, const Environment &env, double wpx, double hpx) {
     o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << wpx << "\" height=\"" << hpx
       << "\" viewBox=\"0 0 " << wpx << " " << hpx << "\">\n"
@@ -38,14 +31,16 @@ std::string render_svg(const Environment &env, double robot_r, const EpisodePict
       << "<rect x=\"" << m.x(0) << "\" y=\"" << m.y(env.height_m) << "\" width=\""
       << env.width_m * kScale << "\" height=\"" << env.height_m * kScale
       << "\" fill=\"#f4f4f4\" stroke=\"black\" stroke-width=\"3\"/>\n";
-    // Start zones (yellow).
     for (const auto &z : env.start_zones)
         o << "<rect x=\"" << m.x(z.x_m) << "\" y=\"" << m.y(z.y_m + z.h_m) << "\" width=\""
           << std::max(2.0, z.w_m * kScale) << "\" height=\"" << std::max(2.0, z.h_m * kScale)
           << "\" fill=\"#ffe24a\" stroke=\"#c9a800\"/>\n";
-    // Direct lines (orange): from a grid of start points, straight to the destination
-    // with the robot's clearance from every obstacle.
-    const std::vector<Shape> obs = env.obstacle_shapes();
+}
+
+// Direct lines (orange): from a grid of start points, straight to the destination
+// with the robot's clearance from every obstacle.
+void draw_direct_lines(std::ostream &o, const Mapper &m, const Environment &env,
+                       const std::vector<Shape> &obs, double robot_r) {
     const Vec2 dest{env.dest_x_m, env.dest_y_m};
     o << "<g stroke=\"#ff8c00\" stroke-width=\"1.2\" stroke-opacity=\"0.7\">\n";
     for (const auto &z : env.start_zones) {
@@ -62,7 +57,10 @@ std::string render_svg(const Environment &env, double robot_r, const EpisodePict
             }
     }
     o << "</g>\n";
-    // Obstacles.
+}
+
+// Obstacles (grey) and the destination.
+void draw_obstacles_and_destination(std::ostream &o, const Mapper &m, const Environment &env) {
     o << "<g fill=\"#5a5a5a\" stroke=\"black\">\n";
     for (const auto &c : env.circles)
         o << "<circle cx=\"" << m.x(c.x_m) << "\" cy=\"" << m.y(c.y_m) << "\" r=\"" << c.r_m * kScale
@@ -74,58 +72,80 @@ std::string render_svg(const Environment &env, double robot_r, const EpisodePict
         o << "\"/>\n";
     }
     o << "</g>\n";
-    // Destination.
-    o << "<circle cx=\"" << m.x(dest.x) << "\" cy=\"" << m.y(dest.y) << "\" r=\""
+    o << "<circle cx=\"" << m.x(env.dest_x_m) << "\" cy=\"" << m.y(env.dest_y_m) << "\" r=\""
       << env.dest_radius_m * kScale << "\" fill=\"#ff8c00\" fill-opacity=\"0.5\" stroke=\"#d35400\" stroke-width=\"2\"/>\n";
+}
+
+// Each sonar sector as a wedge out to its reported range (from the body surface), then
+// the robot's outline and heading at that tick.
+void draw_sonar(std::ostream &o, const Mapper &m, const EpisodePicture &ep, double robot_r) {
+    const std::size_t n = ep.sonar_ranges_m.size();
+    const double step = 2 * kPi / static_cast<double>(n);
+    const double w = ep.cone_rad > step ? ep.cone_rad : step;
+    const Vec2 c = ep.sonar_pos;
+    o << "<g fill=\"#3fa9f5\" fill-opacity=\"0.25\" stroke=\"#1f6fb2\" stroke-width=\"0.8\">\n";
+    for (std::size_t k = 0; k < n; ++k) {
+        const double rr = robot_r + ep.sonar_ranges_m[k];
+        const double a0 = ep.sonar_heading + static_cast<double>(k) * step - 0.5 * w;
+        const double a1 = a0 + w;
+        if (n == 1) {
+            o << "<circle cx=\"" << m.x(c.x) << "\" cy=\"" << m.y(c.y) << "\" r=\"" << rr * kScale << "\"/>\n";
+            continue;
+        }
+        o << "<path d=\"M " << m.x(c.x) << " " << m.y(c.y) << " L "
+          << m.x(c.x + rr * std::cos(a0)) << " " << m.y(c.y + rr * std::sin(a0)) << " A "
+          << rr * kScale << " " << rr * kScale << " 0 " << (w > kPi ? 1 : 0) << " 0 "
+          << m.x(c.x + rr * std::cos(a1)) << " " << m.y(c.y + rr * std::sin(a1)) << " Z\"/>\n";
+    }
+    o << "</g>\n";
+    o << "<circle cx=\"" << m.x(c.x) << "\" cy=\"" << m.y(c.y) << "\" r=\"" << robot_r * kScale
+      << "\" fill=\"none\" stroke=\"#1f6fb2\" stroke-width=\"2\"/>\n"
+      << "<line x1=\"" << m.x(c.x) << "\" y1=\"" << m.y(c.y) << "\" x2=\""
+      << m.x(c.x + robot_r * std::cos(ep.sonar_heading)) << "\" y2=\""
+      << m.y(c.y + robot_r * std::sin(ep.sonar_heading)) << "\" stroke=\"#1f6fb2\" stroke-width=\"2\"/>\n";
+}
+
+// The path with the robot at its start (green) and end (blue), the collision marks (red
+// crosses) and the caption.
+void draw_episode(std::ostream &o, const Mapper &m, const EpisodePicture &ep, double robot_r,
+                  double hpx) {
+    if (!ep.path.empty()) {
+        o << "<polyline fill=\"none\" stroke=\"#0b3d91\" stroke-width=\"2\" points=\"";
+        for (const Vec2 &p : ep.path) o << m.x(p.x) << "," << m.y(p.y) << " ";
+        o << "\"/>\n";
+        const Vec2 s = ep.path.front(), e = ep.path.back();
+        o << "<circle cx=\"" << m.x(s.x) << "\" cy=\"" << m.y(s.y) << "\" r=\"" << robot_r * kScale
+          << "\" fill=\"none\" stroke=\"#2e8b57\" stroke-width=\"2\"/>\n";
+        o << "<circle cx=\"" << m.x(e.x) << "\" cy=\"" << m.y(e.y) << "\" r=\"" << robot_r * kScale
+          << "\" fill=\"none\" stroke=\"#0b3d91\" stroke-width=\"2\"/>\n";
+    }
+    o << "<g stroke=\"red\" stroke-width=\"2.5\">\n";
+    for (const auto &c : ep.collisions) {
+        const double x = m.x(c.contact.x), y = m.y(c.contact.y), d = 6;
+        o << "<line x1=\"" << x - d << "\" y1=\"" << y - d << "\" x2=\"" << x + d << "\" y2=\"" << y + d << "\"/>"
+          << "<line x1=\"" << x - d << "\" y1=\"" << y + d << "\" x2=\"" << x + d << "\" y2=\"" << y - d << "\"/>\n";
+    }
+    o << "</g>\n";
+    if (!ep.caption.empty())
+        o << "<text x=\"" << kMargin << "\" y=\"" << hpx - 8
+          << "\" font-family=\"sans-serif\" font-size=\"14\">" << ep.caption << "</text>\n";
+}
+
+}  // namespace
+
+std::string render_svg(const Environment &env, double robot_r, const EpisodePicture *ep) {
+    const Mapper m{env.height_m};
+    const double wpx = env.width_m * kScale + 2 * kMargin;
+    const double hpx = env.height_m * kScale + 2 * kMargin + (ep && !ep->caption.empty() ? 24 : 0);
+    std::ostringstream o;
+    o.setf(std::ios::fixed);
+    o.precision(2);
+    draw_arena(o, m, env, wpx, hpx);
+    draw_direct_lines(o, m, env, env.obstacle_shapes(), robot_r);
+    draw_obstacles_and_destination(o, m, env);
     if (ep) {
-        if (!ep->sonar_ranges_m.empty()) {
-            // Each sector as a wedge out to its reported range (from the body surface).
-            const std::size_t n = ep->sonar_ranges_m.size();
-            const double step = 2 * kPi / static_cast<double>(n);
-            const double w = ep->cone_rad > step ? ep->cone_rad : step;
-            o << "<g fill=\"#3fa9f5\" fill-opacity=\"0.25\" stroke=\"#1f6fb2\" stroke-width=\"0.8\">\n";
-            for (std::size_t k = 0; k < n; ++k) {
-                const double rr = robot_r + ep->sonar_ranges_m[k];
-                const double a0 = ep->sonar_heading + static_cast<double>(k) * step - 0.5 * w;
-                const double a1 = a0 + w;
-                const Vec2 c = ep->sonar_pos;
-                if (n == 1) {
-                    o << "<circle cx=\"" << m.x(c.x) << "\" cy=\"" << m.y(c.y) << "\" r=\"" << rr * kScale << "\"/>\n";
-                    continue;
-                }
-                o << "<path d=\"M " << m.x(c.x) << " " << m.y(c.y) << " L "
-                  << m.x(c.x + rr * std::cos(a0)) << " " << m.y(c.y + rr * std::sin(a0)) << " A "
-                  << rr * kScale << " " << rr * kScale << " 0 " << (w > kPi ? 1 : 0) << " 0 "
-                  << m.x(c.x + rr * std::cos(a1)) << " " << m.y(c.y + rr * std::sin(a1)) << " Z\"/>\n";
-            }
-            o << "</g>\n";
-            const Vec2 c = ep->sonar_pos;
-            o << "<circle cx=\"" << m.x(c.x) << "\" cy=\"" << m.y(c.y) << "\" r=\"" << robot_r * kScale
-              << "\" fill=\"none\" stroke=\"#1f6fb2\" stroke-width=\"2\"/>\n"
-              << "<line x1=\"" << m.x(c.x) << "\" y1=\"" << m.y(c.y) << "\" x2=\""
-              << m.x(c.x + robot_r * std::cos(ep->sonar_heading)) << "\" y2=\""
-              << m.y(c.y + robot_r * std::sin(ep->sonar_heading)) << "\" stroke=\"#1f6fb2\" stroke-width=\"2\"/>\n";
-        }
-        if (!ep->path.empty()) {
-            o << "<polyline fill=\"none\" stroke=\"#0b3d91\" stroke-width=\"2\" points=\"";
-            for (const Vec2 &p : ep->path) o << m.x(p.x) << "," << m.y(p.y) << " ";
-            o << "\"/>\n";
-            const Vec2 s = ep->path.front(), e = ep->path.back();
-            o << "<circle cx=\"" << m.x(s.x) << "\" cy=\"" << m.y(s.y) << "\" r=\"" << robot_r * kScale
-              << "\" fill=\"none\" stroke=\"#2e8b57\" stroke-width=\"2\"/>\n";
-            o << "<circle cx=\"" << m.x(e.x) << "\" cy=\"" << m.y(e.y) << "\" r=\"" << robot_r * kScale
-              << "\" fill=\"none\" stroke=\"#0b3d91\" stroke-width=\"2\"/>\n";
-        }
-        o << "<g stroke=\"red\" stroke-width=\"2.5\">\n";
-        for (const auto &c : ep->collisions) {
-            const double x = m.x(c.contact.x), y = m.y(c.contact.y), d = 6;
-            o << "<line x1=\"" << x - d << "\" y1=\"" << y - d << "\" x2=\"" << x + d << "\" y2=\"" << y + d << "\"/>"
-              << "<line x1=\"" << x - d << "\" y1=\"" << y + d << "\" x2=\"" << x + d << "\" y2=\"" << y - d << "\"/>\n";
-        }
-        o << "</g>\n";
-        if (!ep->caption.empty())
-            o << "<text x=\"" << kMargin << "\" y=\"" << hpx - 8
-              << "\" font-family=\"sans-serif\" font-size=\"14\">" << ep->caption << "</text>\n";
+        if (!ep->sonar_ranges_m.empty()) draw_sonar(o, m, *ep, robot_r);
+        draw_episode(o, m, *ep, robot_r, hpx);
     }
     o << "</svg>\n";
     return o.str();

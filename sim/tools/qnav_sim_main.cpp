@@ -152,6 +152,29 @@ std::string controller_names() {
     return s;
 }
 
+// What a controller of libqnav's table is, in --controller's help (a row without a line
+// here is listed by its name alone: the list itself is the table's).
+struct ControllerHelp {
+    const char *name, *what;
+};
+constexpr ControllerHelp kControllerHelp[] = {
+    {"body", "obstacles enlarged by the robot's radius + safety distance, speed guard, rank by pre-activation"},
+    {"literal", "the paper's per-sector reading (ablation)"},
+    {"vfh", "VFH+ (Ulrich & Borenstein 1998), no policy"},
+};
+
+// "NAME: what; NAME: what; ..." over libqnav's controller table, in its order.
+std::string controller_help() {
+    std::string s;
+    for (std::uint8_t i = 0; i < qnav_nav_count(); ++i) {
+        const std::string name = qnav_nav_method_at(i)->name;
+        s += (i ? "; " : "") + name;
+        for (const ControllerHelp &h : kControllerHelp)
+            if (name == h.name) s += std::string(": ") + h.what;
+    }
+    return s;
+}
+
 // Initialise nav as the controller called name (libqnav's table, qnav/nav.h) for sim;
 // table: compile a path-quality controller's policy into table mode.
 void init_nav(const qnav_sim_t *sim, const std::string &name, const qnav_policy_t &pol, bool table,
@@ -504,11 +527,7 @@ static CLI::App *add_run(CLI::App &app, RunOpts &o) {
     run->add_option("--episode", o.episode, "first episode seed")->capture_default_str();
     run->add_option("--episodes", o.episodes, "number of episodes")->check(CLI::Range(1u, 1000000u))->capture_default_str();
     run->add_flag("--table", o.table, "run the controller in table mode");
-    run->add_option("--controller", o.controller,
-                    "body: obstacles enlarged by the robot's radius + safety distance, speed guard, "
-                    "rank by pre-activation; literal: the paper's per-sector reading (ablation); "
-                    "vfh: VFH+ (Ulrich & Borenstein 1998), no policy")
-        ->capture_default_str();
+    run->add_option("--controller", o.controller, controller_help())->capture_default_str();
     run->add_option("--limit-factor", o.limit_factor,
                     "episode time limit as a multiple of the environment's (2: judge escapes at twice it)")
         ->check(qnav::cli::finite_range(0.1, 100.0))->capture_default_str();

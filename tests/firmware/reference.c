@@ -37,26 +37,21 @@ double ref_quality(const qnav_policy_t *policy, unsigned level, unsigned dtheta)
 {
     double xt = dtheta / 180.0;
     double xd = level / (double)(QNAV_DIST_LEVELS - 1);
-    if (policy->kind == QNAV_POLICY_PROB) {
+    switch ((qnav_policy_kind_t)policy->kind) {
+    case QNAV_POLICY_PROB: {
         double kg = policy->u.prob.k_goal / 256.0;
         double ks = policy->u.prob.k_safe / 256.0;
         return exp(-kg * xt) * (1.0 - exp(-ks * xd));
     }
-    const qnav_net_t *n = &policy->u.net;
-    double y = n->b_out / 256.0;
-    for (unsigned j = 0; j < n->hidden; ++j) {
-        double z = n->w_theta[j] / 256.0 * xt + n->w_dist[j] / 256.0 * xd + n->b_hidden[j] / 256.0;
-        y += n->w_out[j] / 256.0 * sigmoid(z);
+    case QNAV_POLICY_NET:
+        return sigmoid(ref_preact(policy, level, dtheta));
     }
-    return sigmoid(y);
+    return 0.0;
 }
 
-double ref_quality_bound(const qnav_policy_t *policy)
+/* The network's quality bound (see ref_quality_bound). */
+static double net_quality_bound(const qnav_net_t *n)
 {
-    if (policy->kind == QNAV_POLICY_PROB) {
-        return 2.5e-4;
-    }
-    const qnav_net_t *n = &policy->u.net;
     double sum_out = 0.0;
     for (unsigned j = 0; j < n->hidden; ++j) {
         sum_out += fabs(n->w_out[j] / 256.0);
@@ -69,6 +64,34 @@ double ref_quality_bound(const qnav_policy_t *policy)
     const double e_share = 1.0 / 65536;    /* rounding of each unit's share */
     const double e_y = 1.0 / 4096;         /* rounding of the output to Q5.11 */
     return 0.25 * (sum_out * e_hidden + n->hidden * e_share + e_y) + e_sig;
+}
+
+double ref_quality_bound(const qnav_policy_t *policy)
+{
+    switch ((qnav_policy_kind_t)policy->kind) {
+    case QNAV_POLICY_PROB:
+        return 2.5e-4;
+    case QNAV_POLICY_NET:
+        return net_quality_bound(&policy->u.net);
+    }
+    return 0.0;
+}
+
+int ref_is_network(const qnav_policy_t *policy)
+{
+    switch ((qnav_policy_kind_t)policy->kind) {
+    case QNAV_POLICY_PROB:
+        return 0;
+    case QNAV_POLICY_NET:
+        return 1;
+    }
+    return 0;
+}
+
+int ref_ranks_by_preact(const qnav_ctrl_t *ctrl, const qnav_policy_t *policy)
+{
+    /* the probabilistic policy always ranks by its quality */
+    return ref_is_network(policy) && qnav_ctrl_rank(ctrl) == QNAV_RANK_PREACT;
 }
 
 unsigned ref_goal_deg(qnav_cdeg_t bearing_cdeg)
@@ -91,7 +114,7 @@ void ref_path_qualities(const qnav_ctrl_t *ctrl, const qnav_policy_t *policy,
     uint8_t lvl[QNAV_PATHS];
     (void)qnav_ctrl_path_levels(ctrl, in->ranges_mm, lvl);
     for (unsigned i = 0; i < QNAV_PATHS; ++i) {
-        out[i] = policy->kind == QNAV_POLICY_NET && qnav_ctrl_rank(ctrl) == QNAV_RANK_PREACT
+        out[i] = ref_ranks_by_preact(ctrl, policy)
                      ? ref_preact(policy, lvl[i], ref_dtheta(i, goal))
                      : ref_quality(policy, lvl[i], ref_dtheta(i, goal));
     }

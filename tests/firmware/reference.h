@@ -19,6 +19,11 @@ double ref_quality_bound(const qnav_policy_t *policy);
 double ref_preact(const qnav_policy_t *policy, unsigned level, unsigned dtheta);
 double ref_preact_bound(const qnav_policy_t *policy);
 
+/* 1 when the policy is a network (its keys are pre-activations when ranked by them). */
+int ref_is_network(const qnav_policy_t *policy);
+/* 1 when ctrl ranks this policy's paths by the pre-activation: a network ranked so. */
+int ref_ranks_by_preact(const qnav_ctrl_t *ctrl, const qnav_policy_t *policy);
+
 /* Reference rank values of all 360 paths for a scan, using the controller's own input
  * quantization (qnav_ctrl_path_levels): the pre-activation for a network ranked by it,
  * else the quality. */

@@ -16,27 +16,12 @@
 #include "qnav/ctrl.h"
 #include "qnav/fixed_host.h"
 #include "reference.h"
-#include "runs.h"
 #include "sigmoid_lut.h"
+#include "test_rng.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
-
-static uint32_t rng_u32(void)
-{
-    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return (uint32_t)((z ^ (z >> 31)) >> 32);
-}
-
-static int32_t rng_range(int32_t lo, int32_t hi) /* inclusive */
-{
-    return lo + (int32_t)(rng_u32() % (uint32_t)(hi - lo + 1));
-}
 
 static void random_net(qnav_policy_t *p, uint8_t hidden, int32_t max_raw)
 {
@@ -535,7 +520,7 @@ static void test_argmax_matches_reference_on_random_scans(void **state)
         ref_path_qualities(&c, &p, &in, ref);
         /* networks rank by the pre-activation y: its bound, and the key's 1/128 steps
          * beyond |y| = 8; the probabilistic policy by its quality */
-        int net = p.kind == QNAV_POLICY_NET;
+        int net = ref_is_network(&p);
         double bound = net ? ref_preact_bound(&p) : ref_quality_bound(&p);
         double near = net ? 2.0 * bound + 1.0 / 128.0 : NEAR_TIE;
         unsigned rbest = ref_argmax(ref, ref_goal_deg(in.goal_bearing_cdeg));
@@ -1048,136 +1033,6 @@ static void test_plain_step_stops_when_not_ready(void **state)
     qnav_ctrl_step_plain(&c, &in, NULL, NULL); /* no output: nothing to write, no crash */
 }
 
-/* A row of keys with the features that break shortcuts: plateaus, single-path spikes and
- * dips, valleys, several peaks, long flat stretches. kind 0: stretches of random slope;
- * 1: a valley (falls, then rises); 2: a peak (rises, then falls); 3: a peak, a valley and
- * a higher end; all with flat steps. */
-static void synthetic_row(qnav_qkey_t *row, unsigned kind)
-{
-    int32_t v = rng_range(-200, 200);
-    int32_t slope = rng_range(-3, 3);
-    unsigned turn = (unsigned)rng_range(0, QNAV_DTHETA_MAX);
-    for (unsigned d = 0; d <= QNAV_DTHETA_MAX; ++d) {
-        uint32_t pick = rng_u32() % 100u;
-        if (kind == 0u) {
-            if (pick < 6u) {
-                slope = rng_range(-3, 3); /* a new stretch: rising, falling or flat */
-            }
-            if (pick == 50u) {
-                row[d] = (qnav_qkey_t)(v + rng_range(-5, 5)); /* a spike or a dip */
-                continue;
-            }
-        } else if (kind < 3u) {
-            int32_t sign = (d < turn) == (kind == 1u) ? -1 : 1;
-            slope = pick < 30u ? 0 : sign * rng_range(0, 2); /* flat steps on the way */
-        } else { /* rises to a peak, falls, rises again higher: the top at the far end */
-            int32_t sign = d < turn / 2u ? 1 : (d < turn ? -1 : 1);
-            slope = pick < 30u ? 0 : sign * rng_range(0, d < turn ? 2 : 4);
-        }
-        v += slope;
-        row[d] = (qnav_qkey_t)v;
-    }
-}
-
-/* Keys on lo..hi first never rise, then never fall (no rise is followed by a fall). */
-static int valley_shaped(const qnav_qkey_t *row, uint8_t lo, uint8_t hi)
-{
-    int rose = 0;
-    for (unsigned d = lo; d < hi; ++d) {
-        if (row[d + 1] > row[d]) {
-            rose = 1;
-        } else if (row[d + 1] < row[d] && rose) {
-            return 0;
-        }
-    }
-    return 1;
-}
-
-/* What qnav_run_reduce claims of a narrowed run must hold of the keys, and the run's best
- * path (the brute-force best of the run as handed out) must stay reachable: checked on
- * synthetic rows of every shape in table mode, where reduce reads the table's shapes. */
-static void test_run_reduce_keeps_its_promises_on_any_row(void **state)
-{
-    (void)state;
-    static qnav_qkey_t table[QNAV_QTABLE_ENTRIES];
-    uint8_t lvl[QNAV_PATHS];
-    unsigned codes[4] = {0, 0, 0, 0};
-    for (unsigned trial = 0; trial < 1500; ++trial) {
-        qnav_ctrl_config_t cfg;
-        qnav_ctrl_t c;
-        qnav_run_iter_t it;
-        qnav_run_t r;
-        qnav_best_t best = {QNAV_KEY_NONE, 0, 0};
-        qnav_ctrl_config_default(&cfg);
-        for (unsigned level = 0; level < QNAV_DIST_LEVELS; ++level) {
-            synthetic_row(&table[level * (QNAV_DTHETA_MAX + 1)], (trial + level) % 4u);
-        }
-        assert_int_equal(qnav_ctrl_init_table(&c, &cfg, table, QNAV_RANK_PREACT), QNAV_OK);
-        for (unsigned p = 0; p < QNAV_PATHS;) { /* runs of random levels and lengths */
-            uint8_t level = (uint8_t)rng_range(0, QNAV_DIST_LEVELS - 1);
-            unsigned len = (unsigned)rng_range(1, 40);
-            for (; len > 0 && p < QNAV_PATHS; --len, ++p) {
-                lvl[p] = level;
-            }
-        }
-        qnav_run_start(&it, lvl, (uint16_t)rng_range(0, 359), 0);
-        while (qnav_run_next(&it, &r)) {
-            const qnav_qkey_t *row = &table[r.level * (QNAV_DTHETA_MAX + 1)];
-            const qnav_row_shape_t *sh = &c.p.net.in.row[r.level];
-            uint8_t a0 = qnav_run_dmin(&r);
-            uint8_t b0 = (uint8_t)(a0 + r.count - 1u);
-            /* the run's own best by the step's order, before reduce (dtheta, then turn) */
-            qnav_best_t own = best;
-            for (uint8_t d = a0; d <= b0; ++d) {
-                qnav_best_consider(&own, row[d], qnav_run_path_at(&r, d), d);
-            }
-            qnav_run_t kept = r;
-            uint8_t code = qnav_run_reduce(c.p.net.in.row, &kept, &best, &it);
-            assert_true(code <= QNAV_RUN_PEAK);
-            ++codes[code];
-            if (code == QNAV_RUN_DONE) {
-                /* nothing of the run beats what best now holds */
-                qnav_best_t check = best;
-                for (uint8_t d = a0; d <= b0; ++d) {
-                    qnav_best_consider(&check, row[d], qnav_run_path_at(&r, d), d);
-                }
-                assert_int_equal(check.key, best.key);
-                assert_int_equal(check.dtheta, best.dtheta);
-                assert_int_equal(check.heading, best.heading);
-                continue;
-            }
-            uint8_t a = qnav_run_dmin(&kept);
-            uint8_t e = (uint8_t)(a + kept.count - 1u);
-            assert_true(a == a0 && e <= b0);
-            if (code == QNAV_RUN_VALLEY) {
-                assert_true(valley_shaped(row, a, e));
-            } else if (code == QNAV_RUN_PEAK) {
-                assert_true(sh->peak_lo != QNAV_PEAK_NONE && sh->peak_lo != QNAV_PEAK_MANY);
-                assert_true(a < sh->peak_lo && sh->peak_hi < e);
-                assert_true(valley_shaped(row, a, sh->peak_hi));
-                assert_true(valley_shaped(row, (uint8_t)(sh->peak_hi + 1u), e));
-                assert_true(row[sh->peak_lo - 1u] < row[sh->peak_lo]);
-                for (uint8_t d = sh->peak_lo; d < sh->peak_hi; ++d) {
-                    assert_true(row[d] == row[d + 1]);
-                }
-                assert_true(row[sh->peak_hi + 1u] < row[sh->peak_hi]);
-            }
-            /* the kept paths hold the run's best: offering them reaches the same record */
-            for (uint8_t d = a; d <= e; ++d) {
-                qnav_best_consider(&best, row[d], qnav_run_path_at(&kept, d), d);
-            }
-            assert_int_equal(best.key, own.key);
-            assert_int_equal(best.dtheta, own.dtheta);
-            assert_int_equal(best.heading, own.heading);
-        }
-    }
-    print_message("reduce: %u done, %u all, %u valley, %u peak\n", codes[0], codes[1],
-                  codes[2], codes[3]);
-    for (unsigned k = 0; k < 4; ++k) {
-        assert_true(codes[k] > 100u); /* every rule met often enough to mean something */
-    }
-}
-
 static void reference_levels_wedge(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
                                    unsigned pct, qnav_mm_t near_mm, uint8_t *lvl);
 
@@ -1455,7 +1310,6 @@ int main(void)
         cmocka_unit_test(test_plain_step_stops_when_not_ready),
         cmocka_unit_test(test_path_levels_equal_painting_every_sector),
         cmocka_unit_test(test_wedge_placement_equals_its_definition),
-        cmocka_unit_test(test_run_reduce_keeps_its_promises_on_any_row),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_network_mode),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_probabilistic_mode),
         cmocka_unit_test(test_build_table_refuses_a_table_controller),

@@ -216,6 +216,34 @@ static void test_literal_entry_applies_the_literal_reading(void **state)
     assert_int_equal(seen.body_radius_mm, cfg.body_radius_mm);
 }
 
+/* Every row of the table says where its controller keeps its sensor settings: each one,
+ * initialised for an unusual sensor, reports that sensor back (not another row's). */
+static void test_every_controller_reports_its_own_sensor_settings(void **state)
+{
+    qnav_nav_t nav;
+    qnav_ctrl_config_t cfg;
+    qnav_policy_t p;
+    uint16_t n = 1;
+    qnav_mm_t range = 1;
+    uint8_t i;
+    (void)state;
+    qnav_policy_prob_default(&p);
+    for (i = 0; i < qnav_nav_count(); ++i) {
+        qnav_ctrl_config_default(&cfg);
+        cfg.n_sectors = (uint16_t)(24u + i);
+        cfg.max_range_mm = (qnav_mm_t)(3210u + i);
+        memset(&nav, 0xA5, sizeof nav); /* nothing left from an earlier row */
+        assert_int_equal(qnav_nav_init(&nav, qnav_nav_method_at(i), &cfg, &p), QNAV_OK);
+        qnav_nav_sensors(&nav, &n, &range);
+        assert_int_equal(n, 24u + i);
+        assert_int_equal(range, 3210u + i);
+    }
+    assert_int_equal(qnav_nav_init_named(&nav, "pid", &cfg, &p), QNAV_E_NAME);
+    qnav_nav_sensors(&nav, &n, &range);
+    assert_int_equal(n, 0);
+    assert_int_equal(range, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -228,6 +256,7 @@ int main(void)
         cmocka_unit_test(test_vfh_without_init_or_state_commands_stop),
         cmocka_unit_test(test_table_selects_controllers_by_name),
         cmocka_unit_test(test_literal_entry_applies_the_literal_reading),
+        cmocka_unit_test(test_every_controller_reports_its_own_sensor_settings),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

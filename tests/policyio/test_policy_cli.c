@@ -280,7 +280,7 @@ static void test_cli_header_refuses_bad_requests_without_writing(void **state)
     assert_int_equal(run_tool("header", "--mode", "lookup", "--name", "p",
                               QNAV_POLICYIO_GOOD_DIR "/prob.policy", tmp_path("x.h"), NULL),
                      2);
-    assert_one_line_error("qnav-policy: ", "--mode must be network, probabilistic or table");
+    assert_one_line_error("qnav-policy: ", "--mode must be probabilistic, network or table");
     assert_int_equal(run_tool("header", "--mode", "table", "--name", "p",
                               QNAV_POLICYIO_GOOD_DIR "/prob.policy", NULL),
                      2);

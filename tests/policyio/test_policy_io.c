@@ -99,7 +99,7 @@ static void assert_refused(const char *text, const char *prefix, const char *fra
 {
     qnav_policy_t p;
     char err[QNAV_POLICY_IO_ERRLEN] = "";
-    assert_int_equal(parse_str(text, &p, err), -1);
+    assert_int_equal(parse_str(text, &p, err), QNAV_POLICY_IO_E_PARSE);
     if (strncmp(err, prefix, strlen(prefix)) != 0 || strstr(err, fragment) == NULL) {
         fail_msg("message '%s' lacks prefix '%s' or fragment '%s'", err, prefix, fragment);
     }
@@ -234,7 +234,7 @@ static void test_reader_leaves_output_untouched_on_error(void **state)
     static const char text[] = "qnav-policy 1\nkind network\nmeta a b\n";
     assert_int_equal(qnav_policy_parse_meta(text, sizeof text - 1, "x", &p, &meta, err,
                                             sizeof err),
-                     -1);
+                     QNAV_POLICY_IO_E_PARSE);
     assert_non_null(strstr(err, "x:3: truncated: no 'end' line"));
     assert_int_equal(p.kind, 0xA5);
     assert_int_equal(((unsigned char *)&meta)[0], 0x5A);
@@ -324,13 +324,13 @@ static void test_writer_refuses_invalid_policy_and_keeps_old_file(void **state)
     qnav_policy_prob_default(&p);
     assert_int_equal(qnav_policy_write(path, &p, NULL, err, sizeof err), 0);
     p.u.prob.k_goal = 0;
-    assert_int_equal(qnav_policy_write(path, &p, NULL, err, sizeof err), -1);
+    assert_int_equal(qnav_policy_write(path, &p, NULL, err, sizeof err), QNAV_POLICY_IO_E_INVALID);
     assert_non_null(strstr(err, "refusing to write an invalid policy: k_goal 0 outside"));
     assert_int_equal(qnav_policy_read(path, &q, err, sizeof err), 0);
     qnav_policy_prob_default(&p);
     assert_int_equal(q.u.prob.k_goal, p.u.prob.k_goal); /* the old file is intact */
     p.kind = 9;
-    assert_int_equal(qnav_policy_write(path, &p, NULL, err, sizeof err), -1);
+    assert_int_equal(qnav_policy_write(path, &p, NULL, err, sizeof err), QNAV_POLICY_IO_E_INVALID);
     assert_non_null(strstr(err, "unknown policy kind 9"));
     assert_int_equal(unlink(path), 0);
     assert_int_equal(rmdir(dir), 0);
@@ -344,7 +344,7 @@ static void test_writer_reports_unwritable_directory(void **state)
     qnav_policy_prob_default(&p);
     assert_int_equal(qnav_policy_write("/nonexistent_qnav_dir/p.policy", &p, NULL, err,
                                        sizeof err),
-                     -1);
+                     QNAV_POLICY_IO_E_IO);
     assert_non_null(strstr(err, "/nonexistent_qnav_dir/p.policy: cannot create"));
 }
 
@@ -372,7 +372,7 @@ static void test_long_and_multiline_comments_still_round_trip(void **state)
         char big[QNAV_POLICY_COMMENT_MAX + 2];
         memset(big, 'y', sizeof big - 1);
         big[sizeof big - 1] = '\0';
-        assert_int_equal(qnav_policy_format(&p, NULL, big, NULL, 0, err, sizeof err), -1);
+        assert_int_equal(qnav_policy_format(&p, NULL, big, NULL, 0, err, sizeof err), QNAV_POLICY_IO_E_INVALID);
         assert_non_null(strstr(err, "comment longer than"));
     }
 }
@@ -385,15 +385,15 @@ static void test_meta_set_refuses_values_that_would_not_round_trip(void **state)
     int i;
     (void)state;
     qnav_policy_meta_clear(&meta);
-    assert_int_equal(qnav_policy_meta_set(&meta, "fitness", "1 # 2", err, sizeof err), -1);
+    assert_int_equal(qnav_policy_meta_set(&meta, "fitness", "1 # 2", err, sizeof err), QNAV_POLICY_IO_E_INVALID);
     assert_non_null(strstr(err, "contains '#'"));
-    assert_int_equal(qnav_policy_meta_set(&meta, "fitness", " 1", err, sizeof err), -1);
-    assert_int_equal(qnav_policy_meta_set(&meta, "fitness", "a\nb", err, sizeof err), -1);
-    assert_int_equal(qnav_policy_meta_set(&meta, "fit ness", "1", err, sizeof err), -1);
-    assert_int_equal(qnav_policy_meta_set(&meta, "", "1", err, sizeof err), -1);
+    assert_int_equal(qnav_policy_meta_set(&meta, "fitness", " 1", err, sizeof err), QNAV_POLICY_IO_E_INVALID);
+    assert_int_equal(qnav_policy_meta_set(&meta, "fitness", "a\nb", err, sizeof err), QNAV_POLICY_IO_E_INVALID);
+    assert_int_equal(qnav_policy_meta_set(&meta, "fit ness", "1", err, sizeof err), QNAV_POLICY_IO_E_INVALID);
+    assert_int_equal(qnav_policy_meta_set(&meta, "", "1", err, sizeof err), QNAV_POLICY_IO_E_INVALID);
     memset(big, 'v', sizeof big - 1);
     big[sizeof big - 1] = '\0';
-    assert_int_equal(qnav_policy_meta_set(&meta, "long", big, err, sizeof err), -1);
+    assert_int_equal(qnav_policy_meta_set(&meta, "long", big, err, sizeof err), QNAV_POLICY_IO_E_INVALID);
     assert_int_equal(meta.count, 0);
     for (i = 0; i < QNAV_POLICY_META_MAX; ++i) {
         char name[16];
@@ -402,7 +402,7 @@ static void test_meta_set_refuses_values_that_would_not_round_trip(void **state)
     }
     assert_int_equal(qnav_policy_meta_set(&meta, "k3", "replaced", err, sizeof err), 0);
     assert_string_equal(qnav_policy_meta_get(&meta, "k3"), "replaced");
-    assert_int_equal(qnav_policy_meta_set(&meta, "one_more", "v", err, sizeof err), -1);
+    assert_int_equal(qnav_policy_meta_set(&meta, "one_more", "v", err, sizeof err), QNAV_POLICY_IO_E_INVALID);
     assert_int_equal(meta.count, QNAV_POLICY_META_MAX);
 }
 
@@ -526,7 +526,7 @@ static void test_every_bad_file_is_refused_with_its_expected_line_and_message(vo
         assert_non_null(frag);
         (void)snprintf(path, sizeof path, "%s/%s", QNAV_POLICYIO_BAD_DIR, name);
         (void)snprintf(prefix, sizeof prefix, "%s:%s: ", path, line);
-        if (qnav_policy_read(path, &p, err, sizeof err) != -1) {
+        if (qnav_policy_read(path, &p, err, sizeof err) != QNAV_POLICY_IO_E_PARSE) {
             fail_msg("%s was accepted", name);
         }
         if (strncmp(err, prefix, strlen(prefix)) != 0 || strstr(err, frag) == NULL) {
@@ -550,14 +550,65 @@ static void test_every_bad_file_is_refused_with_its_expected_line_and_message(vo
     assert_int_equal(files, rows);
 }
 
+/* The list every message and the tool's help print names each kind once, from the kinds'
+ * own table, and a short buffer cuts it safely. */
+static void test_kind_list_names_every_kind_once(void **state)
+{
+    char buf[80];
+    char small[8];
+    char quoted[40];
+    unsigned k;
+    size_t named = 0;
+    size_t quotes = 0;
+    const char *c;
+    (void)state;
+    assert_ptr_equal(qnav_policy_kind_list(buf, sizeof buf, "'", ", ", " or "), buf);
+    for (k = 0; k < 256u; ++k) {
+        const char *n = qnav_policy_kind_name((uint8_t)k);
+        if (n != NULL) {
+            (void)snprintf(quoted, sizeof quoted, "'%s'", n);
+            assert_non_null(strstr(buf, quoted));
+            ++named;
+        }
+    }
+    for (c = buf; *c != '\0'; ++c) {
+        quotes += *c == '\'';
+    }
+    assert_true(named >= 2);
+    assert_int_equal(quotes, 2 * named);
+    assert_non_null(strstr(buf, " or "));
+    assert_int_equal(strlen(qnav_policy_kind_list(small, sizeof small, "", "|", "|")),
+                     sizeof small - 1);
+}
+
+static void test_every_status_has_its_own_text(void **state)
+{
+    static const qnav_policy_io_status_t all[] = {
+        QNAV_POLICY_IO_OK,          QNAV_POLICY_IO_E_NULL,  QNAV_POLICY_IO_E_IO,
+        QNAV_POLICY_IO_E_PARSE,     QNAV_POLICY_IO_E_INVALID, QNAV_POLICY_IO_E_NAME,
+        QNAV_POLICY_IO_E_NOMEM};
+    size_t i;
+    size_t k;
+    (void)state;
+    for (i = 0; i < sizeof all / sizeof all[0]; ++i) {
+        assert_true(i == 0 ? all[i] == 0 : all[i] < 0);
+        for (k = 0; k < i; ++k) {
+            assert_string_not_equal(qnav_policy_io_status_str(all[i]),
+                                    qnav_policy_io_status_str(all[k]));
+        }
+    }
+    assert_string_equal(qnav_policy_io_status_str((qnav_policy_io_status_t)-99),
+                        "unknown policyio status");
+}
+
 static void test_missing_file_is_reported_with_its_name(void **state)
 {
     char err[QNAV_POLICY_IO_ERRLEN] = "";
     qnav_policy_t p;
     (void)state;
-    assert_int_equal(qnav_policy_read("/nonexistent/x.policy", &p, err, sizeof err), -1);
+    assert_int_equal(qnav_policy_read("/nonexistent/x.policy", &p, err, sizeof err), QNAV_POLICY_IO_E_IO);
     assert_non_null(strstr(err, "/nonexistent/x.policy: cannot open ("));
-    assert_int_equal(qnav_policy_read("/tmp", &p, err, sizeof err), -1);
+    assert_int_equal(qnav_policy_read("/tmp", &p, err, sizeof err), QNAV_POLICY_IO_E_IO);
     assert_non_null(strstr(err, "/tmp: read error ("));
 }
 
@@ -570,7 +621,7 @@ static void test_oversized_file_is_refused(void **state)
     (void)state;
     assert_non_null(big);
     memset(big, '\n', n);
-    assert_int_equal(qnav_policy_parse(big, n, "big", &p, err, sizeof err), -1);
+    assert_int_equal(qnav_policy_parse(big, n, "big", &p, err, sizeof err), QNAV_POLICY_IO_E_PARSE);
     assert_non_null(strstr(err, "big:1: file larger than"));
     free(big);
 }
@@ -599,7 +650,7 @@ static int parse_mutant(const char *buf, size_t len)
         assert_int_equal(qnav_policy_check(&p, err, sizeof err), 0);
         assert_int_equal(qnav_ctrl_init(&ctrl, &cfg, &p), QNAV_OK);
     } else {
-        assert_int_equal(rc, -1);
+        assert_int_equal(rc, QNAV_POLICY_IO_E_PARSE);
         assert_true(strncmp(err, "m.policy:", 9) == 0);
         assert_true(strlen(err) > 12);
         assert_null(strchr(err, '\n'));
@@ -725,6 +776,8 @@ int main(void)
         cmocka_unit_test(test_line_of_exactly_the_limit_is_accepted_and_one_more_refused),
         cmocka_unit_test(test_reader_agrees_with_ctrl_init_on_every_probabilistic_parameter),
         cmocka_unit_test(test_every_bad_file_is_refused_with_its_expected_line_and_message),
+        cmocka_unit_test(test_every_status_has_its_own_text),
+        cmocka_unit_test(test_kind_list_names_every_kind_once),
         cmocka_unit_test(test_missing_file_is_reported_with_its_name),
         cmocka_unit_test(test_oversized_file_is_refused),
         cmocka_unit_test(test_truncating_a_good_file_at_every_byte_never_crashes),

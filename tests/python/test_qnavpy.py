@@ -342,5 +342,26 @@ class Policies(unittest.TestCase):
         np.testing.assert_array_equal(p.raw, [1, -1, 2, -2, 32767])
 
 
+class NameListsAreTheTables(unittest.TestCase):
+    """Issue 22: every list of controller names that people read is libqnav's table (the CLI
+    help prints it) or is checked against it here (the docs and the header's comment)."""
+
+    def test_docs_and_header_list_exactly_the_controller_table(self):
+        names = qnavpy.controller_names()
+        with open(os.path.join(SRC, "docs", "architecture.md"), encoding="utf-8") as f:
+            seam = f.read().split("## Controllers: the seam", 1)[1].split("\n### ", 1)[0]
+        self.assertEqual(re.findall(r"^\| `([a-z0-9_-]+)` \|", seam, re.M), names)
+        with open(os.path.join(SRC, "firmware", "include", "qnav", "nav.h"), encoding="utf-8") as f:
+            header = f.read().split("*/", 1)[0]
+        self.assertEqual(re.findall(r'^ \*   "([a-z0-9_-]+)"', header, re.M), names)
+
+    def test_qnav_sim_help_names_every_controller_of_the_table(self):
+        out = subprocess.run([QNAV_SIM, "run", "--help"], capture_output=True, text=True,
+                             check=True).stdout
+        help_text = " ".join(out.split("--controller", 1)[1].split("--limit-factor", 1)[0].split())
+        for name in qnavpy.controller_names():
+            self.assertIn(name + ":", help_text)
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -20,11 +20,15 @@ public:
     EpisodeOutcome run(const qnav_policy_t &policy, uint64_t episode_seed) override
     {
         ++calls;
-        if (policy.kind != QNAV_POLICY_NET) { // the probabilistic policy: a fixed score
+        switch (static_cast<qnav_policy_kind_t>(policy.kind)) {
+        case QNAV_POLICY_PROB: { // the probabilistic policy: a fixed score
             Rng r(episode_seed);
             EpisodeOutcome o;
             o.R = -20.0 + (r.uniform01() - 0.5);
             return o;
+        }
+        case QNAV_POLICY_NET:
+            break;
         }
         qnav_net_t net = policy.u.net;
         double d2 = 0.0;

@@ -28,6 +28,7 @@ extern "C" {
 #include "spec.h"
 #include "stats.h"
 #include "worlds.h"
+#include "qnav/nav.h"
 
 using namespace qnav;
 
@@ -370,6 +371,25 @@ static void test_spec_controller_reading_reaches_every_scenario_and_bad_names_fa
     }
 }
 
+/* simevo's readings are rows of libqnav's controller table that take a policy, listed
+ * in its messages from kControllerReadings: a reading that names no such row is caught
+ * here, not at the first episode. */
+static void test_every_controller_reading_is_a_policy_row_of_the_controller_table(void **state)
+{
+    (void)state;
+    std::string names;
+    for (ControllerReading c : kControllerReadings) {
+        const qnav_nav_method_t *m = qnav_nav_find(controller_reading_name(c));
+        assert_non_null(m);
+        assert_int_equal(m->uses_policy, 1);
+        ControllerReading back = ControllerReading::Body;
+        assert_true(controller_reading_parse(controller_reading_name(c), &back));
+        assert_true(back == c);
+        names += (names.empty() ? "" : ", ") + std::string(controller_reading_name(c));
+    }
+    assert_string_equal(controller_reading_names().c_str(), names.c_str());
+}
+
 static void test_spec_checkpoints_parse_and_presets_shrink_their_evaluation(void **state)
 {
     (void)state;
@@ -663,6 +683,7 @@ int main(void)
         cmocka_unit_test(test_spec_parses_inheritance_and_presets),
         cmocka_unit_test(test_spec_fitness_rule_reaches_every_scenario),
         cmocka_unit_test(test_spec_controller_reading_reaches_every_scenario_and_bad_names_fail),
+        cmocka_unit_test(test_every_controller_reading_is_a_policy_row_of_the_controller_table),
         cmocka_unit_test(test_spec_checkpoints_parse_and_presets_shrink_their_evaluation),
         cmocka_unit_test(test_spec_errors_name_file_line_and_problem),
         cmocka_unit_test(test_spec_distribution_parses_and_sources_name_their_own),

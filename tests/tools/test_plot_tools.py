@@ -124,7 +124,10 @@ def tiny_summary():
     return {"title": "t", "name": "t", "figure": None, "runs": 2, "preset": "quick", "curve_bin": 10,
             "episodes_per_candidate": 3, "robot_radius_m": 0.1,
             "conditions": [{"label": "probabilistic", "final_mean": 0.5, "final_ci95": 0.1,
-                            "arrival": {"mean": 0.9, "ci95_low": 0.8, "ci95_high": 0.95}}]}
+                            "arrival": {"mean": 0.9, "ci95_low": 0.8, "ci95_high": 0.95}}],
+            # as simevo writes them from its reference table
+            "references": [{"label": "probabilistic", "plot_name": "probabilistic (held out)",
+                            "plot_style": "--", "plot_color": "tab:gray"}]}
 
 
 class LearningPictureSaysWhatIsHeldOut(unittest.TestCase):

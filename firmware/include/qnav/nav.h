@@ -40,6 +40,11 @@ typedef struct {
     void (*reset)(qnav_nav_t *nav);
     /* One tick: the signature every controller shares. Never fails. */
     void (*step)(qnav_nav_t *nav, const qnav_ctrl_input_t *in, qnav_ctrl_output_t *out);
+    /* Where this controller keeps the sensor settings it was initialised with (sectors N,
+     * maximum range): its own member of nav's union, so that no caller guesses which
+     * member holds them (qnav_nav_sensors). A row without it does not compile
+     * (-Wmissing-field-initializers under -Werror). */
+    const qnav_clearance_t *(*sensors)(const qnav_nav_t *nav);
 } qnav_nav_method_t;
 
 /* A controller instance: the chosen method and its storage. Caller-owned; private fields. */

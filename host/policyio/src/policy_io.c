@@ -81,6 +81,27 @@ static void quote_bytes(const char *s, size_t n, size_t max, char *out, size_t o
     out[o] = '\0';
 }
 
+const char *qnav_policy_io_status_str(qnav_policy_io_status_t status)
+{
+    switch (status) {
+    case QNAV_POLICY_IO_OK:
+        return "ok";
+    case QNAV_POLICY_IO_E_NULL:
+        return "null argument";
+    case QNAV_POLICY_IO_E_IO:
+        return "cannot open, read or write the file";
+    case QNAV_POLICY_IO_E_PARSE:
+        return "not a good policy file";
+    case QNAV_POLICY_IO_E_INVALID:
+        return "invalid policy, metadata or comment";
+    case QNAV_POLICY_IO_E_NAME:
+        return "no policy kind of that name";
+    case QNAV_POLICY_IO_E_NOMEM:
+        return "out of memory";
+    }
+    return "unknown policyio status";
+}
+
 const char *qnav_policy_kind_name(uint8_t kind)
 {
     switch ((qnav_policy_kind_t)kind) {
@@ -92,18 +113,42 @@ const char *qnav_policy_kind_name(uint8_t kind)
     return NULL;
 }
 
-int qnav_policy_kind_from_name(const char *name, size_t len, uint8_t *kind)
+/* Every kind, in the order names are listed. */
+static const qnav_policy_kind_t kinds[] = {QNAV_POLICY_PROB, QNAV_POLICY_NET};
+#define N_KINDS (sizeof kinds / sizeof kinds[0])
+
+qnav_policy_io_status_t qnav_policy_kind_from_name(const char *name, size_t len, uint8_t *kind)
 {
-    static const qnav_policy_kind_t kinds[] = {QNAV_POLICY_PROB, QNAV_POLICY_NET};
     size_t i;
-    for (i = 0; i < sizeof kinds / sizeof kinds[0]; ++i) {
+    for (i = 0; i < N_KINDS; ++i) {
         const char *n = qnav_policy_kind_name((uint8_t)kinds[i]);
         if (strlen(n) == len && memcmp(n, name, len) == 0) {
             *kind = (uint8_t)kinds[i];
-            return 0;
+            return QNAV_POLICY_IO_OK;
         }
     }
-    return -1;
+    return QNAV_POLICY_IO_E_NAME;
+}
+
+const char *qnav_policy_kind_list(char *buf, size_t len, const char *quote, const char *sep,
+                                  const char *last)
+{
+    size_t used = 0;
+    size_t i;
+    if (buf == NULL || len == 0) {
+        return buf;
+    }
+    buf[0] = '\0';
+    for (i = 0; i < N_KINDS && used < len; ++i) {
+        const char *between = i == 0 ? "" : (i + 1 == N_KINDS ? last : sep);
+        int n = snprintf(buf + used, len - used, "%s%s%s%s", between, quote,
+                         qnav_policy_kind_name((uint8_t)kinds[i]), quote);
+        if (n < 0) {
+            break;
+        }
+        used += (size_t)n;
+    }
+    return buf;
 }
 
 int qnav_policy_file_version(const qnav_policy_t *policy)
@@ -119,23 +164,23 @@ int qnav_policy_file_version(const qnav_policy_t *policy)
 
 /* ---- checks on a policy in memory ---------------------------------------------------- */
 
-int qnav_policy_check(const qnav_policy_t *policy, char *err, size_t errlen)
+qnav_policy_io_status_t qnav_policy_check(const qnav_policy_t *policy, char *err, size_t errlen)
 {
     qnav_policy_status_t st = qnav_policy_validate(policy);
     switch (st) {
     case QNAV_POLICY_OK:
-        return 0;
+        return QNAV_POLICY_IO_OK;
     case QNAV_POLICY_E_KIND:
         set_err(err, errlen, "unknown policy kind %u", (unsigned)policy->kind);
-        return -1;
+        return QNAV_POLICY_IO_E_INVALID;
     case QNAV_POLICY_E_HIDDEN:
         set_err(err, errlen, "hidden %u outside 1..%d", (unsigned)policy->u.net.hidden,
                 QNAV_MAX_HIDDEN);
-        return -1;
+        return QNAV_POLICY_IO_E_INVALID;
     case QNAV_POLICY_E_INPUTS:
         set_err(err, errlen, "inputs %u: a network has 2 or 3 inputs",
                 (unsigned)policy->u.net.inputs);
-        return -1;
+        return QNAV_POLICY_IO_E_INVALID;
     case QNAV_POLICY_E_PROB_PARAM:
         if (policy->u.prob.k_goal <= 0 || policy->u.prob.k_goal > K_RAW_MAX) {
             set_err(err, errlen, "k_goal %d outside (0, 64]: raw Q8.8 must be 1..%ld",
@@ -144,13 +189,13 @@ int qnav_policy_check(const qnav_policy_t *policy, char *err, size_t errlen)
             set_err(err, errlen, "k_safe %d outside (0, 64]: raw Q8.8 must be 1..%ld",
                     (int)policy->u.prob.k_safe, K_RAW_MAX);
         }
-        return -1;
+        return QNAV_POLICY_IO_E_INVALID;
     case QNAV_POLICY_E_NULL:
     case QNAV_POLICY_E_KIND_DISABLED:
         break;
     }
     set_err(err, errlen, "%s", qnav_policy_status_str(st));
-    return -1;
+    return QNAV_POLICY_IO_E_INVALID;
 }
 
 int qnav_policy_equal(const qnav_policy_t *a, const qnav_policy_t *b)
@@ -247,7 +292,7 @@ const char *qnav_policy_meta_get(const qnav_policy_meta_t *meta, const char *nam
     return NULL;
 }
 
-int qnav_policy_meta_set(qnav_policy_meta_t *meta, const char *name, const char *value,
+qnav_policy_io_status_t qnav_policy_meta_set(qnav_policy_meta_t *meta, const char *name, const char *value,
                          char *err, size_t errlen)
 {
     size_t i;
@@ -257,35 +302,35 @@ int qnav_policy_meta_set(qnav_policy_meta_t *meta, const char *name, const char 
     char q[80];
     if (meta == NULL || name == NULL || value == NULL) {
         set_err(err, errlen, "meta: null argument");
-        return -1;
+        return QNAV_POLICY_IO_E_NULL;
     }
     nl = strlen(name);
     vl = strlen(value);
     if (!meta_name_ok(name, nl)) {
         quote_bytes(name, nl, 40, q, sizeof q);
         set_err(err, errlen, "meta name '%s' must be 1..31 of A-Z a-z 0-9 _ . -", q);
-        return -1;
+        return QNAV_POLICY_IO_E_INVALID;
     }
     why = meta_value_problem(value, vl);
     if (why != NULL) {
         set_err(err, errlen, "meta %s: value %s", name, why);
-        return -1;
+        return QNAV_POLICY_IO_E_INVALID;
     }
     for (i = 0; i < meta->count && i < QNAV_POLICY_META_MAX; ++i) {
         if (strcmp(meta->entry[i].name, name) == 0) {
             memcpy(meta->entry[i].value, value, vl + 1);
-            return 0;
+            return QNAV_POLICY_IO_OK;
         }
     }
     if (meta->count >= QNAV_POLICY_META_MAX) {
         set_err(err, errlen, "meta %s: more than %d metadata entries", name,
                 QNAV_POLICY_META_MAX);
-        return -1;
+        return QNAV_POLICY_IO_E_INVALID;
     }
     memcpy(meta->entry[meta->count].name, name, nl + 1);
     memcpy(meta->entry[meta->count].value, value, vl + 1);
     meta->count++;
-    return 0;
+    return QNAV_POLICY_IO_OK;
 }
 
 /* ---- the reader ---------------------------------------------------------------------- */
@@ -675,6 +720,7 @@ static int line_key_prob(parser_t *ps, const token_t *tok, size_t ntok, const ch
 static int line_kind(parser_t *ps, const token_t *tok, size_t ntok, const char *q)
 {
     char v[80];
+    char names[80];
     if (!tok_is(&tok[0], "kind")) {
         return fail(ps, "expected 'kind' as the first key, found '%s'", q);
     }
@@ -683,7 +729,8 @@ static int line_kind(parser_t *ps, const token_t *tok, size_t ntok, const char *
     }
     if (qnav_policy_kind_from_name(tok[1].p, tok[1].n, &ps->pol.kind) != 0) {
         quote_bytes(tok[1].p, tok[1].n, 40, v, sizeof v);
-        return fail(ps, "unknown kind '%s' (expected 'network' or 'probabilistic')", v);
+        return fail(ps, "unknown kind '%s' (expected %s)", v,
+                    qnav_policy_kind_list(names, sizeof names, "'", ", ", " or "));
     }
     switch ((qnav_policy_kind_t)ps->pol.kind) {
     case QNAV_POLICY_NET:
@@ -821,7 +868,7 @@ static int parse_line(parser_t *ps, const char *s, size_t n)
     return ntok > 0 ? line_key(ps, buf, blen, tok, ntok) : 0;
 }
 
-int qnav_policy_parse_meta(const char *text, size_t len, const char *name,
+qnav_policy_io_status_t qnav_policy_parse_meta(const char *text, size_t len, const char *name,
                            qnav_policy_t *out, qnav_policy_meta_t *meta, char *err,
                            size_t errlen)
 {
@@ -833,13 +880,13 @@ int qnav_policy_parse_meta(const char *text, size_t len, const char *name,
     }
     if (out == NULL || (text == NULL && len > 0)) {
         set_err(err, errlen, "%s: null argument", name);
-        return -1;
+        return QNAV_POLICY_IO_E_NULL;
     }
     /* the parser state holds a whole policy and metadata: keep it off the stack */
     ps = (parser_t *)calloc(1, sizeof *ps);
     if (ps == NULL) {
         set_err(err, errlen, "%s: out of memory", name);
-        return -1;
+        return QNAV_POLICY_IO_E_NOMEM;
     }
     ps->name = name;
     ps->err = err;
@@ -877,39 +924,39 @@ int qnav_policy_parse_meta(const char *text, size_t len, const char *name,
         }
     }
     free(ps);
-    return rc;
+    return rc == 0 ? QNAV_POLICY_IO_OK : QNAV_POLICY_IO_E_PARSE;
 }
 
-int qnav_policy_parse(const char *text, size_t len, const char *name, qnav_policy_t *out,
+qnav_policy_io_status_t qnav_policy_parse(const char *text, size_t len, const char *name, qnav_policy_t *out,
                       char *err, size_t errlen)
 {
     return qnav_policy_parse_meta(text, len, name, out, NULL, err, errlen);
 }
 
-int qnav_policy_read_meta(const char *path, qnav_policy_t *out, qnav_policy_meta_t *meta,
+qnav_policy_io_status_t qnav_policy_read_meta(const char *path, qnav_policy_t *out, qnav_policy_meta_t *meta,
                           char *err, size_t errlen)
 {
     FILE *f;
     char *buf;
     size_t cap = (size_t)QNAV_POLICY_FILE_MAX + 1;
     size_t len = 0;
-    int rc;
+    qnav_policy_io_status_t rc;
     char nm[200];
     if (path == NULL) {
         set_err(err, errlen, "(null path): cannot open");
-        return -1;
+        return QNAV_POLICY_IO_E_NULL;
     }
     quote_bytes(path, strlen(path), 160, nm, sizeof nm);
     f = fopen(path, "rb");
     if (f == NULL) {
         set_err(err, errlen, "%s: cannot open (%s)", nm, strerror(errno));
-        return -1;
+        return QNAV_POLICY_IO_E_IO;
     }
     buf = (char *)malloc(cap);
     if (buf == NULL) {
         fclose(f);
         set_err(err, errlen, "%s: out of memory", nm);
-        return -1;
+        return QNAV_POLICY_IO_E_NOMEM;
     }
     /* read one byte more than the limit so that an oversized file is detected */
     while (len < cap) {
@@ -924,7 +971,7 @@ int qnav_policy_read_meta(const char *path, qnav_policy_t *out, qnav_policy_meta
         fclose(f);
         free(buf);
         set_err(err, errlen, "%s: read error (%s)", nm, strerror(e));
-        return -1;
+        return QNAV_POLICY_IO_E_IO;
     }
     fclose(f);
     if (len > (size_t)QNAV_POLICY_FILE_MAX) {
@@ -936,14 +983,14 @@ int qnav_policy_read_meta(const char *path, qnav_policy_t *out, qnav_policy_meta
         free(buf);
         set_err(err, errlen, "%s:%lu: file larger than %ld bytes", nm, line,
                 QNAV_POLICY_FILE_MAX);
-        return -1;
+        return QNAV_POLICY_IO_E_PARSE;
     }
     rc = qnav_policy_parse_meta(buf, len, path, out, meta, err, errlen);
     free(buf);
     return rc;
 }
 
-int qnav_policy_read(const char *path, qnav_policy_t *out, char *err, size_t errlen)
+qnav_policy_io_status_t qnav_policy_read(const char *path, qnav_policy_t *out, char *err, size_t errlen)
 {
     return qnav_policy_read_meta(path, out, NULL, err, errlen);
 }
@@ -1048,16 +1095,16 @@ int qnav_policy_format(const qnav_policy_t *policy, const qnav_policy_meta_t *me
     out_t o;
     size_t i;
     if (qnav_policy_check(policy, err, errlen) != 0) {
-        return -1;
+        return QNAV_POLICY_IO_E_INVALID;
     }
     if (comment != NULL && strlen(comment) > QNAV_POLICY_COMMENT_MAX) {
         set_err(err, errlen, "comment longer than %d bytes", QNAV_POLICY_COMMENT_MAX);
-        return -1;
+        return QNAV_POLICY_IO_E_INVALID;
     }
     if (meta != NULL) {
         if (meta->count > QNAV_POLICY_META_MAX) {
             set_err(err, errlen, "more than %d metadata entries", QNAV_POLICY_META_MAX);
-            return -1;
+            return QNAV_POLICY_IO_E_INVALID;
         }
         for (i = 0; i < meta->count; ++i) {
             const qnav_policy_meta_entry_t *e = &meta->entry[i];
@@ -1067,16 +1114,16 @@ int qnav_policy_format(const qnav_policy_t *policy, const qnav_policy_meta_t *me
             size_t k;
             if (nl == sizeof e->name || vl == sizeof e->value || !meta_name_ok(e->name, nl)) {
                 set_err(err, errlen, "metadata entry %zu: bad name or unterminated text", i);
-                return -1;
+                return QNAV_POLICY_IO_E_INVALID;
             }
             if (why != NULL) {
                 set_err(err, errlen, "meta %s: value %s", e->name, why);
-                return -1;
+                return QNAV_POLICY_IO_E_INVALID;
             }
             for (k = 0; k < i; ++k) {
                 if (strcmp(meta->entry[k].name, e->name) == 0) {
                     set_err(err, errlen, "meta %s appears twice", e->name);
-                    return -1;
+                    return QNAV_POLICY_IO_E_INVALID;
                 }
             }
         }
@@ -1165,7 +1212,7 @@ static void sync_dir(char *dir, const char *path, size_t pl)
     }
 }
 
-int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, char *err,
+qnav_policy_io_status_t qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, char *err,
                                 size_t errlen)
 {
     char *tmp;
@@ -1175,13 +1222,13 @@ int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, 
     char nm[200];
     if (path == NULL || (data == NULL && len > 0)) {
         set_err(err, errlen, "(null): null argument");
-        return -1;
+        return QNAV_POLICY_IO_E_NULL;
     }
     quote_bytes(path, strlen(path), 160, nm, sizeof nm);
     pl = strlen(path);
     if (pl == 0) {
         set_err(err, errlen, "(empty path): cannot write");
-        return -1;
+        return QNAV_POLICY_IO_E_IO;
     }
     tmp = (char *)malloc(pl + 16);
     dir = (char *)malloc(pl + 2);
@@ -1189,7 +1236,7 @@ int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, 
         free(tmp);
         free(dir);
         set_err(err, errlen, "%s: out of memory", nm);
-        return -1;
+        return QNAV_POLICY_IO_E_NOMEM;
     }
     memcpy(tmp, path, pl);
     memcpy(tmp + pl, ".tmpXXXXXX", 11);
@@ -1199,7 +1246,7 @@ int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, 
                 strerror(errno));
         free(tmp);
         free(dir);
-        return -1;
+        return QNAV_POLICY_IO_E_IO;
     }
     if (fchmod(fd, 0644) != 0) {
         goto io_error;
@@ -1218,7 +1265,7 @@ int qnav_policy_io_write_atomic(const char *path, const void *data, size_t len, 
     sync_dir(dir, path, pl);
     free(tmp);
     free(dir);
-    return 0;
+    return QNAV_POLICY_IO_OK;
 
 io_error:
     set_err(err, errlen, "%s: cannot write (%s)", nm, strerror(errno));
@@ -1228,10 +1275,10 @@ io_error:
     (void)unlink(tmp);
     free(tmp);
     free(dir);
-    return -1;
+    return QNAV_POLICY_IO_E_IO;
 }
 
-int qnav_policy_write_meta(const char *path, const qnav_policy_t *policy,
+qnav_policy_io_status_t qnav_policy_write_meta(const char *path, const qnav_policy_t *policy,
                            const qnav_policy_meta_t *meta, const char *comment, char *err,
                            size_t errlen)
 {
@@ -1239,31 +1286,31 @@ int qnav_policy_write_meta(const char *path, const qnav_policy_t *policy,
     char nm[200];
     char *buf;
     int n;
-    int rc;
+    qnav_policy_io_status_t rc;
     const char *p = path != NULL ? path : "(null)";
     quote_bytes(p, strlen(p), 160, nm, sizeof nm);
     n = qnav_policy_format(policy, meta, comment, NULL, 0, msg, sizeof msg);
     if (n < 0) {
         set_err(err, errlen, "%s: refusing to write an invalid policy: %s", nm, msg);
-        return -1;
+        return QNAV_POLICY_IO_E_INVALID;
     }
     buf = (char *)malloc((size_t)n + 1);
     if (buf == NULL) {
         set_err(err, errlen, "%s: out of memory", nm);
-        return -1;
+        return QNAV_POLICY_IO_E_NOMEM;
     }
     if (qnav_policy_format(policy, meta, comment, buf, (size_t)n + 1, msg, sizeof msg) != n) {
         set_err(err, errlen, "%s: the policy's text changed length while it was written: %s", nm,
                 msg);
         free(buf);
-        return -1;
+        return QNAV_POLICY_IO_E_INVALID;
     }
     rc = qnav_policy_io_write_atomic(path, buf, (size_t)n, err, errlen);
     free(buf);
     return rc;
 }
 
-int qnav_policy_write(const char *path, const qnav_policy_t *policy, const char *comment,
+qnav_policy_io_status_t qnav_policy_write(const char *path, const qnav_policy_t *policy, const char *comment,
                       char *err, size_t errlen)
 {
     return qnav_policy_write_meta(path, policy, NULL, comment, err, errlen);

@@ -24,12 +24,19 @@
 #define EXIT_BAD_INPUT 2 /* the policy file given is not a good one */
 #define EXIT_USAGE 2
 
-static const char *const usage_text =
-    "usage: qnav-policy check FILE\n"
-    "       qnav-policy show FILE\n"
-    "       qnav-policy new --kind probabilistic|network [--hidden H] [--inputs 2|3] [--seed S] OUT\n"
-    "       qnav-policy header --mode network|probabilistic|table --name NAME IN OUT.h\n"
-    "Policy files are described in docs/policy-format.md.\n";
+/* The usage text; the kinds it names are the policy kinds' own list. */
+static void usage(FILE *f)
+{
+    char kinds[80];
+    (void)qnav_policy_kind_list(kinds, sizeof kinds, "", "|", "|");
+    fprintf(f,
+            "usage: qnav-policy check FILE\n"
+            "       qnav-policy show FILE\n"
+            "       qnav-policy new --kind %s [--hidden H] [--inputs 2|3] [--seed S] OUT\n"
+            "       qnav-policy header --mode %s|table --name NAME IN OUT.h\n"
+            "Policy files are described in docs/policy-format.md.\n",
+            kinds, kinds);
+}
 
 #if defined(__GNUC__)
 #define QNAV_PRINTF_LIKE(f, a) __attribute__((format(printf, f, a)))
@@ -201,71 +208,103 @@ static int new_network(qnav_policy_t *p, qnav_policy_meta_t *meta, uint8_t hidde
     return qnav_policy_meta_set(meta, "source", src, err, errlen);
 }
 
-static int cmd_new(int argc, char **argv)
+/* What `new` was asked for; kind NULL until --kind is given. */
+typedef struct {
+    const char *kind;
+    uint64_t hidden;
+    uint64_t inputs;
+    uint64_t seed;
+    int have_network_option; /* --hidden, --inputs or --seed */
+} new_options_t;
+
+/* One option of `new` into o; 0, or the usage error's exit code. */
+static int new_option(int opt, new_options_t *o, char **argv)
+{
+    switch (opt) {
+    case 'k':
+        o->kind = optarg;
+        return 0;
+    case 'i':
+        if (parse_u64(optarg, 255, &o->inputs) != 0 ||
+            (o->inputs != QNAV_NET_INPUTS_PAPER && o->inputs != QNAV_NET_INPUTS_PREV)) {
+            return usage_error("new: --inputs '%s' must be 2 or 3", optarg);
+        }
+        o->have_network_option = 1;
+        return 0;
+    case 'H':
+        if (parse_u64(optarg, 255, &o->hidden) != 0 || o->hidden < 1 ||
+            o->hidden > QNAV_MAX_HIDDEN) {
+            return usage_error("new: --hidden '%s' must be an integer in 1..%d", optarg,
+                               QNAV_MAX_HIDDEN);
+        }
+        o->have_network_option = 1;
+        return 0;
+    case 's':
+        if (parse_u64(optarg, UINT64_MAX, &o->seed) != 0) {
+            return usage_error("new: --seed '%s' must be an unsigned integer", optarg);
+        }
+        o->have_network_option = 1;
+        return 0;
+    case ':':
+        return usage_error("new: option '%s' needs a value", argv[optind - 1]);
+    default:
+        return usage_error("new: unknown option '%s'", argv[optind - 1]);
+    }
+}
+
+/* The options of `new` up to its OUT file (argv[optind] on success); 0 or an exit code. */
+static int new_options(int argc, char **argv, new_options_t *o)
 {
     static const struct option opts[] = {{"kind", required_argument, NULL, 'k'},
                                          {"hidden", required_argument, NULL, 'H'},
                                          {"seed", required_argument, NULL, 's'},
                                          {"inputs", required_argument, NULL, 'i'},
                                          {NULL, 0, NULL, 0}};
-    uint64_t inputs = QNAV_NET_INPUTS_PAPER;
-    const char *kind = NULL;
-    uint64_t hidden = QNAV_DEFAULT_HIDDEN;
-    uint64_t seed = 1;
-    int have_hidden = 0;
-    int have_seed = 0;
     int opt;
-    int made = -1;
-    qnav_policy_t p;
-    qnav_policy_meta_t meta;
-    char err[QNAV_POLICY_IO_ERRLEN];
+    o->kind = NULL;
+    o->hidden = QNAV_DEFAULT_HIDDEN;
+    o->inputs = QNAV_NET_INPUTS_PAPER;
+    o->seed = 1;
+    o->have_network_option = 0;
     opterr = 0;
     optind = 1;
     while ((opt = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
-        switch (opt) {
-        case 'k':
-            kind = optarg;
-            break;
-        case 'i':
-            if (parse_u64(optarg, 255, &inputs) != 0 ||
-                (inputs != QNAV_NET_INPUTS_PAPER && inputs != QNAV_NET_INPUTS_PREV)) {
-                return usage_error("new: --inputs '%s' must be 2 or 3", optarg);
-            }
-            have_hidden = 1; /* a network option, like --hidden */
-            break;
-        case 'H':
-            if (parse_u64(optarg, 255, &hidden) != 0 || hidden < 1 ||
-                hidden > QNAV_MAX_HIDDEN) {
-                return usage_error("new: --hidden '%s' must be an integer in 1..%d", optarg,
-                                   QNAV_MAX_HIDDEN);
-            }
-            have_hidden = 1;
-            break;
-        case 's':
-            if (parse_u64(optarg, UINT64_MAX, &seed) != 0) {
-                return usage_error("new: --seed '%s' must be an unsigned integer", optarg);
-            }
-            have_seed = 1;
-            break;
-        case ':':
-            return usage_error("new: option '%s' needs a value", argv[optind - 1]);
-        default:
-            return usage_error("new: unknown option '%s'", argv[optind - 1]);
+        const int rc = new_option(opt, o, argv);
+        if (rc != 0) {
+            return rc;
         }
     }
-    if (kind == NULL) {
-        return usage_error("new: --kind probabilistic|network is required");
+    if (o->kind == NULL) {
+        char kinds[80];
+        return usage_error("new: --kind %s is required",
+                           qnav_policy_kind_list(kinds, sizeof kinds, "", "|", "|"));
     }
     if (optind != argc - 1) {
         return usage_error("new: expected exactly one OUT file after the options");
     }
-    if (qnav_policy_kind_from_name(kind, strlen(kind), &p.kind) != 0) {
-        return usage_error("new: --kind '%s' must be 'probabilistic' or 'network'", kind);
+    return 0;
+}
+
+static int cmd_new(int argc, char **argv)
+{
+    new_options_t o;
+    int made = -1;
+    qnav_policy_t p;
+    qnav_policy_meta_t meta;
+    char err[QNAV_POLICY_IO_ERRLEN];
+    const int rc = new_options(argc, argv, &o);
+    if (rc != 0) {
+        return rc;
+    }
+    if (qnav_policy_kind_from_name(o.kind, strlen(o.kind), &p.kind) != 0) {
+        char kinds[80];
+        return usage_error("new: --kind '%s' must be %s", o.kind,
+                           qnav_policy_kind_list(kinds, sizeof kinds, "'", ", ", " or "));
     }
     qnav_policy_meta_clear(&meta);
     switch ((qnav_policy_kind_t)p.kind) {
     case QNAV_POLICY_PROB:
-        if (have_hidden || have_seed) {
+        if (o.have_network_option) {
             return usage_error("new: --hidden, --inputs and --seed apply to --kind network only");
         }
         qnav_policy_prob_default(&p);
@@ -273,7 +312,8 @@ static int cmd_new(int argc, char **argv)
                                     err, sizeof err);
         break;
     case QNAV_POLICY_NET:
-        made = new_network(&p, &meta, (uint8_t)hidden, (uint8_t)inputs, seed, err, sizeof err);
+        made = new_network(&p, &meta, (uint8_t)o.hidden, (uint8_t)o.inputs, o.seed, err,
+                           sizeof err);
         break;
     }
     if (made != 0 || qnav_policy_write_meta(argv[optind], &p, &meta, NULL, err, sizeof err) != 0) {
@@ -452,6 +492,13 @@ static int cmd_header(int argc, char **argv, int full_argc, char *const *full_ar
     return rc;
 }
 
+/* 1 when --mode names a policy kind (the kind's own mode; "table" takes any). */
+static int mode_is_kind(const char *mode)
+{
+    uint8_t kind;
+    return qnav_policy_kind_from_name(mode, strlen(mode), &kind) == QNAV_POLICY_IO_OK;
+}
+
 /* header's options and operands: --mode, --name, IN, OUT.h. Returns 0, or the exit code
  * after one line on stderr. */
 static int header_args(int argc, char **argv, const char **mode, const char **name,
@@ -477,9 +524,10 @@ static int header_args(int argc, char **argv, const char **mode, const char **na
             return usage_error("header: unknown option '%s'", argv[optind - 1]);
         }
     }
-    if (*mode == NULL || (strcmp(*mode, "network") != 0 && strcmp(*mode, "probabilistic") != 0 &&
-                          strcmp(*mode, "table") != 0)) {
-        return usage_error("header: --mode must be network, probabilistic or table");
+    if (*mode == NULL || (!mode_is_kind(*mode) && strcmp(*mode, "table") != 0)) {
+        char kinds[80];
+        return usage_error("header: --mode must be %s or table",
+                           qnav_policy_kind_list(kinds, sizeof kinds, "", ", ", ", "));
     }
     if (*name == NULL || !is_c_identifier(*name)) {
         return usage_error("header: --name must be a C identifier (letters, digits, '_'; "
@@ -618,12 +666,12 @@ int main(int argc, char **argv)
 {
     const char *cmd;
     if (argc < 2) {
-        fputs(usage_text, stderr);
+        usage(stderr);
         return EXIT_USAGE;
     }
     cmd = argv[1];
     if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {
-        fputs(usage_text, stdout);
+        usage(stdout);
         return 0;
     }
     if (strcmp(cmd, "--version") == 0) {

@@ -43,7 +43,7 @@ void set_controller(ExperimentSpec &s, const std::string &name)
 {
     ControllerReading c;
     if (!controller_reading_parse(name, &c)) {
-        throw UserError("--controller: '" + name + "' is not one of body, literal");
+        throw UserError("--controller: '" + name + "' is not one of " + controller_reading_names());
     }
     for_each_scenario(s, [c](Scenario &sc) { sc.controller = c; });
 }

@@ -93,7 +93,10 @@ struct ConditionDecl {
     bool evolved;        /* has runs, learning curves and checkpoints */
     const ReferenceDecl *reference; /* a reference's row of kReferences (task.h), or null */
 };
-extern const ConditionDecl kConditions[4];
+/* Every condition: the two evolved ones, then one row per reference of kReferences in its
+ * order (a reference without its row here stops the build: experiment_plan.cpp). */
+constexpr std::size_t kConditionCount = 2 + kReferenceCount;
+extern const ConditionDecl kConditions[kConditionCount];
 const ConditionDecl &condition_decl(ConditionKind kind);
 /* "transfer-" + source, "direct", "probabilistic". */
 std::string condition_label(ConditionKind kind, const std::string &source = std::string());

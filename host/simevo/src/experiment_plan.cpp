@@ -108,12 +108,32 @@ std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &e
 
 /* ---- conditions ------------------------------------------------------------------ */
 
-const ConditionDecl kConditions[4] = {
+constexpr ConditionDecl kConditions[kConditionCount] = {
     {ConditionKind::Transfer, "transfer-", true, nullptr},
     {ConditionKind::Direct, "direct", true, nullptr},
     {ConditionKind::Probabilistic, kReferences[0].label, false, &kReferences[0]},
     {ConditionKind::Vfh, kReferences[1].label, false, &kReferences[1]},
 };
+
+/* The reference conditions are kReferences, row for row and in its order, none evolved:
+ * a row added to kReferences without its ConditionKind and its row above fails here. */
+constexpr bool conditions_follow_the_reference_table()
+{
+    std::size_t next = 0;
+    for (const ConditionDecl &d : kConditions) {
+        if (d.reference == nullptr) {
+            continue;
+        }
+        if (next >= kReferenceCount || d.reference != &kReferences[next] || d.evolved) {
+            return false;
+        }
+        ++next;
+    }
+    return next == kReferenceCount;
+}
+static_assert(conditions_follow_the_reference_table(),
+              "every row of kReferences (task.h) needs a ConditionKind (experiment.h) and a "
+              "kConditions row pointing at it, in the same order");
 
 const ConditionDecl &condition_decl(ConditionKind kind)
 {

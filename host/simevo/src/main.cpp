@@ -109,8 +109,9 @@ void add_run_args(CLI::App *c, RunArgs &a)
     c->add_option("--per-candidate", a.per_candidate, "override episodes per candidate (k)")->check(CLI::Range(int64_t(1), int64_t(1000)));
     c->add_option("--fitness", a.fitness, "override the fitness rule: progress or paper (docs/sim.md)");
     c->add_option("--controller", a.controller,
-                  "override the controller's reading: body, or literal (the paper's per-sector "
-                  "mapping, no speed guard, rank by quality; docs/architecture.md)");
+                  "override the controller's reading: one of " + controller_reading_names() +
+                      " (literal: the paper's per-sector mapping, no speed guard, rank by "
+                      "quality; docs/architecture.md)");
     c->add_option("--vary", a.vary,
                   "KEY=VALUE: set the target situation's noise or sectors and name the experiment "
                   "NAME.KEY-VALUE (one member of a sweep; docs/cluster.md)");

@@ -28,13 +28,22 @@ const char *controller_reading_name(ControllerReading c)
 
 bool controller_reading_parse(const std::string &name, ControllerReading *out)
 {
-    for (ControllerReading c : {ControllerReading::Body, ControllerReading::Literal}) {
+    for (ControllerReading c : kControllerReadings) {
         if (name == controller_reading_name(c)) {
             *out = c;
             return true;
         }
     }
     return false;
+}
+
+std::string controller_reading_names()
+{
+    std::string s;
+    for (ControllerReading c : kControllerReadings) {
+        s += (s.empty() ? "" : ", ") + std::string(controller_reading_name(c));
+    }
+    return s;
 }
 
 const char *world_set_name(WorldSet w)
@@ -332,7 +341,7 @@ void parse_scenario_rules(const Parser &p, const toml::table &t, ExperimentSpec 
         // Like fitness: one reading for the target and every source.
         const std::string s = p.str(*v, "controller");
         if (!controller_reading_parse(s, &spec.target.controller)) {
-            p.fail(*v, "controller: '" + s + "' is not one of body, literal");
+            p.fail(*v, "controller: '" + s + "' is not one of " + controller_reading_names());
         }
     }
 }

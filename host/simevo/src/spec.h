@@ -34,8 +34,15 @@ public:
  * Literal = each path sees its own sector, no guard, ranked by quality (the ablation). */
 enum class ControllerReading { Body, Literal };
 
+/* Every reading, in the order their names are listed. Each is a row of libqnav's
+ * controller table that takes a policy (qnav/nav.h; tests/simevo/test_evolution.cpp checks
+ * it), named by controller_reading_name. */
+constexpr ControllerReading kControllerReadings[] = {ControllerReading::Body,
+                                                     ControllerReading::Literal};
 /* "body" / "literal". */
 const char *controller_reading_name(ControllerReading c);
+/* Every reading's name, ", " between them ("body, literal"), for help and messages. */
+std::string controller_reading_names();
 /* Parses a name; false when it is not one. */
 bool controller_reading_parse(const std::string &name, ControllerReading *out);
 

@@ -61,8 +61,8 @@ typedef struct {
     uint16_t um_per_count;       /* wheel travel per encoder count, micrometres (> 0) */
     uint16_t nvm_offset;         /* first byte of the policy store in the HAL's storage;
                                     it takes QNAV_BOARD_STORE_BYTES bytes */
-    const char *controller;      /* a name in libqnav's controller table (qnav/nav.h):
-                                    "body" (default), "literal", "vfh" */
+    const char *controller;      /* a name in libqnav's controller table (qnav/nav.h;
+                                    default "body") */
 } qnav_board_config_t;
 
 /*
