@@ -33,6 +33,7 @@
 
 #include "bench_grid.h"
 #include "fixture_io.h"
+#include "qnav/rng.h"
 #include "qnav/sim.h"
 
 #if !QNAV_BENCH_COUNT
@@ -121,18 +122,18 @@ typedef struct {
     const char *out;
 } options_t;
 
-/* ---- random numbers (xorshift64*, seeded through splitmix64) ---------------------- */
+/* ---- random numbers (xorshift64*, seeded through qnav/rng.h's splitmix64) ---------- */
+/* Its own generator rather than qnav/rng.h's xoshiro256**: the committed adversarial set
+ * (bench/adversary/) is this sequence's, and another would change it. */
 
 typedef struct {
     uint64_t s;
 } rng_t;
 
+/* splitmix64's first output from state x (a seed mixer). */
 static uint64_t splitmix64(uint64_t x)
 {
-    x += 0x9E3779B97F4A7C15ull;
-    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-    return x ^ (x >> 31);
+    return qnav_splitmix64(&x);
 }
 
 /* A stream for (seed, a, b, c): phases and starts do not share one. */

@@ -19,6 +19,7 @@
 #include <time.h>
 
 #include "bench_grid.h"
+#include "qnav/clock.h"
 
 #ifndef QNAV_BENCH_BUILD
 #define QNAV_BENCH_BUILD "unknown"
@@ -59,9 +60,7 @@ static volatile int32_t sink;
 
 static double now_ns(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
+    return (double)qnav_mono_ns();
 }
 
 static int cmp_double(const void *a, const void *b)

@@ -14,6 +14,8 @@
 
 #include <math.h>
 
+#include "qnav/clock.h"
+
 #include "qnav/fixed_host.h"
 #include "qnav_link_status_t.h"
 #include "qnav_odometry_t.h"
@@ -24,9 +26,7 @@
 
 int64_t qnav_bridge_utime(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+    return qnav_wall_us();
 }
 
 uint16_t qnav_bridge_policy_crc(const qnav_policy_t *policy)

@@ -41,13 +41,6 @@ static void on_signal(int sig)
     g_quit = sig;
 }
 
-static int64_t utime_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
-
 typedef struct {
     const char *robot, *env, *link, *lcm_url, *nvm, *playback;
     double sectors, seed, episode, noise, reply_ms, wait_s, tick_ms;
@@ -235,7 +228,7 @@ static void publish_true_pose(lcm_t *lcm, qnav_sim_t *sim)
     qnav_pose_t ps;
     qnav_sim_state(sim, &st);
     memset(&ps, 0, sizeof ps);
-    ps.utime = utime_now();
+    ps.utime = qnav_wall_us();
     ps.tick = (int32_t)st.tick;
     ps.x_m = st.x_m;
     ps.y_m = st.y_m;

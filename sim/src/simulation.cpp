@@ -458,14 +458,18 @@ void Simulation::advance() {
     if (!done_) compute_scan();
 }
 
+double Simulation::forward_speed() const {
+    return vel_.x * std::cos(heading_) + vel_.y * std::sin(heading_);
+}
+
 qnav_sim_state_t Simulation::state() const {
     qnav_sim_state_t s{};
     s.tick = tick_;
     s.x_m = pos_.x;
     s.y_m = pos_.y;
     s.heading_rad = heading_;
-    s.speed_mps = vel_.x * std::cos(heading_) + vel_.y * std::sin(heading_);
-    s.goal_distance_m = norm(Vec2{env_.dest_x_m, env_.dest_y_m} - pos_);
+    s.speed_mps = forward_speed();
+    s.goal_distance_m = norm(dest() - pos_);
     s.recovering = recovery_left_ > 0;
     s.recovery_ticks_left = recovery_left_;
     s.collisions = collisions_;
@@ -477,12 +481,12 @@ qnav_sim_state_t Simulation::state() const {
 qnav_sim_result_t Simulation::result() const {
     qnav_sim_result_t r{};
     r.l = l_m_;
-    r.beta_l = std::max(0.0, norm(Vec2{env_.dest_x_m, env_.dest_y_m} - start_) - env_.dest_radius_m);
+    r.beta_l = std::max(0.0, norm(dest() - start_) - env_.dest_radius_m);
     r.tau_l = tick_ * QNAV_SIM_TICK_S;
     r.beta_tau = shortest_time(r.beta_l, robot_.v_max_mps, robot_.accel_mps2);
     r.d_start_m = r.beta_l;
     r.d_end_m = reached_ ? 0.0
-                         : std::max(0.0, norm(Vec2{env_.dest_x_m, env_.dest_y_m} - pos_) - env_.dest_radius_m);
+                         : std::max(0.0, norm(dest() - pos_) - env_.dest_radius_m);
     r.tau_c = tau_c_;
     r.reached = reached_;
     r.ticks = tick_;
@@ -500,7 +504,7 @@ qnav_sim_sample_t Simulation::sample() const {
     s.x_m = pos_.x;
     s.y_m = pos_.y;
     s.heading_rad = heading_;
-    s.speed_mps = vel_.x * std::cos(heading_) + vel_.y * std::sin(heading_);
+    s.speed_mps = forward_speed();
     s.cmd_heading_deg = static_cast<qnav_deg_t>(std::lround(cmd_heading_deg_));
     s.cmd_speed = cmd_speed_;
     s.recovering = recovery_left_ > 0;

@@ -87,6 +87,10 @@ public:
     double sonar_cone_rad() const { return sonar_.cone(); }
 
 private:
+    // Speed along the heading (m/s) and the destination's centre (m): what state(),
+    // sample() and result() report.
+    double forward_speed() const;
+    Vec2 dest() const { return Vec2{env_.dest_x_m, env_.dest_y_m}; }
     void build_world();
     void compute_scan();
     void drive_substep(double dt);

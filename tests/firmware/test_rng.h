@@ -1,21 +1,20 @@
 /*
- * The firmware tests' random numbers: splitmix64 from a fixed seed, one stream per test
- * file (each file that includes this has its own state), so every run draws the same
- * scans, networks and rows.
+ * The firmware tests' random numbers: qnav/rng.h's splitmix64 from a fixed seed, one stream
+ * per test file (each file that includes this has its own state), so every run draws the
+ * same scans, networks and rows.
  */
 #ifndef QNAV_TEST_RNG_H
 #define QNAV_TEST_RNG_H
 
 #include <stdint.h>
 
+#include "qnav/rng.h"
+
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 
 static uint32_t rng_u32(void)
 {
-    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return (uint32_t)((z ^ (z >> 31)) >> 32);
+    return (uint32_t)(qnav_splitmix64(&rng_state) >> 32);
 }
 
 static int32_t rng_range(int32_t lo, int32_t hi) /* inclusive */

@@ -5,6 +5,7 @@
 #define _DEFAULT_SOURCE
 #include "fakeboard.h"
 #include "test_proc.h"
+#include "qnav/clock.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -20,9 +21,7 @@
 
 int64_t fakeboard_ms(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+    return qnav_mono_ms();
 }
 
 int fakeboard_start(fakeboard_t *fb, const char *exe, const char *dir,

@@ -365,6 +365,82 @@ static void test_sighup_stops_robot_before_exit(void **state)
     check_signal_stops_robot_before_exit(SIGHUP, "SIGHUP: robot stopped");
 }
 
+/* The board's side of an upload in the test below: the first chunk is lost on the line. */
+typedef struct {
+    qnav_link_upload_t up;
+    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES]; /* the upload buffer at the last commit */
+    qnav_policy_t got;                        /* the policy of the last commit */
+    int8_t status;                            /* 99 until the first commit */
+    int commits;
+    int lost;
+} board_upload_t;
+
+/* Heartbeats every 50 ms that keep the board in onboard mode. */
+static void board_keep_onboard(fakeboard_t *fb, int64_t *next_hb)
+{
+    qnav_link_heartbeat_t mine = {0, QNAV_LINK_MODE_ONBOARD, QNAV_LINK_STATE_POLICY, 0, 0, 0};
+    uint8_t hp[QNAV_LINK_HEARTBEAT_BYTES];
+    if (fakeboard_ms() < *next_hb) {
+        return;
+    }
+    qnav_link_heartbeat_pack(&mine, hp, sizeof hp);
+    assert_int_equal(fakeboard_send(fb, QNAV_LINK_MSG_HEARTBEAT, hp, sizeof hp), 0);
+    *next_hb = fakeboard_ms() + 50;
+}
+
+static void board_take_chunk(board_upload_t *b, const uint8_t *p, int n)
+{
+    qnav_link_policy_chunk_t ch;
+    assert_int_equal(qnav_link_policy_chunk_unpack(p, (uint16_t)n, &ch), 0);
+    if (b->commits == 0 && !b->lost) {
+        b->lost = 1; /* lost on the line */
+    } else {
+        (void)qnav_link_upload_chunk(&b->up, &ch);
+    }
+}
+
+/* The first commit must find chunks missing; every commit is acked with its status. */
+static void board_take_commit(fakeboard_t *fb, board_upload_t *b, const uint8_t *p, int n)
+{
+    qnav_link_policy_commit_t cm;
+    qnav_link_policy_ack_t ack;
+    uint8_t ap[QNAV_LINK_POLICY_ACK_BYTES];
+    assert_int_equal(qnav_link_policy_commit_unpack(p, (uint16_t)n, &cm), 0);
+    memcpy(b->blob, b->up.blob, sizeof b->blob);
+    b->status = qnav_link_upload_commit(&b->up, &cm, &b->got);
+    if (b->commits++ == 0) {
+        assert_int_equal(b->status, QNAV_LINK_ACK_BAD_LENGTH);
+    }
+    ack.status = b->status;
+    ack.reserved = 0;
+    ack.crc = cm.crc;
+    qnav_link_policy_ack_pack(&ack, ap, sizeof ap);
+    assert_int_equal(fakeboard_send(fb, QNAV_LINK_MSG_POLICY_ACK, ap, sizeof ap), 0);
+}
+
+/* Receive chunks and commits until a commit ends in anything but "chunks missing". */
+static void board_receive_upload(fakeboard_t *fb, board_upload_t *b)
+{
+    uint8_t p[QNAV_LINK_MAX_PAYLOAD];
+    int64_t next_hb = 0;
+    int64_t end = fakeboard_ms() + QNAV_TEST_WAIT_MS; /* a guard only: the loop ends on the ack */
+    b->status = 99;
+    while (fakeboard_ms() < end && (b->status == 99 || b->status == QNAV_LINK_ACK_BAD_LENGTH)) {
+        int n;
+        uint16_t seq;
+        board_keep_onboard(fb, &next_hb);
+        n = fakeboard_wait(fb, 0, 50, p, sizeof p, &seq);
+        if (n <= 0) {
+            continue;
+        }
+        if (fb->last_id == QNAV_LINK_MSG_POLICY_CHUNK) {
+            board_take_chunk(b, p, n);
+        } else if (fb->last_id == QNAV_LINK_MSG_POLICY_COMMIT) {
+            board_take_commit(fb, b, p, n);
+        }
+    }
+}
+
 /* The first upload loses its first chunk on the line: the board answers "chunks missing",
  * and the bridge sends the policy again, which arrives whole. */
 static void test_onboard_upload_delivers_the_policy_file_to_the_board(void **state)
@@ -372,75 +448,33 @@ static void test_onboard_upload_delivers_the_policy_file_to_the_board(void **sta
     const char *args[] = {"--lcm-url", "memq://", "--mode", "onboard", "--policy", g_policy,
                           "--upload", NULL};
     uint8_t p[QNAV_LINK_MAX_PAYLOAD];
-    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES], want[QNAV_LINK_POLICY_MAX_BYTES];
+    uint8_t want[QNAV_LINK_POLICY_MAX_BYTES];
     fakeboard_t fb;
     qnav_link_heartbeat_t hb;
-    qnav_link_upload_t up;
-    qnav_policy_t file_policy, got;
+    board_upload_t board;
+    qnav_policy_t file_policy;
     char perr[QNAV_POLICY_IO_ERRLEN], text[2048];
-    int8_t status = 99;
-    int commits = 0, lost = 0;
     int32_t nwant;
-    int64_t end, next_hb = 0;
     (void)state;
+    memset(&board, 0, sizeof board);
     assert_int_equal(qnav_policy_read(g_policy, &file_policy, perr, sizeof perr), 0);
     nwant = qnav_link_policy_to_blob(&file_policy, want, sizeof want);
     assert_true(nwant > 0);
-    qnav_link_upload_init(&up);
+    qnav_link_upload_init(&board.up);
     assert_int_equal(fakeboard_start(&fb, EXE, g_dir, args), 0);
     /* the bridge asks for onboard mode in its heartbeats */
     assert_true(fakeboard_wait(&fb, QNAV_LINK_MSG_HEARTBEAT, 3000, p, sizeof p, NULL) > 0);
     assert_int_equal(qnav_link_heartbeat_unpack(p, QNAV_LINK_HEARTBEAT_BYTES, &hb), 0);
     assert_int_equal(hb.mode, QNAV_LINK_MODE_ONBOARD);
 
-    end = fakeboard_ms() + QNAV_TEST_WAIT_MS; /* a guard only: the loop ends on the ack */
-    while (fakeboard_ms() < end && (status == 99 || status == QNAV_LINK_ACK_BAD_LENGTH)) {
-        int n;
-        uint16_t seq;
-        if (fakeboard_ms() >= next_hb) {
-            qnav_link_heartbeat_t mine = {0, QNAV_LINK_MODE_ONBOARD, QNAV_LINK_STATE_POLICY,
-                                          0, 0, 0};
-            uint8_t hp[QNAV_LINK_HEARTBEAT_BYTES];
-            qnav_link_heartbeat_pack(&mine, hp, sizeof hp);
-            assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_HEARTBEAT, hp, sizeof hp), 0);
-            next_hb = fakeboard_ms() + 50;
-        }
-        n = fakeboard_wait(&fb, 0, 50, p, sizeof p, &seq);
-        if (n <= 0) {
-            continue;
-        }
-        if (fb.last_id == QNAV_LINK_MSG_POLICY_CHUNK) {
-            qnav_link_policy_chunk_t ch;
-            assert_int_equal(qnav_link_policy_chunk_unpack(p, (uint16_t)n, &ch), 0);
-            if (commits == 0 && !lost) {
-                lost = 1; /* lost on the line */
-            } else {
-                (void)qnav_link_upload_chunk(&up, &ch);
-            }
-        } else if (fb.last_id == QNAV_LINK_MSG_POLICY_COMMIT) {
-            qnav_link_policy_commit_t cm;
-            qnav_link_policy_ack_t ack;
-            uint8_t ap[QNAV_LINK_POLICY_ACK_BYTES];
-            assert_int_equal(qnav_link_policy_commit_unpack(p, (uint16_t)n, &cm), 0);
-            memcpy(blob, up.blob, sizeof blob);
-            status = qnav_link_upload_commit(&up, &cm, &got);
-            if (commits++ == 0) {
-                assert_int_equal(status, QNAV_LINK_ACK_BAD_LENGTH);
-            }
-            ack.status = status;
-            ack.reserved = 0;
-            ack.crc = cm.crc;
-            qnav_link_policy_ack_pack(&ack, ap, sizeof ap);
-            assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_POLICY_ACK, ap, sizeof ap), 0);
-        }
-    }
-    assert_int_equal(status, QNAV_LINK_ACK_OK);
-    assert_int_equal(commits, 2);
-    assert_memory_equal(blob, want, (size_t)nwant);
-    assert_int_equal(got.kind, QNAV_POLICY_NET);
-    assert_int_equal(got.u.net.hidden, file_policy.u.net.hidden);
-    assert_memory_equal(got.u.net.w_theta, file_policy.u.net.w_theta,
-                        sizeof got.u.net.w_theta);
+    board_receive_upload(&fb, &board);
+    assert_int_equal(board.status, QNAV_LINK_ACK_OK);
+    assert_int_equal(board.commits, 2);
+    assert_memory_equal(board.blob, want, (size_t)nwant);
+    assert_int_equal(board.got.kind, QNAV_POLICY_NET);
+    assert_int_equal(board.got.u.net.hidden, file_policy.u.net.hidden);
+    assert_memory_equal(board.got.u.net.w_theta, file_policy.u.net.w_theta,
+                        sizeof board.got.u.net.w_theta);
     /* the bridge has read the ack when it says so */
     assert_int_equal(qnav_test_wait_text(fb.stderr_path, "policy upload: ok", QNAV_TEST_WAIT_MS), 0);
     assert_int_equal(fakeboard_signal_and_wait(&fb, SIGTERM, QNAV_TEST_WAIT_MS), 0);

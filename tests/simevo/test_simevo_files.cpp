@@ -279,11 +279,10 @@ static void test_transfer_task_resumes_from_source_file_and_refuses_other_settin
     assert_true(journal == slurp(join_path(a.dir, "episodes.csv")));
 }
 
-static void test_experiment_results_do_not_depend_on_thread_count_and_summary_reads_them(void **state)
+// Three runs of two sources and a target, small enough to run in a test.
+static ExperimentSpec fake_experiment()
 {
-    (void)state;
-    const std::string root = make_tmp_dir();
-    ExperimentSpec spec = parse_experiment(R"(name = "fake"
+    return parse_experiment(R"(name = "fake"
 runs = 3
 curve_bin = 20
 [evolution]
@@ -304,6 +303,45 @@ checkpoint_every = 0
 checkpoint_episodes = 3
 arrival_threshold = 50
 )", "fake.toml");
+}
+
+// The summary's "direct" row is what the run directories under root hold.
+static void check_direct_summary_reads_the_runs(const std::string &root, const ConditionSummary &direct)
+{
+    assert_string_equal(direct.label.c_str(), "direct");
+    assert_int_equal(direct.final_per_run.size(), 3);
+    assert_int_equal(direct.curve_mean.size(), 5);
+    std::vector<double> r;
+    for (const auto &o : read_eval(join_path(root, "one/run-002/direct/eval.csv"))) {
+        r.push_back(o.R);
+    }
+    assert_true(std::fabs(direct.final_per_run[1] - mean_of(r)) < 1e-12);
+    // What the robots do: arrival and recovery ticks per run, held out and at checkpoints.
+    double arrived = 0, tau = 0;
+    for (const auto &o : read_eval(join_path(root, "one/run-002/direct/eval.csv"))) {
+        arrived += o.reached ? 1 : 0;
+        tau += o.tau_c;
+    }
+    assert_true(std::fabs(direct.arrival_per_run[1] - arrived / 7) < 1e-12);
+    assert_true(std::fabs(direct.tau_c_per_run[1] - tau / 7) < 1e-12);
+    assert_true(direct.arrival.lo <= direct.arrival.mean && direct.arrival.mean <= direct.arrival.hi);
+    assert_int_equal(direct.checkpoints.size(), 2); // 500 is beyond the budget: dropped
+    const auto rows = read_checkpoints(join_path(root, "one/run-003/direct/checkpoints.csv"));
+    assert_true(std::fabs(direct.checkpoints[1].arrival[2] - rows[1].arrived / 3.0) < 1e-12);
+    assert_int_equal(direct.to_threshold.size(), 3);
+    uint32_t not_reached = 0;
+    for (double x : direct.to_threshold) {
+        not_reached += std::isnan(x) ? 1 : 0;
+        assert_true(std::isnan(x) || x == 20 || x == 50);
+    }
+    assert_int_equal(direct.threshold_not_reached, not_reached);
+}
+
+static void test_experiment_results_do_not_depend_on_thread_count_and_summary_reads_them(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    ExperimentSpec spec = fake_experiment();
     const auto t1 = plan_tasks(spec, join_path(root, "one"));
     const auto t3 = plan_tasks(spec, join_path(root, "three"));
     // 3 runs x (2 sources + 2 transfers + direct) + probabilistic
@@ -327,35 +365,9 @@ arrival_threshold = 50
     assert_string_equal(S.conditions[4].label.c_str(), "vfh");
     assert_int_equal(S.conditions[4].final_per_run.size(), 7); // VFH+: per episode, same held-out set
     assert_true(std::fabs(S.conditions[4].final_mean - S.conditions[3].final_mean) > 1.0); // its own episodes
-    const ConditionSummary &direct = S.conditions[2];
-    assert_string_equal(direct.label.c_str(), "direct");
-    assert_int_equal(direct.final_per_run.size(), 3);
-    assert_int_equal(direct.curve_mean.size(), 5);
-    std::vector<double> r;
-    for (const auto &o : read_eval(join_path(root, "one/run-002/direct/eval.csv"))) {
-        r.push_back(o.R);
-    }
-    assert_true(std::fabs(direct.final_per_run[1] - mean_of(r)) < 1e-12);
     assert_int_equal(S.conditions[3].final_per_run.size(), 7); // probabilistic: per episode
-    // What the robots do: arrival and recovery ticks per run, held out and at checkpoints.
-    double arrived = 0, tau = 0;
-    for (const auto &o : read_eval(join_path(root, "one/run-002/direct/eval.csv"))) {
-        arrived += o.reached ? 1 : 0;
-        tau += o.tau_c;
-    }
-    assert_true(std::fabs(direct.arrival_per_run[1] - arrived / 7) < 1e-12);
-    assert_true(std::fabs(direct.tau_c_per_run[1] - tau / 7) < 1e-12);
-    assert_true(direct.arrival.lo <= direct.arrival.mean && direct.arrival.mean <= direct.arrival.hi);
-    assert_int_equal(direct.checkpoints.size(), 2); // 500 is beyond the budget: dropped
-    const auto rows = read_checkpoints(join_path(root, "one/run-003/direct/checkpoints.csv"));
-    assert_true(std::fabs(direct.checkpoints[1].arrival[2] - rows[1].arrived / 3.0) < 1e-12);
-    assert_int_equal(direct.to_threshold.size(), 3);
-    uint32_t not_reached = 0;
-    for (double x : direct.to_threshold) {
-        not_reached += std::isnan(x) ? 1 : 0;
-        assert_true(std::isnan(x) || x == 20 || x == 50);
-    }
-    assert_int_equal(direct.threshold_not_reached, not_reached);
+    const ConditionSummary &direct = S.conditions[2];
+    check_direct_summary_reads_the_runs(root, direct);
     assert_int_equal(S.conditions[0].checkpoints[0].R.size(), 3); // transfer-a: one value per run
     assert_true(S.comparisons[0].a == "transfer-a" && S.comparisons[0].b == "direct");
     assert_true(std::fabs(S.comparisons[0].difference - (S.conditions[0].final_mean - direct.final_mean)) < 1e-12);

@@ -234,74 +234,88 @@ static uint16_t table_mismatches(void)
     return bad;
 }
 
-int main(void)
+/* What the cases found, summed over the run: main prints it at the end and fails on any
+ * non-zero count. The network case's result is kept for the table case that follows it. */
+typedef struct {
+    uint8_t failed;
+    uint16_t table_differs;
+    uint16_t step_differs;
+    uint16_t plain_steps_differ;
+    qnav_ctrl_output_t net12_out;
+    uint32_t net12_hash;
+} tally_t;
+
+static void put_case_name(uint16_t c, uint8_t p, const scan_spec_t *spec)
 {
-    uint8_t failed = 0;
-    uint16_t c;
-    uint16_t bad;
-    uint16_t table_differs = 0;
-    uint16_t step_differs = 0;
-    uint16_t plain_steps_differ = 0;
+    qnav_target_put("v");
+    qnav_target_put_u32(c);
+    qnav_target_put(" ");
+    qnav_target_put(policy_names[p]);
+    qnav_target_put(" n=");
+    qnav_target_put_u32(spec->n_sectors);
+    qnav_target_put(" max=");
+    qnav_target_put_u32(spec->max_range_mm);
+    qnav_target_put(" goal=");
+    qnav_target_put_i32(spec->goal_cdeg);
+}
+
+/* One line: scan c under policy p, then the checks of that step against
+ * qnav_ctrl_quality(), the plain step and (table mode) the network it was made from. */
+static void run_case(uint16_t c, uint8_t p, const qnav_ctrl_config_t *cfg,
+                     const qnav_ctrl_input_t *in, tally_t *t)
+{
+    qnav_ctrl_output_t out;
+    qnav_status_t st = init_policy(p, cfg);
+    uint32_t hash;
+    qnav_ctrl_step(&ctrl, in, &out, qualities);
+    hash = fnv1a_qualities();
+    put_case_name(c, p, &scans[c]);
+    if (st != QNAV_OK) {
+        qnav_target_put(" init=");
+        qnav_target_put_i32(st);
+        t->failed = 1;
+    }
+    put_result(&out, hash);
+    t->step_differs = (uint16_t)(t->step_differs + step_inconsistencies(&scans[c], &out));
+    t->plain_steps_differ = (uint16_t)(t->plain_steps_differ + plain_differs(in, &out, hash));
+    if (p == POL_NET12) {
+        t->net12_out = out;
+        t->net12_hash = hash;
+    } else if (p == POL_TABLE &&
+               (out.heading_deg != t->net12_out.heading_deg || out.speed != t->net12_out.speed ||
+                out.quality != t->net12_out.quality || out.flags != t->net12_out.flags ||
+                hash != t->net12_hash)) {
+        ++t->table_differs;
+    }
+}
+
+static void run_scan(uint16_t c, tally_t *t)
+{
+    const scan_spec_t *spec = &scans[c];
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_input_t in = {0};
+    uint8_t p;
+    make_scan(spec);
+    qnav_ctrl_config_default(&cfg);
+    cfg.n_sectors = spec->n_sectors;
+    cfg.max_range_mm = spec->max_range_mm;
+    in.ranges_mm = ranges;
+    in.goal_bearing_cdeg = spec->goal_cdeg;
+    in.prev_heading_cdeg = 0; /* 2-input policies ignore it */
+    for (p = 0; p < N_POLICIES; ++p) {
+        if (p == POL_NET32 && QNAV_MAX_HIDDEN < 32) {
+            continue; /* the ATmega128 build holds 16 hidden units */
+        }
+        run_case(c, p, &cfg, &in, t);
+    }
+}
+
+/* A controller whose init failed must command a stop. */
+static void run_bad_config(tally_t *t)
+{
     qnav_ctrl_config_t cfg;
     qnav_ctrl_input_t in = {0};
     qnav_ctrl_output_t out;
-    qnav_ctrl_output_t net12_out = {0};
-    uint32_t net12_hash = 0;
-
-    qnav_target_put("qnav shared vectors v2: ");
-    qnav_target_put_u32(N_SCANS);
-    qnav_target_put(" scans x 5 policies (net32 where QNAV_MAX_HIDDEN >= 32)\n");
-
-    for (c = 0; c < N_SCANS; ++c) {
-        const scan_spec_t *spec = &scans[c];
-        uint8_t p;
-        make_scan(spec);
-        qnav_ctrl_config_default(&cfg);
-        cfg.n_sectors = spec->n_sectors;
-        cfg.max_range_mm = spec->max_range_mm;
-        in.ranges_mm = ranges;
-        in.goal_bearing_cdeg = spec->goal_cdeg;
-        in.prev_heading_cdeg = 0; /* 2-input policies ignore it */
-        for (p = 0; p < N_POLICIES; ++p) {
-            qnav_status_t st;
-            uint32_t hash;
-            if (p == POL_NET32 && QNAV_MAX_HIDDEN < 32) {
-                continue; /* the ATmega128 build holds 16 hidden units */
-            }
-            st = init_policy(p, &cfg);
-            qnav_ctrl_step(&ctrl, &in, &out, qualities);
-            hash = fnv1a_qualities();
-            qnav_target_put("v");
-            qnav_target_put_u32(c);
-            qnav_target_put(" ");
-            qnav_target_put(policy_names[p]);
-            qnav_target_put(" n=");
-            qnav_target_put_u32(spec->n_sectors);
-            qnav_target_put(" max=");
-            qnav_target_put_u32(spec->max_range_mm);
-            qnav_target_put(" goal=");
-            qnav_target_put_i32(spec->goal_cdeg);
-            if (st != QNAV_OK) {
-                qnav_target_put(" init=");
-                qnav_target_put_i32(st);
-                failed = 1;
-            }
-            put_result(&out, hash);
-            step_differs = (uint16_t)(step_differs + step_inconsistencies(spec, &out));
-            plain_steps_differ = (uint16_t)(plain_steps_differ + plain_differs(&in, &out, hash));
-            if (p == POL_NET12) {
-                net12_out = out;
-                net12_hash = hash;
-            } else if (p == POL_TABLE &&
-                       (out.heading_deg != net12_out.heading_deg || out.speed != net12_out.speed ||
-                        out.quality != net12_out.quality || out.flags != net12_out.flags ||
-                        hash != net12_hash)) {
-                ++table_differs;
-            }
-        }
-    }
-
-    /* A controller whose init failed must command a stop. */
     qnav_ctrl_config_default(&cfg);
     cfg.n_sectors = 0u;
     qnav_policy_prob_default(&policy);
@@ -313,26 +327,39 @@ int main(void)
     in.prev_heading_cdeg = 0; /* 2-input policies ignore it */
     qnav_ctrl_step(&ctrl, &in, &out, qualities);
     put_result(&out, fnv1a_qualities());
-    plain_steps_differ = (uint16_t)(plain_steps_differ + plain_differs(&in, &out, fnv1a_qualities()));
+    t->plain_steps_differ =
+        (uint16_t)(t->plain_steps_differ + plain_differs(&in, &out, fnv1a_qualities()));
+}
 
-    qnav_target_put("step differs from qnav_ctrl_quality() on ");
-    qnav_target_put_u32(step_differs);
-    qnav_target_put(" paths or choices\n");
-    qnav_target_put("plain step differs from the fast step on ");
-    qnav_target_put_u32(plain_steps_differ);
-    qnav_target_put(" cases\n");
-    qnav_target_put("table mode differs from network mode on ");
-    qnav_target_put_u32(table_differs);
-    qnav_target_put(" scans\n");
-    bad = table_mismatches();
-    qnav_target_put("committed table differs from its network on ");
-    qnav_target_put_u32(bad);
-    qnav_target_put(" of ");
-    qnav_target_put_u32(QNAV_QTABLE_ENTRIES);
-    qnav_target_put(" entries\n");
-    if (table_differs != 0u || bad != 0u || step_differs != 0u || plain_steps_differ != 0u) {
-        failed = 1;
+static void put_count(const char *before, uint32_t n, const char *after)
+{
+    qnav_target_put(before);
+    qnav_target_put_u32(n);
+    qnav_target_put(after);
+}
+
+int main(void)
+{
+    tally_t t = {0};
+    uint16_t c;
+    uint16_t bad;
+
+    put_count("qnav shared vectors v2: ", N_SCANS,
+              " scans x 5 policies (net32 where QNAV_MAX_HIDDEN >= 32)\n");
+    for (c = 0; c < N_SCANS; ++c) {
+        run_scan(c, &t);
     }
-    qnav_target_exit(failed);
-    return failed;
+    run_bad_config(&t);
+
+    put_count("step differs from qnav_ctrl_quality() on ", t.step_differs, " paths or choices\n");
+    put_count("plain step differs from the fast step on ", t.plain_steps_differ, " cases\n");
+    put_count("table mode differs from network mode on ", t.table_differs, " scans\n");
+    bad = table_mismatches();
+    put_count("committed table differs from its network on ", bad, " of ");
+    put_count("", QNAV_QTABLE_ENTRIES, " entries\n");
+    if (t.table_differs != 0u || bad != 0u || t.step_differs != 0u || t.plain_steps_differ != 0u) {
+        t.failed = 1;
+    }
+    qnav_target_exit(t.failed);
+    return t.failed;
 }
