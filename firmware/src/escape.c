@@ -134,6 +134,12 @@ static uint16_t follow_limit(const qnav_clearance_t *c, uint8_t tries)
     return t < QNAV_ESCAPE_MAX_FOLLOW ? t : QNAV_ESCAPE_MAX_FOLLOW;
 }
 
+/* Getting nearer by half a margin (r + d_s) counts as progress toward the destination. */
+static uint16_t progress_mm(const qnav_clearance_t *c)
+{
+    return (uint16_t)(c->margin_mm / 2u);
+}
+
 void qnav_escape_clear(qnav_escape_t *e)
 {
     e->best_mm = 0u;
@@ -191,7 +197,7 @@ static uint8_t gone_round(const qnav_clearance_t *c, qnav_escape_t *e, uint16_t 
         }
         return 0u;
     default:
-        return (uint8_t)((uint32_t)range <= (uint32_t)e->near_mm + c->margin_mm / 2u);
+        return (uint8_t)((uint32_t)range <= (uint32_t)e->near_mm + progress_mm(c));
     }
 }
 
@@ -239,7 +245,7 @@ static uint8_t led_away(const qnav_clearance_t *c, const qnav_ctrl_input_t *in,
 static uint8_t time_up(const qnav_clearance_t *c, qnav_escape_t *e, uint16_t range)
 {
     uint16_t limit = follow_limit(c, e->tries);
-    uint16_t progress = (uint16_t)(c->margin_mm / 2u);
+    uint16_t progress = progress_mm(c);
     if (++e->ticks < limit) {
         return 0u;
     }
@@ -256,7 +262,7 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
 {
     uint16_t goal = qnav_whole_deg(in->goal_bearing_cdeg);
     uint16_t range = in->goal_range_mm;
-    uint16_t progress = (uint16_t)(c->margin_mm / 2u);
+    uint16_t progress = progress_mm(c);
     *e = in->escape;
     if (c->esc_stall_ticks == 0u || range == 0u) {
         qnav_escape_clear(e);
