@@ -14,10 +14,12 @@
  * follow ended is at another obstacle: its side is chosen afresh. */
 #define QNAV_ESCAPE_NEW_MARGINS 4u
 /* A side is given up once it has led this many margins (r + d_s) farther from the
- * destination than where it began (twice as far for each try given up), while the
- * side away from the boundary is open beyond QNAV_ESCAPE_OPEN_MARGINS. */
+ * destination (twice as far for each try given up) while the side away from the boundary
+ * was open beyond QNAV_ESCAPE_OPEN_MARGINS, over the sectors within
+ * QNAV_ESCAPE_OPEN_HALF_DEG of the path 90 degrees away from the boundary. */
 #define QNAV_ESCAPE_AWAY_MARGINS 14u
 #define QNAV_ESCAPE_OPEN_MARGINS 9u
+#define QNAV_ESCAPE_OPEN_HALF_DEG 11
 /* Longest follow, in ticks, however many tries were given up (about 109 s). */
 #define QNAV_ESCAPE_MAX_FOLLOW 1092u
 /* A lost boundary is approached until a path clears its nearest reading by this many levels. */
@@ -155,6 +157,7 @@ void qnav_escape_clear(qnav_escape_t *e)
     e->loop = QNAV_ESCAPE_LOOP_NONE;
     e->from_mm = 0u;
     e->over_mm = 0u;
+    e->prev_mm = 0u;
 }
 
 static uint16_t diff_mm(uint16_t a, uint16_t b)
@@ -210,27 +213,55 @@ static void start_follow(qnav_escape_t *e, int8_t side, uint16_t range)
     e->loop = QNAV_ESCAPE_LOOP_NONE;
     e->from_mm = range;
     e->over_mm = 0u;
+    e->prev_mm = range;
+}
+
+/* The nearest reading on side s's away hand: the sectors whose wedges meet the span of
+ * QNAV_ESCAPE_OPEN_HALF_DEG either side of the path 90 degrees away from the boundary, so
+ * that "open" means the same at every sector count (one 22.5-degree sector at 16 sectors,
+ * three 11.25-degree ones at 32). */
+static qnav_mm_t away_open_mm(const qnav_clearance_t *c, const qnav_ctrl_input_t *in, int8_t s)
+{
+    int16_t centre = (int16_t)(90 * s);
+    uint16_t k = qnav_ctrl_sector_of_path(c->n_sectors,
+                                          wrap((int16_t)(centre - QNAV_ESCAPE_OPEN_HALF_DEG)));
+    uint16_t last = qnav_ctrl_sector_of_path(c->n_sectors,
+                                             wrap((int16_t)(centre + QNAV_ESCAPE_OPEN_HALF_DEG)));
+    qnav_mm_t m = in->ranges_mm[k];
+    while (k != last) {
+        k = (uint16_t)(k + 1u == c->n_sectors ? 0u : k + 1u);
+        if (in->ranges_mm[k] < m) {
+            m = in->ranges_mm[k];
+        }
+    }
+    return m;
 }
 
 /*
  * Has this side led away? Following a long wall the wrong way (its gap lies behind) takes
- * the robot round the arena's corner, ever farther from the destination; a time limit
- * alone lets it go on for the whole try. A side is given up once the robot is
- * QNAV_ESCAPE_AWAY_MARGINS margins (doubled per try given up) farther from the
- * destination than where the side began, but not while the side away from the boundary
- * is closed within QNAV_ESCAPE_OPEN_MARGINS margins: in a corridor or a pocket the way
- * out leads away from the destination first, and turning back there only returns to
- * the dead end.
+ * the robot round the arena's corner, ever farther from the destination through open
+ * space; a time limit alone lets it go on for the whole try. A side is given up once the
+ * robot has got QNAV_ESCAPE_AWAY_MARGINS margins (doubled per try given up) farther from
+ * the destination while the side away from the boundary was open beyond
+ * QNAV_ESCAPE_OPEN_MARGINS: what the range grows by while that side is closed does not
+ * count (from_mm moves with it). In a corridor or a pocket the way out leads away from the
+ * destination first, between walls on both hands, and the away hand opens only at a turn,
+ * which is the way on: giving the side up there only returns to the dead end (at 32
+ * sectors, where one sector sees through a corridor's turn, a budget counted from where
+ * the side began turned the robot back at every turn: docs/results.md).
  */
 static uint8_t led_away(const qnav_clearance_t *c, const qnav_ctrl_input_t *in,
-                        const qnav_escape_t *e, uint16_t range)
+                        qnav_escape_t *e, uint16_t range)
 {
-    uint16_t away_path = wrap((int16_t)(90 * e->side));
-    uint32_t open_mm = (uint32_t)in->ranges_mm[qnav_ctrl_sector_of_path(c->n_sectors, away_path)] +
-                       c->sensor_offset_mm;
+    uint32_t open_mm = (uint32_t)away_open_mm(c, in, e->side) + c->sensor_offset_mm;
     uint8_t shift = e->tries < 6u ? e->tries : 6u;
     uint32_t budget = ((uint32_t)QNAV_ESCAPE_AWAY_MARGINS * c->margin_mm) << shift;
+    uint16_t prev = e->prev_mm;
+    e->prev_mm = range;
     if (open_mm < (uint32_t)QNAV_ESCAPE_OPEN_MARGINS * c->margin_mm) {
+        /* what the range changed by while the away hand was closed does not count */
+        int32_t f = (int32_t)e->from_mm + (int32_t)range - (int32_t)prev;
+        e->from_mm = (uint16_t)(f < 0 ? 0 : (f > 65535 ? 65535 : f));
         return 0u;
     }
     return (uint8_t)((uint32_t)range > (uint32_t)e->from_mm + budget);

@@ -19,7 +19,7 @@
  * space on its other hand, is given up for the other side, each try twice as long or far. While following, a step whose policy would stand still crawls along the
  * boundary or turns in place, so no policy freezes.
  *
- * The memory (qnav_escape_t, 21 bytes) is the caller's: it comes in with the step's input
+ * The memory (qnav_escape_t, 23 bytes) is the caller's: it comes in with the step's input
  * and goes out with its output; the step itself keeps nothing.
  */
 #ifndef QNAV_ESCAPE_H

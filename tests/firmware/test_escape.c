@@ -212,7 +212,8 @@ static void test_a_follow_getting_nearer_outlasts_its_time(void **state)
 /* Following a wall with open space on the other hand, a side that leads 14 margins
  * farther from the destination than where it began is given up before its time (the
  * wrong way along a long wall); the next try may lead twice as far. In a corridor (the
- * other hand closed) the same side is kept: there the way out leads away first. */
+ * other hand closed) the same side is kept: there the way out leads away first, and when
+ * the corridor turns (the other hand opens) only what the side loses from there on counts. */
 static void test_a_follow_leading_away_is_given_up_early(void **state)
 {
     (void)state;
@@ -249,6 +250,17 @@ static void test_a_follow_leading_away_is_given_up_early(void **state)
         tick(&b.c, &b.in, &b.out);
         assert_int_equal(b.out.escape.side, first);
     }
+    /* the corridor turns: the away hand opens. What the range grew by between the walls
+     * does not count; 14 margins more through the open does. */
+    b.r[first > 0 ? N / 4 : 3 * N / 4] = MAX_MM;
+    for (t = 0; t < 28; ++t) {
+        b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, first);
+    }
+    b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
+    tick(&b.c, &b.in, &b.out);
+    assert_int_equal(b.out.escape.side, -first);
 }
 
 /* Following a wall on the right (side +1), the destination behind it: the bearing it

@@ -156,9 +156,12 @@ typedef struct {
     uint8_t loop_deg2;  /* following: the destination's bearing at the mark, 2 deg units */
     uint8_t loop;       /* following: QNAV_ESCAPE_LOOP_* (a follow back at its mark has
                            gone round its obstacle) */
-    uint16_t from_mm;   /* following: the destination's range when this side began, mm */
+    uint16_t from_mm;   /* following: the destination's range when this side began, moved
+                           by every change while the side away from the boundary was
+                           closed, mm */
     uint16_t over_mm;   /* following, past this side's time: nearest the robot has come to
                            the destination since its last progress, mm; 0: not past it */
+    uint16_t prev_mm;   /* following: the destination's range at the previous tick, mm */
 } qnav_escape_t;
 
 /* qnav_escape_t.loop: no mark yet; marked; left the mark; back at it (round once). */
