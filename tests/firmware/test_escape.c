@@ -214,53 +214,42 @@ static void test_a_follow_getting_nearer_outlasts_its_time(void **state)
  * wrong way along a long wall); the next try may lead twice as far. In a corridor (the
  * other hand closed) the same side is kept: there the way out leads away first, and when
  * the corridor turns (the other hand opens) only what the side loses from there on counts. */
+/* n ticks, each half a margin farther from the destination, the side followed kept; then
+ * one more half margin, after which the side is `then`. */
+static void walk_away(bot_t *b, unsigned n, int8_t side, int8_t then)
+{
+    const unsigned step = margin_mm() / 2u;
+    unsigned t;
+    for (t = 0; t <= n; ++t) {
+        if (t == n) {
+            side = then;
+        }
+        b->in.goal_range_mm = (qnav_mm_t)(b->in.goal_range_mm + step);
+        tick(&b->c, &b->in, &b->out);
+        assert_int_equal(b->out.escape.side, side);
+    }
+}
+
 static void test_a_follow_leading_away_is_given_up_early(void **state)
 {
     (void)state;
     bot_t b;
     int8_t first;
-    unsigned t;
-    const unsigned step = margin_mm() / 2u;
     following_a_wall(&b);
     first = b.out.escape.side;
-    for (t = 0; t < 28; ++t) { /* 14 margins in half-margin steps: not beyond yet */
-        b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
-        tick(&b.c, &b.in, &b.out);
-        assert_int_equal(b.out.escape.side, first);
-    }
-    b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
-    tick(&b.c, &b.in, &b.out);
-    assert_int_equal(b.out.escape.side, -first);
+    walk_away(&b, 28, first, (int8_t)-first); /* 14 margins in half-margin steps, then beyond */
     assert_int_equal(b.out.escape.from_mm, b.in.goal_range_mm);
-    for (t = 0; t < 56; ++t) { /* the second try: 28 margins */
-        b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
-        tick(&b.c, &b.in, &b.out);
-        assert_int_equal(b.out.escape.side, -first);
-    }
-    b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
-    tick(&b.c, &b.in, &b.out);
-    assert_int_equal(b.out.escape.side, first);
+    walk_away(&b, 56, (int8_t)-first, first); /* the second try: 28 margins */
 
     following_a_wall(&b);
     first = b.out.escape.side;
     b.r[N / 4] = 400; /* a corridor: walls on both hands */
     b.r[3 * N / 4] = 400;
-    for (t = 0; t < 150; ++t) {
-        b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
-        tick(&b.c, &b.in, &b.out);
-        assert_int_equal(b.out.escape.side, first);
-    }
+    walk_away(&b, 150, first, first);
     /* the corridor turns: the away hand opens. What the range grew by between the walls
      * does not count; 14 margins more through the open does. */
     b.r[first > 0 ? N / 4 : 3 * N / 4] = MAX_MM;
-    for (t = 0; t < 28; ++t) {
-        b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
-        tick(&b.c, &b.in, &b.out);
-        assert_int_equal(b.out.escape.side, first);
-    }
-    b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm + step);
-    tick(&b.c, &b.in, &b.out);
-    assert_int_equal(b.out.escape.side, -first);
+    walk_away(&b, 28, first, (int8_t)-first);
 }
 
 /* Following a wall on the right (side +1), the destination behind it: the bearing it
