@@ -208,51 +208,93 @@ __attribute__((noinline)) static int16_t naive_float_step(const qnav_mm_t *r, ui
     return (int16_t)(best > 180 ? best - 360 : best);
 }
 
-/* What qnav_ctrl_init costs for every network of the set (2 inputs: it learns the shape
- * of each of the 32 rows of keys, docs/architecture.md "Row shapes"); not a step, so not
- * an M line: printed per hidden-unit count as min / max. */
-static void init_times(void)
+/* Sort t[0..n-1] (a handful of values: insertion). */
+static void sort_u32(uint32_t *t, uint8_t n)
 {
-    static const uint8_t hs[] = {4u, 8u, 12u, 16u};
+    uint8_t i, j;
+    for (i = 1; i < n; ++i) {
+        uint32_t v = t[i];
+        for (j = i; j > 0u && t[j - 1u] > v; --j) {
+            t[j] = t[j - 1u];
+        }
+        t[j] = v;
+    }
+}
+
+/* Up to this many policies of one hidden-unit count are timed. */
+#define INIT_TIMED_MAX 24u
+
+/* Times of qnav_ctrl_init (carried 0) or of qnav_ctrl_init_carried with the shapes the
+ * policy carries (carried 1, made untimed first, as a host makes them) for every 2-input
+ * network of H hidden units, sorted into t; their count. */
+static uint8_t init_times_of(uint8_t hidden, uint8_t carried, uint32_t *t)
+{
+    static uint8_t shapes[QNAV_SHAPES_BYTES];
     qnav_ctrl_t *c = qnav_bench_scratch_ctrl();
     qnav_policy_t *p = qnav_bench_scratch_policy();
     char id[QNAV_BENCH_ID_LEN];
     qnav_ctrl_config_t cfg;
-    uint8_t h, i;
+    uint8_t i, count = 0;
     qnav_bench_config(&cfg, 32u);
-    for (h = 0; h < sizeof hs; ++h) {
-        uint32_t lo = 0xFFFFFFFFul, hi = 0;
-        uint8_t count = 0;
-        for (i = 0; i < qnav_bench_policy_count(); ++i) {
-            uint32_t t;
-            qnav_status_t st;
-            (void)qnav_bench_load_policy(i, p, id);
-            if (p->kind != QNAV_POLICY_NET || p->u.net.hidden != hs[h] ||
-                p->u.net.inputs != QNAV_NET_INPUTS_PAPER) {
-                continue;
-            }
-            timer_start();
-            st = qnav_ctrl_init(c, &cfg, p);
-            t = timer_stop() - overhead;
-            if (st != QNAV_OK) {
-                continue;
-            }
-            lo = t < lo ? t : lo;
-            hi = t > hi ? t : hi;
-            ++count;
-        }
-        if (count == 0u) {
+    for (i = 0; i < qnav_bench_policy_count() && count < INIT_TIMED_MAX; ++i) {
+        qnav_status_t st;
+        (void)qnav_bench_load_policy(i, p, id);
+        if (p->kind != QNAV_POLICY_NET || p->u.net.hidden != hidden ||
+            p->u.net.inputs != QNAV_NET_INPUTS_PAPER) {
             continue;
         }
-        PUT("qnav_ctrl_init, 2-input network H=");
-        qnav_target_put_u32(hs[h]);
-        PUT(" (");
-        qnav_target_put_u32(count);
-        PUT(" policies): min ");
-        put_cycles(lo);
-        PUT(", max ");
-        put_cycles(hi);
-        PUT("\n");
+        if (carried && (qnav_ctrl_init(c, &cfg, p) != QNAV_OK ||
+                        qnav_ctrl_shapes_save(c, p, shapes) != QNAV_OK)) {
+            continue;
+        }
+        timer_start();
+        st = carried ? qnav_ctrl_init_carried(c, &cfg, p, shapes, sizeof shapes)
+                     : qnav_ctrl_init(c, &cfg, p);
+        t[count] = timer_stop() - overhead;
+        if (carried && !qnav_ctrl_shapes_carried(c)) {
+            PUT("init: carried shapes not taken: ");
+            qnav_target_put(id);
+            PUT("\n");
+        }
+        if (st == QNAV_OK) {
+            ++count;
+        }
+    }
+    sort_u32(t, count);
+    return count;
+}
+
+/* What qnav_ctrl_init costs for every network of the set (2 inputs: it learns the shape
+ * of each of the 32 rows of keys, docs/architecture.md "Row shapes"), and with the shapes
+ * the policy carries (qnav_ctrl_init_carried); not a step, so not an M line: printed per
+ * hidden-unit count as min / median (lower) / max. */
+static void init_times(void)
+{
+    static const uint8_t hs[] = {4u, 8u, 12u, 16u};
+    uint32_t t[INIT_TIMED_MAX];
+    uint8_t h, carried;
+    for (carried = 0; carried < 2u; ++carried) {
+        for (h = 0; h < sizeof hs; ++h) {
+            uint8_t count = init_times_of(hs[h], carried, t);
+            if (count == 0u) {
+                continue;
+            }
+            if (carried) {
+                PUT("qnav_ctrl_init_carried, 2-input network H=");
+            } else {
+                PUT("qnav_ctrl_init, 2-input network H=");
+            }
+            qnav_target_put_u32(hs[h]);
+            PUT(" (");
+            qnav_target_put_u32(count);
+            PUT(" policies): min ");
+            put_cycles(t[0]);
+            PUT(", median ");
+            put_cycles(t[(count - 1u) / 2u]);
+            PUT(", max ");
+            put_cycles(t[count - 1u]);
+            PUT("\n");
+        }
     }
 }
 

@@ -87,6 +87,7 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     ctrl->out_bias_z = 0;
     ctrl->rank = cfg->rank;
     ctrl->keep_pct = cfg->keep_pct;
+    ctrl->shapes_carried = 0u;
     return QNAV_OK;
 }
 
@@ -115,6 +116,13 @@ static qnav_status_t policy_status(qnav_policy_status_t st)
 qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
                              const qnav_policy_t *policy)
 {
+    return qnav_ctrl_init_carried(ctrl, cfg, policy, 0, 0u);
+}
+
+qnav_status_t qnav_ctrl_init_carried(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
+                                     const qnav_policy_t *policy, const uint8_t *shapes,
+                                     uint16_t len)
+{
     qnav_status_t st = init_common(ctrl, cfg);
     if (st != QNAV_OK) {
         return st;
@@ -133,12 +141,25 @@ qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
     case QNAV_POLICY_NET:
 #if QNAV_WITH_NETWORK
         qnav_net_eval_init(ctrl, &policy->u.net);
+        if (policy->u.net.inputs == QNAV_NET_INPUTS_PAPER) {
+            ctrl->shapes_carried = qnav_shapes_take(ctrl, &policy->u.net, shapes, len);
+            if (!ctrl->shapes_carried) {
+                qnav_net_eval_shapes(ctrl);
+            }
+        }
 #endif
         break;
     }
+    (void)shapes;
+    (void)len;
     ctrl->kind = policy->kind;
     ctrl->magic = QNAV_CTRL_MAGIC;
     return QNAV_OK;
+}
+
+uint8_t qnav_ctrl_shapes_carried(const qnav_ctrl_t *ctrl)
+{
+    return (uint8_t)(ctrl != 0 && ctrl->magic == QNAV_CTRL_MAGIC && ctrl->shapes_carried);
 }
 
 /* The shape of every row of the table (init time: one read per entry). */

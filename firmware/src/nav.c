@@ -7,9 +7,10 @@
 #include "qnav/nav.h"
 
 static qnav_status_t body_init(qnav_nav_t *nav, const qnav_ctrl_config_t *cfg,
-                               const qnav_policy_t *policy)
+                               const qnav_policy_t *policy, const uint8_t *shapes,
+                               uint16_t shapes_len)
 {
-    return qnav_ctrl_init(&nav->u.paths, cfg, policy);
+    return qnav_ctrl_init_carried(&nav->u.paths, cfg, policy, shapes, shapes_len);
 }
 
 
@@ -44,10 +45,13 @@ static void stop(qnav_ctrl_output_t *out)
 
 #if QNAV_WITH_VFH
 static qnav_status_t vfh_init(qnav_nav_t *nav, const qnav_ctrl_config_t *cfg,
-                              const qnav_policy_t *policy)
+                              const qnav_policy_t *policy, const uint8_t *shapes,
+                              uint16_t shapes_len)
 {
     qnav_vfh_config_t vc;
     (void)policy;
+    (void)shapes;
+    (void)shapes_len;
     qnav_vfh_config_default(&vc);
     vc.body = *cfg;
     return qnav_vfh_init(&nav->u.vfh.vfh, &vc);
@@ -66,11 +70,14 @@ static void vfh_step(qnav_nav_t *nav, const qnav_ctrl_input_t *in, qnav_ctrl_out
 /* VFH+ left out of this build (QNAV_WITH_VFH 0): the row keeps its name, so that a board
  * configured for it learns why it has no controller, and its init refuses. */
 static qnav_status_t vfh_init(qnav_nav_t *nav, const qnav_ctrl_config_t *cfg,
-                              const qnav_policy_t *policy)
+                              const qnav_policy_t *policy, const uint8_t *shapes,
+                              uint16_t shapes_len)
 {
     (void)nav;
     (void)cfg;
     (void)policy;
+    (void)shapes;
+    (void)shapes_len;
     return QNAV_E_KIND_DISABLED;
 }
 
@@ -145,6 +152,13 @@ void qnav_nav_config(const qnav_nav_method_t *method, const qnav_ctrl_config_t *
 qnav_status_t qnav_nav_init(qnav_nav_t *nav, const qnav_nav_method_t *method,
                             const qnav_ctrl_config_t *cfg, const qnav_policy_t *policy)
 {
+    return qnav_nav_init_carried(nav, method, cfg, policy, 0, 0u);
+}
+
+qnav_status_t qnav_nav_init_carried(qnav_nav_t *nav, const qnav_nav_method_t *method,
+                                    const qnav_ctrl_config_t *cfg, const qnav_policy_t *policy,
+                                    const uint8_t *shapes, uint16_t shapes_len)
+{
     qnav_ctrl_config_t own;
     qnav_status_t st;
     if (nav == 0) {
@@ -155,7 +169,7 @@ qnav_status_t qnav_nav_init(qnav_nav_t *nav, const qnav_nav_method_t *method,
         return QNAV_E_NULL;
     }
     qnav_nav_config(method, cfg, &own);
-    st = method->init(nav, &own, policy);
+    st = method->init(nav, &own, policy, shapes, shapes_len);
     if (st != QNAV_OK) {
         return st;
     }

@@ -23,8 +23,15 @@ void qnav_prob_eval_row(const qnav_ctrl_t *ctrl, uint8_t level, qnav_qkey_t *row
 
 /* ---- policy_net.c: the evolved network (paper §3.3; 3 inputs: §5) ------------------- */
 
-/* Derive the per-unit integer parameters into ctrl (network already validated). */
+/* Derive the per-unit integer parameters into ctrl (network already validated); a 2-input
+ * network's row shapes are left to qnav_shapes_take or qnav_net_eval_shapes. */
 void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net);
+/* Compute the row shape of every level by evaluating every row (2 inputs). */
+void qnav_net_eval_shapes(qnav_ctrl_t *ctrl);
+/* ctrl_shapes.c: take carried row shapes (qnav_ctrl_init_carried); 1 when taken, 0 when
+ * they are not this network's (the rows are then to be computed). */
+uint8_t qnav_shapes_take(qnav_ctrl_t *ctrl, const qnav_net_t *net, const uint8_t *shapes,
+                         uint16_t len);
 /* The key of one (level, dtheta); a 3-input network with the path on the previous
  * heading (dprev = 0). */
 qnav_qkey_t qnav_net_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta);

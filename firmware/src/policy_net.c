@@ -209,7 +209,7 @@ void qnav_net_eval_row(const qnav_ctrl_t *ctrl, uint8_t level, qnav_qkey_t *row)
 /* The shape of every row (init time): each row evaluated in pieces by eval_run, the same
  * integers as the step. @par Cost: 181 * QNAV_DIST_LEVELS paths of H units (ATmega128:
  * docs/performance.md). */
-static void row_shapes(qnav_ctrl_t *ctrl)
+void qnav_net_eval_shapes(qnav_ctrl_t *ctrl)
 {
     qnav_qkey_t keys[QNAV_EVAL_CHUNK];
     qnav_best_t ignore;
@@ -265,9 +265,6 @@ void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net)
         }
     }
     ctrl->out_bias_z = (int32_t)net->b_out * 128;
-    if (net->inputs == QNAV_NET_INPUTS_PAPER) {
-        row_shapes(ctrl);
-    }
 }
 
 /* Do unit u's shares rise along run r (dtheta moving by r->dir per path)? A unit whose

@@ -501,13 +501,33 @@ static void on_ack(qnav_bridge_t *b, const qnav_link_frame_t *f)
     }
 }
 
+int32_t qnav_bridge_upload_blob(const qnav_ctrl_config_t *cfg, const char *controller,
+                                const qnav_policy_t *policy, uint8_t *out, uint16_t cap)
+{
+    qnav_ctrl_config_t own;
+    qnav_ctrl_t ctrl;
+    uint8_t shapes[QNAV_SHAPES_BYTES];
+    const uint8_t *carried = NULL;
+    const qnav_nav_method_t *m =
+        qnav_nav_find(controller != NULL ? controller : QNAV_BRIDGE_DEFAULT_CONTROLLER);
+    if (m != NULL) {
+        qnav_nav_config(m, cfg, &own);
+        if (qnav_ctrl_init(&ctrl, &own, policy) == QNAV_OK &&
+            qnav_ctrl_shapes_save(&ctrl, policy, shapes) == QNAV_OK) {
+            carried = shapes;
+        }
+    }
+    return qnav_link_policy_to_blob_carried(policy, carried, out, cap);
+}
+
 static void send_upload(qnav_bridge_t *b)
 {
     uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
     uint8_t p[QNAV_LINK_CHUNK_MAX_BYTES];
     qnav_link_policy_chunk_t c;
     qnav_link_policy_commit_t cm;
-    int32_t n = qnav_link_policy_to_blob(&b->cfg.policy, blob, sizeof blob);
+    int32_t n = qnav_bridge_upload_blob(&b->cfg.ctrl, b->cfg.controller, &b->cfg.policy, blob,
+                                        (uint16_t)sizeof blob);
     uint16_t off = 0;
     if (n <= 0) {
         b->upload_state = QNAV_BRIDGE_UPLOAD_DONE;

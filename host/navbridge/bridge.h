@@ -71,9 +71,10 @@ extern "C" {
 #define QNAV_BRIDGE_UPLOAD_TRIES 3
 
 /* How long a policy upload's answer is awaited before the upload is sent again. The board
- * answers after initialising the new controller (a 2-input network's init evaluates every
- * row of keys: up to 1.2 s on a 16 MHz ATmega128 at H = 16, docs/performance.md) and
- * committing it to EEPROM (about 1 s): 3 s leaves room for both. */
+ * answers after initialising the new controller (a 2-input network's init copies the row
+ * shapes the upload carries; a board that ignores them evaluates every row of keys: up to
+ * 1.2 s on a 16 MHz ATmega128 at H = 16, docs/performance.md) and committing it to EEPROM
+ * (about 1.1 s): 3 s leaves room for both even then. */
 #define QNAV_BRIDGE_UPLOAD_WAIT_MS 3000
 
 /* Writes bytes to the serial port; returns 0 or -1. */
@@ -123,6 +124,12 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
                            qnav_command_t *cmd, int16_t *qualities);
 /* CRC-16 of a policy's link blob (0 if it cannot be serialised). */
 uint16_t qnav_bridge_policy_crc(const qnav_policy_t *policy);
+/* The blob an upload sends: the policy's, with a 2-input network's row shapes for the
+ * rank of controller (null: QNAV_BRIDGE_DEFAULT_CONTROLLER) under cfg appended, computed
+ * here (0.2 ms) so that the board's init copies them (docs/hil.md, "Policy blob"). Bytes
+ * written, or a negative QNAV_LINK_E_* status. */
+int32_t qnav_bridge_upload_blob(const qnav_ctrl_config_t *cfg, const char *controller,
+                                const qnav_policy_t *policy, uint8_t *out, uint16_t cap);
 
 /* Where an onboard policy upload stands. */
 typedef enum {

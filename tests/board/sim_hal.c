@@ -124,13 +124,27 @@ static int queue_frame(sim_hal_t *sim, qnav_link_tx_t *tx, uint8_t id, const uin
     return 0;
 }
 
+int32_t sim_hal_blob(const qnav_policy_t *pol, uint8_t *blob, uint16_t cap)
+{
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_t ctrl;
+    uint8_t shapes[QNAV_SHAPES_BYTES];
+    const uint8_t *carried = NULL;
+    qnav_ctrl_config_default(&cfg);
+    if (qnav_ctrl_init(&ctrl, &cfg, pol) == QNAV_OK &&
+        qnav_ctrl_shapes_save(&ctrl, pol, shapes) == QNAV_OK) {
+        carried = shapes;
+    }
+    return qnav_link_policy_to_blob_carried(pol, carried, blob, cap);
+}
+
 int sim_hal_upload(sim_hal_t *sim, qnav_link_tx_t *tx, const qnav_policy_t *pol,
                    uint16_t crc_xor)
 {
     uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES], p[QNAV_LINK_CHUNK_MAX_BYTES];
     qnav_link_policy_chunk_t c;
     qnav_link_policy_commit_t cm;
-    int32_t n = qnav_link_policy_to_blob(pol, blob, sizeof blob);
+    int32_t n = sim_hal_blob(pol, blob, (uint16_t)sizeof blob);
     uint16_t off = 0;
     if (n <= 0) {
         return -1;

@@ -41,6 +41,10 @@ void sim_hal_init(sim_hal_t *sim, qnav_board_hal_t *hal);
 /* Queue bytes for the board to read. */
 void sim_hal_to_board(sim_hal_t *sim, const uint8_t *bytes, uint32_t n);
 
+/* The blob sim_hal_upload sends, as navbridge makes it: the policy's, with a 2-input
+ * network's row shapes (default configuration's rank) carried. Bytes or a QNAV_LINK_E_*. */
+int32_t sim_hal_blob(const qnav_policy_t *pol, uint8_t *blob, uint16_t cap);
+
 /* Queue a whole policy upload for the board, as navbridge sends it: chunks from tx, then
  * the commit, whose CRC is xored with crc_xor (0: correct). 0, or -1 when pol does not
  * serialise. */

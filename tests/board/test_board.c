@@ -313,6 +313,39 @@ static void test_uploaded_policy_is_used_and_a_bad_one_is_refused(void **state)
     assert_int_equal(g.last_ack.crc, g.bot.policy_crc);
 }
 
+/* navbridge's upload carries a 2-input network's row shapes: the board's init copies them
+ * instead of evaluating every row; the policy's CRC stays that of its weights, as a
+ * start-up from the store (which keeps no shapes) computes it. */
+static void test_an_uploaded_network_takes_the_row_shapes_it_carries(void **state)
+{
+    qnav_policy_t net;
+    qnav_board_config_t cfg;
+    uint16_t k, crc;
+    (void)state;
+    bench_start(8);
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    qnav_policy_net_zero(&net, 6);
+    for (k = 0; k < QNAV_NET_WEIGHTS(6); ++k) {
+        *qnav_net_weight(&net.u.net, k) = (qnav_q8_8_t)(k * 733 - 9000);
+    }
+    upload(&net, 0);
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    assert_int_equal(g.last_ack.status, QNAV_LINK_ACK_OK);
+    assert_int_equal(qnav_ctrl_shapes_carried(qnav_nav_paths(&g.bot.nav)), 1);
+    crc = qnav_link_policy_crc(&net);
+    assert_int_equal(g.bot.policy_crc, crc);
+    assert_int_equal(g.last_ack.crc, crc);
+
+    /* a restart loads the stored policy and computes its shapes: the same CRC */
+    cfg = g.bot.cfg;
+    assert_int_equal(qnav_board_init(&g.bot, &cfg, &g.hal), QNAV_BOARD_OK);
+    assert_int_equal(qnav_board_policy_source(&g.bot), QNAV_BOARD_POLICY_STORED);
+    assert_int_equal(qnav_ctrl_shapes_carried(qnav_nav_paths(&g.bot.nav)), 0);
+    assert_int_equal(g.bot.policy_crc, crc);
+}
+
 static void test_board_ignores_a_bridge_of_another_protocol_version(void **state)
 {
     qnav_link_heartbeat_t hb = {0, QNAV_LINK_MODE_ONBOARD, 0, 0, 0, 0};
@@ -656,6 +689,7 @@ int main(void)
         cmocka_unit_test(test_stop_command_holds_until_the_bridge_clears_it),
         cmocka_unit_test(test_corrupted_goal_is_not_acted_on),
         cmocka_unit_test(test_uploaded_policy_is_used_and_a_bad_one_is_refused),
+        cmocka_unit_test(test_an_uploaded_network_takes_the_row_shapes_it_carries),
         cmocka_unit_test(test_board_ignores_a_bridge_of_another_protocol_version),
         cmocka_unit_test(test_pose_integrates_wheel_travel_along_the_heading),
         cmocka_unit_test(test_position_goal_bearing_comes_from_the_pose),

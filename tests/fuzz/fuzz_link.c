@@ -5,7 +5,8 @@
  * Properties beyond "no crash, no sanitizer report": an accepted frame's payload length is
  * within QNAV_LINK_MAX_PAYLOAD; frames taken plus frames dropped never exceed the frames
  * (delimiters + 1) seen; a blob qnav_link_policy_from_blob accepts serialises again with
- * qnav_link_policy_to_blob to the same bytes (the codec reads only what it writes).
+ * qnav_link_policy_to_blob_carried (and the carried row shapes qnav_link_blob_shapes finds
+ * in it, if any) to the same bytes (the codec reads only what it writes).
  */
 #include <stdint.h>
 #include <stdlib.h>
@@ -21,7 +22,8 @@ static void check_blob(const uint8_t *p, uint16_t len)
     if (qnav_link_policy_from_blob(p, len, &pol) != QNAV_LINK_OK) {
         return;
     }
-    n = qnav_link_policy_to_blob(&pol, again, sizeof again);
+    n = qnav_link_policy_to_blob_carried(&pol, qnav_link_blob_shapes(p, len), again,
+                                         sizeof again);
     if (n != (int32_t)len || memcmp(again, p, len) != 0) {
         abort(); /* accepted a blob the codec itself would not write */
     }

@@ -132,6 +132,17 @@ static void blob(const qnav_policy_t *pol)
     put(b, (size_t)n);
 }
 
+/* The blob navbridge uploads: with a 2-input network's carried row shapes. */
+static void carried_blob(const qnav_policy_t *pol)
+{
+    uint8_t b[QNAV_LINK_POLICY_MAX_BYTES];
+    int32_t n = sim_hal_blob(pol, b, (uint16_t)sizeof b);
+    if (n <= 0) {
+        exit(1);
+    }
+    put(b, (size_t)n);
+}
+
 /* An EEPROM after a committed upload of pol (the board core's own store). */
 static void eeprom_with(const qnav_policy_t *pol)
 {
@@ -187,6 +198,7 @@ int main(int argc, char **argv)
     upload(&prob, 0); save("corpus/link", "upload_probabilistic");
     blob(&prob); save("corpus/link", "blob_probabilistic");
     blob(&net); save("corpus/link", "blob_network_4_hidden");
+    carried_blob(&net); save("corpus/link", "blob_network_4_hidden_with_shapes");
 
     /* link regressions */
     heartbeat(QNAV_LINK_MODE_OFFBOARD);

@@ -526,6 +526,50 @@ static void test_policy_blob_round_trips_network_and_probabilistic(void **state)
     assert_int_equal(qnav_link_policy_from_blob(blob, 6, &b), QNAV_LINK_E_VALUE);
 }
 
+/* A 2-input network's blob may carry QNAV_SHAPES_BYTES of row shapes after its weights
+ * (not looked at by the codec: init checks them); nothing else may. */
+static void test_policy_blob_carries_row_shapes_after_a_two_input_network(void **state)
+{
+    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES], shapes[QNAV_SHAPES_BYTES], out[6];
+    qnav_policy_t a, b, prob;
+    uint16_t k, w = (uint16_t)(2u + 2u * QNAV_NET_WEIGHTS(QNAV_MAX_HIDDEN));
+    int32_t n;
+    (void)state;
+    qnav_policy_net_zero(&a, QNAV_MAX_HIDDEN);
+    for (k = 0; k < qnav_net_weight_count(&a.u.net); ++k) {
+        *qnav_net_weight(&a.u.net, k) = (qnav_q8_8_t)(k * 311 - 7000);
+    }
+    for (k = 0; k < sizeof shapes; ++k) {
+        shapes[k] = (uint8_t)(k * 7u + 1u);
+    }
+    n = qnav_link_policy_to_blob_carried(&a, shapes, blob, sizeof blob);
+    assert_int_equal(n, QNAV_LINK_POLICY_MAX_BYTES);
+    assert_int_equal(qnav_link_policy_from_blob(blob, (uint16_t)n, &b), QNAV_LINK_OK);
+    assert_memory_equal(b.u.net.w_out, a.u.net.w_out, sizeof a.u.net.w_out);
+    assert_ptr_equal(qnav_link_blob_shapes(blob, (uint16_t)n), &blob[w]);
+    assert_memory_equal(&blob[w], shapes, sizeof shapes);
+    /* without them: the same policy, no shapes; any other length is refused */
+    assert_int_equal(qnav_link_policy_from_blob(blob, w, &b), QNAV_LINK_OK);
+    assert_null(qnav_link_blob_shapes(blob, w));
+    assert_int_equal(qnav_link_policy_from_blob(blob, (uint16_t)(n - 1), &b), QNAV_LINK_E_LENGTH);
+    assert_null(qnav_link_blob_shapes(blob, (uint16_t)(n - 1)));
+    assert_int_equal(qnav_link_policy_to_blob_carried(&a, shapes, blob, (uint16_t)(n - 1)),
+                     QNAV_LINK_E_SPACE);
+    /* only a 2-input network carries them */
+    qnav_policy_prob_default(&prob);
+    assert_int_equal(qnav_link_policy_to_blob_carried(&prob, shapes, blob, sizeof blob),
+                     QNAV_LINK_E_VALUE);
+    assert_int_equal(qnav_link_policy_to_blob_carried(&prob, NULL, out, sizeof out), 6);
+    qnav_policy_net_zero_inputs(&a, 3u, QNAV_NET_INPUTS_PREV);
+    assert_int_equal(qnav_link_policy_to_blob_carried(&a, shapes, blob, sizeof blob),
+                     QNAV_LINK_E_VALUE);
+    n = qnav_link_policy_to_blob(&a, blob, sizeof blob);
+    memcpy(&blob[n], shapes, sizeof shapes);
+    assert_int_equal(qnav_link_policy_from_blob(blob, (uint16_t)(n + (int32_t)sizeof shapes), &b),
+                     QNAV_LINK_E_LENGTH);
+    assert_null(qnav_link_blob_shapes(blob, (uint16_t)(n + (int32_t)sizeof shapes)));
+}
+
 static void test_policy_blob_round_trips_a_three_input_network(void **state)
 {
     uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
@@ -538,7 +582,7 @@ static void test_policy_blob_round_trips_a_three_input_network(void **state)
         *qnav_net_weight(&a.u.net, k) = (qnav_q8_8_t)(k * 173 - 5000);
     }
     n = qnav_link_policy_to_blob(&a, blob, sizeof blob);
-    assert_int_equal(n, QNAV_LINK_POLICY_MAX_BYTES);
+    assert_int_equal(n, QNAV_LINK_POLICY_WEIGHTS_MAX_BYTES);
     assert_int_equal(blob[1], 0x80u | QNAV_MAX_HIDDEN);
     assert_int_equal(qnav_link_policy_from_blob(blob, (uint16_t)n, &b), QNAV_LINK_OK);
     assert_int_equal(b.u.net.inputs, QNAV_NET_INPUTS_PREV);
@@ -836,6 +880,7 @@ int main(void)
         cmocka_unit_test(test_fuzz_random_damage_never_yields_a_frame_that_was_not_sent),
         cmocka_unit_test(test_policy_blob_round_trips_network_and_probabilistic),
         cmocka_unit_test(test_policy_blob_round_trips_a_three_input_network),
+        cmocka_unit_test(test_policy_blob_carries_row_shapes_after_a_two_input_network),
         cmocka_unit_test(test_policy_blob_refuses_a_policy_that_does_not_validate),
         cmocka_unit_test(test_policy_blob_reader_refuses_what_the_writer_refuses),
         cmocka_unit_test(test_link_status_str_names_every_status),

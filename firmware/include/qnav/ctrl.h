@@ -249,6 +249,7 @@ typedef struct {
     uint8_t inputs;                   /* network inputs, 2 or 3 */
     uint8_t rank;                     /* qnav_rank_t of the keys (table: as given at init) */
     uint8_t keep_pct;                 /* qnav_ctrl_config_t.keep_pct; 0 under QNAV_RANK_PREACT */
+    uint8_t shapes_carried;           /* 1: init took carried row shapes (not evaluated) */
     qnav_clearance_t clr;             /* levels, enlargement, speed guard */
     uint32_t speed_scale;             /* speed = min(MAX, (quality * scale) >> 15) */
     qnav_q1_15_t full_speed_quality;
@@ -319,6 +320,46 @@ QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctr
  */
 QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
                                    const qnav_qkey_t *table, qnav_rank_t rank);
+
+/*
+ * Carried row shapes (docs/architecture.md, "Carried row shapes"): the row shapes a
+ * 2-input network's init would compute, made where the policy is made (a host) and
+ * carried with it, so that a small board's init copies them instead of evaluating every
+ * row (ATmega128, H = 16: about 1 s). QNAV_SHAPES_BYTES bytes, little endian:
+ *   [0] QNAV_SHAPES_FORMAT  [1] the qnav_rank_t of the keys
+ *   [2 + 6 l ..] row l = 0..QNAV_DIST_LEVELS-1: top i16, top_d, fall_d, peak_lo, peak_hi
+ *   [last 4] check u32: CRC-32 (IEEE, reflected) over the network (H, then every weight in
+ *            qnav_net_weight() order, i16 LE) followed by the bytes above
+ */
+#define QNAV_SHAPES_FORMAT 1u
+#define QNAV_SHAPES_BYTES ((uint16_t)(2u + 6u * QNAV_DIST_LEVELS + 4u))
+
+/*
+ * Write the row shapes of ctrl, initialised from policy (a 2-input network), into out
+ * (QNAV_SHAPES_BYTES, caller's buffer) for qnav_ctrl_init_carried() on a board. Returns
+ * QNAV_OK, QNAV_E_NULL, or QNAV_E_NO_TABLE when ctrl is not ready or policy is not a
+ * 2-input network with ctrl's hidden-unit count.
+ */
+QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_shapes_save(const qnav_ctrl_t *ctrl,
+                                                      const qnav_policy_t *policy,
+                                                      uint8_t *out);
+
+/*
+ * qnav_ctrl_init() that takes a 2-input network's row shapes from shapes (len bytes,
+ * written by qnav_ctrl_shapes_save) instead of evaluating every row, when they are this
+ * policy's: the right length and format, the controller's rank, a check that matches the
+ * policy's weights, every field in range, and each row's top equal to the key the network
+ * gives at top_d. Otherwise (null, or any of that fails, or a 3-input network or
+ * probabilistic policy) it computes them as qnav_ctrl_init() does: the same statuses, and
+ * the same controller and decisions either way (qnav_ctrl_shapes_carried says which).
+ */
+QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_init_carried(qnav_ctrl_t *ctrl,
+                                                       const qnav_ctrl_config_t *cfg,
+                                                       const qnav_policy_t *policy,
+                                                       const uint8_t *shapes, uint16_t len);
+
+/* 1 when the last successful init took carried row shapes, else 0. */
+uint8_t qnav_ctrl_shapes_carried(const qnav_ctrl_t *ctrl);
 
 /* The qnav_rank_t of an initialised controller's keys (QNAV_RANK_QUALITY when not ready). */
 qnav_rank_t qnav_ctrl_rank(const qnav_ctrl_t *ctrl);

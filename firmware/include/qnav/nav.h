@@ -33,9 +33,11 @@ typedef struct {
     /* Edit the shared configuration before init (null: use it as given); callers that
      * build a path-quality table apply it too (qnav_nav_config). */
     void (*adjust)(qnav_ctrl_config_t *cfg);
-    /* Configure nav from the shared sensor/body configuration and a policy. */
+    /* Configure nav from the shared sensor/body configuration and a policy, with the
+     * policy's carried row shapes (null: none; qnav_ctrl_init_carried). */
     qnav_status_t (*init)(qnav_nav_t *nav, const qnav_ctrl_config_t *cfg,
-                          const qnav_policy_t *policy);
+                          const qnav_policy_t *policy, const uint8_t *shapes,
+                          uint16_t shapes_len);
     /* Forget everything kept between ticks (start of an episode). */
     void (*reset)(qnav_nav_t *nav);
     /* One tick: the signature every controller shares. Never fails. */
@@ -73,6 +75,15 @@ const qnav_nav_method_t *qnav_nav_find(const char *name);
 QNAV_CHECK_RESULT qnav_status_t qnav_nav_init(qnav_nav_t *nav, const qnav_nav_method_t *method,
                                               const qnav_ctrl_config_t *cfg,
                                               const qnav_policy_t *policy);
+
+/* qnav_nav_init() with the policy's carried row shapes (shapes_len bytes; null: none), which
+ * the path-quality controller takes when they are the policy's (qnav_ctrl_init_carried). */
+QNAV_CHECK_RESULT qnav_status_t qnav_nav_init_carried(qnav_nav_t *nav,
+                                                      const qnav_nav_method_t *method,
+                                                      const qnav_ctrl_config_t *cfg,
+                                                      const qnav_policy_t *policy,
+                                                      const uint8_t *shapes,
+                                                      uint16_t shapes_len);
 
 /* qnav_nav_find(name) then qnav_nav_init(); QNAV_E_NAME when there is no such controller. */
 QNAV_CHECK_RESULT qnav_status_t qnav_nav_init_named(qnav_nav_t *nav, const char *name,

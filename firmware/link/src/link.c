@@ -700,6 +700,56 @@ static int32_t net_to_blob(const qnav_net_t *src, uint8_t *out, uint16_t cap)
     return (int32_t)need;
 }
 
+/* A blob's length without carried shapes, from its first two bytes (0: not a blob). */
+static uint16_t blob_weights_len(const uint8_t *blob)
+{
+    switch ((qnav_policy_kind_t)blob[0]) {
+    case QNAV_POLICY_PROB:
+        return 6u;
+    case QNAV_POLICY_NET:
+        return (uint16_t)(2u + 2u * QNAV_NET_WEIGHTS_IN(
+                                        (uint16_t)(blob[1] & BLOB_NET_HIDDEN),
+                                        (blob[1] & BLOB_NET_PREV) != 0u ? 3u : 2u));
+    }
+    return 0u;
+}
+
+/* Carried shapes may follow only a 2-input network's weights. */
+static uint8_t blob_may_carry(const uint8_t *blob)
+{
+    return (uint8_t)(blob[0] == (uint8_t)QNAV_POLICY_NET && (blob[1] & BLOB_NET_PREV) == 0u);
+}
+
+int32_t qnav_link_policy_to_blob_carried(const qnav_policy_t *policy, const uint8_t *shapes,
+                                         uint8_t *out, uint16_t cap)
+{
+    int32_t n = qnav_link_policy_to_blob(policy, out, cap);
+    uint16_t k;
+    if (n <= 0 || shapes == NULL) {
+        return n;
+    }
+    if (!blob_may_carry(out)) {
+        return QNAV_LINK_E_VALUE;
+    }
+    if ((uint32_t)n + QNAV_SHAPES_BYTES > cap) {
+        return QNAV_LINK_E_SPACE;
+    }
+    for (k = 0; k < QNAV_SHAPES_BYTES; ++k) {
+        out[(uint16_t)n + k] = shapes[k];
+    }
+    return n + (int32_t)QNAV_SHAPES_BYTES;
+}
+
+const uint8_t *qnav_link_blob_shapes(const uint8_t *blob, uint16_t len)
+{
+    uint16_t w;
+    if (blob == NULL || len < 2u || !blob_may_carry(blob)) {
+        return NULL;
+    }
+    w = blob_weights_len(blob);
+    return len == (uint32_t)w + QNAV_SHAPES_BYTES ? &blob[w] : NULL;
+}
+
 int32_t qnav_link_policy_to_blob(const qnav_policy_t *policy, uint8_t *out, uint16_t cap)
 {
     if (policy == NULL || out == NULL) {
@@ -737,7 +787,8 @@ static int32_t net_from_blob(const uint8_t *blob, uint16_t len, qnav_policy_t *p
                                                ? (uint8_t)QNAV_NET_INPUTS_PREV
                                                : (uint8_t)QNAV_NET_INPUTS_PAPER);
     nw = qnav_net_weight_count(&p->u.net);
-    if (len != 2u + 2u * nw) {
+    if (len != 2u + 2u * nw &&
+        !(blob_may_carry(blob) && len == 2u + 2u * nw + QNAV_SHAPES_BYTES)) {
         return QNAV_LINK_E_LENGTH;
     }
     for (k = 0; k < nw; ++k) {

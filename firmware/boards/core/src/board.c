@@ -160,8 +160,17 @@ static void send(qnav_board_t *bot, uint8_t id, const uint8_t *payload, int32_t 
 
 /* A committed upload: switch controllers only when the new one initialises, then keep it
  * in storage. The drive is stopped first: no tick runs while the new controller
- * initialises (a 2-input network's init evaluates every row of keys, up to about 1.2 s on
- * the ATmega128) and the EEPROM write blocks for milliseconds a byte. */
+ * initialises (a 2-input network's init copies the row shapes the blob carries, or
+ * without them evaluates every row of keys, up to about 1.2 s on the ATmega128) and the
+ * EEPROM write blocks for milliseconds a byte. The policy's CRC is that of its blob
+ * without shapes, as navbridge and a start-up from storage compute it. */
+static qnav_status_t init_carried(qnav_board_t *bot, const qnav_policy_t *policy,
+                                  const uint8_t *shapes)
+{
+    return qnav_nav_init_carried(&bot->nav, qnav_nav_find(bot->cfg.controller), &bot->cfg.ctrl,
+                                 policy, shapes, shapes != NULL ? QNAV_SHAPES_BYTES : 0u);
+}
+
 static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm)
 {
     qnav_policy_t fresh;
@@ -172,9 +181,10 @@ static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm
 
     if (status == QNAV_LINK_ACK_OK) {
         bot->hal.drive(bot->hal.ctx, 0, 0);
-        if (qnav_nav_init_named(&bot->nav, bot->cfg.controller, &bot->cfg.ctrl, &fresh) == QNAV_OK) {
+        if (init_carried(bot, &fresh, qnav_link_blob_shapes(bot->upload.blob, cm->total)) ==
+            QNAV_OK) {
             bot->policy = fresh;
-            bot->policy_crc = cm->crc;
+            bot->policy_crc = qnav_link_policy_crc(&fresh);
             bot->policy_source = QNAV_BOARD_POLICY_UPLOADED;
             bot->ctrl_ready = 1;
             bot->stats.uploads_ok++;

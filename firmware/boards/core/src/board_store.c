@@ -33,7 +33,7 @@ static uint8_t read_slot(const qnav_board_hal_t *hal, uint16_t addr, qnav_policy
                          uint16_t *crc, uint8_t *seq)
 {
     uint8_t hdr[QNAV_BOARD_STORE_HEADER_BYTES];
-    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
+    uint8_t blob[QNAV_LINK_POLICY_WEIGHTS_MAX_BYTES];
     uint16_t len;
     uint16_t want;
     if (!hal->nvm_read(hal->ctx, addr, hdr, (uint16_t)sizeof hdr) || hdr[0] != MAGIC0 ||
@@ -42,7 +42,7 @@ static uint8_t read_slot(const qnav_board_hal_t *hal, uint16_t addr, qnav_policy
     }
     len = (uint16_t)(hdr[4] | ((uint16_t)hdr[5] << 8));
     want = (uint16_t)(hdr[6] | ((uint16_t)hdr[7] << 8));
-    if (len == 0u || len > QNAV_LINK_POLICY_MAX_BYTES ||
+    if (len == 0u || len > QNAV_LINK_POLICY_WEIGHTS_MAX_BYTES ||
         !hal->nvm_read(hal->ctx, (uint16_t)(addr + QNAV_BOARD_STORE_HEADER_BYTES), blob, len) ||
         slot_crc(hdr, blob, len) != want ||
         qnav_link_policy_from_blob(blob, len, policy) != QNAV_LINK_OK) {
@@ -90,7 +90,7 @@ uint8_t qnav_board_store_save(const qnav_board_hal_t *hal, uint16_t offset,
                               uint8_t *seq)
 {
     uint8_t hdr[QNAV_BOARD_STORE_HEADER_BYTES];
-    uint8_t blob[QNAV_LINK_POLICY_MAX_BYTES];
+    uint8_t blob[QNAV_LINK_POLICY_WEIGHTS_MAX_BYTES];
     static const uint8_t erased[2] = {0xFFu, 0xFFu};
     int32_t n;
     uint16_t len;

@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "qnav/fixed.h"
+#include "qnav/ctrl.h"
 #include "qnav/policy.h"
 
 #ifdef __cplusplus
@@ -122,9 +123,14 @@ typedef enum {
 #define QNAV_LINK_ACK_BAD_POLICY (-3)  /* blob does not decode to a policy */
 #define QNAV_LINK_ACK_REJECTED (-4)    /* the controller refused it (qnav_ctrl_init) */
 
-/* Largest policy blob: kind, hidden, then up to 5H+1 weights of 2 bytes (3 inputs). */
-#define QNAV_LINK_POLICY_MAX_BYTES \
+/* Largest policy blob without carried row shapes: kind, hidden, then up to 5H+1 weights of
+ * 2 bytes (3 inputs). The board's policy store keeps such blobs (qnav/board.h). */
+#define QNAV_LINK_POLICY_WEIGHTS_MAX_BYTES \
     (2u + 2u * QNAV_NET_WEIGHTS_IN(QNAV_MAX_HIDDEN, QNAV_NET_INPUTS_PREV))
+/* Largest policy blob: a 2-input network's 4H+1 weights and its carried row shapes
+ * (QNAV_SHAPES_BYTES), longer than any blob without them. */
+#define QNAV_LINK_POLICY_MAX_BYTES \
+    (2u + 2u * QNAV_NET_WEIGHTS(QNAV_MAX_HIDDEN) + QNAV_SHAPES_BYTES)
 
 /* ---- Statuses and counters ----------------------------------------------------------- */
 
@@ -353,12 +359,28 @@ int32_t qnav_link_config_unpack(const uint8_t *p, uint16_t len, qnav_link_config
  */
 QNAV_CHECK_RESULT int32_t qnav_link_policy_to_blob(const qnav_policy_t *policy, uint8_t *out, uint16_t cap);
 
-/* The CRC-16 of a policy's blob: what heartbeats, acks and commands call the policy's
- * CRC (0 when it cannot be serialised). */
+/*
+ * The same with a 2-input network's carried row shapes appended (QNAV_SHAPES_BYTES from
+ * qnav_ctrl_shapes_save, copied as they are: the board's init checks them). shapes null:
+ * qnav_link_policy_to_blob. QNAV_LINK_E_VALUE for shapes with any other policy.
+ */
+QNAV_CHECK_RESULT int32_t qnav_link_policy_to_blob_carried(const qnav_policy_t *policy,
+                                                           const uint8_t *shapes,
+                                                           uint8_t *out, uint16_t cap);
+
+/* The carried row shapes inside a blob that qnav_link_policy_from_blob accepts: a pointer
+ * to its QNAV_SHAPES_BYTES, or null when it has none (or len is no blob's length). */
+const uint8_t *qnav_link_blob_shapes(const uint8_t *blob, uint16_t len);
+
+/* The CRC-16 of a policy's blob without carried shapes: what heartbeats, acks and
+ * commands call the policy's CRC, whether or not an upload carried shapes (0 when it
+ * cannot be serialised). */
 uint16_t qnav_link_policy_crc(const qnav_policy_t *policy);
 
-/* Parse a blob back; QNAV_LINK_OK or QNAV_LINK_E_NULL / _LENGTH / _VALUE (also for a
- * policy qnav_policy_validate refuses, as the writer does); *policy untouched on error. */
+/* Parse a blob back, with or without carried shapes (their bytes are not looked at here:
+ * qnav_link_blob_shapes finds them, init checks them); QNAV_LINK_OK or QNAV_LINK_E_NULL /
+ * _LENGTH / _VALUE (also for a policy qnav_policy_validate refuses, as the writer does);
+ * *policy untouched on error. */
 QNAV_CHECK_RESULT
 int32_t qnav_link_policy_from_blob(const uint8_t *blob, uint16_t len, qnav_policy_t *policy);
 
@@ -381,7 +403,8 @@ void qnav_link_upload_init(qnav_link_upload_t *up);
 int32_t qnav_link_upload_chunk(qnav_link_upload_t *up, const qnav_link_policy_chunk_t *c);
 
 /* Finish: check length and CRC and decode. Returns QNAV_LINK_ACK_OK with *policy, or
- * QNAV_LINK_ACK_BAD_LENGTH / _BAD_CRC / _BAD_POLICY. The upload is reset either way. */
+ * QNAV_LINK_ACK_BAD_LENGTH / _BAD_CRC / _BAD_POLICY. The upload is reset either way; its
+ * bytes stay in up->blob until the next chunk (qnav_link_blob_shapes(up->blob, c->total)). */
 int8_t qnav_link_upload_commit(qnav_link_upload_t *up, const qnav_link_policy_commit_t *c,
                                qnav_policy_t *policy);
 
