@@ -8,7 +8,9 @@
  * protocol version (one line saying which). With --robot it runs the controller
  * configuration of that robot's profile and refuses a board whose reported configuration
  * differs (one line naming the field, status 1). --replay re-runs a
- * recorded trial's scans through the controller and checks the commands are identical.
+ * recorded trial's scans through the controller, with the goal distance and previous
+ * heading the log records, and checks the commands are identical; it refuses a log whose
+ * robot it is not told (status 2).
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -92,7 +94,9 @@ static void usage(FILE *f)
             "                     start (a new random token each run); without it navbridge\n"
             "                     takes goals only from its command line and does not listen\n"
             "                     on LCM at all (docs/hil.md, \"Who may move the robot\")\n"
-            "  --replay LOG       re-run LOG's scans, compare with its commands, exit\n"
+            "  --replay LOG       re-run LOG's scans, compare with its commands, exit;\n"
+            "                     needs --robot unless LOG was decided with the default\n"
+            "                     configuration (docs/hil.md, \"Record and replay\")\n"
             "  --help, --version  this text; the version\n");
 }
 
