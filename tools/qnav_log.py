@@ -36,6 +36,7 @@ CHANNELS = {
     "QNAV_LINK_STATUS": "link_status_t",
     "QNAV_WAYPOINTS": "waypoints_t",
     "QNAV_ODOMETRY": "odometry_t",
+    "QNAV_NAV_INPUT": "nav_input_t",
 }
 # navbridge --lcm-goals takes goals and routes on QNAV_GOAL_<token> and
 # QNAV_WAYPOINTS_<token> (docs/hil.md): the same types as the plain channels

@@ -14,6 +14,7 @@
 
 #include <math.h>
 
+#include "qnav/board.h"
 #include "qnav/clock.h"
 
 #include "qnav/fixed_host.h"
@@ -36,9 +37,33 @@ uint16_t qnav_bridge_policy_crc(const qnav_policy_t *policy)
 
 static int bridge_ctrl_reinit(qnav_bridge_ctrl_t *bc)
 {
-    bc->have_last = 0;
+    qnav_ctrl_carry_reset(&bc->carry);
     return bc->method != NULL &&
            qnav_nav_init(&bc->nav, bc->method, &bc->cfg, &bc->policy) == QNAV_OK;
+}
+
+uint16_t qnav_bridge_config_crc(const qnav_ctrl_config_t *cfg, const char *controller)
+{
+    /* the fields a robot profile decides (the board's CONFIG list, one home), each as its
+     * key and its value in 4 little-endian bytes; the scan's two set to 0 */
+    qnav_board_config_t bc;
+    uint8_t b[6 * 64];
+    uint16_t n = 0;
+    const char *name = controller != NULL ? controller : QNAV_BRIDGE_DEFAULT_CONTROLLER;
+    memset(&bc, 0, sizeof bc);
+    bc.ctrl = *cfg;
+    bc.ctrl.n_sectors = 0u;
+    bc.ctrl.max_range_mm = 0u;
+#define QNAV_CRC_FIELD(id, field, member)                                                   \
+    b[n++] = (uint8_t)(id);                                                                 \
+    b[n++] = (uint8_t)(((uint32_t)bc.member) & 0xFFu);                                      \
+    b[n++] = (uint8_t)((((uint32_t)bc.member) >> 8) & 0xFFu);                               \
+    b[n++] = (uint8_t)((((uint32_t)bc.member) >> 16) & 0xFFu);                              \
+    b[n++] = (uint8_t)(((uint32_t)bc.member) >> 24);
+    QNAV_BOARD_ROBOT_FIELDS(QNAV_CRC_FIELD)
+#undef QNAV_CRC_FIELD
+    return qnav_link_crc16(qnav_link_crc16(0xFFFFu, b, n), (const uint8_t *)name,
+                           (uint16_t)strlen(name));
 }
 
 void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg,
@@ -48,19 +73,16 @@ void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg
     bc->cfg = *cfg;
     bc->policy = *policy;
     bc->policy_crc = qnav_bridge_policy_crc(policy);
+    bc->config_crc = qnav_bridge_config_crc(cfg, controller);
     bc->method = qnav_nav_find(controller != NULL ? controller : QNAV_BRIDGE_DEFAULT_CONTROLLER);
     bc->ready = bridge_ctrl_reinit(bc);
 }
 
-void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
-                           qnav_command_t *cmd, int16_t *qualities)
+/* The scan's sector count, 0 when out of range; the controller re-made when the scan's
+ * sectors or range differ from its configuration. */
+static int bridge_ctrl_sync(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan)
 {
-    qnav_mm_t ranges[QNAV_MAX_SECTORS];
-    qnav_ctrl_input_t in = {0};
-    qnav_ctrl_output_t out;
-    int k;
     int n = scan->n_sectors;
-
     if (n < 1 || n > QNAV_MAX_SECTORS) {
         n = 0;
     }
@@ -70,16 +92,61 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
         bc->cfg.max_range_mm = (qnav_mm_t)scan->max_range_mm;
         bc->ready = bridge_ctrl_reinit(bc);
     }
+    return n;
+}
+
+void qnav_bridge_ctrl_input(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan, uint32_t range_mm,
+                            qnav_nav_input_t *rec)
+{
+    qnav_ctrl_input_t in = {0};
+    (void)bridge_ctrl_sync(bc, scan);
+    in.goal_bearing_cdeg = scan->goal_bearing_cdeg;
+    qnav_ctrl_carry_input(&bc->carry, (uint16_t)scan->goal_id, range_mm, &in);
+    memset(rec, 0, sizeof *rec);
+    rec->utime = scan->utime;
+    rec->scan_seq = scan->seq;
+    rec->goal_id = scan->goal_id;
+    rec->goal_range_mm = in.goal_range_mm;
+    rec->prev_heading_cdeg = in.prev_heading_cdeg;
+    rec->config_crc = bc->config_crc;
+}
+
+static void fill_command(const qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
+                         const qnav_ctrl_output_t *out, qnav_command_t *cmd)
+{
+    memset(cmd, 0, sizeof *cmd);
+    cmd->utime = scan->utime;
+    cmd->scan_seq = scan->seq;
+    cmd->heading_deg = out->heading_deg;
+    cmd->speed_q15 = out->speed;
+    cmd->quality_q15 = out->quality;
+    cmd->speed = QNAV_Q1_15_TO_REAL(out->speed);
+    cmd->quality = QNAV_Q1_15_TO_REAL(out->quality);
+    cmd->flags = (int8_t)out->flags;
+    cmd->stop_reason = QNAV_STOP_NONE;
+    cmd->source = QNAV_SOURCE_BRIDGE;
+    cmd->policy_crc = bc->policy_crc;
+}
+
+void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
+                           const qnav_nav_input_t *rec, qnav_command_t *cmd,
+                           int16_t *qualities)
+{
+    qnav_mm_t ranges[QNAV_MAX_SECTORS];
+    qnav_ctrl_input_t in = {0};
+    qnav_ctrl_output_t out;
+    int k;
+    int n = bridge_ctrl_sync(bc, scan);
+
     for (k = 0; k < n; ++k) {
         int32_t r = scan->ranges_mm[k];
         ranges[k] = (qnav_mm_t)(r < 0 ? 0 : (r > 65535 ? 65535 : r));
     }
     in.ranges_mm = ranges;
     in.goal_bearing_cdeg = scan->goal_bearing_cdeg;
-    in.prev_heading_cdeg =
-        bc->have_last ? qnav_ctrl_prev_heading(bc->last_heading_deg, bc->last_goal_cdeg,
-                                               scan->goal_bearing_cdeg)
-                      : 0;
+    qnav_ctrl_carry_input(&bc->carry, (uint16_t)scan->goal_id,
+                          rec->goal_range_mm < 0 ? 0u : (uint32_t)rec->goal_range_mm, &in);
+    in.prev_heading_cdeg = rec->prev_heading_cdeg; /* as recorded (the same, live) */
     if (qualities != NULL) {
         memset(qualities, 0, sizeof(int16_t) * QNAV_PATHS);
     }
@@ -94,23 +161,8 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
     } else {
         qnav_nav_step(&bc->nav, &in, &out);
     }
-    if (!(out.flags & QNAV_FLAG_NOT_READY)) {
-        bc->have_last = 1;
-        bc->last_heading_deg = out.heading_deg;
-        bc->last_goal_cdeg = scan->goal_bearing_cdeg;
-    }
-    memset(cmd, 0, sizeof *cmd);
-    cmd->utime = scan->utime;
-    cmd->scan_seq = scan->seq;
-    cmd->heading_deg = out.heading_deg;
-    cmd->speed_q15 = out.speed;
-    cmd->quality_q15 = out.quality;
-    cmd->speed = QNAV_Q1_15_TO_REAL(out.speed);
-    cmd->quality = QNAV_Q1_15_TO_REAL(out.quality);
-    cmd->flags = (int8_t)out.flags;
-    cmd->stop_reason = QNAV_STOP_NONE;
-    cmd->source = QNAV_SOURCE_BRIDGE;
-    cmd->policy_crc = bc->policy_crc;
+    qnav_ctrl_carry_output(&bc->carry, &in, &out);
+    fill_command(bc, scan, &out, cmd);
 }
 
 void qnav_bridge_config_default(qnav_bridge_config_t *cfg)
@@ -281,18 +333,31 @@ void qnav_bridge_init(qnav_bridge_t *b, const qnav_bridge_config_t *cfg, lcm_t *
     b->last_upload_status = QNAV_BRIDGE_UPLOAD_NONE_YET;
 }
 
+/* The distance to the destination for the escape: the board's own, from its pose report
+ * (the board sends it just before each scan, so it is this tick's; after a lost report the
+ * last one, a tick older, rather than none, which would clear the escape memory) for the
+ * goal the scan is driven to. 0 (no escape) before any report for that goal, and for a
+ * bearing-only goal (the board reports 0). */
+static uint32_t scan_goal_range(const qnav_bridge_t *b, const qnav_link_scan_t *ls)
+{
+    return b->have_pose && b->pose_goal_id == ls->goal_id ? b->pose_goal_distance_mm : 0u;
+}
+
 static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
 {
     qnav_link_scan_t ls;
     qnav_scan_t s;
     qnav_command_t c;
     qnav_path_qualities_t q;
+    qnav_nav_input_t rec;
     int k;
 
     if (qnav_link_scan_unpack(f->payload, f->len, &ls) != QNAV_LINK_OK) {
         return;
     }
     b->last_scan_ms = b->now_ms;
+    b->scan_seq = f->seq;
+    b->scan_goal_cdeg = ls.goal_bearing_cdeg;
     memset(&s, 0, sizeof s);
     s.utime = qnav_bridge_utime();
     s.seq = f->seq;
@@ -304,13 +369,18 @@ static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
     for (k = 0; k < ls.n_sectors; ++k) {
         s.ranges_mm[k] = ls.ranges_mm[k];
     }
+    qnav_bridge_ctrl_input(&b->bc, &s, scan_goal_range(b, &ls), &rec);
+    if (b->cfg.mode == QNAV_LINK_MODE_ONBOARD && b->cfg.check_config == NULL) {
+        rec.config_crc = -1; /* the board decides with a configuration nobody checked */
+    }
+    PUBLISH(b, QNAV_CH_NAV_INPUT, qnav_nav_input_t, &rec);
     PUBLISH(b, QNAV_CH_SCAN, qnav_scan_t, &s);
 
     if ((b->goal.goal_id != 0u || b->goal_cleared) && ls.goal_id != b->goal.goal_id) {
         send_goal(b); /* the board has not got the current goal (or its clearing) yet */
     }
     memset(&q, 0, sizeof q);
-    qnav_bridge_ctrl_step(&b->bc, &s, &c, q.quality_q15);
+    qnav_bridge_ctrl_step(&b->bc, &s, &rec, &c, q.quality_q15);
     if (b->cfg.mode == QNAV_LINK_MODE_OFFBOARD && !b->shutting_down &&
         (b->cfg.check_config == NULL || b->config_ok)) {
         if (b->watchdog_stop && b->diag != NULL) {
@@ -352,6 +422,13 @@ static void on_board_command(qnav_bridge_t *b, const qnav_link_frame_t *f)
     c.source = QNAV_SOURCE_BOARD;
     c.policy_crc = b->board_hb.policy_crc;
     PUBLISH(b, QNAV_CH_COMMAND, qnav_command_t, &c);
+    if (lc.scan_seq == b->scan_seq && !(lc.flags & QNAV_FLAG_NOT_READY)) {
+        /* the board decided: its decision, not the bridge's own (shown only), is the
+         * previous heading the next QNAV_NAV_INPUT records, as the board reads it */
+        b->bc.carry.last_heading_deg = lc.heading_deg;
+        b->bc.carry.last_goal_cdeg = b->scan_goal_cdeg;
+        b->bc.carry.have_last = 1u;
+    }
 }
 
 /* A board heartbeat: 1 when it is of our protocol version and taken. A board of another
@@ -422,6 +499,9 @@ static void on_pose(qnav_bridge_t *b, const qnav_link_frame_t *f)
     if (qnav_link_pose_unpack(f->payload, f->len, &lp) != QNAV_LINK_OK) {
         return;
     }
+    b->have_pose = 1;
+    b->pose_goal_id = lp.goal_id;
+    b->pose_goal_distance_mm = lp.goal_distance_mm;
     if (b->route_n > 0 && b->route_k < b->route_n && lp.goal_id == b->goal.goal_id &&
         b->goal.kind == QNAV_LINK_GOAL_POSITION) {
         double dx = (double)b->route_x_mm[b->route_k] - (double)lp.x_mm;

@@ -23,6 +23,7 @@
 #include "qnav/link.h"
 #include "qnav_command_t.h"
 #include "qnav_goal_t.h"
+#include "qnav_nav_input_t.h"
 #include "qnav_scan_t.h"
 #include "qnav_waypoints_t.h"
 
@@ -39,6 +40,7 @@ extern "C" {
 #define QNAV_CH_LINK_STATUS "QNAV_LINK_STATUS"
 #define QNAV_CH_WAYPOINTS "QNAV_WAYPOINTS"
 #define QNAV_CH_ODOMETRY "QNAV_ODOMETRY"
+#define QNAV_CH_NAV_INPUT "QNAV_NAV_INPUT"
 
 /* Goals and routes from LCM are taken only on these channels followed by the run's token
  * (QNAV_GOAL_<token>, QNAV_WAYPOINTS_<token>), and only when the operator asked for it
@@ -102,7 +104,8 @@ typedef struct {
 } qnav_bridge_config_t;
 
 /* The controller step of the bridge, shared with the replay: re-initialises when the
- * scan's sector count or range changes. */
+ * scan's sector count or range changes; carries the escape memory and the last decision
+ * from scan to scan as the board core does (qnav_ctrl_carry_t). */
 typedef struct {
     qnav_nav_t nav;
     const qnav_nav_method_t *method; /* the controller (null: unknown name, never ready) */
@@ -110,18 +113,28 @@ typedef struct {
     qnav_policy_t policy;
     int ready;                    /* qnav_nav_init succeeded for cfg */
     uint16_t policy_crc;          /* CRC-16 of the policy blob */
-    int have_last;                /* a decision was made since init */
-    int16_t last_heading_deg;     /* its heading, robot frame then */
-    int16_t last_goal_cdeg;       /* the goal bearing it saw */
+    uint16_t config_crc;          /* qnav_bridge_config_crc of cfg and the controller */
+    qnav_ctrl_carry_t carry;      /* escape memory and last decision */
 } qnav_bridge_ctrl_t;
 
 /* controller: a name of the table in qnav/nav.h (null: QNAV_BRIDGE_DEFAULT_CONTROLLER). */
 void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg,
                            const char *controller, const qnav_policy_t *policy);
-/* Run the controller on an LCM scan; fills cmd (integer and float fields, source BRIDGE)
- * and qualities (360 Q1.15 values, may be NULL). */
+/* What the controller is given for scan besides the scan, into rec (the QNAV_NAV_INPUT
+ * record): range_mm to the destination (0: bearing-only goal or unknown: no escape), the
+ * previous heading, the configuration's CRC. */
+void qnav_bridge_ctrl_input(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan, uint32_t range_mm,
+                            qnav_nav_input_t *rec);
+/* Run the controller on an LCM scan with rec (qnav_bridge_ctrl_input's, or a logged one);
+ * fills cmd (integer and float fields, source BRIDGE) and qualities (360 Q1.15 values, may
+ * be NULL). */
 void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
-                           qnav_command_t *cmd, int16_t *qualities);
+                           const qnav_nav_input_t *rec, qnav_command_t *cmd,
+                           int16_t *qualities);
+/* CRC-16 of a controller configuration (every field but n_sectors and max_range_mm, which
+ * come with each scan) and the controller's name (null: the default): what
+ * QNAV_NAV_INPUT's config_crc records. */
+uint16_t qnav_bridge_config_crc(const qnav_ctrl_config_t *cfg, const char *controller);
 /* CRC-16 of a policy's link blob (0 if it cannot be serialised). */
 uint16_t qnav_bridge_policy_crc(const qnav_policy_t *policy);
 /* The blob an upload sends: the policy's, with a 2-input network's row shapes for the
@@ -192,6 +205,14 @@ typedef struct {
     qnav_waypoints_t_subscription_t *route_sub;
     char goal_channel[QNAV_BRIDGE_CHANNEL_MAX];   /* QNAV_GOAL_<token> ("" not subscribed) */
     char route_channel[QNAV_BRIDGE_CHANNEL_MAX];  /* QNAV_WAYPOINTS_<token> */
+
+    /* the board's last pose report (sent before its scan each tick): the escape's goal
+     * distance */
+    int have_pose;
+    uint16_t scan_seq;                /* the board's last scan: its link sequence number */
+    qnav_cdeg_t scan_goal_cdeg;       /* and the destination's bearing it reported */
+    uint16_t pose_goal_id;
+    uint32_t pose_goal_distance_mm;
 
     uint64_t rx_bytes;
     FILE *diag;                   /* one-line notices (upload result, link lost), or NULL */

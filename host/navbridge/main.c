@@ -8,7 +8,9 @@
  * protocol version (one line saying which). With --robot it runs the controller
  * configuration of that robot's profile and refuses a board whose reported configuration
  * differs (one line naming the field, status 1). --replay re-runs a
- * recorded trial's scans through the controller and checks the commands are identical.
+ * recorded trial's scans through the controller, with the goal distance and previous
+ * heading the log records, and checks the commands are identical; it refuses a log whose
+ * robot it is not told (status 2).
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -92,7 +94,9 @@ static void usage(FILE *f)
             "                     start (a new random token each run); without it navbridge\n"
             "                     takes goals only from its command line and does not listen\n"
             "                     on LCM at all (docs/hil.md, \"Who may move the robot\")\n"
-            "  --replay LOG       re-run LOG's scans, compare with its commands, exit\n"
+            "  --replay LOG       re-run LOG's scans, compare with its commands, exit;\n"
+            "                     needs --robot unless LOG was decided with the default\n"
+            "                     configuration (docs/hil.md, \"Record and replay\")\n"
             "  --help, --version  this text; the version\n");
 }
 
@@ -379,21 +383,60 @@ static int parse_args(int argc, char **argv, options_t *o, robot_check_t *robot_
     return -1;
 }
 
+/* Which configuration replays the log: --robot's, or the built-in default when the log
+ * records that its decisions were made with it (QNAV_NAV_INPUT's config_crc). Without
+ * --robot, a log that records another configuration or none is refused: a replay with
+ * the default would compare against a robot that never drove. 0 to go on, else the exit
+ * status after one line. */
+static int replay_config_ok(const options_t *o)
+{
+    uint16_t logged = 0;
+    uint16_t ours = qnav_bridge_config_crc(&o->cfg.ctrl, o->cfg.controller);
+    int found = qnav_replay_log_config(o->replay_path, &logged);
+    if (found < 0) {
+        return 0; /* unreadable: qnav_replay_log says why */
+    }
+    if (o->robot_spec == NULL && found == 0) {
+        fprintf(stderr, "navbridge: --replay %s: --robot NAME|FILE missing (the log does not "
+                        "record which configuration decided)\n", o->replay_path);
+        return 2;
+    }
+    if (o->robot_spec == NULL && logged != ours) {
+        fprintf(stderr, "navbridge: --replay %s: --robot NAME|FILE missing (the log was decided "
+                        "with configuration crc 0x%04x, the default is 0x%04x)\n",
+                o->replay_path, (unsigned)logged, (unsigned)ours);
+        return 2;
+    }
+    if (found == 1 && logged != ours) {
+        fprintf(stderr, "navbridge: --replay %s: decided with configuration crc 0x%04x, "
+                        "--robot %s --controller %s gives 0x%04x\n", o->replay_path,
+                (unsigned)logged, o->robot_spec, o->cfg.controller, (unsigned)ours);
+        return 2;
+    }
+    return 0;
+}
+
 /* navbridge --replay LOG: re-run the log's scans and compare the commands. */
 static int run_replay(const options_t *o)
 {
     char err[QNAV_POLICY_IO_ERRLEN];
     qnav_replay_result_t res;
+    int rc = replay_config_ok(o);
+    if (rc != 0) {
+        return rc;
+    }
     if (qnav_replay_log(o->replay_path, &o->cfg.ctrl, o->cfg.controller, &o->cfg.policy, &res,
                         stdout, err, sizeof err) != 0) {
         fprintf(stderr, "navbridge: %s\n", err);
         return 2;
     }
     printf("replay: %llu scans, %llu commands compared: %llu identical, %llu differ "
-           "(not compared: %llu stops, %llu from another policy)\n",
+           "(not compared: %llu stops, %llu from another policy); %llu scans with their "
+           "logged goal distance and previous heading\n",
            (unsigned long long)res.scans, (unsigned long long)res.compared,
            (unsigned long long)res.identical, (unsigned long long)res.differ,
-           (unsigned long long)res.stops, (unsigned long long)res.other_policy);
+           (unsigned long long)res.stops, (unsigned long long)res.other_policy,
+           (unsigned long long)res.with_input);
     if (res.compared == 0) {
         fprintf(stderr, "navbridge: %s: no commands answering scans in this log\n",
                 o->replay_path);

@@ -27,23 +27,47 @@ typedef struct {
     unsigned next;
     int crc_noted;
     qnav_bridge_ctrl_t bc;
+    qnav_nav_input_t rec;    /* the last logged QNAV_NAV_INPUT */
+    int have_rec;
     qnav_replay_result_t *res;
     FILE *out;
 } replay_t;
 
-/* A logged scan: run the controller on it and keep the command until the log's own. */
+/* A logged controller input: kept for the scan that follows it. */
+static void on_input(replay_t *r, const lcm_eventlog_event_t *ev)
+{
+    if (qnav_nav_input_t_decode(ev->data, 0, ev->datalen, &r->rec) < 0) {
+        r->res->bad_events++;
+        r->have_rec = 0;
+        return;
+    }
+    r->have_rec = 1;
+}
+
+/* A logged scan: run the controller on it, with its logged input (goal distance, previous
+ * heading) when the log has one, and keep the command until the log's own. */
 static void on_scan(replay_t *r, const lcm_eventlog_event_t *ev)
 {
     qnav_scan_t scan;
+    qnav_nav_input_t rec;
     pending_t *p = &r->pend[r->next];
     if (qnav_scan_t_decode(ev->data, 0, ev->datalen, &scan) < 0) {
         r->res->bad_events++;
         return;
     }
     r->res->scans++;
+    if (r->have_rec && r->rec.scan_seq == scan.seq) {
+        rec = r->rec;
+        r->res->with_input++;
+    } else {
+        /* a log from before QNAV_NAV_INPUT: no goal distance (no escape), the previous
+         * heading from the replay's own last decision */
+        qnav_bridge_ctrl_input(&r->bc, &scan, 0u, &rec);
+    }
+    r->have_rec = 0;
     p->used = 1;
     p->seq = scan.seq;
-    qnav_bridge_ctrl_step(&r->bc, &scan, &p->cmd, NULL);
+    qnav_bridge_ctrl_step(&r->bc, &scan, &rec, &p->cmd, NULL);
     r->next = (r->next + 1u) % PENDING;
 }
 
@@ -118,7 +142,9 @@ int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg, const char 
     qnav_bridge_ctrl_init(&r.bc, cfg, controller, policy);
     while ((ev = lcm_eventlog_read_next_event(log)) != NULL) {
         events++;
-        if (strcmp(ev->channel, QNAV_CH_SCAN) == 0) {
+        if (strcmp(ev->channel, QNAV_CH_NAV_INPUT) == 0) {
+            on_input(&r, ev);
+        } else if (strcmp(ev->channel, QNAV_CH_SCAN) == 0) {
             on_scan(&r, ev);
         } else if (strcmp(ev->channel, QNAV_CH_COMMAND) == 0) {
             on_command(&r, ev);
@@ -133,4 +159,29 @@ int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg, const char 
         return -1;
     }
     return 0;
+}
+
+int qnav_replay_log_config(const char *path, uint16_t *crc)
+{
+    lcm_eventlog_t *log = lcm_eventlog_create(path, "r");
+    lcm_eventlog_event_t *ev;
+    qnav_nav_input_t rec;
+    int found = 0;
+    int seen = 0;
+    unsigned events = 0;
+    if (log == NULL) {
+        return -1;
+    }
+    while (!seen && (ev = lcm_eventlog_read_next_event(log)) != NULL) {
+        events++;
+        if (strcmp(ev->channel, QNAV_CH_NAV_INPUT) == 0 &&
+            qnav_nav_input_t_decode(ev->data, 0, ev->datalen, &rec) >= 0) {
+            seen = 1;
+            *crc = (uint16_t)rec.config_crc;
+            found = rec.config_crc >= 0; /* -1: not known to the bridge (onboard) */
+        }
+        lcm_eventlog_free_event(ev);
+    }
+    lcm_eventlog_destroy(log);
+    return events == 0 ? -1 : found; /* no events: not a log (qnav_replay_log says so) */
 }

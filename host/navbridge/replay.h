@@ -1,8 +1,10 @@
 /*
  * Replay of a recorded trial through the bridge's controller: every QNAV_SCAN event of an
  * LCM log (lcm-logger's or navbridge --log's) runs through libqnav again with the given
- * policy, and each logged QNAV_COMMAND that answered a scan is compared field by field
- * with the fresh result. Same library, same integers: a clean trial replays identically.
+ * policy, fed the goal distance and previous heading that the QNAV_NAV_INPUT before it
+ * records and carrying the escape memory from scan to scan as the bridge did, and each
+ * logged QNAV_COMMAND that answered a scan is compared field by field with the fresh
+ * result. Same library, same integers: a clean trial replays identically.
  */
 #ifndef QNAV_NAVBRIDGE_REPLAY_H
 #define QNAV_NAVBRIDGE_REPLAY_H
@@ -14,6 +16,9 @@
 
 typedef struct {
     uint64_t scans;       /* QNAV_SCAN events read */
+    uint64_t with_input;  /* of those, replayed with their logged QNAV_NAV_INPUT (goal
+                             distance and previous heading); the others (logs from before
+                             it) without a goal distance, i.e. without the escape */
     uint64_t compared;    /* logged commands matched to a scan and compared */
     uint64_t identical;   /* of those, equal in heading, speed, quality and flags */
     uint64_t differ;      /* of those, different */
@@ -34,5 +39,13 @@ typedef struct {
 int qnav_replay_log(const char *path, const qnav_ctrl_config_t *cfg, const char *controller,
                     const qnav_policy_t *policy, qnav_replay_result_t *res, FILE *out,
                     char *err, size_t errlen);
+
+/*
+ * The controller configuration the log's decisions were made with: the config_crc of its
+ * first QNAV_NAV_INPUT (qnav_bridge_config_crc) into crc. 1 found, 0 the log records none
+ * (recorded before QNAV_NAV_INPUT existed, or onboard without --robot), -1 the log cannot
+ * be opened or holds no events.
+ */
+int qnav_replay_log_config(const char *path, uint16_t *crc);
 
 #endif /* QNAV_NAVBRIDGE_REPLAY_H */

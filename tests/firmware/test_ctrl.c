@@ -1278,6 +1278,70 @@ static void test_zero_net_clamps_hidden_units(void **state)
     assert_int_equal(p.u.net.hidden, QNAV_MAX_HIDDEN);
 }
 
+/* Arrange: a fresh carry, zero input and output. */
+static void carry_fresh(qnav_ctrl_carry_t *c, qnav_ctrl_input_t *in, qnav_ctrl_output_t *out)
+{
+    memset(in, 0, sizeof *in);
+    memset(out, 0, sizeof *out);
+    qnav_ctrl_carry_reset(c);
+}
+
+/* The carry: a new destination clears the escape memory; the same one keeps it. */
+static void test_carry_clears_escape_memory_only_for_a_new_goal(void **state)
+{
+    qnav_ctrl_carry_t c;
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+    (void)state;
+    carry_fresh(&c, &in, &out);
+    qnav_ctrl_carry_input(&c, 7u, 3000u, &in);
+    out.escape.side = 1;
+    out.escape.ticks = 42u;
+    qnav_ctrl_carry_output(&c, &in, &out);
+    qnav_ctrl_carry_input(&c, 7u, 2900u, &in);
+    assert_int_equal(in.escape.side, 1);
+    assert_int_equal(in.escape.ticks, 42);
+    qnav_ctrl_carry_input(&c, 8u, 2900u, &in);
+    assert_int_equal(in.escape.side, 0);
+    assert_int_equal(in.escape.ticks, 0);
+}
+
+/* The carry: the distance saturates at 65535 mm; 0 (a bearing goal) stays 0 (no escape). */
+static void test_carry_saturates_goal_range(void **state)
+{
+    qnav_ctrl_carry_t c;
+    qnav_ctrl_input_t in;
+    (void)state;
+    memset(&in, 0, sizeof in);
+    qnav_ctrl_carry_reset(&c);
+    qnav_ctrl_carry_input(&c, 1u, 70000u, &in);
+    assert_int_equal(in.goal_range_mm, 65535);
+    qnav_ctrl_carry_input(&c, 1u, 0u, &in);
+    assert_int_equal(in.goal_range_mm, 0);
+}
+
+/* The carry: the previous heading is the last ready decision seen from the new bearing; a
+ * not-ready output leaves it as it was. */
+static void test_carry_gives_previous_heading_of_last_ready_decision(void **state)
+{
+    qnav_ctrl_carry_t c;
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+    (void)state;
+    carry_fresh(&c, &in, &out);
+    in.goal_bearing_cdeg = 1000;
+    qnav_ctrl_carry_input(&c, 1u, 0u, &in);
+    assert_int_equal(in.prev_heading_cdeg, 0);
+    out.heading_deg = 30;
+    qnav_ctrl_carry_output(&c, &in, &out);
+    out.heading_deg = -90;
+    out.flags = QNAV_FLAG_NOT_READY;
+    qnav_ctrl_carry_output(&c, &in, &out);
+    in.goal_bearing_cdeg = 500; /* the robot turned 5 deg left since */
+    qnav_ctrl_carry_input(&c, 1u, 0u, &in);
+    assert_int_equal(in.prev_heading_cdeg, 2500);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1315,6 +1379,9 @@ int main(void)
         cmocka_unit_test(test_build_table_refuses_a_table_controller),
         cmocka_unit_test(test_net_weight_walks_the_flat_order),
         cmocka_unit_test(test_zero_net_clamps_hidden_units),
+        cmocka_unit_test(test_carry_clears_escape_memory_only_for_a_new_goal),
+        cmocka_unit_test(test_carry_saturates_goal_range),
+        cmocka_unit_test(test_carry_gives_previous_heading_of_last_ready_decision),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -15,6 +15,7 @@
 #include "qnav_command_t.h"
 #include "qnav_goal_t.h"
 #include "qnav_link_status_t.h"
+#include "qnav_nav_input_t.h"
 #include "qnav_path_qualities_t.h"
 #include "qnav_pose_t.h"
 #include "qnav_scan_t.h"
@@ -62,6 +63,7 @@ DEFINE_CATCHER(qnav_command_t)
 DEFINE_CATCHER(qnav_path_qualities_t)
 DEFINE_CATCHER(qnav_pose_t)
 DEFINE_CATCHER(qnav_link_status_t)
+DEFINE_CATCHER(qnav_nav_input_t)
 
 static void test_scan_round_trips_over_memq(void **state)
 {
@@ -198,6 +200,26 @@ static void test_decoder_refuses_truncated_buffer(void **state)
     assert_int_equal(qnav_command_t_decode(buf, 0, n, &out), n);
 }
 
+static void test_nav_input_round_trips_over_memq(void **state)
+{
+    qnav_nav_input_t m;
+    (void)state;
+    memset(&m, 0, sizeof m);
+    m.utime = 1700000000123456LL;
+    m.scan_seq = 65535;
+    m.goal_id = 65535;
+    m.goal_range_mm = 65535;
+    m.prev_heading_cdeg = -17999;
+    m.config_crc = -1;
+    round_trip_qnav_nav_input_t(&m, "QNAV_NAV_INPUT");
+    assert_int_equal(got_qnav_nav_input_t.utime, m.utime);
+    assert_int_equal(got_qnav_nav_input_t.scan_seq, 65535);
+    assert_int_equal(got_qnav_nav_input_t.goal_id, 65535);
+    assert_int_equal(got_qnav_nav_input_t.goal_range_mm, 65535);
+    assert_int_equal(got_qnav_nav_input_t.prev_heading_cdeg, -17999);
+    assert_int_equal(got_qnav_nav_input_t.config_crc, -1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -207,6 +229,7 @@ int main(void)
         cmocka_unit_test(test_path_qualities_round_trip_all_360_over_memq),
         cmocka_unit_test(test_pose_round_trips_over_memq),
         cmocka_unit_test(test_link_status_round_trips_over_memq),
+        cmocka_unit_test(test_nav_input_round_trips_over_memq),
         cmocka_unit_test(test_decoder_refuses_truncated_buffer),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

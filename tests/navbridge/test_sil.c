@@ -82,47 +82,76 @@ static void destination_of(const char *sil_out, char *goal, size_t len)
     goal[n] = '\0';
 }
 
-static void replay_is_identical(const char *log)
+/* navbridge --replay log (with --robot robot unless NULL): every decision identical, and
+ * every scan replayed with its logged goal distance and previous heading. */
+static void replay_robot_is_identical(const char *log, const char *robot)
 {
     char out[320], err[320], text[2048];
-    const char *argv[] = {NAVBRIDGE_EXE, "--replay", log, NULL};
+    const char *argv[] = {NAVBRIDGE_EXE, "--replay", log, "--robot", robot, NULL};
+    unsigned long scans = 0, with_input = 0;
+    if (robot == NULL) {
+        argv[3] = NULL;
+    }
     snprintf(out, sizeof out, "%s/replay.out", g_dir);
     snprintf(err, sizeof err, "%s/replay.err", g_dir);
     assert_int_equal(run_program(argv, out, err), 0);
     assert_true(read_text(out, text, sizeof text) > 0);
     print_message("%s", text);
     assert_non_null(strstr(text, "identical, 0 differ"));
+    assert_int_equal(sscanf(text, "replay: %lu scans,", &scans), 1);
+    assert_non_null(strstr(text, "; "));
+    assert_int_equal(sscanf(strstr(text, "; "), "; %lu scans with their logged", &with_input), 1);
+    assert_int_equal(with_input, scans);
+}
+
+static void replay_is_identical(const char *log)
+{
+    replay_robot_is_identical(log, NULL);
+}
+
+/* The files of one SIL trial named tag in g_dir: the robot's and navbridge's output. */
+typedef struct {
+    char sil_out[300], sil_err[300], nb_out[300], nb_err[300];
+} trial_files_t;
+
+/* Run a SIL robot (sil) and then navbridge (nb, whose --goal-at value is goal) to the
+ * end of the episode: the robot reaches its destination (status 0), its end closes the pty
+ * and navbridge sees the hang-up and leaves with 1. */
+static void drive_trial(const char *const *sil, const char *const *nb, const char *tag,
+                        char *goal, size_t goal_len, trial_files_t *f)
+{
+    pid_t ps, pn;
+    snprintf(f->sil_out, sizeof f->sil_out, "%s/sil%s.out", g_dir, tag);
+    snprintf(f->sil_err, sizeof f->sil_err, "%s/sil%s.err", g_dir, tag);
+    snprintf(f->nb_out, sizeof f->nb_out, "%s/nb%s.out", g_dir, tag);
+    snprintf(f->nb_err, sizeof f->nb_err, "%s/nb%s.err", g_dir, tag);
+    ps = qnav_test_spawn(sil, f->sil_out, f->sil_err);
+    assert_true(ps > 0);
+    assert_int_equal(qnav_test_wait_text(f->sil_out, "link on", QNAV_TEST_WAIT_MS), 0);
+    destination_of(f->sil_out, goal, goal_len);
+    pn = qnav_test_spawn(nb, f->nb_out, f->nb_err);
+    assert_true(pn > 0);
+    assert_int_equal(qnav_test_wait_exit(ps), 0); /* 0: destination reached */
+    assert_int_equal(wait_exit_within(pn, QNAV_TEST_WAIT_MS), 1);
 }
 
 static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void **state)
 {
-    char link[300], log[300], sil_out[300], sil_err[300], nb_out[300], nb_err[300];
+    char link[300], log[300];
     char text[2048], goal[64];
     /* lockstep is about repeatability: a loaded machine may take more than 300 ms to answer */
     const char *sil[] = {SIL_EXE, "--lockstep", "--reply-ms", "3000", "--link", link, NULL};
     const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--log", log,
                         "--goal-at", goal, NULL};
-    pid_t ps, pn;
+    trial_files_t f;
     int scan, cmd, qual, status, pose;
     (void)state;
     snprintf(link, sizeof link, "%s/link", g_dir);
     snprintf(log, sizeof log, "%s/memq.lcmlog", g_dir);
-    snprintf(sil_out, sizeof sil_out, "%s/sil.out", g_dir);
-    snprintf(sil_err, sizeof sil_err, "%s/sil.err", g_dir);
-    snprintf(nb_out, sizeof nb_out, "%s/nb.out", g_dir);
-    snprintf(nb_err, sizeof nb_err, "%s/nb.err", g_dir);
-    ps = qnav_test_spawn(sil, sil_out, sil_err);
-    assert_true(ps > 0);
-    assert_int_equal(qnav_test_wait_text(sil_out, "link on", QNAV_TEST_WAIT_MS), 0);
-    destination_of(sil_out, goal, sizeof goal);
-    pn = qnav_test_spawn(nb, nb_out, nb_err);
-    assert_true(pn > 0);
-    assert_int_equal(qnav_test_wait_exit(ps), 0); /* 0: destination reached */
-    /* the robot's end closes the pty: navbridge sees the hang-up and leaves with 1 */
-    assert_int_equal(wait_exit_within(pn, QNAV_TEST_WAIT_MS), 1);
-    assert_true(read_text(nb_err, text, sizeof text) > 0);
+    drive_trial(sil, nb, "", goal, sizeof goal, &f);
+    assert_true(read_text(f.nb_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "device hung up: link lost"));
-    assert_true(read_text(sil_out, text, sizeof text) > 0);
+    assert_true(read_text(f.sil_out, text, sizeof text) > 0);
     print_message("%s", text);
     assert_non_null(strstr(text, "reached yes"));
     assert_non_null(strstr(text, " 0 ticks without a command"));
@@ -191,6 +220,51 @@ static void test_sil_pioneer3dx_is_driven_by_its_robot_and_refused_by_another(vo
     assert_int_equal(run_program(replay, nb_out, nb_err), 0);
     assert_true(read_text(nb_out, text, sizeof text) > 0);
     assert_non_null(strstr(text, "identical, 0 differ"));
+}
+
+/* One lockstep TekBot trial in the committed U-pocket world (pocket_tekbot.toml), navbridge
+ * in mode ("offboard" or "onboard") with --robot tekbot logging to log: the robot must
+ * reach its destination. */
+static void pocket_trial(const char *mode, const char *log)
+{
+    char link[300], tag[32], text[2048], goal[64];
+    const char *sil[] = {SIL_EXE, "--robot", "tekbot", "--env", POCKET_ENV, "--lockstep",
+                         "--reply-ms", "3000", "--link", link, NULL};
+    const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--log", log,
+                        "--goal-at", goal, "--robot", "tekbot", "--mode", mode, NULL};
+    trial_files_t f;
+    snprintf(link, sizeof link, "%s/link-pocket-%s", g_dir, mode);
+    snprintf(tag, sizeof tag, "-pocket-%s", mode);
+    drive_trial(sil, nb, tag, goal, sizeof goal, &f);
+    assert_true(read_text(f.sil_out, text, sizeof text) > 0);
+    print_message("%s: %s", mode, text);
+    assert_non_null(strstr(text, "reached yes"));
+}
+
+/* Issues 17 and 18: in a U-pocket facing the start, the offboard robot leaves the dead end
+ * as the onboard one does (navbridge runs the board's escape, fed the board's distance to
+ * the goal); both logs replay identically with the logged goal distance and previous
+ * heading on every scan; a replay that does not say which robot is refused. */
+static void test_sil_offboard_leaves_a_pocket_as_onboard_does_and_replays_identically(
+    void **state)
+{
+    char log[300], out[320], err[320], text[2048];
+    const char *no_robot[] = {NAVBRIDGE_EXE, "--replay", log, NULL};
+    (void)state;
+    snprintf(log, sizeof log, "%s/pocket-onboard.lcmlog", g_dir);
+    pocket_trial("onboard", log);
+    replay_robot_is_identical(log, "tekbot");
+    snprintf(log, sizeof log, "%s/pocket-offboard.lcmlog", g_dir);
+    pocket_trial("offboard", log);
+    replay_robot_is_identical(log, "tekbot");
+
+    snprintf(out, sizeof out, "%s/pocket-norobot.out", g_dir);
+    snprintf(err, sizeof err, "%s/pocket-norobot.err", g_dir);
+    assert_int_equal(run_program(no_robot, out, err), 2);
+    assert_true(read_text(err, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, "--robot NAME|FILE missing"));
+    assert_ptr_equal(strchr(text, '\n'), text + strlen(text) - 1); /* one line */
 }
 
 static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(void **state)
@@ -505,6 +579,7 @@ int main(void)
         cmocka_unit_test(test_sil_robot_reaches_destination_through_navbridge_over_memq),
         cmocka_unit_test(test_sil_pioneer3dx_is_driven_by_its_robot_and_refused_by_another),
         cmocka_unit_test(test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically),
+        cmocka_unit_test(test_sil_offboard_leaves_a_pocket_as_onboard_does_and_replays_identically),
         cmocka_unit_test(test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically),
         cmocka_unit_test(test_sil_route_of_three_waypoints_through_dense_replays_identically),
         cmocka_unit_test(test_sil_robot_keeps_an_uploaded_policy_in_its_nvm_file),

@@ -194,6 +194,38 @@ typedef struct {
     qnav_escape_t escape;     /* to pass in with the next tick's input */
 } qnav_ctrl_output_t;
 
+/*
+ * What a caller carries from one tick's decision to the next (the step keeps nothing): the
+ * escape memory of the destination it belongs to and the last decision, from which the
+ * previous heading is seen. The board core and navbridge (live and --replay) carry it
+ * alike, so an offboard robot leaves dead ends as an onboard one does. Zero (or
+ * qnav_ctrl_carry_reset) at the start.
+ */
+typedef struct {
+    qnav_escape_t escape;        /* the last output's escape memory */
+    uint16_t goal_id;            /* the destination it belongs to (0: none) */
+    qnav_deg_t last_heading_deg; /* the last decision's heading, robot frame then, degrees */
+    qnav_cdeg_t last_goal_cdeg;  /* the destination's bearing it saw, 0.01 deg */
+    uint8_t have_last;           /* a decision was made since the reset */
+} qnav_ctrl_carry_t;
+
+/* Forget everything (a new controller, or the start). */
+void qnav_ctrl_carry_reset(qnav_ctrl_carry_t *c);
+
+/*
+ * Fill in's prev_heading_cdeg, goal_range_mm and escape for a tick toward destination
+ * goal_id (a new id clears the escape memory) at bearing in->goal_bearing_cdeg (set it
+ * first) and range_mm away (0: a bearing-only goal or no distance known: no escape;
+ * beyond 65535 saturates).
+ */
+void qnav_ctrl_carry_input(qnav_ctrl_carry_t *c, uint16_t goal_id, uint32_t range_mm,
+                           qnav_ctrl_input_t *in);
+
+/* Keep what the next tick needs from this tick's input and output (a not-ready output
+ * leaves the last decision as it was). */
+void qnav_ctrl_carry_output(qnav_ctrl_carry_t *c, const qnav_ctrl_input_t *in,
+                            const qnav_ctrl_output_t *out);
+
 /* Derived, per-hidden-unit network parameters (docs/qformats.md, "network step"). */
 typedef struct {
     int32_t bias_z;    /* hidden bias, units of 2^-19 */

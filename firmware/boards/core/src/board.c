@@ -236,9 +236,6 @@ static void on_frame(qnav_board_t *bot, const qnav_link_frame_t *f, uint32_t now
     case QNAV_LINK_MSG_GOAL: {
         qnav_link_goal_t g;
         if (qnav_link_goal_unpack(f->payload, f->len, &g) == QNAV_LINK_OK) {
-            if (g.goal_id != bot->goal.goal_id) {
-                memset(&bot->escape, 0, sizeof bot->escape); /* a new destination */
-            }
             bot->goal = g;
             bot->have_goal = (uint8_t)(g.goal_id != 0u);
         }
@@ -495,22 +492,12 @@ void qnav_board_tick(qnav_board_t *bot)
     }
     in.ranges_mm = bot->ranges;
     in.goal_bearing_cdeg = goal_bearing(bot, &dist_mm);
-    /* the previous decision, seen from where the robot points now (3-input policies) */
-    in.prev_heading_cdeg = bot->have_decision ? qnav_ctrl_prev_heading(bot->decided_deg,
-                                                                       bot->decided_goal_cdeg,
-                                                                       in.goal_bearing_cdeg)
-                                              : 0;
-    /* the distance to a position goal (0 for a bearing goal: no escape) and the memory */
-    in.goal_range_mm = (qnav_mm_t)(dist_mm > 65535u ? 65535u : dist_mm);
-    in.escape = bot->escape;
+    /* the previous decision, seen from where the robot points now (3-input policies), the
+     * distance to a position goal (0 for a bearing goal: no escape) and the memory */
+    qnav_ctrl_carry_input(&bot->carry, bot->have_goal ? bot->goal.goal_id : 0u, dist_mm, &in);
 
     decide(bot, now, &in, &out);
-    bot->escape = out.escape;
-    if (!(out.flags & QNAV_FLAG_NOT_READY)) {
-        bot->decided_deg = out.heading_deg;
-        bot->decided_goal_cdeg = in.goal_bearing_cdeg;
-        bot->have_decision = 1;
-    }
+    qnav_ctrl_carry_output(&bot->carry, &in, &out);
     moving = (uint8_t)(bot->link_ok && !bot->hold_stop && bot->have_goal && bot->mode != 0u &&
                        out.speed > 0);
     if (!moving) {
@@ -520,11 +507,12 @@ void qnav_board_tick(qnav_board_t *bot)
     /* act: the drive is set every tick, to 0 whenever anything is wrong */
     bot->hal.drive(bot->hal.ctx, moving ? out.heading_deg : 0, out.speed);
 
-    /* report: scan, heartbeat (before the decision, so the bridge labels it with the
-     * current policy), pose, onboard decision */
+    /* report: heartbeat (before the decision, so the bridge labels it with the current
+     * policy), pose (before the scan, so navbridge's offboard controller has this tick's
+     * distance to the goal with the scan, as the board's own has), scan, onboard decision */
+    send_status(bot, now, moving, dist_mm);
     send_scan(bot, now, in.goal_bearing_cdeg);
     scan_seq = bot->stats.last_scan_seq;
-    send_status(bot, now, moving, dist_mm);
     if (bot->mode == QNAV_LINK_MODE_ONBOARD) {
         tel.scan_seq = scan_seq;
         tel.heading_deg = out.heading_deg;

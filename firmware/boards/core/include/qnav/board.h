@@ -135,13 +135,9 @@ typedef struct {
     qnav_link_upload_t upload;
     qnav_nav_t nav;              /* the chosen controller (cfg.controller) and its state */
     qnav_policy_t policy;        /* the policy nav was made from (if it takes one) */
-    qnav_deg_t decided_deg;      /* last decision's heading, robot frame then, degrees */
-    qnav_cdeg_t decided_goal_cdeg; /* the destination's bearing it saw: with it the previous
-                                    decision is seen from now (qnav_ctrl_prev_heading, as
-                                    navbridge and its replay compute it) */
-    uint8_t have_decision;       /* decided_deg is set */
-    qnav_escape_t escape;        /* the controller's escape memory, carried from each tick's
-                                    decision to the next; cleared with every new goal */
+    qnav_ctrl_carry_t carry;     /* the escape memory (cleared with every new goal) and the
+                                    last decision, carried from tick to tick as navbridge
+                                    and its replay carry them (qnav_ctrl_carry_input) */
     uint16_t policy_crc;
     uint8_t policy_source;       /* qnav_board_policy_source_t */
     uint8_t store_slot;          /* slot the running stored policy is in (0/1), 0xFF none */
