@@ -79,6 +79,7 @@ static void assert_same_output(const qnav_ctrl_output_t *a, const qnav_ctrl_outp
     assert_int_equal(a->escape.loop, b->escape.loop);
     assert_int_equal(a->escape.from_mm, b->escape.from_mm);
     assert_int_equal(a->escape.over_mm, b->escape.over_mm);
+    assert_int_equal(a->escape.prev_mm, b->escape.prev_mm);
 }
 
 /* a and b decide alike on SCANS scans: every output field and every path's quality. */
