@@ -252,6 +252,51 @@ static void test_a_follow_leading_away_is_given_up_early(void **state)
     walk_away(&b, 28, first, (int8_t)-first);
 }
 
+/* At 32 sectors the open hand is read over +-11 degrees of the path 90 degrees off the
+ * boundary (three sectors), as one sector does at 16: a corridor whose 90-degree sector
+ * alone sees through (a turn, a doorway) is still closed, and the side is kept. */
+static void test_the_open_hand_is_read_alike_at_32_sectors(void **state)
+{
+    enum { N32 = 32 };
+    qnav_policy_t p;
+    qnav_ctrl_t c;
+    qnav_ctrl_config_t cfg;
+    qnav_mm_t r[N32];
+    qnav_ctrl_input_t in;
+    qnav_ctrl_output_t out;
+    const unsigned step = margin_mm() / 2u;
+    unsigned t;
+    int8_t first;
+    unsigned away;
+    (void)state;
+    qnav_policy_prob_default(&p);
+    qnav_ctrl_config_default(&cfg);
+    cfg.n_sectors = N32;
+    cfg.max_range_mm = MAX_MM;
+    cfg.escape_stall_ticks = 20;
+    assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_OK);
+    memset(&in, 0, sizeof in);
+    for (t = 0; t < N32; ++t) {
+        r[t] = MAX_MM;
+    }
+    r[N32 - 1] = r[0] = r[1] = 300; /* a wall ahead, the destination behind it */
+    in.ranges_mm = r;
+    in.goal_range_mm = 3000;
+    for (t = 0; t < 21; ++t) {
+        tick(&c, &in, &out);
+    }
+    first = out.escape.side;
+    assert_int_not_equal(first, 0);
+    away = first > 0 ? N32 / 4 : 3 * N32 / 4;
+    r[away - 1] = 400; /* the open hand's sectors at 78.75 and 101.25 degrees read a wall; */
+    r[away + 1] = 400; /* the one at 90 degrees sees through */
+    for (t = 0; t < 60; ++t) { /* 30 margins farther: more than the 14 of the budget */
+        in.goal_range_mm = (qnav_mm_t)(in.goal_range_mm + step);
+        tick(&c, &in, &out);
+        assert_int_equal(out.escape.side, first);
+    }
+}
+
 /* Following a wall on the right (side +1), the destination behind it: the bearing it
  * skirts by is found from the wall itself, so the decision is the same whatever the
  * previous command was (a search from 90 degrees off the previous command swung with the
@@ -438,6 +483,7 @@ int main(void)
         cmocka_unit_test(test_a_long_follow_tries_the_other_side),
         cmocka_unit_test(test_a_follow_getting_nearer_outlasts_its_time),
         cmocka_unit_test(test_a_follow_leading_away_is_given_up_early),
+        cmocka_unit_test(test_the_open_hand_is_read_alike_at_32_sectors),
         cmocka_unit_test(test_the_follow_bearing_comes_from_the_boundary),
         cmocka_unit_test(test_round_an_island_leaves_at_its_nearest_place),
         cmocka_unit_test(test_a_new_obstacle_chooses_its_side_afresh),
