@@ -38,15 +38,13 @@ static uint32_t crc32_i16(uint32_t crc, int16_t v)
 static uint32_t shapes_check(const qnav_net_t *net, const uint8_t *rec)
 {
     uint32_t crc = 0xFFFFFFFFul;
-    uint8_t j;
+    uint16_t n = qnav_net_weight_count(net);
+    uint16_t k;
     crc = crc32_add(crc, &net->hidden, 1u);
-    for (j = 0; j < net->hidden; ++j) {
-        crc = crc32_i16(crc, net->w_theta[j]);
-        crc = crc32_i16(crc, net->w_dist[j]);
-        crc = crc32_i16(crc, net->b_hidden[j]);
-        crc = crc32_i16(crc, net->w_out[j]);
+    for (k = 0; k < n; ++k) {
+        /* read only: qnav_net_weight is the one home of the weights' order */
+        crc = crc32_i16(crc, *qnav_net_weight((qnav_net_t *)net, k));
     }
-    crc = crc32_i16(crc, net->b_out);
     crc = crc32_add(crc, rec, (uint16_t)(QNAV_SHAPES_BYTES - 4u));
     return ~crc;
 }
