@@ -99,28 +99,38 @@ static uint8_t enlarge_deg(uint32_t margin_mm, uint32_t d_mm)
 /*
  * The enlargement of one reading: the smallest whole degree g with sin g >= margin / D, D the
  * reading's own distance from the centre (range + sensor offset, at most 65535 mm), the same
- * definition as enlarge_deg(). Its level's gamma (enlarge_deg[] at init, from the level's
- * smallest range) is the largest the reading can have, so the search walks down from it: a
- * level spans up to 161 mm of range (5 m sonar, 32 levels), and at 0.7-1.2 m from a Pioneer
- * the level's floor widens each side by up to 5 degrees more than the reading does, which
- * closes gaps the robot fits through (docs/architecture.md, "The reading's own distance,
- * and braking that does not wait for a turn").
- * @par Cost: one 16 x 16 bit product per degree below the level's gamma and one more
- * (1-2 for most readings; more only within a few decimetres); products stay below 2^31 as
- * in enlarge_deg().
+ * definition as enlarge_deg(), at most its level's gamma (enlarge_deg[] at init, from the
+ * level's smallest range): a level spans up to 161 mm of range (5 m sonar, 32 levels), and
+ * at 0.7-1.2 m from a Pioneer the level's floor widens each side by up to 5 degrees more
+ * than the reading does, which closes gaps the robot fits through (docs/architecture.md,
+ * "The reading's own distance, and braking that does not wait for a turn"). The reading
+ * lies below the next level's smallest range, so its gamma is at least that level's: the
+ * answer is searched by halving between the two (none when they agree), not walked down
+ * from the top a degree at a time (sin g * D >= margin holds from the answer on).
+ * @par Cost: one 16 x 16 bit product per halving, ceil(log2(spread + 1)) for the spread of
+ * degrees between the two levels' gammas: 0 or 1 beyond about a metre, 2-13 nearer and up
+ * to 45 at the nearest two levels (32 levels, 2.5-5 m sonars, margins of 170-400 mm),
+ * so at most 6 products where the walk took up to spread + 1; they stay below 2^31 as in
+ * enlarge_deg(). level < QNAV_DIST_LEVELS - 1.
  */
 static uint8_t reading_gamma(const qnav_clearance_t *c, qnav_mm_t range_mm, uint8_t level)
 {
-    uint8_t g = c->enlarge_deg[level];
+    uint8_t hi = c->enlarge_deg[level];
+    uint8_t lo = c->enlarge_deg[level + 1u];
     uint32_t need = (uint32_t)c->margin_mm << 15;
     uint16_t d = (uint16_t)(range_mm + c->sensor_offset_mm); /* 16 x 16 bit products below */
     if (d < range_mm) {
         d = 65535u; /* the sum passed 65535 */
     }
-    while (g > 0u && (uint32_t)QNAV_FLASH_READ_U16(&sin_deg_q15[g - 1u]) * (uint32_t)d >= need) {
-        --g;
+    while (lo < hi) {
+        uint8_t mid = (uint8_t)(lo + (uint8_t)((uint8_t)(hi - lo) >> 1));
+        if ((uint32_t)QNAV_FLASH_READ_U16(&sin_deg_q15[mid]) * (uint32_t)d >= need) {
+            hi = mid;
+        } else {
+            lo = (uint8_t)(mid + 1u);
+        }
     }
-    return g;
+    return hi;
 }
 
 static uint32_t isqrt32(uint32_t x)

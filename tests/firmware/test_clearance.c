@@ -2,7 +2,8 @@
  * Body-aware clearance (firmware/src/clearance.[ch]) against the computations the step made
  * before they were made faster. The references below are clearance.c's own code as it
  * stood at c6f786c, kept here so that the faster forms are checked to give the same values,
- * not merely close ones. Built for 32, 64, 2 and 23 distance levels (tests/firmware).
+ * not merely close ones; each reading's own gamma against the walk that found it at 5d57e83.
+ * Built for 32, 64, 2 and 23 distance levels (tests/firmware).
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -95,6 +96,56 @@ static qnav_q1_15_t ref_speed_cap(const qnav_ctrl_config_t *cfg, uint8_t level)
     d = ref_floor(cfg->max_range_mm, level) + cfg->sensor_offset_mm;
     d = d > 65535u ? 65535u : d;
     return ref_stop_speed(d > margin ? d - margin : 0u, cfg->v_max_mm_s, cfg->decel_mm_s2);
+}
+
+
+/* ---- reference: each reading's own gamma as the step walked it down at 5d57e83 ---------- */
+
+/* clearance.c's sin(g degrees) in units of 2^-15, g = 0..90. */
+static const uint16_t ref_sin_q15[91] = {
+    0, 572, 1144, 1715, 2286, 2856, 3425, 3993, 4560, 5126, 5690, 6252,
+    6813, 7371, 7927, 8481, 9032, 9580, 10126, 10668, 11207, 11743, 12275, 12803,
+    13328, 13848, 14365, 14876, 15384, 15886, 16384, 16877, 17364, 17847, 18324, 18795,
+    19261, 19720, 20174, 20622, 21063, 21498, 21926, 22348, 22763, 23170, 23571, 23965,
+    24351, 24730, 25102, 25466, 25822, 26170, 26510, 26842, 27166, 27482, 27789, 28088,
+    28378, 28660, 28932, 29197, 29452, 29698, 29935, 30163, 30382, 30592, 30792, 30983,
+    31164, 31336, 31499, 31651, 31795, 31928, 32052, 32166, 32270, 32365, 32449, 32524,
+    32588, 32643, 32688, 32723, 32748, 32763, 32767,
+};
+
+/* enlarge_deg(): the smallest whole degree g with sin(g) >= margin / d. */
+static uint8_t ref_enlarge(uint32_t margin_mm, uint32_t d_mm)
+{
+    if (margin_mm == 0u) {
+        return 0;
+    }
+    if (d_mm <= margin_mm) {
+        return 90;
+    }
+    for (uint8_t g = 0; g < 90u; ++g) {
+        if ((uint32_t)ref_sin_q15[g] * d_mm >= margin_mm * 32768u) {
+            return g;
+        }
+    }
+    return 90;
+}
+
+/* reading_gamma(): from the gamma of the reading's level's smallest range, down a degree
+ * at a time while the reading's own distance still allows it. */
+static uint8_t ref_reading_gamma(const qnav_ctrl_config_t *cfg, qnav_mm_t range_mm)
+{
+    uint32_t margin = (uint32_t)cfg->body_radius_mm + cfg->safety_mm;
+    uint32_t floor_d = ref_floor(cfg->max_range_mm, ref_level(cfg->max_range_mm, range_mm)) +
+                       cfg->sensor_offset_mm;
+    uint32_t d = (uint32_t)range_mm + cfg->sensor_offset_mm;
+    uint8_t g;
+    margin = margin > 65535u ? 65535u : margin;
+    g = ref_enlarge(margin, floor_d > 65535u ? 65535u : floor_d);
+    d = d > 65535u ? 65535u : d;
+    while (g > 0u && (uint32_t)ref_sin_q15[g - 1u] * d >= (margin << 15)) {
+        --g;
+    }
+    return g;
 }
 
 /* ---- tests ------------------------------------------------------------------------------ */
@@ -196,11 +247,62 @@ static void test_speed_cap_equals_the_computation_for_every_level(void **state)
     assert_true(between > 100u);
 }
 
+
+/* Each reading's gamma, read off the painted arc of a lone reading at 360 sectors (2 gamma + 1
+ * paths), equals the old walk down from its level's gamma, for every range below the maximum
+ * of sonars short and long, bodies from none to a metre and sensor offsets. */
+static void test_reading_gamma_equals_the_walk_for_every_range(void **state)
+{
+    (void)state;
+    static const qnav_mm_t max_mm[] = {40, 300, 1000, 2500, 5000, 12345};
+    static const uint16_t body_mm[] = {0, 40, 120, 170, 400, 1000};
+    static const qnav_mm_t offset_mm[] = {0, 120, 300};
+    static qnav_mm_t ranges[QNAV_MAX_SECTORS];
+    uint8_t lvl[QNAV_PATHS];
+    for (unsigned m = 0; m < sizeof max_mm / sizeof max_mm[0]; ++m) {
+        for (unsigned b = 0; b < sizeof body_mm / sizeof body_mm[0]; ++b) {
+            for (unsigned o = 0; o < sizeof offset_mm / sizeof offset_mm[0]; ++o) {
+                qnav_ctrl_config_t cfg;
+                qnav_clearance_t c;
+                qnav_ctrl_config_default(&cfg);
+                cfg.n_sectors = QNAV_MAX_SECTORS;
+                cfg.max_range_mm = max_mm[m];
+                cfg.body_radius_mm = body_mm[b];
+                cfg.safety_mm = (uint16_t)(body_mm[b] / 4u);
+                cfg.sensor_offset_mm = offset_mm[o];
+                assert_int_equal(qnav_clearance_setup(&c, &cfg), QNAV_OK);
+                for (uint16_t i = 0; i < QNAV_MAX_SECTORS; ++i) {
+                    ranges[i] = cfg.max_range_mm;
+                }
+                for (uint32_t r = 0; r < cfg.max_range_mm; ++r) {
+                    unsigned painted = 0;
+                    unsigned want = 0;
+                    ranges[0] = (qnav_mm_t)r;
+                    qnav_clearance_levels(&c, ranges, lvl);
+                    for (uint16_t p = 0; p < QNAV_PATHS; ++p) {
+                        painted += lvl[p] != QNAV_DIST_LEVELS - 1u;
+                    }
+                    if (ref_level(cfg.max_range_mm, r) != QNAV_DIST_LEVELS - 1u) {
+                        want = 2u * ref_reading_gamma(&cfg, (qnav_mm_t)r) + 1u;
+                    }
+                    if (painted != want) {
+                        fail_msg("max %u mm, margin %u mm, offset %u mm, range %u mm: %u paths "
+                                 "painted, the walk gives %u", (unsigned)cfg.max_range_mm,
+                                 (unsigned)(body_mm[b] + body_mm[b] / 4u),
+                                 (unsigned)offset_mm[o], (unsigned)r, painted, want);
+                    }
+                }
+            }
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_level_of_equals_the_formula_for_every_range),
         cmocka_unit_test(test_speed_cap_equals_the_computation_for_every_level),
+        cmocka_unit_test(test_reading_gamma_equals_the_walk_for_every_range),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
