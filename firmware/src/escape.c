@@ -26,6 +26,9 @@
 #define QNAV_ESCAPE_SKIRT_STEP 3u
 /* Nearer the boundary than half the follow level: this many degrees more away per level. */
 #define QNAV_ESCAPE_AWAY_DEG 10
+/* The leave rule's clear way is the shortest reading within this many degrees of the
+ * destination's bearing (rest_mm). */
+#define QNAV_ESCAPE_LEAVE_HALF_DEG 11
 
 qnav_status_t qnav_escape_setup(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
 {
@@ -113,15 +116,28 @@ static int8_t choose_side(const qnav_clearance_t *c, const uint8_t *lvl, uint16_
 }
 
 /* How near the destination (range_mm away) the clear way toward it ends: range less how
- * far the robot's centre can go toward it before its margin reaches the reading of the
- * sector that looks that way (0: the destination is in plain view). The whole sector's
- * reading, not the path's painted level: with readings placed on the central part of their
- * wedge (wedge_pct) the paths between sector centres are left clear at long range. */
+ * far the robot's centre can go toward it before its margin reaches the shortest reading
+ * of the sectors that look within QNAV_ESCAPE_LEAVE_HALF_DEG of it (0: the destination is
+ * in plain view). The sectors' readings, not the paths' painted levels: with readings placed
+ * on the central part of their wedge (wedge_pct) the paths between sector centres are left
+ * clear at long range. The shortest of the sectors near the bearing, not the one sector
+ * under it: a bearing that wobbles across a sector boundary (a noisy compass) must not see
+ * a longer clear way on one tick than is there, or the leave rule fires and the robot
+ * drives back into the pocket it is leaving (docs/architecture.md, "Leaving"). */
 static uint16_t rest_mm(const qnav_clearance_t *c, const qnav_ctrl_input_t *in, uint16_t goal,
                         uint16_t range_mm)
 {
-    uint32_t r = in->ranges_mm[qnav_ctrl_sector_of_path(c->n_sectors, goal)];
+    uint16_t s = qnav_ctrl_sector_of_path(c->n_sectors,
+                                          wrap((int16_t)(goal - QNAV_ESCAPE_LEAVE_HALF_DEG)));
+    uint16_t last = qnav_ctrl_sector_of_path(c->n_sectors,
+                                             wrap((int16_t)(goal + QNAV_ESCAPE_LEAVE_HALF_DEG)));
+    uint32_t r = in->ranges_mm[last];
     uint32_t clear_mm;
+    for (; s != last; s = (uint16_t)(s + 1u == c->n_sectors ? 0u : s + 1u)) {
+        if (in->ranges_mm[s] < r) {
+            r = in->ranges_mm[s];
+        }
+    }
     r = (r < c->max_range_mm ? r : c->max_range_mm) + c->sensor_offset_mm;
     clear_mm = r > c->margin_mm ? r - c->margin_mm : 0u;
     return (uint16_t)(range_mm > clear_mm ? range_mm - clear_mm : 0u);

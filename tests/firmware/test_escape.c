@@ -128,6 +128,37 @@ static void test_follows_after_a_stall_and_leaves_when_nearer(void **state)
     assert_true(b.out.heading_deg <= 5 && b.out.heading_deg >= -5);
 }
 
+/* The leave rule reads the clear way toward the destination from every sector within 11
+ * degrees of its bearing, not only the one under it: a bearing 22 degrees off (sector 1's,
+ * half a degree from sector 0's) does not see past a wall that sector 0 still reads as
+ * near as at the hit point, however open sector 1 is. A compass whose noise carries the
+ * bearing across a sector boundary must not make the robot leave on one tick and drive back
+ * into the pocket it is leaving (docs/architecture.md, "Leaving"). */
+static void test_the_leave_rule_reads_the_sectors_near_the_bearing(void **state)
+{
+    (void)state;
+    bot_t b;
+    qnav_policy_prob_default(&b.p);
+    facing_wall(&b, 20, 2000, 5000);
+    for (unsigned t = 0; t < 21; ++t) {
+        tick(&b.c, &b.in, &b.out);
+    }
+    assert_int_not_equal(b.out.escape.side, 0);
+    assert_int_equal(b.out.escape.hit_mm, 5000 - free_mm(2000));
+    /* sector 1 open to the sonar's range: on its own it would end the clear way 500 mm
+     * nearer than at the hit; sector 0, 11 degrees off the bearing, still reads the wall */
+    b.in.goal_bearing_cdeg = 2200;
+    b.r[1] = MAX_MM;
+    for (unsigned t = 0; t < 5; ++t) {
+        tick(&b.c, &b.in, &b.out);
+        assert_int_not_equal(b.out.escape.side, 0);
+    }
+    /* the wall gone from sector 0 too: the way is clear, the robot leaves */
+    b.r[0] = MAX_MM;
+    tick(&b.c, &b.in, &b.out);
+    assert_int_equal(b.out.escape.side, 0);
+}
+
 /* Progress resets the stall count: a robot that keeps getting nearer never follows. */
 static void test_progress_never_follows(void **state)
 {
@@ -479,6 +510,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_follows_after_a_stall_and_leaves_when_nearer),
+        cmocka_unit_test(test_the_leave_rule_reads_the_sectors_near_the_bearing),
         cmocka_unit_test(test_progress_never_follows),
         cmocka_unit_test(test_a_long_follow_tries_the_other_side),
         cmocka_unit_test(test_a_follow_getting_nearer_outlasts_its_time),
