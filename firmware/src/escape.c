@@ -27,7 +27,7 @@
 /* Nearer the boundary than half the follow level: this many degrees more away per level. */
 #define QNAV_ESCAPE_AWAY_DEG 10
 /* The leave rule's clear way is the shortest reading within this many degrees of the
- * destination's bearing (rest_mm). */
+ * destination's bearing (way_opened). */
 #define QNAV_ESCAPE_LEAVE_HALF_DEG 11
 
 qnav_status_t qnav_escape_setup(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
@@ -117,20 +117,15 @@ static int8_t choose_side(const qnav_clearance_t *c, const uint8_t *lvl, uint16_
 
 /* How near the destination (range_mm away) the clear way toward it ends: range less how
  * far the robot's centre can go toward it before its margin reaches the shortest reading
- * of the sectors that look within QNAV_ESCAPE_LEAVE_HALF_DEG of it (0: the destination is
- * in plain view). The sectors' readings, not the paths' painted levels: with readings placed
- * on the central part of their wedge (wedge_pct) the paths between sector centres are left
- * clear at long range. The shortest of the sectors near the bearing, not the one sector
- * under it: a bearing that wobbles across a sector boundary (a noisy compass) must not see
- * a longer clear way on one tick than is there, or the leave rule fires and the robot
- * drives back into the pocket it is leaving (docs/architecture.md, "Leaving"). */
+ * of the sectors that look within half_deg of it (0: the one sector under the bearing;
+ * the result 0: the destination is in plain view). The sectors' readings, not the paths'
+ * painted levels: with readings placed on the central part of their wedge (wedge_pct) the
+ * paths between sector centres are left clear at long range. */
 static uint16_t rest_mm(const qnav_clearance_t *c, const qnav_ctrl_input_t *in, uint16_t goal,
-                        uint16_t range_mm)
+                        uint16_t range_mm, int16_t half_deg)
 {
-    uint16_t s = qnav_ctrl_sector_of_path(c->n_sectors,
-                                          wrap((int16_t)(goal - QNAV_ESCAPE_LEAVE_HALF_DEG)));
-    uint16_t last = qnav_ctrl_sector_of_path(c->n_sectors,
-                                             wrap((int16_t)(goal + QNAV_ESCAPE_LEAVE_HALF_DEG)));
+    uint16_t s = qnav_ctrl_sector_of_path(c->n_sectors, wrap((int16_t)((int16_t)goal - half_deg)));
+    uint16_t last = qnav_ctrl_sector_of_path(c->n_sectors, wrap((int16_t)((int16_t)goal + half_deg)));
     uint32_t r = in->ranges_mm[last];
     uint32_t clear_mm;
     for (; s != last; s = (uint16_t)(s + 1u == c->n_sectors ? 0u : s + 1u)) {
@@ -156,6 +151,23 @@ static uint16_t follow_limit(const qnav_clearance_t *c, uint8_t tries)
 static uint16_t progress_mm(const qnav_clearance_t *c)
 {
     return (uint16_t)(c->margin_mm / 2u);
+}
+
+/* DistBug's leave rule (Kamon & Rivlin 1997): the clear way toward the destination ends
+ * nearer to it, by a step, than it did at the hit point. Read over the sectors within
+ * QNAV_ESCAPE_LEAVE_HALF_DEG of the bearing, not only the one under it: a bearing that
+ * wobbles across a sector boundary (a noisy compass) must not see a longer way on one tick
+ * than is there, or the robot leaves and drives back into the pocket it is leaving. The one
+ * sector under the bearing still leaves when it sees far past the hit (by
+ * QNAV_ESCAPE_NEW_MARGINS margins, more than a neighbour's wall can fake): the end of a bar
+ * seen past its corner (docs/architecture.md, "Leaving"). */
+static uint8_t way_opened(const qnav_clearance_t *c, const qnav_ctrl_input_t *in,
+                          const qnav_escape_t *e, uint16_t goal, uint16_t range)
+{
+    return (uint8_t)((uint32_t)rest_mm(c, in, goal, range, QNAV_ESCAPE_LEAVE_HALF_DEG) +
+                             progress_mm(c) <= e->hit_mm ||
+                     (uint32_t)rest_mm(c, in, goal, range, 0) +
+                             QNAV_ESCAPE_NEW_MARGINS * c->margin_mm <= e->hit_mm);
 }
 
 void qnav_escape_clear(qnav_escape_t *e)
@@ -316,10 +328,8 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
         return goal;
     }
     if (e->side != 0) {
-        /* DistBug's leave rule (Kamon & Rivlin 1997): leave when the clear way toward the
-         * destination ends nearer to it, by a step, than it did at the hit point */
         uint8_t round = gone_round(c, e, range, goal);
-        if (round != 0u || ((uint32_t)rest_mm(c, in, goal, range) + progress <= e->hit_mm &&
+        if (round != 0u || (way_opened(c, in, e, goal, range) != 0u &&
                             !blocked(c, lvl, (int16_t)goal))) {
             if (round != 0u) {
                 e->last_side = 0; /* gone round an island: the next stall chooses afresh */
@@ -356,7 +366,7 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
     }
     e->stall_mm = e->best_mm;
     start_follow(e, e->last_side != 0 ? e->last_side : choose_side(c, lvl, goal), range);
-    e->hit_mm = rest_mm(c, in, goal, e->best_mm);
+    e->hit_mm = rest_mm(c, in, goal, e->best_mm, QNAV_ESCAPE_LEAVE_HALF_DEG);
     return skirt(c, lvl, e->side);
 }
 

@@ -159,6 +159,36 @@ static void test_the_leave_rule_reads_the_sectors_near_the_bearing(void **state)
     assert_int_equal(b.out.escape.side, 0);
 }
 
+/* The one sector under the bearing still leaves when it sees far past the hit point, by
+ * four margins (r + d_s), more than a neighbour's wall can fake, though a neighbour within
+ * 11 degrees reads nearer: the way past the end of a bar, seen beside its corner. */
+static void test_the_sector_under_the_bearing_leaves_when_it_sees_far(void **state)
+{
+    (void)state;
+    bot_t b;
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_config_default(&cfg);
+    const unsigned margin = cfg.body_radius_mm + cfg.safety_mm;
+    const unsigned hit = 5000 - free_mm(2000);
+    qnav_policy_prob_default(&b.p);
+    facing_wall(&b, 20, 2000, 5000);
+    for (unsigned t = 0; t < 21; ++t) {
+        tick(&b.c, &b.in, &b.out);
+    }
+    assert_int_not_equal(b.out.escape.side, 0);
+    b.in.goal_bearing_cdeg = 2200;
+    b.r[0] = 1500; /* the bar's corner, 11 degrees off the bearing: the near way is shut */
+    b.r[1] = MAX_MM;
+    /* sector 1 sees the clear way end 4 margins less 1 mm short of the hit's: following */
+    b.in.goal_range_mm = (qnav_mm_t)(hit - 4u * margin + free_mm(MAX_MM) + 1u);
+    tick(&b.c, &b.in, &b.out);
+    assert_int_not_equal(b.out.escape.side, 0);
+    /* 4 margins: it leaves */
+    b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm - 1u);
+    tick(&b.c, &b.in, &b.out);
+    assert_int_equal(b.out.escape.side, 0);
+}
+
 /* Progress resets the stall count: a robot that keeps getting nearer never follows. */
 static void test_progress_never_follows(void **state)
 {
@@ -511,6 +541,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_follows_after_a_stall_and_leaves_when_nearer),
         cmocka_unit_test(test_the_leave_rule_reads_the_sectors_near_the_bearing),
+        cmocka_unit_test(test_the_sector_under_the_bearing_leaves_when_it_sees_far),
         cmocka_unit_test(test_progress_never_follows),
         cmocka_unit_test(test_a_long_follow_tries_the_other_side),
         cmocka_unit_test(test_a_follow_getting_nearer_outlasts_its_time),
