@@ -178,10 +178,13 @@ static qnav_q1_15_t stop_speed(uint32_t s_mm, uint32_t v_max_mm_s, uint32_t dece
 }
 
 /* The clearance (mm) a path at level leaves for stopping: the nearest its obstacle can be,
- * less the robot's radius and safety distance. */
+ * less the robot's radius and safety distance. A sonar reads its minimum range for
+ * anything that near or nearer, so a level that holds that range may hide an obstacle at
+ * the transducers: its floor would promise room the robot may not have (the Pioneer's
+ * 0.1 m reads at level 1, floor 81 mm, and crept into walls at 0.14 m/s). */
 static uint32_t stop_room_mm(const qnav_clearance_t *c, uint8_t level)
 {
-    uint32_t d = level_distance_mm(c, level);
+    uint32_t d = level <= c->guard_min_level ? c->sensor_offset_mm : level_distance_mm(c, level);
     return d > c->margin_mm ? d - c->margin_mm : 0u;
 }
 
@@ -202,6 +205,7 @@ void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
     c->sensor_offset_mm = cfg->sensor_offset_mm;
     c->v_max_mm_s = cfg->v_max_mm_s;
     c->decel_mm_s2 = cfg->decel_mm_s2;
+    c->guard_min_level = qnav_clearance_level_of(c, cfg->range_min_mm);
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
         c->enlarge_deg[level] = enlarge_deg(margin, level_distance_mm(c, level));
     }
@@ -219,8 +223,8 @@ void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
 
 /* The cap is 0 below guard_from_level and full speed from guard_full_level on (both found
  * at init from the cap itself), so only the levels between compute it: a binary search, a
- * square root and two divisions, for one level on the TekBot's profile (2), six on the
- * Pioneer's. A table of every level's cap would be 62 bytes of RAM. */
+ * square root and two divisions, for one level on the TekBot's profile (2), five on the
+ * Pioneer's (2-6; level 1 holds its sonar's minimum range). A table of every level's cap would be 62 bytes of RAM. */
 qnav_q1_15_t qnav_clearance_speed_cap(const qnav_clearance_t *c, uint8_t level)
 {
     if (level >= c->guard_full_level) {
@@ -244,7 +248,7 @@ qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t
     if (cfg->n_sectors < 1u || cfg->n_sectors > QNAV_MAX_SECTORS) {
         return QNAV_E_SECTORS;
     }
-    if (cfg->max_range_mm == 0u) {
+    if (cfg->max_range_mm == 0u || cfg->range_min_mm >= cfg->max_range_mm) {
         return QNAV_E_RANGE;
     }
     c->n_sectors = cfg->n_sectors;

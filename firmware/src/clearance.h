@@ -26,9 +26,10 @@ void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg);
 
 /* The speed guard's cap for a path at level: the largest speed (Q1.15 of v_max) that stops
  * within the level's clearance after one reaction tick (QNAV_Q1_15_MAX without a guard or
- * at the farthest level), the same as computing it for every step. @par Cost: two
+ * at the farthest level; a level that holds the sonar's minimum range counts as an
+ * obstacle at the transducers, since the sonar reads that range for anything nearer), the same as computing it for every step. @par Cost: two
  * compares for levels whose cap is 0 or full speed; for the levels between them (found at
- * init: one on the TekBot's profile, six on the Pioneer's) a binary search over ranges, a
+ * init: one on the TekBot's profile, five on the Pioneer's) a binary search over ranges, a
  * square root and two divisions, about 2 000 cycles on the ATmega128. */
 qnav_q1_15_t qnav_clearance_speed_cap(const qnav_clearance_t *c, uint8_t level);
 

@@ -35,6 +35,7 @@ void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg)
     cfg->escape_follow_mm = 500u;
     cfg->escape_follow_s = 20u;
     cfg->keep_pct = 0u;
+    cfg->range_min_mm = 0u;
 }
 
 void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg)
@@ -579,7 +580,7 @@ const char *qnav_status_str(qnav_status_t status)
     case QNAV_E_SECTORS:
         return "n_sectors outside 1..QNAV_MAX_SECTORS";
     case QNAV_E_RANGE:
-        return "max_range_mm is 0";
+        return "max_range_mm is 0, or range_min_mm not below it";
     case QNAV_E_SPEED:
         return "full_speed_quality outside (0, 1)";
     case QNAV_E_POLICY_KIND:

@@ -19,6 +19,7 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->body_radius_mm = to_mm(p.radius_m);
     cfg->safety_mm = to_mm(p.safety_m);
     cfg->sensor_offset_mm = to_mm(p.sonar_offset_m);
+    cfg->range_min_mm = to_mm(p.range_min_m);
     cfg->v_max_mm_s = to_mm(p.v_max_mps);
     cfg->decel_mm_s2 = p.speed_guard ? to_mm(p.decel_mps2) : 0;
     cfg->wedge_pct = p.wedge_pct;

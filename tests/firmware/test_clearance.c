@@ -84,16 +84,19 @@ static qnav_q1_15_t ref_stop_speed(uint32_t s_mm, uint32_t v_max_mm_s, uint32_t 
     return (qnav_q1_15_t)((v * 32768u) / v_max_mm_s);
 }
 
-/* qnav_clearance_speed_cap() with qnav_clearance_init()'s fields spelt out from cfg. */
+/* qnav_clearance_speed_cap() with qnav_clearance_init()'s fields spelt out from cfg; since
+ * range_min_mm, a level whose floor is at or below the sonar's minimum range (the sonar
+ * reads that range for anything nearer) is taken as range 0. */
 static qnav_q1_15_t ref_speed_cap(const qnav_ctrl_config_t *cfg, uint8_t level)
 {
     uint32_t margin = (uint32_t)cfg->body_radius_mm + cfg->safety_mm;
+    uint32_t floor_mm = ref_floor(cfg->max_range_mm, level);
     uint32_t d;
     margin = margin > 65535u ? 65535u : margin;
     if (cfg->v_max_mm_s == 0u || cfg->decel_mm_s2 == 0u || level >= QNAV_DIST_LEVELS - 1u) {
         return QNAV_Q1_15_MAX;
     }
-    d = ref_floor(cfg->max_range_mm, level) + cfg->sensor_offset_mm;
+    d = (floor_mm <= cfg->range_min_mm ? 0u : floor_mm) + cfg->sensor_offset_mm;
     d = d > 65535u ? 65535u : d;
     return ref_stop_speed(d > margin ? d - margin : 0u, cfg->v_max_mm_s, cfg->decel_mm_s2);
 }
@@ -199,19 +202,25 @@ static const qnav_mm_t guard_offsets_mm[] = {0, 120, 65535};
 static const qnav_mm_t guard_radii_mm[][2] = {{0, 0}, {120, 50}, {260, 50}, {65535, 65535}};
 static const uint16_t guard_v_max_mm_s[] = {0, 1, 500, 1000, 65535};
 static const uint16_t guard_decel_mm_s2[] = {0, 1, 9, 100, 600, 2000, 65535};
+static const qnav_mm_t guard_range_min_mm[] = {0, 30, 100, 4999};
 
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
 
 static void check_caps(const qnav_ctrl_config_t *cfg, unsigned *between)
 {
     qnav_clearance_t c;
+    if (cfg->range_min_mm >= cfg->max_range_mm) {
+        assert_int_equal(qnav_clearance_setup(&c, cfg), QNAV_E_RANGE);
+        return;
+    }
     assert_int_equal(qnav_clearance_setup(&c, cfg), QNAV_OK);
     for (uint8_t level = 0; level < QNAV_DIST_LEVELS; ++level) {
         qnav_q1_15_t want = ref_speed_cap(cfg, level);
         qnav_q1_15_t got = qnav_clearance_speed_cap(&c, level);
         if (got != want) {
-            fail_msg("range %u offset %u radius %u safety %u v_max %u decel %u level %u: cap "
-                     "%d, computed %d", (unsigned)cfg->max_range_mm,
+            fail_msg("range %u min %u offset %u radius %u safety %u v_max %u decel %u level "
+                     "%u: cap %d, computed %d", (unsigned)cfg->max_range_mm,
+                     (unsigned)cfg->range_min_mm,
                      (unsigned)cfg->sensor_offset_mm, (unsigned)cfg->body_radius_mm,
                      (unsigned)cfg->safety_mm, (unsigned)cfg->v_max_mm_s,
                      (unsigned)cfg->decel_mm_s2, (unsigned)level, got, want);
@@ -231,13 +240,16 @@ static void test_speed_cap_equals_the_computation_for_every_level(void **state)
             for (size_t k = 0; k < COUNT(guard_radii_mm); ++k) {
                 for (size_t v = 0; v < COUNT(guard_v_max_mm_s); ++v) {
                     for (size_t a = 0; a < COUNT(guard_decel_mm_s2); ++a) {
-                        cfg.max_range_mm = guard_ranges_mm[i];
-                        cfg.sensor_offset_mm = guard_offsets_mm[j];
-                        cfg.body_radius_mm = guard_radii_mm[k][0];
-                        cfg.safety_mm = guard_radii_mm[k][1];
-                        cfg.v_max_mm_s = guard_v_max_mm_s[v];
-                        cfg.decel_mm_s2 = guard_decel_mm_s2[a];
-                        check_caps(&cfg, &between);
+                        for (size_t m = 0; m < COUNT(guard_range_min_mm); ++m) {
+                            cfg.max_range_mm = guard_ranges_mm[i];
+                            cfg.sensor_offset_mm = guard_offsets_mm[j];
+                            cfg.body_radius_mm = guard_radii_mm[k][0];
+                            cfg.safety_mm = guard_radii_mm[k][1];
+                            cfg.v_max_mm_s = guard_v_max_mm_s[v];
+                            cfg.decel_mm_s2 = guard_decel_mm_s2[a];
+                            cfg.range_min_mm = guard_range_min_mm[m];
+                            check_caps(&cfg, &between);
+                        }
                     }
                 }
             }
@@ -247,6 +259,38 @@ static void test_speed_cap_equals_the_computation_for_every_level(void **state)
     assert_true(between > 100u);
 }
 
+/* A sonar reads its minimum range for anything that near or nearer: with the Pioneer's
+ * figures (0.1 m, distance level 1 of a 5 m sonar, levels 161 mm wide) the level that
+ * holds it caps the speed at 0, where its floor (81 mm) alone left 0.141 m/s to creep
+ * into a wall; the next level's cap is its floor's, as without a minimum range. */
+static void test_speed_cap_is_zero_at_the_level_of_the_minimum_range(void **state)
+{
+    (void)state;
+    qnav_ctrl_config_t cfg;
+    qnav_clearance_t with_min;
+    qnav_clearance_t without;
+    uint8_t level;
+    qnav_ctrl_config_default(&cfg);
+    cfg.max_range_mm = 5000u;
+    cfg.body_radius_mm = 260u;
+    cfg.safety_mm = 50u;
+    cfg.sensor_offset_mm = 260u;
+    cfg.v_max_mm_s = 1000u;
+    cfg.decel_mm_s2 = 600u;
+    assert_int_equal(qnav_clearance_setup(&without, &cfg), QNAV_OK);
+    cfg.range_min_mm = 100u;
+    assert_int_equal(qnav_clearance_setup(&with_min, &cfg), QNAV_OK);
+    level = qnav_clearance_level_of(&with_min, cfg.range_min_mm);
+    if (QNAV_DIST_LEVELS == 32u) { /* other level counts: the floor alone may give 0 already */
+        assert_int_equal(level, 1);
+        assert_int_equal(qnav_clearance_speed_cap(&without, level), 4620); /* 0.141 m/s */
+    }
+    assert_int_equal(qnav_clearance_speed_cap(&with_min, level), 0);
+    if (level + 1u < QNAV_DIST_LEVELS) {
+        assert_int_equal(qnav_clearance_speed_cap(&with_min, (uint8_t)(level + 1u)),
+                         qnav_clearance_speed_cap(&without, (uint8_t)(level + 1u)));
+    }
+}
 
 /* Each reading's gamma, read off the painted arc of a lone reading at 360 sectors (2 gamma + 1
  * paths), equals the old walk down from its level's gamma, for every range below the maximum
@@ -302,6 +346,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_level_of_equals_the_formula_for_every_range),
         cmocka_unit_test(test_speed_cap_equals_the_computation_for_every_level),
+        cmocka_unit_test(test_speed_cap_is_zero_at_the_level_of_the_minimum_range),
         cmocka_unit_test(test_reading_gamma_equals_the_walk_for_every_range),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

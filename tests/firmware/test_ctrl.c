@@ -89,6 +89,11 @@ static void test_init_rejects_bad_configuration(void **state)
     qnav_ctrl_config_default(&cfg);
     cfg.max_range_mm = 0;
     assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_E_RANGE);
+    cfg.max_range_mm = 5000;
+    cfg.range_min_mm = 5000; /* the minimum range must lie below the maximum */
+    assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_E_RANGE);
+    cfg.range_min_mm = 4999;
+    assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_OK);
 
     qnav_ctrl_config_default(&cfg);
     cfg.full_speed_quality = 0;

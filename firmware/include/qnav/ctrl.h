@@ -30,7 +30,7 @@ typedef enum {
     QNAV_OK = 0,
     QNAV_E_NULL = -1,         /* a required pointer was null */
     QNAV_E_SECTORS = -2,      /* n_sectors outside 1..QNAV_MAX_SECTORS */
-    QNAV_E_RANGE = -3,        /* max_range_mm is 0 */
+    QNAV_E_RANGE = -3,        /* max_range_mm is 0, or range_min_mm not below it */
     QNAV_E_SPEED = -4,        /* full_speed_quality outside (0, 1) */
     QNAV_E_POLICY_KIND = -5,  /* policy kind unknown */
     QNAV_E_HIDDEN = -6,       /* hidden units outside 1..QNAV_MAX_HIDDEN */
@@ -127,6 +127,12 @@ typedef struct {
                                          "Holding the heading"). Applies when keys are
                                          qualities (QNAV_RANK_QUALITY: the probabilistic
                                          policy, its tables); 0..100, default 0 (off) */
+    qnav_mm_t range_min_mm;           /* sonar minimum range, mm, below max_range_mm: the
+                                         sonar reads this for anything this near or nearer,
+                                         so the speed guard takes a distance level that
+                                         holds it as an obstacle at the transducers (no
+                                         room to stop: cap 0 whenever sensor_offset_mm <=
+                                         body_radius_mm + safety_mm). Default 0 */
 } qnav_ctrl_config_t;
 
 /* The escape memory: what the robot remembers between ticks to leave dead ends
@@ -251,6 +257,8 @@ typedef struct {
     uint8_t level_scale_hi;           /* 0 unless max_range_mm < QNAV_DIST_LEVELS */
     uint8_t guard_from_level;         /* speed guard: levels below cap the speed at 0 */
     uint8_t guard_full_level;         /* speed guard: levels from here on leave it uncapped */
+    uint8_t guard_min_level;          /* speed guard: levels up to this one hold the sonar's
+                                         minimum range and are taken as range 0 */
     uint8_t esc_stall_ticks;          /* escape: ticks without progress; 0: off */
     uint8_t esc_free_level;           /* escape: lowest level of a free path */
     uint16_t esc_follow_ticks;        /* escape: first follow's length, ticks */

@@ -88,6 +88,7 @@ typedef struct {
     X(13, escape_follow_mm, ctrl.escape_follow_mm)                                          \
     X(14, escape_follow_s, ctrl.escape_follow_s)                                            \
     X(15, keep_pct, ctrl.keep_pct)                                                          \
+    X(16, range_min_mm, ctrl.range_min_mm)                                                  \
     X(32, tick_ms, tick_ms)                                                                 \
     X(33, track_mm, track_mm)                                                               \
     X(34, um_per_count, um_per_count)

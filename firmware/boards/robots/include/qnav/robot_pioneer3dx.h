@@ -34,6 +34,7 @@
         .ctrl.escape_follow_mm = 800, \
         .ctrl.escape_follow_s = 20, \
         .ctrl.keep_pct = 25, \
+        .ctrl.range_min_mm = 100, \
         .tick_ms = 100, \
         .track_mm = 330, \
         .um_per_count = 485, \

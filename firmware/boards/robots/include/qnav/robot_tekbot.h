@@ -34,6 +34,7 @@
         .ctrl.escape_follow_mm = 500, \
         .ctrl.escape_follow_s = 20, \
         .ctrl.keep_pct = 15, \
+        .ctrl.range_min_mm = 30, \
         .tick_ms = 100, \
         .track_mm = 180, \
         .um_per_count = 6872, \
