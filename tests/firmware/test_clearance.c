@@ -10,6 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
+#include <math.h>
 
 #include "clearance.h"
 #include "qnav/ctrl.h"
@@ -104,17 +105,14 @@ static qnav_q1_15_t ref_speed_cap(const qnav_ctrl_config_t *cfg, uint8_t level)
 
 /* ---- reference: each reading's own gamma as the step walked it down at 5d57e83 ---------- */
 
-/* clearance.c's sin(g degrees) in units of 2^-15, g = 0..90. */
-static const uint16_t ref_sin_q15[91] = {
-    0, 572, 1144, 1715, 2286, 2856, 3425, 3993, 4560, 5126, 5690, 6252,
-    6813, 7371, 7927, 8481, 9032, 9580, 10126, 10668, 11207, 11743, 12275, 12803,
-    13328, 13848, 14365, 14876, 15384, 15886, 16384, 16877, 17364, 17847, 18324, 18795,
-    19261, 19720, 20174, 20622, 21063, 21498, 21926, 22348, 22763, 23170, 23571, 23965,
-    24351, 24730, 25102, 25466, 25822, 26170, 26510, 26842, 27166, 27482, 27789, 28088,
-    28378, 28660, 28932, 29197, 29452, 29698, 29935, 30163, 30382, 30592, 30792, 30983,
-    31164, 31336, 31499, 31651, 31795, 31928, 32052, 32166, 32270, 32365, 32449, 32524,
-    32588, 32643, 32688, 32723, 32748, 32763, 32767,
-};
+/* sin(g degrees) in units of 2^-15, g = 0..90, rounded and capped at 32767 as clearance.c's
+ * table is said to be made: computed here from libm, not copied, so that the reference
+ * checks the table too. */
+static uint16_t ref_sin_q15(unsigned g)
+{
+    double v = floor(sin((double)g * 3.14159265358979323846 / 180.0) * 32768.0 + 0.5);
+    return (uint16_t)(v > 32767.0 ? 32767.0 : v);
+}
 
 /* enlarge_deg(): the smallest whole degree g with sin(g) >= margin / d. */
 static uint8_t ref_enlarge(uint32_t margin_mm, uint32_t d_mm)
@@ -126,7 +124,7 @@ static uint8_t ref_enlarge(uint32_t margin_mm, uint32_t d_mm)
         return 90;
     }
     for (uint8_t g = 0; g < 90u; ++g) {
-        if ((uint32_t)ref_sin_q15[g] * d_mm >= margin_mm * 32768u) {
+        if ((uint32_t)ref_sin_q15(g) * d_mm >= margin_mm * 32768u) {
             return g;
         }
     }
@@ -145,7 +143,7 @@ static uint8_t ref_reading_gamma(const qnav_ctrl_config_t *cfg, qnav_mm_t range_
     margin = margin > 65535u ? 65535u : margin;
     g = ref_enlarge(margin, floor_d > 65535u ? 65535u : floor_d);
     d = d > 65535u ? 65535u : d;
-    while (g > 0u && (uint32_t)ref_sin_q15[g - 1u] * d >= (margin << 15)) {
+    while (g > 0u && (uint32_t)ref_sin_q15(g - 1u) * d >= (margin << 15)) {
         --g;
     }
     return g;
