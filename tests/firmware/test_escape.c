@@ -63,17 +63,23 @@ static void tick(const qnav_ctrl_t *c, qnav_ctrl_input_t *in, qnav_ctrl_output_t
     in->prev_heading_cdeg = (qnav_cdeg_t)(out->heading_deg * 100);
 }
 
-/* A controller of the default probabilistic policy facing a wall 300 mm ahead, the
- * destination 3000 mm away beyond it, ticked until it has stalled and follows the wall. */
-static void following_a_wall(bot_t *b)
+/* A controller of the default probabilistic policy facing a wall near_mm ahead, the
+ * destination range_mm away beyond it, ticked until it has stalled and follows the wall. */
+static void following_a_wall_at(bot_t *b, qnav_mm_t near_mm, qnav_mm_t range_mm)
 {
     unsigned t;
     qnav_policy_prob_default(&b->p);
-    facing_wall(b, 20, 300, 3000);
+    facing_wall(b, 20, near_mm, range_mm);
     for (t = 0; t < 21; ++t) {
         tick(&b->c, &b->in, &b->out);
     }
     assert_int_not_equal(b->out.escape.side, 0);
+}
+
+/* The same, the wall 300 mm ahead and the destination 3000 mm away. */
+static void following_a_wall(bot_t *b)
+{
+    following_a_wall_at(b, 300, 3000);
 }
 
 /* How far the robot's centre can go toward a reading near_mm away (the controller's
@@ -138,12 +144,7 @@ static void test_the_leave_rule_reads_the_sectors_near_the_bearing(void **state)
 {
     (void)state;
     bot_t b;
-    qnav_policy_prob_default(&b.p);
-    facing_wall(&b, 20, 2000, 5000);
-    for (unsigned t = 0; t < 21; ++t) {
-        tick(&b.c, &b.in, &b.out);
-    }
-    assert_int_not_equal(b.out.escape.side, 0);
+    following_a_wall_at(&b, 2000, 5000);
     assert_int_equal(b.out.escape.hit_mm, 5000 - free_mm(2000));
     /* sector 1 open to the sonar's range: on its own it would end the clear way 500 mm
      * nearer than at the hit; sector 0, 11 degrees off the bearing, still reads the wall */
@@ -170,12 +171,7 @@ static void test_the_sector_under_the_bearing_leaves_when_it_sees_far(void **sta
     qnav_ctrl_config_default(&cfg);
     const unsigned margin = cfg.body_radius_mm + cfg.safety_mm;
     const unsigned hit = 5000 - free_mm(2000);
-    qnav_policy_prob_default(&b.p);
-    facing_wall(&b, 20, 2000, 5000);
-    for (unsigned t = 0; t < 21; ++t) {
-        tick(&b.c, &b.in, &b.out);
-    }
-    assert_int_not_equal(b.out.escape.side, 0);
+    following_a_wall_at(&b, 2000, 5000);
     b.in.goal_bearing_cdeg = 2200;
     b.r[0] = 1500; /* the bar's corner, 11 degrees off the bearing: the near way is shut */
     b.r[1] = MAX_MM;
