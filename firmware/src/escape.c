@@ -339,7 +339,9 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
             e->hit_mm = range; /* where this follow ended: a stall far nearer is a new obstacle */
             e->best_mm = range;
             e->ticks = 0u;
-            e->tries = 0u;
+            if (round != 0u) {
+                e->tries = 0u;
+            } /* else the tries are kept until the next stall: a side given up stays given up */
             return goal;
         }
         if (time_up(c, e, range) != 0u || led_away(c, in, e, range) != 0u) {
@@ -359,10 +361,19 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
         return goal;
     }
     if (e->stall_mm != 0u && (uint32_t)e->best_mm + progress > e->stall_mm && e->last_side != 0) {
-        e->last_side = (int8_t)-e->last_side; /* no nearer than when the last follow began:
-                                                 it led back here, go the other way round */
-    } else if ((uint32_t)e->best_mm + QNAV_ESCAPE_NEW_MARGINS * c->margin_mm < e->hit_mm) {
-        e->last_side = 0; /* far nearer than where the last follow ended: another obstacle */
+        /* no nearer than when the last follow began: it led back here, go the other way
+         * round; unless the last follow already was the other way, after the first side was
+         * given up (tries): then the first side is known to lead away and this one, left
+         * early (a leave on a noisy reading, docs/architecture.md "Leaving"), goes on, for
+         * as long as its try allows */
+        if (e->tries == 0u) {
+            e->last_side = (int8_t)-e->last_side;
+        }
+    } else {
+        if ((uint32_t)e->best_mm + QNAV_ESCAPE_NEW_MARGINS * c->margin_mm < e->hit_mm) {
+            e->last_side = 0; /* far nearer than where the last follow ended: another obstacle */
+        }
+        e->tries = 0u;
     }
     e->stall_mm = e->best_mm;
     start_follow(e, e->last_side != 0 ? e->last_side : choose_side(c, lvl, goal), range);

@@ -234,6 +234,34 @@ static void test_a_long_follow_tries_the_other_side(void **state)
     assert_int_equal(b.out.escape.side, first);
 }
 
+/* A side given up stays given up: after the first side's try, the other side is left
+ * early (a way seen open for a tick) and the robot stalls again no nearer; it goes on
+ * round the other side, with that try's length, instead of going back the side it gave
+ * up (the rule for a follow that led back to its wall). */
+static void test_a_side_given_up_is_not_taken_again(void **state)
+{
+    (void)state;
+    bot_t b;
+    int8_t first;
+    unsigned t;
+    following_a_wall(&b);
+    first = b.out.escape.side;
+    for (t = 0; t < 220; ++t) {
+        tick(&b.c, &b.in, &b.out);
+    }
+    assert_int_equal(b.out.escape.side, -first);
+    assert_int_equal(b.out.escape.tries, 1);
+    wall_ahead(b.r, MAX_MM); /* the way opens for a tick */
+    tick(&b.c, &b.in, &b.out);
+    assert_int_equal(b.out.escape.side, 0);
+    wall_ahead(b.r, 300); /* and closes: the same wall, no nearer */
+    for (t = 0; t < 21; ++t) {
+        tick(&b.c, &b.in, &b.out);
+    }
+    assert_int_equal(b.out.escape.side, -first);
+    assert_int_equal(b.out.escape.tries, 1);
+}
+
 /* Past its time, a follow that still gets nearer to the destination (round the far end of
  * a long wall) goes on; once it stops getting nearer, it is given up a stall time later. */
 static void test_a_follow_getting_nearer_outlasts_its_time(void **state)
@@ -540,6 +568,7 @@ int main(void)
         cmocka_unit_test(test_the_sector_under_the_bearing_leaves_when_it_sees_far),
         cmocka_unit_test(test_progress_never_follows),
         cmocka_unit_test(test_a_long_follow_tries_the_other_side),
+        cmocka_unit_test(test_a_side_given_up_is_not_taken_again),
         cmocka_unit_test(test_a_follow_getting_nearer_outlasts_its_time),
         cmocka_unit_test(test_a_follow_leading_away_is_given_up_early),
         cmocka_unit_test(test_the_open_hand_is_read_alike_at_32_sectors),
