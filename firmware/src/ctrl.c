@@ -380,17 +380,26 @@ void qnav_ctrl_stop(qnav_ctrl_output_t *out, uint8_t flags, qnav_q1_15_t *qualit
     }
 }
 
+/* Table mode: every run, read where its row's shape leaves anything to read. Out of line
+ * on AVR: inlined, its run and registers sit in the step's frame under the network's
+ * evaluation too, the deepest call path (11 bytes). */
+QNAV_AVR_NOINLINE static void table_paths_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it,
+                                               qnav_best_t *best, qnav_qkey_t *keys)
+{
+    qnav_run_t r;
+    while (qnav_run_next(it, &r)) {
+        if (keys != 0 || qnav_run_reduce(ctrl->p.net.in.row, &r, best, it) != QNAV_RUN_DONE) {
+            eval_table_run(ctrl, &r, best, keys);
+        }
+    }
+}
+
 /* Every path: table mode through its runs, a policy through its kind's evaluation. */
 static void paths_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best,
                        qnav_qkey_t *keys)
 {
-    qnav_run_t r;
     if (qnav_table_of(ctrl) != 0) {
-        while (qnav_run_next(it, &r)) {
-            if (keys != 0 || qnav_run_reduce(ctrl->p.net.in.row, &r, best, it) != QNAV_RUN_DONE) {
-                eval_table_run(ctrl, &r, best, keys);
-            }
-        }
+        table_paths_best(ctrl, it, best, keys);
         return;
     }
     switch ((qnav_policy_kind_t)ctrl->kind) {

@@ -21,6 +21,15 @@
  * (implementation-defined in C99; true on gcc, avr-gcc and arm-none-eabi-gcc). */
 typedef char qnav_arith_shift_check[((-8 >> 1) == -4) ? 1 : -1];
 
+/* Out of line on the ATmega128: inlined, a helper's registers and spills join its caller's
+ * frame, which the step's deepest call path stacks on its 360-byte level array (4 KB of
+ * RAM; docs/performance.md, "Controller RAM"). Elsewhere the compiler decides. */
+#if defined(__AVR__)
+#define QNAV_AVR_NOINLINE __attribute__((noinline))
+#else
+#define QNAV_AVR_NOINLINE
+#endif
+
 static inline int16_t qnav_sat16(int32_t v)
 {
     if (v > 32767) {
