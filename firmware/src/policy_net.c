@@ -116,7 +116,7 @@ static inline int32_t unit_base(const qnav_ctrl_unit_t *u, uint8_t level)
 static inline int32_t path_acc_prev(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta,
                              uint8_t dprev)
 {
-    int32_t acc = ctrl->out_bias_z;
+    int32_t acc = ctrl->p.net.out_bias_z;
     uint8_t j;
     QNAV_COUNT_EVALS(ctrl, ctrl->hidden);
     for (j = 0; j < ctrl->hidden; ++j) {
@@ -131,7 +131,7 @@ static inline int32_t path_acc_prev(const qnav_ctrl_t *ctrl, uint8_t level, uint
 /* The key of one 2-input path (inline: the step calls it without a frame of its own). */
 static inline qnav_qkey_t key_of_path(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
 {
-    int32_t acc = ctrl->out_bias_z;
+    int32_t acc = ctrl->p.net.out_bias_z;
     uint8_t j;
     QNAV_COUNT_EVALS(ctrl, ctrl->hidden);
     /* dprev = 0: the third input's term is 0 */
@@ -178,7 +178,7 @@ static void eval_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *
         uint8_t j;
         QNAV_COUNT_EVALS(ctrl, (uint16_t)n * ctrl->hidden);
         for (k = 0; k < n; ++k) {
-            acc[k] = ctrl->out_bias_z;
+            acc[k] = ctrl->p.net.out_bias_z;
         }
         for (j = 0; j < ctrl->hidden; ++j) {
             const qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
@@ -274,7 +274,7 @@ void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net)
                 div_round((int32_t)net->w_prev[j] * 2048, QNAV_DTHETA_MAX);
         }
     }
-    ctrl->out_bias_z = (int32_t)net->b_out * 128;
+    ctrl->p.net.out_bias_z = (int32_t)net->b_out * 128;
 }
 
 /* Do unit u's shares rise along run r (dtheta moving by r->dir per path)? A unit whose
@@ -380,7 +380,7 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
     }
     two_sums(ctrl, r, n.lo, n.hi, &n.s_lo, &n.s_hi);
     for (;;) {
-        qnav_qkey_t bound = step_key_of(ctrl, ctrl->out_bias_z + n.s_lo + n.s_hi);
+        qnav_qkey_t bound = step_key_of(ctrl, ctrl->p.net.out_bias_z + n.s_lo + n.s_hi);
         uint8_t d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + n.lo : r->dtheta0 - n.hi);
         if (may_win(best, bound, d_near)) {
             /* halves lo..mid and mid + 1..hi: the left keeps n.s_lo, the right n.s_hi */
@@ -390,8 +390,8 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
             qnav_qkey_t k_left;
             qnav_qkey_t k_right;
             two_sums(ctrl, r, (uint8_t)(mid + 1u), mid, &right_lo, &left_hi);
-            k_left = step_key_of(ctrl, ctrl->out_bias_z + n.s_lo + left_hi);
-            k_right = step_key_of(ctrl, ctrl->out_bias_z + right_lo + n.s_hi);
+            k_left = step_key_of(ctrl, ctrl->p.net.out_bias_z + n.s_lo + left_hi);
+            k_right = step_key_of(ctrl, ctrl->p.net.out_bias_z + right_lo + n.s_hi);
             /* the more promising half first (on equal bounds, the one nearer the goal); the
              * other waits */
             if (k_left > k_right || (k_left == k_right && r->dir > 0)) {
