@@ -26,7 +26,8 @@ typedef char qnav_arith_shift_check[((-8 >> 1) == -4) ? 1 : -1];
 
 /* Out of line on the ATmega128: inlined, a helper's registers and spills join its caller's
  * frame, which the step's deepest call path stacks on its 360-byte level array (4 KB of
- * RAM; docs/performance.md, "Controller RAM"). Elsewhere the compiler decides. */
+ * RAM; docs/performance.md, "Issue 19: controller RAM within 1 KB"). Elsewhere the
+ * compiler decides. */
 #if defined(__AVR__)
 #define QNAV_AVR_NOINLINE __attribute__((noinline))
 #else
