@@ -81,11 +81,11 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     q_full = (uint32_t)cfg->full_speed_quality;
     ctrl->full_speed_quality = cfg->full_speed_quality;
     ctrl->speed_scale = ((uint32_t)32768u * 32768u + q_full / 2u) / q_full;
-    ctrl->table = 0;
-    ctrl->kind = 0u;
+    ctrl->kind = QNAV_CTRL_KIND_TABLE; /* until a policy's init sets its kind */
+    ctrl->p.net.table = 0;
     ctrl->hidden = 0u;
     ctrl->inputs = 0u;
-    ctrl->out_bias_z = 0;
+    ctrl->p.net.out_bias_z = 0;
     ctrl->rank = cfg->rank;
     ctrl->keep_pct = cfg->keep_pct;
     ctrl->shapes_carried = 0u;
@@ -169,7 +169,7 @@ static void table_shapes(qnav_ctrl_t *ctrl)
     uint16_t level;
     uint16_t d;
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
-        const qnav_qkey_t *row = &ctrl->table[level * QNAV_TABLE_STRIDE];
+        const qnav_qkey_t *row = &ctrl->p.net.table[level * QNAV_TABLE_STRIDE];
         qnav_row_scan_t sc;
         qnav_row_shape_start(&sc, &ctrl->p.net.in.row[level], QNAV_FLASH_READ_I16(&row[0]));
         for (d = 1; d <= QNAV_DTHETA_MAX; ++d) {
@@ -194,10 +194,10 @@ qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *
     if (!QNAV_WITH_TABLE) {
         return QNAV_E_KIND_DISABLED;
     }
-    ctrl->table = table;
+    ctrl->p.net.table = table;
     ctrl->rank = (uint8_t)rank;
     table_shapes(ctrl);
-    ctrl->kind = 0u;
+    ctrl->kind = QNAV_CTRL_KIND_TABLE;
     ctrl->magic = QNAV_CTRL_MAGIC;
     return QNAV_OK;
 }
@@ -315,7 +315,8 @@ uint16_t qnav_ctrl_sector_of_path(uint16_t n_sectors, uint16_t path_deg)
 static void eval_table_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *best,
                            qnav_qkey_t *keys)
 {
-    const qnav_qkey_t *p = &ctrl->table[(uint16_t)r->level * QNAV_TABLE_STRIDE + r->dtheta0];
+    const qnav_qkey_t *p =
+        &ctrl->p.net.table[(uint16_t)r->level * QNAV_TABLE_STRIDE + r->dtheta0];
     qnav_qkey_t top = QNAV_KEY_NONE;
     uint8_t top_k = 0;
     uint8_t k;
@@ -380,17 +381,26 @@ void qnav_ctrl_stop(qnav_ctrl_output_t *out, uint8_t flags, qnav_q1_15_t *qualit
     }
 }
 
+/* Table mode: every run, read where its row's shape leaves anything to read. Out of line
+ * on AVR: inlined, its run and registers sit in the step's frame under the network's
+ * evaluation too, the deepest call path (11 bytes). */
+QNAV_AVR_NOINLINE static void table_paths_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it,
+                                               qnav_best_t *best, qnav_qkey_t *keys)
+{
+    qnav_run_t r;
+    while (qnav_run_next(it, &r)) {
+        if (keys != 0 || qnav_run_reduce(ctrl->p.net.in.row, &r, best, it) != QNAV_RUN_DONE) {
+            eval_table_run(ctrl, &r, best, keys);
+        }
+    }
+}
+
 /* Every path: table mode through its runs, a policy through its kind's evaluation. */
 static void paths_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best,
                        qnav_qkey_t *keys)
 {
-    qnav_run_t r;
     if (qnav_table_of(ctrl) != 0) {
-        while (qnav_run_next(it, &r)) {
-            if (keys != 0 || qnav_run_reduce(ctrl->p.net.in.row, &r, best, it) != QNAV_RUN_DONE) {
-                eval_table_run(ctrl, &r, best, keys);
-            }
-        }
+        table_paths_best(ctrl, it, best, keys);
         return;
     }
     switch ((qnav_policy_kind_t)ctrl->kind) {

@@ -13,6 +13,9 @@
 
 #define QNAV_CTRL_MAGIC 0x514Eu
 
+/* qnav_ctrl_t.kind of a controller in table mode (policy kinds start at 1). */
+#define QNAV_CTRL_KIND_TABLE 0u
+
 #define QNAV_TABLE_STRIDE (QNAV_DTHETA_MAX + 1)
 /* No key: below every key a policy gives (keys are -32767..32767). */
 #define QNAV_KEY_NONE (-32767 - 1)
@@ -20,6 +23,16 @@
 /* The network arithmetic shifts signed values right and relies on it being arithmetic
  * (implementation-defined in C99; true on gcc, avr-gcc and arm-none-eabi-gcc). */
 typedef char qnav_arith_shift_check[((-8 >> 1) == -4) ? 1 : -1];
+
+/* Out of line on the ATmega128: inlined, a helper's registers and spills join its caller's
+ * frame, which the step's deepest call path stacks on its 360-byte level array (4 KB of
+ * RAM; docs/performance.md, "Issue 19: controller RAM within 1 KB"). Elsewhere the
+ * compiler decides. */
+#if defined(__AVR__)
+#define QNAV_AVR_NOINLINE __attribute__((noinline))
+#else
+#define QNAV_AVR_NOINLINE
+#endif
 
 static inline int16_t qnav_sat16(int32_t v)
 {
@@ -65,12 +78,13 @@ static inline qnav_qkey_t qnav_preact_key(int32_t acc)
  * expand to Q5.11 (saturating at +-16) and take the sigmoid. */
 qnav_q1_15_t qnav_preact_key_quality(qnav_qkey_t key);
 
-/* The controller's compiled table, or null. Without table mode (QNAV_WITH_TABLE 0) never
- * one, so the compiler leaves the table's paths out of the step. */
+/* The controller's compiled table, or null. The pointer shares the union with the
+ * probabilistic tables, so only table mode's kind reads it. Without table mode
+ * (QNAV_WITH_TABLE 0) never one, so the compiler leaves the table's paths out of the step. */
 static inline const qnav_qkey_t *qnav_table_of(const qnav_ctrl_t *ctrl)
 {
 #if QNAV_WITH_TABLE
-    return ctrl->table;
+    return ctrl->kind == QNAV_CTRL_KIND_TABLE ? ctrl->p.net.table : 0;
 #else
     (void)ctrl;
     return 0;

@@ -57,8 +57,8 @@ qnav_status_t qnav_ctrl_shapes_save(const qnav_ctrl_t *ctrl, const qnav_policy_t
     if (ctrl == 0 || policy == 0 || out == 0) {
         return QNAV_E_NULL;
     }
-    if (ctrl->magic != QNAV_CTRL_MAGIC || ctrl->table != 0 ||
-        ctrl->kind != (uint8_t)QNAV_POLICY_NET || ctrl->inputs != QNAV_NET_INPUTS_PAPER ||
+    if (ctrl->magic != QNAV_CTRL_MAGIC || ctrl->kind != (uint8_t)QNAV_POLICY_NET ||
+        ctrl->inputs != QNAV_NET_INPUTS_PAPER ||
         policy->kind != (uint8_t)QNAV_POLICY_NET ||
         policy->u.net.inputs != QNAV_NET_INPUTS_PAPER || policy->u.net.hidden != ctrl->hidden) {
         return QNAV_E_NO_TABLE;

@@ -69,6 +69,16 @@ static inline qnav_qkey_t net_key_of(const qnav_ctrl_t *ctrl, int32_t acc)
     return ctrl->rank == (uint8_t)QNAV_RANK_PREACT ? qnav_preact_key(acc) : net_output(acc);
 }
 
+/* net_key_of for the step's searches and single paths (key_of_path, search_run's bounds,
+ * 3 inputs). Out of line on AVR: inlined at each of its dozen uses there, its 32-bit
+ * companding cost qnav_net_eval_paths 13 bytes of spills, on the step's deepest call path,
+ * and no cycles were saved (the step is 0.2-0.7 % faster with the call). eval_run, one
+ * key per path after H units, keeps it inline. */
+QNAV_AVR_NOINLINE static qnav_qkey_t step_key_of(const qnav_ctrl_t *ctrl, int32_t acc)
+{
+    return net_key_of(ctrl, acc);
+}
+
 /* a * b for a small unsigned b (the low 32 bits, which is the product: |a * b| < 2^31
  * wherever it is used). avr-gcc would call its 32 x 32 bit __mulsi3 (about 70 cycles):
  * four 8 x 8 bit MULs do it in 16; the shared vectors check it on the ATmega128. */
@@ -106,7 +116,7 @@ static inline int32_t unit_base(const qnav_ctrl_unit_t *u, uint8_t level)
 static inline int32_t path_acc_prev(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta,
                              uint8_t dprev)
 {
-    int32_t acc = ctrl->out_bias_z;
+    int32_t acc = ctrl->p.net.out_bias_z;
     uint8_t j;
     QNAV_COUNT_EVALS(ctrl, ctrl->hidden);
     for (j = 0; j < ctrl->hidden; ++j) {
@@ -121,7 +131,7 @@ static inline int32_t path_acc_prev(const qnav_ctrl_t *ctrl, uint8_t level, uint
 /* The key of one 2-input path (inline: the step calls it without a frame of its own). */
 static inline qnav_qkey_t key_of_path(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
 {
-    int32_t acc = ctrl->out_bias_z;
+    int32_t acc = ctrl->p.net.out_bias_z;
     uint8_t j;
     QNAV_COUNT_EVALS(ctrl, ctrl->hidden);
     /* dprev = 0: the third input's term is 0 */
@@ -129,7 +139,7 @@ static inline qnav_qkey_t key_of_path(const qnav_ctrl_t *ctrl, uint8_t level, ui
         const qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
         acc += unit_share(unit_base(u, level) + mul_u8(u->per_deg, dtheta), u->out);
     }
-    return net_key_of(ctrl, acc);
+    return step_key_of(ctrl, acc);
 }
 
 qnav_qkey_t qnav_net_eval_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8_t dtheta)
@@ -141,7 +151,7 @@ qnav_qkey_t qnav_net_eval_path_key(const qnav_ctrl_t *ctrl, uint8_t level, uint8
                                    uint8_t dprev)
 {
     if (ctrl->inputs == QNAV_NET_INPUTS_PREV) {
-        return net_key_of(ctrl, path_acc_prev(ctrl, level, dtheta, dprev));
+        return step_key_of(ctrl, path_acc_prev(ctrl, level, dtheta, dprev));
     }
     return qnav_net_eval_key(ctrl, level, dtheta);
 }
@@ -168,7 +178,7 @@ static void eval_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *
         uint8_t j;
         QNAV_COUNT_EVALS(ctrl, (uint16_t)n * ctrl->hidden);
         for (k = 0; k < n; ++k) {
-            acc[k] = ctrl->out_bias_z;
+            acc[k] = ctrl->p.net.out_bias_z;
         }
         for (j = 0; j < ctrl->hidden; ++j) {
             const qnav_ctrl_unit_t *u = &ctrl->p.net.unit[j];
@@ -264,7 +274,7 @@ void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net)
                 div_round((int32_t)net->w_prev[j] * 2048, QNAV_DTHETA_MAX);
         }
     }
-    ctrl->out_bias_z = (int32_t)net->b_out * 128;
+    ctrl->p.net.out_bias_z = (int32_t)net->b_out * 128;
 }
 
 /* Do unit u's shares rise along run r (dtheta moving by r->dir per path)? A unit whose
@@ -370,7 +380,7 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
     }
     two_sums(ctrl, r, n.lo, n.hi, &n.s_lo, &n.s_hi);
     for (;;) {
-        qnav_qkey_t bound = net_key_of(ctrl, ctrl->out_bias_z + n.s_lo + n.s_hi);
+        qnav_qkey_t bound = step_key_of(ctrl, ctrl->p.net.out_bias_z + n.s_lo + n.s_hi);
         uint8_t d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + n.lo : r->dtheta0 - n.hi);
         if (may_win(best, bound, d_near)) {
             /* halves lo..mid and mid + 1..hi: the left keeps n.s_lo, the right n.s_hi */
@@ -380,8 +390,8 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
             qnav_qkey_t k_left;
             qnav_qkey_t k_right;
             two_sums(ctrl, r, (uint8_t)(mid + 1u), mid, &right_lo, &left_hi);
-            k_left = net_key_of(ctrl, ctrl->out_bias_z + n.s_lo + left_hi);
-            k_right = net_key_of(ctrl, ctrl->out_bias_z + right_lo + n.s_hi);
+            k_left = step_key_of(ctrl, ctrl->p.net.out_bias_z + n.s_lo + left_hi);
+            k_right = step_key_of(ctrl, ctrl->p.net.out_bias_z + right_lo + n.s_hi);
             /* the more promising half first (on equal bounds, the one nearer the goal); the
              * other waits */
             if (k_left > k_right || (k_left == k_right && r->dir > 0)) {
@@ -513,7 +523,7 @@ static void eval_paths_prev(const qnav_ctrl_t *ctrl, const qnav_run_iter_t *it,
     uint16_t p;
     for (p = 0; p < QNAV_PATHS; ++p) {
         uint8_t dtheta = qnav_angle_dist_deg(p, it->goal);
-        qnav_qkey_t q = net_key_of(ctrl, path_acc_prev(ctrl, it->lvl[p], dtheta,
+        qnav_qkey_t q = step_key_of(ctrl, path_acc_prev(ctrl, it->lvl[p], dtheta,
                                                   qnav_angle_dist_deg(p, it->prev)));
         if (keys != 0) {
             keys[p] = q;

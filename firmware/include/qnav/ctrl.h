@@ -283,8 +283,8 @@ typedef struct {
  * are private: reach them through the functions below. */
 typedef struct {
     uint16_t magic;                   /* set by a successful init */
-    uint8_t kind;                     /* the policy's qnav_policy_kind_t (table mode: the
-                                         kind that built the table is not known, table set) */
+    uint8_t kind;                     /* the policy's qnav_policy_kind_t; table mode: 0 (the
+                                         kind that built the table is not known) */
     uint8_t hidden;
     uint8_t inputs;                   /* network inputs, 2 or 3 */
     uint8_t rank;                     /* qnav_rank_t of the keys (table: as given at init) */
@@ -293,14 +293,17 @@ typedef struct {
     qnav_clearance_t clr;             /* levels, enlargement, speed guard */
     uint32_t speed_scale;             /* speed = min(MAX, (quality * scale) >> 15) */
     qnav_q1_15_t full_speed_quality;
-    const qnav_qkey_t *table;         /* table mode: [QNAV_DIST_LEVELS][181] rank keys */
-    int32_t out_bias_z;               /* network output bias, units of 2^-15 */
+    /* One kind's data. On the ATmega128 (16 hidden units) the probabilistic tables are
+     * the largest member, so what only networks and table mode use is kept in theirs. */
     union {
         struct {
             qnav_q1_15_t goal[QNAV_DTHETA_MAX + 1]; /* P_goal by dtheta */
             qnav_q1_15_t safe[QNAV_DIST_LEVELS];    /* P_safe by distance level */
         } prob;
         struct {
+            const qnav_qkey_t *table;               /* table mode: [QNAV_DIST_LEVELS][181]
+                                                       rank keys (kind 0) */
+            int32_t out_bias_z;                     /* network output bias, units of 2^-15 */
             qnav_ctrl_unit_t unit[QNAV_MAX_HIDDEN]; /* network */
             union {
                 qnav_row_shape_t row[QNAV_DIST_LEVELS]; /* 2 inputs, and table mode */
