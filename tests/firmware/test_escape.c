@@ -208,24 +208,31 @@ static unsigned margin_mm(void)
 }
 
 /* A follow that does not get nearer is given up for the other side after escape_follow_s
- * and one stall time more (the window in which it could still have got nearer), and the
- * next try lasts twice as long. */
+ * and one stall time more (the window in which it could still have got nearer): the
+ * default robot following a wall until then. Returns the side given up. */
+static int8_t first_side_given_up(bot_t *b)
+{
+    int8_t first;
+    unsigned t;
+    following_a_wall(b);
+    first = b->out.escape.side;
+    for (t = 0; t < 219; ++t) {
+        tick(&b->c, &b->in, &b->out);
+        assert_int_equal(b->out.escape.side, first);
+    }
+    tick(&b->c, &b->in, &b->out);
+    assert_int_equal(b->out.escape.side, -first);
+    assert_int_equal(b->out.escape.tries, 1);
+    return first;
+}
+
+/* ... and the next try lasts twice as long. */
 static void test_a_long_follow_tries_the_other_side(void **state)
 {
     (void)state;
     bot_t b;
-    int8_t first;
+    int8_t first = first_side_given_up(&b);
     unsigned t;
-    following_a_wall(&b);
-    first = b.out.escape.side;
-    assert_int_not_equal(first, 0);
-    for (t = 0; t < 219; ++t) {
-        tick(&b.c, &b.in, &b.out);
-        assert_int_equal(b.out.escape.side, first);
-    }
-    tick(&b.c, &b.in, &b.out);
-    assert_int_equal(b.out.escape.side, -first);
-    assert_int_equal(b.out.escape.tries, 1);
     for (t = 0; t < 419; ++t) {
         tick(&b.c, &b.in, &b.out);
         assert_int_equal(b.out.escape.side, -first);
@@ -242,15 +249,8 @@ static void test_a_side_given_up_is_not_taken_again(void **state)
 {
     (void)state;
     bot_t b;
-    int8_t first;
+    int8_t first = first_side_given_up(&b);
     unsigned t;
-    following_a_wall(&b);
-    first = b.out.escape.side;
-    for (t = 0; t < 220; ++t) {
-        tick(&b.c, &b.in, &b.out);
-    }
-    assert_int_equal(b.out.escape.side, -first);
-    assert_int_equal(b.out.escape.tries, 1);
     wall_ahead(b.r, MAX_MM); /* the way opens for a tick */
     tick(&b.c, &b.in, &b.out);
     assert_int_equal(b.out.escape.side, 0);
