@@ -53,7 +53,8 @@ static inline int32_t unit_share(int32_t z, int16_t out)
     if (z >= (int32_t)QNAV_SIGMOID_FIRST_TOP * 256 - 128) {
         return (int32_t)out * 128 + (((int32_t)128 - out) >> 8);
     }
-    h = qnav_sigmoid_q5_11(qnav_sat16((z + 128) >> 8));
+    /* strictly between the flat ends now, so the table is read without checking them */
+    h = qnav_sigmoid_q5_11_between(qnav_sat16((z + 128) >> 8));
     return ((int32_t)out * h + 128) >> 8;
 }
 

@@ -870,20 +870,25 @@ static void check_table_mode_identical(const qnav_policy_t *p, uint16_t n)
     }
 }
 
-/* The flat ends that the network's share skips the table for are the table's. */
+/* The flat ends that the network's share and qnav_sigmoid_q5_11 skip the table for are
+ * where the stored grid points give 0 and 32767, and nothing between them is flat. */
 static void test_sigmoid_flat_ends_match_the_table(void **state)
 {
+    int16_t prev = 0;
     (void)state;
-    for (int32_t v = -32768; v <= 32767; ++v) {
-        int16_t h = qnav_sigmoid_q5_11((int16_t)v);
-        if (v <= QNAV_SIGMOID_LAST_ZERO) {
-            assert_int_equal(h, 0);
-        } else if (v >= QNAV_SIGMOID_FIRST_TOP) {
-            assert_int_equal(h, 32767);
-        }
+    assert_int_equal(qnav_sigmoid_q5_11_between(QNAV_SIGMOID_LAST_ZERO), 0);
+    assert_int_equal(qnav_sigmoid_q5_11_between(QNAV_SIGMOID_FIRST_TOP), 32767);
+    for (int32_t v = QNAV_SIGMOID_LAST_ZERO + 1; v < QNAV_SIGMOID_FIRST_TOP; ++v) {
+        int16_t h = qnav_sigmoid_q5_11_between((int16_t)v);
+        assert_true(h > 0 && h < 32767);
+        assert_true(h >= prev);
+        assert_int_equal(qnav_sigmoid_q5_11((int16_t)v), h);
+        prev = h;
     }
-    assert_true(qnav_sigmoid_q5_11(QNAV_SIGMOID_LAST_ZERO + 1) > 0);
-    assert_true(qnav_sigmoid_q5_11(QNAV_SIGMOID_FIRST_TOP - 1) < 32767);
+    assert_int_equal(qnav_sigmoid_q5_11(-32768), 0);
+    assert_int_equal(qnav_sigmoid_q5_11(QNAV_SIGMOID_LAST_ZERO), 0);
+    assert_int_equal(qnav_sigmoid_q5_11(QNAV_SIGMOID_FIRST_TOP), 32767);
+    assert_int_equal(qnav_sigmoid_q5_11(32767), 32767);
 }
 
 /* Scans with the structure real ones have (clear, one obstacle at the goal, a corridor, a

@@ -64,7 +64,7 @@
  *   QNAV_WITH_PROB     the probabilistic policy: src/policy_prob.c
  *   QNAV_WITH_TABLE    table mode, compiled key tables (qnav_ctrl_init_table, _build_table)
  *   QNAV_WITH_VFH      the VFH+ controller: src/vfh.c (the nav table's "vfh" row refuses)
- * src/sigmoid_lut.c (8 KB) is needed with QNAV_WITH_NETWORK or QNAV_WITH_TABLE: a table of
+ * src/sigmoid_lut.c (5.3 KB) is needed with QNAV_WITH_NETWORK or QNAV_WITH_TABLE: a table of
  * pre-activation keys turns its chosen key into a quality through the sigmoid.
  * The switches change no struct layout.
  */
