@@ -28,8 +28,8 @@
         .ctrl.v_max_mm_s = 1000, \
         .ctrl.decel_mm_s2 = 600, \
         .ctrl.rank = 1, \
-        .ctrl.wedge_pct = 25, \
-        .ctrl.wedge_near_mm = 500, \
+        .ctrl.wedge_pct = 10, \
+        .ctrl.wedge_near_mm = 0, \
         .ctrl.escape_stall_ticks = 40, \
         .ctrl.escape_follow_mm = 800, \
         .ctrl.escape_follow_s = 20, \
