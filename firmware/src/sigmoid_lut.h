@@ -46,7 +46,9 @@ static inline int16_t qnav_sigmoid_q5_11_between(int16_t z)
 /*
  * sigmoid(z) for any z in Q5.11 ([-16, 16)), result Q1.15 in [0, 32767]: the flat ends
  * without the table, the rest through qnav_sigmoid_q5_11_between(). The same values as an
- * interpolation over the whole grid (test_ctrl checks every z).
+ * interpolation over the whole grid: tools/gen_sigmoid_lut.py finds the flat ends on the
+ * whole grid and stores every point read between them; test_ctrl checks every z for the
+ * ends and monotony, and the shared vectors the outputs on every target.
  */
 static inline int16_t qnav_sigmoid_q5_11(int16_t z)
 {
