@@ -59,6 +59,23 @@ static uint8_t blocked(const qnav_clearance_t *c, const uint8_t *lvl, int16_t p)
     return (uint8_t)(lvl[wrap(p)] < c->esc_free_level);
 }
 
+/* The lowest level on side s's boundary half (from straight ahead round to straight
+ * behind, ends excluded), and in *at the first path that has it (left as it was when the
+ * half is all at 255). */
+static uint8_t nearest_on_side(const uint8_t *lvl, int8_t s, int16_t *at)
+{
+    uint8_t lw = 255u;
+    int16_t k;
+    for (k = 1; k < (int16_t)QNAV_DTHETA_MAX; ++k) {
+        uint8_t l = lvl[wrap((int16_t)(-s * k))];
+        if (l < lw) {
+            lw = l;
+            *at = (int16_t)(-s * k);
+        }
+    }
+    return lw;
+}
+
 /*
  * The free path that skirts the boundary on side s (+1: obstacle on the right, the robot
  * goes round it counter-clockwise; -1: mirrored). Reference: the nearest reading on that
@@ -70,16 +87,9 @@ static uint8_t blocked(const qnav_clearance_t *c, const uint8_t *lvl, int16_t p)
 static uint16_t skirt(const qnav_clearance_t *c, const uint8_t *lvl, int8_t s)
 {
     int16_t w = (int16_t)(-90 * s);
-    uint8_t lw = 255u;
+    uint8_t lw = nearest_on_side(lvl, s, &w);
     uint8_t need;
     int16_t k;
-    for (k = 1; k < (int16_t)QNAV_DTHETA_MAX; ++k) {
-        uint8_t l = lvl[wrap((int16_t)(-s * k))];
-        if (l < lw) {
-            lw = l;
-            w = (int16_t)(-s * k);
-        }
-    }
     need = (uint8_t)(lw + QNAV_ESCAPE_SKIRT_STEP);
     if (need < c->esc_free_level) {
         need = c->esc_free_level;
@@ -385,7 +395,26 @@ void qnav_escape_keep_moving(const qnav_clearance_t *c, const uint8_t *lvl,
                              const qnav_escape_t *e, uint16_t goal, qnav_ctrl_output_t *out)
 {
     qnav_q1_15_t cap;
-    if (e->side == 0 || out->speed >= QNAV_ESCAPE_CRAWL) {
+    if (e->side == 0) {
+        return;
+    }
+    if (out->speed >= QNAV_ESCAPE_CRAWL) {
+        /* the follow drives: as fast as the robot can stop within the clearance of the
+         * chosen path, of straight ahead and of the boundary (the side it turns into when
+         * the follow turns back) */
+        int16_t at = 0;
+        uint16_t path = wrap(out->heading_deg);
+        uint8_t level = nearest_on_side(lvl, e->side, &at);
+        if (lvl[path] < level) {
+            level = lvl[path];
+        }
+        if (lvl[0] < level) {
+            level = lvl[0];
+        }
+        cap = qnav_clearance_speed_cap(c, level);
+        if (out->speed < cap) {
+            out->speed = cap;
+        }
         return;
     }
     out->heading_deg = qnav_signed_deg(goal);

@@ -44,8 +44,11 @@ uint16_t qnav_escape_goal(const qnav_clearance_t *c, const uint8_t *lvl,
 /* Zero the memory (going to the destination, nothing seen yet). */
 void qnav_escape_clear(qnav_escape_t *e);
 
-/* While following a boundary, a decision that stands still becomes a crawl along the
- * boundary path goal (or a turn in place toward it when that path is not free). */
+/* While following a boundary, a decision that moves goes at least at the speed guard's cap
+ * for the lowest clearance of its path, straight ahead and the boundary's half (the
+ * policy's speed is its confidence in a way toward the destination, which a follow is not),
+ * and one that stands still becomes a crawl along the boundary path goal (or a turn in
+ * place toward it when that path is not free). */
 void qnav_escape_keep_moving(const qnav_clearance_t *c, const uint8_t *lvl,
                              const qnav_escape_t *e, uint16_t goal, qnav_ctrl_output_t *out);
 

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <cmocka.h>
 
+#include "clearance.h"
 #include "qnav/ctrl.h"
 
 #define N 16
@@ -546,6 +547,58 @@ static void test_a_policy_of_zeros_does_not_freeze(void **state)
     assert_true(moving >= 30);
 }
 
+/* While following, a decision that moves goes as fast as the robot can stop within the
+ * clearance of its path, of straight ahead and of the boundary's half (the speed guard's
+ * cap at the lowest of them): the probabilistic policy's speed is its quality, its
+ * confidence in a way toward the destination, and along a boundary that is a crawl. The
+ * boundary's half counts because a follow that turns back turns into it. */
+static void test_a_follow_goes_at_its_speed_cap(void **state)
+{
+    static const qnav_cdeg_t prev[] = {0, 9000, -4000, 17000};
+    bot_t b;
+    qnav_escape_t following;
+    qnav_ctrl_config_t cfg;
+    uint8_t lvl[QNAV_PATHS];
+    uint8_t low = 255u;
+    unsigned t;
+    (void)state;
+    following_a_wall(&b);
+    following = b.out.escape;
+    qnav_ctrl_config_default(&cfg); /* the same controller, braking slowly */
+    cfg.n_sectors = N;
+    cfg.max_range_mm = MAX_MM;
+    cfg.escape_stall_ticks = 20;
+    cfg.decel_mm_s2 = 250;
+    assert_int_equal(qnav_ctrl_init(&b.c, &cfg, &b.p), QNAV_OK);
+    for (t = 0; t < N; ++t) {
+        b.r[t] = MAX_MM;
+    }
+    b.r[N / 4 * 3 - 1] = 600; /* a wall 600 mm to the right, the destination behind it */
+    b.r[N / 4 * 3] = 600;     /* as far beyond it as the first wall left it (no leave), */
+    b.r[N / 4 * 3 + 1] = 600;
+    b.r[N - 1] = 800;         /* and a post 800 mm away 22.5 degrees right of ahead: the */
+    b.in.goal_bearing_cdeg = -9000; /* policy's own speed past it is 0.86 */
+    b.in.goal_range_mm = 3300;
+    (void)qnav_ctrl_path_levels(&b.c, b.r, lvl);
+    for (t = 1; t < QNAV_PATHS / 2u; ++t) {
+        low = lvl[QNAV_PATHS - t] < low ? lvl[QNAV_PATHS - t] : low; /* the boundary's half */
+    }
+    for (t = 0; t < sizeof prev / sizeof prev[0]; ++t) {
+        int16_t h;
+        uint16_t path;
+        uint8_t level = low < lvl[0] ? low : lvl[0];
+        b.in.escape = following;
+        b.in.prev_heading_cdeg = prev[t];
+        qnav_ctrl_step(&b.c, &b.in, &b.out, NULL);
+        assert_int_equal(b.out.escape.side, 1);
+        h = b.out.heading_deg;
+        path = (uint16_t)(h < 0 ? h + QNAV_PATHS : h);
+        level = lvl[path] < level ? lvl[path] : level;
+        assert_int_equal(b.out.speed, qnav_clearance_speed_cap(&b.c.clr, level));
+        assert_true(b.out.speed < qnav_clearance_turn_cap(&b.c.clr, lvl, path));
+    }
+}
+
 /* Without a distance to the destination (0) there is no escape, and the memory stays 0. */
 static void test_no_range_no_escape(void **state)
 {
@@ -576,6 +629,7 @@ int main(void)
         cmocka_unit_test(test_round_an_island_leaves_at_its_nearest_place),
         cmocka_unit_test(test_a_new_obstacle_chooses_its_side_afresh),
         cmocka_unit_test(test_a_policy_of_zeros_does_not_freeze),
+        cmocka_unit_test(test_a_follow_goes_at_its_speed_cap),
         cmocka_unit_test(test_no_range_no_escape),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
