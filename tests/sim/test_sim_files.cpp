@@ -156,7 +156,7 @@ static void test_profile_carries_its_tuned_probabilistic_policy(void **state) {
     qnav_sim_robot_prob_policy(robot, &p);
     assert_int_equal(p.kind, QNAV_POLICY_PROB);
     assert_int_equal(p.u.prob.k_goal, 256);
-    assert_int_equal(p.u.prob.k_safe, 512);
+    assert_int_equal(p.u.prob.k_safe, 1024);
     qnav_sim_robot_free(robot);
     /* no robot: libqnav's defaults */
     qnav_policy_t d;
