@@ -15,13 +15,19 @@
 #define N 16
 #define MAX_MM 2500
 
+/* The tests' configuration: the defaults with N sectors, MAX_MM range and the stall time. */
+static void test_config(qnav_ctrl_config_t *cfg, uint8_t stall_ticks)
+{
+    qnav_ctrl_config_default(cfg);
+    cfg->n_sectors = N;
+    cfg->max_range_mm = MAX_MM;
+    cfg->escape_stall_ticks = stall_ticks;
+}
+
 static void init_ctrl(qnav_ctrl_t *c, const qnav_policy_t *p, uint8_t stall_ticks)
 {
     qnav_ctrl_config_t cfg;
-    qnav_ctrl_config_default(&cfg);
-    cfg.n_sectors = N;
-    cfg.max_range_mm = MAX_MM;
-    cfg.escape_stall_ticks = stall_ticks;
+    test_config(&cfg, stall_ticks);
     assert_int_equal(qnav_ctrl_init(c, &cfg, p), QNAV_OK);
 }
 
@@ -90,6 +96,14 @@ static qnav_mm_t free_mm(qnav_mm_t near_mm)
     qnav_ctrl_config_t cfg;
     qnav_ctrl_config_default(&cfg);
     return (qnav_mm_t)(near_mm + cfg.sensor_offset_mm - cfg.body_radius_mm - cfg.safety_mm);
+}
+
+/* The controller's default margin (body radius and safety distance), mm. */
+static unsigned margin_mm(void)
+{
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_config_default(&cfg);
+    return (unsigned)(cfg.body_radius_mm + cfg.safety_mm);
 }
 
 /* Facing a wall with the destination behind it and no progress: the robot goes for the
@@ -168,9 +182,7 @@ static void test_the_sector_under_the_bearing_leaves_when_it_sees_far(void **sta
 {
     (void)state;
     bot_t b;
-    qnav_ctrl_config_t cfg;
-    qnav_ctrl_config_default(&cfg);
-    const unsigned margin = cfg.body_radius_mm + cfg.safety_mm;
+    const unsigned margin = margin_mm();
     const unsigned hit = 5000 - free_mm(2000);
     following_a_wall_at(&b, 2000, 5000);
     b.in.goal_bearing_cdeg = 2200;
@@ -198,14 +210,6 @@ static void test_progress_never_follows(void **state)
         assert_int_equal(b.out.escape.side, 0);
         b.in.goal_range_mm = (qnav_mm_t)(b.in.goal_range_mm - 40u); /* 0.4 m/s */
     }
-}
-
-/* The controller's default margin (body radius and safety distance), mm. */
-static unsigned margin_mm(void)
-{
-    qnav_ctrl_config_t cfg;
-    qnav_ctrl_config_default(&cfg);
-    return (unsigned)(cfg.body_radius_mm + cfg.safety_mm);
 }
 
 /* A follow that does not get nearer is given up for the other side after escape_follow_s
@@ -356,10 +360,8 @@ static void test_the_open_hand_is_read_alike_at_32_sectors(void **state)
     unsigned away;
     (void)state;
     qnav_policy_prob_default(&p);
-    qnav_ctrl_config_default(&cfg);
+    test_config(&cfg, 20);
     cfg.n_sectors = N32;
-    cfg.max_range_mm = MAX_MM;
-    cfg.escape_stall_ticks = 20;
     assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_OK);
     memset(&in, 0, sizeof in);
     for (t = 0; t < N32; ++t) {
@@ -505,11 +507,8 @@ static int8_t side_of_next_stall(qnav_mm_t end_mm, qnav_mm_t range_mm)
  * (round a room, back to the same wall): the other way round. */
 static void test_a_new_obstacle_chooses_its_side_afresh(void **state)
 {
-    qnav_ctrl_config_t cfg;
-    qnav_mm_t margin;
+    const qnav_mm_t margin = (qnav_mm_t)margin_mm();
     (void)state;
-    qnav_ctrl_config_default(&cfg);
-    margin = (qnav_mm_t)(cfg.body_radius_mm + cfg.safety_mm);
     assert_int_equal(side_of_next_stall(2500, 2450), 1);
     assert_int_equal(side_of_next_stall(2500, (qnav_mm_t)(2500 - 4 * margin + 10)), 1);
     assert_int_equal(side_of_next_stall(2500, (qnav_mm_t)(2500 - 4 * margin - 10)), -1);
@@ -564,10 +563,7 @@ static void test_a_follow_goes_at_its_speed_cap(void **state)
     (void)state;
     following_a_wall(&b);
     following = b.out.escape;
-    qnav_ctrl_config_default(&cfg); /* the same controller, braking slowly */
-    cfg.n_sectors = N;
-    cfg.max_range_mm = MAX_MM;
-    cfg.escape_stall_ticks = 20;
+    test_config(&cfg, 20); /* the same controller, braking slowly */
     cfg.decel_mm_s2 = 250;
     assert_int_equal(qnav_ctrl_init(&b.c, &cfg, &b.p), QNAV_OK);
     for (t = 0; t < N; ++t) {
