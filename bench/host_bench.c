@@ -10,7 +10,8 @@
  * qnav_bench_count_adversary over the adversarial set, bench/adversary/) it measures no
  * time: the value is the number of hidden-unit evaluations of the step
  * (qnav_ctrl_count_evals), target "count", network mode only; tools/bench-proxy sets these
- * counts beside the same steps' simavr cycles.
+ * counts beside the same steps' simavr cycles. Exit status 1 too when a step makes more
+ * evaluations than QNAV_NET_STEP_EVALS_MAX (qnav/ctrl.h), the bound by construction.
  */
 #define _POSIX_C_SOURCE 199309L
 #include <stdint.h>
@@ -32,6 +33,9 @@
 #define TARGET "count"
 #define MODES QNAV_BENCH_MODE_BIT(QNAV_BENCH_NETWORK)
 
+/* Steps that made more evaluations than the bound by construction (qnav/ctrl.h). */
+static unsigned over_bound;
+
 static uint32_t measure(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
                         qnav_ctrl_output_t *out, uint8_t mode)
 {
@@ -42,6 +46,12 @@ static uint32_t measure(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     qnav_ctrl_count_evals(c, &evals);
     qnav_ctrl_step(c, in, out, 0);
     qnav_ctrl_count_evals(c, 0);
+    if (evals > QNAV_NET_STEP_EVALS_MAX(ctrl->hidden)) {
+        printf("BOUND %lu evaluations, more than QNAV_NET_STEP_EVALS_MAX(%u) = %lu\n",
+               (unsigned long)evals, (unsigned)ctrl->hidden,
+               (unsigned long)QNAV_NET_STEP_EVALS_MAX(ctrl->hidden));
+        ++over_bound;
+    }
     return evals;
 }
 
@@ -128,5 +138,11 @@ int main(void)
         printf("MISMATCH count %u\n", (unsigned)bad);
         return 1;
     }
+#if QNAV_BENCH_COUNT
+    if (over_bound != 0u) {
+        printf("BOUND exceeded by %u steps\n", over_bound);
+        return 1;
+    }
+#endif
     return 0;
 }

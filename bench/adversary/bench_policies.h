@@ -11,31 +11,31 @@
 #define QNAV_BENCH_POLICY_COUNT 18u
 
 static const qnav_bench_policy_t qnav_bench_policies[QNAV_BENCH_POLICY_COUNT] QNAV_FLASH = {
-    /* joint search from fixture e12-o2d-xsingle-r03; 6648 evaluations on scan adversary:0 */
+    /* joint search from fixture e12-o2d-xsingle-r03; 4860 evaluations on scan adversary:0 */
     {"adv-j12-n32-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {-3298, -271, -1702, -2408, 17220, -10751, -2052, 9808, -32571, -3258, 16644, 442},
-        .w_dist = {99, -3061, 3054, 286, -7008, 17347, 612, 26795, 17781, 830, -32259, 0},
-        .b_hidden = {-390, 29, 280, 748, -20016, -24132, 608, -28684, -8451, 982, 20242, -36},
-        .w_out = {535, -1156, 399, 1082, 32330, 12013, -78, 8940, 26575, -528, 6895, 2537},
-        .b_out = -9816}}}},
-    /* joint search from random-h12-0 (clipped Cauchy weights of scale 0.3, seed 1); 6264 evaluations on scan adversary:1 */
+        .w_theta = {-783, 4560, 30679, -2923, -10972, -10751, -8594, 9808, 24255, -3112, 16644, 465},
+        .w_dist = {80, 27926, 15487, 266, -7008, 17347, -30309, 26795, 27220, 560, 1808, -286},
+        .b_hidden = {-288, 27926, 16021, 1077, -20016, -24132, -13841, 17328, -20769, 684, 20242, -119},
+        .w_out = {1186, -12492, 24705, 935, 32330, 12013, 14024, 8133, -20339, -317, -26129, 2632},
+        .b_out = 25928}}}},
+    /* joint search from fixture e12-n100-src10-r05; 4860 evaluations on scan adversary:1 */
     {"adv-j12-n32-1", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {-95, -690, 141, 33, -57, -709, -12, 90, 9, -1640, -330, -391},
-        .w_dist = {8, 33, 306, -146, -201, -22, -82, 1157, 77, -161, 10, -86},
-        .b_hidden = {-340, -22, -145, -662, -81, 49, 282, -66, 63, 55, 700, 55},
-        .w_out = {299, -54, -17, -191, 154, 11, 344, 34, -283, 13, -29, -51},
-        .b_out = -867}}}},
-    /* joint search from h12-pocket-xopen-r1 (file:policies/h12-pocket-xopen-r1.policy, open-to-pocket transfer-open run-001 at c6f786c); 6240 evaluations on scan adversary:2 */
+        .w_theta = {15174, 8558, 11894, -19687, 1592, -28917, -16731, 992, 15893, 6673, -13233, 553},
+        .w_dist = {7934, 4025, -4008, -4395, -1749, 7615, 4134, -17386, 10982, -15215, -11551, -18018},
+        .b_hidden = {10622, 6344, -20008, 27475, -6, 22834, -17216, -646, 31714, 11795, -32124, -284},
+        .w_out = {2116, 27891, -12725, -9969, 1224, -16460, 10231, 2256, 9339, -31037, 22857, -4560},
+        .b_out = -3700}}}},
+    /* joint search from fixture r12-vec; 4860 evaluations on scan adversary:2 */
     {"adv-j12-n32-2", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {17214, -2195, -532, -26769, 2390, 10049, 7659, -28874, 164, -9819, -11240, 21392},
-        .w_dist = {-26025, 995, 853, 9274, -895, 109, 32253, -12733, 2576, 8548, 28370, 12520},
-        .b_hidden = {-16518, 1833, -935, 20446, 690, -1034, -18296, -24850, -1690, 24237, -19144, 17998},
-        .w_out = {-19197, 625, 3108, -860, -2115, 284, 90, 17304, 6631, -209, -32724, -6611},
-        .b_out = 6488}}}},
-    /* scan search, the evolved policy unchanged from h12-rooms-direct-r1 (file:policies/h12-rooms-direct-r1.policy, open-to-rooms direct run-001 at c6f786c); 2688 evaluations on scan adversary:3 */
+        .w_theta = {25058, -13330, -3699, 18801, 29313, -19362, -10912, -17586, -537, -27065, 1383, 22467},
+        .w_dist = {-30656, 19181, -27355, -2976, -7903, -19842, -12522, 24677, 262, 30035, -180, -7888},
+        .b_hidden = {32736, -20119, -18254, 6446, 10029, 32272, -23173, -24442, 225, -31265, 546, -16069},
+        .w_out = {22341, 28911, 14130, 29289, -31569, -2994, -17742, 12671, 807, -18348, 916, 7030},
+        .b_out = -20692}}}},
+    /* scan search, the evolved policy unchanged from h12-rooms-direct-r1 (file:policies/h12-rooms-direct-r1.policy, open-to-rooms direct run-001 at c6f786c); 3192 evaluations on scan adversary:3 */
     {"adv-e12-n32-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
         .w_theta = {-112, 1988, -53, -979, -2027, -525, -291, -560, 502, -68, 1961, -480},
@@ -43,7 +43,7 @@ static const qnav_bench_policy_t qnav_bench_policies[QNAV_BENCH_POLICY_COUNT] QN
         .b_hidden = {-419, 3629, 686, -1065, -39, -2091, -2517, -2273, 1570, 169, 2202, 539},
         .w_out = {-623, -290, -721, 4636, -477, -1884, -2446, -1241, -3239, -74, 149, 414},
         .b_out = 1826}}}},
-    /* scan search, the evolved policy unchanged from h12-pocket-xopen-r1 (file:policies/h12-pocket-xopen-r1.policy, open-to-pocket transfer-open run-001 at c6f786c); 1656 evaluations on scan adversary:4 */
+    /* scan search, the evolved policy unchanged from h12-pocket-xopen-r1 (file:policies/h12-pocket-xopen-r1.policy, open-to-pocket transfer-open run-001 at c6f786c); 1956 evaluations on scan adversary:4 */
     {"adv-e12-n32-1", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
         .w_theta = {-1721, -2194, -341, 425, 2378, -219, -1290, 565, 164, -553, -2845, 1266},
@@ -51,39 +51,39 @@ static const qnav_bench_policy_t qnav_bench_policies[QNAV_BENCH_POLICY_COUNT] QN
         .b_hidden = {-1151, 2999, -935, 2478, 686, -875, 4886, 1942, -1690, 3958, -3084, 404},
         .w_out = {-1273, 617, 3109, -1288, -2208, 394, -90, 179, 6816, 347, -1392, -459},
         .b_out = 1778}}}},
-    /* scan search, the fixture policy unchanged from fixture e12-o2d-xsingle-r03; 1500 evaluations on scan adversary:5 */
+    /* scan search, the fixture policy unchanged from fixture e12-n100-src10-r05; 2172 evaluations on scan adversary:5 */
     {"adv-f12-n32-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {-1674, -137, -1575, -2440, -335, -2809, -2396, -2948, -361, -2916, 7450, 442},
-        .w_dist = {-4, -1944, 2987, 382, -554, -1934, 16, 1407, -3458, 942, 1461, -100},
-        .b_hidden = {-416, -6, 298, 822, -1866, -252, 643, -2839, 882, 930, 2601, -66},
-        .w_out = {453, -2633, 280, 1045, 642, -557, -37, -1403, -105, -450, 1174, 427},
-        .b_out = -154}}}},
-    /* joint search from h16-gaps-srcopen-r1 (file:policies/h16-gaps-srcopen-r1.policy, open-to-gaps source-open run-001 at c6f786c); 8832 evaluations on scan adversary:6 */
+        .w_theta = {816, 2384, -197, 974, 415, -60, -48, 682, 280, 393, -4667, 434},
+        .w_dist = {3338, -712, -502, -606, -2911, -180, -1837, -2480, 530, -1697, 1652, -2356},
+        .b_hidden = {836, -3687, 667, 1123, -91, -2178, -1086, -419, -1080, -553, -539, 253},
+        .w_out = {-83, -189, 265, 888, 152, 5376, 633, 2696, -26, 371, 1545, -3583},
+        .b_out = 2359}}}},
+    /* joint search from h16-gaps-srcopen-r1 (file:policies/h16-gaps-srcopen-r1.policy, open-to-gaps source-open run-001 at c6f786c); 6480 evaluations on scan adversary:6 */
     {"adv-j16-n32-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 16, .inputs = 2,
-        .w_theta = {7756, 239, 459, 28679, 2309, 51, 64, -29542, -435, -6372, 995, 266, -16076, -31208, -2676, 17892},
-        .w_dist = {7615, 19, -67, -23632, 99, -411, 441, -5519, 30, -16139, -81, -131, -26336, -9666, 23358, -14996},
-        .b_hidden = {24683, -137, -272, -26341, 150, 220, 70, -7143, -378, -26953, 330, -215, -15389, 7252, -28573, -25191},
-        .w_out = {3698, 886, -489, -4165, 106, 1036, 1510, -6359, -967, 11711, -614, -457, 22099, 19383, 5563, 29350},
-        .b_out = -4224}}}},
-    /* joint search from h16-gaps-direct-r2 (file:policies/h16-gaps-direct-r2.policy, open-to-gaps direct run-002 at c6f786c); 8832 evaluations on scan adversary:7 */
+        .w_theta = {7756, 1848, -2615, 28679, 3240, -11179, 11212, 24648, -1969, 5006, 2097, -32598, 3086, 21071, 2379, 17892},
+        .w_dist = {7615, -11332, 27860, -23632, -23399, -16696, 7838, -2229, 4695, 19512, 9455, -20993, 16747, -21037, 23358, -14996},
+        .b_hidden = {24683, -32302, -31116, -26341, 27366, 14612, -10975, -19935, -428, -26953, 446, 27684, 4293, 11902, -25401, -25191},
+        .w_out = {-26551, -21498, -23614, -4165, 21596, 19045, -29138, -6359, -1525, 11711, -1554, -14415, -13187, -9995, 29151, 29350},
+        .b_out = 25175}}}},
+    /* joint search from h16-gaps-direct-r2 (file:policies/h16-gaps-direct-r2.policy, open-to-gaps direct run-002 at c6f786c); 6480 evaluations on scan adversary:7 */
     {"adv-j16-n32-1", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 16, .inputs = 2,
-        .w_theta = {-15568, -30484, -6128, -585, 1272, -1477, 671, -2583, -1809, -2077, 2669, 1488, 6646, -869, 3334, 2783},
-        .w_dist = {-6261, 27536, 3259, 2180, 1171, -3096, 2524, -30449, -743, -419, 19345, 1265, 1665, 81, 1596, -292},
-        .b_hidden = {30014, -2822, -1468, 37, -185, 2727, -69, -26354, -928, 2148, -31616, -2296, -19685, 1903, -264, -488},
-        .w_out = {7470, -15032, 24327, 1142, 713, -2787, 2535, -5892, 4543, -95, 3485, -735, -18180, 1675, 251, -662},
-        .b_out = -22851}}}},
-    /* joint search from h16-corridor-xopen-r2 (file:policies/h16-corridor-xopen-r2.policy, open-to-corridor transfer-open run-002 at c6f786c); 8608 evaluations on scan adversary:8 */
+        .w_theta = {-15568, 16043, 8099, -1966, -13111, 31434, 439, -2583, -11476, 23787, 2669, -21865, 20856, 18792, 4977, 4682},
+        .w_dist = {-6261, 28825, 5941, -22640, -4338, 4160, -31085, -30449, -22240, -32768, 19345, 27665, 30639, -958, -29301, -31309},
+        .b_hidden = {-28163, -22226, 1042, 913, 16533, 13015, -204, -26354, -4763, 12306, -31616, 21524, -31330, 27024, -901, -727},
+        .w_out = {27341, 23017, 24327, 992, -29568, 29424, 3251, -5892, 12656, -26775, 3485, -2823, -14545, -11527, 490, -695},
+        .b_out = -19149}}}},
+    /* joint search from h16-gaps-xopen-r2 (file:policies/h16-gaps-xopen-r2.policy, open-to-gaps transfer-open run-002 at c6f786c); 6480 evaluations on scan adversary:8 */
     {"adv-j16-n32-2", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 16, .inputs = 2,
-        .w_theta = {-5758, 1014, 829, -32352, 118, 1738, 6953, -3868, -2031, -581, -8617, 11340, -709, -24521, -143, -20046},
-        .w_dist = {22278, -2949, 1275, 15939, 512, 4602, -14890, 20958, 100, -4034, 31797, -2565, -1331, 14952, 1955, -25656},
-        .b_hidden = {21447, -96, 262, 27876, -393, 85, -14981, 25946, -133, -424, 15961, 18945, 1217, 21935, -743, -21897},
-        .w_out = {-11183, -74, -347, -270, 2270, 5372, 3627, 2553, 2225, 1012, -7092, -21333, 581, 6936, 422, -399},
-        .b_out = 24152}}}},
-    /* scan search, the evolved policy unchanged from h16-gaps-direct-r2 (file:policies/h16-gaps-direct-r2.policy, open-to-gaps direct run-002 at c6f786c); 3936 evaluations on scan adversary:9 */
+        .w_theta = {-4648, 2977, -12635, -14974, 4026, 32357, -10355, 27419, -1772, 2542, -5110, 20883, -15487, -12242, 9789, -11840},
+        .w_dist = {28296, -25872, 21579, -19095, 195, 579, -29097, 24523, 187, -28868, 1685, -30724, 5713, 15220, 14978, 19843},
+        .b_hidden = {28198, 26002, -1658, -17032, 22, -16150, 9390, 4018, -28, -29185, -20153, 24922, -22673, 29004, -20473, -14378},
+        .w_out = {3126, -13890, 748, 31285, 7734, 14121, 1952, 3184, -8789, -31153, -6001, -14498, 10467, -12513, -522, -17281},
+        .b_out = 2914}}}},
+    /* scan search, the evolved policy unchanged from h16-gaps-direct-r2 (file:policies/h16-gaps-direct-r2.policy, open-to-gaps direct run-002 at c6f786c); 3920 evaluations on scan adversary:9 */
     {"adv-e16-n32-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 16, .inputs = 2,
         .w_theta = {-38, 3106, 1736, -547, 1455, 592, 671, -565, -1383, -1981, -1447, 1415, -1723, -863, 2917, 3007},
@@ -91,7 +91,7 @@ static const qnav_bench_policy_t qnav_bench_policies[QNAV_BENCH_POLICY_COUNT] QN
         .b_hidden = {1074, -2588, -3008, 30, -181, 2619, -69, -4017, -855, 2407, -755, -2324, -2686, 1901, -121, -478},
         .w_out = {2164, -733, -679, 1142, 696, -3014, 2620, -2759, 2956, -95, 78, -1173, -686, 1046, 444, -672},
         .b_out = -1043}}}},
-    /* scan search, the evolved policy unchanged from h16-gaps-srcopen-r1 (file:policies/h16-gaps-srcopen-r1.policy, open-to-gaps source-open run-001 at c6f786c); 1376 evaluations on scan adversary:10 */
+    /* scan search, the evolved policy unchanged from h16-gaps-srcopen-r1 (file:policies/h16-gaps-srcopen-r1.policy, open-to-gaps source-open run-001 at c6f786c); 1312 evaluations on scan adversary:10 */
     {"adv-e16-n32-1", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 16, .inputs = 2,
         .w_theta = {166, 258, 472, -40, 543, 54, -1961, -232, -382, 230, 1191, 45, -287, -18, -835, -72},
@@ -99,39 +99,39 @@ static const qnav_bench_policy_t qnav_bench_policies[QNAV_BENCH_POLICY_COUNT] QN
         .b_hidden = {-374, -136, -252, -171, 199, 585, -71, -2494, -370, 1310, 331, -274, 2488, 742, 681, -2658},
         .w_out = {46, 908, -474, 812, 116, 1157, 1579, 86, -975, 119, -630, -460, 1047, -1143, -2, -382},
         .b_out = -106}}}},
-    /* scan search, the fixture policy unchanged from fixture e16-dense32-s2; 464 evaluations on scan adversary:11 */
+    /* scan search, the fixture policy unchanged from fixture e16-dense16-s1; 448 evaluations on scan adversary:11 */
     {"adv-f16-n32-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 16, .inputs = 2,
-        .w_theta = {1314, 967, -916, -37, -4, -2706, -1128, -1392, 249, -766, 2951, -952, -493, -1135, -450, 498},
-        .w_dist = {-1061, 4873, -3346, -331, -443, -96, 1229, 2201, 2509, 985, -1178, 2122, 546, 2742, -530, -70},
-        .b_hidden = {379, -459, 48, -638, -1458, -1971, -2493, -155, -622, -241, 754, -1137, -396, 470, 1142, 28},
-        .w_out = {-2735, -70, 1341, 572, -1157, -574, -338, -229, 2072, 293, -42, -1403, 1492, 2825, 114, -2696},
-        .b_out = 343}}}},
-    /* joint search from random-h12-0 (clipped Cauchy weights of scale 0.3, seed 1); 6768 evaluations on scan adversary:12 */
+        .w_theta = {2842, -149, -579, 342, 175, -562, 311, -29, -40, 740, -408, -92, -1409, 285, 125, -726},
+        .w_dist = {-543, -658, -3211, 439, 3435, -2776, 54, -1143, 3043, -194, -185, 199, 456, -1221, 29, 2659},
+        .b_hidden = {-1926, -393, 50, -1898, -778, -27, 1388, 111, -488, 290, 1299, 2283, 576, 607, -637, -917},
+        .w_out = {-427, -186, 119, -47, 827, 252, 2725, 985, 475, -1619, 1136, -31, -345, 26, -24, 213},
+        .b_out = 1047}}}},
+    /* joint search from fixture e12-o2d-xsingle-r03; 4860 evaluations on scan adversary:12 */
     {"adv-j12-n180-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {-95, -424, -23372, -3805, -63, -752, -12, 90, 9, -8684, -378, -356},
-        .w_dist = {46, 161, -19860, -12206, -365, 57, 79, -894, 39, -15002, 9, -84},
-        .b_hidden = {-347, -14, 3389, 26780, 93, 172, -184, -45, -67, -25379, 638, -64},
-        .w_out = {299, -54, 3297, 137, 159, 11, 324, 51, -327, -1715, -29, -51},
-        .b_out = -1766}}}},
-    /* joint search from fixture e12-o2d-xsingle-r03; 6204 evaluations on scan adversary:13 */
+        .w_theta = {12449, -1069, 21477, -3113, 4275, -1919, 804, -28022, -12905, -2569, 21562, -25691},
+        .w_dist = {26858, -6106, -22817, 594, 16698, -12055, -15904, 22556, -31078, 361, -126, -22750},
+        .b_hidden = {-15461, -26308, -14130, 821, 19605, -17472, -9917, -23696, -15909, 883, -15634, 656},
+        .w_out = {-28823, 1997, 20822, 1351, 29539, 20082, 2566, 15442, 6269, -1574, -723, 8132},
+        .b_out = 14380}}}},
+    /* joint search from fixture r12-vec; 4860 evaluations on scan adversary:13 */
     {"adv-j12-n180-1", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {-1537, -138, -8797, -2443, 27108, -19669, 804, -19042, -14897, -3004, -3254, 446},
-        .w_dist = {-1163, -2121, 2592, 268, 3778, -20071, -7912, 31369, -10344, 882, 32501, -108},
-        .b_hidden = {2209, -7, 100, 816, -23643, 30298, -9917, 2232, 15832, 964, -11749, -33},
-        .w_out = {102, -21339, 224, 1014, 1225, -132, 2566, -459, 1848, -461, 662, 432},
-        .b_out = -3896}}}},
-    /* joint search from h12-rooms-direct-r1 (file:policies/h12-rooms-direct-r1.policy, open-to-rooms direct run-001 at c6f786c); 6204 evaluations on scan adversary:14 */
+        .w_theta = {4524, -765, -1616, -16492, -1101, -19542, -8695, 28618, 16046, 18972, 13318, -1553},
+        .w_dist = {-31271, -2477, 32208, 15070, 18625, 21156, 24515, 24099, 23711, -30048, 15189, -17534},
+        .b_hidden = {27126, 210, -32555, 13320, -785, -5658, -29974, 8365, -17034, 10798, -10344, 123},
+        .w_out = {8265, 1432, 4194, 2824, 10397, 21934, -7524, 32767, -23737, -2201, 6965, -1757},
+        .b_out = -17992}}}},
+    /* joint search from h12-pocket-direct-r1 (file:policies/h12-pocket-direct-r1.policy, open-to-pocket direct run-001 at c6f786c); 4860 evaluations on scan adversary:14 */
     {"adv-j12-n180-2", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {-112, -23037, -49, -977, -2022, -5524, 1083, -478, 712, -195, 29236, -449},
-        .w_dist = {1694, -32518, -1626, 2461, 2618, 774, 944, 1228, -2811, 17923, -9909, 1372},
-        .b_hidden = {-583, -17530, 653, -1065, -37, -8252, -2904, -2196, 1570, -22048, 31319, 512},
-        .w_out = {-683, -3925, -792, 4635, -477, 13168, 26162, 12874, -2742, -23660, -14377, 431},
-        .b_out = 9255}}}},
-    /* scan search, the evolved policy unchanged from h12-rooms-direct-r1 (file:policies/h12-rooms-direct-r1.policy, open-to-rooms direct run-001 at c6f786c); 3252 evaluations on scan adversary:15 */
+        .w_theta = {1105, -32250, 22745, 23135, -1473, -1263, -30656, 19954, 1432, -16093, 6243, 9297},
+        .w_dist = {8190, -9398, -9629, 30384, 427, 36, -28024, 16583, 551, 18535, -32510, 24825},
+        .b_hidden = {-31959, 614, -19101, -21471, 437, 887, 1479, 17794, -1305, -2957, -18992, 21956},
+        .w_out = {28694, -28205, -16687, -15328, 765, -641, 32767, 5479, 317, 23955, 7196, 1421},
+        .b_out = 5557}}}},
+    /* scan search, the evolved policy unchanged from h12-rooms-direct-r1 (file:policies/h12-rooms-direct-r1.policy, open-to-rooms direct run-001 at c6f786c); 3444 evaluations on scan adversary:15 */
     {"adv-e12-n180-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
         .w_theta = {-112, 1988, -53, -979, -2027, -525, -291, -560, 502, -68, 1961, -480},
@@ -139,15 +139,15 @@ static const qnav_bench_policy_t qnav_bench_policies[QNAV_BENCH_POLICY_COUNT] QN
         .b_hidden = {-419, 3629, 686, -1065, -39, -2091, -2517, -2273, 1570, 169, 2202, 539},
         .w_out = {-623, -290, -721, 4636, -477, -1884, -2446, -1241, -3239, -74, 149, 414},
         .b_out = 1826}}}},
-    /* scan search, the evolved policy unchanged from h12-pocket-xopen-r2 (file:policies/h12-pocket-xopen-r2.policy, open-to-pocket transfer-open run-002 at c6f786c); 2256 evaluations on scan adversary:16 */
+    /* scan search, the evolved policy unchanged from h12-pocket-direct-r1 (file:policies/h12-pocket-direct-r1.policy, open-to-pocket direct run-001 at c6f786c); 2232 evaluations on scan adversary:16 */
     {"adv-e12-n180-1", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {316, 3433, -5123, -23, -412, -2267, 1826, 2120, -1707, -2492, -792, 546},
-        .w_dist = {-1694, -1599, 476, -684, -138, 646, 363, -23, 838, -326, -3292, -3285},
-        .b_hidden = {-2557, -52, -246, 2462, 491, 1009, 1950, -83, 1176, 1669, -1412, 767},
-        .w_out = {833, -5659, -524, 596, 1080, -527, -459, 46, -444, 820, -2223, -3456},
-        .b_out = 2793}}}},
-    /* scan search, the fixture policy unchanged from fixture e12-o2d-xsingle-r03; 2208 evaluations on scan adversary:17 */
+        .w_theta = {-154, 733, -387, 3468, -1831, -1329, -1045, -409, 845, -664, 119, 575},
+        .w_dist = {344, 271, -834, 1071, 458, 184, -266, 87, 247, 45, -2876, -70},
+        .b_hidden = {600, -374, 2073, -955, 411, 681, 332, -483, -341, -1432, -24, 2894},
+        .w_out = {220, 20, -587, 234, 887, -778, 466, 640, 542, -41, 51, 2532},
+        .b_out = -255}}}},
+    /* scan search, the fixture policy unchanged from fixture e12-o2d-xsingle-r03; 2388 evaluations on scan adversary:17 */
     {"adv-f12-n180-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
         .w_theta = {-1674, -137, -1575, -2440, -335, -2809, -2396, -2948, -361, -2916, 7450, 442},

@@ -120,9 +120,11 @@ qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
     return qnav_ctrl_init_carried(ctrl, cfg, policy, 0, 0u);
 }
 
-qnav_status_t qnav_ctrl_init_carried(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
-                                     const qnav_policy_t *policy, const uint8_t *shapes,
-                                     uint16_t len)
+/* qnav_ctrl_init_carried's body; with_shapes 0 leaves a 2-input network's row shapes
+ * unmade (qnav_ctrl_init_compiled makes them from the table). */
+static qnav_status_t init_policy(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
+                                 const qnav_policy_t *policy, const uint8_t *shapes,
+                                 uint16_t len, uint8_t with_shapes)
 {
     qnav_status_t st = init_common(ctrl, cfg);
     if (st != QNAV_OK) {
@@ -142,7 +144,7 @@ qnav_status_t qnav_ctrl_init_carried(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t
     case QNAV_POLICY_NET:
 #if QNAV_WITH_NETWORK
         qnav_net_eval_init(ctrl, &policy->u.net);
-        if (policy->u.net.inputs == QNAV_NET_INPUTS_PAPER) {
+        if (policy->u.net.inputs == QNAV_NET_INPUTS_PAPER && with_shapes) {
             ctrl->shapes_carried = qnav_shapes_take(ctrl, &policy->u.net, shapes, len);
             if (!ctrl->shapes_carried) {
                 qnav_net_eval_shapes(ctrl);
@@ -153,9 +155,17 @@ qnav_status_t qnav_ctrl_init_carried(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t
     }
     (void)shapes;
     (void)len;
+    (void)with_shapes;
     ctrl->kind = policy->kind;
     ctrl->magic = QNAV_CTRL_MAGIC;
     return QNAV_OK;
+}
+
+qnav_status_t qnav_ctrl_init_carried(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
+                                     const qnav_policy_t *policy, const uint8_t *shapes,
+                                     uint16_t len)
+{
+    return init_policy(ctrl, cfg, policy, shapes, len, 1u);
 }
 
 uint8_t qnav_ctrl_shapes_carried(const qnav_ctrl_t *ctrl)
@@ -200,6 +210,29 @@ qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *
     ctrl->kind = QNAV_CTRL_KIND_TABLE;
     ctrl->magic = QNAV_CTRL_MAGIC;
     return QNAV_OK;
+}
+
+qnav_status_t qnav_ctrl_init_compiled(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
+                                      const qnav_policy_t *policy, qnav_qkey_t *table)
+{
+    qnav_status_t st;
+    if (ctrl != 0) {
+        ctrl->magic = 0u;
+    }
+    if (table == 0) {
+        return QNAV_E_NULL;
+    }
+    st = init_policy(ctrl, cfg, policy, 0, 0u, 0u);
+    if (st == QNAV_OK) {
+        st = qnav_ctrl_build_table(ctrl, table);
+    }
+    if (st == QNAV_OK) {
+        st = qnav_ctrl_init_table(ctrl, cfg, table, qnav_ctrl_rank(ctrl));
+    }
+    if (st != QNAV_OK && ctrl != 0) {
+        ctrl->magic = 0u; /* never a network without its row shapes */
+    }
+    return st;
 }
 
 #if QNAV_WITH_PREACT_KEYS

@@ -5,9 +5,9 @@
  * output's pre-activation, companded into 16 bits (docs/qformats.md), or the quality under
  * QNAV_RANK_QUALITY. Two inputs: init learns the shape of every row of keys (a level,
  * dtheta 0..180), which settles most runs of paths with one evaluation or none; the rest
- * are searched by halving with exact bounds, never more than two sigmoids per hidden unit
- * and path. Three inputs: every path is evaluated (dprev breaks the runs' shape, and a
- * table would need a third dimension, docs/architecture.md).
+ * are searched by halving with exact bounds paid from a credit, so that no step evaluates
+ * more than QNAV_NET_STEP_EVALS_MAX units. Three inputs: every path is evaluated (dprev
+ * breaks the runs' shape, and a table would need a third dimension, docs/architecture.md).
  */
 #include "policy_eval.h"
 #include "sigmoid_lut.h"
@@ -348,7 +348,15 @@ static inline uint8_t may_win(const qnav_best_t *best, qnav_qkey_t bound, uint8_
     return (uint8_t)(bound > best->key || (bound == best->key && d_near <= best->dtheta));
 }
 
-/* Offsets lo..hi of run r, each path evaluated. */
+/* The number of paths lo..hi. */
+static inline uint8_t span_size(uint8_t lo, uint8_t hi)
+{
+    return (uint8_t)((uint8_t)(hi - lo) + 1u);
+}
+
+/* Offsets lo..hi of run r, each path evaluated (one path at a time: evaluating a few
+ * together, as eval_run does, took the step's deepest frame 47 bytes past the ATmega128's
+ * 1 KB budget for controller and stack). */
 static inline void span_direct(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_t lo,
                                uint8_t hi, qnav_best_t *best)
 {
@@ -359,60 +367,101 @@ static inline void span_direct(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uin
     }
 }
 
+/* The step's credit: how many evaluations (H sigmoids each) it may still spend beyond one
+ * per path not yet settled (docs/architecture.md, "The run search"). It starts at
+ * QNAV_PATHS / QNAV_NET_SEARCH_SLACK; paths settled without an evaluation add one each, a
+ * bound of the run search takes one. */
+typedef uint16_t qnav_credit_t;
+
+/* Span n halved, lo..mid and mid + 1..hi (the left keeps n's s_lo, the right its s_hi): the
+ * more promising half stays in n (on equal bounds, the one nearer the goal), the other
+ * waits in *w with its bound. One sigmoid per unit. */
+static void halve(const qnav_ctrl_t *ctrl, const qnav_run_t *r, span_t *n, later_t *w)
+{
+    uint8_t mid = (uint8_t)(n->lo + (uint8_t)(n->hi - n->lo) / 2u);
+    int32_t left_hi;
+    int32_t right_lo;
+    qnav_qkey_t k_left;
+    qnav_qkey_t k_right;
+    two_sums(ctrl, r, (uint8_t)(mid + 1u), mid, &right_lo, &left_hi);
+    k_left = step_key_of(ctrl, ctrl->p.net.out_bias_z + n->s_lo + left_hi);
+    k_right = step_key_of(ctrl, ctrl->p.net.out_bias_z + right_lo + n->s_hi);
+    if (k_left > k_right || (k_left == k_right && r->dir > 0)) {
+        w->lo = (uint8_t)(mid + 1u);
+        w->hi = n->hi;
+        w->bound = k_right;
+        n->hi = mid;
+        n->s_hi = left_hi;
+    } else {
+        w->lo = n->lo;
+        w->hi = mid;
+        w->bound = k_left;
+        n->lo = (uint8_t)(mid + 1u);
+        n->s_lo = right_lo;
+    }
+}
+
+/* What a search leaves when its credit is spent: span n (which may still win), then every
+ * waiting span that may, path by path (a span ruled out adds its paths to the credit).
+ * Inline: as a call its frame alone took the step's stack past the 1 KB budget. */
+static inline void search_rest(const qnav_ctrl_t *ctrl, const qnav_run_t *r,
+                               const span_t *n, const later_t *stack, uint8_t depth,
+                               qnav_best_t *best, qnav_credit_t *credit)
+{
+    span_direct(ctrl, r, n->lo, n->hi, best);
+    while (depth != 0u) {
+        const later_t *w = &stack[--depth];
+        uint8_t d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + w->lo : r->dtheta0 - w->hi);
+        if (may_win(best, w->bound, d_near)) {
+            span_direct(ctrl, r, w->lo, w->hi, best);
+        } else {
+            *credit = (qnav_credit_t)(*credit + span_size(w->lo, w->hi));
+        }
+    }
+}
+
 /*
  * The best path of run r by branch and bound: a span whose bound cannot beat the best is
  * dropped; a short one is evaluated path by path; otherwise it is halved, and each half's
  * bound needs one new sigmoid per unit (the rising units' shares at the left half's end,
  * the others' at the right half's start; the outer ends are the parent's). The half left
  * for later keeps its bound and costs one sigmoid per unit again only if it is taken up.
- * So a run of k paths costs fewer than 2 k sigmoids per unit whatever the pruning does,
- * and in the usual case far fewer (docs/architecture.md, "Row shapes").
+ * Each bound is paid from the step's credit, and each span dropped adds its paths to it;
+ * with none left, every path not yet ruled out is evaluated. So the step evaluates at most
+ * QNAV_PATHS + QNAV_PATHS / QNAV_NET_SEARCH_SLACK paths whatever the policy
+ * (QNAV_NET_STEP_EVALS_MAX), and in the usual case far fewer.
  */
-static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *best)
+static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *best,
+                       qnav_credit_t *credit)
 {
     later_t stack[QNAV_SPAN_DEPTH];
     uint8_t depth = 0;
+    uint8_t d_near;
     span_t n;
     n.lo = 0;
     n.hi = (uint8_t)(r->count - 1u);
-    if (r->count <= QNAV_SPAN_DIRECT) {
+    if (r->count <= QNAV_SPAN_DIRECT || *credit == 0u) {
         span_direct(ctrl, r, n.lo, n.hi, best);
         return;
     }
     two_sums(ctrl, r, n.lo, n.hi, &n.s_lo, &n.s_hi);
+    --*credit;
     for (;;) {
         qnav_qkey_t bound = step_key_of(ctrl, ctrl->p.net.out_bias_z + n.s_lo + n.s_hi);
-        uint8_t d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + n.lo : r->dtheta0 - n.hi);
+        d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + n.lo : r->dtheta0 - n.hi);
         if (may_win(best, bound, d_near)) {
-            /* halves lo..mid and mid + 1..hi: the left keeps n.s_lo, the right n.s_hi */
-            uint8_t mid = (uint8_t)(n.lo + (uint8_t)(n.hi - n.lo) / 2u);
-            int32_t left_hi;
-            int32_t right_lo;
-            qnav_qkey_t k_left;
-            qnav_qkey_t k_right;
-            two_sums(ctrl, r, (uint8_t)(mid + 1u), mid, &right_lo, &left_hi);
-            k_left = step_key_of(ctrl, ctrl->p.net.out_bias_z + n.s_lo + left_hi);
-            k_right = step_key_of(ctrl, ctrl->p.net.out_bias_z + right_lo + n.s_hi);
-            /* the more promising half first (on equal bounds, the one nearer the goal); the
-             * other waits */
-            if (k_left > k_right || (k_left == k_right && r->dir > 0)) {
-                stack[depth].lo = (uint8_t)(mid + 1u);
-                stack[depth].hi = n.hi;
-                stack[depth].bound = k_right;
-                n.hi = mid;
-                n.s_hi = left_hi;
-            } else {
-                stack[depth].lo = n.lo;
-                stack[depth].hi = mid;
-                stack[depth].bound = k_left;
-                n.lo = (uint8_t)(mid + 1u);
-                n.s_lo = right_lo;
+            if (*credit == 0u) {
+                search_rest(ctrl, r, &n, stack, depth, best, credit);
+                return;
             }
-            ++depth;
+            halve(ctrl, r, &n, &stack[depth++]);
+            --*credit;
             if ((uint8_t)(n.hi - n.lo) >= QNAV_SPAN_DIRECT) {
                 continue;
             }
             span_direct(ctrl, r, n.lo, n.hi, best);
+        } else {
+            *credit = (qnav_credit_t)(*credit + span_size(n.lo, n.hi));
         }
         /* the next waiting span that may still win */
         for (;;) {
@@ -424,13 +473,19 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
             n.hi = stack[depth].hi;
             d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + n.lo : r->dtheta0 - n.hi);
             if (!may_win(best, stack[depth].bound, d_near)) {
+                *credit = (qnav_credit_t)(*credit + span_size(n.lo, n.hi));
                 continue;
             }
             if ((uint8_t)(n.hi - n.lo) < QNAV_SPAN_DIRECT) {
                 span_direct(ctrl, r, n.lo, n.hi, best);
                 continue;
             }
+            if (*credit == 0u) {
+                search_rest(ctrl, r, &n, stack, depth, best, credit);
+                return;
+            }
             two_sums(ctrl, r, n.lo, n.hi, &n.s_lo, &n.s_hi);
+            --*credit;
             break;
         }
     }
@@ -460,7 +515,8 @@ static inline void offer_valley(const qnav_ctrl_t *ctrl, const qnav_run_t *r, ui
         qnav_best_consider(best, k_lo, qnav_run_path_at(r, lo), lo);
         return;
     }
-    if (key_of_path(ctrl, r->level, (uint8_t)(hi - 1u)) >= k_hi) {
+    /* (two paths: the key at lo, below k_hi, is the one before hi; no need to read it) */
+    if ((uint8_t)(hi - 1u) != lo && key_of_path(ctrl, r->level, (uint8_t)(hi - 1u)) >= k_hi) {
         uint8_t x = (uint8_t)(lo + 1u); /* the key at lo is below k_hi */
         hi = (uint8_t)(hi - 1u);
         while (x < hi) {
@@ -482,10 +538,17 @@ static inline void offer_valley(const qnav_ctrl_t *ctrl, const qnav_run_t *r, ui
 static void two_inputs_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_best_t *best)
 {
     qnav_run_t r;
+    qnav_credit_t credit = QNAV_PATHS / QNAV_NET_SEARCH_SLACK;
     while (qnav_run_next(it, &r)) {
+        uint8_t paths = r.count;
         uint8_t a;
         uint8_t e;
-        switch (qnav_run_reduce(ctrl->p.net.in.row, &r, best, it)) {
+        uint8_t how = qnav_run_reduce(ctrl->p.net.in.row, &r, best, it);
+        /* the paths ruled out credit the search; the rest cost at most one evaluation each
+         * (a valley or a peak fewer, not counted) */
+        credit = (qnav_credit_t)(credit +
+                                 (how == QNAV_RUN_DONE ? paths : (uint8_t)(paths - r.count)));
+        switch (how) {
         case QNAV_RUN_DONE:
             break;
         case QNAV_RUN_ALL:
@@ -493,7 +556,7 @@ static void two_inputs_best(const qnav_ctrl_t *ctrl, qnav_run_iter_t *it, qnav_b
                 qnav_best_consider(best, key_of_path(ctrl, r.level, r.dtheta0), r.first,
                                    r.dtheta0);
             } else {
-                search_run(ctrl, &r, best);
+                search_run(ctrl, &r, best, &credit);
             }
             break;
         case QNAV_RUN_VALLEY:

@@ -133,16 +133,16 @@ void init_ctrl(const qnav_sim_t *sim, const qnav_policy_t &pol, bool table,
                std::vector<qnav_qkey_t> &table_buf, qnav_ctrl_t *ctrl) {
     qnav_ctrl_config_t cc;
     qnav_sim_ctrl_config(sim, &cc);
-    qnav_status_t st = qnav_ctrl_init(ctrl, &cc, &pol);
-    if (st != QNAV_OK)
-        throw SimError(QNAV_SIM_E_PARAM, "policy: rejected by qnav_ctrl_init (status " + std::to_string(st) + ")");
     if (table) {
         table_buf.assign(QNAV_QTABLE_ENTRIES, 0);
-        st = qnav_ctrl_build_table(ctrl, table_buf.data());
-        if (st == QNAV_OK) st = qnav_ctrl_init_table(ctrl, &cc, table_buf.data(), qnav_ctrl_rank(ctrl));
+        const qnav_status_t st = qnav_ctrl_init_compiled(ctrl, &cc, &pol, table_buf.data());
         if (st != QNAV_OK)
             throw SimError(QNAV_SIM_E_PARAM, "policy: table mode failed (status " + std::to_string(st) + ")");
+        return;
     }
+    const qnav_status_t st = qnav_ctrl_init(ctrl, &cc, &pol);
+    if (st != QNAV_OK)
+        throw SimError(QNAV_SIM_E_PARAM, "policy: rejected by qnav_ctrl_init (status " + std::to_string(st) + ")");
 }
 
 // Names of every controller in libqnav's table, for messages: "body, literal, vfh".

@@ -977,53 +977,105 @@ static void plain_case_init(qnav_ctrl_t *c, qnav_qkey_t *table, unsigned k, uint
     }
 }
 
+/* Five ticks of the fast and the plain step from the same input (each fed its own previous
+ * output), which must agree in everything: heading, speed, quality, flags, escape memory,
+ * and all 360 qualities on the ticks that ask for them. */
+static void expect_steps_agree(qnav_ctrl_t *c, const qnav_mm_t *ranges, qnav_cdeg_t goal,
+                               unsigned k, uint16_t n)
+{
+    static qnav_q1_15_t q_fast[QNAV_PATHS];
+    static qnav_q1_15_t q_plain[QNAV_PATHS];
+    qnav_ctrl_input_t in_fast = {0};
+    qnav_ctrl_input_t in_plain = {0};
+    qnav_ctrl_output_t fast;
+    qnav_ctrl_output_t plain;
+    in_fast.ranges_mm = ranges;
+    in_fast.goal_bearing_cdeg = goal;
+    in_fast.prev_heading_cdeg = (qnav_cdeg_t)rng_range(-18000, 18000);
+    in_fast.goal_range_mm = (qnav_mm_t)rng_range(0, 6000);
+    in_plain = in_fast;
+    memset(&fast, 0, sizeof fast);
+    memset(&plain, 0, sizeof plain);
+    for (unsigned tick = 0; tick < 5u; ++tick) {
+        qnav_ctrl_step(c, &in_fast, &fast, (k + tick) % 2u ? q_fast : NULL);
+        qnav_ctrl_step_plain(c, &in_plain, &plain, (k + tick) % 2u ? q_plain : NULL);
+        if (memcmp(&fast, &plain, sizeof fast) != 0 ||
+            ((k + tick) % 2u && memcmp(q_fast, q_plain, sizeof q_fast) != 0)) {
+            fail_msg("case %u tick %u (N = %u, kind %u): fast heading %d, plain %d", k, tick,
+                     n, k % 4u, fast.heading_deg, plain.heading_deg);
+        }
+        in_fast.escape = fast.escape;
+        in_plain.escape = plain.escape;
+        in_fast.prev_heading_cdeg = (qnav_cdeg_t)(fast.heading_deg * 100);
+        in_plain.prev_heading_cdeg = (qnav_cdeg_t)(plain.heading_deg * 100);
+    }
+}
+
 /* The fast step (row shapes, settled levels, the run search; with qualities, every run
  * evaluated) must decide exactly as the library's plain step, which evaluates every path
- * from its own inputs: heading, speed, quality, flags, escape memory and all 360
- * qualities, tick after tick (each step fed its own previous output), for every kind,
- * both ranks, holding the heading, escapes, all sector counts. */
+ * from its own inputs, for every kind, both ranks, holding the heading, escapes, all
+ * sector counts. */
 static void test_fast_step_equals_plain_step(void **state)
 {
     (void)state;
     static const uint16_t sectors[] = {1, 5, 8, 16, 32, 64, 180, 360};
     static qnav_qkey_t table[QNAV_QTABLE_ENTRIES];
-    static qnav_q1_15_t q_fast[QNAV_PATHS];
-    static qnav_q1_15_t q_plain[QNAV_PATHS];
     qnav_mm_t ranges[360];
-    unsigned checked = 0;
     for (unsigned k = 0; k < 3000; ++k) {
         uint16_t n = sectors[k % 8u];
         qnav_ctrl_t c;
-        qnav_ctrl_input_t in_fast = {0};
-        qnav_ctrl_input_t in_plain = {0};
-        qnav_ctrl_output_t fast;
-        qnav_ctrl_output_t plain;
         qnav_cdeg_t goal;
         plain_case_init(&c, table, k, n);
         structured_scan(ranges, n, 4000, k / 96u, &goal);
-        in_fast.ranges_mm = ranges;
-        in_fast.goal_bearing_cdeg = goal;
-        in_fast.prev_heading_cdeg = (qnav_cdeg_t)rng_range(-18000, 18000);
-        in_fast.goal_range_mm = (qnav_mm_t)rng_range(0, 6000);
-        in_plain = in_fast;
-        memset(&fast, 0, sizeof fast);
-        memset(&plain, 0, sizeof plain);
-        for (unsigned tick = 0; tick < 5u; ++tick) {
-            qnav_ctrl_step(&c, &in_fast, &fast, (k + tick) % 2u ? q_fast : NULL);
-            qnav_ctrl_step_plain(&c, &in_plain, &plain, (k + tick) % 2u ? q_plain : NULL);
-            if (memcmp(&fast, &plain, sizeof fast) != 0 ||
-                ((k + tick) % 2u && memcmp(q_fast, q_plain, sizeof q_fast) != 0)) {
-                fail_msg("case %u tick %u (N = %u, kind %u): fast heading %d, plain %d", k,
-                         tick, n, k % 4u, fast.heading_deg, plain.heading_deg);
-            }
-            in_fast.escape = fast.escape;
-            in_plain.escape = plain.escape;
-            in_fast.prev_heading_cdeg = (qnav_cdeg_t)(fast.heading_deg * 100);
-            in_plain.prev_heading_cdeg = (qnav_cdeg_t)(plain.heading_deg * 100);
-            ++checked;
-        }
+        expect_steps_agree(&c, ranges, goal, k, n);
     }
-    assert_int_equal(checked, 15000);
+}
+
+/*
+ * The same on networks made to defeat the run search's bounds, so that the step's credit
+ * runs out and the rest of a run is evaluated path by path (policy_net.c, search_rest):
+ * units in pairs that cancel, the same unit twice with output weights of opposite sign
+ * but for a small difference. Along a run one share of a pair rises and the other falls,
+ * so a span's bound counts each pair's whole swing while the keys stay nearly flat: no
+ * span but the shortest can be ruled out.
+ */
+static void test_fast_step_equals_plain_step_when_the_search_runs_out(void **state)
+{
+    (void)state;
+    static const uint16_t sectors[] = {1, 8, 16, 32, 180, 360};
+    qnav_mm_t ranges[360];
+    for (unsigned k = 0; k < 600; ++k) {
+        uint16_t n = sectors[k % 6u];
+        qnav_ctrl_config_t cfg;
+        qnav_policy_t p;
+        qnav_ctrl_t c;
+        qnav_cdeg_t goal;
+        uint8_t hidden = (uint8_t)(2u * (2u + k % 7u));
+        int32_t spread = rng_range(0, 48);
+        qnav_ctrl_config_default(&cfg);
+        cfg.n_sectors = n;
+        cfg.max_range_mm = 4000;
+        cfg.keep_pct = (uint8_t)(k % 3u * 10u);
+        if (k % 4u == 3u) {
+            qnav_ctrl_config_literal(&cfg);
+        }
+        qnav_policy_net_zero_inputs(&p, hidden, 2u);
+        for (uint8_t j = 0; j < hidden; j = (uint8_t)(j + 2u)) {
+            int32_t w = rng_range(-127 * 256, 127 * 256);
+            int32_t out = rng_range(1024, 127 * 256);
+            p.u.net.w_theta[j] = p.u.net.w_theta[j + 1u] = (qnav_q8_8_t)w;
+            p.u.net.w_dist[j] = p.u.net.w_dist[j + 1u] = (qnav_q8_8_t)rng_range(-2048, 2048);
+            /* the transition somewhere along dtheta */
+            p.u.net.b_hidden[j] = p.u.net.b_hidden[j + 1u] =
+                (qnav_q8_8_t)(-(w / 256) * rng_range(0, 256));
+            p.u.net.w_out[j] = (qnav_q8_8_t)out;
+            p.u.net.w_out[j + 1u] = (qnav_q8_8_t)(-out + rng_range(-spread, spread));
+        }
+        p.u.net.b_out = (qnav_q8_8_t)rng_range(-512, 512);
+        assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_OK);
+        structured_scan(ranges, n, 4000, k / 6u, &goal);
+        expect_steps_agree(&c, ranges, goal, k, n);
+    }
 }
 
 /* Not ready (no controller, no scan) is the same stop from both steps. */
@@ -1262,6 +1314,62 @@ static void test_build_table_refuses_a_table_controller(void **state)
     assert_int_equal(qnav_ctrl_build_table(&c, table), QNAV_E_POLICY_KIND);
 }
 
+/* qnav_ctrl_init_compiled is init, build and init_table in one: the same table and the
+ * same controller, byte for byte, for networks of every scale and both ranks and the
+ * probabilistic policy; a 3-input network, a null table or a bad configuration leave the
+ * controller not ready. */
+static void test_init_compiled_equals_init_then_build_then_init_table(void **state)
+{
+    (void)state;
+    static qnav_qkey_t want_table[QNAV_QTABLE_ENTRIES];
+    static qnav_qkey_t got_table[QNAV_QTABLE_ENTRIES];
+    static const int32_t scales[] = {256, 1024, 32767};
+    qnav_ctrl_config_t cfg;
+    qnav_policy_t p;
+    qnav_ctrl_t want;
+    qnav_ctrl_t got;
+    for (unsigned k = 0; k < 13u; ++k) {
+        qnav_ctrl_config_default(&cfg);
+        cfg.n_sectors = (uint16_t)(k % 2u ? 16u : 32u);
+        cfg.rank = (uint8_t)(k % 3u == 0u ? QNAV_RANK_QUALITY : QNAV_RANK_PREACT);
+        if (k == 12u) {
+            qnav_policy_prob_default(&p);
+        } else {
+            random_net(&p, (uint8_t)rng_range(1, QNAV_MAX_HIDDEN), scales[k % 3u]);
+        }
+        memset(&want, 0, sizeof want);
+        memset(&got, 0, sizeof got);
+        memset(got_table, 0x5A, sizeof got_table);
+        assert_int_equal(qnav_ctrl_init(&want, &cfg, &p), QNAV_OK);
+        assert_int_equal(qnav_ctrl_build_table(&want, want_table), QNAV_OK);
+        assert_int_equal(qnav_ctrl_init_table(&want, &cfg, want_table, qnav_ctrl_rank(&want)),
+                         QNAV_OK);
+        assert_int_equal(qnav_ctrl_init_compiled(&got, &cfg, &p, got_table), QNAV_OK);
+        assert_memory_equal(got_table, want_table, sizeof want_table);
+        /* the one field that differs by construction: where the table is */
+        assert_ptr_equal(got.p.net.table, got_table);
+        got.p.net.table = want_table;
+        assert_memory_equal(&got, &want, sizeof want);
+    }
+    qnav_ctrl_config_default(&cfg);
+    qnav_policy_net_zero_inputs(&p, 4, 3u);
+    assert_int_equal(qnav_ctrl_init_compiled(&got, &cfg, &p, got_table), QNAV_E_NO_TABLE);
+    {
+        qnav_mm_t ranges[16];
+        qnav_ctrl_input_t in = {0};
+        qnav_ctrl_output_t out;
+        fill(ranges, 16, 1000);
+        in.ranges_mm = ranges;
+        qnav_ctrl_step(&got, &in, &out, NULL);
+        assert_int_equal(out.flags & QNAV_FLAG_NOT_READY, QNAV_FLAG_NOT_READY);
+    }
+    random_net(&p, 4, 1024);
+    assert_int_equal(qnav_ctrl_init_compiled(&got, &cfg, &p, NULL), QNAV_E_NULL);
+    assert_int_equal(qnav_ctrl_init_compiled(&got, NULL, &p, got_table), QNAV_E_NULL);
+    cfg.keep_pct = 101u;
+    assert_int_equal(qnav_ctrl_init_compiled(&got, &cfg, &p, got_table), QNAV_E_KEEP);
+}
+
 /* --- policy helpers --- */
 
 static void test_net_weight_walks_the_flat_order(void **state)
@@ -1381,12 +1489,14 @@ int main(void)
         cmocka_unit_test(test_preactivation_rank_agrees_with_float_network_on_saturated_nets),
         cmocka_unit_test(test_sigmoid_flat_ends_match_the_table),
         cmocka_unit_test(test_fast_step_equals_plain_step),
+        cmocka_unit_test(test_fast_step_equals_plain_step_when_the_search_runs_out),
         cmocka_unit_test(test_plain_step_stops_when_not_ready),
         cmocka_unit_test(test_path_levels_equal_painting_every_sector),
         cmocka_unit_test(test_wedge_placement_equals_its_definition),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_network_mode),
         cmocka_unit_test(test_table_mode_is_bit_identical_to_probabilistic_mode),
         cmocka_unit_test(test_build_table_refuses_a_table_controller),
+        cmocka_unit_test(test_init_compiled_equals_init_then_build_then_init_table),
         cmocka_unit_test(test_net_weight_walks_the_flat_order),
         cmocka_unit_test(test_zero_net_clamps_hidden_units),
         cmocka_unit_test(test_carry_clears_escape_memory_only_for_a_new_goal),

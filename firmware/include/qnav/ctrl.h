@@ -318,6 +318,17 @@ typedef struct {
 #endif
 } qnav_ctrl_t;
 
+/*
+ * The most hidden-unit evaluations one qnav_ctrl_step() of a network policy with h hidden
+ * units makes, whatever its weights and the scan: every path once, at most an eighth more
+ * for the 2-input run search's bounds (QNAV_NET_SEARCH_SLACK), and the held heading's path
+ * (docs/architecture.md, "The run search"; cycles in docs/performance.md). The bench's
+ * counted build checks every step of the fixtures and the adversarial set against it.
+ */
+#define QNAV_NET_SEARCH_SLACK 8u
+#define QNAV_NET_STEP_EVALS_MAX(h)                                                         \
+    ((uint32_t)(QNAV_PATHS + QNAV_PATHS / QNAV_NET_SEARCH_SLACK + 1u) * (uint32_t)(h))
+
 #if QNAV_BENCH_COUNT
 /* Benchmarks only (QNAV_BENCH_COUNT = 1): from now on each hidden-unit evaluation of this
  * network controller (H per path evaluated) adds 1 to *evals; null stops counting. Call it
@@ -363,6 +374,20 @@ QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_init(qnav_ctrl_t *ctrl, const qnav_ctr
  */
 QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg,
                                    const qnav_qkey_t *table, qnav_rank_t rank);
+
+/*
+ * qnav_ctrl_init(), qnav_ctrl_build_table() into table, then qnav_ctrl_init_table() from
+ * it, in one call that evaluates the policy at each (level, dtheta) once: the rows go
+ * straight into the table and the row shapes are read from there (qnav_ctrl_init alone
+ * evaluates every row for the shapes, and building the table again). For a host that
+ * compiles many policies (simevo: one per candidate). table: QNAV_QTABLE_ENTRIES keys,
+ * outliving ctrl. Statuses as those three; QNAV_E_NO_TABLE for a 3-input network. On any
+ * error ctrl is left not ready.
+ */
+QNAV_CHECK_RESULT qnav_status_t qnav_ctrl_init_compiled(qnav_ctrl_t *ctrl,
+                                                        const qnav_ctrl_config_t *cfg,
+                                                        const qnav_policy_t *policy,
+                                                        qnav_qkey_t *table);
 
 /*
  * Carried row shapes (docs/architecture.md, "Carried row shapes"): the row shapes a

@@ -184,16 +184,19 @@ const qnav_ctrl_t &SimRunner::controller_for(const qnav_policy_t &policy)
     }
     Compiled &c = compiled_[least_recent_];
     c.valid = false;
-    const qnav_status_t st = qnav_ctrl_init(&c.ctrl, &ctrl_cfg_, &policy);
-    if (st != QNAV_OK) {
-        throw UserError("controller: qnav_ctrl_init refused the policy (status " +
-                        std::to_string(static_cast<int>(st)) + ")");
-    }
     if (use_table_ && has_table(policy)) {
+        /* each (level, dtheta) evaluated once: the table, and the row shapes from it */
         c.table.resize(QNAV_QTABLE_ENTRIES);
-        if (qnav_ctrl_build_table(&c.ctrl, c.table.data()) != QNAV_OK ||
-            qnav_ctrl_init_table(&c.ctrl, &ctrl_cfg_, c.table.data(), qnav_ctrl_rank(&c.ctrl)) != QNAV_OK) {
-            throw UserError("controller: could not compile the policy into a quality table");
+        const qnav_status_t st = qnav_ctrl_init_compiled(&c.ctrl, &ctrl_cfg_, &policy, c.table.data());
+        if (st != QNAV_OK) {
+            throw UserError("controller: could not compile the policy into a quality table (status " +
+                            std::to_string(static_cast<int>(st)) + ")");
+        }
+    } else {
+        const qnav_status_t st = qnav_ctrl_init(&c.ctrl, &ctrl_cfg_, &policy);
+        if (st != QNAV_OK) {
+            throw UserError("controller: qnav_ctrl_init refused the policy (status " +
+                            std::to_string(static_cast<int>(st)) + ")");
         }
     }
     c.policy = policy;
