@@ -21,7 +21,7 @@
     { \
         .ctrl.n_sectors = 16, \
         .ctrl.max_range_mm = 2500, \
-        .ctrl.full_speed_quality = 16384, \
+        .ctrl.full_speed_quality = 29491, \
         .ctrl.body_radius_mm = 120, \
         .ctrl.safety_mm = 50, \
         .ctrl.sensor_offset_mm = 120, \
