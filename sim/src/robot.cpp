@@ -23,8 +23,9 @@ static void parse_motion(const TomlReader &r, RobotProfile &p) {
 
     const toml::table &drive = r.table(root, "drive");
     r.only_keys(drive, {"v_max_mps", "accel_mps2", "decel_mps2", "turn_rate_max_dps",
-                        "heading_gain_per_s", "limits"});
+                        "heading_gain_per_s", "limits", "full_speed_quality"});
     p.v_max_mps = r.number(drive, "v_max_mps", 0.01, 20.0);
+    p.full_speed_quality = r.number(drive, "full_speed_quality", 0.01, 1.0);
     p.accel_mps2 = r.number(drive, "accel_mps2", 0.01, 100.0);
     p.decel_mps2 = r.number(drive, "decel_mps2", 0.01, 100.0);
     p.turn_rate_max_dps = r.number(drive, "turn_rate_max_dps", 1.0, 3600.0);

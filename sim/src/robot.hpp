@@ -19,6 +19,8 @@ struct RobotProfile {
     double wheel_base_m = 0.3;      // distance between the driven wheels, m
     // drive
     double v_max_mps = 0.5;         // maximum wheel / forward speed, m/s
+    double full_speed_quality = 0.9; // the chosen path's quality commanded at v_max (speed
+                                     // linear below it; paper: 0.9), (0, 1]
     double accel_mps2 = 1.0;        // wheel acceleration limit (speeding up), m/s^2
     double decel_mps2 = 1.0;        // wheel deceleration limit (slowing down), m/s^2
     // where accel_mps2 / decel_mps2 act (docs/sim.md, "Drive model"): on each wheel, or on

@@ -21,6 +21,8 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->sensor_offset_mm = to_mm(p.sonar_offset_m);
     cfg->range_min_mm = to_mm(p.range_min_m);
     cfg->v_max_mm_s = to_mm(p.v_max_mps);
+    cfg->full_speed_quality = static_cast<qnav_q1_15_t>(
+        std::min(32767L, std::lround(p.full_speed_quality * 32768.0)));
     cfg->decel_mm_s2 = p.speed_guard ? to_mm(p.decel_mps2) : 0;
     cfg->wedge_pct = p.wedge_pct;
     cfg->wedge_near_mm = to_mm(p.wedge_near_m);

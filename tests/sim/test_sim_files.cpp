@@ -145,6 +145,44 @@ static void test_bad_robot_profiles_are_refused(void **state) {
     t8.replace(t8.find("offset_m = 0.26"), 15, "offset_m = 0.30");
     assert_int_equal(parse_robot(t8, &msg), QNAV_SIM_E_PARSE);
     assert_true(msg.find("offset_m") != std::string::npos);
+    std::string t9 = good;
+    t9.erase(t9.find("full_speed_quality"),
+             t9.find('\n', t9.find("full_speed_quality")) - t9.find("full_speed_quality") + 1);
+    assert_int_equal(parse_robot(t9, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("missing key 'full_speed_quality'") != std::string::npos);
+    std::string t10 = good;
+    t10.replace(t10.find("full_speed_quality = 0.9"), 24, "full_speed_quality = 0.0");
+    assert_int_equal(parse_robot(t10, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("full_speed_quality") != std::string::npos);
+    assert_true(one_line(msg));
+}
+
+/* The quality commanded at v_max is the profile's (both robots: the paper's 0.9), not a
+ * default of libqnav's: a copy of the TekBot's profile with another value gives it. */
+static void test_profile_sets_the_speed_at_full_quality(void **state) {
+    (void)state;
+    char err[QNAV_SIM_ERRLEN] = "";
+    static const struct {
+        const char *robot;
+        qnav_q1_15_t q;
+    } want[] = {{"tekbot", 29491}, {"pioneer3dx", 29491}};
+    for (const auto &w : want) {
+        qnav_sim_robot_t *robot = nullptr;
+        qnav_ctrl_config_t cfg;
+        assert_int_equal(qnav_sim_robot_load(w.robot, &robot, err, sizeof err), QNAV_SIM_OK);
+        qnav_sim_robot_ctrl_config(robot, 0, &cfg);
+        assert_int_equal(cfg.full_speed_quality, w.q);
+        qnav_sim_robot_free(robot);
+    }
+    std::string t = read_data("robots/tekbot.toml");
+    t.replace(t.find("full_speed_quality = 0.9"), 24, "full_speed_quality = 0.5");
+    qnav_sim_robot_t *robot = nullptr;
+    qnav_ctrl_config_t cfg;
+    assert_int_equal(qnav_sim_robot_parse(t.data(), t.size(), "fsq.toml", &robot, err, sizeof err),
+                     QNAV_SIM_OK);
+    qnav_sim_robot_ctrl_config(robot, 0, &cfg);
+    assert_int_equal(cfg.full_speed_quality, 16384);
+    qnav_sim_robot_free(robot);
 }
 
 static void test_profile_carries_its_tuned_probabilistic_policy(void **state) {
@@ -424,6 +462,7 @@ int main(void) {
         cmocka_unit_test(test_start_zone_inside_an_obstacle_is_refused_with_its_line),
         cmocka_unit_test(test_bad_robot_profiles_are_refused),
         cmocka_unit_test(test_profile_carries_its_tuned_probabilistic_policy),
+        cmocka_unit_test(test_profile_sets_the_speed_at_full_quality),
         cmocka_unit_test(test_missing_file_is_an_io_error_naming_it),
         cmocka_unit_test(test_impossible_parameters_are_refused_by_field),
         cmocka_unit_test(test_mismatched_controller_is_refused),
