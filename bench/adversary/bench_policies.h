@@ -11,31 +11,31 @@
 #define QNAV_BENCH_POLICY_COUNT 18u
 
 static const qnav_bench_policy_t qnav_bench_policies[QNAV_BENCH_POLICY_COUNT] QNAV_FLASH = {
-    /* joint search from fixture e12-o2d-xsingle-r03; 4860 evaluations on scan adversary:0 */
+    /* joint search from fixture e12-o2d-xsingle-r03; 4584 evaluations on scan adversary:0 */
     {"adv-j12-n32-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {-783, 4560, 30679, -2923, -10972, -10751, -8594, 9808, 24255, -3112, 16644, 465},
-        .w_dist = {80, 27926, 15487, 266, -7008, 17347, -30309, 26795, 27220, 560, 1808, -286},
-        .b_hidden = {-288, 27926, 16021, 1077, -20016, -24132, -13841, 17328, -20769, 684, 20242, -119},
-        .w_out = {1186, -12492, 24705, 935, 32330, 12013, 14024, 8133, -20339, -317, -26129, 2632},
-        .b_out = 25928}}}},
-    /* joint search from fixture e12-n100-src10-r05; 4860 evaluations on scan adversary:1 */
+        .w_theta = {-28072, -22088, -1253, -2916, 17220, 29067, 21836, 9808, 24255, -4291, 24669, 905},
+        .w_dist = {5429, 27926, -28441, 316, -7008, 17347, -22271, 26795, 13092, 996, -13953, -303},
+        .b_hidden = {26546, 27926, 16021, 998, 23567, 22297, 344, 17328, -20769, 1039, -10752, 206},
+        .w_out = {-49, -31373, 17612, 1138, 32330, -19848, 14468, 2193, 30916, -473, -11256, 2033},
+        .b_out = -15734}}}},
+    /* joint search from fixture e12-n100-src10-r05; 4584 evaluations on scan adversary:1 */
     {"adv-j12-n32-1", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {15174, 8558, 11894, -19687, 1592, -28917, -16731, 992, 15893, 6673, -13233, 553},
-        .w_dist = {7934, 4025, -4008, -4395, -1749, 7615, 4134, -17386, 10982, -15215, -11551, -18018},
-        .b_hidden = {10622, 6344, -20008, 27475, -6, 22834, -17216, -646, 31714, 11795, -32124, -284},
-        .w_out = {2116, 27891, -12725, -9969, 1224, -16460, 10231, 2256, 9339, -31037, 22857, -4560},
+        .w_theta = {29218, -27555, 6477, -19687, -26217, 12040, -16731, 1358, -32536, -19546, 28025, 422},
+        .w_dist = {-32193, -7512, -601, -4395, 10270, 7615, 4134, -17386, 10982, -24696, 9941, -18018},
+        .b_hidden = {10622, -30922, -4105, 27475, 28800, 22834, -17216, -187, -7239, -24177, -27360, 256},
+        .w_out = {-10278, 27891, 4672, -9969, -2186, 30084, 10231, 2425, 25057, 3321, -12898, -10995},
         .b_out = -3700}}}},
-    /* joint search from fixture r12-vec; 4860 evaluations on scan adversary:2 */
+    /* joint search from fixture r12-vec; 4584 evaluations on scan adversary:2 */
     {"adv-j12-n32-2", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {25058, -13330, -3699, 18801, 29313, -19362, -10912, -17586, -537, -27065, 1383, 22467},
-        .w_dist = {-30656, 19181, -27355, -2976, -7903, -19842, -12522, 24677, 262, 30035, -180, -7888},
-        .b_hidden = {32736, -20119, -18254, 6446, 10029, 32272, -23173, -24442, 225, -31265, 546, -16069},
-        .w_out = {22341, 28911, 14130, 29289, -31569, -2994, -17742, 12671, 807, -18348, 916, 7030},
-        .b_out = -20692}}}},
-    /* scan search, the evolved policy unchanged from h12-rooms-direct-r1 (file:policies/h12-rooms-direct-r1.policy, open-to-rooms direct run-001 at c6f786c); 3192 evaluations on scan adversary:3 */
+        .w_theta = {25058, -13330, -3699, -5569, 29313, -19362, 29547, -29053, -2739, -27065, 304, -1548},
+        .w_dist = {-30656, 19181, 12196, 21121, -7903, -29071, -17799, 11721, -29980, 30035, -525, 3861},
+        .b_hidden = {-24129, -17952, 24691, -20886, -32768, -18487, -11389, -9327, -29998, -31265, 627, -272},
+        .w_out = {-24443, 28911, 6125, 1070, -13125, -3598, 21491, 12671, 7842, -18348, 639, 22320},
+        .b_out = -28391}}}},
+    /* scan search, the evolved policy unchanged from h12-rooms-direct-r1 (file:policies/h12-rooms-direct-r1.policy, open-to-rooms direct run-001 at c6f786c); 3360 evaluations on scan adversary:3 */
     {"adv-e12-n32-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
         .w_theta = {-112, 1988, -53, -979, -2027, -525, -291, -560, 502, -68, 1961, -480},
@@ -59,31 +59,31 @@ static const qnav_bench_policy_t qnav_bench_policies[QNAV_BENCH_POLICY_COUNT] QN
         .b_hidden = {836, -3687, 667, 1123, -91, -2178, -1086, -419, -1080, -553, -539, 253},
         .w_out = {-83, -189, 265, 888, 152, 5376, 633, 2696, -26, 371, 1545, -3583},
         .b_out = 2359}}}},
-    /* joint search from h16-gaps-srcopen-r1 (file:policies/h16-gaps-srcopen-r1.policy, open-to-gaps source-open run-001 at c6f786c); 6480 evaluations on scan adversary:6 */
+    /* joint search from fixture r16-vec-wide; 6112 evaluations on scan adversary:6 */
     {"adv-j16-n32-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 16, .inputs = 2,
-        .w_theta = {7756, 1848, -2615, 28679, 3240, -11179, 11212, 24648, -1969, 5006, 2097, -32598, 3086, 21071, 2379, 17892},
-        .w_dist = {7615, -11332, 27860, -23632, -23399, -16696, 7838, -2229, 4695, 19512, 9455, -20993, 16747, -21037, 23358, -14996},
-        .b_hidden = {24683, -32302, -31116, -26341, 27366, 14612, -10975, -19935, -428, -26953, 446, 27684, 4293, 11902, -25401, -25191},
-        .w_out = {-26551, -21498, -23614, -4165, 21596, 19045, -29138, -6359, -1525, 11711, -1554, -14415, -13187, -9995, 29151, 29350},
-        .b_out = 25175}}}},
-    /* joint search from h16-gaps-direct-r2 (file:policies/h16-gaps-direct-r2.policy, open-to-gaps direct run-002 at c6f786c); 6480 evaluations on scan adversary:7 */
+        .w_theta = {-7105, -11288, 22866, 5782, 6608, 9062, 8058, 24696, -24903, 22651, -13357, -22105, -27337, 8142, 27607, -3598},
+        .w_dist = {-45, 25337, -11637, 13036, 25529, 27221, -28059, -14107, 27280, -11116, 10698, -18684, -27913, -14467, 22477, -24370},
+        .b_hidden = {22948, 24902, -11325, -17370, -17113, -32768, 18396, 4569, -26709, -23673, -30013, 1702, -10463, 147, -17326, -4249},
+        .w_out = {-1507, 1375, 23138, -7134, 462, 16821, -342, -289, 28676, -18283, -4528, 10295, 561, -32653, 460, -5031},
+        .b_out = -177}}}},
+    /* joint search from h16-gaps-srcopen-r1 (file:policies/h16-gaps-srcopen-r1.policy, open-to-gaps source-open run-001 at c6f786c); 6112 evaluations on scan adversary:7 */
     {"adv-j16-n32-1", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 16, .inputs = 2,
-        .w_theta = {-15568, 16043, 8099, -1966, -13111, 31434, 439, -2583, -11476, 23787, 2669, -21865, 20856, 18792, 4977, 4682},
-        .w_dist = {-6261, 28825, 5941, -22640, -4338, 4160, -31085, -30449, -22240, -32768, 19345, 27665, 30639, -958, -29301, -31309},
-        .b_hidden = {-28163, -22226, 1042, 913, 16533, 13015, -204, -26354, -4763, 12306, -31616, 21524, -31330, 27024, -901, -727},
-        .w_out = {27341, 23017, 24327, 992, -29568, 29424, 3251, -5892, 12656, -26775, 3485, -2823, -14545, -11527, 490, -695},
-        .b_out = -19149}}}},
-    /* joint search from h16-gaps-xopen-r2 (file:policies/h16-gaps-xopen-r2.policy, open-to-gaps transfer-open run-002 at c6f786c); 6480 evaluations on scan adversary:8 */
+        .w_theta = {7756, 23691, 755, -26170, 3240, 21361, -12915, 29197, -556, -6372, 5479, -32598, 18373, -29757, 3810, 17892},
+        .w_dist = {28564, -11332, 27860, 9581, -23399, -15175, -17248, 23614, 4695, 14280, 9455, -20993, -26336, -21037, -12847, -14996},
+        .b_hidden = {-31513, -21645, 100, 22578, 18123, 14741, -16514, -22659, 417, 26046, -1985, 27684, 21109, -23384, 8857, -25191},
+        .w_out = {-19118, -21498, -1615, -4165, -11893, 22098, -29138, 27802, -3087, -32379, -222, 982, 22099, -1952, 7354, 29350},
+        .b_out = 6902}}}},
+    /* joint search from h16-gaps-direct-r2 (file:policies/h16-gaps-direct-r2.policy, open-to-gaps direct run-002 at c6f786c); 6112 evaluations on scan adversary:8 */
     {"adv-j16-n32-2", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 16, .inputs = 2,
-        .w_theta = {-4648, 2977, -12635, -14974, 4026, 32357, -10355, 27419, -1772, 2542, -5110, 20883, -15487, -12242, 9789, -11840},
-        .w_dist = {28296, -25872, 21579, -19095, 195, 579, -29097, 24523, 187, -28868, 1685, -30724, 5713, 15220, 14978, 19843},
-        .b_hidden = {28198, 26002, -1658, -17032, 22, -16150, 9390, 4018, -28, -29185, -20153, 24922, -22673, 29004, -20473, -14378},
-        .w_out = {3126, -13890, 748, 31285, 7734, 14121, 1952, 3184, -8789, -31153, -6001, -14498, 10467, -12513, -522, -17281},
-        .b_out = 2914}}}},
-    /* scan search, the evolved policy unchanged from h16-gaps-direct-r2 (file:policies/h16-gaps-direct-r2.policy, open-to-gaps direct run-002 at c6f786c); 3920 evaluations on scan adversary:9 */
+        .w_theta = {-8483, 16043, 8099, -15779, -7710, -29322, 3709, 2576, -11476, -20500, 2669, -21865, -5887, 18792, -31791, 4682},
+        .w_dist = {-25087, 27434, 5941, -5547, 3127, 4160, -31085, 22276, -22240, 22506, 19345, -19133, 1665, -958, -29301, 17932},
+        .b_hidden = {31795, -30175, 1042, 22774, -19708, 25490, -175, -22394, -4763, -4977, -31616, -27569, -3613, 27024, 16234, -393},
+        .w_out = {-13406, -15032, 24327, 21178, 23888, -8109, 2755, 182, 12656, 10765, 3485, -2822, -18180, 2055, 4970, -2007},
+        .b_out = -30994}}}},
+    /* scan search, the evolved policy unchanged from h16-gaps-direct-r2 (file:policies/h16-gaps-direct-r2.policy, open-to-gaps direct run-002 at c6f786c); 3952 evaluations on scan adversary:9 */
     {"adv-e16-n32-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 16, .inputs = 2,
         .w_theta = {-38, 3106, 1736, -547, 1455, 592, 671, -565, -1383, -1981, -1447, 1415, -1723, -863, 2917, 3007},
@@ -107,31 +107,31 @@ static const qnav_bench_policy_t qnav_bench_policies[QNAV_BENCH_POLICY_COUNT] QN
         .b_hidden = {-1926, -393, 50, -1898, -778, -27, 1388, 111, -488, 290, 1299, 2283, 576, 607, -637, -917},
         .w_out = {-427, -186, 119, -47, 827, 252, 2725, 985, 475, -1619, 1136, -31, -345, 26, -24, 213},
         .b_out = 1047}}}},
-    /* joint search from fixture e12-o2d-xsingle-r03; 4860 evaluations on scan adversary:12 */
+    /* joint search from fixture e12-o2d-xsingle-r03; 4584 evaluations on scan adversary:12 */
     {"adv-j12-n180-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {12449, -1069, 21477, -3113, 4275, -1919, 804, -28022, -12905, -2569, 21562, -25691},
-        .w_dist = {26858, -6106, -22817, 594, 16698, -12055, -15904, 22556, -31078, 361, -126, -22750},
-        .b_hidden = {-15461, -26308, -14130, 821, 19605, -17472, -9917, -23696, -15909, 883, -15634, 656},
-        .w_out = {-28823, 1997, 20822, 1351, 29539, 20082, 2566, 15442, 6269, -1574, -723, 8132},
-        .b_out = 14380}}}},
-    /* joint search from fixture r12-vec; 4860 evaluations on scan adversary:13 */
+        .w_theta = {12449, -352, -701, -1762, 4275, -11740, -22969, 26317, -12905, 30921, -24960, 17894},
+        .w_dist = {-20931, -1017, -4583, -1861, 16698, 20154, -15904, 5476, -31078, 853, -10280, -22750},
+        .b_hidden = {11173, 27, 131, 736, 19605, -12647, 11323, 16274, -15909, -15608, 22732, -13330},
+        .w_out = {9296, -4995, 3519, 505, 29107, -16451, -4677, 10580, 6269, -18669, -19191, -22611},
+        .b_out = -3520}}}},
+    /* joint search from fixture r12-vec; 4584 evaluations on scan adversary:13 */
     {"adv-j12-n180-1", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {4524, -765, -1616, -16492, -1101, -19542, -8695, 28618, 16046, 18972, 13318, -1553},
-        .w_dist = {-31271, -2477, 32208, 15070, 18625, 21156, 24515, 24099, 23711, -30048, 15189, -17534},
-        .b_hidden = {27126, 210, -32555, 13320, -785, -5658, -29974, 8365, -17034, 10798, -10344, 123},
-        .w_out = {8265, 1432, 4194, 2824, 10397, 21934, -7524, 32767, -23737, -2201, 6965, -1757},
-        .b_out = -17992}}}},
-    /* joint search from h12-pocket-direct-r1 (file:policies/h12-pocket-direct-r1.policy, open-to-pocket direct run-001 at c6f786c); 4860 evaluations on scan adversary:14 */
+        .w_theta = {-10758, -6982, -1616, -16492, -3109, -3414, 7365, -31031, 16046, -31030, -21630, -3520},
+        .w_dist = {197, 10318, 32208, 15070, -14307, 17217, 5616, -21767, -15229, 19170, -30731, -17534},
+        .b_hidden = {-5457, -2254, -32555, -22541, -801, -5454, -7451, -1852, -8226, -9488, 23431, -95},
+        .w_out = {-7352, -17725, -11234, 2824, 5716, 21934, -7524, -23559, 16314, -909, -28950, -605},
+        .b_out = 30713}}}},
+    /* joint search from h12-pocket-direct-r1 (file:policies/h12-pocket-direct-r1.policy, open-to-pocket direct run-001 at c6f786c); 4584 evaluations on scan adversary:14 */
     {"adv-j12-n180-2", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
-        .w_theta = {1105, -32250, 22745, 23135, -1473, -1263, -30656, 19954, 1432, -16093, 6243, 9297},
-        .w_dist = {8190, -9398, -9629, 30384, 427, 36, -28024, 16583, 551, 18535, -32510, 24825},
-        .b_hidden = {-31959, 614, -19101, -21471, 437, 887, 1479, 17794, -1305, -2957, -18992, 21956},
-        .w_out = {28694, -28205, -16687, -15328, 765, -641, 32767, 5479, 317, 23955, 7196, 1421},
-        .b_out = 5557}}}},
-    /* scan search, the evolved policy unchanged from h12-rooms-direct-r1 (file:policies/h12-rooms-direct-r1.policy, open-to-rooms direct run-001 at c6f786c); 3444 evaluations on scan adversary:15 */
+        .w_theta = {1105, -32250, -18356, 9574, -2542, -1164, -9035, -10883, -27114, -4827, -13404, 9297},
+        .w_dist = {8190, -21482, -9629, 30346, 653, 78, -28024, 16583, -5290, 15157, -32510, 24825},
+        .b_hidden = {-31959, -16575, -19101, -21471, -175, 207, 3176, -32768, 24155, 31870, -18992, 21956},
+        .w_out = {28694, 3872, -16687, -14041, 592, -1266, 4799, -32058, 4029, -759, 7196, 990},
+        .b_out = -2036}}}},
+    /* scan search, the evolved policy unchanged from h12-rooms-direct-r1 (file:policies/h12-rooms-direct-r1.policy, open-to-rooms direct run-001 at c6f786c); 3252 evaluations on scan adversary:15 */
     {"adv-e12-n180-0", QNAV_BENCH_SET_ADVERSARY, 0, {.kind = QNAV_POLICY_NET, .u = {.net = {
         .hidden = 12, .inputs = 2,
         .w_theta = {-112, 1988, -53, -979, -2027, -525, -291, -560, 502, -68, 1961, -480},
