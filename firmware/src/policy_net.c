@@ -278,6 +278,18 @@ void qnav_net_eval_init(qnav_ctrl_t *ctrl, const qnav_net_t *net)
     ctrl->p.net.out_bias_z = (int32_t)net->b_out * 128;
 }
 
+/* The dtheta of run r's path at offset i. */
+static inline uint8_t dtheta_at(const qnav_run_t *r, uint8_t i)
+{
+    return (uint8_t)(r->dir > 0 ? r->dtheta0 + i : r->dtheta0 - i);
+}
+
+/* The dtheta of the path of offsets lo..hi nearest the goal. */
+static inline uint8_t dtheta_near(const qnav_run_t *r, uint8_t lo, uint8_t hi)
+{
+    return dtheta_at(r, r->dir > 0 ? lo : hi);
+}
+
 /* Do unit u's shares rise along run r (dtheta moving by r->dir per path)? A unit whose
  * pre-activation does not move is constant: either answer holds. */
 static inline uint8_t rises_along(const qnav_ctrl_unit_t *u, const qnav_run_t *r)
@@ -298,8 +310,8 @@ static inline uint8_t rises_along(const qnav_ctrl_unit_t *u, const qnav_run_t *r
 static inline void two_sums(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uint8_t i_lo,
                             uint8_t i_hi, int32_t *s_lo, int32_t *s_hi)
 {
-    uint8_t d_lo = (uint8_t)(r->dir > 0 ? r->dtheta0 + i_lo : r->dtheta0 - i_lo);
-    uint8_t d_hi = (uint8_t)(r->dir > 0 ? r->dtheta0 + i_hi : r->dtheta0 - i_hi);
+    uint8_t d_lo = dtheta_at(r, i_lo);
+    uint8_t d_hi = dtheta_at(r, i_hi);
     int32_t lo = 0;
     int32_t hi = 0;
     uint8_t j;
@@ -362,7 +374,7 @@ static inline void span_direct(const qnav_ctrl_t *ctrl, const qnav_run_t *r, uin
 {
     uint8_t i;
     for (i = lo; i <= hi; ++i) {
-        uint8_t d = (uint8_t)(r->dir > 0 ? r->dtheta0 + i : r->dtheta0 - i);
+        uint8_t d = dtheta_at(r, i);
         qnav_best_consider(best, key_of_path(ctrl, r->level, d), (uint16_t)(r->first + i), d);
     }
 }
@@ -411,7 +423,7 @@ static inline void search_rest(const qnav_ctrl_t *ctrl, const qnav_run_t *r,
     span_direct(ctrl, r, n->lo, n->hi, best);
     while (depth != 0u) {
         const later_t *w = &stack[--depth];
-        uint8_t d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + w->lo : r->dtheta0 - w->hi);
+        uint8_t d_near = dtheta_near(r, w->lo, w->hi);
         if (may_win(best, w->bound, d_near)) {
             span_direct(ctrl, r, w->lo, w->hi, best);
         } else {
@@ -448,7 +460,7 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
     --*credit;
     for (;;) {
         qnav_qkey_t bound = step_key_of(ctrl, ctrl->p.net.out_bias_z + n.s_lo + n.s_hi);
-        d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + n.lo : r->dtheta0 - n.hi);
+        d_near = dtheta_near(r, n.lo, n.hi);
         if (may_win(best, bound, d_near)) {
             if (*credit == 0u) {
                 search_rest(ctrl, r, &n, stack, depth, best, credit);
@@ -471,7 +483,7 @@ static void search_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t
             --depth;
             n.lo = stack[depth].lo;
             n.hi = stack[depth].hi;
-            d_near = (uint8_t)(r->dir > 0 ? r->dtheta0 + n.lo : r->dtheta0 - n.hi);
+            d_near = dtheta_near(r, n.lo, n.hi);
             if (!may_win(best, stack[depth].bound, d_near)) {
                 *credit = (qnav_credit_t)(*credit + span_size(n.lo, n.hi));
                 continue;
