@@ -99,7 +99,8 @@ static void parse_controller_settings(const TomlReader &r, RobotProfile &p) {
                                     "(QNAV_SIM_TICK_S, DESIGN.md section 4)");
 }
 
-// The optional [escape] and [recovery]: what the robot does when stuck or in collision.
+// The optional [escape] and [map], and [recovery]: what the robot does when stuck or in
+// collision.
 static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
     const toml::table &root = r.root();
     if (root.get("escape")) {
@@ -108,6 +109,17 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         p.escape_stall_s = r.number(es, "stall_s", 0.0, 25.5, true, p.escape_stall_s);
         p.escape_follow_m = r.number(es, "follow_m", 0.0, 65.0, true, p.escape_follow_m);
         p.escape_follow_s = r.number(es, "follow_s", 1.0, 109.0, true, p.escape_follow_s);
+    }
+
+    if (root.get("map")) {
+        const toml::table &mp = r.table(root, "map");
+        r.only_keys(mp, {"cell_m", "reach_m", "look_m", "plan_s", "near_m", "near_cost"});
+        p.map_cell_m = r.number(mp, "cell_m", 0.02, 1.0);
+        p.map_reach_m = r.number(mp, "reach_m", 0.1, 65.0, true, p.map_reach_m);
+        p.map_look_m = r.number(mp, "look_m", 0.0, 65.0, true, p.map_look_m);
+        p.map_plan_s = r.number(mp, "plan_s", 0.1, 25.5, true, p.map_plan_s);
+        p.map_near_m = r.number(mp, "near_m", 0.0, 65.0, true, p.map_near_m);
+        p.map_near_cost = r.number(mp, "near_cost", 0.0, 25.5, true, p.map_near_cost);
     }
 
     const toml::table &rec = r.table(root, "recovery");
@@ -125,7 +137,7 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
     TomlReader r(text, name);
     const toml::table &root = r.root();
     r.only_keys(root, {"name", "body", "drive", "slip", "sonar", "noise", "recovery", "probabilistic",
-                      "clearance", "odometry", "control", "escape"});
+                      "clearance", "odometry", "control", "escape", "map"});
     RobotProfile p;
     p.name = r.string(root, "name");
     if (p.name.empty()) r.fail(root, "'name' must not be empty");

@@ -52,6 +52,14 @@ struct RobotProfile {
                                     // s; 0: no escape
     double escape_follow_m = 0.5;   // paths with less clearance are blocked when following, m
     double escape_follow_s = 20.0;  // first follow of one side at most, s
+    // the map and its plan above the controller (libqnav qnav/map.h; docs/architecture.md,
+    // "A map and a plan"); map_cell_m 0: none
+    double map_cell_m = 0.0;        // cell side, m
+    double map_reach_m = 2.0;       // readings mark cells out to this distance, m
+    double map_look_m = 1.0;        // the sub-goal lies this far along the plan, m
+    double map_plan_s = 1.0;        // time between plans, s
+    double map_near_m = 0.2;        // cells this much beyond the body's reach of a wall...
+    double map_near_cost = 1.0;     // ...cost this much more to cross, in cell sides
     // what only the board needs (qnav-sim robot-header)
     std::uint32_t um_per_count = 1000;  // wheel travel per encoder count, micrometres
     std::uint32_t tick_ms = 100;        // control tick, ms (the simulator's QNAV_SIM_TICK_S)

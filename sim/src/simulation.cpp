@@ -85,6 +85,27 @@ Simulation::Simulation(const RobotProfile &robot, const Environment &env, const 
     true_dist_.assign(cfg_.n_sectors, kInf);
     scan_.n_sectors = cfg_.n_sectors;
     scan_.max_range_mm = max_range_mm_;
+    if (robot_.map_cell_m > 0) {
+        qnav_map_config_t mc;
+        qnav_map_config_default(&mc);
+        mc.cell_mm = static_cast<std::uint16_t>(std::lround(robot_.map_cell_m * 1000.0));
+        mc.reach_mm = static_cast<std::uint16_t>(std::lround(std::min(65.0, robot_.map_reach_m) * 1000.0));
+        mc.look_mm = static_cast<std::uint16_t>(std::lround(std::min(65.0, robot_.map_look_m) * 1000.0));
+        mc.plan_ticks = static_cast<std::uint8_t>(std::clamp(std::lround(robot_.map_plan_s / QNAV_SIM_TICK_S), 1L, 255L));
+        mc.near_mm = static_cast<std::uint16_t>(std::lround(robot_.map_near_m * 1000.0));
+        mc.near_cost = static_cast<std::uint8_t>(std::lround(robot_.map_near_cost * 10.0));
+        const auto mm = [](double m) { return static_cast<std::uint32_t>(std::ceil(m * 1000.0)); };
+        const std::uint32_t cells = qnav_map_cells(mm(env_.width_m), mm(env_.height_m), mc.cell_mm);
+        map_mem_.assign((qnav_map_bytes(cells) + 1) / 2, 0);
+        qnav_ctrl_config_t cc;
+        robot_ctrl_config(robot_, cfg_.n_sectors, &cc);
+        const qnav_status_t st = qnav_map_init(&map_, &mc, &cc, 0, 0, mm(env_.width_m), mm(env_.height_m),
+                                               map_mem_.data(), map_mem_.size() * 2);
+        if (st != QNAV_OK)
+            throw SimError(QNAV_SIM_E_PARAM, robot_.name + ": [map] for a " + std::to_string(env_.width_m) +
+                                                 " x " + std::to_string(env_.height_m) + " m arena: " +
+                                                 qnav_status_str(st));
+    }
 }
 
 Simulation::~Simulation() = default;
@@ -182,6 +203,7 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     marks_.clear();
     vel_ = {0, 0};
     body_stale_ = false;
+    if (!map_mem_.empty()) qnav_map_reset(&map_);
     Vec2 unused;
     touching(&unused);  // sets clearance_m_
     const double dx = env_.dest_x_m - pos_.x, dy = env_.dest_y_m - pos_.y;
@@ -225,7 +247,28 @@ void Simulation::compute_scan() {
     scan_.goal_range_mm = static_cast<qnav_mm_t>(std::clamp(goal_m * 1000.0 + 0.5, 1.0, 65535.0));
     sensed_heading_ = hd;
     scan_.prev_heading_cdeg = have_prev_ ? to_cdeg(prev_world_rad_ - hd) : 0;
+    scan_.escape_clear = 0;
+    if (!map_mem_.empty()) guide_scan();
     if (profiling_) prof_.sonar_s += std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// The map marks what this scan saw from the true pose (a board's odometry, good to a cell
+// over an episode: an assumption, docs/architecture.md "A map and a plan") and gives the
+// controller the plan's sub-goal, its bearing seen with the sensed heading as the
+// destination's is.
+void Simulation::guide_scan() {
+    const auto mm = [](double m) { return static_cast<std::int32_t>(std::lround(m * 1000.0)); };
+    const auto cdeg = [](double rad) { return static_cast<std::int32_t>(std::lround(rad * 18000.0 / kPi)); };
+    const qnav_pose_t truth{mm(pos_.x), mm(pos_.y), cdeg(heading_)};
+    qnav_map_observe(&map_, scan_.ranges_mm, &truth);
+    const qnav_pose_t sensed{truth.x_mm, truth.y_mm, cdeg(sensed_heading_)};
+    qnav_ctrl_input_t in{};
+    in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
+    in.goal_range_mm = scan_.goal_range_mm;
+    const int got = qnav_map_guide(&map_, &sensed, mm(env_.dest_x_m), mm(env_.dest_y_m), &in);
+    scan_.goal_bearing_cdeg = in.goal_bearing_cdeg;
+    scan_.goal_range_mm = in.goal_range_mm;
+    scan_.escape_clear = (got & QNAV_MAP_ESCAPE_CLEARED) ? 1 : 0;
 }
 
 namespace {
@@ -563,7 +606,7 @@ qnav_sim_result_t Simulation::run_episode_with(StepFn step, void *self, std::uin
         in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
         in.prev_heading_cdeg = scan_.prev_heading_cdeg;
         in.goal_range_mm = scan_.goal_range_mm;
-        in.escape = out.escape;
+        in.escape = scan_.escape_clear ? qnav_escape_t{} : out.escape;
         Clock::time_point t0;
         if (profiling_) t0 = Clock::now();
         step(self, &in, &out);

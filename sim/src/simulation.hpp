@@ -11,6 +11,7 @@
 
 #include "env.hpp"
 #include "qnav/nav.h"
+#include "qnav/map.h"
 #include "qnav/sim.h"
 #include "qnav/rng.hpp"
 #include "robot.hpp"
@@ -93,6 +94,7 @@ private:
     Vec2 dest() const { return Vec2{env_.dest_x_m, env_.dest_y_m}; }
     void build_world();
     void compute_scan();
+    void guide_scan();
     void drive_substep(double dt);
     void recovery_wheels();
     void heading_wheels(double dt);
@@ -102,6 +104,10 @@ private:
 
     RobotProfile robot_;
     Environment env_;
+    // the profile's [map] (libqnav qnav/map.h): what the sonar has seen and a plan over it,
+    // giving the scan a sub-goal; map_mem_ empty: none
+    qnav_map_t map_{};
+    std::vector<std::uint16_t> map_mem_;
     SimConfig cfg_;
     SonarRing sonar_;
     std::uint16_t max_range_mm_;

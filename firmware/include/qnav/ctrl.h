@@ -43,7 +43,9 @@ typedef enum {
     QNAV_E_WEDGE = -13,       /* wedge_pct above 100 */
     QNAV_E_KIND_DISABLED = -14, /* a policy kind, table mode or controller left out of
                                   this build (a QNAV_WITH_* switch at 0, qnav/qnav_config.h) */
-    QNAV_E_KEEP = -15         /* keep_pct above 100 */
+    QNAV_E_KEEP = -15,        /* keep_pct above 100 */
+    QNAV_E_MAP = -16          /* a map's configuration, size or memory out of range
+                                 (qnav/map.h) */
 } qnav_status_t;
 
 /*

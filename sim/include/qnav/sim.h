@@ -291,6 +291,12 @@ typedef struct {
                                               destination's, mm, 1..65535 (the pose the
                                               board's odometry or the inertial sensors give;
                                               exact): qnav_ctrl_input_t.goal_range_mm */
+    uint8_t escape_clear;                  /* 1: pass this tick's controller a cleared
+                                              escape memory (qnav_ctrl_input_t.escape):
+                                              the map's plan grew (its way closed). With a
+                                              profile's [map], goal_bearing_cdeg and
+                                              goal_range_mm are the plan's sub-goal and
+                                              planned distance (qnav/map.h) */
 } qnav_sim_scan_t;
 
 /* The robot's true state. */

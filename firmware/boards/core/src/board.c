@@ -335,7 +335,7 @@ static void update_pose(qnav_board_t *bot)
     bot->odo_left = l;
     bot->odo_right = r;
     step = (step * (int32_t)bot->cfg.um_per_count) / 2;
-    qnav_board_cos_sin((int32_t)h0 + (int32_t)qnav_board_wrap_cdeg((int32_t)h - (int32_t)h0) / 2,
+    qnav_cos_sin_q14((int32_t)h0 + (int32_t)qnav_wrap_cdeg((int32_t)h - (int32_t)h0) / 2,
                        &c, &s);
     /* in pieces that keep piece * cos inside int32 (a long stall moves far in one tick) */
     while (step != 0) {
@@ -358,10 +358,10 @@ static qnav_cdeg_t goal_bearing(qnav_board_t *bot, uint32_t *dist_mm)
     if (bot->goal.kind == QNAV_LINK_GOAL_POSITION) {
         int32_t dx = bot->goal.x_mm - bot->pose.x_um / (int32_t)1000;
         int32_t dy = bot->goal.y_mm - bot->pose.y_um / (int32_t)1000;
-        qnav_cdeg_t world = qnav_board_atan2(dy, dx, dist_mm);
-        return qnav_board_wrap_cdeg((int32_t)world - (int32_t)bot->pose.heading_cdeg);
+        qnav_cdeg_t world = qnav_atan2_cdeg(dy, dx, dist_mm);
+        return qnav_wrap_cdeg((int32_t)world - (int32_t)bot->pose.heading_cdeg);
     }
-    return qnav_board_wrap_cdeg((int32_t)bot->goal.bearing_cdeg -
+    return qnav_wrap_cdeg((int32_t)bot->goal.bearing_cdeg -
                                 (int32_t)bot->pose.heading_cdeg);
 }
 

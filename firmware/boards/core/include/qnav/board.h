@@ -28,6 +28,7 @@
 #include "qnav/check.h"
 #include "qnav/nav.h"
 #include "qnav/link.h"
+#include "qnav/trig.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -196,18 +197,6 @@ qnav_board_policy_source_t qnav_board_policy_source(const qnav_board_t *bot);
 void qnav_board_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_deg_t spin_deg,
                     qnav_q1_15_t *left, qnav_q1_15_t *right);
 
-/*
- * Integer trigonometry for the pose (CORDIC, 16 iterations, no tables in RAM).
- * qnav_board_cos_sin: cos and sin of a (0.01 deg, any value) in Q2.14 (16384 = 1),
- * error <= 2/16384. qnav_board_atan2: direction of (x, y) in 0.01 deg, -18000..17999
- * (0 for the origin), error <= 1 cdeg for |x|, |y| up to 2^21; *dist (may be NULL) its
- * length, same unit as x and y, error <= 0.1 % + 2.
- * @par Scaling and overflow: inputs are clamped to +-2^21.
- */
-void qnav_board_cos_sin(int32_t a_cdeg, int16_t *cos_q14, int16_t *sin_q14);
-/* An angle in 0.01 deg wrapped into -18000..17999. */
-qnav_cdeg_t qnav_board_wrap_cdeg(int32_t a_cdeg);
-qnav_cdeg_t qnav_board_atan2(int32_t y, int32_t x, uint32_t *dist);
 
 #ifdef __cplusplus
 }

@@ -1,9 +1,9 @@
 /*
- * Integer trigonometry for the board's pose (qnav/board.h): CORDIC in 32-bit integers,
+ * Integer trigonometry (qnav/trig.h): CORDIC in 32-bit integers,
  * angles in 1/64 of 0.01 deg inside, 16 iterations. No floats, no tables in RAM (the 16
  * arctangents are constants in code), no file-scope state.
  */
-#include "qnav/board.h"
+#include "qnav/trig.h"
 
 #include <stddef.h>
 
@@ -46,7 +46,7 @@ static int32_t clamp(int32_t v)
     return v > LIMIT ? LIMIT : (v < -LIMIT ? -LIMIT : v);
 }
 
-qnav_cdeg_t qnav_board_wrap_cdeg(int32_t a)
+qnav_cdeg_t qnav_wrap_cdeg(int32_t a)
 {
     a %= INT32_C(36000);
     if (a < -INT32_C(18000)) {
@@ -57,9 +57,9 @@ qnav_cdeg_t qnav_board_wrap_cdeg(int32_t a)
     return (qnav_cdeg_t)a;
 }
 
-void qnav_board_cos_sin(int32_t a_cdeg, int16_t *cos_q14, int16_t *sin_q14)
+void qnav_cos_sin_q14(int32_t a_cdeg, int16_t *cos_q14, int16_t *sin_q14)
 {
-    int32_t a = qnav_board_wrap_cdeg(a_cdeg);
+    int32_t a = qnav_wrap_cdeg(a_cdeg);
     int32_t x = K_Q14 * INT32_C(1024); /* 10 more bits inside, rounded off at the end */
     int32_t y = 0;
     int32_t z;
@@ -98,7 +98,7 @@ void qnav_board_cos_sin(int32_t a_cdeg, int16_t *cos_q14, int16_t *sin_q14)
     }
 }
 
-qnav_cdeg_t qnav_board_atan2(int32_t y, int32_t x, uint32_t *dist)
+qnav_cdeg_t qnav_atan2_cdeg(int32_t y, int32_t x, uint32_t *dist)
 {
     int32_t z = 0;
     uint8_t i;
@@ -145,5 +145,5 @@ qnav_cdeg_t qnav_board_atan2(int32_t y, int32_t x, uint32_t *dist)
         *dist = (m / 16u) * (uint32_t)K_Q14 / 1024u + ((m % 16u) * (uint32_t)K_Q14) / 16384u;
     }
     z = z >= 0 ? (z + UNIT / 2) / UNIT : -((-z + UNIT / 2) / UNIT);
-    return qnav_board_wrap_cdeg(z);
+    return qnav_wrap_cdeg(z);
 }

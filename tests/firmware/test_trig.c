@@ -1,5 +1,5 @@
 /*
- * The board core's integer trigonometry (CORDIC) against the C library: cos and sin
+ * libqnav's integer trigonometry (CORDIC, qnav/trig.h) against the C library: cos and sin
  * within 2/16384 over the whole circle, atan2 within 1 cdeg of the integer point's direction and lengths within 0.1 % + 2
  * over every quadrant, from a few millimetres to 2 km.
  */
@@ -13,7 +13,7 @@
 
 #include <cmocka.h>
 
-#include "qnav/board.h"
+#include "qnav/trig.h"
 
 static void test_cos_sin_are_within_two_counts_of_q14_over_the_circle(void **state)
 {
@@ -24,7 +24,7 @@ static void test_cos_sin_are_within_two_counts_of_q14_over_the_circle(void **sta
         int16_t c, s;
         double r = a * M_PI / 18000.0;
         int ec, es;
-        qnav_board_cos_sin(a, &c, &s);
+        qnav_cos_sin_q14(a, &c, &s);
         ec = abs(c - (int)lround(cos(r) * 16384.0));
         es = abs(s - (int)lround(sin(r) * 16384.0));
         worst = ec > worst ? ec : worst;
@@ -49,7 +49,7 @@ static void test_atan2_is_within_one_cdeg_and_length_within_a_permille(void **st
             double want = atan2((double)y, (double)x) * 18000.0 / M_PI;
             double len = sqrt((double)x * x + (double)y * y);
             uint32_t dist;
-            qnav_cdeg_t got = qnav_board_atan2(y, x, &dist);
+            qnav_cdeg_t got = qnav_atan2_cdeg(y, x, &dist);
             double err = fabs(got - want);
             if (err > 18000.0) {
                 err = 36000.0 - err; /* -18000 and 17999 are neighbours */
@@ -62,9 +62,9 @@ static void test_atan2_is_within_one_cdeg_and_length_within_a_permille(void **st
             assert_true(fabs(dist - len) <= len * 0.001 + 2.0);
         }
     }
-    assert_int_equal(qnav_board_atan2(0, 0, NULL), 0);
-    assert_int_equal(qnav_board_atan2(0, -5000, NULL), -18000);
-    assert_int_equal(qnav_board_atan2(5000, 0, NULL), 9000);
+    assert_int_equal(qnav_atan2_cdeg(0, 0, NULL), 0);
+    assert_int_equal(qnav_atan2_cdeg(0, -5000, NULL), -18000);
+    assert_int_equal(qnav_atan2_cdeg(5000, 0, NULL), 9000);
     print_message("worst atan2 error %d cdeg\n", worst);
 }
 

@@ -1,0 +1,132 @@
+/*
+ * A map of what the sonar has seen, and a plan over it (docs/architecture.md, "A map and
+ * a plan"). The path-quality step has no memory of place: in a world of dead ends, doors
+ * and gaps it searches by following walls, and a wrong first side costs more than a world's
+ * time limit. The map remembers which cells the sonar has seen free and which it has seen
+ * a reading end in; a plan over it (unknown cells taken as free) gives the controller a
+ * sub-goal a little way along the shortest known-passable way to the destination instead
+ * of the destination itself. The controller, its policy and its escape memory are
+ * unchanged: the map only rewrites the input's goal bearing and range.
+ *
+ * Fixed point, no heap: the caller gives the memory (qnav_map_bytes()) and keeps it; the
+ * robot's pose (millimetres, 0.01 deg, in the frame the destination is given in) comes from
+ * the caller's odometry or the simulator. One map per destination and world: reset it
+ * when either changes.
+ *
+ * Use: qnav_map_init() once -> every tick qnav_map_observe() with the scan and the pose,
+ * then qnav_map_guide() on the controller's input before qnav_ctrl_step() (or any
+ * qnav_nav_t step).
+ */
+#ifndef QNAV_MAP_H
+#define QNAV_MAP_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "qnav/check.h"
+#include "qnav/ctrl.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* What the map is made of (docs/architecture.md, "A map and a plan"). */
+typedef struct {
+    uint16_t cell_mm;      /* a cell's side, mm, 20..1000; default 100 */
+    uint16_t reach_mm;     /* readings mark cells out to this distance from the robot's
+                              centre, mm; default 2000 */
+    uint16_t look_mm;      /* the sub-goal lies this far along the plan, mm; default 1000 */
+    uint16_t jump_mm;      /* a plan longer by this than the last tick's clears the escape
+                              memory (the way it was following is closed), mm; default 1000 */
+    uint8_t plan_ticks;    /* ticks between plans, 1..255; default 10 */
+    uint8_t noise_pct;     /* a cell this many % of the reading short of it (plus 3/4 of a
+                              cell) is not marked free: the sonar's range noise; default 5 */
+    uint8_t near_cost;     /* extra plan cost of a cell within near_mm beyond the body's
+                              reach of an occupied cell (10: one more cell side); default 10 */
+    uint16_t near_mm;      /* mm; default 200 (measured: docs/architecture.md) */
+} qnav_map_config_t;
+
+/* The robot's pose in the destination's frame. */
+typedef struct {
+    int32_t x_mm;
+    int32_t y_mm;
+    int32_t heading_cdeg;  /* direction of the robot's straight ahead (sector 0), any value */
+} qnav_pose_t;
+
+/* One map. Private fields: read them through the functions below. */
+typedef struct {
+    qnav_map_config_t cfg;
+    uint16_t n_sectors;
+    qnav_mm_t max_range_mm;
+    qnav_mm_t offset_mm;      /* sensor offset: a reading r lies r + offset from the centre */
+    uint16_t inflate_mm;      /* body radius + safety distance */
+    int32_t x0_mm, y0_mm;     /* the world corner of cell (0, 0) */
+    uint16_t nx, ny;
+    int8_t *evidence;         /* per cell: < 0 seen free, >= QNAV_MAP_OCCUPIED occupied */
+    uint16_t *cost;           /* per cell: plan cost to the destination, 10 per cell side */
+    uint16_t *heap;           /* the plan's queue */
+    uint16_t *slot;           /* per cell: its place in the queue */
+    uint8_t *blocked;         /* per cell: too near an occupied cell for the body */
+    int32_t goal_x_mm, goal_y_mm;
+    uint16_t ticks;           /* observations since the last plan */
+    uint16_t last_mm;         /* the last guided tick's planned distance; 0: none */
+    uint8_t planned;          /* a plan toward goal_* exists */
+} qnav_map_t;
+
+/* Evidence at or above this marks a cell occupied. */
+#define QNAV_MAP_OCCUPIED 2
+/* Plan cost of an unreachable cell. */
+#define QNAV_MAP_UNREACHED UINT16_C(0xFFFF)
+
+void qnav_map_config_default(qnav_map_config_t *cfg);
+
+/* Cells of a width_mm x height_mm world at cell_mm; 0 when too many (> 65 000) or cell_mm 0. */
+uint32_t qnav_map_cells(uint32_t width_mm, uint32_t height_mm, uint16_t cell_mm);
+/* Bytes of memory a map of that many cells needs (8 per cell). */
+size_t qnav_map_bytes(uint32_t cells);
+
+/*
+ * A map of the world [x0, x0 + width) x [y0, y0 + height) mm for a robot whose controller
+ * is configured by ctrl (sectors, sonar range and offset, body): buf holds len bytes,
+ * at least qnav_map_bytes(), aligned for uint16_t. Starts empty (every cell unknown).
+ */
+QNAV_CHECK_RESULT qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
+                                              const qnav_ctrl_config_t *ctrl, int32_t x0_mm,
+                                              int32_t y0_mm, uint32_t width_mm,
+                                              uint32_t height_mm, void *buf, size_t len);
+
+/* Forget everything seen (a new world or start). */
+void qnav_map_reset(qnav_map_t *m);
+
+/* Mark what this scan (n_sectors ranges, mm, from the sensor) says about the cells. */
+void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose_t *pose);
+
+/* Plan every cell's cost to the destination over what the map has seen (unknown cells
+ * passable). At most 8 queue operations per cell. */
+void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm);
+
+/* What qnav_map_guide() did. */
+#define QNAV_MAP_GUIDED 1         /* the input's goal bearing and range are the plan's */
+#define QNAV_MAP_ESCAPE_CLEARED 2 /* the plan grew by jump_mm: in->escape was cleared */
+
+/*
+ * One tick, after qnav_map_observe(): plan again when plan_ticks have passed or the
+ * destination moved, and when the robot's cell has a way to the destination, replace
+ * in->goal_bearing_cdeg with the bearing of the point look_mm along it (seen from pose)
+ * and in->goal_range_mm with the planned distance, clearing in->escape when that grew by
+ * jump_mm since the last guided tick (the way the escape was following has closed).
+ * Returns QNAV_MAP_* flags; 0 when the map knows no way (the input stays as it was).
+ */
+int qnav_map_guide(qnav_map_t *m, const qnav_pose_t *pose, int32_t goal_x_mm,
+                   int32_t goal_y_mm, qnav_ctrl_input_t *in);
+
+/* A cell's evidence (< 0 free, >= QNAV_MAP_OCCUPIED occupied) and plan cost; for tests
+ * and pictures. Out of the map: 0 and QNAV_MAP_UNREACHED. */
+int8_t qnav_map_evidence(const qnav_map_t *m, int32_t x_mm, int32_t y_mm);
+uint16_t qnav_map_cost(const qnav_map_t *m, int32_t x_mm, int32_t y_mm);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,480 @@
+/*
+ * The map and its plan (qnav/map.h; docs/architecture.md, "A map and a plan").
+ *
+ * What a sonar reading says: a sector reports the nearest obstacle point inside its wedge,
+ * so every point of the wedge nearer than the reading is free, and somewhere on the arc at
+ * the reading lies an obstacle. A cell inside the wedge and nearer than the reading (less
+ * the range noise and most of a cell) is marked free; a cell on the arc that has never been
+ * seen free gains one count of occupied evidence; a cell seen free stays free until a
+ * reading ends in it again after it was forgotten (free evidence is kept, the arc's is
+ * weak: at most one of the arc's cells holds the obstacle, and the others are carved free
+ * by the wedges that see past them as the robot moves and turns). Cells nearer than the body
+ * radius and safety distance to an occupied cell are blocked; the plan is Dijkstra's from
+ * the destination's cell over the rest (8 neighbours, 10 per side, 14 per diagonal, no
+ * corner cutting past a blocked cell), unknown cells passable.
+ */
+#include "qnav/map.h"
+
+#include <string.h>
+
+#include "qnav/trig.h"
+
+#define EVIDENCE_FREE_MIN (-4)
+#define EVIDENCE_MAX 3
+#define STEP_SIDE 10u
+#define STEP_DIAG 14u
+#define NOT_QUEUED UINT16_C(0xFFFF)
+#define MAX_CELLS UINT32_C(65000)
+
+void qnav_map_config_default(qnav_map_config_t *cfg)
+{
+    if (cfg == NULL) {
+        return;
+    }
+    cfg->cell_mm = 100u;
+    cfg->reach_mm = 2000u;
+    cfg->look_mm = 1000u;
+    cfg->jump_mm = 1000u;
+    cfg->plan_ticks = 10u;
+    cfg->noise_pct = 5u;
+    cfg->near_mm = 200u;
+    cfg->near_cost = 10u;
+}
+
+uint32_t qnav_map_cells(uint32_t width_mm, uint32_t height_mm, uint16_t cell_mm)
+{
+    uint32_t nx, ny;
+    if (cell_mm == 0u) {
+        return 0u;
+    }
+    nx = (width_mm + cell_mm - 1u) / cell_mm;
+    ny = (height_mm + cell_mm - 1u) / cell_mm;
+    if (nx == 0u || ny == 0u || nx > MAX_CELLS || ny > MAX_CELLS / nx) {
+        return 0u;
+    }
+    return nx * ny;
+}
+
+size_t qnav_map_bytes(uint32_t cells)
+{
+    /* cost, heap, slot: 2 bytes each; evidence, blocked: 1 */
+    return (size_t)cells * 8u;
+}
+
+qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
+                            const qnav_ctrl_config_t *ctrl, int32_t x0_mm, int32_t y0_mm,
+                            uint32_t width_mm, uint32_t height_mm, void *buf, size_t len)
+{
+    uint32_t cells;
+    uint8_t *p = (uint8_t *)buf;
+    if (m == NULL || cfg == NULL || ctrl == NULL || buf == NULL) {
+        return QNAV_E_NULL;
+    }
+    cells = qnav_map_cells(width_mm, height_mm, cfg->cell_mm);
+    if (cfg->cell_mm < 20u || cfg->cell_mm > 1000u || cfg->plan_ticks == 0u || cells == 0u ||
+        len < qnav_map_bytes(cells) || ((uintptr_t)buf & 1u) != 0u || ctrl->n_sectors == 0u ||
+        ctrl->n_sectors > QNAV_MAX_SECTORS || ctrl->max_range_mm == 0u) {
+        return QNAV_E_MAP;
+    }
+    memset(m, 0, sizeof *m);
+    m->cfg = *cfg;
+    m->n_sectors = ctrl->n_sectors;
+    m->max_range_mm = ctrl->max_range_mm;
+    m->offset_mm = ctrl->sensor_offset_mm;
+    m->inflate_mm = (uint16_t)((uint32_t)ctrl->body_radius_mm + ctrl->safety_mm > 65535u
+                                   ? 65535u
+                                   : (uint32_t)ctrl->body_radius_mm + ctrl->safety_mm);
+    m->x0_mm = x0_mm;
+    m->y0_mm = y0_mm;
+    m->nx = (uint16_t)((width_mm + cfg->cell_mm - 1u) / cfg->cell_mm);
+    m->ny = (uint16_t)(cells / m->nx);
+    m->cost = (uint16_t *)(void *)p;
+    m->heap = m->cost + cells;
+    m->slot = m->heap + cells;
+    m->evidence = (int8_t *)(void *)(m->slot + cells);
+    m->blocked = (uint8_t *)(m->evidence + cells);
+    qnav_map_reset(m);
+    return QNAV_OK;
+}
+
+static uint32_t cell_count(const qnav_map_t *m)
+{
+    return (uint32_t)m->nx * m->ny;
+}
+
+void qnav_map_reset(qnav_map_t *m)
+{
+    uint32_t i, n;
+    if (m == NULL || m->cost == NULL) {
+        return;
+    }
+    n = cell_count(m);
+    memset(m->evidence, 0, (size_t)n);
+    memset(m->blocked, 0, (size_t)n);
+    for (i = 0; i < n; ++i) {
+        m->cost[i] = QNAV_MAP_UNREACHED;
+    }
+    m->ticks = 0u;
+    m->last_mm = 0u;
+    m->planned = 0u;
+}
+
+/* The cell holding world point (x, y), clamped into the map. */
+static void cell_of(const qnav_map_t *m, int32_t x_mm, int32_t y_mm, int32_t *i, int32_t *j)
+{
+    int32_t a = (x_mm - m->x0_mm) / (int32_t)m->cfg.cell_mm;
+    int32_t b = (y_mm - m->y0_mm) / (int32_t)m->cfg.cell_mm;
+    if (x_mm < m->x0_mm) {
+        a = -1;
+    }
+    if (y_mm < m->y0_mm) {
+        b = -1;
+    }
+    *i = a < 0 ? 0 : (a >= (int32_t)m->nx ? (int32_t)m->nx - 1 : a);
+    *j = b < 0 ? 0 : (b >= (int32_t)m->ny ? (int32_t)m->ny - 1 : b);
+}
+
+/* (i, j) is a cell of the map. */
+static int in_map(const qnav_map_t *m, int32_t i, int32_t j)
+{
+    return i >= 0 && j >= 0 && i < (int32_t)m->nx && j < (int32_t)m->ny;
+}
+
+/* The index of cell (i, j) of the map. */
+static uint32_t at_cell(const qnav_map_t *m, int32_t i, int32_t j)
+{
+    return (uint32_t)j * m->nx + (uint32_t)i;
+}
+
+static int32_t centre_x(const qnav_map_t *m, int32_t i)
+{
+    return m->x0_mm + i * (int32_t)m->cfg.cell_mm + (int32_t)m->cfg.cell_mm / 2;
+}
+
+static int32_t centre_y(const qnav_map_t *m, int32_t j)
+{
+    return m->y0_mm + j * (int32_t)m->cfg.cell_mm + (int32_t)m->cfg.cell_mm / 2;
+}
+
+/* The sector whose wedge holds robot-frame direction a (0.01 deg). */
+static uint16_t sector_of(const qnav_map_t *m, int32_t a_cdeg)
+{
+    int32_t a = a_cdeg % INT32_C(36000);
+    uint32_t k;
+    if (a < 0) {
+        a += INT32_C(36000);
+    }
+    /* sector k is centred on k * 360 / N: round a * N / 360 deg */
+    k = ((uint32_t)a * m->n_sectors + 18000u) / 36000u;
+    return (uint16_t)(k % m->n_sectors);
+}
+
+/* Seen free: any occupied evidence is dropped, free evidence grows to its floor. */
+static void mark_free(int8_t *c)
+{
+    const int8_t v = (int8_t)((*c > 0 ? 0 : *c) - 1);
+    *c = v < EVIDENCE_FREE_MIN ? (int8_t)EVIDENCE_FREE_MIN : v;
+}
+
+void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose_t *pose)
+{
+    int32_t i0, i1, j0, j1, i, j;
+    const int32_t reach = (int32_t)m->cfg.reach_mm;
+    const int32_t three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
+    const int64_t reach2 = (int64_t)reach * reach;
+    if (m == NULL || m->cost == NULL || ranges_mm == NULL || pose == NULL) {
+        return;
+    }
+    cell_of(m, pose->x_mm - reach, pose->y_mm - reach, &i0, &j0);
+    cell_of(m, pose->x_mm + reach, pose->y_mm + reach, &i1, &j1);
+    for (j = j0; j <= j1; ++j) {
+        const int32_t dy = centre_y(m, j) - pose->y_mm;
+        for (i = i0; i <= i1; ++i) {
+            const int32_t dx = centre_x(m, i) - pose->x_mm;
+            const int64_t d2 = (int64_t)dx * dx + (int64_t)dy * dy;
+            int8_t *c = &m->evidence[at_cell(m, i, j)];
+            uint16_t k;
+            int32_t rc, tol, lo;
+            if (d2 > reach2 || d2 == 0) {
+                continue;
+            }
+            k = sector_of(m, (int32_t)qnav_atan2_cdeg(dy, dx, NULL) - pose->heading_cdeg);
+            rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
+            if (ranges_mm[k] >= m->max_range_mm) {
+                /* nothing in the wedge: free out to the reach */
+                mark_free(c);
+                continue;
+            }
+            tol = three_quarters + rc * (int32_t)m->cfg.noise_pct / 100;
+            lo = rc - tol;
+            if (lo > 0 && d2 < (int64_t)lo * lo) {
+                mark_free(c);
+            } else if (*c >= 0 && d2 <= (int64_t)(rc + three_quarters) * (rc + three_quarters)) {
+                *c = (int8_t)(*c + 1 > EVIDENCE_MAX ? EVIDENCE_MAX : *c + 1);
+            }
+        }
+    }
+}
+
+/* ---- Dijkstra's queue: a binary heap of cells keyed by cost, slot[] for decrease-key ---- */
+
+static void heap_set(qnav_map_t *m, uint16_t at, uint16_t cell)
+{
+    m->heap[at] = cell;
+    m->slot[cell] = at;
+}
+
+static void heap_up(qnav_map_t *m, uint16_t at)
+{
+    const uint16_t cell = m->heap[at];
+    while (at > 0u) {
+        const uint16_t parent = (uint16_t)((at - 1u) / 2u);
+        if (m->cost[m->heap[parent]] <= m->cost[cell]) {
+            break;
+        }
+        heap_set(m, at, m->heap[parent]);
+        at = parent;
+    }
+    heap_set(m, at, cell);
+}
+
+static void heap_down(qnav_map_t *m, uint16_t at, uint16_t size)
+{
+    const uint16_t cell = m->heap[at];
+    for (;;) {
+        uint32_t child = 2u * (uint32_t)at + 1u;
+        if (child >= size) {
+            break;
+        }
+        if (child + 1u < size && m->cost[m->heap[child + 1u]] < m->cost[m->heap[child]]) {
+            child++;
+        }
+        if (m->cost[m->heap[child]] >= m->cost[cell]) {
+            break;
+        }
+        heap_set(m, at, m->heap[child]);
+        at = (uint16_t)child;
+    }
+    heap_set(m, at, cell);
+}
+
+/* Cells within the body's reach of an occupied cell cannot hold the robot's centre
+ * (BLOCKED); cells within near_mm more cost more to cross (NEAR), so the plan keeps off
+ * walls and wall ends where it has room. */
+#define BLOCKED 2u
+#define NEAR 1u
+static void mark_blocked(qnav_map_t *m)
+{
+    const int32_t cell = (int32_t)m->cfg.cell_mm;
+    const int32_t outer = (int32_t)m->inflate_mm + (int32_t)m->cfg.near_mm;
+    const int32_t n = (outer + cell - 1) / cell;
+    const int64_t r2 = (int64_t)m->inflate_mm * m->inflate_mm;
+    const int64_t o2 = (int64_t)outer * outer;
+    int32_t i, j, a, b;
+    memset(m->blocked, 0, (size_t)cell_count(m));
+    for (j = 0; j < (int32_t)m->ny; ++j) {
+        for (i = 0; i < (int32_t)m->nx; ++i) {
+            if (m->evidence[at_cell(m, i, j)] < QNAV_MAP_OCCUPIED) {
+                continue;
+            }
+            for (b = -n; b <= n; ++b) {
+                for (a = -n; a <= n; ++a) {
+                    const int32_t ii = i + a, jj = j + b;
+                    const int64_t d2 = (int64_t)(a * a + b * b) * cell * cell;
+                    uint8_t *c;
+                    if (!in_map(m, ii, jj) ||
+                        d2 > o2) {
+                        continue;
+                    }
+                    c = &m->blocked[at_cell(m, ii, jj)];
+                    *c = d2 <= r2 ? BLOCKED : (*c > NEAR ? *c : NEAR);
+                }
+            }
+        }
+    }
+}
+
+void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
+{
+    uint32_t n, c;
+    uint16_t size = 0u;
+    int32_t gi, gj;
+    if (m == NULL || m->cost == NULL) {
+        return;
+    }
+    n = cell_count(m);
+    mark_blocked(m);
+    for (c = 0; c < n; ++c) {
+        m->cost[c] = QNAV_MAP_UNREACHED;
+        m->slot[c] = NOT_QUEUED;
+    }
+    cell_of(m, goal_x_mm, goal_y_mm, &gi, &gj);
+    c = at_cell(m, gi, gj);
+    m->cost[c] = 0u;
+    heap_set(m, size++, (uint16_t)c);
+    while (size > 0u) {
+        const uint16_t at = m->heap[0];
+        const int32_t i = (int32_t)(at % m->nx), j = (int32_t)(at / m->nx);
+        int32_t a, b;
+        m->slot[at] = NOT_QUEUED;
+        if (--size > 0u) {
+            heap_set(m, 0u, m->heap[size]);
+            heap_down(m, 0u, size);
+        }
+        for (b = -1; b <= 1; ++b) {
+            for (a = -1; a <= 1; ++a) {
+                const int32_t ii = i + a, jj = j + b;
+                uint32_t to;
+                uint32_t nc;
+                if ((a == 0 && b == 0) || !in_map(m, ii, jj)) {
+                    continue;
+                }
+                to = at_cell(m, ii, jj);
+                if (m->blocked[to] == BLOCKED ||
+                    (a != 0 && b != 0 &&
+                     (m->blocked[at_cell(m, ii, j)] == BLOCKED ||
+                      m->blocked[at_cell(m, i, jj)] == BLOCKED))) {
+                    continue;
+                }
+                nc = (uint32_t)m->cost[at] + (a != 0 && b != 0 ? STEP_DIAG : STEP_SIDE) +
+                     (m->blocked[to] == NEAR ? m->cfg.near_cost : 0u);
+                if (nc >= m->cost[to]) {
+                    continue;
+                }
+                m->cost[to] = (uint16_t)(nc >= QNAV_MAP_UNREACHED ? QNAV_MAP_UNREACHED - 1u : nc);
+                if (m->slot[to] == NOT_QUEUED) {
+                    heap_set(m, size++, (uint16_t)to);
+                }
+                heap_up(m, m->slot[to]);
+            }
+        }
+    }
+    m->goal_x_mm = goal_x_mm;
+    m->goal_y_mm = goal_y_mm;
+    m->planned = 1u;
+    m->ticks = 0u;
+}
+
+/* The cost of cell (i, j), or from the nearest reachable cell within two (the robot's
+ * own cell may be blocked: it stands near a wall). QNAV_MAP_UNREACHED: none. */
+static uint32_t cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi, int32_t *bj)
+{
+    uint32_t best = QNAV_MAP_UNREACHED;
+    int32_t a, b;
+    *bi = i;
+    *bj = j;
+    if (m->cost[at_cell(m, i, j)] != QNAV_MAP_UNREACHED) {
+        return m->cost[at_cell(m, i, j)];
+    }
+    for (b = -2; b <= 2; ++b) {
+        for (a = -2; a <= 2; ++a) {
+            const int32_t ii = i + a, jj = j + b;
+            uint32_t c;
+            if (!in_map(m, ii, jj)) {
+                continue;
+            }
+            c = m->cost[at_cell(m, ii, jj)];
+            if (c == QNAV_MAP_UNREACHED) {
+                continue;
+            }
+            /* to that cell: 10 a side, 14 a diagonal */
+            c += (uint32_t)((a < 0 ? -a : a) + (b < 0 ? -b : b)) * STEP_SIDE;
+            if (c < best) {
+                best = c;
+                *bi = ii;
+                *bj = jj;
+            }
+        }
+    }
+    return best;
+}
+
+int qnav_map_guide(qnav_map_t *m, const qnav_pose_t *pose, int32_t goal_x_mm,
+                   int32_t goal_y_mm, qnav_ctrl_input_t *in)
+{
+    int32_t i, j, ri, rj, steps, sx, sy;
+    uint32_t cost, mm;
+    int jumped;
+    if (m == NULL || m->cost == NULL || pose == NULL || in == NULL) {
+        return 0;
+    }
+    if (!m->planned || m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm ||
+        ++m->ticks >= m->cfg.plan_ticks) {
+        qnav_map_plan(m, goal_x_mm, goal_y_mm);
+    }
+    cell_of(m, pose->x_mm, pose->y_mm, &ri, &rj);
+    cost = cost_near(m, ri, rj, &i, &j);
+    if (cost == QNAV_MAP_UNREACHED) {
+        m->last_mm = 0u;
+        return 0;
+    }
+    /* steepest descent for look_mm */
+    for (steps = (int32_t)(m->cfg.look_mm / m->cfg.cell_mm); steps > 0; --steps) {
+        uint16_t here = m->cost[at_cell(m, i, j)];
+        int32_t a, b, ni = i, nj = j;
+        for (b = -1; b <= 1; ++b) {
+            for (a = -1; a <= 1; ++a) {
+                const int32_t ii = i + a, jj = j + b;
+                if (!in_map(m, ii, jj)) {
+                    continue;
+                }
+                if (m->cost[at_cell(m, ii, jj)] < here) {
+                    here = m->cost[at_cell(m, ii, jj)];
+                    ni = ii;
+                    nj = jj;
+                }
+            }
+        }
+        if (ni == i && nj == j) {
+            break;
+        }
+        i = ni;
+        j = nj;
+    }
+    if (m->cost[at_cell(m, i, j)] == 0u) {
+        sx = goal_x_mm; /* the plan ends in the destination's cell: aim at the destination */
+        sy = goal_y_mm;
+    } else {
+        sx = centre_x(m, i);
+        sy = centre_y(m, j);
+    }
+    if (sx != pose->x_mm || sy != pose->y_mm) {
+        in->goal_bearing_cdeg =
+            qnav_wrap_cdeg((int32_t)qnav_atan2_cdeg(sy - pose->y_mm, sx - pose->x_mm, NULL) -
+                           pose->heading_cdeg);
+    }
+    mm = cost * m->cfg.cell_mm / STEP_SIDE;
+    mm = mm == 0u ? 1u : (mm > 65535u ? 65535u : mm);
+    jumped = m->last_mm != 0u && mm > (uint32_t)m->last_mm + m->cfg.jump_mm;
+    m->last_mm = (uint16_t)mm;
+    in->goal_range_mm = (qnav_mm_t)mm;
+    if (jumped) {
+        memset(&in->escape, 0, sizeof in->escape);
+        return QNAV_MAP_GUIDED | QNAV_MAP_ESCAPE_CLEARED;
+    }
+    return QNAV_MAP_GUIDED;
+}
+
+/* The index of the cell holding (x, y); -1 outside the map. */
+static int32_t index_of(const qnav_map_t *m, int32_t x_mm, int32_t y_mm)
+{
+    int32_t i, j;
+    if (m == NULL || m->cost == NULL || x_mm < m->x0_mm || y_mm < m->y0_mm) {
+        return -1;
+    }
+    i = (x_mm - m->x0_mm) / (int32_t)m->cfg.cell_mm;
+    j = (y_mm - m->y0_mm) / (int32_t)m->cfg.cell_mm;
+    return i < (int32_t)m->nx && j < (int32_t)m->ny ? j * (int32_t)m->nx + i : -1;
+}
+
+int8_t qnav_map_evidence(const qnav_map_t *m, int32_t x_mm, int32_t y_mm)
+{
+    const int32_t k = index_of(m, x_mm, y_mm);
+    return k < 0 ? 0 : m->evidence[k];
+}
+
+uint16_t qnav_map_cost(const qnav_map_t *m, int32_t x_mm, int32_t y_mm)
+{
+    const int32_t k = index_of(m, x_mm, y_mm);
+    return k < 0 ? QNAV_MAP_UNREACHED : m->cost[k];
+}

@@ -1,0 +1,223 @@
+/*
+ * The map and its plan (qnav/map.h): what a reading marks, a plan round a wall to its gap,
+ * the escape memory cleared when the plan's way closes, and refusals. Scans come from a
+ * small ray marcher over rectangles written here, so each sector reports the nearest
+ * obstacle point inside its wedge, as the simulator's sonar does.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "qnav/map.h"
+#include "qnav/trig.h"
+
+#define N 16
+#define WORLD_MM 6000
+#define CELLS_MAX 4000
+
+static uint16_t mem[CELLS_MAX * 4];
+
+typedef struct {
+    int32_t x0, y0, x1, y1;
+} box_t;
+
+/* A wall across the world at y 2950..3050 with a gap at x 4500..5300. */
+static const box_t wall_with_gap[] = {{0, 2950, 4500, 3050}, {5300, 2950, WORLD_MM, 3050}};
+
+static void sensor_config(qnav_ctrl_config_t *cfg)
+{
+    qnav_ctrl_config_default(cfg);
+    cfg->n_sectors = N;
+    cfg->max_range_mm = 2500;
+    cfg->sensor_offset_mm = 120;
+    cfg->body_radius_mm = 120;
+    cfg->safety_mm = 50;
+}
+
+static void map_of(qnav_map_t *m, uint8_t plan_ticks)
+{
+    qnav_map_config_t mc;
+    qnav_ctrl_config_t cc;
+    sensor_config(&cc);
+    qnav_map_config_default(&mc);
+    mc.plan_ticks = plan_ticks;
+    assert_true(qnav_map_cells(WORLD_MM, WORLD_MM, mc.cell_mm) <= CELLS_MAX);
+    assert_int_equal(qnav_map_init(m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
+                     QNAV_OK);
+}
+
+static int inside(const box_t *boxes, size_t n, int32_t x, int32_t y)
+{
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        if (x >= boxes[i].x0 && x <= boxes[i].x1 && y >= boxes[i].y0 && y <= boxes[i].y1) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Each sector's reading from pose: the nearest box point on 24 rays across its wedge,
+ * marched in 5 mm steps, less the sensor offset, clipped to the range. */
+static void scan(const box_t *boxes, size_t n, const qnav_pose_t *p, qnav_mm_t *ranges)
+{
+    int k, r;
+    for (k = 0; k < N; ++k) {
+        int32_t best = 2500 + 120;
+        for (r = 0; r < 24; ++r) {
+            const int32_t a = p->heading_cdeg + k * 36000 / N - 36000 / N / 2 +
+                              (36000 / N) * r / 23;
+            int16_t c, s;
+            int32_t d;
+            qnav_cos_sin_q14(a, &c, &s);
+            for (d = 0; d < best; d += 5) {
+                if (inside(boxes, n, p->x_mm + d * c / 16384, p->y_mm + d * s / 16384)) {
+                    best = d;
+                    break;
+                }
+            }
+        }
+        ranges[k] = (qnav_mm_t)(best - 120 > 2500 ? 2500 : (best < 120 ? 0 : best - 120));
+    }
+}
+
+static void test_a_reading_frees_its_wedge_and_marks_its_arc(void **state)
+{
+    qnav_map_t m;
+    qnav_mm_t ranges[N];
+    const qnav_pose_t p = {3000, 3000, 0};
+    int k;
+    (void)state;
+    map_of(&m, 10);
+    for (k = 0; k < N; ++k) {
+        ranges[k] = 2500;
+    }
+    ranges[0] = 1000; /* an obstacle 1 120 mm ahead of the centre */
+    qnav_map_observe(&m, ranges, &p);
+    assert_true(qnav_map_evidence(&m, 3550, 3050) < 0);       /* inside the wedge, nearer */
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3050), 1);   /* on the arc: one count */
+    assert_true(qnav_map_evidence(&m, 3050, 4550) < 0);       /* a clear sector, 1.5 m */
+    assert_int_equal(qnav_map_evidence(&m, 3050, 5550), 0);   /* beyond the reach: unknown */
+    qnav_map_observe(&m, ranges, &p);
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3050), QNAV_MAP_OCCUPIED);
+    /* the same cell seen through, from elsewhere: free, and it stays free */
+    ranges[0] = 2500;
+    qnav_map_observe(&m, ranges, &p);
+    assert_true(qnav_map_evidence(&m, 4150, 3050) < 0);
+    ranges[0] = 1000;
+    qnav_map_observe(&m, ranges, &p);
+    assert_true(qnav_map_evidence(&m, 4150, 3050) <= 0);
+}
+
+/* The robot drives along y = 1500 facing the wall and observes it, then plans. */
+static void observe_the_wall(qnav_map_t *m)
+{
+    qnav_mm_t ranges[N];
+    int32_t x;
+    for (x = 500; x <= 5500; x += 250) {
+        const qnav_pose_t p = {x, 1500, 9000};
+        scan(wall_with_gap, 2, &p, ranges);
+        qnav_map_observe(m, ranges, &p);
+    }
+}
+
+static void test_the_plan_leads_round_the_wall_to_its_gap(void **state)
+{
+    qnav_map_t m;
+    qnav_ctrl_input_t in;
+    const qnav_pose_t p = {1500, 1500, 9000}; /* facing the wall (+y) */
+    (void)state;
+    map_of(&m, 1);
+    /* nothing seen yet: the plan is the straight line */
+    memset(&in, 0, sizeof in);
+    assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &in), QNAV_MAP_GUIDED);
+    assert_true(in.goal_bearing_cdeg > -1000 && in.goal_bearing_cdeg < 1000);
+    assert_true(in.goal_range_mm > 3300 && in.goal_range_mm < 3700);
+    assert_int_equal(qnav_map_cost(&m, 1550, 5050), 0);
+    observe_the_wall(&m);
+    assert_true(qnav_map_evidence(&m, 2050, 2950) >= QNAV_MAP_OCCUPIED ||
+                qnav_map_evidence(&m, 2050, 3050) >= QNAV_MAP_OCCUPIED);
+    in.escape.side = 1;
+    in.escape.ticks = 42;
+    /* the way is through the gap, to the right: the plan grew by metres, so the escape
+     * memory of the closed way is cleared */
+    assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &in),
+                     QNAV_MAP_GUIDED | QNAV_MAP_ESCAPE_CLEARED);
+    assert_true(in.goal_bearing_cdeg < -2000);
+    assert_true(in.goal_range_mm > 3500 + 4000);
+    assert_int_equal(in.escape.side, 0);
+    assert_int_equal(in.escape.ticks, 0);
+    /* no wall cell is on the way: the cost under the wall's middle is unreached or more
+     * than the way round */
+    assert_true(qnav_map_cost(&m, 1550, 3000) == QNAV_MAP_UNREACHED);
+    /* next tick, the same plan: nothing cleared */
+    in.escape.side = 1;
+    assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &in), QNAV_MAP_GUIDED);
+    assert_int_equal(in.escape.side, 1);
+}
+
+static void test_a_destination_walled_in_leaves_the_input_alone(void **state)
+{
+    qnav_map_t m;
+    qnav_ctrl_input_t in;
+    static const box_t closed[] = {{0, 2950, WORLD_MM, 3050}};
+    qnav_mm_t ranges[N];
+    const qnav_pose_t p = {1500, 1500, 9000};
+    int32_t x;
+    (void)state;
+    map_of(&m, 1);
+    for (x = 300; x <= 5700; x += 200) {
+        const qnav_pose_t q = {x, 1500, 9000};
+        scan(closed, 1, &q, ranges);
+        qnav_map_observe(&m, ranges, &q);
+    }
+    memset(&in, 0, sizeof in);
+    in.goal_bearing_cdeg = 1234;
+    in.goal_range_mm = 3500;
+    assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &in), 0);
+    assert_int_equal(in.goal_bearing_cdeg, 1234);
+    assert_int_equal(in.goal_range_mm, 3500);
+}
+
+static void test_bad_maps_are_refused(void **state)
+{
+    qnav_map_t m;
+    qnav_map_config_t mc;
+    qnav_ctrl_config_t cc;
+    (void)state;
+    sensor_config(&cc);
+    qnav_map_config_default(&mc);
+    assert_int_equal(qnav_map_init(NULL, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem),
+                     QNAV_E_NULL);
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, NULL, sizeof mem),
+                     QNAV_E_NULL);
+    /* too little memory for 6 000 mm square at 100 mm: 3 600 cells, 8 bytes each */
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem,
+                                   qnav_map_bytes(3600) - 1),
+                     QNAV_E_MAP);
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem,
+                                   qnav_map_bytes(3600)),
+                     QNAV_OK);
+    mc.cell_mm = 10;
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
+    mc.cell_mm = 100;
+    mc.plan_ticks = 0;
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
+    assert_int_equal(qnav_map_cells(100000000u, 100000000u, 100), 0);
+    assert_string_not_equal(qnav_status_str(QNAV_E_MAP), "unknown status");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_a_reading_frees_its_wedge_and_marks_its_arc),
+        cmocka_unit_test(test_the_plan_leads_round_the_wall_to_its_gap),
+        cmocka_unit_test(test_a_destination_walled_in_leaves_the_input_alone),
+        cmocka_unit_test(test_bad_maps_are_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
