@@ -117,6 +117,7 @@ void qnav_map_reset(qnav_map_t *m)
     m->ticks = 0u;
     m->last_mm = 0u;
     m->planned = 0u;
+    m->dirty = 0u;
 }
 
 /* The cell holding world point (x, y), clamped into the map. */
@@ -156,6 +157,32 @@ static int32_t centre_y(const qnav_map_t *m, int32_t j)
     return m->y0_mm + j * (int32_t)m->cfg.cell_mm + (int32_t)m->cfg.cell_mm / 2;
 }
 
+/*
+ * Direction of (x, y), |x|, |y| < 2^16, in 0.01 deg, 0..35999, within 0.25 deg: in each
+ * octant atan(t) ~ 45 t + 15.64 t (1 - t) deg for t = min / max in [0, 1] (largest error
+ * 0.22 deg), one division. The map needs a cell's sector, not its exact direction: a cell
+ * within a quarter degree of a sector's edge may take the neighbour's reading, and the
+ * CORDIC's 16 steps per cell were most of the map's time.
+ */
+static int32_t direction_cdeg(int32_t x, int32_t y)
+{
+    const uint32_t ax = (uint32_t)(x < 0 ? -x : x), ay = (uint32_t)(y < 0 ? -y : y);
+    const uint32_t hi = ax > ay ? ax : ay, lo = ax > ay ? ay : ax;
+    uint32_t t, a;
+    if (hi == 0u) {
+        return 0;
+    }
+    t = (lo << 15) / hi;                                        /* Q15, 0..32768 */
+    a = (4500u * t + ((1564u * t) >> 15) * (32768u - t)) >> 15; /* 0..4500 */
+    if (ay > ax) {
+        a = 9000u - a;
+    }
+    if (x < 0) {
+        a = 18000u - a;
+    }
+    return y < 0 ? (int32_t)(36000u - a) % 36000 : (int32_t)a;
+}
+
 /* The sector whose wedge holds robot-frame direction a (0.01 deg). */
 static uint16_t sector_of(const qnav_map_t *m, int32_t a_cdeg)
 {
@@ -170,9 +197,12 @@ static uint16_t sector_of(const qnav_map_t *m, int32_t a_cdeg)
 }
 
 /* Seen free: any occupied evidence is dropped, free evidence grows to its floor. */
-static void mark_free(int8_t *c)
+static void mark_free(qnav_map_t *m, int8_t *c)
 {
     const int8_t v = (int8_t)((*c > 0 ? 0 : *c) - 1);
+    if (*c >= QNAV_MAP_OCCUPIED) {
+        m->dirty = 1u;
+    }
     *c = v < EVIDENCE_FREE_MIN ? (int8_t)EVIDENCE_FREE_MIN : v;
 }
 
@@ -198,19 +228,22 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose
             if (d2 > reach2 || d2 == 0) {
                 continue;
             }
-            k = sector_of(m, (int32_t)qnav_atan2_cdeg(dy, dx, NULL) - pose->heading_cdeg);
+            k = sector_of(m, direction_cdeg(dx, dy) - pose->heading_cdeg);
             rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
             if (ranges_mm[k] >= m->max_range_mm) {
                 /* nothing in the wedge: free out to the reach */
-                mark_free(c);
+                mark_free(m, c);
                 continue;
             }
             tol = three_quarters + rc * (int32_t)m->cfg.noise_pct / 100;
             lo = rc - tol;
             if (lo > 0 && d2 < (int64_t)lo * lo) {
-                mark_free(c);
+                mark_free(m, c);
             } else if (*c >= 0 && d2 <= (int64_t)(rc + three_quarters) * (rc + three_quarters)) {
                 *c = (int8_t)(*c + 1 > EVIDENCE_MAX ? EVIDENCE_MAX : *c + 1);
+                if (*c == QNAV_MAP_OCCUPIED) {
+                    m->dirty = 1u;
+                }
             }
         }
     }
@@ -353,6 +386,7 @@ void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
     m->goal_y_mm = goal_y_mm;
     m->planned = 1u;
     m->ticks = 0u;
+    m->dirty = 0u;
 }
 
 /* The cost of cell (i, j), or from the nearest reachable cell within two (the robot's
@@ -398,9 +432,15 @@ int qnav_map_guide(qnav_map_t *m, const qnav_pose_t *pose, int32_t goal_x_mm,
     if (m == NULL || m->cost == NULL || pose == NULL || in == NULL) {
         return 0;
     }
-    if (!m->planned || m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm ||
-        ++m->ticks >= m->cfg.plan_ticks) {
+    if (!m->planned || m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm) {
         qnav_map_plan(m, goal_x_mm, goal_y_mm);
+    } else if (++m->ticks >= m->cfg.plan_ticks) {
+        /* the plan's turn: made again only when a cell became or stopped being occupied
+         * since the last (the same plan otherwise) */
+        if (m->dirty) {
+            qnav_map_plan(m, goal_x_mm, goal_y_mm);
+        }
+        m->ticks = 0u;
     }
     cell_of(m, pose->x_mm, pose->y_mm, &ri, &rj);
     cost = cost_near(m, ri, rj, &i, &j);

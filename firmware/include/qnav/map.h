@@ -71,6 +71,7 @@ typedef struct {
     uint16_t ticks;           /* observations since the last plan */
     uint16_t last_mm;         /* the last guided tick's planned distance; 0: none */
     uint8_t planned;          /* a plan toward goal_* exists */
+    uint8_t dirty;            /* a cell became or stopped being occupied since the plan */
 } qnav_map_t;
 
 /* Evidence at or above this marks a cell occupied. */
