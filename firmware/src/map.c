@@ -57,7 +57,7 @@ uint32_t qnav_map_cells(uint32_t width_mm, uint32_t height_mm, uint16_t cell_mm)
 
 size_t qnav_map_bytes(uint32_t cells)
 {
-    /* cost, heap, slot: 2 bytes each; evidence, blocked: 1 */
+    /* cost, next, prev: 2 bytes each; evidence, blocked: 1 */
     return (size_t)cells * 8u;
 }
 
@@ -89,9 +89,9 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
     m->nx = (uint16_t)((width_mm + cfg->cell_mm - 1u) / cfg->cell_mm);
     m->ny = (uint16_t)(cells / m->nx);
     m->cost = (uint16_t *)(void *)p;
-    m->heap = m->cost + cells;
-    m->slot = m->heap + cells;
-    m->evidence = (int8_t *)(void *)(m->slot + cells);
+    m->next = m->cost + cells;
+    m->prev = m->next + cells;
+    m->evidence = (int8_t *)(void *)(m->prev + cells);
     m->blocked = (uint8_t *)(m->evidence + cells);
     qnav_map_reset(m);
     return QNAV_OK;
@@ -208,13 +208,15 @@ static void mark_free(qnav_map_t *m, int8_t *c)
 
 void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose_t *pose)
 {
-    int32_t i0, i1, j0, j1, i, j;
-    const int32_t reach = (int32_t)m->cfg.reach_mm;
-    const int32_t three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
-    const int64_t reach2 = (int64_t)reach * reach;
+    int32_t i0, i1, j0, j1, i, j, reach, three_quarters, heading;
+    int64_t reach2;
     if (m == NULL || m->cost == NULL || ranges_mm == NULL || pose == NULL) {
         return;
     }
+    reach = (int32_t)m->cfg.reach_mm;
+    three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
+    reach2 = (int64_t)reach * reach;
+    heading = qnav_wrap_cdeg(pose->heading_cdeg);
     cell_of(m, pose->x_mm - reach, pose->y_mm - reach, &i0, &j0);
     cell_of(m, pose->x_mm + reach, pose->y_mm + reach, &i1, &j1);
     for (j = j0; j <= j1; ++j) {
@@ -228,7 +230,7 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose
             if (d2 > reach2 || d2 == 0) {
                 continue;
             }
-            k = sector_of(m, direction_cdeg(dx, dy) - pose->heading_cdeg);
+            k = sector_of(m, direction_cdeg(dx, dy) - heading);
             rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
             if (ranges_mm[k] >= m->max_range_mm) {
                 /* nothing in the wedge: free out to the reach */
@@ -249,46 +251,44 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose
     }
 }
 
-/* ---- Dijkstra's queue: a binary heap of cells keyed by cost, slot[] for decrease-key ---- */
+/*
+ * Dijkstra's queue: Dial's buckets. Every step costs at most STEP_DIAG + near_cost, so the
+ * queued costs lie within that many of the least, and a ring of that many + 1 buckets,
+ * each a doubly linked list of cells (next in m->next, previous in m->prev), pops cells in
+ * order of cost in constant time; a binary heap took most of the plan's time.
+ */
+#define QUEUE_HEAD UINT16_C(0xFFFE) /* prev[] of the first cell of its bucket */
+#define QUEUE_END UINT16_C(0xFFFF)  /* next[] of the last cell of its bucket */
+#define BUCKETS (STEP_DIAG + 255u + 1u)
 
-static void heap_set(qnav_map_t *m, uint16_t at, uint16_t cell)
+typedef struct {
+    uint16_t head[BUCKETS];
+    uint16_t count; /* buckets in use: the largest step + 1 */
+} buckets_t;
+
+static void queue_push(qnav_map_t *m, buckets_t *q, uint16_t cell)
 {
-    m->heap[at] = cell;
-    m->slot[cell] = at;
+    uint16_t *head = &q->head[m->cost[cell] % q->count];
+    m->next[cell] = *head;
+    m->prev[cell] = QUEUE_HEAD;
+    if (*head != QUEUE_END) {
+        m->prev[*head] = cell;
+    }
+    *head = cell;
 }
 
-static void heap_up(qnav_map_t *m, uint16_t at)
+static void queue_unlink(qnav_map_t *m, buckets_t *q, uint16_t cell)
 {
-    const uint16_t cell = m->heap[at];
-    while (at > 0u) {
-        const uint16_t parent = (uint16_t)((at - 1u) / 2u);
-        if (m->cost[m->heap[parent]] <= m->cost[cell]) {
-            break;
-        }
-        heap_set(m, at, m->heap[parent]);
-        at = parent;
+    const uint16_t prev = m->prev[cell], next = m->next[cell];
+    if (prev == QUEUE_HEAD) {
+        q->head[m->cost[cell] % q->count] = next;
+    } else {
+        m->next[prev] = next;
     }
-    heap_set(m, at, cell);
-}
-
-static void heap_down(qnav_map_t *m, uint16_t at, uint16_t size)
-{
-    const uint16_t cell = m->heap[at];
-    for (;;) {
-        uint32_t child = 2u * (uint32_t)at + 1u;
-        if (child >= size) {
-            break;
-        }
-        if (child + 1u < size && m->cost[m->heap[child + 1u]] < m->cost[m->heap[child]]) {
-            child++;
-        }
-        if (m->cost[m->heap[child]] >= m->cost[cell]) {
-            break;
-        }
-        heap_set(m, at, m->heap[child]);
-        at = (uint16_t)child;
+    if (next != QUEUE_END) {
+        m->prev[next] = prev;
     }
-    heap_set(m, at, cell);
+    m->prev[cell] = NOT_QUEUED;
 }
 
 /* Cells within the body's reach of an occupied cell cannot hold the robot's centre
@@ -329,8 +329,8 @@ static void mark_blocked(qnav_map_t *m)
 
 void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
 {
-    uint32_t n, c;
-    uint16_t size = 0u;
+    buckets_t q;
+    uint32_t n, c, queued = 1u, d = 0u;
     int32_t gi, gj;
     if (m == NULL || m->cost == NULL) {
         return;
@@ -339,21 +339,27 @@ void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
     mark_blocked(m);
     for (c = 0; c < n; ++c) {
         m->cost[c] = QNAV_MAP_UNREACHED;
-        m->slot[c] = NOT_QUEUED;
+        m->prev[c] = NOT_QUEUED;
+    }
+    q.count = (uint16_t)(STEP_DIAG + m->cfg.near_cost + 1u);
+    for (c = 0; c < q.count; ++c) {
+        q.head[c] = QUEUE_END;
     }
     cell_of(m, goal_x_mm, goal_y_mm, &gi, &gj);
     c = at_cell(m, gi, gj);
     m->cost[c] = 0u;
-    heap_set(m, size++, (uint16_t)c);
-    while (size > 0u) {
-        const uint16_t at = m->heap[0];
-        const int32_t i = (int32_t)(at % m->nx), j = (int32_t)(at / m->nx);
-        int32_t a, b;
-        m->slot[at] = NOT_QUEUED;
-        if (--size > 0u) {
-            heap_set(m, 0u, m->heap[size]);
-            heap_down(m, 0u, size);
+    queue_push(m, &q, (uint16_t)c);
+    while (queued > 0u) {
+        uint16_t at;
+        int32_t i, j, a, b;
+        while (q.head[d % q.count] == QUEUE_END) {
+            d++;
         }
+        at = q.head[d % q.count];
+        queue_unlink(m, &q, at);
+        queued--;
+        i = (int32_t)(at % m->nx);
+        j = (int32_t)(at / m->nx);
         for (b = -1; b <= 1; ++b) {
             for (a = -1; a <= 1; ++a) {
                 const int32_t ii = i + a, jj = j + b;
@@ -374,11 +380,13 @@ void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
                 if (nc >= m->cost[to]) {
                     continue;
                 }
-                m->cost[to] = (uint16_t)(nc >= QNAV_MAP_UNREACHED ? QNAV_MAP_UNREACHED - 1u : nc);
-                if (m->slot[to] == NOT_QUEUED) {
-                    heap_set(m, size++, (uint16_t)to);
+                if (m->prev[to] != NOT_QUEUED) {
+                    queue_unlink(m, &q, (uint16_t)to);
+                    queued--;
                 }
-                heap_up(m, m->slot[to]);
+                m->cost[to] = (uint16_t)(nc >= QNAV_MAP_UNREACHED ? QNAV_MAP_UNREACHED - 1u : nc);
+                queue_push(m, &q, (uint16_t)to);
+                queued++;
             }
         }
     }
@@ -481,7 +489,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_pose_t *pose, int32_t goal_x_mm,
     if (sx != pose->x_mm || sy != pose->y_mm) {
         in->goal_bearing_cdeg =
             qnav_wrap_cdeg((int32_t)qnav_atan2_cdeg(sy - pose->y_mm, sx - pose->x_mm, NULL) -
-                           pose->heading_cdeg);
+                           qnav_wrap_cdeg(pose->heading_cdeg));
     }
     mm = cost * m->cfg.cell_mm / STEP_SIDE;
     mm = mm == 0u ? 1u : (mm > 65535u ? 65535u : mm);

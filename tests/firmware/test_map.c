@@ -154,6 +154,14 @@ static void test_the_plan_leads_round_the_wall_to_its_gap(void **state)
     /* no wall cell is on the way: the cost under the wall's middle is unreached or more
      * than the way round */
     assert_true(qnav_map_cost(&m, 1550, 3000) == QNAV_MAP_UNREACHED);
+    /* the heading taken modulo a turn: a pose that has turned three times decides alike */
+    {
+        const qnav_pose_t turned = {1500, 1500, 9000 + 3 * 36000};
+        qnav_ctrl_input_t again = in;
+        assert_int_equal(qnav_map_guide(&m, &turned, 1500, 5000, &again) & QNAV_MAP_GUIDED,
+                         QNAV_MAP_GUIDED);
+        assert_int_equal(again.goal_bearing_cdeg, in.goal_bearing_cdeg);
+    }
     /* next tick, the same plan: nothing cleared */
     in.escape.side = 1;
     assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &in), QNAV_MAP_GUIDED);

@@ -64,8 +64,8 @@ typedef struct {
     uint16_t nx, ny;
     int8_t *evidence;         /* per cell: < 0 seen free, >= QNAV_MAP_OCCUPIED occupied */
     uint16_t *cost;           /* per cell: plan cost to the destination, 10 per cell side */
-    uint16_t *heap;           /* the plan's queue */
-    uint16_t *slot;           /* per cell: its place in the queue */
+    uint16_t *next;           /* per cell: the next cell in its plan queue bucket */
+    uint16_t *prev;           /* per cell: the previous one, or not queued */
     uint8_t *blocked;         /* per cell: too near an occupied cell for the body */
     int32_t goal_x_mm, goal_y_mm;
     uint16_t ticks;           /* observations since the last plan */
