@@ -38,6 +38,7 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->plan_ticks = 10u;
     cfg->noise_pct = 5u;
     cfg->near_mm = 200u;
+    cfg->arc_pct = 100u;
     cfg->near_cost = 10u;
 }
 
@@ -72,6 +73,7 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
     }
     cells = qnav_map_cells(width_mm, height_mm, cfg->cell_mm);
     if (cfg->cell_mm < 20u || cfg->cell_mm > 1000u || cfg->plan_ticks == 0u || cells == 0u ||
+        cfg->arc_pct > 100u ||
         len < qnav_map_bytes(cells) || ((uintptr_t)buf & 1u) != 0u || ctrl->n_sectors == 0u ||
         ctrl->n_sectors > QNAV_MAX_SECTORS || ctrl->max_range_mm == 0u) {
         return QNAV_E_MAP;
@@ -196,6 +198,18 @@ static uint16_t sector_of(const qnav_map_t *m, int32_t a_cdeg)
     return (uint16_t)(k % m->n_sectors);
 }
 
+/* How far robot-frame direction a (0.01 deg) lies from sector k's centre, 0.01 deg. */
+static int32_t off_centre(const qnav_map_t *m, int32_t a_cdeg, uint16_t k)
+{
+    int32_t d = (a_cdeg - (int32_t)((uint32_t)k * 36000u / m->n_sectors)) % INT32_C(36000);
+    if (d < -INT32_C(18000)) {
+        d += INT32_C(36000);
+    } else if (d >= INT32_C(18000)) {
+        d -= INT32_C(36000);
+    }
+    return d < 0 ? -d : d;
+}
+
 /* Seen free: any occupied evidence is dropped, free evidence grows to its floor. */
 static void mark_free(qnav_map_t *m, int8_t *c)
 {
@@ -208,7 +222,7 @@ static void mark_free(qnav_map_t *m, int8_t *c)
 
 void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose_t *pose)
 {
-    int32_t i0, i1, j0, j1, i, j, reach, three_quarters, heading;
+    int32_t i0, i1, j0, j1, i, j, reach, three_quarters, heading, arc_half;
     int64_t reach2;
     if (m == NULL || m->cost == NULL || ranges_mm == NULL || pose == NULL) {
         return;
@@ -217,6 +231,7 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose
     three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
     reach2 = (int64_t)reach * reach;
     heading = qnav_wrap_cdeg(pose->heading_cdeg);
+    arc_half = (int32_t)(INT32_C(18000) * (int32_t)m->cfg.arc_pct / 100 / (int32_t)m->n_sectors);
     cell_of(m, pose->x_mm - reach, pose->y_mm - reach, &i0, &j0);
     cell_of(m, pose->x_mm + reach, pose->y_mm + reach, &i1, &j1);
     for (j = j0; j <= j1; ++j) {
@@ -226,11 +241,12 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose
             const int64_t d2 = (int64_t)dx * dx + (int64_t)dy * dy;
             int8_t *c = &m->evidence[at_cell(m, i, j)];
             uint16_t k;
-            int32_t rc, tol, lo;
+            int32_t rc, tol, lo, rel;
             if (d2 > reach2 || d2 == 0) {
                 continue;
             }
-            k = sector_of(m, direction_cdeg(dx, dy) - heading);
+            rel = direction_cdeg(dx, dy) - heading;
+            k = sector_of(m, rel);
             rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
             if (ranges_mm[k] >= m->max_range_mm) {
                 /* nothing in the wedge: free out to the reach */
@@ -241,7 +257,8 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose
             lo = rc - tol;
             if (lo > 0 && d2 < (int64_t)lo * lo) {
                 mark_free(m, c);
-            } else if (*c >= 0 && d2 <= (int64_t)(rc + three_quarters) * (rc + three_quarters)) {
+            } else if (*c >= 0 && d2 <= (int64_t)(rc + three_quarters) * (rc + three_quarters) &&
+                       off_centre(m, rel, k) <= arc_half) {
                 *c = (int8_t)(*c + 1 > EVIDENCE_MAX ? EVIDENCE_MAX : *c + 1);
                 if (*c == QNAV_MAP_OCCUPIED) {
                     m->dirty = 1u;

@@ -60,6 +60,7 @@ struct RobotProfile {
     double map_plan_s = 1.0;        // time between plans, s
     double map_near_m = 0.2;        // cells this much beyond the body's reach of a wall...
     double map_near_cost = 1.0;     // ...cost this much more to cross, in cell sides
+    int map_arc_pct = 100;          // arcs marked in the central this % of the wedge
     // what only the board needs (qnav-sim robot-header)
     std::uint32_t um_per_count = 1000;  // wheel travel per encoder count, micrometres
     std::uint32_t tick_ms = 100;        // control tick, ms (the simulator's QNAV_SIM_TICK_S)

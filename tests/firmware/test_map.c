@@ -38,16 +38,22 @@ static void sensor_config(qnav_ctrl_config_t *cfg)
     cfg->safety_mm = 50;
 }
 
-static void map_of(qnav_map_t *m, uint8_t plan_ticks)
+static void map_with_arcs(qnav_map_t *m, uint8_t plan_ticks, uint8_t arc_pct)
 {
     qnav_map_config_t mc;
     qnav_ctrl_config_t cc;
     sensor_config(&cc);
     qnav_map_config_default(&mc);
     mc.plan_ticks = plan_ticks;
+    mc.arc_pct = arc_pct;
     assert_true(qnav_map_cells(WORLD_MM, WORLD_MM, mc.cell_mm) <= CELLS_MAX);
     assert_int_equal(qnav_map_init(m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
                      QNAV_OK);
+}
+
+static void map_of(qnav_map_t *m, uint8_t plan_ticks)
+{
+    map_with_arcs(m, plan_ticks, 100);
 }
 
 static int inside(const box_t *boxes, size_t n, int32_t x, int32_t y)
@@ -83,6 +89,28 @@ static void scan(const box_t *boxes, size_t n, const qnav_pose_t *p, qnav_mm_t *
         }
         ranges[k] = (qnav_mm_t)(best - 120 > 2500 ? 2500 : (best < 120 ? 0 : best - 120));
     }
+}
+
+/* arc_pct: the arc is marked only near the wedge's centre line. */
+static void test_arcs_are_marked_in_the_central_part_of_the_wedge(void **state)
+{
+    qnav_map_t m;
+    qnav_mm_t ranges[N];
+    const qnav_pose_t p = {3050, 3050, 0};
+    int k;
+    (void)state;
+    for (k = 0; k < N; ++k) {
+        ranges[k] = 2500;
+    }
+    ranges[0] = 1000; /* 1 120 mm from the centre; the wedge is +-11.25 deg */
+    map_with_arcs(&m, 10, 100);
+    qnav_map_observe(&m, ranges, &p);
+    assert_int_equal(qnav_map_evidence(&m, 4170, 3050), 1); /* dead ahead */
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3250), 1); /* 10 deg off, on the arc */
+    map_with_arcs(&m, 10, 25);                              /* +-2.8 deg */
+    qnav_map_observe(&m, ranges, &p);
+    assert_int_equal(qnav_map_evidence(&m, 4170, 3050), 1);
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3250), 0);
 }
 
 static void test_a_reading_frees_its_wedge_and_marks_its_arc(void **state)
@@ -215,6 +243,9 @@ static void test_bad_maps_are_refused(void **state)
     mc.cell_mm = 100;
     mc.plan_ticks = 0;
     assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
+    mc.plan_ticks = 10;
+    mc.arc_pct = 101;
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
     assert_int_equal(qnav_map_cells(100000000u, 100000000u, 100), 0);
     assert_string_not_equal(qnav_status_str(QNAV_E_MAP), "unknown status");
 }
@@ -223,6 +254,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_a_reading_frees_its_wedge_and_marks_its_arc),
+        cmocka_unit_test(test_arcs_are_marked_in_the_central_part_of_the_wedge),
         cmocka_unit_test(test_the_plan_leads_round_the_wall_to_its_gap),
         cmocka_unit_test(test_a_destination_walled_in_leaves_the_input_alone),
         cmocka_unit_test(test_bad_maps_are_refused),

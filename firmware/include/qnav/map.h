@@ -44,6 +44,8 @@ typedef struct {
     uint8_t near_cost;     /* extra plan cost of a cell within near_mm beyond the body's
                               reach of an occupied cell (10: one more cell side); default 10 */
     uint16_t near_mm;      /* mm; default 200 (measured: docs/architecture.md) */
+    uint8_t arc_pct;       /* a reading marks occupied only the arc cells within the central
+                              arc_pct % of its wedge, 0..100; default 100 */
 } qnav_map_config_t;
 
 /* The robot's pose in the destination's frame. */
