@@ -220,7 +220,7 @@ static void mark_free(qnav_map_t *m, int8_t *c)
     *c = v < EVIDENCE_FREE_MIN ? (int8_t)EVIDENCE_FREE_MIN : v;
 }
 
-void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose_t *pose)
+void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *pose)
 {
     int32_t i0, i1, j0, j1, i, j, reach, three_quarters, heading, arc_half;
     int64_t reach2;
@@ -448,7 +448,7 @@ static uint32_t cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi
     return best;
 }
 
-int qnav_map_guide(qnav_map_t *m, const qnav_pose_t *pose, int32_t goal_x_mm,
+int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
                    int32_t goal_y_mm, qnav_ctrl_input_t *in)
 {
     int32_t i, j, ri, rj, steps, sx, sy;

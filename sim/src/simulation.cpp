@@ -260,9 +260,9 @@ void Simulation::compute_scan() {
 void Simulation::guide_scan() {
     const auto mm = [](double m) { return static_cast<std::int32_t>(std::lround(m * 1000.0)); };
     const auto cdeg = [](double rad) { return static_cast<std::int32_t>(std::lround(rad * 18000.0 / kPi)); };
-    const qnav_pose_t truth{mm(pos_.x), mm(pos_.y), cdeg(heading_)};
+    const qnav_map_pose_t truth{mm(pos_.x), mm(pos_.y), cdeg(heading_)};
     qnav_map_observe(&map_, scan_.ranges_mm, &truth);
-    const qnav_pose_t sensed{truth.x_mm, truth.y_mm, cdeg(sensed_heading_)};
+    const qnav_map_pose_t sensed{truth.x_mm, truth.y_mm, cdeg(sensed_heading_)};
     qnav_ctrl_input_t in{};
     in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
     in.goal_range_mm = scan_.goal_range_mm;

@@ -416,6 +416,43 @@ static void test_position_goal_bearing_comes_from_the_pose(void **state)
     assert_int_equal(g.last_scan.goal_bearing_cdeg, -4500);
 }
 
+/* With a map, a position goal behind a wall the sonar keeps seeing is steered round it;
+ * without one, straight at it. The scripted robot stands at the origin facing +x. */
+static void test_a_board_with_a_map_steers_round_what_it_has_seen(void **state)
+{
+    static uint16_t mem[60 * 60 * 4];
+    qnav_map_t map;
+    qnav_map_config_t mc;
+    qnav_link_goal_t gl = {9, 0, 0, QNAV_LINK_GOAL_POSITION, 3000, 0};
+    uint8_t p[QNAV_LINK_GOAL_BYTES];
+    uint16_t k;
+    (void)state;
+    bench_start(16);
+    for (k = 0; k < 16; ++k) {
+        g.sim.ranges_mm[k] = g.bot.cfg.ctrl.max_range_mm;
+    }
+    /* a wall 1 m ahead across the three sectors round straight ahead */
+    g.sim.ranges_mm[15] = g.sim.ranges_mm[0] = g.sim.ranges_mm[1] =
+        (qnav_mm_t)(1000 - g.bot.cfg.ctrl.sensor_offset_mm);
+    qnav_map_config_default(&mc);
+    mc.plan_ticks = 1;
+    assert_true(qnav_map_bytes(qnav_map_cells(6000, 6000, mc.cell_mm)) <= sizeof mem);
+    assert_int_equal(qnav_map_init(&map, &mc, &g.bot.cfg.ctrl, -3000, -3000, 6000, 6000, mem,
+                                   sizeof mem),
+                     QNAV_OK);
+    to_board(QNAV_LINK_MSG_GOAL, p, qnav_link_goal_pack(&gl, p, sizeof p));
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    assert_int_equal(g.last_scan.goal_bearing_cdeg, 0);
+    assert_int_equal(qnav_board_set_map(&g.bot, &map), 1);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 500);
+    assert_true(qnav_map_evidence(&map, 1000, 50) >= QNAV_MAP_OCCUPIED);
+    assert_true(g.last_scan.goal_bearing_cdeg > 2000 || g.last_scan.goal_bearing_cdeg < -2000);
+    assert_int_equal(qnav_board_set_map(&g.bot, NULL), 1);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 200);
+    assert_int_equal(g.last_scan.goal_bearing_cdeg, 0);
+}
+
 /* ---- the board against navbridge's core, in one process ---- */
 
 static int bridge_write(void *user, const uint8_t *bytes, size_t n)
@@ -693,6 +730,7 @@ int main(void)
         cmocka_unit_test(test_board_ignores_a_bridge_of_another_protocol_version),
         cmocka_unit_test(test_pose_integrates_wheel_travel_along_the_heading),
         cmocka_unit_test(test_position_goal_bearing_comes_from_the_pose),
+        cmocka_unit_test(test_a_board_with_a_map_steers_round_what_it_has_seen),
         cmocka_unit_test(test_board_and_bridge_drive_together_in_both_modes),
         cmocka_unit_test(test_route_from_lcm_advances_within_the_radius_and_stops_at_its_end),
         cmocka_unit_test(test_bridge_takes_lcm_goals_only_on_a_token_of_letters_and_digits),

@@ -69,7 +69,7 @@ static int inside(const box_t *boxes, size_t n, int32_t x, int32_t y)
 
 /* Each sector's reading from pose: the nearest box point on 24 rays across its wedge,
  * marched in 5 mm steps, less the sensor offset, clipped to the range. */
-static void scan(const box_t *boxes, size_t n, const qnav_pose_t *p, qnav_mm_t *ranges)
+static void scan(const box_t *boxes, size_t n, const qnav_map_pose_t *p, qnav_mm_t *ranges)
 {
     int k, r;
     for (k = 0; k < N; ++k) {
@@ -96,7 +96,7 @@ static void test_arcs_are_marked_in_the_central_part_of_the_wedge(void **state)
 {
     qnav_map_t m;
     qnav_mm_t ranges[N];
-    const qnav_pose_t p = {3050, 3050, 0};
+    const qnav_map_pose_t p = {3050, 3050, 0};
     int k;
     (void)state;
     for (k = 0; k < N; ++k) {
@@ -117,7 +117,7 @@ static void test_a_reading_frees_its_wedge_and_marks_its_arc(void **state)
 {
     qnav_map_t m;
     qnav_mm_t ranges[N];
-    const qnav_pose_t p = {3000, 3000, 0};
+    const qnav_map_pose_t p = {3000, 3000, 0};
     int k;
     (void)state;
     map_of(&m, 10);
@@ -147,7 +147,7 @@ static void observe_the_wall(qnav_map_t *m)
     qnav_mm_t ranges[N];
     int32_t x;
     for (x = 500; x <= 5500; x += 250) {
-        const qnav_pose_t p = {x, 1500, 9000};
+        const qnav_map_pose_t p = {x, 1500, 9000};
         scan(wall_with_gap, 2, &p, ranges);
         qnav_map_observe(m, ranges, &p);
     }
@@ -157,7 +157,7 @@ static void test_the_plan_leads_round_the_wall_to_its_gap(void **state)
 {
     qnav_map_t m;
     qnav_ctrl_input_t in;
-    const qnav_pose_t p = {1500, 1500, 9000}; /* facing the wall (+y) */
+    const qnav_map_pose_t p = {1500, 1500, 9000}; /* facing the wall (+y) */
     (void)state;
     map_of(&m, 1);
     /* nothing seen yet: the plan is the straight line */
@@ -184,7 +184,7 @@ static void test_the_plan_leads_round_the_wall_to_its_gap(void **state)
     assert_true(qnav_map_cost(&m, 1550, 3000) == QNAV_MAP_UNREACHED);
     /* the heading taken modulo a turn: a pose that has turned three times decides alike */
     {
-        const qnav_pose_t turned = {1500, 1500, 9000 + 3 * 36000};
+        const qnav_map_pose_t turned = {1500, 1500, 9000 + 3 * 36000};
         qnav_ctrl_input_t again = in;
         assert_int_equal(qnav_map_guide(&m, &turned, 1500, 5000, &again) & QNAV_MAP_GUIDED,
                          QNAV_MAP_GUIDED);
@@ -202,12 +202,12 @@ static void test_a_destination_walled_in_leaves_the_input_alone(void **state)
     qnav_ctrl_input_t in;
     static const box_t closed[] = {{0, 2950, WORLD_MM, 3050}};
     qnav_mm_t ranges[N];
-    const qnav_pose_t p = {1500, 1500, 9000};
+    const qnav_map_pose_t p = {1500, 1500, 9000};
     int32_t x;
     (void)state;
     map_of(&m, 1);
     for (x = 300; x <= 5700; x += 200) {
-        const qnav_pose_t q = {x, 1500, 9000};
+        const qnav_map_pose_t q = {x, 1500, 9000};
         scan(closed, 1, &q, ranges);
         qnav_map_observe(&m, ranges, &q);
     }

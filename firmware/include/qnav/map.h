@@ -53,7 +53,7 @@ typedef struct {
     int32_t x_mm;
     int32_t y_mm;
     int32_t heading_cdeg;  /* direction of the robot's straight ahead (sector 0), any value */
-} qnav_pose_t;
+} qnav_map_pose_t;
 
 /* One map. Private fields: read them through the functions below. */
 typedef struct {
@@ -102,7 +102,7 @@ QNAV_CHECK_RESULT qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_conf
 void qnav_map_reset(qnav_map_t *m);
 
 /* Mark what this scan (n_sectors ranges, mm, from the sensor) says about the cells. */
-void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_pose_t *pose);
+void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *pose);
 
 /* Plan every cell's cost to the destination over what the map has seen (unknown cells
  * passable). At most 8 queue operations per cell. */
@@ -120,7 +120,7 @@ void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm);
  * jump_mm since the last guided tick (the way the escape was following has closed).
  * Returns QNAV_MAP_* flags; 0 when the map knows no way (the input stays as it was).
  */
-int qnav_map_guide(qnav_map_t *m, const qnav_pose_t *pose, int32_t goal_x_mm,
+int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
                    int32_t goal_y_mm, qnav_ctrl_input_t *in);
 
 /* A cell's evidence (< 0 free, >= QNAV_MAP_OCCUPIED occupied) and plan cost; for tests

@@ -495,6 +495,16 @@ void qnav_board_tick(qnav_board_t *bot)
     /* the previous decision, seen from where the robot points now (3-input policies), the
      * distance to a position goal (0 for a bearing goal: no escape) and the memory */
     qnav_ctrl_carry_input(&bot->carry, bot->have_goal ? bot->goal.goal_id : 0u, dist_mm, &in);
+#if QNAV_BOARD_WITH_MAP
+    if (bot->map != NULL && bot->have_goal && bot->goal.kind == QNAV_LINK_GOAL_POSITION) {
+        const qnav_map_pose_t pose = {bot->pose.x_um / (int32_t)1000, bot->pose.y_um / (int32_t)1000,
+                                  bot->pose.heading_cdeg};
+        qnav_map_observe(bot->map, bot->ranges, &pose);
+        if (qnav_map_guide(bot->map, &pose, bot->goal.x_mm, bot->goal.y_mm, &in) != 0) {
+            dist_mm = in.goal_range_mm;
+        }
+    }
+#endif
 
     decide(bot, now, &in, &out);
     qnav_ctrl_carry_output(&bot->carry, &in, &out);
@@ -522,6 +532,15 @@ void qnav_board_tick(qnav_board_t *bot)
         tel.reserved = 0;
         send(bot, QNAV_LINK_MSG_COMMAND, p, qnav_link_command_pack(&tel, p, sizeof p));
     }
+}
+
+int qnav_board_set_map(qnav_board_t *bot, qnav_map_t *map)
+{
+    if (bot == NULL || !QNAV_BOARD_WITH_MAP) {
+        return 0;
+    }
+    bot->map = map;
+    return 1;
 }
 
 const qnav_board_stats_t *qnav_board_stats(const qnav_board_t *bot)

@@ -28,6 +28,7 @@
 #include "qnav/check.h"
 #include "qnav/nav.h"
 #include "qnav/link.h"
+#include "qnav/map.h"
 #include "qnav/trig.h"
 
 #ifdef __cplusplus
@@ -140,6 +141,7 @@ typedef struct {
     qnav_ctrl_carry_t carry;     /* the escape memory (cleared with every new goal) and the
                                     last decision, carried from tick to tick as navbridge
                                     and its replay carry them (qnav_ctrl_carry_input) */
+    qnav_map_t *map;             /* the caller's map (qnav_board_set_map), or NULL */
     uint16_t policy_crc;
     uint8_t policy_source;       /* qnav_board_policy_source_t */
     uint8_t store_slot;          /* slot the running stored policy is in (0/1), 0xFF none */
@@ -176,6 +178,28 @@ void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t
  * is set to 0. Returns QNAV_BOARD_OK, _E_NULL, _E_CONFIG or _E_CTRL. */
 QNAV_CHECK_RESULT qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t *cfg,
                                     const qnav_board_hal_t *hal);
+
+/* Whether the board core can use a map: not on an AVR (8 bytes a cell: no map an ATmega
+ * fits, and its code would cost 10 KB of flash); -DQNAV_BOARD_WITH_MAP=0/1 decides. */
+#ifndef QNAV_BOARD_WITH_MAP
+#ifdef __AVR__
+#define QNAV_BOARD_WITH_MAP 0
+#else
+#define QNAV_BOARD_WITH_MAP 1
+#endif
+#endif
+
+/*
+ * Reach position goals through a map of what the sonar has seen (qnav/map.h;
+ * docs/architecture.md, "A map and a plan"): each tick marks the map from the pose and
+ * gives the controller the plan's sub-goal and planned distance (also reported as the
+ * POSE frame's goal distance). The caller initialises the map over the part of the
+ * odometry frame the robot may reach, in memory it keeps (qnav_map_bytes(): 8 bytes a
+ * cell, more than an ATmega128 has for any useful area), and resets it for a new world.
+ * NULL turns it off. Bearing goals are never planned. Returns 1, or 0 (and keeps no map)
+ * in a build without QNAV_BOARD_WITH_MAP.
+ */
+int qnav_board_set_map(qnav_board_t *bot, qnav_map_t *map);
 
 /* Drain the UART (qnav_board_receive) and run a control tick when tick_ms has passed. */
 void qnav_board_poll(qnav_board_t *bot);
