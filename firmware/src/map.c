@@ -68,7 +68,7 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
 {
     uint32_t cells;
     uint8_t *p = (uint8_t *)buf;
-    if (m == NULL || cfg == NULL || ctrl == NULL || buf == NULL) {
+    if (m == NULL || cfg == NULL || ctrl == NULL) {
         return QNAV_E_NULL;
     }
     cells = qnav_map_cells(width_mm, height_mm, cfg->cell_mm);
@@ -77,6 +77,9 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
         len < qnav_map_bytes(cells) || ((uintptr_t)buf & 1u) != 0u || ctrl->n_sectors == 0u ||
         ctrl->n_sectors > QNAV_MAX_SECTORS || ctrl->max_range_mm == 0u) {
         return QNAV_E_MAP;
+    }
+    if (buf == NULL) {
+        return QNAV_E_NULL;
     }
     memset(m, 0, sizeof *m);
     m->cfg = *cfg;

@@ -3,6 +3,7 @@
 #include "simulation.hpp"
 
 #include <algorithm>
+#include <sstream>
 #include <cmath>
 
 #include <box2d/box2d.h>
@@ -85,27 +86,32 @@ Simulation::Simulation(const RobotProfile &robot, const Environment &env, const 
     true_dist_.assign(cfg_.n_sectors, kInf);
     scan_.n_sectors = cfg_.n_sectors;
     scan_.max_range_mm = max_range_mm_;
-    if (robot_.map_cell_m > 0) {
-        qnav_map_config_t mc;
-        qnav_map_config_default(&mc);
-        mc.cell_mm = static_cast<std::uint16_t>(std::lround(robot_.map_cell_m * 1000.0));
-        mc.reach_mm = static_cast<std::uint16_t>(std::lround(std::min(65.0, robot_.map_reach_m) * 1000.0));
-        mc.look_mm = static_cast<std::uint16_t>(std::lround(std::min(65.0, robot_.map_look_m) * 1000.0));
-        mc.plan_ticks = static_cast<std::uint8_t>(std::clamp(std::lround(robot_.map_plan_s / QNAV_SIM_TICK_S), 1L, 255L));
-        mc.near_mm = static_cast<std::uint16_t>(std::lround(robot_.map_near_m * 1000.0));
-        mc.near_cost = static_cast<std::uint8_t>(std::lround(robot_.map_near_cost * 10.0));
-        mc.arc_pct = static_cast<std::uint8_t>(robot_.map_arc_pct);
-        const auto mm = [](double m) { return static_cast<std::uint32_t>(std::ceil(m * 1000.0)); };
-        const std::uint32_t cells = qnav_map_cells(mm(env_.width_m), mm(env_.height_m), mc.cell_mm);
-        map_mem_.assign((qnav_map_bytes(cells) + 1) / 2, 0);
-        qnav_ctrl_config_t cc;
-        robot_ctrl_config(robot_, cfg_.n_sectors, &cc);
-        const qnav_status_t st = qnav_map_init(&map_, &mc, &cc, 0, 0, mm(env_.width_m), mm(env_.height_m),
-                                               map_mem_.data(), map_mem_.size() * 2);
-        if (st != QNAV_OK)
-            throw SimError(QNAV_SIM_E_PARAM, robot_.name + ": [map] for a " + std::to_string(env_.width_m) +
-                                                 " x " + std::to_string(env_.height_m) + " m arena: " +
-                                                 qnav_status_str(st));
+    if (robot_.map_cell_m > 0) init_map();
+}
+
+// The profile's [map] over the whole arena (libqnav qnav/map.h; 8 bytes a cell).
+void Simulation::init_map() {
+    qnav_map_config_t mc;
+    qnav_map_config_default(&mc);
+    mc.cell_mm = static_cast<std::uint16_t>(std::lround(robot_.map_cell_m * 1000.0));
+    mc.reach_mm = static_cast<std::uint16_t>(std::lround(std::min(65.0, robot_.map_reach_m) * 1000.0));
+    mc.look_mm = static_cast<std::uint16_t>(std::lround(std::min(65.0, robot_.map_look_m) * 1000.0));
+    mc.plan_ticks = static_cast<std::uint8_t>(std::clamp(std::lround(robot_.map_plan_s / QNAV_SIM_TICK_S), 1L, 255L));
+    mc.near_mm = static_cast<std::uint16_t>(std::lround(robot_.map_near_m * 1000.0));
+    mc.near_cost = static_cast<std::uint8_t>(std::lround(robot_.map_near_cost * 10.0));
+    mc.arc_pct = static_cast<std::uint8_t>(robot_.map_arc_pct);
+    const auto mm = [](double m) { return static_cast<std::uint32_t>(std::ceil(m * 1000.0)); };
+    const std::uint32_t cells = qnav_map_cells(mm(env_.width_m), mm(env_.height_m), mc.cell_mm);
+    map_mem_.assign((qnav_map_bytes(cells) + 1) / 2, 0);
+    qnav_ctrl_config_t cc;
+    robot_ctrl_config(robot_, cfg_.n_sectors, &cc);
+    const qnav_status_t st = qnav_map_init(&map_, &mc, &cc, 0, 0, mm(env_.width_m), mm(env_.height_m),
+                                           map_mem_.data(), map_mem_.size() * 2);
+    if (st != QNAV_OK) {
+        std::ostringstream why;
+        why << robot_.name << ": [map] cell_m " << robot_.map_cell_m << " for a " << env_.width_m << " x "
+            << env_.height_m << " m arena: " << qnav_status_str(st);
+        throw SimError(QNAV_SIM_E_PARAM, why.str());
     }
 }
 

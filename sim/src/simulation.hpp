@@ -94,6 +94,7 @@ private:
     Vec2 dest() const { return Vec2{env_.dest_x_m, env_.dest_y_m}; }
     void build_world();
     void compute_scan();
+    void init_map();
     void guide_scan();
     void drive_substep(double dt);
     void recovery_wheels();
