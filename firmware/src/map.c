@@ -39,6 +39,7 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->noise_pct = 5u;
     cfg->near_mm = 200u;
     cfg->arc_pct = 100u;
+    cfg->sight = 1u;
     cfg->near_cost = 10u;
 }
 
@@ -417,6 +418,25 @@ void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
     m->dirty = 0u;
 }
 
+/* The straight line between the centres of cells (i0, j0) and (i1, j1) crosses no blocked
+ * cell (sampled every half cell): the robot aiming at the second does not cut a corner. */
+static int in_sight(const qnav_map_t *m, int32_t i0, int32_t j0, int32_t i1, int32_t j1)
+{
+    const int32_t di = i1 - i0, dj = j1 - j0;
+    const int32_t n = 2 * ((di < 0 ? -di : di) > (dj < 0 ? -dj : dj) ? (di < 0 ? -di : di)
+                                                                      : (dj < 0 ? -dj : dj));
+    int32_t t;
+    for (t = 1; t < n; ++t) {
+        /* cell of the point t / n along, rounded to the nearest */
+        const int32_t i = i0 + (2 * di * t + (di >= 0 ? n : -n)) / (2 * n);
+        const int32_t j = j0 + (2 * dj * t + (dj >= 0 ? n : -n)) / (2 * n);
+        if (m->blocked[at_cell(m, i, j)] == BLOCKED) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* The cost of cell (i, j), or from the nearest reachable cell within two (the robot's
  * own cell may be blocked: it stands near a wall). QNAV_MAP_UNREACHED: none. */
 static uint32_t cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi, int32_t *bj)
@@ -493,7 +513,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
                 }
             }
         }
-        if (ni == i && nj == j) {
+        if ((ni == i && nj == j) || (m->cfg.sight && !in_sight(m, ri, rj, ni, nj))) {
             break;
         }
         i = ni;

@@ -61,6 +61,7 @@ struct RobotProfile {
     double map_near_m = 0.2;        // cells this much beyond the body's reach of a wall...
     double map_near_cost = 1.0;     // ...cost this much more to cross, in cell sides
     int map_arc_pct = 100;          // arcs marked in the central this % of the wedge
+    bool map_sight = true;          // the sub-goal kept in a straight line's sight
     // what only the board needs (qnav-sim robot-header)
     std::uint32_t um_per_count = 1000;  // wheel travel per encoder count, micrometres
     std::uint32_t tick_ms = 100;        // control tick, ms (the simulator's QNAV_SIM_TICK_S)

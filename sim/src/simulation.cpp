@@ -100,6 +100,7 @@ void Simulation::init_map() {
     mc.near_mm = static_cast<std::uint16_t>(std::lround(robot_.map_near_m * 1000.0));
     mc.near_cost = static_cast<std::uint8_t>(std::lround(robot_.map_near_cost * 10.0));
     mc.arc_pct = static_cast<std::uint8_t>(robot_.map_arc_pct);
+    mc.sight = robot_.map_sight ? 1 : 0;
     const auto mm = [](double m) { return static_cast<std::uint32_t>(std::ceil(m * 1000.0)); };
     const std::uint32_t cells = qnav_map_cells(mm(env_.width_m), mm(env_.height_m), mc.cell_mm);
     map_mem_.assign((qnav_map_bytes(cells) + 1) / 2, 0);

@@ -38,7 +38,7 @@ static void sensor_config(qnav_ctrl_config_t *cfg)
     cfg->safety_mm = 50;
 }
 
-static void map_with_arcs(qnav_map_t *m, uint8_t plan_ticks, uint8_t arc_pct)
+static void map_with(qnav_map_t *m, uint8_t plan_ticks, uint8_t arc_pct, uint8_t sight)
 {
     qnav_map_config_t mc;
     qnav_ctrl_config_t cc;
@@ -46,6 +46,7 @@ static void map_with_arcs(qnav_map_t *m, uint8_t plan_ticks, uint8_t arc_pct)
     qnav_map_config_default(&mc);
     mc.plan_ticks = plan_ticks;
     mc.arc_pct = arc_pct;
+    mc.sight = sight;
     assert_true(qnav_map_cells(WORLD_MM, WORLD_MM, mc.cell_mm) <= CELLS_MAX);
     assert_int_equal(qnav_map_init(m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
                      QNAV_OK);
@@ -53,7 +54,7 @@ static void map_with_arcs(qnav_map_t *m, uint8_t plan_ticks, uint8_t arc_pct)
 
 static void map_of(qnav_map_t *m, uint8_t plan_ticks)
 {
-    map_with_arcs(m, plan_ticks, 100);
+    map_with(m, plan_ticks, 100, 1);
 }
 
 static int inside(const box_t *boxes, size_t n, int32_t x, int32_t y)
@@ -103,11 +104,11 @@ static void test_arcs_are_marked_in_the_central_part_of_the_wedge(void **state)
         ranges[k] = 2500;
     }
     ranges[0] = 1000; /* 1 120 mm from the centre; the wedge is +-11.25 deg */
-    map_with_arcs(&m, 10, 100);
+    map_with(&m, 10, 100, 1);
     qnav_map_observe(&m, ranges, &p);
     assert_int_equal(qnav_map_evidence(&m, 4170, 3050), 1); /* dead ahead */
     assert_int_equal(qnav_map_evidence(&m, 4150, 3250), 1); /* 10 deg off, on the arc */
-    map_with_arcs(&m, 10, 25);                              /* +-2.8 deg */
+    map_with(&m, 10, 25, 1);                               /* +-2.8 deg */
     qnav_map_observe(&m, ranges, &p);
     assert_int_equal(qnav_map_evidence(&m, 4170, 3050), 1);
     assert_int_equal(qnav_map_evidence(&m, 4150, 3250), 0);
@@ -196,6 +197,28 @@ static void test_the_plan_leads_round_the_wall_to_its_gap(void **state)
     assert_int_equal(in.escape.side, 1);
 }
 
+/* Below the wall, left of its gap, with the destination beyond the wall to the left: the
+ * plan turns round the gap's edge within the look-ahead. With sight the sub-goal stays
+ * where the robot sees it past the edge (further right); without, it lies behind it. */
+static void test_the_sub_goal_is_not_behind_a_corner(void **state)
+{
+    qnav_map_t m;
+    qnav_ctrl_input_t with, without;
+    const qnav_map_pose_t p = {4200, 2650, 9000};
+    (void)state;
+    memset(&with, 0, sizeof with);
+    memset(&without, 0, sizeof without);
+    map_with(&m, 1, 100, 0);
+    observe_the_wall(&m);
+    assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &without) & QNAV_MAP_GUIDED,
+                     QNAV_MAP_GUIDED);
+    map_with(&m, 1, 100, 1);
+    observe_the_wall(&m);
+    assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &with) & QNAV_MAP_GUIDED,
+                     QNAV_MAP_GUIDED);
+    assert_true(with.goal_bearing_cdeg < without.goal_bearing_cdeg - 1000); /* -90 / -54 deg */
+}
+
 static void test_a_destination_walled_in_leaves_the_input_alone(void **state)
 {
     qnav_map_t m;
@@ -256,6 +279,7 @@ int main(void)
         cmocka_unit_test(test_a_reading_frees_its_wedge_and_marks_its_arc),
         cmocka_unit_test(test_arcs_are_marked_in_the_central_part_of_the_wedge),
         cmocka_unit_test(test_the_plan_leads_round_the_wall_to_its_gap),
+        cmocka_unit_test(test_the_sub_goal_is_not_behind_a_corner),
         cmocka_unit_test(test_a_destination_walled_in_leaves_the_input_alone),
         cmocka_unit_test(test_bad_maps_are_refused),
     };

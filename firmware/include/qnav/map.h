@@ -46,6 +46,8 @@ typedef struct {
     uint16_t near_mm;      /* mm; default 200 (measured: docs/architecture.md) */
     uint8_t arc_pct;       /* a reading marks occupied only the arc cells within the central
                               arc_pct % of its wedge, 0..100; default 100 */
+    uint8_t sight;         /* 1: the sub-goal stops where the straight line to it from the
+                              robot's cell would cross a blocked cell; default 1 */
 } qnav_map_config_t;
 
 /* The robot's pose in the destination's frame. */
