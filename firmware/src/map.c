@@ -215,7 +215,7 @@ static int32_t off_centre(const qnav_map_t *m, int32_t a_cdeg, uint16_t k)
 }
 
 /* Seen free: any occupied evidence is dropped, free evidence grows to its floor. */
-static void mark_free(qnav_map_t *m, int8_t *c)
+static void mark_clear(qnav_map_t *m, int8_t *c)
 {
     const int8_t v = (int8_t)((*c > 0 ? 0 : *c) - 1);
     if (*c >= QNAV_MAP_OCCUPIED) {
@@ -254,13 +254,13 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
             rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
             if (ranges_mm[k] >= m->max_range_mm) {
                 /* nothing in the wedge: free out to the reach */
-                mark_free(m, c);
+                mark_clear(m, c);
                 continue;
             }
             tol = three_quarters + rc * (int32_t)m->cfg.noise_pct / 100;
             lo = rc - tol;
             if (lo > 0 && d2 < (int64_t)lo * lo) {
-                mark_free(m, c);
+                mark_clear(m, c);
             } else if (*c >= 0 && d2 <= (int64_t)(rc + three_quarters) * (rc + three_quarters) &&
                        off_centre(m, rel, k) <= arc_half) {
                 *c = (int8_t)(*c + 1 > EVIDENCE_MAX ? EVIDENCE_MAX : *c + 1);

@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "qnav/ctrl.h"
+#include "qnav/map.h"
 
 namespace qnav {
 
@@ -87,5 +88,9 @@ RobotProfile parse_robot_profile(std::string_view text, const std::string &name)
 // generator and navbridge all call it). Fields the profile does not decide keep
 // qnav_ctrl_config_default()'s values.
 void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl_config_t *cfg);
+
+// The map's configuration a profile's [map] gives (libqnav qnav/map.h), beside the
+// controller's; cell_mm 0 when the profile has none.
+void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg);
 
 }  // namespace qnav

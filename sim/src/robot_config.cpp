@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "qnav/sim.h"
 #include "robot.hpp"
 
 namespace qnav {
@@ -30,6 +31,18 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->escape_follow_mm = to_mm(p.escape_follow_m);
     cfg->escape_follow_s = static_cast<std::uint8_t>(std::lround(p.escape_follow_s));
     cfg->keep_pct = static_cast<std::uint8_t>(std::lround(p.prob_keep * 100.0));
+}
+
+void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg) {
+    qnav_map_config_default(cfg);
+    cfg->cell_mm = to_mm(p.map_cell_m);
+    cfg->reach_mm = to_mm(p.map_reach_m);
+    cfg->look_mm = to_mm(p.map_look_m);
+    cfg->plan_ticks = static_cast<std::uint8_t>(std::clamp(std::lround(p.map_plan_s / QNAV_SIM_TICK_S), 1L, 255L));
+    cfg->near_mm = to_mm(p.map_near_m);
+    cfg->near_cost = static_cast<std::uint8_t>(std::lround(p.map_near_cost * 10.0));
+    cfg->arc_pct = static_cast<std::uint8_t>(p.map_arc_pct);
+    cfg->sight = p.map_sight ? 1 : 0;
 }
 
 }  // namespace qnav

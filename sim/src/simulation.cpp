@@ -92,15 +92,7 @@ Simulation::Simulation(const RobotProfile &robot, const Environment &env, const 
 // The profile's [map] over the whole arena (libqnav qnav/map.h; 8 bytes a cell).
 void Simulation::init_map() {
     qnav_map_config_t mc;
-    qnav_map_config_default(&mc);
-    mc.cell_mm = static_cast<std::uint16_t>(std::lround(robot_.map_cell_m * 1000.0));
-    mc.reach_mm = static_cast<std::uint16_t>(std::lround(std::min(65.0, robot_.map_reach_m) * 1000.0));
-    mc.look_mm = static_cast<std::uint16_t>(std::lround(std::min(65.0, robot_.map_look_m) * 1000.0));
-    mc.plan_ticks = static_cast<std::uint8_t>(std::clamp(std::lround(robot_.map_plan_s / QNAV_SIM_TICK_S), 1L, 255L));
-    mc.near_mm = static_cast<std::uint16_t>(std::lround(robot_.map_near_m * 1000.0));
-    mc.near_cost = static_cast<std::uint8_t>(std::lround(robot_.map_near_cost * 10.0));
-    mc.arc_pct = static_cast<std::uint8_t>(robot_.map_arc_pct);
-    mc.sight = robot_.map_sight ? 1 : 0;
+    robot_map_config(robot_, &mc);
     const auto mm = [](double m) { return static_cast<std::uint32_t>(std::ceil(m * 1000.0)); };
     const std::uint32_t cells = qnav_map_cells(mm(env_.width_m), mm(env_.height_m), mc.cell_mm);
     map_mem_.assign((qnav_map_bytes(cells) + 1) / 2, 0);
@@ -266,10 +258,9 @@ void Simulation::compute_scan() {
 // destination's is.
 void Simulation::guide_scan() {
     const auto mm = [](double m) { return static_cast<std::int32_t>(std::lround(m * 1000.0)); };
-    const auto cdeg = [](double rad) { return static_cast<std::int32_t>(std::lround(rad * 18000.0 / kPi)); };
-    const qnav_map_pose_t truth{mm(pos_.x), mm(pos_.y), cdeg(heading_)};
+    const qnav_map_pose_t truth{mm(pos_.x), mm(pos_.y), to_cdeg(heading_)};
     qnav_map_observe(&map_, scan_.ranges_mm, &truth);
-    const qnav_map_pose_t sensed{truth.x_mm, truth.y_mm, cdeg(sensed_heading_)};
+    const qnav_map_pose_t sensed{truth.x_mm, truth.y_mm, to_cdeg(sensed_heading_)};
     qnav_ctrl_input_t in{};
     in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
     in.goal_range_mm = scan_.goal_range_mm;

@@ -92,18 +92,24 @@ static void scan(const box_t *boxes, size_t n, const qnav_map_pose_t *p, qnav_mm
     }
 }
 
+/* Every sector clear but the one straight ahead, which reads ahead_mm. */
+static void clear_but_ahead(qnav_mm_t *ranges, qnav_mm_t ahead_mm)
+{
+    int k;
+    for (k = 0; k < N; ++k) {
+        ranges[k] = 2500;
+    }
+    ranges[0] = ahead_mm;
+}
+
 /* arc_pct: the arc is marked only near the wedge's centre line. */
 static void test_arcs_are_marked_in_the_central_part_of_the_wedge(void **state)
 {
     qnav_map_t m;
     qnav_mm_t ranges[N];
     const qnav_map_pose_t p = {3050, 3050, 0};
-    int k;
     (void)state;
-    for (k = 0; k < N; ++k) {
-        ranges[k] = 2500;
-    }
-    ranges[0] = 1000; /* 1 120 mm from the centre; the wedge is +-11.25 deg */
+    clear_but_ahead(ranges, 1000); /* 1 120 mm from the centre; the wedge is +-11.25 deg */
     map_with(&m, 10, 100, 1);
     qnav_map_observe(&m, ranges, &p);
     assert_int_equal(qnav_map_evidence(&m, 4170, 3050), 1); /* dead ahead */
@@ -119,13 +125,9 @@ static void test_a_reading_frees_its_wedge_and_marks_its_arc(void **state)
     qnav_map_t m;
     qnav_mm_t ranges[N];
     const qnav_map_pose_t p = {3000, 3000, 0};
-    int k;
     (void)state;
     map_of(&m, 10);
-    for (k = 0; k < N; ++k) {
-        ranges[k] = 2500;
-    }
-    ranges[0] = 1000; /* an obstacle 1 120 mm ahead of the centre */
+    clear_but_ahead(ranges, 1000); /* an obstacle 1 120 mm ahead of the centre */
     qnav_map_observe(&m, ranges, &p);
     assert_true(qnav_map_evidence(&m, 3550, 3050) < 0);       /* inside the wedge, nearer */
     assert_int_equal(qnav_map_evidence(&m, 4150, 3050), 1);   /* on the arc: one count */
