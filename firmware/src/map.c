@@ -476,7 +476,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
 {
     int32_t i, j, ri, rj, steps, sx, sy;
     uint32_t cost, mm;
-    int jumped;
+    int jumped, direct = 0;
     if (m == NULL || m->cost == NULL || pose == NULL || in == NULL) {
         return 0;
     }
@@ -522,6 +522,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     if (m->cost[at_cell(m, i, j)] == 0u) {
         sx = goal_x_mm; /* the plan ends in the destination's cell: aim at the destination */
         sy = goal_y_mm;
+        direct = QNAV_MAP_DIRECT;
     } else {
         sx = centre_x(m, i);
         sy = centre_y(m, j);
@@ -538,9 +539,9 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     in->goal_range_mm = (qnav_mm_t)mm;
     if (jumped) {
         memset(&in->escape, 0, sizeof in->escape);
-        return QNAV_MAP_GUIDED | QNAV_MAP_ESCAPE_CLEARED;
+        return QNAV_MAP_GUIDED | QNAV_MAP_ESCAPE_CLEARED | direct;
     }
-    return QNAV_MAP_GUIDED;
+    return QNAV_MAP_GUIDED | direct;
 }
 
 /* The index of the cell holding (x, y); -1 outside the map. */

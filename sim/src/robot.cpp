@@ -88,8 +88,11 @@ static void parse_controller_settings(const TomlReader &r, RobotProfile &p) {
     p.speed_guard = guard->value_or(true);
 
     const toml::table &odo = r.table(root, "odometry");
-    r.only_keys(odo, {"um_per_count"});
+    r.only_keys(odo, {"um_per_count", "err_scale_pct", "err_turn_pct", "err_curve_deg_m"});
     p.um_per_count = static_cast<std::uint32_t>(r.integer(odo, "um_per_count", 1, 65535));
+    p.odom_err_scale_pct = r.number(odo, "err_scale_pct", 0.0, 50.0, true, p.odom_err_scale_pct);
+    p.odom_err_turn_pct = r.number(odo, "err_turn_pct", 0.0, 50.0, true, p.odom_err_turn_pct);
+    p.odom_err_curve_deg_m = r.number(odo, "err_curve_deg_m", 0.0, 90.0, true, p.odom_err_curve_deg_m);
 
     const toml::table &ctl = r.table(root, "control");
     r.only_keys(ctl, {"tick_ms"});

@@ -63,6 +63,12 @@ struct RobotProfile {
     double map_near_cost = 1.0;     // ...cost this much more to cross, in cell sides
     int map_arc_pct = 100;          // arcs marked in the central this % of the wedge
     bool map_sight = true;          // the sub-goal kept in a straight line's sight
+    // the odometry's errors, drawn once an episode with these standard deviations (all 0:
+    // the map's pose is the true one): distance scale (wheel diameter), rotation scale
+    // (wheel track), a curve (unequal wheels: heading error per metre driven)
+    double odom_err_scale_pct = 0.0;
+    double odom_err_turn_pct = 0.0;
+    double odom_err_curve_deg_m = 0.0;
     // what only the board needs (qnav-sim robot-header)
     std::uint32_t um_per_count = 1000;  // wheel travel per encoder count, micrometres
     std::uint32_t tick_ms = 100;        // control tick, ms (the simulator's QNAV_SIM_TICK_S)

@@ -160,6 +160,7 @@ void Simulation::reset(std::uint64_t episode_seed) {
     rng_start_ = Rng::stream(cfg_.seed, episode_seed, 1);
     rng_sensor_ = Rng::stream(cfg_.seed, episode_seed, 2);
     rng_act_ = Rng::stream(cfg_.seed, episode_seed, 3);
+    rng_odom_ = Rng::stream(cfg_.seed, episode_seed, 4);
     // Start zone weighted by area (equal weights when all are points or lines).
     double total = 0;
     for (const auto &z : env_.start_zones) total += z.w_m * z.h_m;
@@ -203,7 +204,19 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     marks_.clear();
     vel_ = {0, 0};
     body_stale_ = false;
-    if (!map_mem_.empty()) qnav_map_reset(&map_);
+    if (!map_mem_.empty()) {
+        qnav_map_reset(&map_);
+        // the odometry's frame is the world's at the start (the destination's bearing and
+        // range place it there each tick: anchor_goal)
+        odom_on_ = robot_.odom_err_scale_pct > 0 || robot_.odom_err_turn_pct > 0 ||
+                   robot_.odom_err_curve_deg_m > 0;
+        odom_pos_ = odom_last_pos_ = pos_;
+        odom_heading_ = odom_last_heading_ = heading_;
+        odom_goal_ = plan_goal_ = {env_.dest_x_m, env_.dest_y_m};
+        odom_scale_ = robot_.odom_err_scale_pct / 100.0 * rng_odom_.normal();
+        odom_turn_ = robot_.odom_err_turn_pct / 100.0 * rng_odom_.normal();
+        odom_curve_ = robot_.odom_err_curve_deg_m * kPi / 180.0 * rng_odom_.normal();
+    }
     Vec2 unused;
     touching(&unused);  // sets clearance_m_
     const double dx = env_.dest_x_m - pos_.x, dy = env_.dest_y_m - pos_.y;
@@ -252,22 +265,59 @@ void Simulation::compute_scan() {
     if (profiling_) prof_.sonar_s += std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// The map marks what this scan saw from the true pose (a board's odometry, good to a cell
-// over an episode: an assumption, docs/architecture.md "A map and a plan") and gives the
-// controller the plan's sub-goal, its bearing seen with the sensed heading as the
-// destination's is.
+// The map marks what this scan saw from the robot's pose and gives the controller the
+// plan's sub-goal. The pose is the true one, or with odometry errors in the profile the
+// odometry's (docs/architecture.md, "The map's pose"); the plan's bearing is turned into
+// the robot's frame with the heading the map knows: the sensed one on the true pose, the
+// odometry's own in its frame.
 void Simulation::guide_scan() {
     const auto mm = [](double m) { return static_cast<std::int32_t>(std::lround(m * 1000.0)); };
-    const qnav_map_pose_t truth{mm(pos_.x), mm(pos_.y), to_cdeg(heading_)};
-    qnav_map_observe(&map_, scan_.ranges_mm, &truth);
-    const qnav_map_pose_t sensed{truth.x_mm, truth.y_mm, to_cdeg(sensed_heading_)};
+    if (odom_on_) odometry();
+    const Vec2 at = odom_on_ ? odom_pos_ : pos_;
+    const double hd = odom_on_ ? odom_heading_ : heading_;
+    const qnav_map_pose_t pose{mm(at.x), mm(at.y), to_cdeg(hd)};
+    qnav_map_observe(&map_, scan_.ranges_mm, &pose);
+    const qnav_map_pose_t seen{pose.x_mm, pose.y_mm, odom_on_ ? pose.heading_cdeg : to_cdeg(sensed_heading_)};
+    const Vec2 goal = odom_on_ ? anchor_goal(at, hd) : Vec2{env_.dest_x_m, env_.dest_y_m};
     qnav_ctrl_input_t in{};
     in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
     in.goal_range_mm = scan_.goal_range_mm;
-    const int got = qnav_map_guide(&map_, &sensed, mm(env_.dest_x_m), mm(env_.dest_y_m), &in);
+    const int got = qnav_map_guide(&map_, &seen, mm(goal.x), mm(goal.y), &in);
+    scan_.escape_clear = (got & QNAV_MAP_ESCAPE_CLEARED) ? 1 : 0;
+    if (odom_on_ && (got & QNAV_MAP_DIRECT)) return;  // the destination in sight: its sensed bearing
     scan_.goal_bearing_cdeg = in.goal_bearing_cdeg;
     scan_.goal_range_mm = in.goal_range_mm;
-    scan_.escape_clear = (got & QNAV_MAP_ESCAPE_CLEARED) ? 1 : 0;
+}
+
+// The destination in the odometry's frame, from its sensed bearing and range (the scan's,
+// before the map) seen from the odometry's pose: averaged over ticks (the bearing's noise),
+// and moved for the plan only when that has moved by more than a cell and a half, so a
+// drifting frame does not make a plan a tick.
+Vec2 Simulation::anchor_goal(Vec2 at, double heading) {
+    const double dir = heading + static_cast<double>(scan_.goal_bearing_cdeg) * kPi / 18000.0;
+    const double r = static_cast<double>(scan_.goal_range_mm) / 1000.0;
+    odom_goal_.x += 0.05 * (at.x + r * std::cos(dir) - odom_goal_.x);
+    odom_goal_.y += 0.05 * (at.y + r * std::sin(dir) - odom_goal_.y);
+    if (std::hypot(odom_goal_.x - plan_goal_.x, odom_goal_.y - plan_goal_.y) > 1.5 * robot_.map_cell_m)
+        plan_goal_ = odom_goal_;
+    return plan_goal_;
+}
+
+// Dead reckoning from the wheels: the true motion since the last scan as encoders see it
+// (the travel along the heading and the turn; sideways slip unseen), with this episode's
+// scale, rotation and curve errors.
+void Simulation::odometry() {
+    const double turn = wrap_pi(heading_ - odom_last_heading_);
+    const Vec2 d = pos_ - odom_last_pos_;
+    const double mid = odom_last_heading_ + turn / 2;
+    const double ds = d.x * std::cos(mid) + d.y * std::sin(mid);
+    const double ds_est = ds * (1.0 + odom_scale_);
+    const double turn_est = turn * (1.0 + odom_turn_) + odom_curve_ * std::abs(ds);
+    odom_heading_ += turn_est / 2;
+    odom_pos_ = {odom_pos_.x + ds_est * std::cos(odom_heading_), odom_pos_.y + ds_est * std::sin(odom_heading_)};
+    odom_heading_ = wrap_pi(odom_heading_ + turn_est / 2);
+    odom_last_pos_ = pos_;
+    odom_last_heading_ = heading_;
 }
 
 namespace {

@@ -117,7 +117,15 @@ private:
     std::unique_ptr<b2World> world_;
     b2Body *body_ = nullptr;
 
-    Rng rng_start_, rng_sensor_, rng_act_;
+    Rng rng_start_, rng_sensor_, rng_act_, rng_odom_;
+    // the map's pose: odometry integrated from the true motion with this episode's errors
+    bool odom_on_ = false;
+    Vec2 odom_pos_{}, odom_last_pos_{};
+    Vec2 odom_goal_{}, plan_goal_{};  // the destination in its frame: averaged, and the plan's
+    double odom_heading_ = 0, odom_last_heading_ = 0;
+    double odom_scale_ = 0, odom_turn_ = 0, odom_curve_ = 0;  // this episode's errors
+    void odometry();
+    Vec2 anchor_goal(Vec2 at, double heading);
     bool started_ = false, done_ = false, reached_ = false;
     std::uint32_t tick_ = 0, tau_c_ = 0, collisions_ = 0;
     std::uint32_t recovery_left_ = 0;

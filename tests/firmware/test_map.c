@@ -221,6 +221,23 @@ static void test_the_sub_goal_is_not_behind_a_corner(void **state)
     assert_true(with.goal_bearing_cdeg < without.goal_bearing_cdeg - 1000); /* -90 / -54 deg */
 }
 
+/* The sub-goal is the destination itself once the plan reaches it within the look-ahead
+ * (QNAV_MAP_DIRECT: a caller with a beacon may keep the sensed bearing), not before. */
+static void test_the_destination_in_reach_is_flagged_direct(void **state)
+{
+    qnav_map_t m;
+    qnav_ctrl_input_t in;
+    const qnav_map_pose_t far = {1500, 1500, 9000}, near = {1500, 4300, 9000};
+    (void)state;
+    map_of(&m, 1);
+    memset(&in, 0, sizeof in);
+    assert_int_equal(qnav_map_guide(&m, &far, 1500, 5000, &in), QNAV_MAP_GUIDED);
+    assert_int_equal(qnav_map_guide(&m, &near, 1500, 5000, &in),
+                     QNAV_MAP_GUIDED | QNAV_MAP_DIRECT);
+    assert_true(in.goal_bearing_cdeg > -300 && in.goal_bearing_cdeg < 300);
+    assert_true(in.goal_range_mm >= 600 && in.goal_range_mm <= 800);
+}
+
 static void test_a_destination_walled_in_leaves_the_input_alone(void **state)
 {
     qnav_map_t m;
@@ -282,6 +299,7 @@ int main(void)
         cmocka_unit_test(test_arcs_are_marked_in_the_central_part_of_the_wedge),
         cmocka_unit_test(test_the_plan_leads_round_the_wall_to_its_gap),
         cmocka_unit_test(test_the_sub_goal_is_not_behind_a_corner),
+        cmocka_unit_test(test_the_destination_in_reach_is_flagged_direct),
         cmocka_unit_test(test_a_destination_walled_in_leaves_the_input_alone),
         cmocka_unit_test(test_bad_maps_are_refused),
     };

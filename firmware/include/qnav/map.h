@@ -114,6 +114,9 @@ void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm);
 /* What qnav_map_guide() did. */
 #define QNAV_MAP_GUIDED 1         /* the input's goal bearing and range are the plan's */
 #define QNAV_MAP_ESCAPE_CLEARED 2 /* the plan grew by jump_mm: in->escape was cleared */
+#define QNAV_MAP_DIRECT 4         /* the sub-goal is the destination itself: a caller that
+                                     senses the destination's bearing (a beacon) better than
+                                     its pose gives it may keep its own */
 
 /*
  * One tick, after qnav_map_observe(): plan again when plan_ticks have passed or the

@@ -1,0 +1,118 @@
+// The map above the controller in the simulator (a profile's [map]; docs/architecture.md,
+// "A map and a plan"): a wall across the arena with its gap far to one side, which the
+// probabilistic policy alone rarely finds in time, and the map's pose taken from odometry
+// with errors drawn once an episode (what a board's dead reckoning gives it).
+#include "sim_test_util.hpp"
+
+#include "qnav/ctrl.h"
+
+namespace {
+
+// A wall across at y = 5 with a 1 m gap at its east end; the destination straight north of
+// the start, beyond the wall.
+const char *const kWall =
+    "name = \"wall\"\nepisode_limit_s = 60.0\n[arena]\nwidth_m = 10.0\nheight_m = 10.0\n"
+    "[destination]\nx_m = 3.0\ny_m = 8.5\nradius_m = 0.4\n"
+    "[[start_zone]]\nx_m = 2.5\ny_m = 1.0\nw_m = 1.0\nh_m = 1.0\n"
+    "[[box]]\nx_m = 4.25\ny_m = 5.0\nw_m = 8.5\nh_m = 0.2\n";
+
+// The TekBot's profile with extra appended and odometry keys added to its [odometry].
+std::string tekbot_with(const std::string &extra, const std::string &odometry = "") {
+    std::string text = read_text_file(std::string(QNAV_TEST_DATA_DIR) + "/robots/tekbot.toml");
+    const std::size_t at = text.find('\n', text.find("um_per_count", text.find("[odometry]")));
+    assert_true(at != std::string::npos);
+    return text.insert(at + 1, odometry) + "\n" + extra;
+}
+
+struct Run {
+    unsigned reached = 0;
+    uint32_t ticks = 0;     // summed over the episodes
+    uint32_t collisions = 0;
+};
+
+// Episodes 0..n-1 of the probabilistic policy with this profile text in kWall.
+Run run(const std::string &profile, unsigned n) {
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_robot_t *robot = nullptr;
+    qnav_sim_env_t *env = nullptr;
+    qnav_sim_t *sim = nullptr;
+    if (qnav_sim_robot_parse(profile.data(), profile.size(), "tekbot-map.toml", &robot, err,
+                             sizeof err) != QNAV_SIM_OK)
+        fail_with("robot", err);
+    if (qnav_sim_env_parse(kWall, std::strlen(kWall), "wall.toml", &env, err, sizeof err) != QNAV_SIM_OK)
+        fail_with("env", err);
+    qnav_sim_config_t cfg;
+    qnav_sim_config_default(&cfg);
+    cfg.n_sectors = 16;
+    cfg.sensor_noise = 0.05;
+    cfg.actuation_noise = 0.01;
+    cfg.seed = 3;
+    if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK) fail_with("sim", err);
+    qnav_ctrl_config_t cc;
+    qnav_sim_ctrl_config(sim, &cc);
+    qnav_policy_t p;
+    qnav_sim_robot_prob_policy(robot, &p);
+    qnav_ctrl_t ctrl;
+    assert_int_equal(qnav_ctrl_init(&ctrl, &cc, &p), QNAV_OK);
+    Run r;
+    for (uint64_t e = 0; e < n; ++e) {
+        qnav_sim_result_t res;
+        assert_int_equal(qnav_sim_run_episode(sim, &ctrl, e, &res, nullptr, nullptr), QNAV_SIM_OK);
+        r.reached += res.reached ? 1u : 0u;
+        r.ticks += res.ticks;
+        r.collisions += res.collisions;
+    }
+    qnav_sim_destroy(sim);
+    qnav_sim_env_free(env);
+    qnav_sim_robot_free(robot);
+    return r;
+}
+
+void test_the_map_finds_the_gap_the_policy_alone_misses(void **) {
+    const Run without = run(tekbot_with(""), 10);
+    const Run with = run(tekbot_with("[map]\ncell_m = 0.1\n"), 10);
+    print_message("wall with a far gap: %u/10 arrive with the map (%u collisions), %u/10 without\n",
+                  with.reached, with.collisions, without.reached);
+    assert_true(with.reached >= 9);
+    assert_true(with.reached >= without.reached + 3);
+    assert_int_equal(with.collisions, 0);
+}
+
+void test_odometry_errors_move_the_maps_pose_only_when_drawn(void **) {
+    const std::string map = "[map]\ncell_m = 0.1\n";
+    const Run truth = run(tekbot_with(map), 4);
+    // errors of 0 are the true pose: the same episodes, tick for tick
+    const Run zero = run(tekbot_with(map, "err_scale_pct = 0\nerr_turn_pct = 0\nerr_curve_deg_m = 0\n"), 4);
+    assert_int_equal(zero.ticks, truth.ticks);
+    assert_int_equal(zero.reached, truth.reached);
+    // drawn errors: other episodes, the same ones again for the same seeds
+    const std::string drift = "err_scale_pct = 2\nerr_turn_pct = 5\nerr_curve_deg_m = 3\n";
+    const Run a = run(tekbot_with(map, drift), 4);
+    const Run b = run(tekbot_with(map, drift), 4);
+    assert_int_equal(a.ticks, b.ticks);
+    assert_int_not_equal(a.ticks, truth.ticks);
+    print_message("drifting odometry: %u/4 arrive (true pose %u/4)\n", a.reached, truth.reached);
+}
+
+void test_bad_odometry_settings_are_refused_by_field(void **) {
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_robot_t *robot = nullptr;
+    const std::string bad = tekbot_with("[map]\ncell_m = 0.1\n", "err_turn_pct = -1\n");
+    assert_int_not_equal(qnav_sim_robot_parse(bad.data(), bad.size(), "bad.toml", &robot, err, sizeof err),
+                         QNAV_SIM_OK);
+    assert_null(robot);
+    print_message("%s\n", err);
+    assert_non_null(std::strstr(err, "err_turn_pct"));
+    assert_non_null(std::strstr(err, "bad.toml"));
+}
+
+}  // namespace
+
+int main() {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_the_map_finds_the_gap_the_policy_alone_misses),
+        cmocka_unit_test(test_odometry_errors_move_the_maps_pose_only_when_drawn),
+        cmocka_unit_test(test_bad_odometry_settings_are_refused_by_field),
+    };
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
