@@ -322,6 +322,15 @@ int cmd_run(const RunOpts &o) {
                 qnav_sim_fitness_rule_name(rule),
                 !uses_policy ? "none" : o.policy.empty() ? "probabilistic (default)" : o.policy.c_str(),
                 o.table ? " (table mode)" : "");
+    const qnav::RobotProfile &rp = sim.robot();
+    if (rp.map_cell_m > 0) {
+        if (rp.odom_err_scale_pct > 0 || rp.odom_err_turn_pct > 0 || rp.odom_err_curve_deg_m > 0)
+            std::printf("map %g m cells, its pose from odometry with errors (sd) %g %% scale, %g %% turn, "
+                        "%g deg/m curve\n",
+                        rp.map_cell_m, rp.odom_err_scale_pct, rp.odom_err_turn_pct, rp.odom_err_curve_deg_m);
+        else
+            std::printf("map %g m cells, its pose the true one\n", rp.map_cell_m);
+    }
     RunTotals totals;
     for (unsigned e = 0; e < o.episodes; ++e) {
         const std::uint64_t es = o.episode + e;
