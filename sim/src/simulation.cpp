@@ -87,6 +87,7 @@ Simulation::Simulation(const RobotProfile &robot, const Environment &env, const 
     scan_.n_sectors = cfg_.n_sectors;
     scan_.max_range_mm = max_range_mm_;
     if (robot_.map_cell_m > 0) init_map();
+    odom_on_ = !map_mem_.empty() && has_odometry_errors(robot_);
 }
 
 // The profile's [map] over the whole arena (libqnav qnav/map.h; 8 bytes a cell).
@@ -208,8 +209,6 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
         qnav_map_reset(&map_);
         // the odometry's frame is the world's at the start (the destination's bearing and
         // range place it there each tick: anchor_goal)
-        odom_on_ = robot_.odom_err_scale_pct > 0 || robot_.odom_err_turn_pct > 0 ||
-                   robot_.odom_err_curve_deg_m > 0;
         odom_pos_ = odom_last_pos_ = pos_;
         odom_heading_ = odom_last_heading_ = heading_;
         odom_goal_ = plan_goal_ = {env_.dest_x_m, env_.dest_y_m};

@@ -119,7 +119,7 @@ private:
 
     Rng rng_start_, rng_sensor_, rng_act_, rng_odom_;
     // the map's pose: odometry integrated from the true motion with this episode's errors
-    bool odom_on_ = false;
+    bool odom_on_ = false;  // a map whose pose is odometry with errors (set once, at construction)
     Vec2 odom_pos_{}, odom_last_pos_{};
     Vec2 odom_goal_{}, plan_goal_{};  // the destination in its frame: averaged, and the plan's
     double odom_heading_ = 0, odom_last_heading_ = 0;

@@ -324,7 +324,7 @@ int cmd_run(const RunOpts &o) {
                 o.table ? " (table mode)" : "");
     const qnav::RobotProfile &rp = sim.robot();
     if (rp.map_cell_m > 0) {
-        if (rp.odom_err_scale_pct > 0 || rp.odom_err_turn_pct > 0 || rp.odom_err_curve_deg_m > 0)
+        if (qnav::has_odometry_errors(rp))
             std::printf("map %g m cells, its pose from odometry with errors (sd) %g %% scale, %g %% turn, "
                         "%g deg/m curve\n",
                         rp.map_cell_m, rp.odom_err_scale_pct, rp.odom_err_turn_pct, rp.odom_err_curve_deg_m);
