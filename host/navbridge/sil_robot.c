@@ -57,7 +57,9 @@ static void usage(FILE *f)
             "                      [--lockstep | --tick-ms N] [--reply-ms N] [--wait-s N]\n"
             "                      [--lcm-url URL | --pose]\n"
             "  --robot, --env   robot profile and environment (tekbot, open): the board\n"
-            "                   core runs the configuration generated from the profile\n"
+            "                   core runs the configuration generated from the profile,\n"
+            "                   and plans position goals over a map when it has a [map]\n"
+            "                   (not with --playback)\n"
             "  --sectors N      sonar sectors (0 = the profile's default)\n"
             "  --seed, --episode  simulator seed and episode seed (1, 1)\n"
             "  --noise P        sensor, actuation and wheel-slip (odometry) noise level p (0)\n"
@@ -246,6 +248,8 @@ typedef struct {
     sil_hal_t hal;
     qnav_sim_t *sim;
     lcm_t *lcm;
+    qnav_map_t map;           /* the board core's map, with a profile's [map] */
+    void *map_mem;
     uint32_t missed;          /* offboard ticks whose scan got no answer within reply_ms */
     uint32_t ticks;
 } robot_t;
@@ -306,6 +310,57 @@ static void print_destination(robot_t *r, qnav_sim_env_t *env)
            "--goal-at %.3f:%.3f)\n", x / 1000.0, y / 1000.0, x / 1000.0, y / 1000.0);
 }
 
+/* A profile with a [map] gives the board core a map (qnav_board_set_map), as a board with
+ * the memory for one would run it: over the arena's bounding box in the odometry frame
+ * (plus 1 m for drift), marked from the board's own dead reckoning. 0, or 2 after one line
+ * when the area needs more cells than a map holds. */
+static int board_map(robot_t *r, const options_t *o, const qnav_sim_robot_t *robot,
+                     qnav_sim_env_t *env, const qnav_board_config_t *bc)
+{
+    qnav_map_config_t mc;
+    qnav_sim_env_info_t ei;
+    double x0 = 1e12, y0 = 1e12, x1 = -1e12, y1 = -1e12;
+    uint32_t cells, w_mm, h_mm;
+    size_t bytes;
+    int k;
+    if (r->sim == NULL || !qnav_sim_robot_map_config(robot, &mc)) {
+        return 0;
+    }
+    qnav_sim_env_info(env, &ei);
+    for (k = 0; k < 4; ++k) {
+        double x, y;
+        sil_hal_world_to_odometry(&r->hal, (k & 1) ? ei.width_m : 0.0, (k & 2) ? ei.height_m : 0.0,
+                                  &x, &y);
+        x0 = fmin(x0, x - 1000.0);
+        y0 = fmin(y0, y - 1000.0);
+        x1 = fmax(x1, x + 1000.0);
+        y1 = fmax(y1, y + 1000.0);
+    }
+    w_mm = (uint32_t)ceil(x1 - x0);
+    h_mm = (uint32_t)ceil(y1 - y0);
+    cells = qnav_map_cells(w_mm, h_mm, mc.cell_mm);
+    if (cells == 0u) {
+        fprintf(stderr, "qnav-sil-robot: --robot %s: [map] cells of %u mm over %.1f x %.1f m "
+                        "are more than a map holds (65 000); use larger cells\n",
+                o->robot, (unsigned)mc.cell_mm, w_mm / 1000.0, h_mm / 1000.0);
+        return 2;
+    }
+    bytes = qnav_map_bytes(cells);
+    r->map_mem = malloc(bytes);
+    if (r->map_mem == NULL ||
+        qnav_map_init(&r->map, &mc, &bc->ctrl, (int32_t)floor(x0), (int32_t)floor(y0), w_mm,
+                      h_mm, r->map_mem, bytes) != QNAV_OK ||
+        !qnav_board_set_map(&r->bot, &r->map)) {
+        fprintf(stderr, "qnav-sil-robot: --robot %s: the board core cannot keep a map of %lu "
+                        "bytes\n", o->robot, (unsigned long)bytes);
+        return 2;
+    }
+    fprintf(stderr, "qnav-sil-robot: the board core plans over a map of %u mm cells, %.1f x "
+                    "%.1f m of the odometry frame (%lu bytes)\n",
+            (unsigned)mc.cell_mm, w_mm / 1000.0, h_mm / 1000.0, (unsigned long)bytes);
+    return 0;
+}
+
 /* Simulator (or playback), board core and pty up; 0 or an exit status. */
 static int start(robot_t *r, const options_t *o, qnav_sim_robot_t **robot,
                  qnav_sim_env_t **env, char **slave)
@@ -362,6 +417,9 @@ static int start(robot_t *r, const options_t *o, qnav_sim_robot_t **robot,
     sil_hal_start_odometry(&r->hal);
     if (qnav_board_init(&r->bot, &bc, &hal) != QNAV_BOARD_OK) {
         fprintf(stderr, "qnav-sil-robot: the board core refused its configuration\n");
+        return 2;
+    }
+    if (board_map(r, o, *robot, *env, &bc) != 0) {
         return 2;
     }
     fprintf(stderr, "qnav-sil-robot: running the %s policy (crc 0x%04x)\n",
@@ -491,6 +549,7 @@ int main(int argc, char **argv)
         lcm_destroy(r.lcm);
     }
     sil_hal_free(&r.hal);
+    free(r.map_mem);
     qnav_sim_destroy(r.sim);
     qnav_sim_env_free(env);
     qnav_sim_robot_free(robot);

@@ -274,6 +274,12 @@ void qnav_sim_robot_ctrl_config(const qnav_sim_robot_t *robot, uint16_t n_sector
     qnav::robot_ctrl_config(robot->profile, n_sectors, cfg);
 }
 
+int qnav_sim_robot_map_config(const qnav_sim_robot_t *robot, qnav_map_config_t *cfg) {
+    if (!robot || !cfg || robot->profile.map_cell_m <= 0.0) return 0;
+    qnav::robot_map_config(robot->profile, cfg);
+    return 1;
+}
+
 qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
                                        uint64_t episode_seed, qnav_sim_result_t *res,
                                        qnav_sim_trace_fn trace, void *user) {

@@ -267,6 +267,93 @@ static void test_sil_offboard_leaves_a_pocket_as_onboard_does_and_replays_identi
     assert_ptr_equal(strchr(text, '\n'), text + strlen(text) - 1); /* one line */
 }
 
+/* One lockstep trial of episode ep in the wall-gap world (wall_gap.toml) with the robot
+ * profile prof and navbridge in mode ("onboard", or "offboard": its controller steers by
+ * the bearing the board reports), tagged tag: the SIL robot's exit status (0: reached),
+ * its output and its error output in out and err. */
+static int wall_gap_trial(const char *prof, const char *ep, const char *mode, const char *tag,
+                          char *out, size_t out_len, char *err, size_t err_len)
+{
+    char link[300], f_out[300], f_err[300], nb_out[300], nb_err[300], goal[64];
+    const char *sil[] = {SIL_EXE, "--robot", prof, "--env", WALL_GAP_ENV, "--episode", ep,
+                         "--lockstep", "--reply-ms", "3000", "--link", link, NULL};
+    const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--goal-at",
+                        goal, "--mode", mode, NULL};
+    pid_t ps, pn;
+    int status;
+    snprintf(link, sizeof link, "%s/link-%s", g_dir, tag);
+    snprintf(f_out, sizeof f_out, "%s/sil-%s.out", g_dir, tag);
+    snprintf(f_err, sizeof f_err, "%s/sil-%s.err", g_dir, tag);
+    snprintf(nb_out, sizeof nb_out, "%s/nb-%s.out", g_dir, tag);
+    snprintf(nb_err, sizeof nb_err, "%s/nb-%s.err", g_dir, tag);
+    ps = qnav_test_spawn(sil, f_out, f_err);
+    assert_true(ps > 0);
+    assert_int_equal(qnav_test_wait_text(f_out, "link on", QNAV_TEST_WAIT_MS), 0);
+    destination_of(f_out, goal, sizeof goal);
+    pn = qnav_test_spawn(nb, nb_out, nb_err);
+    assert_true(pn > 0);
+    status = qnav_test_wait_exit(ps);
+    assert_int_equal(wait_exit_within(pn, QNAV_TEST_WAIT_MS), 1); /* the robot hung up */
+    assert_true(read_text(f_out, out, out_len) > 0);
+    assert_true(read_text(f_err, err, err_len) > 0);
+    return status;
+}
+
+/* The TekBot's profile with a [map] of cell_m cells, written to path. */
+static void tekbot_with_map(const char *path, const char *cell_m)
+{
+    static char profile[16384];
+    FILE *f;
+    int n = read_text(QNAV_DATA_DIR "/robots/tekbot.toml", profile, (int)sizeof profile);
+    assert_true(n > 0 && n < (int)sizeof profile - 1);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "%s\n[map]\ncell_m = %s\n", profile, cell_m);
+    assert_int_equal(fclose(f), 0);
+}
+
+/* Issue 18: a profile's [map] is run by the board core itself (qnav_board_set_map), marked
+ * from the board's own dead reckoning: behind a wall whose gap is far to one side, the
+ * robot reaches a destination that the policy alone does not reach in the world's time;
+ * a map too large for its cells is refused with one line. */
+static void test_sil_board_core_with_a_map_finds_the_far_gap(void **state)
+{
+    char prof[300], fine[300], out[320], eout[320], text[2048], err[2048];
+    const char *eps[] = {"2", "3"}, *modes[] = {"offboard", "onboard"};
+    const char *sil_fine[] = {SIL_EXE, "--robot", fine, "--env", WALL_GAP_ENV, NULL};
+    size_t k;
+    (void)state;
+    snprintf(prof, sizeof prof, "%s/tekbot-map.toml", g_dir);
+    tekbot_with_map(prof, "0.1");
+    for (k = 0; k < sizeof eps / sizeof eps[0]; ++k) {
+        char tag[32];
+        snprintf(tag, sizeof tag, "gap-map-%s", eps[k]);
+        assert_int_equal(wall_gap_trial(prof, eps[k], modes[k], tag, text, sizeof text, err,
+                                        sizeof err), 0);
+        print_message("map, episode %s, %s: %s", eps[k], modes[k], text);
+        assert_non_null(strstr(text, "reached yes, "));
+        assert_non_null(strstr(text, " 0 collisions"));
+        assert_non_null(strstr(err, "the board core plans over a map of 100 mm cells"));
+    }
+    /* the contrast: the same episode without the map times out sliding along the wall */
+    assert_int_equal(wall_gap_trial("tekbot", "2", "offboard", "gap-nomap", text, sizeof text, err,
+                                    sizeof err), 1);
+    print_message("no map, episode 2: %s", text);
+    assert_non_null(strstr(text, "reached no, "));
+    assert_null(strstr(err, "plans over a map"));
+
+    /* 4 cm cells over the arena's bounding box in the odometry frame: too many */
+    snprintf(fine, sizeof fine, "%s/tekbot-fine.toml", g_dir);
+    tekbot_with_map(fine, "0.04");
+    snprintf(out, sizeof out, "%s/sil-fine.out", g_dir);
+    snprintf(eout, sizeof eout, "%s/sil-fine.err", g_dir);
+    assert_int_equal(run_program(sil_fine, out, eout), 2);
+    assert_true(read_text(eout, err, sizeof err) > 0);
+    print_message("%s", err);
+    assert_non_null(strstr(err, "[map] cells of 40 mm over "));
+    assert_ptr_equal(strchr(err, '\n'), err + strlen(err) - 1); /* one line */
+}
+
 static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(void **state)
 {
     char link[300], log[300], pol[300], sil_out[300], sil_err[300], nb_out[300], nb_err[300];
@@ -580,6 +667,7 @@ int main(void)
         cmocka_unit_test(test_sil_pioneer3dx_is_driven_by_its_robot_and_refused_by_another),
         cmocka_unit_test(test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically),
         cmocka_unit_test(test_sil_offboard_leaves_a_pocket_as_onboard_does_and_replays_identically),
+        cmocka_unit_test(test_sil_board_core_with_a_map_finds_the_far_gap),
         cmocka_unit_test(test_sil_trial_on_udpm_recorded_by_lcm_logger_replays_identically),
         cmocka_unit_test(test_sil_route_of_three_waypoints_through_dense_replays_identically),
         cmocka_unit_test(test_sil_robot_keeps_an_uploaded_policy_in_its_nvm_file),

@@ -30,6 +30,7 @@
 
 #include "qnav/ctrl.h"
 #include "qnav/check.h"
+#include "qnav/map.h"
 #include "qnav/nav.h"
 
 #ifdef __cplusplus
@@ -204,6 +205,11 @@ void qnav_sim_ctrl_config(const qnav_sim_t *sim, qnav_ctrl_config_t *cfg);
  * description"). */
 void qnav_sim_robot_ctrl_config(const qnav_sim_robot_t *robot, uint16_t n_sectors,
                                 qnav_ctrl_config_t *cfg);
+
+/* The map a robot profile's [map] section describes (qnav/map.h; docs/sim.md): 1 and cfg
+ * filled when the profile has one (the simulator, the SIL robot and a board made from the
+ * profile then plan over it), 0 and cfg left alone when it has none. */
+int qnav_sim_robot_map_config(const qnav_sim_robot_t *robot, qnav_map_config_t *cfg);
 
 /* The episode's figures (paper Eq. 1-3; definitions in docs/sim.md). */
 typedef struct {
