@@ -5,6 +5,7 @@
  * made at init so that the step does no multiply or division here.
  */
 #include "clearance.h"
+#include "ctrl_internal.h"
 
 #include <string.h>
 
@@ -414,6 +415,30 @@ static inline uint8_t sector_level(const qnav_clearance_t *c, qnav_mm_t range_mm
     return level_of(c, range_mm);
 }
 
+/* The level sector p saw: the farthest for the one the destination makes irrelevant. */
+static inline uint8_t seen_level(const qnav_clearance_t *c, const qnav_mm_t *p,
+                                 const qnav_mm_t *skip, uint8_t *flags)
+{
+    return p == skip ? (uint8_t)(QNAV_DIST_LEVELS - 1u) : sector_level(c, *p, flags);
+}
+
+uint16_t qnav_clearance_reach_sector(const qnav_clearance_t *c, const qnav_ctrl_input_t *in)
+{
+    uint16_t k;
+    qnav_mm_t r;
+    if (in->goal_range_mm == 0u || (uint32_t)in->goal_range_mm + c->margin_mm >=
+                                        (uint32_t)c->max_range_mm + c->sensor_offset_mm) {
+        return c->n_sectors; /* unknown, or no reading can lie beyond it (most ticks) */
+    }
+    k = qnav_ctrl_sector_of_path(c->n_sectors, qnav_whole_deg(in->goal_bearing_cdeg));
+    r = in->ranges_mm[k];
+    if (r >= c->max_range_mm ||
+        (uint32_t)r + c->sensor_offset_mm < (uint32_t)in->goal_range_mm + c->margin_mm) {
+        return c->n_sectors;
+    }
+    return k;
+}
+
 /* A sector's enlargement: its reading's own (reading_gamma); none for a sector that saw
  * nothing within range, which is never painted. */
 static inline uint8_t gamma_of(const qnav_clearance_t *c, qnav_mm_t range_mm, uint8_t level)
@@ -452,15 +477,17 @@ static void fill_clear(uint8_t *lvl)
  * when p < 360 - q * N; sector 0 is cut in two pieces, paths 0.. and the last ones before
  * 360. Pieces are painted in path order, each knowing its neighbours' levels (the piece
  * before piece 0 holds path 359). */
-uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint8_t *lvl)
+uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint16_t skip,
+                              uint8_t *lvl)
 {
     const qnav_mm_t *next_range = ranges + 1; /* the sector after the current piece's */
     const qnav_mm_t *end = ranges + c->n_sectors;
+    const qnav_mm_t *skip_at = skip < c->n_sectors ? ranges + skip : end; /* end: none */
     uint16_t first = 0;                       /* the current piece: paths first..stop - 1 */
     uint16_t stop = c->first_sector_paths;
     uint16_t phase = (uint16_t)(stop * c->n_sectors - QNAV_PATHS / 2u); /* of the next sector */
     uint8_t flags = 0;
-    uint8_t level0 = sector_level(c, ranges[0], &flags);
+    uint8_t level0 = seen_level(c, ranges, skip_at, &flags);
     uint8_t gamma0 = gamma_of(c, ranges[0], level0);
     uint8_t level = level0;
     uint8_t gamma = gamma0;
@@ -468,7 +495,7 @@ uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges
     uint8_t prev = level0;
     uint8_t prev_gamma = gamma0;
     if (c->n_sectors > QNAV_DTHETA_MAX) {
-        prev = sector_level(c, end[-1], &flags);
+        prev = seen_level(c, end - 1, skip_at, &flags);
         prev_gamma = gamma_of(c, end[-1], prev);
     }
     fill_clear(lvl);
@@ -477,7 +504,7 @@ uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges
         uint8_t next = level0;
         uint8_t next_gamma = gamma0;
         if (next_range != end) {
-            next = sector_level(c, *next_range, &flags);
+            next = seen_level(c, next_range, skip_at, &flags);
             next_gamma = gamma_of(c, *next_range, next);
             ++next_range;
         }

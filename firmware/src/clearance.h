@@ -38,12 +38,23 @@ qnav_q1_15_t qnav_clearance_speed_cap(const qnav_clearance_t *c, uint8_t level);
 qnav_q1_15_t qnav_clearance_turn_cap(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t path);
 
 /*
+ * The destination in reach (docs/architecture.md, "The destination in reach"): the sector
+ * under the destination's bearing when its reading lies beyond the destination by at least
+ * the body's margin (range + sensor offset >= goal range + margin_mm), so that what it saw
+ * cannot stop the robot before it arrives; c->n_sectors when there is none (the goal range
+ * unknown, 0, or the sector clear anyway).
+ */
+uint16_t qnav_clearance_reach_sector(const qnav_clearance_t *c, const qnav_ctrl_input_t *in);
+
+/*
  * The distance level of every path (lvl[i] for path i, i = 0..359) from the n_sectors
- * ranges: the minimum over the sectors whose enlarged arc covers the path.
+ * ranges: the minimum over the sectors whose enlarged arc covers the path, sector skip
+ * (< n_sectors; n_sectors for none) counted as clear.
  * Returns QNAV_FLAG_RANGE_CLIPPED when a range above max_range_mm was clipped, else 0.
  * @par Cost: 360 byte writes plus count + 2 * gamma per sector nearer than the maximum.
  */
-uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint8_t *lvl);
+uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint16_t skip,
+                              uint8_t *lvl);
 
 /* The distance level of a range, mm (docs/qformats.md; at or beyond max_range_mm:
  * QNAV_DIST_LEVELS - 1). */

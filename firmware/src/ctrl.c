@@ -455,7 +455,7 @@ uint8_t qnav_ctrl_path_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges_m
     if (ctrl == 0 || ctrl->magic != QNAV_CTRL_MAGIC || ranges_mm == 0 || lvl == 0) {
         return QNAV_FLAG_NOT_READY;
     }
-    return qnav_clearance_levels(&ctrl->clr, ranges_mm, lvl);
+    return qnav_clearance_levels(&ctrl->clr, ranges_mm, ctrl->clr.n_sectors, lvl);
 }
 
 /*
@@ -550,7 +550,8 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     best.key = QNAV_KEY_NONE;
     best.dtheta = 0;
     best.heading = 0;
-    flags = qnav_clearance_levels(&ctrl->clr, in->ranges_mm, lvl);
+    flags = qnav_clearance_levels(&ctrl->clr, in->ranges_mm,
+                                  qnav_clearance_reach_sector(&ctrl->clr, in), lvl);
     /* the memory goes straight to the output (no copy on the stack: the ATmega128's RAM) */
     goal = qnav_escape_goal(&ctrl->clr, lvl, in, &out->escape);
     prev = qnav_whole_deg(in->prev_heading_cdeg);

@@ -107,12 +107,30 @@ unsigned ref_dtheta(unsigned path, unsigned goal)
     return d <= 180u ? d : 360u - d;
 }
 
+void ref_seen_ranges(const qnav_clearance_t *c, const qnav_ctrl_input_t *in,
+                     qnav_mm_t seen[QNAV_MAX_SECTORS])
+{
+    unsigned k, goal = ref_goal_deg(in->goal_bearing_cdeg);
+    /* the sector whose wedge holds the destination's whole-degree path: sector k covers
+     * the paths within half a wedge of k * 360 / N (the half-open boundary as the step's) */
+    unsigned sector = (unsigned)(((unsigned long)goal * c->n_sectors + 180u) / 360u) % c->n_sectors;
+    for (k = 0; k < c->n_sectors; ++k) {
+        seen[k] = in->ranges_mm[k];
+    }
+    if (in->goal_range_mm != 0u && seen[sector] < c->max_range_mm &&
+        (double)seen[sector] + c->sensor_offset_mm >= (double)in->goal_range_mm + c->margin_mm) {
+        seen[sector] = c->max_range_mm;
+    }
+}
+
 void ref_path_qualities(const qnav_ctrl_t *ctrl, const qnav_policy_t *policy,
                         const qnav_ctrl_input_t *in, double out[QNAV_PATHS])
 {
     unsigned goal = ref_goal_deg(in->goal_bearing_cdeg);
     uint8_t lvl[QNAV_PATHS];
-    (void)qnav_ctrl_path_levels(ctrl, in->ranges_mm, lvl);
+    qnav_mm_t seen[QNAV_MAX_SECTORS];
+    ref_seen_ranges(&ctrl->clr, in, seen);
+    (void)qnav_ctrl_path_levels(ctrl, seen, lvl);
     for (unsigned i = 0; i < QNAV_PATHS; ++i) {
         out[i] = ref_ranks_by_preact(ctrl, policy)
                      ? ref_preact(policy, lvl[i], ref_dtheta(i, goal))

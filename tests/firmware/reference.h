@@ -30,6 +30,12 @@ int ref_ranks_by_preact(const qnav_ctrl_t *ctrl, const qnav_policy_t *policy);
 void ref_path_qualities(const qnav_ctrl_t *ctrl, const qnav_policy_t *policy,
                         const qnav_ctrl_input_t *in, double out[QNAV_PATHS]);
 
+/* The ranges the step sees (docs/architecture.md, "The destination in reach"): in's, with
+ * the reading under the destination's bearing taken as clear when it lies beyond the
+ * destination by the body's margin or more. */
+void ref_seen_ranges(const qnav_clearance_t *c, const qnav_ctrl_input_t *in,
+                     qnav_mm_t seen[QNAV_MAX_SECTORS]);
+
 /* Whole-degree destination bearing (0..359) as the controller rounds it. */
 unsigned ref_goal_deg(qnav_cdeg_t bearing_cdeg);
 

@@ -320,7 +320,7 @@ static void test_reading_gamma_equals_the_walk_for_every_range(void **state)
                     unsigned painted = 0;
                     unsigned want = 0;
                     ranges[0] = (qnav_mm_t)r;
-                    qnav_clearance_levels(&c, ranges, lvl);
+                    qnav_clearance_levels(&c, ranges, c.n_sectors, lvl);
                     for (uint16_t p = 0; p < QNAV_PATHS; ++p) {
                         painted += lvl[p] != QNAV_DIST_LEVELS - 1u;
                     }

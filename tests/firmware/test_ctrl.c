@@ -344,6 +344,46 @@ static void test_ctrl_prefers_goal_over_far_obstacle(void **state)
     assert_int_equal(out.heading_deg, 45);
 }
 
+/* The destination in reach (docs/architecture.md): a wall just beyond the destination
+ * does not block the way to it, one nearer than the destination plus the body's margin
+ * does, and an unknown distance (0) changes nothing. */
+static void test_a_wall_beyond_the_destination_does_not_block_the_way_to_it(void **state)
+{
+    qnav_ctrl_t c;
+    qnav_policy_t p;
+    qnav_ctrl_config_t cfg;
+    qnav_mm_t ranges[16];
+    qnav_ctrl_output_t unknown, reach, short_of;
+    qnav_q1_15_t q_unknown[QNAV_PATHS], q_reach[QNAV_PATHS], q_short[QNAV_PATHS];
+    (void)state;
+    qnav_policy_prob_default(&p);
+    qnav_ctrl_config_default(&cfg);
+    cfg.n_sectors = 16;
+    cfg.max_range_mm = 2500;
+    cfg.body_radius_mm = 120;
+    cfg.safety_mm = 50; /* margin 170 mm */
+    cfg.sensor_offset_mm = 0;
+    assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_OK);
+    fill(ranges, 16, 2500);
+    ranges[15] = ranges[0] = ranges[1] = 900; /* a wall across the way, 0.9 m ahead */
+    {
+        qnav_ctrl_input_t in = {ranges, 0};
+        qnav_ctrl_step(&c, &in, &unknown, q_unknown);
+        in.goal_range_mm = 600; /* 0.3 m short of the wall: 900 >= 600 + 170 */
+        qnav_ctrl_step(&c, &in, &reach, q_reach);
+        in.goal_range_mm = 800; /* 900 < 800 + 170: the body would touch it first */
+        qnav_ctrl_step(&c, &in, &short_of, q_short);
+    }
+    print_message("path 0: quality %d without a distance, %d with the destination in reach\n",
+                  q_unknown[0], q_reach[0]);
+    assert_true(q_reach[0] > q_unknown[0]);
+    assert_int_equal(reach.heading_deg, 0);
+    assert_true(reach.speed > 0);
+    assert_memory_equal(q_short, q_unknown, sizeof q_unknown);
+    assert_int_equal(short_of.heading_deg, unknown.heading_deg);
+
+}
+
 static void test_speed_is_linear_in_quality_up_to_full(void **state)
 {
     (void)state;
@@ -1474,6 +1514,7 @@ int main(void)
         cmocka_unit_test(test_holding_keeps_the_previous_of_two_equal_ways),
         cmocka_unit_test(test_holding_leaves_preactivation_keys_alone),
         cmocka_unit_test(test_ctrl_prefers_goal_over_far_obstacle),
+        cmocka_unit_test(test_a_wall_beyond_the_destination_does_not_block_the_way_to_it),
         cmocka_unit_test(test_speed_is_linear_in_quality_up_to_full),
         cmocka_unit_test(test_equal_qualities_choose_the_goal_direction),
         cmocka_unit_test(test_ranges_beyond_max_are_clipped_and_flagged),

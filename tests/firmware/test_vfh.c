@@ -93,6 +93,26 @@ static void test_vfh_steers_around_an_obstacle_on_the_goal_line(void **state)
     assert_true(f.out.speed > 0);
 }
 
+/* The destination in reach (docs/architecture.md): VFH+ reads the same levels as the
+ * path-quality step, so an obstacle beyond the destination by the body's margin does not
+ * turn it away, and one that is not beyond it does. */
+static void test_vfh_drives_at_a_destination_in_front_of_an_obstacle(void **state)
+{
+    fixture_t f;
+    (void)state;
+    setup(&f, 5000);
+    f.r[0] = 600; /* straight ahead, 0.6 m: the destination 0.2 m short of it */
+    f.in.goal_range_mm = 200;
+    step(&f);
+    assert_int_equal(f.out.heading_deg, 0);
+    assert_true(f.out.speed > 0);
+    setup(&f, 5000);
+    f.r[0] = 600;
+    f.in.goal_range_mm = 590; /* as far as the obstacle: the body would touch it first */
+    step(&f);
+    assert_true(f.out.heading_deg > 20 || f.out.heading_deg < -20);
+}
+
 static void test_vfh_hysteresis_keeps_a_sector_blocked_between_the_thresholds(void **state)
 {
     fixture_t f;
@@ -250,6 +270,7 @@ int main(void)
         cmocka_unit_test(test_vfh_init_rejects_bad_parameters),
         cmocka_unit_test(test_vfh_drives_at_goal_in_open_space_at_full_speed),
         cmocka_unit_test(test_vfh_steers_around_an_obstacle_on_the_goal_line),
+        cmocka_unit_test(test_vfh_drives_at_a_destination_in_front_of_an_obstacle),
         cmocka_unit_test(test_vfh_hysteresis_keeps_a_sector_blocked_between_the_thresholds),
         cmocka_unit_test(test_vfh_previous_direction_breaks_a_symmetric_choice),
         cmocka_unit_test(test_vfh_slows_near_obstacles_and_stops_when_boxed_in),
