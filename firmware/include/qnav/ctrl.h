@@ -189,7 +189,10 @@ typedef struct {
                                          on the first tick. Read by 3-input networks and
                                          VFH+; the step itself keeps no memory */
     qnav_mm_t goal_range_mm;          /* distance to the destination, mm (65535 and
-                                         beyond: 65535); 0: unknown, no escape */
+                                         beyond: 65535); 0: unknown, no escape. The
+                                         reading under the destination's bearing counts
+                                         as clear when it lies beyond the destination by
+                                         body radius + safety distance or more */
     qnav_escape_t escape;             /* the previous output's escape; zero at the start */
 } qnav_ctrl_input_t;
 
