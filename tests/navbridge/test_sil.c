@@ -222,6 +222,20 @@ static void test_sil_pioneer3dx_is_driven_by_its_robot_and_refused_by_another(vo
     assert_non_null(strstr(text, "identical, 0 differ"));
 }
 
+/* Run argv to its end (output in g_dir/tag.out and .err): it must exit 2 after one line
+ * on stderr that contains expect. */
+static void refused_in_one_line(const char *const *argv, const char *tag, const char *expect)
+{
+    char out[320], err[320], text[2048];
+    snprintf(out, sizeof out, "%s/%s.out", g_dir, tag);
+    snprintf(err, sizeof err, "%s/%s.err", g_dir, tag);
+    assert_int_equal(run_program(argv, out, err), 2);
+    assert_true(read_text(err, text, sizeof text) > 0);
+    print_message("%s", text);
+    assert_non_null(strstr(text, expect));
+    assert_ptr_equal(strchr(text, '\n'), text + strlen(text) - 1); /* one line */
+}
+
 /* One lockstep TekBot trial in the committed U-pocket world (pocket_tekbot.toml), navbridge
  * in mode ("offboard" or "onboard") with --robot tekbot logging to log: the robot must
  * reach its destination. */
@@ -248,7 +262,7 @@ static void pocket_trial(const char *mode, const char *log)
 static void test_sil_offboard_leaves_a_pocket_as_onboard_does_and_replays_identically(
     void **state)
 {
-    char log[300], out[320], err[320], text[2048];
+    char log[300];
     const char *no_robot[] = {NAVBRIDGE_EXE, "--replay", log, NULL};
     (void)state;
     snprintf(log, sizeof log, "%s/pocket-onboard.lcmlog", g_dir);
@@ -258,13 +272,7 @@ static void test_sil_offboard_leaves_a_pocket_as_onboard_does_and_replays_identi
     pocket_trial("offboard", log);
     replay_robot_is_identical(log, "tekbot");
 
-    snprintf(out, sizeof out, "%s/pocket-norobot.out", g_dir);
-    snprintf(err, sizeof err, "%s/pocket-norobot.err", g_dir);
-    assert_int_equal(run_program(no_robot, out, err), 2);
-    assert_true(read_text(err, text, sizeof text) > 0);
-    print_message("%s", text);
-    assert_non_null(strstr(text, "--robot NAME|FILE missing"));
-    assert_ptr_equal(strchr(text, '\n'), text + strlen(text) - 1); /* one line */
+    refused_in_one_line(no_robot, "pocket-norobot", "--robot NAME|FILE missing");
 }
 
 /* One lockstep trial of episode ep in the wall-gap world (wall_gap.toml) with the robot
@@ -318,7 +326,7 @@ static void tekbot_with_map(const char *path, const char *cell_m)
  * a map too large for its cells is refused with one line. */
 static void test_sil_board_core_with_a_map_finds_the_far_gap(void **state)
 {
-    char prof[300], fine[300], out[320], eout[320], text[2048], err[2048];
+    char prof[300], fine[300], text[2048], err[2048];
     const char *eps[] = {"2", "3"}, *modes[] = {"offboard", "onboard"};
     const char *sil_fine[] = {SIL_EXE, "--robot", fine, "--env", WALL_GAP_ENV, NULL};
     size_t k;
@@ -345,13 +353,7 @@ static void test_sil_board_core_with_a_map_finds_the_far_gap(void **state)
     /* 4 cm cells over the arena's bounding box in the odometry frame: too many */
     snprintf(fine, sizeof fine, "%s/tekbot-fine.toml", g_dir);
     tekbot_with_map(fine, "0.04");
-    snprintf(out, sizeof out, "%s/sil-fine.out", g_dir);
-    snprintf(eout, sizeof eout, "%s/sil-fine.err", g_dir);
-    assert_int_equal(run_program(sil_fine, out, eout), 2);
-    assert_true(read_text(eout, err, sizeof err) > 0);
-    print_message("%s", err);
-    assert_non_null(strstr(err, "[map] cells of 40 mm over "));
-    assert_ptr_equal(strchr(err, '\n'), err + strlen(err) - 1); /* one line */
+    refused_in_one_line(sil_fine, "sil-fine", "[map] cells of 40 mm over ");
 }
 
 static void test_sil_robot_onboard_runs_uploaded_policy_and_replays_identically(void **state)
