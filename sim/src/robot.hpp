@@ -91,7 +91,6 @@ inline bool has_odometry_errors(const RobotProfile &p) {
     return p.odom_err_scale_pct > 0 || p.odom_err_turn_pct > 0 || p.odom_err_curve_deg_m > 0;
 }
 
-
 // Parse a profile (TOML text); name is used in error messages. Throws SimError.
 RobotProfile parse_robot_profile(std::string_view text, const std::string &name);
 

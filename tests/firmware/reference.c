@@ -110,10 +110,10 @@ unsigned ref_dtheta(unsigned path, unsigned goal)
 void ref_seen_ranges(const qnav_clearance_t *c, const qnav_ctrl_input_t *in,
                      qnav_mm_t seen[QNAV_MAX_SECTORS])
 {
-    unsigned k, goal = ref_goal_deg(in->goal_bearing_cdeg);
-    /* the sector whose wedge holds the destination's whole-degree path: sector k covers
-     * the paths within half a wedge of k * 360 / N (the half-open boundary as the step's) */
-    unsigned sector = (unsigned)(((unsigned long)goal * c->n_sectors + 180u) / 360u) % c->n_sectors;
+    unsigned k;
+    /* the sector whose wedge holds the destination's whole-degree path */
+    unsigned sector = qnav_ctrl_sector_of_path(c->n_sectors,
+                                               (uint16_t)ref_goal_deg(in->goal_bearing_cdeg));
     for (k = 0; k < c->n_sectors; ++k) {
         seen[k] = in->ranges_mm[k];
     }

@@ -115,12 +115,14 @@ typedef struct {
 } trial_files_t;
 
 /* Run a SIL robot (sil) and then navbridge (nb, whose --goal-at value is goal) to the
- * end of the episode: the robot reaches its destination (status 0), its end closes the pty
- * and navbridge sees the hang-up and leaves with 1. */
-static void drive_trial(const char *const *sil, const char *const *nb, const char *tag,
-                        char *goal, size_t goal_len, trial_files_t *f)
+ * end of the episode, the files named by tag: the robot's end closes the pty and navbridge
+ * sees the hang-up and leaves with 1. Returns the robot's exit status (0: destination
+ * reached). */
+static int drive_trial(const char *const *sil, const char *const *nb, const char *tag,
+                       char *goal, size_t goal_len, trial_files_t *f)
 {
     pid_t ps, pn;
+    int status;
     snprintf(f->sil_out, sizeof f->sil_out, "%s/sil%s.out", g_dir, tag);
     snprintf(f->sil_err, sizeof f->sil_err, "%s/sil%s.err", g_dir, tag);
     snprintf(f->nb_out, sizeof f->nb_out, "%s/nb%s.out", g_dir, tag);
@@ -131,8 +133,9 @@ static void drive_trial(const char *const *sil, const char *const *nb, const cha
     destination_of(f->sil_out, goal, goal_len);
     pn = qnav_test_spawn(nb, f->nb_out, f->nb_err);
     assert_true(pn > 0);
-    assert_int_equal(qnav_test_wait_exit(ps), 0); /* 0: destination reached */
+    status = qnav_test_wait_exit(ps);
     assert_int_equal(wait_exit_within(pn, QNAV_TEST_WAIT_MS), 1);
+    return status;
 }
 
 static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void **state)
@@ -148,7 +151,7 @@ static void test_sil_robot_reaches_destination_through_navbridge_over_memq(void 
     (void)state;
     snprintf(link, sizeof link, "%s/link", g_dir);
     snprintf(log, sizeof log, "%s/memq.lcmlog", g_dir);
-    drive_trial(sil, nb, "", goal, sizeof goal, &f);
+    assert_int_equal(drive_trial(sil, nb, "", goal, sizeof goal, &f), 0);
     assert_true(read_text(f.nb_err, text, sizeof text) > 0);
     assert_non_null(strstr(text, "device hung up: link lost"));
     assert_true(read_text(f.sil_out, text, sizeof text) > 0);
@@ -249,7 +252,7 @@ static void pocket_trial(const char *mode, const char *log)
     trial_files_t f;
     snprintf(link, sizeof link, "%s/link-pocket-%s", g_dir, mode);
     snprintf(tag, sizeof tag, "-pocket-%s", mode);
-    drive_trial(sil, nb, tag, goal, sizeof goal, &f);
+    assert_int_equal(drive_trial(sil, nb, tag, goal, sizeof goal, &f), 0);
     assert_true(read_text(f.sil_out, text, sizeof text) > 0);
     print_message("%s: %s", mode, text);
     assert_non_null(strstr(text, "reached yes"));
@@ -282,28 +285,17 @@ static void test_sil_offboard_leaves_a_pocket_as_onboard_does_and_replays_identi
 static int wall_gap_trial(const char *prof, const char *ep, const char *mode, const char *tag,
                           char *out, size_t out_len, char *err, size_t err_len)
 {
-    char link[300], f_out[300], f_err[300], nb_out[300], nb_err[300], goal[64];
+    char link[300], goal[64];
     const char *sil[] = {SIL_EXE, "--robot", prof, "--env", WALL_GAP_ENV, "--episode", ep,
                          "--lockstep", "--reply-ms", "3000", "--link", link, NULL};
     const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--goal-at",
                         goal, "--mode", mode, NULL};
-    pid_t ps, pn;
+    trial_files_t f;
     int status;
-    snprintf(link, sizeof link, "%s/link-%s", g_dir, tag);
-    snprintf(f_out, sizeof f_out, "%s/sil-%s.out", g_dir, tag);
-    snprintf(f_err, sizeof f_err, "%s/sil-%s.err", g_dir, tag);
-    snprintf(nb_out, sizeof nb_out, "%s/nb-%s.out", g_dir, tag);
-    snprintf(nb_err, sizeof nb_err, "%s/nb-%s.err", g_dir, tag);
-    ps = qnav_test_spawn(sil, f_out, f_err);
-    assert_true(ps > 0);
-    assert_int_equal(qnav_test_wait_text(f_out, "link on", QNAV_TEST_WAIT_MS), 0);
-    destination_of(f_out, goal, sizeof goal);
-    pn = qnav_test_spawn(nb, nb_out, nb_err);
-    assert_true(pn > 0);
-    status = qnav_test_wait_exit(ps);
-    assert_int_equal(wait_exit_within(pn, QNAV_TEST_WAIT_MS), 1); /* the robot hung up */
-    assert_true(read_text(f_out, out, out_len) > 0);
-    assert_true(read_text(f_err, err, err_len) > 0);
+    snprintf(link, sizeof link, "%s/link%s", g_dir, tag);
+    status = drive_trial(sil, nb, tag, goal, sizeof goal, &f);
+    assert_true(read_text(f.sil_out, out, (int)out_len) > 0);
+    assert_true(read_text(f.sil_err, err, (int)err_len) > 0);
     return status;
 }
 
@@ -335,7 +327,7 @@ static void test_sil_board_core_with_a_map_finds_the_far_gap(void **state)
     tekbot_with_map(prof, "0.1");
     for (k = 0; k < sizeof eps / sizeof eps[0]; ++k) {
         char tag[32];
-        snprintf(tag, sizeof tag, "gap-map-%s", eps[k]);
+        snprintf(tag, sizeof tag, "-gap-map-%s", eps[k]);
         assert_int_equal(wall_gap_trial(prof, eps[k], modes[k], tag, text, sizeof text, err,
                                         sizeof err), 0);
         print_message("map, episode %s, %s: %s", eps[k], modes[k], text);
@@ -344,7 +336,7 @@ static void test_sil_board_core_with_a_map_finds_the_far_gap(void **state)
         assert_non_null(strstr(err, "the board core plans over a map of 100 mm cells"));
     }
     /* the contrast: the same episode without the map times out sliding along the wall */
-    assert_int_equal(wall_gap_trial("tekbot", "2", "offboard", "gap-nomap", text, sizeof text, err,
+    assert_int_equal(wall_gap_trial("tekbot", "2", "offboard", "-gap-nomap", text, sizeof text, err,
                                     sizeof err), 1);
     print_message("no map, episode 2: %s", text);
     assert_non_null(strstr(text, "reached no, "));
@@ -528,30 +520,19 @@ static void test_sil_route_of_three_waypoints_through_dense_replays_identically(
 /* One onboard SIL trial with --nvm; navbridge's stderr into text. */
 static void nvm_trial(const char *nvm, const char *pol, int upload, char *text, int cap)
 {
-    char link[300], s_out[300], s_err[300], nb_out[300], nb_err[300], goal[64];
+    char link[300], goal[64];
     const char *sil[] = {SIL_EXE, "--tick-ms", "10", "--nvm", nvm, "--link", link, NULL};
     const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--mode",
                         "onboard", "--goal-at", goal, upload ? "--policy" : NULL, pol,
                         "--upload", NULL};
-    pid_t ps, pn;
+    trial_files_t f;
     int rc;
     snprintf(link, sizeof link, "%s/link-nvm", g_dir);
-    snprintf(s_out, sizeof s_out, "%s/sil-nvm.out", g_dir);
-    snprintf(s_err, sizeof s_err, "%s/sil-nvm.err", g_dir);
-    snprintf(nb_out, sizeof nb_out, "%s/nb-nvm.out", g_dir);
-    snprintf(nb_err, sizeof nb_err, "%s/nb-nvm.err", g_dir);
-    ps = qnav_test_spawn(sil, s_out, s_err);
-    assert_true(ps > 0);
-    assert_int_equal(qnav_test_wait_text(s_out, "link on", QNAV_TEST_WAIT_MS), 0);
-    destination_of(s_out, goal, sizeof goal);
-    pn = qnav_test_spawn(nb, nb_out, nb_err);
-    assert_true(pn > 0);
-    rc = qnav_test_wait_exit(ps);
-    assert_int_equal(wait_exit_within(pn, QNAV_TEST_WAIT_MS), 1);
-    assert_true(read_text(s_out, text, cap) > 0);
+    rc = drive_trial(sil, nb, "-nvm", goal, sizeof goal, &f);
+    assert_true(read_text(f.sil_out, text, cap) > 0);
     print_message("%s", text);
     assert_int_equal(rc, 0);
-    assert_true(read_text(nb_err, text, cap) > 0);
+    assert_true(read_text(f.nb_err, text, cap) > 0);
 }
 
 static void test_sil_robot_keeps_an_uploaded_policy_in_its_nvm_file(void **state)
