@@ -5,6 +5,8 @@
  */
 #include "escape.h"
 
+#include <stddef.h>
+
 #include "clearance.h"
 #include "ctrl_internal.h"
 
@@ -178,6 +180,28 @@ static uint8_t way_opened(const qnav_clearance_t *c, const qnav_ctrl_input_t *in
                              progress_mm(c) <= e->hit_mm ||
                      (uint32_t)rest_mm(c, in, goal, range, 0) +
                              QNAV_ESCAPE_NEW_MARGINS * c->margin_mm <= e->hit_mm);
+}
+
+static void grow_mm(uint16_t *v, uint16_t d)
+{
+    if (*v != 0u) {
+        *v = (uint16_t)((uint32_t)*v + d > 65535u ? 65535u : *v + d);
+    }
+}
+
+void qnav_escape_grow(qnav_escape_t *e, uint16_t d_mm)
+{
+    if (e == NULL || d_mm == 0u) {
+        return;
+    }
+    grow_mm(&e->best_mm, d_mm);
+    grow_mm(&e->hit_mm, d_mm);
+    grow_mm(&e->stall_mm, d_mm);
+    grow_mm(&e->near_mm, d_mm);
+    grow_mm(&e->loop_mm, d_mm);
+    grow_mm(&e->from_mm, d_mm);
+    grow_mm(&e->over_mm, d_mm);
+    grow_mm(&e->prev_mm, d_mm);
 }
 
 void qnav_escape_clear(qnav_escape_t *e)

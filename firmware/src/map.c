@@ -17,6 +17,7 @@
 
 #include <string.h>
 
+#include "escape.h"
 #include "qnav/trig.h"
 
 #define EVIDENCE_FREE_MIN (-4)
@@ -40,6 +41,7 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->near_mm = 200u;
     cfg->arc_pct = 100u;
     cfg->sight = 1u;
+    cfg->escape_grow = 1u;
     cfg->near_cost = 10u;
 }
 
@@ -124,6 +126,7 @@ void qnav_map_reset(qnav_map_t *m)
     m->last_mm = 0u;
     m->planned = 0u;
     m->dirty = 0u;
+    m->grown_mm = 0u;
 }
 
 /* The cell holding world point (x, y), clamped into the map. */
@@ -471,29 +474,39 @@ static uint32_t cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi
     return best;
 }
 
+/* A plan for a new destination; again on the plan's turn when a cell became or stopped
+ * being occupied since the last (the same plan otherwise). 1 when a plan for the same
+ * destination was made again. */
+static int plan_when_due(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
+{
+    int again = 0;
+    if (!m->planned || m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm) {
+        qnav_map_plan(m, goal_x_mm, goal_y_mm);
+    } else if (++m->ticks >= m->cfg.plan_ticks) {
+        if (m->dirty) {
+            qnav_map_plan(m, goal_x_mm, goal_y_mm);
+            again = 1;
+        }
+        m->ticks = 0u;
+    }
+    return again;
+}
+
 int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
                    int32_t goal_y_mm, qnav_ctrl_input_t *in)
 {
     int32_t i, j, ri, rj, steps, sx, sy;
     uint32_t cost, mm;
-    int jumped, direct = 0;
+    int jumped, replanned, direct = 0, grew = 0;
     if (m == NULL || m->cost == NULL || pose == NULL || in == NULL) {
         return 0;
     }
-    if (!m->planned || m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm) {
-        qnav_map_plan(m, goal_x_mm, goal_y_mm);
-    } else if (++m->ticks >= m->cfg.plan_ticks) {
-        /* the plan's turn: made again only when a cell became or stopped being occupied
-         * since the last (the same plan otherwise) */
-        if (m->dirty) {
-            qnav_map_plan(m, goal_x_mm, goal_y_mm);
-        }
-        m->ticks = 0u;
-    }
+    replanned = plan_when_due(m, goal_x_mm, goal_y_mm);
     cell_of(m, pose->x_mm, pose->y_mm, &ri, &rj);
     cost = cost_near(m, ri, rj, &i, &j);
     if (cost == QNAV_MAP_UNREACHED) {
         m->last_mm = 0u;
+        m->grown_mm = 0u;
         return 0;
     }
     /* steepest descent for look_mm */
@@ -535,13 +548,20 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     mm = cost * m->cfg.cell_mm / STEP_SIDE;
     mm = mm == 0u ? 1u : (mm > 65535u ? 65535u : mm);
     jumped = m->last_mm != 0u && mm > (uint32_t)m->last_mm + m->cfg.jump_mm;
+    m->grown_mm = 0u;
+    if (!jumped && replanned && m->cfg.escape_grow && m->last_mm != 0u && mm > m->last_mm) {
+        /* a new plan, longer (by less than a jump) where the robot is */
+        m->grown_mm = (uint16_t)(mm - m->last_mm);
+        qnav_escape_grow(&in->escape, m->grown_mm);
+        grew = QNAV_MAP_ESCAPE_GROWN;
+    }
     m->last_mm = (uint16_t)mm;
     in->goal_range_mm = (qnav_mm_t)mm;
     if (jumped) {
         memset(&in->escape, 0, sizeof in->escape);
         return QNAV_MAP_GUIDED | QNAV_MAP_ESCAPE_CLEARED | direct;
     }
-    return QNAV_MAP_GUIDED | direct;
+    return QNAV_MAP_GUIDED | grew | direct;
 }
 
 /* The index of the cell holding (x, y); -1 outside the map. */
@@ -554,6 +574,11 @@ static int32_t index_of(const qnav_map_t *m, int32_t x_mm, int32_t y_mm)
     i = (x_mm - m->x0_mm) / (int32_t)m->cfg.cell_mm;
     j = (y_mm - m->y0_mm) / (int32_t)m->cfg.cell_mm;
     return i < (int32_t)m->nx && j < (int32_t)m->ny ? j * (int32_t)m->nx + i : -1;
+}
+
+uint16_t qnav_map_grown_mm(const qnav_map_t *m)
+{
+    return m == NULL ? 0u : m->grown_mm;
 }
 
 int8_t qnav_map_evidence(const qnav_map_t *m, int32_t x_mm, int32_t y_mm)

@@ -373,6 +373,7 @@ int qpy_env_step(qpy_env_t *e, qpy_ctrl_t *ctrl, double heading_deg, double spee
         in.prev_heading_cdeg = e->scan.prev_heading_cdeg;
         in.goal_range_mm = e->scan.goal_range_mm;
         in.escape = e->scan.escape_clear ? qnav_escape_t{} : ctrl->last.escape;
+        qnav_escape_grow(&in.escape, e->scan.escape_grow_mm);
         qnav_nav_step(&ctrl->nav, &in, &ctrl->last);
         if (ctrl->last.flags & QNAV_FLAG_NOT_READY)
             return fail(err, errlen, "controller: not initialised (qnav_ctrl_init failed or was not called)",

@@ -63,6 +63,7 @@ struct RobotProfile {
     double map_near_cost = 1.0;     // ...cost this much more to cross, in cell sides
     int map_arc_pct = 100;          // arcs marked in the central this % of the wedge
     bool map_sight = true;          // the sub-goal kept in a straight line's sight
+    bool map_escape_grow = true;    // a longer plan grows the escape's distances with it
     // the odometry's errors, drawn once an episode with these standard deviations (all 0:
     // the map's pose is the true one): distance scale (wheel diameter), rotation scale
     // (wheel track), a curve (unequal wheels: heading error per metre driven)

@@ -43,6 +43,7 @@ void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg) {
     cfg->near_cost = static_cast<std::uint8_t>(std::lround(p.map_near_cost * 10.0));
     cfg->arc_pct = static_cast<std::uint8_t>(p.map_arc_pct);
     cfg->sight = p.map_sight ? 1 : 0;
+    cfg->escape_grow = p.map_escape_grow ? 1 : 0;
 }
 
 }  // namespace qnav

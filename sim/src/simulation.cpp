@@ -260,6 +260,7 @@ void Simulation::compute_scan() {
     sensed_heading_ = hd;
     scan_.prev_heading_cdeg = have_prev_ ? to_cdeg(prev_world_rad_ - hd) : 0;
     scan_.escape_clear = 0;
+    scan_.escape_grow_mm = 0;
     if (!map_mem_.empty()) guide_scan();
     if (profiling_) prof_.sonar_s += std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -283,6 +284,7 @@ void Simulation::guide_scan() {
     in.goal_range_mm = scan_.goal_range_mm;
     const int got = qnav_map_guide(&map_, &seen, mm(goal.x), mm(goal.y), &in);
     scan_.escape_clear = (got & QNAV_MAP_ESCAPE_CLEARED) ? 1 : 0;
+    scan_.escape_grow_mm = (got & QNAV_MAP_ESCAPE_GROWN) ? qnav_map_grown_mm(&map_) : 0;
     if (odom_on_ && (got & QNAV_MAP_DIRECT)) return;  // the destination in sight: its sensed bearing
     scan_.goal_bearing_cdeg = in.goal_bearing_cdeg;
     scan_.goal_range_mm = in.goal_range_mm;
@@ -655,6 +657,7 @@ qnav_sim_result_t Simulation::run_episode_with(StepFn step, void *self, std::uin
         in.prev_heading_cdeg = scan_.prev_heading_cdeg;
         in.goal_range_mm = scan_.goal_range_mm;
         in.escape = scan_.escape_clear ? qnav_escape_t{} : out.escape;
+        qnav_escape_grow(&in.escape, scan_.escape_grow_mm);
         Clock::time_point t0;
         if (profiling_) t0 = Clock::now();
         step(self, &in, &out);

@@ -84,6 +84,8 @@ public:
     const Environment &env() const { return env_; }
     const RobotProfile &robot() const { return robot_; }
     const SimConfig &config() const { return cfg_; }
+    // The profile's map (qnav/map.h) in its frame, or null when the profile has none.
+    const qnav_map_t *map() const { return map_mem_.empty() ? nullptr : &map_; }
     std::uint16_t max_range_mm() const { return max_range_mm_; }
     double sonar_cone_rad() const { return sonar_.cone(); }
 

@@ -76,6 +76,16 @@ void draw_obstacles_and_destination(std::ostream &o, const Mapper &m, const Envi
       << env.dest_radius_m * kScale << "\" fill=\"#ff8c00\" fill-opacity=\"0.5\" stroke=\"#d35400\" stroke-width=\"2\"/>\n";
 }
 
+// The map's occupied cells (translucent red squares) at the sonar's tick.
+void draw_map(std::ostream &o, const Mapper &m, const EpisodePicture &ep) {
+    const double side = ep.map_cell_m * kScale;
+    o << "<g fill=\"#d62728\" fill-opacity=\"0.35\">\n";
+    for (const Vec2 &c : ep.map_occupied)
+        o << "<rect x=\"" << m.x(c.x) << "\" y=\"" << m.y(c.y + ep.map_cell_m) << "\" width=\"" << side
+          << "\" height=\"" << side << "\"/>\n";
+    o << "</g>\n";
+}
+
 // Each sonar sector as a wedge out to its reported range (from the body surface), then
 // the robot's outline and heading at that tick.
 void draw_sonar(std::ostream &o, const Mapper &m, const EpisodePicture &ep, double robot_r) {
@@ -144,6 +154,7 @@ std::string render_svg(const Environment &env, double robot_r, const EpisodePict
     draw_direct_lines(o, m, env, env.obstacle_shapes(), robot_r);
     draw_obstacles_and_destination(o, m, env);
     if (ep) {
+        if (ep->map_cell_m > 0) draw_map(o, m, *ep);
         if (!ep->sonar_ranges_m.empty()) draw_sonar(o, m, *ep, robot_r);
         draw_episode(o, m, *ep, robot_r, hpx);
     }

@@ -23,6 +23,10 @@ struct EpisodePicture {
     std::vector<double> sonar_ranges_m;   // reported ranges (from the body surface), m
     double range_max_m = 0;
     double cone_rad = 0;                  // each sector's wedge, rad (0: 2*pi/N)
+    // The map at that tick (drawn when map_cell_m > 0): the lower-left corners of its
+    // occupied cells, m, in the map's frame (the world's on the true pose).
+    double map_cell_m = 0;
+    std::vector<Vec2> map_occupied;
     std::string caption;
 };
 

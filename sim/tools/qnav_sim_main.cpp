@@ -249,7 +249,26 @@ struct EpisodeRecord {
             pic.sonar_heading = smp.heading_rad;
             pic.sonar_ranges_m.clear();
             for (unsigned k = 0; k < sim.config().n_sectors; ++k) pic.sonar_ranges_m.push_back(sim.scan().ranges_mm[k] / 1000.0);
+            snapshot_map();
         }
+    }
+
+    // The map's occupied cells now, for the picture (the map covers the arena from (0, 0)).
+    void snapshot_map() {
+        const qnav_map_t *m = sim.map();
+        if (!m) return;
+        const double cell = sim.robot().map_cell_m;
+        const auto nx = static_cast<long>(std::ceil(sim.env().width_m / cell - 1e-9));
+        const auto ny = static_cast<long>(std::ceil(sim.env().height_m / cell - 1e-9));
+        pic.map_cell_m = cell;
+        pic.map_occupied.clear();
+        for (long j = 0; j < ny; ++j)
+            for (long i = 0; i < nx; ++i) {
+                const double x = (static_cast<double>(i) + 0.5) * cell, y = (static_cast<double>(j) + 0.5) * cell;
+                if (qnav_map_evidence(m, static_cast<std::int32_t>(std::lround(x * 1000)),
+                                      static_cast<std::int32_t>(std::lround(y * 1000))) >= QNAV_MAP_OCCUPIED)
+                    pic.map_occupied.push_back({x - 0.5 * cell, y - 0.5 * cell});
+            }
     }
 };
 

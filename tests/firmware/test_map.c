@@ -199,6 +199,55 @@ static void test_the_plan_leads_round_the_wall_to_its_gap(void **state)
     assert_int_equal(in.escape.side, 1);
 }
 
+/* Left of the gap, the destination straight beyond the wall: once the wall is seen the way
+ * bends through the gap, a few decimetres longer (less than a jump). The escape memory's
+ * distances grow by what the plan grew, so its stall timer measures progress along the new
+ * plan; 0 stays "none"; with escape_grow 0 they stay. */
+static uint16_t grow_after_the_wall(uint8_t escape_grow, qnav_ctrl_input_t *in, int *got)
+{
+    qnav_map_t m;
+    qnav_map_config_t mc;
+    qnav_ctrl_config_t cc;
+    const qnav_map_pose_t p = {4300, 1500, 9000};
+    uint16_t before;
+    sensor_config(&cc);
+    qnav_map_config_default(&mc);
+    mc.plan_ticks = 1;
+    mc.escape_grow = escape_grow;
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
+                     QNAV_OK);
+    memset(in, 0, sizeof *in);
+    assert_int_equal(qnav_map_guide(&m, &p, 4300, 5000, in), QNAV_MAP_GUIDED);
+    before = in->goal_range_mm;
+    observe_the_wall(&m);
+    in->escape.best_mm = 3000;
+    in->escape.stall_mm = 3200;
+    in->escape.ticks = 7;
+    *got = qnav_map_guide(&m, &p, 4300, 5000, in);
+    print_message("plan %u -> %u mm, flags %d\n", before, in->goal_range_mm, *got);
+    assert_true(in->goal_range_mm > before + 100 && in->goal_range_mm < before + 1000);
+    assert_int_equal(qnav_map_grown_mm(&m), escape_grow ? in->goal_range_mm - before : 0);
+    return (uint16_t)(in->goal_range_mm - before);
+}
+
+static void test_a_longer_plan_grows_the_escape_memory(void **state)
+{
+    qnav_ctrl_input_t in;
+    int got;
+    uint16_t d;
+    (void)state;
+    d = grow_after_the_wall(1, &in, &got);
+    assert_int_equal(got, QNAV_MAP_GUIDED | QNAV_MAP_ESCAPE_GROWN);
+    assert_int_equal(in.escape.best_mm, 3000 + d);
+    assert_int_equal(in.escape.stall_mm, 3200 + d);
+    assert_int_equal(in.escape.hit_mm, 0);  /* none stays none */
+    assert_int_equal(in.escape.ticks, 7);   /* the stall's time goes on */
+    d = grow_after_the_wall(0, &in, &got);
+    assert_int_equal(got, QNAV_MAP_GUIDED);
+    assert_int_equal(in.escape.best_mm, 3000);
+    assert_int_equal(in.escape.stall_mm, 3200);
+}
+
 /* Below the wall, left of its gap, with the destination beyond the wall to the left: the
  * plan turns round the gap's edge within the look-ahead. With sight the sub-goal stays
  * where the robot sees it past the edge (further right); without, it lies behind it. */
@@ -299,6 +348,7 @@ int main(void)
         cmocka_unit_test(test_arcs_are_marked_in_the_central_part_of_the_wedge),
         cmocka_unit_test(test_the_plan_leads_round_the_wall_to_its_gap),
         cmocka_unit_test(test_the_sub_goal_is_not_behind_a_corner),
+        cmocka_unit_test(test_a_longer_plan_grows_the_escape_memory),
         cmocka_unit_test(test_the_destination_in_reach_is_flagged_direct),
         cmocka_unit_test(test_a_destination_walled_in_leaves_the_input_alone),
         cmocka_unit_test(test_bad_maps_are_refused),

@@ -78,6 +78,72 @@ void test_the_map_finds_the_gap_the_policy_alone_misses(void **) {
     assert_int_equal(with.collisions, 0);
 }
 
+// The step API gives a caller who keeps the escape memory what the map did to it: cleared
+// (escape_clear) or grown with a longer plan (escape_grow_mm). Applied, the episodes are
+// the simulator's own, tick for tick; the wall makes the plan grow.
+void test_the_step_api_carries_what_the_map_did_to_the_escape(void **) {
+    char err[QNAV_SIM_ERRLEN] = "";
+    const std::string profile = tekbot_with("[map]\ncell_m = 0.1\n");
+    qnav_sim_robot_t *robot = nullptr;
+    qnav_sim_env_t *env = nullptr;
+    qnav_sim_t *sim = nullptr;
+    if (qnav_sim_robot_parse(profile.data(), profile.size(), "tekbot-map.toml", &robot, err,
+                             sizeof err) != QNAV_SIM_OK)
+        fail_with("robot", err);
+    if (qnav_sim_env_parse(kWall, std::strlen(kWall), "wall.toml", &env, err, sizeof err) != QNAV_SIM_OK)
+        fail_with("env", err);
+    qnav_sim_config_t cfg;
+    qnav_sim_config_default(&cfg);
+    cfg.n_sectors = 16;
+    cfg.sensor_noise = 0.05;
+    cfg.actuation_noise = 0.01;
+    cfg.seed = 3;
+    if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK) fail_with("sim", err);
+    qnav_ctrl_config_t cc;
+    qnav_sim_ctrl_config(sim, &cc);
+    qnav_policy_t p;
+    qnav_sim_robot_prob_policy(robot, &p);
+    qnav_ctrl_t ctrl;
+    assert_int_equal(qnav_ctrl_init(&ctrl, &cc, &p), QNAV_OK);
+    unsigned grown = 0, cleared = 0;
+    for (uint64_t e = 0; e < 4; ++e) {
+        qnav_sim_result_t whole, stepped;
+        assert_int_equal(qnav_sim_run_episode(sim, &ctrl, e, &whole, nullptr, nullptr), QNAV_SIM_OK);
+        qnav_sim_state_t whole_end, st;
+        assert_int_equal(qnav_sim_state(sim, &whole_end), QNAV_SIM_OK);
+        assert_int_equal(qnav_sim_reset(sim, e), QNAV_SIM_OK);
+        assert_int_equal(qnav_sim_state(sim, &st), QNAV_SIM_OK);
+        qnav_ctrl_output_t out{};
+        while (!st.done) {
+            qnav_sim_scan_t s;
+            assert_int_equal(qnav_sim_scan(sim, &s), QNAV_SIM_OK);
+            qnav_ctrl_input_t in{};
+            in.ranges_mm = s.ranges_mm;
+            in.goal_bearing_cdeg = s.goal_bearing_cdeg;
+            in.prev_heading_cdeg = s.prev_heading_cdeg;
+            in.goal_range_mm = s.goal_range_mm;
+            in.escape = s.escape_clear ? qnav_escape_t{} : out.escape;
+            qnav_escape_grow(&in.escape, s.escape_grow_mm);
+            grown += s.escape_grow_mm > 0 ? 1u : 0u;
+            cleared += s.escape_clear;
+            qnav_ctrl_step(&ctrl, &in, &out, nullptr);
+            assert_int_equal(qnav_sim_command(sim, &out), QNAV_SIM_OK);
+            assert_int_equal(qnav_sim_advance(sim), QNAV_SIM_OK);
+            assert_int_equal(qnav_sim_state(sim, &st), QNAV_SIM_OK);
+        }
+        assert_int_equal(qnav_sim_result(sim, &stepped), QNAV_SIM_OK);
+        assert_int_equal(stepped.ticks, whole.ticks);
+        assert_int_equal(stepped.reached, whole.reached);
+        assert_true(st.x_m == whole_end.x_m && st.y_m == whole_end.y_m);
+    }
+    print_message("wall with a far gap, 4 episodes: the plan grew the escape memory on %u ticks and "
+                  "cleared it on %u\n", grown, cleared);
+    assert_true(grown > 0);
+    qnav_sim_destroy(sim);
+    qnav_sim_env_free(env);
+    qnav_sim_robot_free(robot);
+}
+
 void test_odometry_errors_move_the_maps_pose_only_when_drawn(void **) {
     const std::string map = "[map]\ncell_m = 0.1\n";
     const Run truth = run(tekbot_with(map), 4);
@@ -111,6 +177,7 @@ void test_bad_odometry_settings_are_refused_by_field(void **) {
 int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_the_map_finds_the_gap_the_policy_alone_misses),
+        cmocka_unit_test(test_the_step_api_carries_what_the_map_did_to_the_escape),
         cmocka_unit_test(test_odometry_errors_move_the_maps_pose_only_when_drawn),
         cmocka_unit_test(test_bad_odometry_settings_are_refused_by_field),
     };

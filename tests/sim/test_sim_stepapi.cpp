@@ -48,6 +48,7 @@ static qnav_sim_result_t step_episode(qnav_sim_t *sim, qnav_nav_t *nav, uint64_t
         in.goal_range_mm = s.goal_range_mm;
         // the caller carries the escape memory, cleared when the map says so
         in.escape = s.escape_clear ? qnav_escape_t{} : out.escape;
+        qnav_escape_grow(&in.escape, s.escape_grow_mm);
         qnav_nav_step(nav, &in, &out);
         assert_int_equal(qnav_sim_command(sim, &out), QNAV_SIM_OK);
         assert_int_equal(qnav_sim_advance(sim), QNAV_SIM_OK);

@@ -172,6 +172,11 @@ typedef struct {
     uint16_t prev_mm;   /* following: the destination's range at the previous tick, mm */
 } qnav_escape_t;
 
+/* The destination's distance is now measured d_mm longer where the robot is (a map's new,
+ * longer plan: qnav/map.h): every distance the memory holds grows by d_mm, so that a stall
+ * is no progress along the new measure, not along the old one; 0 stays "none yet". */
+void qnav_escape_grow(qnav_escape_t *e, uint16_t d_mm);
+
 /* qnav_escape_t.loop: no mark yet; marked; left the mark; back at it (round once). */
 #define QNAV_ESCAPE_LOOP_NONE 0u
 #define QNAV_ESCAPE_LOOP_MARKED 1u

@@ -49,6 +49,9 @@ typedef struct {
                               arc_pct % of its wedge, 0..100; default 100 */
     uint8_t sight;         /* 1: the sub-goal stops where the straight line to it from the
                               robot's cell would cross a blocked cell; default 1 */
+    uint8_t escape_grow;   /* 1: when a new plan is longer where the robot is (by less than
+                              jump_mm), every distance the escape memory holds grows as
+                              much (qnav_escape_grow); default 1 */
 } qnav_map_config_t;
 
 /* The robot's pose in the destination's frame. */
@@ -77,6 +80,7 @@ typedef struct {
     uint16_t last_mm;         /* the last guided tick's planned distance; 0: none */
     uint8_t planned;          /* a plan toward goal_* exists */
     uint8_t dirty;            /* a cell became or stopped being occupied since the plan */
+    uint16_t grown_mm;        /* what this tick's guide grew the escape memory by, mm */
 } qnav_map_t;
 
 /* Evidence at or above this marks a cell occupied. */
@@ -117,17 +121,26 @@ void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm);
 #define QNAV_MAP_DIRECT 4         /* the sub-goal is the destination itself: a caller that
                                      senses the destination's bearing (a beacon) better than
                                      its pose gives it may keep its own */
+#define QNAV_MAP_ESCAPE_GROWN 8   /* a new plan is longer by less than jump_mm where the
+                                     robot is: in->escape's distances grew by
+                                     qnav_map_grown_mm() (a stall is no progress along this
+                                     plan, not along the last one's) */
 
 /*
  * One tick, after qnav_map_observe(): plan again when plan_ticks have passed or the
  * destination moved, and when the robot's cell has a way to the destination, replace
  * in->goal_bearing_cdeg with the bearing of the point look_mm along it (seen from pose)
  * and in->goal_range_mm with the planned distance, clearing in->escape when that grew by
- * jump_mm since the last guided tick (the way the escape was following has closed).
+ * jump_mm since the last guided tick (the way the escape was following has closed), and
+ * growing in->escape's distances by what a new plan added when it grew by less.
  * Returns QNAV_MAP_* flags; 0 when the map knows no way (the input stays as it was).
  */
 int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
                    int32_t goal_y_mm, qnav_ctrl_input_t *in);
+
+/* What the last qnav_map_guide() grew the escape memory by (QNAV_MAP_ESCAPE_GROWN), mm;
+ * for a caller that keeps the memory elsewhere than the input it gave (qnav_escape_grow). */
+uint16_t qnav_map_grown_mm(const qnav_map_t *m);
 
 /* A cell's evidence (< 0 free, >= QNAV_MAP_OCCUPIED occupied) and plan cost; for tests
  * and pictures. Out of the map: 0 and QNAV_MAP_UNREACHED. */
