@@ -25,6 +25,20 @@ inline std::string test_env_text(const std::string &extra) {
            "[[start_zone]]\nx_m = 0.5\ny_m = 0.5\nw_m = 0.5\nh_m = 0.5\n" + extra;
 }
 
+// The input a step-API caller gives its controller for scan s after output out: the
+// ranges, the destination's bearing and range, the last decision, and the escape memory it
+// carries, cleared or grown as the map says (qnav_sim_scan_t.escape_clear, escape_grow_mm).
+inline qnav_ctrl_input_t step_input(const qnav_sim_scan_t &s, const qnav_ctrl_output_t &out) {
+    qnav_ctrl_input_t in{};
+    in.ranges_mm = s.ranges_mm;
+    in.goal_bearing_cdeg = s.goal_bearing_cdeg;
+    in.prev_heading_cdeg = s.prev_heading_cdeg;
+    in.goal_range_mm = s.goal_range_mm;
+    in.escape = s.escape_clear ? qnav_escape_t{} : out.escape;
+    qnav_escape_grow(&in.escape, s.escape_grow_mm);
+    return in;
+}
+
 // The whole file at path; fails the test when it cannot be opened.
 inline std::string read_text_file(const std::string &path) {
     std::FILE *f = std::fopen(path.c_str(), "rb");

@@ -30,41 +30,51 @@ struct Run {
     uint32_t collisions = 0;
 };
 
-// Episodes 0..n-1 of the probabilistic policy with this profile text in kWall.
-Run run(const std::string &profile, unsigned n) {
-    char err[QNAV_SIM_ERRLEN] = "";
+// The probabilistic policy with this profile text in kWall: robot, world, context and its
+// controller, freed at the end of the scope.
+struct WallSim {
     qnav_sim_robot_t *robot = nullptr;
     qnav_sim_env_t *env = nullptr;
     qnav_sim_t *sim = nullptr;
-    if (qnav_sim_robot_parse(profile.data(), profile.size(), "tekbot-map.toml", &robot, err,
-                             sizeof err) != QNAV_SIM_OK)
-        fail_with("robot", err);
-    if (qnav_sim_env_parse(kWall, std::strlen(kWall), "wall.toml", &env, err, sizeof err) != QNAV_SIM_OK)
-        fail_with("env", err);
-    qnav_sim_config_t cfg;
-    qnav_sim_config_default(&cfg);
-    cfg.n_sectors = 16;
-    cfg.sensor_noise = 0.05;
-    cfg.actuation_noise = 0.01;
-    cfg.seed = 3;
-    if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK) fail_with("sim", err);
-    qnav_ctrl_config_t cc;
-    qnav_sim_ctrl_config(sim, &cc);
-    qnav_policy_t p;
-    qnav_sim_robot_prob_policy(robot, &p);
     qnav_ctrl_t ctrl;
-    assert_int_equal(qnav_ctrl_init(&ctrl, &cc, &p), QNAV_OK);
+    explicit WallSim(const std::string &profile) {
+        char err[QNAV_SIM_ERRLEN] = "";
+        if (qnav_sim_robot_parse(profile.data(), profile.size(), "tekbot-map.toml", &robot, err,
+                                 sizeof err) != QNAV_SIM_OK)
+            fail_with("robot", err);
+        if (qnav_sim_env_parse(kWall, std::strlen(kWall), "wall.toml", &env, err, sizeof err) != QNAV_SIM_OK)
+            fail_with("env", err);
+        qnav_sim_config_t cfg;
+        qnav_sim_config_default(&cfg);
+        cfg.n_sectors = 16;
+        cfg.sensor_noise = 0.05;
+        cfg.actuation_noise = 0.01;
+        cfg.seed = 3;
+        if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK) fail_with("sim", err);
+        qnav_ctrl_config_t cc;
+        qnav_sim_ctrl_config(sim, &cc);
+        qnav_policy_t p;
+        qnav_sim_robot_prob_policy(robot, &p);
+        assert_int_equal(qnav_ctrl_init(&ctrl, &cc, &p), QNAV_OK);
+    }
+    ~WallSim() {
+        qnav_sim_destroy(sim);
+        qnav_sim_env_free(env);
+        qnav_sim_robot_free(robot);
+    }
+};
+
+// Episodes 0..n-1 of the probabilistic policy with this profile text in kWall.
+Run run(const std::string &profile, unsigned n) {
+    WallSim w(profile);
     Run r;
     for (uint64_t e = 0; e < n; ++e) {
         qnav_sim_result_t res;
-        assert_int_equal(qnav_sim_run_episode(sim, &ctrl, e, &res, nullptr, nullptr), QNAV_SIM_OK);
+        assert_int_equal(qnav_sim_run_episode(w.sim, &w.ctrl, e, &res, nullptr, nullptr), QNAV_SIM_OK);
         r.reached += res.reached ? 1u : 0u;
         r.ticks += res.ticks;
         r.collisions += res.collisions;
     }
-    qnav_sim_destroy(sim);
-    qnav_sim_env_free(env);
-    qnav_sim_robot_free(robot);
     return r;
 }
 
@@ -82,56 +92,28 @@ void test_the_map_finds_the_gap_the_policy_alone_misses(void **) {
 // (escape_clear) or grown with a longer plan (escape_grow_mm). Applied, the episodes are
 // the simulator's own, tick for tick; the wall makes the plan grow.
 void test_the_step_api_carries_what_the_map_did_to_the_escape(void **) {
-    char err[QNAV_SIM_ERRLEN] = "";
-    const std::string profile = tekbot_with("[map]\ncell_m = 0.1\n");
-    qnav_sim_robot_t *robot = nullptr;
-    qnav_sim_env_t *env = nullptr;
-    qnav_sim_t *sim = nullptr;
-    if (qnav_sim_robot_parse(profile.data(), profile.size(), "tekbot-map.toml", &robot, err,
-                             sizeof err) != QNAV_SIM_OK)
-        fail_with("robot", err);
-    if (qnav_sim_env_parse(kWall, std::strlen(kWall), "wall.toml", &env, err, sizeof err) != QNAV_SIM_OK)
-        fail_with("env", err);
-    qnav_sim_config_t cfg;
-    qnav_sim_config_default(&cfg);
-    cfg.n_sectors = 16;
-    cfg.sensor_noise = 0.05;
-    cfg.actuation_noise = 0.01;
-    cfg.seed = 3;
-    if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK) fail_with("sim", err);
-    qnav_ctrl_config_t cc;
-    qnav_sim_ctrl_config(sim, &cc);
-    qnav_policy_t p;
-    qnav_sim_robot_prob_policy(robot, &p);
-    qnav_ctrl_t ctrl;
-    assert_int_equal(qnav_ctrl_init(&ctrl, &cc, &p), QNAV_OK);
+    WallSim w(tekbot_with("[map]\ncell_m = 0.1\n"));
     unsigned grown = 0, cleared = 0;
     for (uint64_t e = 0; e < 4; ++e) {
         qnav_sim_result_t whole, stepped;
-        assert_int_equal(qnav_sim_run_episode(sim, &ctrl, e, &whole, nullptr, nullptr), QNAV_SIM_OK);
+        assert_int_equal(qnav_sim_run_episode(w.sim, &w.ctrl, e, &whole, nullptr, nullptr), QNAV_SIM_OK);
         qnav_sim_state_t whole_end, st;
-        assert_int_equal(qnav_sim_state(sim, &whole_end), QNAV_SIM_OK);
-        assert_int_equal(qnav_sim_reset(sim, e), QNAV_SIM_OK);
-        assert_int_equal(qnav_sim_state(sim, &st), QNAV_SIM_OK);
+        assert_int_equal(qnav_sim_state(w.sim, &whole_end), QNAV_SIM_OK);
+        assert_int_equal(qnav_sim_reset(w.sim, e), QNAV_SIM_OK);
+        assert_int_equal(qnav_sim_state(w.sim, &st), QNAV_SIM_OK);
         qnav_ctrl_output_t out{};
         while (!st.done) {
             qnav_sim_scan_t s;
-            assert_int_equal(qnav_sim_scan(sim, &s), QNAV_SIM_OK);
-            qnav_ctrl_input_t in{};
-            in.ranges_mm = s.ranges_mm;
-            in.goal_bearing_cdeg = s.goal_bearing_cdeg;
-            in.prev_heading_cdeg = s.prev_heading_cdeg;
-            in.goal_range_mm = s.goal_range_mm;
-            in.escape = s.escape_clear ? qnav_escape_t{} : out.escape;
-            qnav_escape_grow(&in.escape, s.escape_grow_mm);
+            assert_int_equal(qnav_sim_scan(w.sim, &s), QNAV_SIM_OK);
+            const qnav_ctrl_input_t in = step_input(s, out);
             grown += s.escape_grow_mm > 0 ? 1u : 0u;
             cleared += s.escape_clear;
-            qnav_ctrl_step(&ctrl, &in, &out, nullptr);
-            assert_int_equal(qnav_sim_command(sim, &out), QNAV_SIM_OK);
-            assert_int_equal(qnav_sim_advance(sim), QNAV_SIM_OK);
-            assert_int_equal(qnav_sim_state(sim, &st), QNAV_SIM_OK);
+            qnav_ctrl_step(&w.ctrl, &in, &out, nullptr);
+            assert_int_equal(qnav_sim_command(w.sim, &out), QNAV_SIM_OK);
+            assert_int_equal(qnav_sim_advance(w.sim), QNAV_SIM_OK);
+            assert_int_equal(qnav_sim_state(w.sim, &st), QNAV_SIM_OK);
         }
-        assert_int_equal(qnav_sim_result(sim, &stepped), QNAV_SIM_OK);
+        assert_int_equal(qnav_sim_result(w.sim, &stepped), QNAV_SIM_OK);
         assert_int_equal(stepped.ticks, whole.ticks);
         assert_int_equal(stepped.reached, whole.reached);
         assert_true(st.x_m == whole_end.x_m && st.y_m == whole_end.y_m);
@@ -139,9 +121,6 @@ void test_the_step_api_carries_what_the_map_did_to_the_escape(void **) {
     print_message("wall with a far gap, 4 episodes: the plan grew the escape memory on %u ticks and "
                   "cleared it on %u\n", grown, cleared);
     assert_true(grown > 0);
-    qnav_sim_destroy(sim);
-    qnav_sim_env_free(env);
-    qnav_sim_robot_free(robot);
 }
 
 void test_odometry_errors_move_the_maps_pose_only_when_drawn(void **) {

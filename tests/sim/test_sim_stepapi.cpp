@@ -41,14 +41,8 @@ static qnav_sim_result_t step_episode(qnav_sim_t *sim, qnav_nav_t *nav, uint64_t
         qnav_sim_scan_t s;
         std::memset(&s, 0xA5, sizeof s);  // a field the call leaves alone shows as garbage
         assert_int_equal(qnav_sim_scan(sim, &s), QNAV_SIM_OK);
-        qnav_ctrl_input_t in;
-        in.ranges_mm = s.ranges_mm;
-        in.goal_bearing_cdeg = s.goal_bearing_cdeg;
-        in.prev_heading_cdeg = s.prev_heading_cdeg;
-        in.goal_range_mm = s.goal_range_mm;
-        // the caller carries the escape memory, cleared when the map says so
-        in.escape = s.escape_clear ? qnav_escape_t{} : out.escape;
-        qnav_escape_grow(&in.escape, s.escape_grow_mm);
+        // the caller carries the escape memory, cleared or grown when the map says so
+        const qnav_ctrl_input_t in = step_input(s, out);
         qnav_nav_step(nav, &in, &out);
         assert_int_equal(qnav_sim_command(sim, &out), QNAV_SIM_OK);
         assert_int_equal(qnav_sim_advance(sim), QNAV_SIM_OK);
