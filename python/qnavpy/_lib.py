@@ -14,7 +14,7 @@ KIND_ROBOT_PROB = 0    # QPY_KIND_ROBOT_PROB: the robot's tuned probabilistic po
 KIND_NONE = -1         # no policy (VFH+)
 KIND_PROB = 1          # QNAV_POLICY_PROB
 KIND_NET = 2           # QNAV_POLICY_NET
-OBS_INT_EXTRA = 3
+OBS_INT_EXTRA = 5
 OBS_FLOAT = 5
 INFO = 10
 TRACE_COLS = 9
@@ -70,7 +70,7 @@ _SIGNATURES = {
     "qpy_ctrl_free": (None, [c_void_p]),
     "qpy_ctrl_sensors": (None, [c_void_p, _P, _P]),
     "qpy_ctrl_reset": (None, [c_void_p]),
-    "qpy_ctrl_step": (c_int32, [c_void_p, _P, c_int32, c_int32, c_int32, c_int32, _P, _P] + _ERR),
+    "qpy_ctrl_step": (c_int32, [c_void_p, _P, c_int32, c_int32, c_int32, c_int32, c_int32, c_int32, _P, _P] + _ERR),
     "qpy_ctrl_grid": (c_int32, [c_void_p, _P, _P, _P] + _ERR),
     "qpy_evaluate": (c_int32, [c_char_p, c_char_p, c_int32, c_double, c_uint64, c_char_p, c_int32, _P, _P, _P,
                                _P, ctypes.c_uint32, c_int32, _P, _P, _P, _P, _P] + _ERR),

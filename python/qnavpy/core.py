@@ -236,16 +236,20 @@ class Controller:
         """Forget the memory kept between ticks (start of an episode)."""
         lib.qpy_ctrl_reset(self._handle)
 
-    def step(self, ranges_mm, goal_bearing_cdeg, prev_heading_cdeg=0, goal_range_mm=0, qualities=False):
+    def step(self, ranges_mm, goal_bearing_cdeg, prev_heading_cdeg=0, goal_range_mm=0, qualities=False, *,
+             escape_clear=0, escape_grow_mm=0):
         """One control tick on a scan: ``ranges_mm`` (n_sectors readings, mm, sector k
         centred k*360/N degrees counter-clockwise of straight ahead), the destination's
         bearing and the previous tick's heading in 0.01 degrees (robot frame, CCW), the
-        destination's distance in mm (0: unknown, no escape). Returns a :class:`Decision`;
+        destination's distance in mm (0: unknown, no escape). ``escape_clear`` (1: forget the
+        escape memory first) and ``escape_grow_mm`` (grow its distances by this much) carry a
+        map's verdicts (an :class:`~qnavpy.Env` observation's). Returns a :class:`Decision`;
         with ``qualities=True`` also the 360 path qualities (path-quality controllers)."""
         r = np.ascontiguousarray(ranges_mm, dtype=np.uint16)
         q = np.zeros(360, dtype=np.int16) if qualities else None
         self._err.check(lib.qpy_ctrl_step(self._handle, r.ctypes.data, len(r), int(goal_bearing_cdeg),
-                                          int(prev_heading_cdeg), int(goal_range_mm), self._out.ctypes.data,
+                                          int(prev_heading_cdeg), int(goal_range_mm), int(escape_clear),
+                                          int(escape_grow_mm), self._out.ctypes.data,
                                           None if q is None else q.ctypes.data, self._err.buf, _lib.ERRLEN))
         o = self._out
         return Decision(int(o[0]), int(o[1]), int(o[2]), int(o[3]), q)
@@ -253,7 +257,9 @@ class Controller:
     def decide(self, observation, qualities=False):
         """:meth:`step` on an :class:`~qnavpy.Env` observation."""
         return self.step(observation["ranges_mm"], observation["goal_bearing_cdeg"],
-                         observation["prev_heading_cdeg"], observation["goal_range_mm"], qualities)
+                         observation["prev_heading_cdeg"], observation["goal_range_mm"], qualities,
+                         escape_clear=observation.get("escape_clear", 0),
+                         escape_grow_mm=observation.get("escape_grow_mm", 0))
 
     def grid(self):
         """What the path-quality controller ranks by and what it drives with, over its

@@ -57,8 +57,10 @@ class Env:
 
     Observation (a dict, fresh arrays every tick): ``ranges_mm`` (n_sectors int32, the sonar
     scan as the controller reads it), ``goal_bearing_cdeg`` and ``prev_heading_cdeg`` (robot
-    frame, 0.01 deg, CCW), ``goal_range_mm``, and ``pose`` (x_m, y_m, heading_rad; world
-    frame, the true pose). Reward: 0 on every tick but the last, which gets the episode's
+    frame, 0.01 deg, CCW), ``goal_range_mm``, ``escape_clear`` and ``escape_grow_mm`` (what a
+    profile's map did to the escape memory a controller carries: cleared, or grown by this
+    many mm; 0 without a map), and ``pose`` (x_m, y_m, heading_rad; world frame, the true
+    pose). Reward: 0 on every tick but the last, which gets the episode's
     fitness R (Eq. 1-3), so an episode's rewards sum to R. ``terminated``: the destination
     was reached; ``truncated``: the time limit ran out.
     """
@@ -98,7 +100,8 @@ class Env:
     def _observation(self):
         oi, of, n = self._obs_i, self._obs_f, self.n_sectors
         return {"ranges_mm": oi[:n].copy(), "goal_bearing_cdeg": int(oi[n]), "prev_heading_cdeg": int(oi[n + 1]),
-                "goal_range_mm": int(oi[n + 2]), "pose": of[:3].copy()}
+                "goal_range_mm": int(oi[n + 2]), "escape_clear": int(oi[n + 3]), "escape_grow_mm": int(oi[n + 4]),
+                "pose": of[:3].copy()}
 
     def _info_dict(self):
         i = self._info

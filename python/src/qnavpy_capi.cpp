@@ -177,6 +177,8 @@ void write_obs(const qpy_env *e, int32_t *obs_i, double *obs_f) {
     obs_i[n] = e->scan.goal_bearing_cdeg;
     obs_i[n + 1] = e->scan.prev_heading_cdeg;
     obs_i[n + 2] = e->scan.goal_range_mm;
+    obs_i[n + 3] = e->scan.escape_clear;
+    obs_i[n + 4] = e->scan.escape_grow_mm;
     qnav_sim_state_t s;
     (void)qnav_sim_state(e->sim, &s);
     obs_f[0] = s.x_m;
@@ -521,8 +523,8 @@ void qpy_ctrl_reset(qpy_ctrl_t *c) {
 }
 
 int qpy_ctrl_step(qpy_ctrl_t *c, const uint16_t *ranges_mm, int32_t n, int32_t goal_bearing_cdeg,
-                  int32_t prev_heading_cdeg, int32_t goal_range_mm, int32_t *out, int16_t *qualities, char *err,
-                  size_t errlen) {
+                  int32_t prev_heading_cdeg, int32_t goal_range_mm, int32_t escape_clear, int32_t escape_grow_mm,
+                  int32_t *out, int16_t *qualities, char *err, size_t errlen) {
     if (n != c->n_sectors)
         return fail(err, errlen, "ranges: " + std::to_string(n) + " readings for a controller of " +
                                      std::to_string(c->n_sectors) + " sectors");
@@ -531,7 +533,8 @@ int qpy_ctrl_step(qpy_ctrl_t *c, const uint16_t *ranges_mm, int32_t n, int32_t g
     in.goal_bearing_cdeg = static_cast<qnav_cdeg_t>(std::clamp(goal_bearing_cdeg, -32768, 32767));
     in.prev_heading_cdeg = static_cast<qnav_cdeg_t>(std::clamp(prev_heading_cdeg, -32768, 32767));
     in.goal_range_mm = static_cast<qnav_mm_t>(std::clamp(goal_range_mm, 0, 65535));
-    in.escape = c->last.escape;
+    in.escape = escape_clear ? qnav_escape_t{} : c->last.escape;
+    qnav_escape_grow(&in.escape, static_cast<uint16_t>(std::clamp(escape_grow_mm, 0, 65535)));
     qnav_ctrl_t *paths = qnav_nav_paths(&c->nav);
     if (qualities && !paths) return fail(err, errlen, "qualities: VFH+ has no path qualities");
     if (qualities)

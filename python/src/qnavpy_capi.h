@@ -26,7 +26,7 @@ extern "C" {
 #define QPY_KIND_ROBOT_PROB 0
 /* Length of the per-tick integer observation after the N ranges, and of the float and
  * info arrays (see qpy_env_step). */
-#define QPY_OBS_INT_EXTRA 3
+#define QPY_OBS_INT_EXTRA 5
 #define QPY_OBS_FLOAT 5
 #define QPY_INFO 10
 /* Columns of a trajectory row (qpy_env_trace). */
@@ -77,7 +77,8 @@ int qpy_env_reset(qpy_env_t *env, uint64_t episode_seed, qpy_ctrl_t *ctrl, int32
  * One tick: ctrl decides from this tick's scan (exactly as qnav_sim_run_episode_nav does),
  * or with ctrl null the command is (heading_deg, speed); then advance and write the next
  * observation. obs_i: N ranges (mm), goal bearing (0.01 deg), previous heading (0.01 deg),
- * goal range (mm). obs_f: x_m, y_m, heading_rad, speed_mps, goal_distance_m. info: tick,
+ * goal range (mm), escape_clear (0/1), escape_grow_mm (qnav_sim_scan_t's: what the map did
+ * to the escape memory a caller carries). obs_f: x_m, y_m, heading_rad, speed_mps, goal_distance_m. info: tick,
  * done, reached, recovering, collisions, collided this tick, command heading (deg),
  * command speed (fraction), controller flags (-1 without ctrl), episode R when done.
  */
@@ -111,12 +112,15 @@ void qpy_ctrl_free(qpy_ctrl_t *ctrl);
 void qpy_ctrl_sensors(const qpy_ctrl_t *ctrl, int32_t *n_sectors, int32_t *max_range_mm);
 /* Forget the escape memory and VFH+ histogram (start of an episode). */
 void qpy_ctrl_reset(qpy_ctrl_t *ctrl);
-/* One qnav step on a scan of n ranges; the escape memory is carried to the next step.
+/* One qnav step on a scan of n ranges; the escape memory is carried to the next step,
+ * cleared first when escape_clear is 1, else grown by escape_grow_mm (a map's verdicts:
+ * qnav_sim_scan_t).
  * out[4] = heading_deg, speed (Q1.15), quality (Q1.15), flags. qualities (360 Q1.15
  * values, path-quality controllers only) when not null. */
 int qpy_ctrl_step(qpy_ctrl_t *ctrl, const uint16_t *ranges_mm, int32_t n, int32_t goal_bearing_cdeg,
-                  int32_t prev_heading_cdeg, int32_t goal_range_mm, int32_t *out, int16_t *qualities,
-                  char *err, size_t errlen);
+                  int32_t prev_heading_cdeg, int32_t goal_range_mm, int32_t escape_clear,
+                  int32_t escape_grow_mm, int32_t *out, int16_t *qualities, char *err,
+                  size_t errlen);
 /* The rank key and quality grids of a path-quality controller's policy, 32 distance levels
  * x 181 dtheta (what tools/plot_policy.py draws): keys and qualities row-major. */
 int qpy_ctrl_grid(const qpy_ctrl_t *ctrl, int16_t *keys, int16_t *qualities, int32_t *rank,

@@ -113,8 +113,14 @@ class SteppedEpisodeEqualsQnavSimRun(unittest.TestCase):
         # the controller stepped on each observation from Python, its decision given back
         # as (heading, speed): every decision must equal the one qnav-sim run made (VFH+
         # with its histogram; the path-quality controller leaving a U-pocket with its
-        # escape memory)
-        cases = [("vfh", "dense", "pioneer3dx", 4, 0), ("body", "gen:pocket:2", "tekbot", 6, 3)]
+        # escape memory; and with a map, whose verdicts on that memory, cleared or grown,
+        # come with each observation)
+        map_profile = os.path.join(self.work, "tekbot-map.toml")
+        with open(os.path.join(SRC, "data", "robots", "tekbot.toml")) as f, open(map_profile, "w") as out:
+            out.write(f.read() + "\n[map]\ncell_m = 0.1\n")
+        cases = [("vfh", "dense", "pioneer3dx", 4, 0), ("body", "gen:pocket:2", "tekbot", 6, 3),
+                 ("body", "gen:rooms:3000038:0.5:tekbot", map_profile, 1, 0)]
+        verdicts = 0
         for name, world, robot, seed, episode in cases:
             with self.subTest(controller=name, world=world):
                 rows, line = qnav_sim_trace(self.work, "--seed", str(seed), "--controller", name, "--env", world,
@@ -124,6 +130,8 @@ class SteppedEpisodeEqualsQnavSimRun(unittest.TestCase):
                 flags = []
 
                 def decide(obs):
+                    nonlocal verdicts
+                    verdicts += obs["escape_clear"] + (obs["escape_grow_mm"] > 0)
                     d = ctrl.decide(obs)
                     flags.append(d.flags)
                     return d.heading_deg, d.speed
@@ -133,6 +141,7 @@ class SteppedEpisodeEqualsQnavSimRun(unittest.TestCase):
                 self.assertEqual(mine, rows)
                 self.assertEqual(episode_line(episode, result), line)
                 self.assertEqual(len(flags), len(rows) - 1)
+        self.assertGreater(verdicts, 0)  # the map did clear or grow the memory
 
     def test_run_episode_in_c_equals_the_stepped_episode(self):
         env = qnavpy.Env("dense", "tekbot", seed=2)
