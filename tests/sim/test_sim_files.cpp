@@ -344,6 +344,32 @@ static void test_cli_runs_an_episode_and_writes_a_complete_picture(void **state)
     rmdir(dir);
 }
 
+// With a profile's [map], the picture also draws the map's occupied cells at its tick (one
+// translucent red square each); without one, none.
+static void test_the_picture_draws_the_maps_cells(void **state) {
+    (void)state;
+    char dir[] = "/tmp/qnav_sim_test_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    const std::string svg = std::string(dir) + "/ep.svg", robot = std::string(dir) + "/tekbot-map.toml";
+    const std::string profile = read_text_file(std::string(QNAV_TEST_DATA_DIR) + "/robots/tekbot.toml");
+    std::FILE *f = std::fopen(robot.c_str(), "w");
+    assert_non_null(f);
+    std::fputs((profile + "\n[map]\ncell_m = 0.1\n").c_str(), f);
+    std::fclose(f);
+    const std::string rest = " --env " + std::string(QNAV_TEST_DATA_DIR) +
+                             "/envs/dense.toml --sectors 16 --sensor-noise 0 --actuation-noise 0 --svg " + svg +
+                             " --svg-tick 40";
+    const std::string cell = "<g fill=\"#d62728\" fill-opacity=\"0.35\">\n<rect ";
+    std::string out;
+    assert_int_equal(run_tool("run --robot " + robot + rest, &out), 0);
+    assert_true(read_text_file(svg).find(cell) != std::string::npos);
+    assert_int_equal(run_tool("run --robot tekbot" + rest, &out), 0);
+    assert_true(read_text_file(svg).find("#d62728") == std::string::npos);
+    std::remove(svg.c_str());
+    std::remove(robot.c_str());
+    rmdir(dir);
+}
+
 static void test_obstacle_wholly_outside_the_arena_is_refused(void **state) {
     (void)state;
     std::string msg;
@@ -469,6 +495,7 @@ int main(void) {
         cmocka_unit_test(test_generator_is_seeded_connected_and_writes_what_it_reads),
         cmocka_unit_test(test_cli_prints_one_line_and_fails_on_bad_input),
         cmocka_unit_test(test_cli_runs_an_episode_and_writes_a_complete_picture),
+        cmocka_unit_test(test_the_picture_draws_the_maps_cells),
         cmocka_unit_test(test_obstacle_wholly_outside_the_arena_is_refused),
         cmocka_unit_test(test_obstacle_overlapping_the_destination_is_refused),
         cmocka_unit_test(test_walled_in_start_zone_is_refused_when_the_world_is_made),
