@@ -56,6 +56,14 @@ uint16_t qnav_clearance_reach_sector(const qnav_clearance_t *c, const qnav_ctrl_
 uint8_t qnav_clearance_levels(const qnav_clearance_t *c, const qnav_mm_t *ranges, uint16_t skip,
                               uint8_t *lvl);
 
+/* Every path's level as a step sees it: from the input's ranges, with the destination in
+ * reach counted clear. What every controller's step calls. */
+static inline uint8_t qnav_clearance_input_levels(const qnav_clearance_t *c,
+                                                  const qnav_ctrl_input_t *in, uint8_t *lvl)
+{
+    return qnav_clearance_levels(c, in->ranges_mm, qnav_clearance_reach_sector(c, in), lvl);
+}
+
 /* The distance level of a range, mm (docs/qformats.md; at or beyond max_range_mm:
  * QNAV_DIST_LEVELS - 1). */
 uint8_t qnav_clearance_level_of(const qnav_clearance_t *c, qnav_mm_t range_mm);

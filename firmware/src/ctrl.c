@@ -550,8 +550,7 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     best.key = QNAV_KEY_NONE;
     best.dtheta = 0;
     best.heading = 0;
-    flags = qnav_clearance_levels(&ctrl->clr, in->ranges_mm,
-                                  qnav_clearance_reach_sector(&ctrl->clr, in), lvl);
+    flags = qnav_clearance_input_levels(&ctrl->clr, in, lvl);
     /* the memory goes straight to the output (no copy on the stack: the ATmega128's RAM) */
     goal = qnav_escape_goal(&ctrl->clr, lvl, in, &out->escape);
     prev = qnav_whole_deg(in->prev_heading_cdeg);

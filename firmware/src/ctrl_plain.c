@@ -56,8 +56,7 @@ void qnav_ctrl_step_plain(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
         qnav_ctrl_stop(out, QNAV_FLAG_NOT_READY, qualities);
         return;
     }
-    flags = qnav_clearance_levels(&ctrl->clr, in->ranges_mm,
-                                  qnav_clearance_reach_sector(&ctrl->clr, in), lvl);
+    flags = qnav_clearance_input_levels(&ctrl->clr, in, lvl);
     goal = qnav_escape_goal(&ctrl->clr, lvl, in, &out->escape);
     prev = qnav_whole_deg(in->prev_heading_cdeg);
     for (path = 0; path < QNAV_PATHS; ++path) {

@@ -241,8 +241,7 @@ void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ct
         stop(out, QNAV_FLAG_NOT_READY);
         return;
     }
-    flags = qnav_clearance_levels(&vfh->clr, in->ranges_mm,
-                                  qnav_clearance_reach_sector(&vfh->clr, in), lvl);
+    flags = qnav_clearance_input_levels(&vfh->clr, in, lvl);
     goal = qnav_escape_goal(&vfh->clr, lvl, in, &esc);
     n_blocked = binary_histogram(vfh, state, lvl);
     if (n_blocked == vfh->n_hist) {
