@@ -147,6 +147,12 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
     qnav_ctrl_carry_input(&bc->carry, (uint16_t)scan->goal_id,
                           rec->goal_range_mm < 0 ? 0u : (uint32_t)rec->goal_range_mm, &in);
     in.prev_heading_cdeg = rec->prev_heading_cdeg; /* as recorded (the same, live) */
+    if (rec->escape_clear != 0) {
+        memset(&in.escape, 0, sizeof in.escape); /* the board's plan jumped */
+    }
+    qnav_escape_grow(&in.escape, (uint16_t)(rec->escape_grow_mm < 0 ? 0
+                                            : rec->escape_grow_mm > 65535 ? 65535
+                                                                          : rec->escape_grow_mm));
     if (qualities != NULL) {
         memset(qualities, 0, sizeof(int16_t) * QNAV_PATHS);
     }
@@ -343,6 +349,20 @@ static uint32_t scan_goal_range(const qnav_bridge_t *b, const qnav_link_scan_t *
     return b->have_pose && b->pose_goal_id == ls->goal_id ? b->pose_goal_distance_mm : 0u;
 }
 
+/* What the board's map did to the escape memory in the scan's tick (its pose report of the
+ * same board time and goal), into rec, once: a lost pose report loses it, and it is never
+ * applied to another tick's scan. */
+static void scan_escape_verdict(qnav_bridge_t *b, const qnav_link_scan_t *ls,
+                                qnav_nav_input_t *rec)
+{
+    if (b->have_pose && b->pose_goal_id == ls->goal_id && b->pose_board_ms == ls->board_ms) {
+        rec->escape_clear = (int8_t)b->pose_escape_clear;
+        rec->escape_grow_mm = (int32_t)b->pose_escape_grow_mm;
+    }
+    b->pose_escape_clear = 0u;
+    b->pose_escape_grow_mm = 0u;
+}
+
 static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
 {
     qnav_link_scan_t ls;
@@ -370,6 +390,7 @@ static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
         s.ranges_mm[k] = ls.ranges_mm[k];
     }
     qnav_bridge_ctrl_input(&b->bc, &s, scan_goal_range(b, &ls), &rec);
+    scan_escape_verdict(b, &ls, &rec);
     if (b->cfg.mode == QNAV_LINK_MODE_ONBOARD && b->cfg.check_config == NULL) {
         rec.config_crc = -1; /* the board decides with a configuration nobody checked */
     }
@@ -502,6 +523,9 @@ static void on_pose(qnav_bridge_t *b, const qnav_link_frame_t *f)
     b->have_pose = 1;
     b->pose_goal_id = lp.goal_id;
     b->pose_goal_distance_mm = lp.goal_distance_mm;
+    b->pose_board_ms = lp.board_ms;
+    b->pose_escape_clear = lp.escape_clear;
+    b->pose_escape_grow_mm = lp.escape_grow_mm;
     if (b->route_n > 0 && b->route_k < b->route_n && lp.goal_id == b->goal.goal_id &&
         b->goal.kind == QNAV_LINK_GOAL_POSITION) {
         double dx = (double)b->route_x_mm[b->route_k] - (double)lp.x_mm;

@@ -125,7 +125,9 @@ void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg
  * previous heading, the configuration's CRC. */
 void qnav_bridge_ctrl_input(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan, uint32_t range_mm,
                             qnav_nav_input_t *rec);
-/* Run the controller on an LCM scan with rec (qnav_bridge_ctrl_input's, or a logged one);
+/* Run the controller on an LCM scan with rec (qnav_bridge_ctrl_input's, or a logged one;
+ * its escape_clear and escape_grow_mm, what the board's map did to the escape memory this
+ * tick, applied to the carried memory as the board's map applies them onboard);
  * fills cmd (integer and float fields, source BRIDGE) and qualities (360 Q1.15 values, may
  * be NULL). */
 void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
@@ -213,6 +215,9 @@ typedef struct {
     qnav_cdeg_t scan_goal_cdeg;       /* and the destination's bearing it reported */
     uint16_t pose_goal_id;
     uint32_t pose_goal_distance_mm;
+    uint32_t pose_board_ms;           /* its board clock: the scan of the same tick has it */
+    uint8_t pose_escape_clear;        /* what the board's map did to the escape memory that */
+    uint16_t pose_escape_grow_mm;     /* tick (qnav_link_pose_t), until a scan takes it */
 
     uint64_t rx_bytes;
     FILE *diag;                   /* one-line notices (upload result, link lost), or NULL */

@@ -437,6 +437,11 @@ static int run_replay(const options_t *o)
            (unsigned long long)res.identical, (unsigned long long)res.differ,
            (unsigned long long)res.stops, (unsigned long long)res.other_policy,
            (unsigned long long)res.with_input);
+    if (res.bad_events > 0) {
+        fprintf(stderr, "navbridge: %s: %llu events on qnav channels did not decode (a log "
+                        "recorded with other LCM types: those events are not replayed)\n",
+                o->replay_path, (unsigned long long)res.bad_events);
+    }
     if (res.compared == 0) {
         fprintf(stderr, "navbridge: %s: no commands answering scans in this log\n",
                 o->replay_path);

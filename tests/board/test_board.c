@@ -32,6 +32,7 @@ typedef struct {
     uint16_t last_scan_seq;
     qnav_link_scan_t last_scan;
     qnav_link_policy_ack_t last_ack;
+    uint32_t pose_clears, pose_grown_mm; /* the map's verdicts the POSE frames carried */
 } bench_t;
 
 static bench_t g;
@@ -99,6 +100,11 @@ static void read_board(void)
         } else if (f.msg_id == QNAV_LINK_MSG_COMMAND) {
             assert_int_equal(qnav_link_command_unpack(f.payload, f.len, &g.last_tel), 0);
             g.telemetry++;
+        } else if (f.msg_id == QNAV_LINK_MSG_POSE) {
+            qnav_link_pose_t ps;
+            assert_int_equal(qnav_link_pose_unpack(f.payload, f.len, &ps), 0);
+            g.pose_clears += ps.escape_clear;
+            g.pose_grown_mm += ps.escape_grow_mm;
         } else if (f.msg_id == QNAV_LINK_MSG_POLICY_ACK) {
             assert_int_equal(qnav_link_policy_ack_unpack(f.payload, f.len, &g.last_ack), 0);
             g.acks++;
@@ -444,13 +450,20 @@ static void test_a_board_with_a_map_steers_round_what_it_has_seen(void **state)
     heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
     run_ms(100);
     assert_int_equal(g.last_scan.goal_bearing_cdeg, 0);
+    read_board();
+    assert_int_equal(g.pose_clears + g.pose_grown_mm, 0);
     assert_int_equal(qnav_board_set_map(&g.bot, &map), 1);
     run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 500);
     assert_true(qnav_map_evidence(&map, 1000, 50) >= QNAV_MAP_OCCUPIED);
     assert_true(g.last_scan.goal_bearing_cdeg > 2000 || g.last_scan.goal_bearing_cdeg < -2000);
+    /* the plan round the wall is longer than the straight one was: the POSE says what
+     * that did to the escape memory, for an offboard controller */
+    assert_true(g.pose_clears + g.pose_grown_mm > 0);
     assert_int_equal(qnav_board_set_map(&g.bot, NULL), 1);
+    g.pose_clears = g.pose_grown_mm = 0;
     run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 200);
     assert_int_equal(g.last_scan.goal_bearing_cdeg, 0);
+    assert_int_equal(g.pose_clears + g.pose_grown_mm, 0);
 }
 
 /* ---- the board against navbridge's core, in one process ---- */

@@ -806,7 +806,7 @@ static void test_decoder_accepts_heartbeats_of_every_version_length(void **state
 static void test_position_goal_and_pose_round_trip_with_negative_coordinates(void **state)
 {
     qnav_link_goal_t g = {3, -4500, 0, QNAV_LINK_GOAL_POSITION, -1234567, 7654321}, g2;
-    qnav_link_pose_t ps = {0xFFFFFFFEu, -2000000, 1999999, -17999, 3, 4000000u}, ps2;
+    qnav_link_pose_t ps = {0xFFFFFFFEu, -2000000, 1999999, -17999, 3, 4000000u, 1u, 65535u}, ps2;
     uint8_t p[QNAV_LINK_POSE_BYTES];
     (void)state;
     assert_int_equal(qnav_link_goal_pack(&g, p, sizeof p), QNAV_LINK_GOAL_BYTES);
@@ -823,7 +823,15 @@ static void test_position_goal_and_pose_round_trip_with_negative_coordinates(voi
     assert_int_equal(ps2.y_mm, 1999999);
     assert_int_equal(ps2.heading_cdeg, -17999);
     assert_int_equal(ps2.goal_distance_mm, 4000000u);
+    assert_int_equal(ps2.escape_clear, 1u);
+    assert_int_equal(ps2.escape_grow_mm, 65535u);
     assert_int_equal(qnav_link_pose_pack(&ps, p, QNAV_LINK_POSE_BYTES - 1u), QNAV_LINK_E_SPACE);
+    /* the map's clear is 0 or 1: anything else is refused both ways */
+    p[20] = 2u;
+    assert_int_equal(qnav_link_pose_unpack(p, QNAV_LINK_POSE_BYTES, &ps2), QNAV_LINK_E_VALUE);
+    ps.escape_clear = 2u;
+    assert_int_equal(qnav_link_pose_pack(&ps, p, sizeof p), QNAV_LINK_E_VALUE);
+    assert_int_equal(qnav_link_pose_unpack(p, QNAV_LINK_POSE_BYTES - 3u, &ps2), QNAV_LINK_E_LENGTH);
 }
 
 static uint32_t g_sent;

@@ -210,6 +210,8 @@ static void test_nav_input_round_trips_over_memq(void **state)
     m.goal_id = 65535;
     m.goal_range_mm = 65535;
     m.prev_heading_cdeg = -17999;
+    m.escape_clear = 1;
+    m.escape_grow_mm = 65535;
     m.config_crc = -1;
     round_trip_qnav_nav_input_t(&m, "QNAV_NAV_INPUT");
     assert_int_equal(got_qnav_nav_input_t.utime, m.utime);
@@ -217,6 +219,8 @@ static void test_nav_input_round_trips_over_memq(void **state)
     assert_int_equal(got_qnav_nav_input_t.goal_id, 65535);
     assert_int_equal(got_qnav_nav_input_t.goal_range_mm, 65535);
     assert_int_equal(got_qnav_nav_input_t.prev_heading_cdeg, -17999);
+    assert_int_equal(got_qnav_nav_input_t.escape_clear, 1);
+    assert_int_equal(got_qnav_nav_input_t.escape_grow_mm, 65535);
     assert_int_equal(got_qnav_nav_input_t.config_crc, -1);
 }
 

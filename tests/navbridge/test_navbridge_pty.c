@@ -219,6 +219,114 @@ static void test_offboard_commands_equal_libqnav_and_replay_identically(void **s
     }
 }
 
+/* The escape scenario below: ticks, the board's distance to its goal (constant: no
+ * progress, so the escape starts to follow a boundary), and what its map did each tick. */
+#define ESC_TICKS 70
+#define ESC_GOAL_MM 3000u
+#define ESC_CLEAR_AT 32  /* the board's plan jumped: memory cleared */
+#define ESC_GROW_AT 45   /* its new plan 0.4 m longer: memory grown */
+#define ESC_STALE_AT 56  /* a clear reported for another tick's scan: must not count */
+
+/* The scan of tick i, driven to goal 1. */
+static uint16_t escape_scan(int i, uint8_t *out, qnav_link_scan_t *s)
+{
+    (void)scan_payload(i, 16, out, s);
+    s->goal_id = 1u;
+    return (uint16_t)qnav_link_scan_pack(s, out, QNAV_LINK_MAX_PAYLOAD);
+}
+
+/* libqnav's decisions over the scenario, carrying the escape memory as the board does,
+ * with the map's clear and growth applied at the ticks given (-1: never). */
+static void escape_model(const qnav_policy_t *p, int clear_at, int grow_at, int stale_at,
+                         qnav_ctrl_output_t *outs)
+{
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_t c;
+    qnav_ctrl_carry_t carry;
+    int i;
+    qnav_ctrl_config_default(&cfg);
+    cfg.n_sectors = 16;
+    cfg.max_range_mm = 5000;
+    assert_int_equal(qnav_ctrl_init(&c, &cfg, p), QNAV_OK);
+    qnav_ctrl_carry_reset(&carry);
+    for (i = 0; i < ESC_TICKS; ++i) {
+        uint8_t buf[QNAV_LINK_MAX_PAYLOAD];
+        qnav_link_scan_t s;
+        qnav_ctrl_input_t in = {0};
+        (void)escape_scan(i, buf, &s);
+        in.ranges_mm = s.ranges_mm;
+        in.goal_bearing_cdeg = s.goal_bearing_cdeg;
+        qnav_ctrl_carry_input(&carry, 1u, ESC_GOAL_MM, &in);
+        if (i == clear_at || i == stale_at) {
+            memset(&in.escape, 0, sizeof in.escape);
+        }
+        qnav_escape_grow(&in.escape, i == grow_at ? 400u : 0u);
+        qnav_ctrl_step(&c, &in, &outs[i], NULL);
+        qnav_ctrl_carry_output(&carry, &in, &outs[i]);
+    }
+}
+
+/* Whether two decision sequences differ at some tick. */
+static int decisions_differ(const qnav_ctrl_output_t *a, const qnav_ctrl_output_t *b)
+{
+    int i;
+    for (i = 0; i < ESC_TICKS; ++i) {
+        if (a[i].heading_deg != b[i].heading_deg || a[i].speed != b[i].speed) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Issue 18: the board's map clears or grows the escape memory when its plan jumps or
+ * grows, and says so in its POSE; navbridge's offboard controller applies that to its own
+ * memory, so it decides as an onboard board with the map does, for exactly the tick the
+ * POSE belongs to (a report whose board time is not the scan's is not applied). */
+static void test_offboard_escape_takes_the_boards_map_verdicts(void **state)
+{
+    const char *args[] = {"--lcm-url", "memq://", "--policy", g_policy, NULL};
+    static qnav_ctrl_output_t want[ESC_TICKS], plain[ESC_TICKS], stale[ESC_TICKS];
+    fakeboard_t fb;
+    qnav_policy_t policy;
+    char perr[QNAV_POLICY_IO_ERRLEN];
+    int i;
+    (void)state;
+    assert_int_equal(qnav_policy_read(g_policy, &policy, perr, sizeof perr), 0);
+    escape_model(&policy, ESC_CLEAR_AT, ESC_GROW_AT, -1, want);
+    escape_model(&policy, -1, -1, -1, plain);
+    escape_model(&policy, ESC_CLEAR_AT, ESC_GROW_AT, ESC_STALE_AT, stale);
+    /* the scenario is one where the verdicts change decisions, stale one included */
+    assert_true(decisions_differ(want, plain));
+    assert_true(decisions_differ(want, stale));
+
+    assert_int_equal(fakeboard_start(&fb, EXE, g_dir, args), 0);
+    wait_bridge_up(&fb);
+    for (i = 0; i < ESC_TICKS; ++i) {
+        uint8_t p[QNAV_LINK_MAX_PAYLOAD];
+        qnav_link_pose_t pose;
+        qnav_link_scan_t s;
+        qnav_link_command_t c;
+        uint16_t seq;
+        memset(&pose, 0, sizeof pose);
+        pose.board_ms = (uint32_t)(i * 100) + (i == ESC_STALE_AT ? 1u : 0u);
+        pose.goal_id = 1u;
+        pose.goal_distance_mm = ESC_GOAL_MM;
+        pose.escape_clear = (uint8_t)(i == ESC_CLEAR_AT || i == ESC_STALE_AT);
+        pose.escape_grow_mm = i == ESC_GROW_AT ? 400u : 0u;
+        assert_int_equal(qnav_link_pose_pack(&pose, p, sizeof p), (int)QNAV_LINK_POSE_BYTES);
+        assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_POSE, p, QNAV_LINK_POSE_BYTES), 0);
+        seq = fb.tx.next_seq;
+        assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_SCAN, p, escape_scan(i, p, &s)), 0);
+        assert_int_equal(wait_command_for(&fb, seq, &c), 0);
+        assert_int_equal(c.heading_deg, want[i].heading_deg);
+        assert_int_equal(c.speed, want[i].speed);
+    }
+    kill(fb.pid, SIGTERM);
+    assert_int_equal(wait_stop(&fb, QNAV_TEST_WAIT_MS), 0);
+    assert_int_equal(fakeboard_signal_and_wait(&fb, 0, QNAV_TEST_WAIT_MS), 0);
+    fakeboard_close(&fb);
+}
+
 static void test_corrupted_and_replayed_scans_are_not_answered(void **state)
 {
     const char *args[] = {"--lcm-url", "memq://", NULL};
@@ -646,6 +754,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_offboard_commands_equal_libqnav_and_replay_identically),
+        cmocka_unit_test(test_offboard_escape_takes_the_boards_map_verdicts),
         cmocka_unit_test(test_corrupted_and_replayed_scans_are_not_answered),
         cmocka_unit_test(test_watchdog_stops_robot_within_its_timeout),
         cmocka_unit_test(test_onboard_watchdog_stops_robot_when_heartbeats_stop),

@@ -651,12 +651,17 @@ int32_t qnav_link_pose_pack(const qnav_link_pose_t *m, uint8_t *out, uint16_t ca
     if (cap < QNAV_LINK_POSE_BYTES) {
         return QNAV_LINK_E_SPACE;
     }
+    if (m->escape_clear > 1u) {
+        return QNAV_LINK_E_VALUE;
+    }
     put_u32(&out[0], m->board_ms);
     put_u32(&out[4], (uint32_t)m->x_mm);
     put_u32(&out[8], (uint32_t)m->y_mm);
     put_u16(&out[12], as_u16(m->heading_cdeg));
     put_u16(&out[14], m->goal_id);
     put_u32(&out[16], m->goal_distance_mm);
+    out[20] = m->escape_clear;
+    put_u16(&out[21], m->escape_grow_mm);
     return (int32_t)QNAV_LINK_POSE_BYTES;
 }
 
@@ -674,7 +679,9 @@ int32_t qnav_link_pose_unpack(const uint8_t *p, uint16_t len, qnav_link_pose_t *
     m->heading_cdeg = as_i16(get_u16(&p[12]));
     m->goal_id = get_u16(&p[14]);
     m->goal_distance_mm = get_u32(&p[16]);
-    return QNAV_LINK_OK;
+    m->escape_clear = p[20];
+    m->escape_grow_mm = get_u16(&p[21]);
+    return m->escape_clear > 1u ? QNAV_LINK_E_VALUE : QNAV_LINK_OK;
 }
 
 /* ---- policy blobs ---- */

@@ -392,7 +392,10 @@ static void send_scan(qnav_board_t *bot, uint32_t now, qnav_cdeg_t bearing)
     send(bot, QNAV_LINK_MSG_SCAN, p, (int32_t)len);
 }
 
-static void send_status(qnav_board_t *bot, uint32_t now, uint8_t moving, uint32_t dist_mm)
+/* The heartbeat, and the pose with the distance to the goal and what the map did to the
+ * escape memory this tick (esc: its clear and grow_mm, the rest unused). */
+static void send_status(qnav_board_t *bot, uint32_t now, uint8_t moving, uint32_t dist_mm,
+                        const qnav_link_pose_t *esc)
 {
     qnav_link_heartbeat_t hb;
     qnav_link_pose_t ps;
@@ -418,6 +421,8 @@ static void send_status(qnav_board_t *bot, uint32_t now, uint8_t moving, uint32_
     ps.heading_cdeg = bot->pose.heading_cdeg;
     ps.goal_id = bot->have_goal ? bot->goal.goal_id : 0u;
     ps.goal_distance_mm = dist_mm;
+    ps.escape_clear = esc->escape_clear;
+    ps.escape_grow_mm = esc->escape_grow_mm;
     send(bot, QNAV_LINK_MSG_POSE, p, qnav_link_pose_pack(&ps, p, sizeof p));
 }
 
@@ -453,9 +458,38 @@ static void decide(qnav_board_t *bot, uint32_t now, const qnav_ctrl_input_t *in,
     }
 }
 
+/* With a map and a position goal: mark this tick's readings, and steer to the plan's
+ * sub-goal (in's goal bearing and range; *dist_mm the planned distance). The map clears or
+ * grows in's escape memory when its plan jumps or grows; esc gets the same verdict for the
+ * POSE, for an offboard controller whose memory the map cannot touch. */
+static void guide_by_map(qnav_board_t *bot, qnav_ctrl_input_t *in, uint32_t *dist_mm,
+                         qnav_link_pose_t *esc)
+{
+#if QNAV_BOARD_WITH_MAP
+    if (bot->map != NULL && bot->have_goal && bot->goal.kind == QNAV_LINK_GOAL_POSITION) {
+        const qnav_map_pose_t pose = {bot->pose.x_um / (int32_t)1000, bot->pose.y_um / (int32_t)1000,
+                                  bot->pose.heading_cdeg};
+        int got;
+        qnav_map_observe(bot->map, bot->ranges, &pose);
+        got = qnav_map_guide(bot->map, &pose, bot->goal.x_mm, bot->goal.y_mm, in);
+        if (got != 0) {
+            *dist_mm = in->goal_range_mm;
+        }
+        esc->escape_clear = (uint8_t)((got & QNAV_MAP_ESCAPE_CLEARED) != 0);
+        esc->escape_grow_mm = (got & QNAV_MAP_ESCAPE_GROWN) != 0 ? qnav_map_grown_mm(bot->map) : 0u;
+    }
+#else
+    (void)bot;
+    (void)in;
+    (void)dist_mm;
+    (void)esc;
+#endif
+}
+
 void qnav_board_tick(qnav_board_t *bot)
 {
     qnav_link_command_t tel;
+    qnav_link_pose_t esc = {0};
     qnav_ctrl_input_t in = {0};
     qnav_ctrl_output_t out;
     uint8_t p[QNAV_LINK_COMMAND_BYTES];
@@ -495,16 +529,7 @@ void qnav_board_tick(qnav_board_t *bot)
     /* the previous decision, seen from where the robot points now (3-input policies), the
      * distance to a position goal (0 for a bearing goal: no escape) and the memory */
     qnav_ctrl_carry_input(&bot->carry, bot->have_goal ? bot->goal.goal_id : 0u, dist_mm, &in);
-#if QNAV_BOARD_WITH_MAP
-    if (bot->map != NULL && bot->have_goal && bot->goal.kind == QNAV_LINK_GOAL_POSITION) {
-        const qnav_map_pose_t pose = {bot->pose.x_um / (int32_t)1000, bot->pose.y_um / (int32_t)1000,
-                                  bot->pose.heading_cdeg};
-        qnav_map_observe(bot->map, bot->ranges, &pose);
-        if (qnav_map_guide(bot->map, &pose, bot->goal.x_mm, bot->goal.y_mm, &in) != 0) {
-            dist_mm = in.goal_range_mm;
-        }
-    }
-#endif
+    guide_by_map(bot, &in, &dist_mm, &esc);
 
     decide(bot, now, &in, &out);
     qnav_ctrl_carry_output(&bot->carry, &in, &out);
@@ -520,7 +545,7 @@ void qnav_board_tick(qnav_board_t *bot)
     /* report: heartbeat (before the decision, so the bridge labels it with the current
      * policy), pose (before the scan, so navbridge's offboard controller has this tick's
      * distance to the goal with the scan, as the board's own has), scan, onboard decision */
-    send_status(bot, now, moving, dist_mm);
+    send_status(bot, now, moving, dist_mm, &esc);
     send_scan(bot, now, in.goal_bearing_cdeg);
     scan_seq = bot->stats.last_scan_seq;
     if (bot->mode == QNAV_LINK_MODE_ONBOARD) {

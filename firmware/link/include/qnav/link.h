@@ -51,8 +51,10 @@ extern "C" {
  * side refuses a peer of another version). Version 1 (before issue 10) had a 12-byte
  * heartbeat without the version byte and bearing-only goals; version 2 adds the version
  * byte, position goals and the board's POSE; version 3 (issue 17) adds the board's CONFIG
- * report, so that a bridge refuses a board built for another robot. */
-#define QNAV_LINK_PROTOCOL_VERSION 3u
+ * report, so that a bridge refuses a board built for another robot; version 4 (issue 18)
+ * adds to the POSE what the board's map did to the escape memory this tick, so that an
+ * offboard controller keeps its memory as the onboard one does. */
+#define QNAV_LINK_PROTOCOL_VERSION 4u
 
 /* Message ids. Direction: B->H board to host (navbridge), H->B host to board. */
 typedef enum {
@@ -77,7 +79,7 @@ typedef enum {
 #define QNAV_LINK_HEARTBEAT_BYTES 13u     /* this version's; any version's is >= 12 */
 #define QNAV_LINK_HEARTBEAT_V1_BYTES 12u  /* version 1's (no version byte) */
 #define QNAV_LINK_HEARTBEAT_MAX_BYTES 32u /* longest a later version may send */
-#define QNAV_LINK_POSE_BYTES 20u
+#define QNAV_LINK_POSE_BYTES 23u
 /* CONFIG: [count u8] then count x ([key u8][value i32]); at most this many fields. */
 #define QNAV_LINK_CONFIG_MAX_FIELDS 20u
 #define QNAV_LINK_CONFIG_MAX_BYTES (1u + 5u * QNAV_LINK_CONFIG_MAX_FIELDS)
@@ -269,7 +271,13 @@ typedef struct {
     int32_t y_mm;
     qnav_cdeg_t heading_cdeg;          /* heading in that frame, 0.01 deg, CCW */
     uint16_t goal_id;                  /* goal being driven to (0 none) */
-    uint32_t goal_distance_mm;         /* POSITION goal: distance to it, mm (0 otherwise) */
+    uint32_t goal_distance_mm;         /* POSITION goal: distance to it, mm (0 otherwise); with
+                                          a map, the planned distance */
+    uint8_t escape_clear;              /* 1: this tick the map's plan jumped and the escape
+                                          memory was cleared (QNAV_MAP_ESCAPE_CLEARED) */
+    uint16_t escape_grow_mm;           /* this tick the map's new plan was longer where the
+                                          robot is: the memory grew this much
+                                          (QNAV_MAP_ESCAPE_GROWN, qnav_escape_grow); 0 none */
 } qnav_link_pose_t;
 
 typedef struct {
