@@ -22,6 +22,7 @@
 
 #define EVIDENCE_FREE_MIN (-4)
 #define EVIDENCE_MAX 3
+#define EVIDENCE_REFUSED 100 /* a cell the robot could not pass: kept until the refusal lapses */
 #define STEP_SIDE 10u
 #define STEP_DIAG 14u
 #define NOT_QUEUED UINT16_C(0xFFFF)
@@ -43,6 +44,8 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->sight = 1u;
     cfg->escape_grow = 1u;
     cfg->near_cost = 10u;
+    cfg->refuse_ticks = 30u;
+    cfg->refuse_life_ticks = 200u;
 }
 
 uint32_t qnav_map_cells(uint32_t width_mm, uint32_t height_mm, uint16_t cell_mm)
@@ -76,7 +79,7 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
     }
     cells = qnav_map_cells(width_mm, height_mm, cfg->cell_mm);
     if (cfg->cell_mm < 20u || cfg->cell_mm > 1000u || cfg->plan_ticks == 0u || cells == 0u ||
-        cfg->arc_pct > 100u ||
+        cfg->arc_pct > 100u || (cfg->refuse_ticks > 0u && cfg->refuse_life_ticks == 0u) ||
         len < qnav_map_bytes(cells) || ((uintptr_t)buf & 1u) != 0u || ctrl->n_sectors == 0u ||
         ctrl->n_sectors > QNAV_MAX_SECTORS || ctrl->max_range_mm == 0u) {
         return QNAV_E_MAP;
@@ -127,6 +130,9 @@ void qnav_map_reset(qnav_map_t *m)
     m->planned = 0u;
     m->dirty = 0u;
     m->grown_mm = 0u;
+    m->stall_best_mm = 0u;
+    m->stall_ticks = 0u;
+    m->refused_ticks = 0u;
 }
 
 /* The cell holding world point (x, y), clamped into the map. */
@@ -221,6 +227,9 @@ static int32_t off_centre(const qnav_map_t *m, int32_t a_cdeg, uint16_t k)
 static void mark_clear(qnav_map_t *m, int8_t *c)
 {
     const int8_t v = (int8_t)((*c > 0 ? 0 : *c) - 1);
+    if (*c == EVIDENCE_REFUSED) {
+        return;
+    }
     if (*c >= QNAV_MAP_OCCUPIED) {
         m->dirty = 1u;
     }
@@ -264,7 +273,8 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
             lo = rc - tol;
             if (lo > 0 && d2 < (int64_t)lo * lo) {
                 mark_clear(m, c);
-            } else if (*c >= 0 && d2 <= (int64_t)(rc + three_quarters) * (rc + three_quarters) &&
+            } else if (*c >= 0 && *c < EVIDENCE_REFUSED &&
+                       d2 <= (int64_t)(rc + three_quarters) * (rc + three_quarters) &&
                        off_centre(m, rel, k) <= arc_half) {
                 *c = (int8_t)(*c + 1 > EVIDENCE_MAX ? EVIDENCE_MAX : *c + 1);
                 if (*c == QNAV_MAP_OCCUPIED) {
@@ -492,6 +502,79 @@ static int plan_when_due(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
     return again;
 }
 
+/* One step of steepest descent on the plan's costs from cell (*i, *j): to its cheapest
+ * neighbour (8), when cheaper; 0 when none is. */
+static int descend(const qnav_map_t *m, int32_t *i, int32_t *j)
+{
+    uint16_t here = m->cost[at_cell(m, *i, *j)];
+    int32_t a, b, ni = *i, nj = *j;
+    for (b = -1; b <= 1; ++b) {
+        for (a = -1; a <= 1; ++a) {
+            if (in_map(m, *i + a, *j + b) && m->cost[at_cell(m, *i + a, *j + b)] < here) {
+                here = m->cost[at_cell(m, *i + a, *j + b)];
+                ni = *i + a;
+                nj = *j + b;
+            }
+        }
+    }
+    if (ni == *i && nj == *j) {
+        return 0;
+    }
+    *i = ni;
+    *j = nj;
+    return 1;
+}
+
+/* Lapse the refusal: every refused cell back to unknown. */
+static void refusal_lapses(qnav_map_t *m)
+{
+    uint32_t c, n = cell_count(m);
+    for (c = 0; c < n; ++c) {
+        if (m->evidence[c] == EVIDENCE_REFUSED) {
+            m->evidence[c] = 0;
+        }
+    }
+    m->dirty = 1u;
+}
+
+/* The robot made no progress along the plan for a long time though the plan kept its way:
+ * the way is one the robot cannot take (a gap the controller will not pass). Refuse the
+ * plan's cells from 'from' to look_mm ahead of the robot's cell, so the plan seeks another
+ * way; the refusal lapses after a while. */
+static void refuse_when_stalled(qnav_map_t *m, int32_t ri, int32_t rj, uint16_t mm, int jumped)
+{
+    int32_t i, j, steps, k, from;
+    if (m->cfg.refuse_ticks == 0u) {
+        return;
+    }
+    if (jumped || m->stall_best_mm == 0u || (uint32_t)mm + m->cfg.cell_mm < m->stall_best_mm) {
+        m->stall_best_mm = mm;
+        m->stall_ticks = 0u;
+        return;
+    }
+    if (m->grown_mm > 0u) {
+        m->stall_best_mm = (uint16_t)(m->stall_best_mm + m->grown_mm > 65535u ? 65535u : m->stall_best_mm + m->grown_mm);
+    }
+    if (++m->stall_ticks < m->cfg.refuse_ticks) {
+        return;
+    }
+    (void)cost_near(m, ri, rj, &i, &j);
+    steps = (int32_t)(m->cfg.look_mm / m->cfg.cell_mm);
+    /* refused cells lie more than the body's reach and a cell along the plan, so that the
+     * robot's own cell stays unblocked and the plan starts where the robot stands */
+    from = ((int32_t)m->inflate_mm + (int32_t)m->cfg.cell_mm - 1) / (int32_t)m->cfg.cell_mm + 1;
+    for (k = 0; k < steps && descend(m, &i, &j) && m->cost[at_cell(m, i, j)] != 0u; ++k) {
+        if (k >= from) {
+            m->evidence[at_cell(m, i, j)] = EVIDENCE_REFUSED;
+        }
+    }
+    m->dirty = 1u;
+    m->ticks = m->cfg.plan_ticks; /* plan again at once */
+    m->refused_ticks = m->cfg.refuse_life_ticks;
+    m->stall_best_mm = 0u;
+    m->stall_ticks = 0u;
+}
+
 int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
                    int32_t goal_y_mm, qnav_ctrl_input_t *in)
 {
@@ -500,6 +583,9 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     int jumped, replanned, direct = 0, grew = 0;
     if (m == NULL || m->cost == NULL || pose == NULL || in == NULL) {
         return 0;
+    }
+    if (m->refused_ticks > 0u && --m->refused_ticks == 0u) {
+        refusal_lapses(m);
     }
     replanned = plan_when_due(m, goal_x_mm, goal_y_mm);
     cell_of(m, pose->x_mm, pose->y_mm, &ri, &rj);
@@ -511,22 +597,8 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     }
     /* steepest descent for look_mm */
     for (steps = (int32_t)(m->cfg.look_mm / m->cfg.cell_mm); steps > 0; --steps) {
-        uint16_t here = m->cost[at_cell(m, i, j)];
-        int32_t a, b, ni = i, nj = j;
-        for (b = -1; b <= 1; ++b) {
-            for (a = -1; a <= 1; ++a) {
-                const int32_t ii = i + a, jj = j + b;
-                if (!in_map(m, ii, jj)) {
-                    continue;
-                }
-                if (m->cost[at_cell(m, ii, jj)] < here) {
-                    here = m->cost[at_cell(m, ii, jj)];
-                    ni = ii;
-                    nj = jj;
-                }
-            }
-        }
-        if ((ni == i && nj == j) || (m->cfg.sight && !in_sight(m, ri, rj, ni, nj))) {
+        int32_t ni = i, nj = j;
+        if (!descend(m, &ni, &nj) || (m->cfg.sight && !in_sight(m, ri, rj, ni, nj))) {
             break;
         }
         i = ni;
@@ -557,6 +629,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     }
     m->last_mm = (uint16_t)mm;
     in->goal_range_mm = (qnav_mm_t)mm;
+    refuse_when_stalled(m, ri, rj, (uint16_t)mm, jumped);
     if (jumped) {
         memset(&in->escape, 0, sizeof in->escape);
         return QNAV_MAP_GUIDED | QNAV_MAP_ESCAPE_CLEARED | direct;

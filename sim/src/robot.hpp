@@ -64,6 +64,8 @@ struct RobotProfile {
     int map_arc_pct = 100;          // arcs marked in the central this % of the wedge
     bool map_sight = true;          // the sub-goal kept in a straight line's sight
     bool map_escape_grow = true;    // a longer plan grows the escape's distances with it
+    double map_refuse_s = 3.0;      // no progress along the plan this long: its next cells refused
+    double map_refuse_life_s = 20.0;  // for this long
     // the odometry's errors, drawn once an episode with these standard deviations (all 0:
     // the map's pose is the true one): distance scale (wheel diameter), rotation scale
     // (wheel track), a curve (unequal wheels: heading error per metre driven)

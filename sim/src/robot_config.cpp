@@ -44,6 +44,9 @@ void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg) {
     cfg->arc_pct = static_cast<std::uint8_t>(p.map_arc_pct);
     cfg->sight = p.map_sight ? 1 : 0;
     cfg->escape_grow = p.map_escape_grow ? 1 : 0;
+    cfg->refuse_ticks = static_cast<std::uint8_t>(std::clamp(std::lround(p.map_refuse_s / QNAV_SIM_TICK_S), 0L, 255L));
+    cfg->refuse_life_ticks =
+        static_cast<std::uint16_t>(std::clamp(std::lround(p.map_refuse_life_s / QNAV_SIM_TICK_S), 1L, 65535L));
 }
 
 }  // namespace qnav

@@ -1,6 +1,7 @@
 /*
  * The map and its plan (qnav/map.h): what a reading marks, a plan round a wall to its gap,
- * the escape memory cleared when the plan's way closes, and refusals. Scans come from a
+ * the escape memory cleared when the plan's way closes, a way the robot cannot take refused
+ * for a while, and bad maps refused. Scans come from a
  * small ray marcher over rectangles written here, so each sector reports the nearest
  * obstacle point inside its wedge, as the simulator's sonar does.
  */
@@ -310,6 +311,59 @@ static void test_a_destination_walled_in_leaves_the_input_alone(void **state)
     assert_int_equal(in.goal_range_mm, 3500);
 }
 
+/* Below the gap, the destination beyond it, the robot makes no progress (a controller that
+ * will not pass where the plan leads): after refuse_ticks guided ticks the plan's cells
+ * ahead are refused, so the plan no longer leads through the gap (here there is no other
+ * way: the input is left alone); after refuse_life_ticks the refusal lapses and the plan
+ * leads through the gap again. With refuse_ticks 0, never. */
+static int ticks_until_unguided(uint8_t refuse_ticks, qnav_map_t *m)
+{
+    qnav_map_config_t mc;
+    qnav_ctrl_config_t cc;
+    qnav_ctrl_input_t in;
+    const qnav_map_pose_t p = {4900, 2300, 9000};
+    int t;
+    sensor_config(&cc);
+    qnav_map_config_default(&mc);
+    mc.plan_ticks = 1;
+    mc.refuse_ticks = refuse_ticks;
+    mc.refuse_life_ticks = 50;
+    assert_int_equal(qnav_map_init(m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
+                     QNAV_OK);
+    observe_the_wall(m);
+    assert_true(qnav_map_evidence(m, 4950, 3050) < QNAV_MAP_OCCUPIED); /* the gap is open */
+    for (t = 0; t < 100; ++t) {
+        memset(&in, 0, sizeof in);
+        if (qnav_map_guide(m, &p, 4900, 5000, &in) == 0) {
+            return t;
+        }
+        assert_true(in.goal_bearing_cdeg > -1500 && in.goal_bearing_cdeg < 1500);
+    }
+    return -1;
+}
+
+static void test_a_way_the_robot_cannot_take_is_refused_for_a_while(void **state)
+{
+    qnav_map_t m;
+    qnav_ctrl_input_t in;
+    const qnav_map_pose_t p = {4900, 2300, 9000};
+    int t;
+    (void)state;
+    /* the first tick plans and starts the count; refused on the 31st; planned again on the
+     * 32nd, without a way */
+    assert_int_equal(ticks_until_unguided(30, &m), 31);
+    assert_true(qnav_map_evidence(&m, 4950, 3050) >= QNAV_MAP_OCCUPIED);
+    assert_true(qnav_map_evidence(&m, 4950, 2550) < QNAV_MAP_OCCUPIED); /* not at the robot */
+    for (t = 0; t < 48; ++t) {
+        memset(&in, 0, sizeof in);
+        assert_int_equal(qnav_map_guide(&m, &p, 4900, 5000, &in), 0);
+    }
+    memset(&in, 0, sizeof in);
+    assert_int_equal(qnav_map_guide(&m, &p, 4900, 5000, &in) & QNAV_MAP_GUIDED, QNAV_MAP_GUIDED);
+    assert_true(qnav_map_evidence(&m, 4950, 3050) < QNAV_MAP_OCCUPIED);
+    assert_int_equal(ticks_until_unguided(0, &m), -1);
+}
+
 static void test_bad_maps_are_refused(void **state)
 {
     qnav_map_t m;
@@ -337,6 +391,11 @@ static void test_bad_maps_are_refused(void **state)
     mc.plan_ticks = 10;
     mc.arc_pct = 101;
     assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
+    mc.arc_pct = 100;
+    mc.refuse_life_ticks = 0; /* a refusal that would never lapse */
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
+    mc.refuse_ticks = 0;
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_OK);
     assert_int_equal(qnav_map_cells(100000000u, 100000000u, 100), 0);
     assert_string_not_equal(qnav_status_str(QNAV_E_MAP), "unknown status");
 }
@@ -351,6 +410,7 @@ int main(void)
         cmocka_unit_test(test_a_longer_plan_grows_the_escape_memory),
         cmocka_unit_test(test_the_destination_in_reach_is_flagged_direct),
         cmocka_unit_test(test_a_destination_walled_in_leaves_the_input_alone),
+        cmocka_unit_test(test_a_way_the_robot_cannot_take_is_refused_for_a_while),
         cmocka_unit_test(test_bad_maps_are_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -52,6 +52,13 @@ typedef struct {
     uint8_t escape_grow;   /* 1: when a new plan is longer where the robot is (by less than
                               jump_mm), every distance the escape memory holds grows as
                               much (qnav_escape_grow); default 1 */
+    uint8_t refuse_ticks;  /* guided ticks without a cell's progress along the plan after
+                              which the plan's next cells (beyond the body's reach, up to
+                              look_mm) are refused: marked occupied until the refusal
+                              lapses, so the plan seeks another way than one the robot
+                              cannot take; 0: never; default 30 */
+    uint16_t refuse_life_ticks; /* ticks a refusal lasts (every refused cell then unknown
+                              again), 1..65535; default 200 */
 } qnav_map_config_t;
 
 /* The robot's pose in the destination's frame. */
@@ -81,6 +88,9 @@ typedef struct {
     uint8_t planned;          /* a plan toward goal_* exists */
     uint8_t dirty;            /* a cell became or stopped being occupied since the plan */
     uint16_t grown_mm;        /* what this tick's guide grew the escape memory by, mm */
+    uint16_t stall_best_mm;   /* the least planned distance since the last refusal */
+    uint16_t stall_ticks;     /* guided ticks since it last shrank by a cell */
+    uint16_t refused_ticks;   /* ticks the refused cells have left; 0: none */
 } qnav_map_t;
 
 /* Evidence at or above this marks a cell occupied. */
