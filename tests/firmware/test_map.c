@@ -39,18 +39,24 @@ static void sensor_config(qnav_ctrl_config_t *cfg)
     cfg->safety_mm = 50;
 }
 
+/* A map of the world with configuration mc, for the sensor above. */
+static void map_from(qnav_map_t *m, const qnav_map_config_t *mc)
+{
+    qnav_ctrl_config_t cc;
+    sensor_config(&cc);
+    assert_true(qnav_map_cells(WORLD_MM, WORLD_MM, mc->cell_mm) <= CELLS_MAX);
+    assert_int_equal(qnav_map_init(m, mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
+                     QNAV_OK);
+}
+
 static void map_with(qnav_map_t *m, uint8_t plan_ticks, uint8_t arc_pct, uint8_t sight)
 {
     qnav_map_config_t mc;
-    qnav_ctrl_config_t cc;
-    sensor_config(&cc);
     qnav_map_config_default(&mc);
     mc.plan_ticks = plan_ticks;
     mc.arc_pct = arc_pct;
     mc.sight = sight;
-    assert_true(qnav_map_cells(WORLD_MM, WORLD_MM, mc.cell_mm) <= CELLS_MAX);
-    assert_int_equal(qnav_map_init(m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
-                     QNAV_OK);
+    map_from(m, &mc);
 }
 
 static void map_of(qnav_map_t *m, uint8_t plan_ticks)
@@ -208,15 +214,12 @@ static uint16_t grow_after_the_wall(uint8_t escape_grow, qnav_ctrl_input_t *in, 
 {
     qnav_map_t m;
     qnav_map_config_t mc;
-    qnav_ctrl_config_t cc;
     const qnav_map_pose_t p = {4300, 1500, 9000};
     uint16_t before;
-    sensor_config(&cc);
     qnav_map_config_default(&mc);
     mc.plan_ticks = 1;
     mc.escape_grow = escape_grow;
-    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
-                     QNAV_OK);
+    map_from(&m, &mc);
     memset(in, 0, sizeof *in);
     assert_int_equal(qnav_map_guide(&m, &p, 4300, 5000, in), QNAV_MAP_GUIDED);
     before = in->goal_range_mm;
@@ -319,17 +322,14 @@ static void test_a_destination_walled_in_leaves_the_input_alone(void **state)
 static int ticks_until_unguided(uint8_t refuse_ticks, qnav_map_t *m)
 {
     qnav_map_config_t mc;
-    qnav_ctrl_config_t cc;
     qnav_ctrl_input_t in;
     const qnav_map_pose_t p = {4900, 2300, 9000};
     int t;
-    sensor_config(&cc);
     qnav_map_config_default(&mc);
     mc.plan_ticks = 1;
     mc.refuse_ticks = refuse_ticks;
     mc.refuse_life_ticks = 50;
-    assert_int_equal(qnav_map_init(m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
-                     QNAV_OK);
+    map_from(m, &mc);
     observe_the_wall(m);
     assert_true(qnav_map_evidence(m, 4950, 3050) < QNAV_MAP_OCCUPIED); /* the gap is open */
     for (t = 0; t < 100; ++t) {
