@@ -552,8 +552,9 @@ static void refuse_when_stalled(qnav_map_t *m, int32_t ri, int32_t rj, uint16_t 
         m->stall_ticks = 0u;
         return;
     }
-    if (m->grown_mm > 0u) {
-        m->stall_best_mm = (uint16_t)(m->stall_best_mm + m->grown_mm > 65535u ? 65535u : m->stall_best_mm + m->grown_mm);
+    if (m->grown_mm > 0u) { /* a new plan, longer: progress is measured along it */
+        const uint32_t best = (uint32_t)m->stall_best_mm + m->grown_mm;
+        m->stall_best_mm = (uint16_t)(best > 65535u ? 65535u : best);
     }
     if (++m->stall_ticks < m->cfg.refuse_ticks) {
         return;
