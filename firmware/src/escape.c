@@ -204,6 +204,18 @@ void qnav_escape_grow(qnav_escape_t *e, uint16_t d_mm)
     grow_mm(&e->prev_mm, d_mm);
 }
 
+void qnav_escape_follow_plan(qnav_escape_t *e, int clear, uint16_t grow_mm)
+{
+    if (e == NULL) {
+        return;
+    }
+    if (clear) {
+        qnav_escape_clear(e);
+    } else {
+        qnav_escape_grow(e, grow_mm);
+    }
+}
+
 void qnav_escape_clear(qnav_escape_t *e)
 {
     e->best_mm = 0u;

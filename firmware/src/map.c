@@ -625,17 +625,13 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     if (!jumped && replanned && m->cfg.escape_grow && m->last_mm != 0u && mm > m->last_mm) {
         /* a new plan, longer (by less than a jump) where the robot is */
         m->grown_mm = (uint16_t)(mm - m->last_mm);
-        qnav_escape_grow(&in->escape, m->grown_mm);
         grew = QNAV_MAP_ESCAPE_GROWN;
     }
+    qnav_escape_follow_plan(&in->escape, jumped, m->grown_mm);
     m->last_mm = (uint16_t)mm;
     in->goal_range_mm = (qnav_mm_t)mm;
     refuse_when_stalled(m, ri, rj, (uint16_t)mm, jumped);
-    if (jumped) {
-        memset(&in->escape, 0, sizeof in->escape);
-        return QNAV_MAP_GUIDED | QNAV_MAP_ESCAPE_CLEARED | direct;
-    }
-    return QNAV_MAP_GUIDED | grew | direct;
+    return QNAV_MAP_GUIDED | (jumped ? QNAV_MAP_ESCAPE_CLEARED : grew) | direct;
 }
 
 /* The index of the cell holding (x, y); -1 outside the map. */

@@ -147,12 +147,10 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
     qnav_ctrl_carry_input(&bc->carry, (uint16_t)scan->goal_id,
                           rec->goal_range_mm < 0 ? 0u : (uint32_t)rec->goal_range_mm, &in);
     in.prev_heading_cdeg = rec->prev_heading_cdeg; /* as recorded (the same, live) */
-    if (rec->escape_clear != 0) {
-        memset(&in.escape, 0, sizeof in.escape); /* the board's plan jumped */
-    }
-    qnav_escape_grow(&in.escape, (uint16_t)(rec->escape_grow_mm < 0 ? 0
-                                            : rec->escape_grow_mm > 65535 ? 65535
-                                                                          : rec->escape_grow_mm));
+    qnav_escape_follow_plan(&in.escape, rec->escape_clear,
+                            (uint16_t)(rec->escape_grow_mm < 0        ? 0
+                                       : rec->escape_grow_mm > 65535 ? 65535
+                                                                     : rec->escape_grow_mm));
     if (qualities != NULL) {
         memset(qualities, 0, sizeof(int16_t) * QNAV_PATHS);
     }

@@ -374,8 +374,8 @@ int qpy_env_step(qpy_env_t *e, qpy_ctrl_t *ctrl, double heading_deg, double spee
         in.goal_bearing_cdeg = e->scan.goal_bearing_cdeg;
         in.prev_heading_cdeg = e->scan.prev_heading_cdeg;
         in.goal_range_mm = e->scan.goal_range_mm;
-        in.escape = e->scan.escape_clear ? qnav_escape_t{} : ctrl->last.escape;
-        qnav_escape_grow(&in.escape, e->scan.escape_grow_mm);
+        in.escape = ctrl->last.escape;
+        qnav_escape_follow_plan(&in.escape, e->scan.escape_clear, e->scan.escape_grow_mm);
         qnav_nav_step(&ctrl->nav, &in, &ctrl->last);
         if (ctrl->last.flags & QNAV_FLAG_NOT_READY)
             return fail(err, errlen, "controller: not initialised (qnav_ctrl_init failed or was not called)",
@@ -533,8 +533,9 @@ int qpy_ctrl_step(qpy_ctrl_t *c, const uint16_t *ranges_mm, int32_t n, int32_t g
     in.goal_bearing_cdeg = static_cast<qnav_cdeg_t>(std::clamp(goal_bearing_cdeg, -32768, 32767));
     in.prev_heading_cdeg = static_cast<qnav_cdeg_t>(std::clamp(prev_heading_cdeg, -32768, 32767));
     in.goal_range_mm = static_cast<qnav_mm_t>(std::clamp(goal_range_mm, 0, 65535));
-    in.escape = escape_clear ? qnav_escape_t{} : c->last.escape;
-    qnav_escape_grow(&in.escape, static_cast<uint16_t>(std::clamp(escape_grow_mm, 0, 65535)));
+    in.escape = c->last.escape;
+    qnav_escape_follow_plan(&in.escape, escape_clear,
+                            static_cast<uint16_t>(std::clamp(escape_grow_mm, 0, 65535)));
     qnav_ctrl_t *paths = qnav_nav_paths(&c->nav);
     if (qualities && !paths) return fail(err, errlen, "qualities: VFH+ has no path qualities");
     if (qualities)

@@ -656,8 +656,8 @@ qnav_sim_result_t Simulation::run_episode_with(StepFn step, void *self, std::uin
         in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
         in.prev_heading_cdeg = scan_.prev_heading_cdeg;
         in.goal_range_mm = scan_.goal_range_mm;
-        in.escape = scan_.escape_clear ? qnav_escape_t{} : out.escape;
-        qnav_escape_grow(&in.escape, scan_.escape_grow_mm);
+        in.escape = out.escape;
+        qnav_escape_follow_plan(&in.escape, scan_.escape_clear, scan_.escape_grow_mm);
         Clock::time_point t0;
         if (profiling_) t0 = Clock::now();
         step(self, &in, &out);

@@ -34,8 +34,8 @@ inline qnav_ctrl_input_t step_input(const qnav_sim_scan_t &s, const qnav_ctrl_ou
     in.goal_bearing_cdeg = s.goal_bearing_cdeg;
     in.prev_heading_cdeg = s.prev_heading_cdeg;
     in.goal_range_mm = s.goal_range_mm;
-    in.escape = s.escape_clear ? qnav_escape_t{} : out.escape;
-    qnav_escape_grow(&in.escape, s.escape_grow_mm);
+    in.escape = out.escape;
+    qnav_escape_follow_plan(&in.escape, s.escape_clear, s.escape_grow_mm);
     return in;
 }
 

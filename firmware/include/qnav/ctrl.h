@@ -177,6 +177,12 @@ typedef struct {
  * is no progress along the new measure, not along the old one; 0 stays "none yet". */
 void qnav_escape_grow(qnav_escape_t *e, uint16_t d_mm);
 
+/* What a map's plan did to the escape memory this tick (qnav/map.h: the flags
+ * QNAV_MAP_ESCAPE_CLEARED and QNAV_MAP_ESCAPE_GROWN, qnav_map_grown_mm), applied by the map
+ * itself or by a caller that carries the memory apart from the map's input (the step API,
+ * navbridge offboard): cleared when clear is non-zero, otherwise grown by grow_mm. */
+void qnav_escape_follow_plan(qnav_escape_t *e, int clear, uint16_t grow_mm);
+
 /* qnav_escape_t.loop: no mark yet; marked; left the mark; back at it (round once). */
 #define QNAV_ESCAPE_LOOP_NONE 0u
 #define QNAV_ESCAPE_LOOP_MARKED 1u

@@ -305,8 +305,8 @@ typedef struct {
                                               planned distance (qnav/map.h) */
     uint16_t escape_grow_mm;               /* unless escape_clear: grow the escape memory
                                               passed to this tick's controller by this much
-                                              (qnav_escape_grow): the map's new plan is that
-                                              much longer; 0: none */
+                                              (qnav_escape_follow_plan applies both): the
+                                              map's new plan is that much longer; 0: none */
 } qnav_sim_scan_t;
 
 /* The robot's true state. */
