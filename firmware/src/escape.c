@@ -66,16 +66,39 @@ static uint8_t blocked(const qnav_clearance_t *c, const uint8_t *lvl, int16_t p)
  * half is all at 255). */
 static uint8_t nearest_on_side(const uint8_t *lvl, int8_t s, int16_t *at)
 {
+    /* path -s * k for k = 1..179: upward from path 1 (s = -1) or downward from 359 */
+    const int8_t step = (int8_t)-s;
+    const uint8_t *q = s < 0 ? lvl + 1 : lvl + QNAV_PATHS - 1;
     uint8_t lw = 255u;
     int16_t k;
-    for (k = 1; k < (int16_t)QNAV_DTHETA_MAX; ++k) {
-        uint8_t l = lvl[wrap((int16_t)(-s * k))];
-        if (l < lw) {
-            lw = l;
-            *at = (int16_t)(-s * k);
+    for (k = 1; k < (int16_t)QNAV_DTHETA_MAX; ++k, q += step) {
+        if (*q < lw) {
+            lw = *q;
+            *at = (int16_t)(step * k);
         }
     }
     return lw;
+}
+
+/* The least k in 1..359 such that path from + s * k (round the circle) has a level of at
+ * least need; 0 when none has: one walk along the bytes that jumps at the wrap, where a
+ * wrapped index per path cost the host two thirds of the follow's instructions. */
+static int16_t first_at_least(const uint8_t *lvl, int16_t from, int8_t s, uint8_t need)
+{
+    const uint16_t p0 = wrap((int16_t)(from + s));
+    /* paths up to the wrap: p0..359 upward, or p0..0 downward */
+    const int16_t before = s > 0 ? (int16_t)(QNAV_PATHS - p0) : (int16_t)(p0 + 1u);
+    const uint8_t *q = lvl + p0;
+    int16_t k;
+    for (k = 1; k < (int16_t)QNAV_PATHS; ++k, q += s) {
+        if (k == before + 1) {
+            q = s > 0 ? lvl : lvl + QNAV_PATHS - 1;
+        }
+        if (*q >= need) {
+            return k;
+        }
+    }
+    return 0;
 }
 
 /*
@@ -99,13 +122,12 @@ static uint16_t skirt(const qnav_clearance_t *c, const uint8_t *lvl, int8_t s)
     if (need > QNAV_DIST_LEVELS - 1u) {
         need = QNAV_DIST_LEVELS - 1u;
     }
-    for (k = 1; k < (int16_t)QNAV_PATHS; ++k) {
-        if (lvl[wrap((int16_t)(w + s * k))] >= need) {
-            /* nearer than half the follow level: a little more away from the boundary */
-            uint8_t half = (uint8_t)(c->esc_free_level / 2u);
-            int16_t off = lw < half ? (int16_t)((half - lw) * QNAV_ESCAPE_AWAY_DEG) : 0;
-            return wrap((int16_t)(w + s * (k + off)));
-        }
+    k = first_at_least(lvl, w, s, need);
+    if (k != 0) {
+        /* nearer than half the follow level: a little more away from the boundary */
+        uint8_t half = (uint8_t)(c->esc_free_level / 2u);
+        int16_t off = lw < half ? (int16_t)((half - lw) * QNAV_ESCAPE_AWAY_DEG) : 0;
+        return wrap((int16_t)(w + s * (k + off)));
     }
     return wrap(180);
 }

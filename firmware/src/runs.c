@@ -6,6 +6,29 @@
  */
 #include "runs.h"
 
+#include <stddef.h>
+#include <string.h>
+
+/* Elsewhere than on AVR the level walks below compare a machine word of levels at a time
+ * when the compiler can find a word's first differing byte (GCC, Clang; little-endian
+ * words: x86-64, Cortex-M), and a byte at a time otherwise. */
+#if !defined(__AVR__) && defined(__GNUC__) && defined(__BYTE_ORDER__) &&                  \
+    __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define QNAV_WORD_WALK 1
+typedef unsigned long walk_word_t;
+#define WALK_BYTES ((uint8_t)sizeof(walk_word_t))
+
+/* The word of WALK_BYTES levels at q, each byte xor level: 0 where a byte is level. */
+static inline walk_word_t walk_diff(const uint8_t *q, uint8_t level)
+{
+    walk_word_t w;
+    memcpy(&w, q, sizeof w);
+    return w ^ ((~(walk_word_t)0 / 0xFFu) * level);
+}
+#else
+#define QNAV_WORD_WALK 0
+#endif
+
 uint16_t qnav_whole_deg(qnav_cdeg_t cdeg)
 {
     int16_t d = (int16_t)(cdeg / 100);
@@ -57,6 +80,14 @@ static inline const uint8_t *same_up(const uint8_t *q, uint8_t n, uint8_t level)
     return q;
 #else
     const uint8_t *end = q + n;
+#if QNAV_WORD_WALK
+    for (; end - q >= (ptrdiff_t)WALK_BYTES; q += WALK_BYTES) {
+        const walk_word_t d = walk_diff(q, level);
+        if (d != 0u) {
+            return q + (__builtin_ctzl(d) >> 3); /* the lowest address differs first */
+        }
+    }
+#endif
     while (q != end && *q == level) {
         ++q;
     }
@@ -94,8 +125,18 @@ static inline const uint8_t *same_down(const uint8_t *q, uint8_t n, uint8_t leve
     }
     return q;
 #else
-    uint8_t i;
-    for (i = 0; i < n && q[-1] == level; ++i) {
+    uint8_t i = 0;
+#if QNAV_WORD_WALK
+    for (; (uint8_t)(n - i) >= WALK_BYTES; i = (uint8_t)(i + WALK_BYTES)) {
+        const walk_word_t d = walk_diff(q - WALK_BYTES, level);
+        if (d != 0u) {
+            /* the highest address below q that differs is the word's top differing byte */
+            return q - (__builtin_clzl(d) >> 3);
+        }
+        q -= WALK_BYTES;
+    }
+#endif
+    for (; i < n && q[-1] == level; ++i) {
         --q;
     }
     return q;
