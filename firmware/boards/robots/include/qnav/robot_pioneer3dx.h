@@ -23,7 +23,7 @@
         .ctrl.max_range_mm = 5000, \
         .ctrl.full_speed_quality = 29491, \
         .ctrl.body_radius_mm = 260, \
-        .ctrl.safety_mm = 50, \
+        .ctrl.safety_mm = 20, \
         .ctrl.sensor_offset_mm = 260, \
         .ctrl.v_max_mm_s = 1000, \
         .ctrl.decel_mm_s2 = 600, \
