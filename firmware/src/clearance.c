@@ -118,7 +118,7 @@ static uint8_t reading_gamma(const qnav_clearance_t *c, qnav_mm_t range_mm, uint
 {
     uint8_t hi = c->enlarge_deg[level];
     uint8_t lo = c->enlarge_deg[level + 1u];
-    uint32_t need = (uint32_t)c->margin_mm << 15;
+    uint32_t need = (uint32_t)c->pass_margin_mm << 15;
     uint16_t d = (uint16_t)(range_mm + c->sensor_offset_mm); /* 16 x 16 bit products below */
     if (d < range_mm) {
         d = 65535u; /* the sum passed 65535 */
@@ -201,14 +201,16 @@ static qnav_q1_15_t level_cap(const qnav_clearance_t *c, uint8_t level)
 void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
 {
     uint32_t margin = (uint32_t)cfg->body_radius_mm + cfg->safety_mm;
+    uint32_t pass = (uint32_t)cfg->body_radius_mm + cfg->pass_mm;
     uint8_t level;
     c->margin_mm = margin > 65535u ? 65535u : (uint16_t)margin;
+    c->pass_margin_mm = pass > 65535u ? 65535u : (uint16_t)pass;
     c->sensor_offset_mm = cfg->sensor_offset_mm;
     c->v_max_mm_s = cfg->v_max_mm_s;
     c->decel_mm_s2 = cfg->decel_mm_s2;
     c->guard_min_level = qnav_clearance_level_of(c, cfg->range_min_mm);
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
-        c->enlarge_deg[level] = enlarge_deg(margin, level_distance_mm(c, level));
+        c->enlarge_deg[level] = enlarge_deg(pass, level_distance_mm(c, level));
     }
     /* where the cap leaves 0, and from where on it is full speed (level L - 1 always is) */
     c->guard_from_level = 0;

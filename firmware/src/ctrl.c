@@ -25,6 +25,7 @@ void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg)
     cfg->full_speed_quality = 29491; /* 0.9 in Q1.15 */
     cfg->body_radius_mm = 120u;
     cfg->safety_mm = 50u;
+    cfg->pass_mm = 50u;
     cfg->sensor_offset_mm = 120u;
     cfg->v_max_mm_s = 500u;
     cfg->decel_mm_s2 = 2000u;
@@ -45,6 +46,7 @@ void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg)
     }
     cfg->body_radius_mm = 0u;
     cfg->safety_mm = 0u;
+    cfg->pass_mm = 0u;
     cfg->decel_mm_s2 = 0u;
     cfg->rank = (uint8_t)QNAV_RANK_QUALITY;
     cfg->wedge_pct = 100u;

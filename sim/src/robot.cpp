@@ -117,7 +117,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
     if (root.get("map")) {
         const toml::table &mp = r.table(root, "map");
         r.only_keys(mp, {"cell_m", "reach_m", "look_m", "plan_s", "near_m", "near_cost", "arc_pct", "sight", "escape_grow",
-                         "refuse_s", "refuse_life_s"});
+                         "refuse_s", "refuse_life_s", "pass_m"});
         p.map_cell_m = r.number(mp, "cell_m", 0.02, 1.0);
         p.map_reach_m = r.number(mp, "reach_m", 0.1, 65.0, true, p.map_reach_m);
         p.map_look_m = r.number(mp, "look_m", 0.0, 65.0, true, p.map_look_m);
@@ -129,6 +129,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         if (mp.get("escape_grow")) p.map_escape_grow = r.integer(mp, "escape_grow", 0, 1) != 0;
         p.map_refuse_s = r.number(mp, "refuse_s", 0.0, 25.5, true, p.map_refuse_s);
         p.map_refuse_life_s = r.number(mp, "refuse_life_s", 0.1, 6553.5, true, p.map_refuse_life_s);
+        p.map_pass_m = r.number(mp, "pass_m", 0.0, 10.0, true, p.map_pass_m);
     }
 
     const toml::table &rec = r.table(root, "recovery");

@@ -9,6 +9,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 #include <cmocka.h>
 #include <math.h>
 
@@ -135,7 +136,7 @@ static uint8_t ref_enlarge(uint32_t margin_mm, uint32_t d_mm)
  * at a time while the reading's own distance still allows it. */
 static uint8_t ref_reading_gamma(const qnav_ctrl_config_t *cfg, qnav_mm_t range_mm)
 {
-    uint32_t margin = (uint32_t)cfg->body_radius_mm + cfg->safety_mm;
+    uint32_t margin = (uint32_t)cfg->body_radius_mm + cfg->pass_mm;
     uint32_t floor_d = ref_floor(cfg->max_range_mm, ref_level(cfg->max_range_mm, range_mm)) +
                        cfg->sensor_offset_mm;
     uint32_t d = (uint32_t)range_mm + cfg->sensor_offset_mm;
@@ -310,7 +311,8 @@ static void test_reading_gamma_equals_the_walk_for_every_range(void **state)
                 cfg.n_sectors = QNAV_MAX_SECTORS;
                 cfg.max_range_mm = max_mm[m];
                 cfg.body_radius_mm = body_mm[b];
-                cfg.safety_mm = (uint16_t)(body_mm[b] / 4u);
+                cfg.pass_mm = (uint16_t)(body_mm[b] / 4u);
+                cfg.safety_mm = (uint16_t)(body_mm[b] / 2u); /* the guard's, not gamma's */
                 cfg.sensor_offset_mm = offset_mm[o];
                 assert_int_equal(qnav_clearance_setup(&c, &cfg), QNAV_OK);
                 for (uint16_t i = 0; i < QNAV_MAX_SECTORS; ++i) {
@@ -339,6 +341,49 @@ static void test_reading_gamma_equals_the_walk_for_every_range(void **state)
     }
 }
 
+/* The two distances do one job each: pass_mm alone decides the enlargement (what a reading
+ * paints), safety_mm alone what the speed guard leaves to stop in (a TekBot with a map:
+ * safety 50 mm, pass 10 mm; docs/architecture.md, "Passing distance"). */
+static void test_pass_sets_the_enlargement_and_safety_the_guard(void **state)
+{
+    static const qnav_mm_t reading_mm[] = {150, 330, 480, 700, 1200, 2400};
+    static qnav_mm_t ranges[16];
+    uint8_t lvl_a[QNAV_PATHS], lvl_b[QNAV_PATHS], lvl_c[QNAV_PATHS];
+    qnav_clearance_t a, b, c; /* a: safety 50, pass 10; b: both 10; c: both 50 */
+    qnav_ctrl_config_t cfg;
+    unsigned wider = 0, slower = 0;
+    (void)state;
+    qnav_ctrl_config_default(&cfg);
+    cfg.max_range_mm = 2500u;
+    cfg.range_min_mm = 30u;
+    cfg.pass_mm = 10u;
+    assert_int_equal(qnav_clearance_setup(&a, &cfg), QNAV_OK);
+    cfg.safety_mm = 10u;
+    assert_int_equal(qnav_clearance_setup(&b, &cfg), QNAV_OK);
+    cfg.safety_mm = 50u;
+    cfg.pass_mm = 50u;
+    assert_int_equal(qnav_clearance_setup(&c, &cfg), QNAV_OK);
+    for (size_t i = 0; i < COUNT(reading_mm); ++i) {
+        for (uint16_t k = 0; k < 16u; ++k) {
+            ranges[k] = 2500u;
+        }
+        ranges[1] = reading_mm[i];
+        qnav_clearance_levels(&a, ranges, 16u, lvl_a);
+        qnav_clearance_levels(&b, ranges, 16u, lvl_b);
+        qnav_clearance_levels(&c, ranges, 16u, lvl_c);
+        assert_memory_equal(lvl_a, lvl_b, QNAV_PATHS);
+        wider += memcmp(lvl_a, lvl_c, QNAV_PATHS) != 0;
+    }
+    for (uint8_t level = 0; level < QNAV_DIST_LEVELS; ++level) {
+        assert_int_equal(qnav_clearance_speed_cap(&a, level), qnav_clearance_speed_cap(&c, level));
+        slower += qnav_clearance_speed_cap(&a, level) != qnav_clearance_speed_cap(&b, level);
+    }
+    assert_true(wider > 0u);  /* pass 50 paints more than pass 10 */
+    if (QNAV_DIST_LEVELS >= 16u) { /* two levels: no level lies between the two caps */
+        assert_true(slower > 0u);  /* safety 50 caps where safety 10 does not */
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -346,6 +391,7 @@ int main(void)
         cmocka_unit_test(test_speed_cap_equals_the_computation_for_every_level),
         cmocka_unit_test(test_speed_cap_is_zero_at_the_level_of_the_minimum_range),
         cmocka_unit_test(test_reading_gamma_equals_the_walk_for_every_range),
+        cmocka_unit_test(test_pass_sets_the_enlargement_and_safety_the_guard),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -89,10 +89,17 @@ typedef struct {
     qnav_q1_15_t full_speed_quality;  /* quality giving full speed (F is linear through 0),
                                          Q1.15 in (0, 1); default 0.9 */
     qnav_mm_t body_radius_mm;         /* robot radius r (centre to the farthest point of the
-                                         body), mm; with safety_mm the obstacle enlargement
-                                         asin((r + d_s) / D); both 0: the paper's per-sector
-                                         mapping. Default 120 (TekBot class) */
-    qnav_mm_t safety_mm;              /* safety distance d_s added to r, mm; default 50 */
+                                         body), mm; with pass_mm the obstacle enlargement
+                                         asin((r + pass_mm) / D); both 0: the paper's
+                                         per-sector mapping. Default 120 (TekBot class) */
+    qnav_mm_t safety_mm;              /* safety distance d_s the robot keeps, added to r, mm:
+                                         the speed guard stops d_s short of an obstacle, the
+                                         escape's and the map's distances keep it; default 50 */
+    qnav_mm_t pass_mm;                /* passing distance added to r in the enlargement, mm:
+                                         a path passes a reading's placed arc by at least r +
+                                         pass_mm. Below safety_mm a robot passes narrower gaps
+                                         and still brakes d_s short (docs/architecture.md,
+                                         "Passing distance"); default 50 */
     qnav_mm_t sensor_offset_mm;       /* robot centre to where ranges are measured from, mm
                                          (transducers on the body's rim: r); D = range +
                                          offset. Default 120 */
@@ -278,7 +285,8 @@ typedef struct {
     uint8_t esc_stall_ticks;          /* escape: ticks without progress; 0: off */
     uint8_t esc_free_level;           /* escape: lowest level of a free path */
     uint16_t esc_follow_ticks;        /* escape: first follow's length, ticks */
-    uint16_t margin_mm;               /* body radius + safety distance (speed guard) */
+    uint16_t margin_mm;               /* body radius + safety distance (speed guard, escape) */
+    uint16_t pass_margin_mm;          /* body radius + passing distance (enlargement) */
     qnav_mm_t sensor_offset_mm;
     uint16_t v_max_mm_s;
     uint16_t decel_mm_s2;

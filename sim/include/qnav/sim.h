@@ -198,7 +198,8 @@ void qnav_sim_ctrl_config(const qnav_sim_t *sim, qnav_ctrl_config_t *cfg);
  * default_sectors): the one mapping from a profile to libqnav, used by the simulator, the
  * board header generator (qnav-sim robot-header) and navbridge --robot. Sets n_sectors,
  * max_range_mm ([sonar] range_max_m), body_radius_mm ([body] radius_m), safety_mm
- * ([clearance] safety_m), sensor_offset_mm ([sonar] offset_m), range_min_mm ([sonar]
+ * ([clearance] safety_m), pass_mm ([map] pass_m when the profile has a map that gives it,
+ * else safety_m), sensor_offset_mm ([sonar] offset_m), range_min_mm ([sonar]
  * range_min_m), v_max_mm_s ([drive] v_max_mps), decel_mm_s2 ([drive] decel_mps2, 0 with
  * [clearance] speed_guard = false);
  * every other field is qnav_ctrl_config_default()'s (docs/sim.md, "One robot

@@ -35,6 +35,7 @@
         .ctrl.escape_follow_s = 20, \
         .ctrl.keep_pct = 25, \
         .ctrl.range_min_mm = 100, \
+        .ctrl.pass_mm = 20, \
         .tick_ms = 100, \
         .track_mm = 330, \
         .um_per_count = 485, \

@@ -35,6 +35,7 @@
         .ctrl.escape_follow_s = 20, \
         .ctrl.keep_pct = 15, \
         .ctrl.range_min_mm = 30, \
+        .ctrl.pass_mm = 50, \
         .tick_ms = 100, \
         .track_mm = 180, \
         .um_per_count = 6872, \
