@@ -151,6 +151,41 @@ void test_bad_odometry_settings_are_refused_by_field(void **) {
     assert_non_null(std::strstr(err, "bad.toml"));
 }
 
+// The controller configuration a profile gives (qnav_sim_robot_ctrl_config, the one mapping
+// the simulator, the board headers and navbridge use); fails the test on a parse error.
+qnav_ctrl_config_t profile_config(const std::string &profile) {
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_robot_t *robot = nullptr;
+    if (qnav_sim_robot_parse(profile.data(), profile.size(), "p.toml", &robot, err, sizeof err) != QNAV_SIM_OK)
+        fail_with("robot", err);
+    qnav_ctrl_config_t cc;
+    qnav_sim_robot_ctrl_config(robot, 0, &cc);
+    qnav_sim_robot_free(robot);
+    return cc;
+}
+
+// [map] pass_m is the controller's passing distance while a map guides it; without it, or
+// without a map, the passing distance is the safety distance (docs/architecture.md,
+// "Passing distance"). A bad value is refused naming the key.
+void test_a_maps_passing_distance_reaches_the_controller(void **) {
+    const qnav_ctrl_config_t plain = profile_config(tekbot_with(""));
+    const qnav_ctrl_config_t map = profile_config(tekbot_with("[map]\ncell_m = 0.1\n"));
+    const qnav_ctrl_config_t pass = profile_config(tekbot_with("[map]\ncell_m = 0.1\npass_m = 0.01\n"));
+    assert_int_equal(plain.safety_mm, 50);
+    assert_int_equal(plain.pass_mm, plain.safety_mm);
+    assert_int_equal(map.pass_mm, map.safety_mm);
+    assert_int_equal(pass.pass_mm, 10);
+    assert_int_equal(pass.safety_mm, 50);
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_robot_t *robot = nullptr;
+    const std::string bad = tekbot_with("[map]\ncell_m = 0.1\npass_m = -0.01\n");
+    assert_int_not_equal(qnav_sim_robot_parse(bad.data(), bad.size(), "bad.toml", &robot, err, sizeof err),
+                         QNAV_SIM_OK);
+    assert_null(robot);
+    print_message("%s\n", err);
+    assert_non_null(std::strstr(err, "pass_m"));
+}
+
 }  // namespace
 
 int main() {
@@ -159,6 +194,7 @@ int main() {
         cmocka_unit_test(test_the_step_api_carries_what_the_map_did_to_the_escape),
         cmocka_unit_test(test_odometry_errors_move_the_maps_pose_only_when_drawn),
         cmocka_unit_test(test_bad_odometry_settings_are_refused_by_field),
+        cmocka_unit_test(test_a_maps_passing_distance_reaches_the_controller),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
