@@ -129,7 +129,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         if (mp.get("escape_grow")) p.map_escape_grow = r.integer(mp, "escape_grow", 0, 1) != 0;
         p.map_refuse_s = r.number(mp, "refuse_s", 0.0, 25.5, true, p.map_refuse_s);
         p.map_refuse_life_s = r.number(mp, "refuse_life_s", 0.1, 6553.5, true, p.map_refuse_life_s);
-        p.map_pass_m = r.number(mp, "pass_m", 0.0, 10.0, true, p.map_pass_m);
+        if (mp.get("pass_m")) p.map_pass_m = r.number(mp, "pass_m", 0.0, 10.0);
     }
 
     const toml::table &rec = r.table(root, "recovery");

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -66,9 +67,9 @@ struct RobotProfile {
     bool map_escape_grow = true;    // a longer plan grows the escape's distances with it
     double map_refuse_s = 3.0;      // no progress along the plan this long: its next cells refused
     double map_refuse_life_s = 20.0;  // for this long
-    double map_pass_m = -1.0;       // the controller's passing distance (the enlargement's,
-                                    // qnav_ctrl_config_t.pass_mm) when the map guides it, m;
-                                    // < 0: safety_m, as without a map
+    std::optional<double> map_pass_m;  // the controller's passing distance (the enlargement's,
+                                       // qnav_ctrl_config_t.pass_mm) when the map guides it,
+                                       // m; none: safety_m, as without a map
     // the odometry's errors, drawn once an episode with these standard deviations (all 0:
     // the map's pose is the true one): distance scale (wheel diameter), rotation scale
     // (wheel track), a curve (unequal wheels: heading error per metre driven)

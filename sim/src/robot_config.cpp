@@ -21,7 +21,7 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->safety_mm = to_mm(p.safety_m);
     // a map's plan keeps the robot the safety distance off what it has seen, so the
     // controller may pass readings nearer (docs/architecture.md, "Passing distance")
-    cfg->pass_mm = to_mm(p.map_cell_m > 0.0 && p.map_pass_m >= 0.0 ? p.map_pass_m : p.safety_m);
+    cfg->pass_mm = to_mm(p.map_cell_m > 0.0 ? p.map_pass_m.value_or(p.safety_m) : p.safety_m);
     cfg->sensor_offset_mm = to_mm(p.sonar_offset_m);
     cfg->range_min_mm = to_mm(p.range_min_m);
     cfg->v_max_mm_s = to_mm(p.v_max_mps);
