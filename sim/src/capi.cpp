@@ -76,6 +76,13 @@ std::string resolve_data_spec(const char *spec, const char *kind) {
     if (is_path) return s;
     return qnav::resource_dir("QNAV_DATA_DIR", "data", QNAV_SIM_DATA_DIR) + "/" + kind + "/" + s + ".toml";
 }
+
+bool robot_spec_with_map(const std::string &spec, std::string *base) {
+    static const std::string kMap = "+map";
+    if (spec.size() <= kMap.size() || spec.compare(spec.size() - kMap.size(), kMap.size(), kMap) != 0) return false;
+    *base = spec.substr(0, spec.size() - kMap.size());
+    return true;
+}
 }  // namespace qnav
 
 extern "C" {
@@ -97,7 +104,22 @@ qnav_sim_status_t qnav_sim_robot_parse(const char *text, size_t len, const char 
 
 qnav_sim_status_t qnav_sim_robot_load(const char *spec, qnav_sim_robot_t **out, char *err,
                                       size_t errlen) {
-    return load_spec(spec, "robots", "robot", qnav_sim_robot_parse, out, err, errlen);
+    // NAME+map: the profile with its [map] (written with on = false) switched on
+    std::string base;
+    if (!spec || !qnav::robot_spec_with_map(spec, &base))
+        return load_spec(spec, "robots", "robot", qnav_sim_robot_parse, out, err, errlen);
+    const qnav_sim_status_t st = load_spec(base.c_str(), "robots", "robot", qnav_sim_robot_parse, out, err, errlen);
+    if (st != QNAV_SIM_OK) return st;
+    qnav::RobotProfile &p = (*out)->profile;
+    if (p.map_cell_m <= 0.0 && p.map_off_cell_m <= 0.0) {
+        qnav_sim_robot_free(*out);
+        *out = nullptr;
+        put_err(err, errlen, std::string("robot '") + spec + "': " + qnav::resolve_data_spec(base.c_str(), "robots") +
+                                 " has no [map] section to switch on");
+        return QNAV_SIM_E_PARSE;
+    }
+    if (p.map_cell_m <= 0.0) p.map_cell_m = p.map_off_cell_m;
+    return QNAV_SIM_OK;
 }
 
 void qnav_sim_robot_free(qnav_sim_robot_t *robot) { delete robot; }

@@ -116,9 +116,18 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
 
     if (root.get("map")) {
         const toml::table &mp = r.table(root, "map");
-        r.only_keys(mp, {"cell_m", "reach_m", "look_m", "plan_s", "near_m", "near_cost", "arc_pct", "sight", "escape_grow",
-                         "refuse_s", "refuse_life_s", "pass_m"});
+        r.only_keys(mp, {"on", "cell_m", "reach_m", "look_m", "plan_s", "near_m", "near_cost", "arc_pct", "sight",
+                         "escape_grow", "refuse_s", "refuse_life_s", "pass_m"});
+        bool on = true;
+        if (const toml::node *o = mp.get("on")) {
+            if (!o->is_boolean()) r.fail(*o, "'on' must be true or false");
+            on = o->value_or(true);
+        }
         p.map_cell_m = r.number(mp, "cell_m", 0.02, 1.0);
+        if (!on) {  // described for a board that has the RAM, switched on by NAME+map
+            p.map_off_cell_m = p.map_cell_m;
+            p.map_cell_m = 0.0;
+        }
         p.map_reach_m = r.number(mp, "reach_m", 0.1, 65.0, true, p.map_reach_m);
         p.map_look_m = r.number(mp, "look_m", 0.0, 65.0, true, p.map_look_m);
         p.map_plan_s = r.number(mp, "plan_s", 0.1, 25.5, true, p.map_plan_s);

@@ -57,6 +57,7 @@ struct RobotProfile {
     // the map and its plan above the controller (libqnav qnav/map.h; docs/architecture.md,
     // "A map and a plan"); map_cell_m 0: none
     double map_cell_m = 0.0;        // cell side, m
+    double map_off_cell_m = 0.0;    // [map] on = false: the cell side NAME+map switches on
     double map_reach_m = 2.0;       // readings mark cells out to this distance, m
     double map_look_m = 1.0;        // the sub-goal lies this far along the plan, m
     double map_plan_s = 1.0;        // time between plans, s

@@ -299,13 +299,18 @@ static int wall_gap_trial(const char *prof, const char *ep, const char *mode, co
     return status;
 }
 
-/* The TekBot's profile with a [map] of cell_m cells, written to path. */
+/* The TekBot's profile with a [map] of cell_m cells (in place of its own, which is off and
+ * last), written to path. */
 static void tekbot_with_map(const char *path, const char *cell_m)
 {
     static char profile[16384];
     FILE *f;
+    char *own;
     int n = read_text(QNAV_DATA_DIR "/robots/tekbot.toml", profile, (int)sizeof profile);
     assert_true(n > 0 && n < (int)sizeof profile - 1);
+    own = strstr(profile, "\n[map]");
+    assert_non_null(own);
+    own[1] = '\0';
     f = fopen(path, "w");
     assert_non_null(f);
     fprintf(f, "%s\n[map]\ncell_m = %s\n", profile, cell_m);

@@ -117,7 +117,8 @@ class SteppedEpisodeEqualsQnavSimRun(unittest.TestCase):
         # come with each observation)
         map_profile = os.path.join(self.work, "tekbot-map.toml")
         with open(os.path.join(SRC, "data", "robots", "tekbot.toml")) as f, open(map_profile, "w") as out:
-            out.write(f.read() + "\n[map]\ncell_m = 0.1\n")
+            # the profile's own [map] (off, its last section) replaced by one that is on
+            out.write(f.read().split("\n[map]")[0] + "\n\n[map]\ncell_m = 0.1\n")
         cases = [("vfh", "dense", "pioneer3dx", 4, 0), ("body", "gen:pocket:2", "tekbot", 6, 3),
                  ("body", "gen:rooms:3000038:0.5:tekbot", map_profile, 1, 0)]
         verdicts = 0

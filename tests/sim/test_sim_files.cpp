@@ -352,9 +352,11 @@ static void test_the_picture_draws_the_maps_cells(void **state) {
     assert_non_null(mkdtemp(dir));
     const std::string svg = std::string(dir) + "/ep.svg", robot = std::string(dir) + "/tekbot-map.toml";
     const std::string profile = read_text_file(std::string(QNAV_TEST_DATA_DIR) + "/robots/tekbot.toml");
+    const std::size_t off = profile.find("\n[map]");  // the profile's own [map] (off, last) replaced
+    assert_true(off != std::string::npos);
     std::FILE *f = std::fopen(robot.c_str(), "w");
     assert_non_null(f);
-    std::fputs((profile + "\n[map]\ncell_m = 0.1\n").c_str(), f);
+    std::fputs((profile.substr(0, off + 1) + "\n[map]\ncell_m = 0.1\n").c_str(), f);
     std::fclose(f);
     const std::string rest = " --env " + std::string(QNAV_TEST_DATA_DIR) +
                              "/envs/dense.toml --sectors 16 --sensor-noise 0 --actuation-noise 0 --svg " + svg +

@@ -5,6 +5,11 @@
 #include "sim_test_util.hpp"
 
 #include "qnav/ctrl.h"
+#include "qnav/map.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
 
 namespace {
 
@@ -19,6 +24,9 @@ const char *const kWall =
 // The TekBot's profile with extra appended and odometry keys added to its [odometry].
 std::string tekbot_with(const std::string &extra, const std::string &odometry = "") {
     std::string text = read_text_file(std::string(QNAV_TEST_DATA_DIR) + "/robots/tekbot.toml");
+    const std::size_t map = text.find("\n[map]");  // the profile's own (off, last): extra replaces it
+    assert_true(map != std::string::npos);
+    text.erase(map + 1);
     const std::size_t at = text.find('\n', text.find("um_per_count", text.find("[odometry]")));
     assert_true(at != std::string::npos);
     return text.insert(at + 1, odometry) + "\n" + extra;
@@ -184,6 +192,55 @@ void test_a_maps_passing_distance_reaches_the_controller(void **) {
     assert_true(refusal(tekbot_with("[map]\ncell_m = 0.1\npass_m = -0.01\n")).find("pass_m") != std::string::npos);
 }
 
+// A loaded robot spec's map configuration: 1 and cfg when its map is on, 0 when off; the
+// test fails if the spec does not load.
+int loaded_map(const char *spec, qnav_map_config_t *cfg, qnav_ctrl_config_t *cc) {
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_robot_t *robot = nullptr;
+    if (qnav_sim_robot_load(spec, &robot, err, sizeof err) != QNAV_SIM_OK) fail_with(spec, err);
+    const int on = qnav_sim_robot_map_config(robot, cfg);
+    qnav_sim_robot_ctrl_config(robot, 0, cc);
+    qnav_sim_robot_free(robot);
+    return on;
+}
+
+// The committed profiles describe each robot's map with on = false (their boards have no
+// RAM for it, and every figure without a map stays as measured); NAME+map switches it on,
+// as written, and nothing else. A profile with no [map] has nothing to switch on: refused
+// naming the file. 'on' takes only true or false.
+void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
+    for (const char *robot : {"tekbot", "pioneer3dx"}) {
+        qnav_map_config_t off, on;
+        qnav_ctrl_config_t plain, with;
+        assert_int_equal(loaded_map(robot, &off, &plain), 0);
+        assert_int_equal(loaded_map((std::string(robot) + "+map").c_str(), &on, &with), 1);
+        assert_int_equal(on.cell_mm, 100);
+        assert_int_equal(with.safety_mm, plain.safety_mm);
+        assert_int_equal(with.n_sectors, plain.n_sectors);
+        assert_int_equal(with.max_range_mm, plain.max_range_mm);
+        assert_int_equal(on.reach_mm, std::string(robot) == "pioneer3dx" ? 3000 : 2000);
+        assert_int_equal(with.pass_mm, std::string(robot) == "tekbot" ? 10 : plain.safety_mm);
+        assert_int_equal(plain.pass_mm, plain.safety_mm);
+    }
+    char dir[] = "/tmp/qnav_map_test_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    const std::string file = std::string(dir) + "/nomap.toml";
+    std::FILE *f = std::fopen(file.c_str(), "w");
+    assert_non_null(f);
+    std::fputs(tekbot_with("").c_str(), f);
+    assert_int_equal(std::fclose(f), 0);
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_robot_t *robot = nullptr;
+    assert_int_not_equal(qnav_sim_robot_load((file + "+map").c_str(), &robot, err, sizeof err), QNAV_SIM_OK);
+    assert_null(robot);
+    print_message("%s\n", err);
+    assert_true(std::string(err).find(file + " has no [map]") != std::string::npos);
+    assert_int_equal(std::remove(file.c_str()), 0);
+    assert_int_equal(rmdir(dir), 0);
+    assert_true(refusal(tekbot_with("[map]\non = 1\ncell_m = 0.1\n")).find("'on' must be true or false") !=
+                std::string::npos);
+}
+
 }  // namespace
 
 int main() {
@@ -193,6 +250,7 @@ int main() {
         cmocka_unit_test(test_odometry_errors_move_the_maps_pose_only_when_drawn),
         cmocka_unit_test(test_bad_odometry_settings_are_refused_by_field),
         cmocka_unit_test(test_a_maps_passing_distance_reaches_the_controller),
+        cmocka_unit_test(test_name_plus_map_switches_on_the_profiles_own_map),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
