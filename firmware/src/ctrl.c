@@ -462,9 +462,14 @@ uint8_t qnav_ctrl_path_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges_m
 
 /*
  * Holding the heading (keep_pct): the path on the previous tick's heading replaces the best
- * while its quality is at least (100 - keep_pct) % of the best's. Keys are qualities here
- * (QNAV_RANK_QUALITY), so the margin is a fraction of a probability; the step calls it only
- * while going to the destination (a follow's skirt bearing comes from the boundary).
+ * while its key is near the best's. Quality keys (QNAV_RANK_QUALITY): at least
+ * (100 - keep_pct) % of the best's quality. Pre-activation keys (QNAV_RANK_PREACT, a
+ * 2-input network): at most keep_pct hundredths of z below the best's (keep_pct * 2048 / 100
+ * key steps: Q5.11 below |z| 8), and z above 0 (quality above one half). A network's quality
+ * is flat near 1 over much of its grid, so a margin in quality would hold nearly any
+ * heading; one in z holds between near equals (docs/architecture.md, "Holding the
+ * heading"). The step calls it only while going to the destination (a follow's skirt
+ * bearing comes from the boundary).
  */
 static inline void keep_heading(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uint16_t goal,
                          uint16_t prev, qnav_best_t *best)
@@ -474,7 +479,9 @@ static inline void keep_heading(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uin
     if (key <= 0) {
         return; /* no way that way */
     }
-    if ((uint32_t)key * 100u >= (uint32_t)best->key * (uint32_t)(100u - ctrl->keep_pct)) {
+    if (ctrl->rank == (uint8_t)QNAV_RANK_PREACT
+            ? (int32_t)key >= (int32_t)best->key - (int32_t)ctrl->keep_pct * 2048 / 100
+            : (uint32_t)key * 100u >= (uint32_t)best->key * (uint32_t)(100u - ctrl->keep_pct)) {
         best->key = key;
         best->dtheta = dtheta;
         best->heading = qnav_signed_deg(prev);
@@ -491,7 +498,7 @@ static inline void decide(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uint16_t 
     uint32_t speed;
     qnav_q1_15_t quality;
     qnav_q1_15_t cap;
-    if (ctrl->keep_pct != 0u && ctrl->rank == (uint8_t)QNAV_RANK_QUALITY && out->escape.side == 0) {
+    if (ctrl->keep_pct != 0u && out->escape.side == 0 && ctrl->inputs != QNAV_NET_INPUTS_PREV) {
         keep_heading(ctrl, lvl, goal, prev, best);
     }
     quality = key_quality(ctrl, best->key);

@@ -23,12 +23,18 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-static void random_net(qnav_policy_t *p, uint8_t hidden, int32_t max_raw)
+/* Every weight of the network p already holds, drawn uniformly in [-max_raw, max_raw]. */
+static void random_net_weights(qnav_policy_t *p, int32_t max_raw)
 {
-    qnav_policy_net_zero(p, hidden);
     for (uint16_t k = 0; k < qnav_net_weight_count(&p->u.net); ++k) {
         *qnav_net_weight(&p->u.net, k) = (qnav_q8_8_t)rng_range(-max_raw, max_raw);
     }
+}
+
+static void random_net(qnav_policy_t *p, uint8_t hidden, int32_t max_raw)
+{
+    qnav_policy_net_zero(p, hidden);
+    random_net_weights(p, max_raw);
 }
 
 static void random_scan(qnav_mm_t *ranges, uint16_t n, qnav_mm_t max_mm)
@@ -311,21 +317,47 @@ static void test_holding_keeps_the_previous_of_two_equal_ways(void **state)
     assert_int_equal(heading_with_prev(&c, ranges, -9000), -90);
 }
 
-static void test_holding_leaves_preactivation_keys_alone(void **state)
+/* Pre-activation keys (a 2-input network) are held in z: the previous heading's path
+ * replaces the best when its key is at most keep_pct hundredths of z (keep_pct * 2048 / 100
+ * key steps) below the best's and above 0; a 3-input network is never held. */
+static void test_holding_preactivation_keys_within_a_margin_of_z(void **state)
 {
     (void)state;
     qnav_ctrl_t off;
     qnav_ctrl_t on;
     qnav_policy_t p;
-    qnav_mm_t ranges[32];
-    for (int k = 0; k < 200; ++k) {
+    qnav_mm_t ranges[16];
+    uint8_t lvl[QNAV_PATHS];
+    int held = 0;
+    int not_held = 0;
+    for (int k = 0; k < 400; ++k) {
         random_net(&p, 12, 1024);
         random_scan(ranges, 16, 5000);
         init_keep(&off, 0, QNAV_RANK_PREACT, &p);
-        init_keep(&on, 50, QNAV_RANK_PREACT, &p);
-        qnav_cdeg_t prev = (qnav_cdeg_t)rng_range(-17999, 18000);
-        assert_int_equal(heading_with_prev(&on, ranges, prev), heading_with_prev(&off, ranges, prev));
+        init_keep(&on, 15, QNAV_RANK_PREACT, &p);
+        int prev = (int)rng_range(-179, 180);
+        qnav_deg_t h_off = heading_with_prev(&off, ranges, (qnav_cdeg_t)(prev * 100));
+        qnav_deg_t h_on = heading_with_prev(&on, ranges, (qnav_cdeg_t)(prev * 100));
+        (void)qnav_ctrl_path_levels(&on, ranges, lvl);
+        qnav_qkey_t kp = qnav_ctrl_key(&on, lvl[(prev + 360) % 360], (uint8_t)(prev < 0 ? -prev : prev));
+        qnav_qkey_t kb = qnav_ctrl_key(&on, lvl[(h_off + 360) % 360], (uint8_t)(h_off < 0 ? -h_off : h_off));
+        if (kp > 0 && (int32_t)kp >= (int32_t)kb - 15 * 2048 / 100) {
+            assert_int_equal(h_on, prev);
+            held += h_on != h_off;
+        } else {
+            assert_int_equal(h_on, h_off);
+            ++not_held;
+        }
+        qnav_policy_net_zero_inputs(&p, 12, QNAV_NET_INPUTS_PREV);
+        random_net_weights(&p, 1024);
+        init_keep(&off, 0, QNAV_RANK_PREACT, &p);
+        init_keep(&on, 100, QNAV_RANK_PREACT, &p);
+        assert_int_equal(heading_with_prev(&on, ranges, (qnav_cdeg_t)(prev * 100)),
+                         heading_with_prev(&off, ranges, (qnav_cdeg_t)(prev * 100)));
     }
+    print_message("held %d of 400 (a heading other than the best's), not held %d\n", held, not_held);
+    assert_true(held > 20);
+    assert_true(not_held > 20);
 }
 
 static void test_ctrl_prefers_goal_over_far_obstacle(void **state)
@@ -857,7 +889,7 @@ static void test_preactivation_rank_agrees_with_float_network_on_saturated_nets(
     print_message("saturated nets: heading agrees with the float network on %u / %u clear scans "
                   "ranked by pre-activation, %u / %u ranked by quality\n",
                   agree[0], clear, agree[1], clear);
-    assert_true(clear * 3u >= SCANS);
+    assert_true(clear * 4u >= SCANS); /* enough clear scans to judge (about a third are) */
     assert_true(agree[0] * 100u >= clear * 99u);
     assert_true(agree[0] > agree[1]);
 }
@@ -1512,7 +1544,7 @@ int main(void)
         cmocka_unit_test(test_ctrl_drives_at_goal_in_open_space),
         cmocka_unit_test(test_ctrl_turns_away_from_near_obstacle),
         cmocka_unit_test(test_holding_keeps_the_previous_of_two_equal_ways),
-        cmocka_unit_test(test_holding_leaves_preactivation_keys_alone),
+        cmocka_unit_test(test_holding_preactivation_keys_within_a_margin_of_z),
         cmocka_unit_test(test_ctrl_prefers_goal_over_far_obstacle),
         cmocka_unit_test(test_a_wall_beyond_the_destination_does_not_block_the_way_to_it),
         cmocka_unit_test(test_speed_is_linear_in_quality_up_to_full),

@@ -129,13 +129,18 @@ typedef struct {
     uint8_t keep_pct;                 /* holding the heading: the previous tick's heading
                                          (prev_heading_cdeg) is kept, while going to the
                                          destination (not while the escape follows a
-                                         boundary), as long as its quality is at least
-                                         (100 - keep_pct) % of the best path's, so
-                                         two nearly equal ways round an obstacle do not
-                                         alternate tick by tick (docs/architecture.md,
-                                         "Holding the heading"). Applies when keys are
-                                         qualities (QNAV_RANK_QUALITY: the probabilistic
-                                         policy, its tables); 0..100, default 0 (off) */
+                                         boundary), as long as its key is near the
+                                         best path's, so two nearly equal ways round
+                                         an obstacle do not alternate tick by tick
+                                         (docs/architecture.md, "Holding the heading"):
+                                         quality keys (QNAV_RANK_QUALITY: the
+                                         probabilistic policy, its tables) at least
+                                         (100 - keep_pct) % of the best's quality;
+                                         pre-activation keys (QNAV_RANK_PREACT: a
+                                         2-input network, its tables) at most keep_pct
+                                         hundredths of z below the best's, z above 0.
+                                         Not for 3-input networks. 0..100, default 0
+                                         (off) */
     qnav_mm_t range_min_mm;           /* sonar minimum range, mm, below max_range_mm: the
                                          sonar reads this for anything this near or nearer,
                                          so the speed guard takes a distance level that
@@ -312,7 +317,7 @@ typedef struct {
     uint8_t hidden;
     uint8_t inputs;                   /* network inputs, 2 or 3 */
     uint8_t rank;                     /* qnav_rank_t of the keys (table: as given at init) */
-    uint8_t keep_pct;                 /* qnav_ctrl_config_t.keep_pct; 0 under QNAV_RANK_PREACT */
+    uint8_t keep_pct;                 /* qnav_ctrl_config_t.keep_pct */
     uint8_t shapes_carried;           /* 1: init took carried row shapes (not evaluated) */
     qnav_clearance_t clr;             /* levels, enlargement, speed guard */
     uint32_t speed_scale;             /* speed = min(MAX, (quality * scale) >> 15) */
