@@ -428,44 +428,40 @@ static void escape_cost(void)
     PUT(" bytes\n");
 }
 
-/* What holding the heading (docs/architecture.md, "Holding the heading") adds to a step:
- * the probabilistic policy on every 32-sector scan with keep_pct 0 against the TekBot
- * profile's 15 (one key lookup of the previous heading's path, two products). A scan whose
- * step got cheaper counts as 0. */
-static void keep_cost(void)
+/* What holding the heading (docs/architecture.md, "Holding the heading") adds to a step of
+ * policy p (initialised once, keep_pct then set to 0 and to the TekBot profile's 15 for each
+ * 32-sector scan): one key of the previous heading's path (a lookup for the probabilistic
+ * policy, H units' evaluation for a network) and the comparison. A scan whose step got
+ * cheaper counts as 0. */
+static void keep_cost_of(const qnav_policy_t *p, const char *label)
 {
     qnav_mm_t *r = qnav_bench_scratch_ranges();
     qnav_ctrl_t *c = qnav_bench_scratch_ctrl();
-    qnav_policy_t *p = qnav_bench_scratch_policy();
     qnav_ctrl_config_t cfg;
     uint32_t cost[2];
     uint32_t add_max = 0, add_sum = 0;
     uint8_t n = 0;
     uint16_t s;
     uint8_t keep;
-    qnav_policy_prob_default(p);
+    qnav_bench_config(&cfg, 32u);
+    if (qnav_ctrl_init(c, &cfg, p) != QNAV_OK) {
+        PUT("holding: init failed\n");
+        return;
+    }
     for (s = 0; s < qnav_bench_scan_count(); ++s) {
         qnav_ctrl_input_t in = {0};
         qnav_ctrl_output_t out;
         uint8_t type, k;
+        if (qnav_bench_load_scan(s, r, &in.goal_bearing_cdeg, &type, &k) != 32u) {
+            continue;
+        }
+        in.ranges_mm = r;
+        in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
         for (keep = 0; keep < 2u; ++keep) {
-            qnav_bench_config(&cfg, 32u);
-            cfg.keep_pct = (uint8_t)(keep ? 15u : 0u);
-            if (qnav_ctrl_init(c, &cfg, p) != QNAV_OK) {
-                PUT("holding: init failed\n");
-                return;
-            }
-            if (qnav_bench_load_scan(s, r, &in.goal_bearing_cdeg, &type, &k) != 32u) {
-                break;
-            }
-            in.ranges_mm = r;
-            in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
+            c->keep_pct = (uint8_t)(keep ? 15u : 0u);
             timer_start();
             qnav_ctrl_step(c, &in, &out, 0);
             cost[keep] = timer_stop() - overhead;
-        }
-        if (keep < 2u) {
-            continue;
         }
         cost[1] = cost[1] > cost[0] ? cost[1] - cost[0] : 0u;
         add_sum += cost[1];
@@ -474,11 +470,31 @@ static void keep_cost(void)
     }
     PUT("holding the heading (keep_pct 15) on the ");
     qnav_target_put_u32(n);
-    PUT(" 32-sector scans, probabilistic policy: adds mean ");
+    PUT(" 32-sector scans, ");
+    qnav_target_put(label);
+    PUT(": adds mean ");
     put_cycles(add_sum / n);
     PUT(", max ");
     qnav_target_put_u32(add_max);
     PUT(" cycles\n");
+}
+
+/* The hold's cost for the probabilistic policy and the first evolved H = 12 network. */
+static void keep_cost(void)
+{
+    qnav_policy_t *p = qnav_bench_scratch_policy();
+    char id[QNAV_BENCH_ID_LEN];
+    uint8_t i = 0;
+    qnav_policy_prob_default(p);
+    keep_cost_of(p, "probabilistic policy");
+    while (i < qnav_bench_policy_count() &&
+           (qnav_bench_load_policy(i, p, id) != QNAV_BENCH_SET_EVOLVED ||
+            p->kind != QNAV_POLICY_NET || p->u.net.hidden != 12u)) {
+        ++i;
+    }
+    if (i < qnav_bench_policy_count()) {
+        keep_cost_of(p, "evolved network (H = 12)");
+    }
 }
 
 /* VFH+ (qnav/vfh.h), the second controller, on every 32-sector scan through its own step
