@@ -465,7 +465,7 @@ uint8_t qnav_ctrl_path_levels(const qnav_ctrl_t *ctrl, const qnav_mm_t *ranges_m
  * while its key is near the best's. Quality keys (QNAV_RANK_QUALITY): at least
  * (100 - keep_pct) % of the best's quality. Pre-activation keys (QNAV_RANK_PREACT, a
  * 2-input network): at most keep_pct hundredths of z below the best's (keep_pct * 2048 / 100
- * key steps: Q5.11 below |z| 8), and z above 0 (quality above one half). A network's quality
+ * key steps, written 512 / 25 so that the ATmega128 divides 16-bit: Q5.11 below |z| 8), and z above 0 (quality above one half). A network's quality
  * is flat near 1 over much of its grid, so a margin in quality would hold nearly any
  * heading; one in z holds between near equals (docs/architecture.md, "Holding the
  * heading"). The step calls it only while going to the destination (a follow's skirt
@@ -480,7 +480,7 @@ static inline void keep_heading(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uin
         return; /* no way that way */
     }
     if (ctrl->rank == (uint8_t)QNAV_RANK_PREACT
-            ? (int32_t)key >= (int32_t)best->key - (int32_t)ctrl->keep_pct * 2048 / 100
+            ? (int32_t)key >= (int32_t)best->key - (int32_t)(uint16_t)(ctrl->keep_pct * 512u / 25u)
             : (uint32_t)key * 100u >= (uint32_t)best->key * (uint32_t)(100u - ctrl->keep_pct)) {
         best->key = key;
         best->dtheta = dtheta;
