@@ -1,6 +1,6 @@
 """tools/fit-network against the built qnavpy: the network it writes gives, through libqnav,
 the robot's probabilistic policy's quality over every (level, dtheta) to within a few
-thousandths, and ranks the paths of a row as the probabilistic policy does; it never
+thousandths, and a clear row still prefers the smallest turn; it never
 overwrites a file, and a bad robot or hidden count is one line and a non-zero exit."""
 import os
 import subprocess
