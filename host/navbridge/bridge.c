@@ -456,6 +456,7 @@ static int on_board_heartbeat(qnav_bridge_t *b, const qnav_link_frame_t *f)
 {
     qnav_link_heartbeat_t hb;
     uint8_t stored;
+    uint8_t table;
     if (qnav_link_heartbeat_unpack(f->payload, f->len, &hb) != QNAV_LINK_OK) {
         return 0;
     }
@@ -465,14 +466,17 @@ static int on_board_heartbeat(qnav_bridge_t *b, const qnav_link_frame_t *f)
     }
     b->board_hb = hb;
     stored = (uint8_t)((hb.state & QNAV_LINK_STATE_STORED) != 0u);
-    if (b->diag != NULL &&
-        (!b->heard_board || stored != b->board_stored || hb.policy_crc != b->board_crc_reported)) {
+    table = (uint8_t)((hb.state & QNAV_LINK_STATE_TABLE) != 0u);
+    if (b->diag != NULL && (!b->heard_board || stored != b->board_stored ||
+                            hb.policy_crc != b->board_crc_reported || table != b->board_table)) {
         fprintf(b->diag, "navbridge: board speaks link protocol %u and runs its %s policy "
-                         "(crc 0x%04x)\n", (unsigned)hb.protocol,
-                stored ? "uploaded" : "built-in", hb.policy_crc);
+                         "(crc 0x%04x)%s\n", (unsigned)hb.protocol,
+                stored ? "uploaded" : "built-in", hb.policy_crc,
+                table ? " from its compiled table (table mode)" : "");
     }
     b->heard_board = 1;
     b->board_stored = stored;
+    b->board_table = table;
     b->board_crc_reported = hb.policy_crc;
     return 1;
 }

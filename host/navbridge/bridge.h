@@ -188,6 +188,7 @@ typedef struct {
     int config_refused;               /* one did not (main exits): config_diff says why */
     char config_diff[96];
     uint8_t board_stored;             /* last reported QNAV_LINK_STATE_STORED bit */
+    uint8_t board_table;              /* last reported QNAV_LINK_STATE_TABLE bit */
     uint16_t board_crc_reported;
 
     /* the route (waypoints): goal k of n in the odometry frame, mm */

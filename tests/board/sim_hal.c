@@ -102,6 +102,31 @@ void sim_hal_init(sim_hal_t *sim, qnav_board_hal_t *hal)
     hal->nvm_read = sim_nvm_read;
     hal->nvm_write = sim_nvm_write;
     hal->nvm_bytes = SIM_HAL_NVM;
+    hal->table_area = NULL;
+    hal->table_page_bytes = 0;
+    hal->table_pages = 0;
+    hal->table_write_page = NULL;
+}
+
+static uint8_t sim_table_write(void *ctx, uint16_t page, const uint8_t *bytes)
+{
+    sim_hal_t *sim = (sim_hal_t *)ctx;
+    if (page >= SIM_HAL_TABLE_PAGES ||
+        (sim->table_fail_after != 0u && sim->table_pages_written >= sim->table_fail_after)) {
+        return 0;
+    }
+    memcpy(&sim->table[(uint32_t)page * SIM_HAL_TABLE_PAGE], bytes, SIM_HAL_TABLE_PAGE);
+    sim->table_pages_written++;
+    return 1;
+}
+
+void sim_hal_table(sim_hal_t *sim, qnav_board_hal_t *hal)
+{
+    memset(sim->table, 0xFF, sizeof sim->table);
+    hal->table_area = sim->table;
+    hal->table_page_bytes = SIM_HAL_TABLE_PAGE;
+    hal->table_pages = SIM_HAL_TABLE_PAGES;
+    hal->table_write_page = sim_table_write;
 }
 
 void sim_hal_to_board(sim_hal_t *sim, const uint8_t *bytes, uint32_t n)

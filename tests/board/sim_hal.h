@@ -15,6 +15,8 @@
 
 #define SIM_HAL_QUEUE 65536
 #define SIM_HAL_NVM 4096
+#define SIM_HAL_TABLE_PAGE 256
+#define SIM_HAL_TABLE_PAGES 46   /* the ATmega128's: ceil(QNAV_BOARD_TABLE_BYTES / 256) */
 
 typedef struct {
     uint32_t now_ms;
@@ -33,10 +35,17 @@ typedef struct {
     uint8_t nvm[SIM_HAL_NVM];       /* erased = 0xFF */
     uint32_t nvm_written;           /* bytes written so far */
     uint32_t nvm_cut_after;         /* power lost after this many written bytes (0 never) */
+    uint8_t table[SIM_HAL_TABLE_PAGE * SIM_HAL_TABLE_PAGES]; /* a table area (sim_hal_table) */
+    uint32_t table_pages_written;   /* pages written so far */
+    uint32_t table_fail_after;      /* page writes after this many fail (0 never) */
 } sim_hal_t;
 
 /* Reset the simulated hardware (EEPROM erased) and fill hal with functions over it. */
 void sim_hal_init(sim_hal_t *sim, qnav_board_hal_t *hal);
+
+/* Give hal a table area (SIM_HAL_TABLE_PAGES pages of SIM_HAL_TABLE_PAGE bytes, erased to
+ * 0xFF), as the ATmega128's flash gives the TekBot board one. sim_hal_init leaves it out. */
+void sim_hal_table(sim_hal_t *sim, qnav_board_hal_t *hal);
 
 /* Queue bytes for the board to read. */
 void sim_hal_to_board(sim_hal_t *sim, const uint8_t *bytes, uint32_t n);

@@ -37,12 +37,16 @@ typedef struct {
 
 static bench_t g;
 
-static void bench_start(uint16_t sectors)
+/* The bench with `sectors` sonar sectors; with_table: the HAL has a table area. */
+static void bench_start_with(uint16_t sectors, int with_table)
 {
     qnav_board_config_t cfg;
     uint16_t k;
     memset(&g, 0, sizeof g);
     sim_hal_init(&g.sim, &g.hal);
+    if (with_table) {
+        sim_hal_table(&g.sim, &g.hal);
+    }
     g.sim.n_ranges = sectors;
     for (k = 0; k < sectors; ++k) {
         g.sim.ranges_mm[k] = (qnav_mm_t)(1500 + 250 * k);
@@ -52,6 +56,11 @@ static void bench_start(uint16_t sectors)
     assert_int_equal(qnav_board_init(&g.bot, &cfg, &g.hal), QNAV_BOARD_OK);
     qnav_link_tx_init(&g.btx);
     qnav_link_rx_init(&g.brx);
+}
+
+static void bench_start(uint16_t sectors)
+{
+    bench_start_with(sectors, 0);
 }
 
 static void to_board(uint8_t id, const uint8_t *p, int32_t n)
@@ -350,6 +359,130 @@ static void test_an_uploaded_network_takes_the_row_shapes_it_carries(void **stat
     assert_int_equal(qnav_board_policy_source(&g.bot), QNAV_BOARD_POLICY_STORED);
     assert_int_equal(qnav_ctrl_shapes_carried(qnav_nav_paths(&g.bot.nav)), 0);
     assert_int_equal(g.bot.policy_crc, crc);
+}
+
+/* The rest of a table build at once (a board polls thousands of times a tick). */
+static void finish_table(void)
+{
+    uint32_t n = 0;
+    while (qnav_board_table_work(&g.bot)) {
+        assert_true(++n < 10000u);
+    }
+}
+
+/* A restart of the board (a power cycle: storage and table area kept). */
+static void restart(void)
+{
+    qnav_board_config_t cfg = g.bot.cfg;
+    assert_int_equal(qnav_board_init(&g.bot, &cfg, &g.hal), QNAV_BOARD_OK);
+}
+
+/* Table mode on the board (qnav/board.h): an uploaded 2-input network is compiled into the
+ * HAL's table area a page at a time between ticks, then the controller reads it. The
+ * area's keys are qnav_ctrl_build_table()'s and the decisions the network's; a restart
+ * finds the table whole and uses it without writing; a changed key makes a restart build
+ * it again; a failed page write leaves the network step driving. */
+static void test_an_uploaded_network_is_compiled_into_the_table_area(void **state)
+{
+    static qnav_qkey_t want[QNAV_QTABLE_ENTRIES];
+    qnav_policy_t net;
+    qnav_ctrl_t ref;
+    qnav_ctrl_config_t cc;
+    qnav_ctrl_input_t in = {0};
+    qnav_ctrl_output_t out;
+    uint32_t pages;
+    uint16_t k;
+    (void)state;
+    bench_start_with(16, 1);
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_NONE); /* built-in */
+    qnav_policy_net_zero(&net, 12);
+    for (k = 0; k < QNAV_NET_WEIGHTS(12); ++k) {
+        *qnav_net_weight(&net.u.net, k) = (qnav_q8_8_t)((int)((k * 733u) % 3001u) - 1500);
+    }
+    upload(&net, 0);
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    assert_int_equal(g.acks, 1);
+    assert_int_equal(g.last_ack.status, QNAV_LINK_ACK_OK);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_BUILDING);
+    assert_true(g.bot.table_at > 0u); /* polls between ticks made keys */
+    finish_table();
+    goal(1, 5500);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 500);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_IN_USE);
+    assert_int_equal(g.bot.stats.tables_built, 1);
+    assert_int_equal(g.sim.table_pages_written, SIM_HAL_TABLE_PAGES);
+    assert_true(moving());
+
+    qnav_nav_config(qnav_nav_find("body"), &g.bot.cfg.ctrl, &cc);
+    assert_int_equal(qnav_ctrl_init(&ref, &cc, &net), QNAV_OK);
+    assert_int_equal(qnav_ctrl_build_table(&ref, want), QNAV_OK);
+    assert_memory_equal(g.sim.table, want, sizeof want);
+    in.ranges_mm = g.last_scan.ranges_mm;
+    in.goal_bearing_cdeg = g.last_scan.goal_bearing_cdeg;
+    qnav_ctrl_step(&ref, &in, &out, NULL);
+    assert_int_equal(g.last_tel.heading_deg, out.heading_deg);
+    assert_int_equal(g.last_tel.speed, out.speed);
+
+    pages = g.sim.table_pages_written;
+    restart();
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_IN_USE);
+    assert_int_equal(g.bot.stats.tables_reused, 1);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 500);
+    assert_int_equal(g.sim.table_pages_written, pages);
+
+    g.sim.table[2 * 1000 + 1] ^= 0x40u; /* one key of level 5 */
+    restart();
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_BUILDING);
+    /* a page of 128 keys is made in 32 calls of 4 keys, then written in a call of its own */
+    for (k = 0; k < 32u; ++k) {
+        assert_int_equal(qnav_board_table_need_ms(&g.bot), QNAV_BOARD_TABLE_KEYS_MS);
+        assert_int_equal(qnav_board_table_work(&g.bot), 1);
+    }
+    assert_int_equal(g.sim.table_pages_written, pages);
+    assert_int_equal(qnav_board_table_need_ms(&g.bot), QNAV_BOARD_TABLE_WRITE_MS);
+    assert_int_equal(qnav_board_table_work(&g.bot), 1);
+    assert_int_equal(g.sim.table_pages_written, pages + 1u);
+    finish_table();
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_IN_USE);
+    assert_int_equal(g.sim.table_pages_written, pages + SIM_HAL_TABLE_PAGES);
+    assert_memory_equal(g.sim.table, want, sizeof want);
+
+    g.sim.table[0] ^= 0x01u;
+    g.sim.table_fail_after = g.sim.table_pages_written + 3u;
+    restart();
+    goal(2, 5500); /* a restart forgets the goal */
+    finish_table();
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 500);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_NONE);
+    assert_int_equal(g.bot.stats.table_writes_failed, 1);
+    assert_true(g.bot.ctrl_ready);
+    assert_true(moving());
+}
+
+/* Only a 2-input network is compiled: the built-in policy and a 3-input network leave the
+ * area alone. */
+static void test_only_a_two_input_network_uses_the_table_area(void **state)
+{
+    qnav_policy_t net3;
+    uint16_t k;
+    (void)state;
+    bench_start_with(16, 1);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 300);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_NONE);
+    qnav_policy_net_zero_inputs(&net3, 4, QNAV_NET_INPUTS_PREV);
+    for (k = 0; k < qnav_net_weight_count(&net3.u.net); ++k) {
+        *qnav_net_weight(&net3.u.net, k) = (qnav_q8_8_t)(k * 211 - 3000);
+    }
+    upload(&net3, 0);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 1000);
+    assert_int_equal(g.acks, 1);
+    assert_int_equal(g.last_ack.status, QNAV_LINK_ACK_OK);
+    assert_int_equal(g.bot.policy.u.net.inputs, QNAV_NET_INPUTS_PREV);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_NONE);
+    assert_int_equal(g.sim.table_pages_written, 0);
 }
 
 static void test_board_ignores_a_bridge_of_another_protocol_version(void **state)
@@ -740,6 +873,8 @@ int main(void)
         cmocka_unit_test(test_corrupted_goal_is_not_acted_on),
         cmocka_unit_test(test_uploaded_policy_is_used_and_a_bad_one_is_refused),
         cmocka_unit_test(test_an_uploaded_network_takes_the_row_shapes_it_carries),
+        cmocka_unit_test(test_an_uploaded_network_is_compiled_into_the_table_area),
+        cmocka_unit_test(test_only_a_two_input_network_uses_the_table_area),
         cmocka_unit_test(test_board_ignores_a_bridge_of_another_protocol_version),
         cmocka_unit_test(test_pose_integrates_wheel_travel_along_the_heading),
         cmocka_unit_test(test_position_goal_bearing_comes_from_the_pose),

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "board_store.h"
+#include "board_table.h"
 
 /* Most UART bytes handled per receive, so one poll never starves the tick. */
 #define UART_BURST 128u
@@ -110,6 +111,7 @@ static void load_policy(qnav_board_t *bot)
             bot->policy_crc = crc;
             bot->policy_source = QNAV_BOARD_POLICY_STORED;
             bot->ctrl_ready = 1;
+            qnav_board_table_start(bot);
             return;
         }
     }
@@ -118,6 +120,7 @@ static void load_policy(qnav_board_t *bot)
     bot->ctrl_ready = (uint8_t)(qnav_nav_init_named(&bot->nav, bot->cfg.controller, cc,
                                                     &bot->policy) == QNAV_OK);
     bot->policy_crc = qnav_link_policy_crc(&bot->policy);
+    qnav_board_table_start(bot);
 }
 
 qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t *cfg,
@@ -188,6 +191,7 @@ static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm
             bot->policy_source = QNAV_BOARD_POLICY_UPLOADED;
             bot->ctrl_ready = 1;
             bot->stats.uploads_ok++;
+            qnav_board_table_start(bot);
             if (!qnav_board_store_save(&bot->hal, bot->cfg.nvm_offset, &fresh, &crc,
                                        &bot->store_slot, &bot->store_seq)) {
                 bot->stats.store_writes_failed++;
@@ -197,6 +201,7 @@ static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm
             bot->ctrl_ready =
                 (uint8_t)(qnav_nav_init_named(&bot->nav, bot->cfg.controller, &bot->cfg.ctrl,
                                               &bot->policy) == QNAV_OK);
+            qnav_board_table_start(bot);
             status = QNAV_LINK_ACK_REJECTED;
         }
     }
@@ -313,6 +318,12 @@ void qnav_board_poll(qnav_board_t *bot)
         }
         qnav_board_tick(bot);
     }
+    /* one piece of a table build per poll, so the UART is drained between pieces */
+    if (bot->table_state == QNAV_BOARD_TABLE_BUILDING &&
+           (int32_t)(bot->next_tick_ms - bot->hal.millis(bot->hal.ctx)) >=
+               (int32_t)qnav_board_table_need_ms(bot)) {
+        (void)qnav_board_table_work(bot);
+    }
 }
 
 /* Dead reckoning: the mean wheel travel since the last tick along the mid-tick heading. */
@@ -409,7 +420,9 @@ static void send_status(qnav_board_t *bot, uint32_t now, uint8_t moving, uint32_
                          (moving ? 0u : QNAV_LINK_STATE_STOPPED) |
                          (bot->policy_source != QNAV_BOARD_POLICY_BUILTIN
                               ? QNAV_LINK_STATE_STORED
-                              : 0u));
+                              : 0u) |
+                         (bot->table_state == QNAV_BOARD_TABLE_IN_USE ? QNAV_LINK_STATE_TABLE
+                                                                      : 0u));
     hb.rx_ok = (uint16_t)bot->rx.stats.frames_ok;
     hb.rx_dropped = (uint16_t)qnav_link_rx_dropped_total(&bot->rx);
     hb.policy_crc = bot->policy_crc;

@@ -14,11 +14,17 @@
  *           odometry the core dead-reckons from. The heading per count comes from the
  *           robot's profile (track and encoder scale, qnav/robots.h)
  *   storage the 4 KiB EEPROM (avr-libc eeprom_*_block; a byte takes 8.5 ms to write)
+ *   table   46 pages of program memory, page-aligned below 64 KiB, where the core compiles
+ *           an uploaded network (qnav/board.h, "Table mode on the board"), written with
+ *           SPM by a routine the linker places in the boot loader section (0x1FC00, inside
+ *           the boot section for every BOOTSZ setting), the only place SPM works
  * Pin choices and scale factors are the knobs at the top; docs/hil.md lists the wiring.
  */
+#include <avr/boot.h>
 #include <avr/eeprom.h>
 #include <avr/interrupt.h>
 #include <avr/io.h>
+#include <avr/pgmspace.h>
 
 #include "qnav/board.h"
 #include "qnav/robots.h"
@@ -233,6 +239,51 @@ static uint8_t avr_nvm_write(void *ctx, uint16_t addr, const uint8_t *bytes, uin
     return 1;
 }
 
+/* The table area: in .progmem (below 64 KiB, where LPM reaches), page-aligned; zeros in
+ * the image, which no record takes for a table. */
+#define TABLE_PAGES ((QNAV_BOARD_TABLE_BYTES + SPM_PAGESIZE - 1u) / SPM_PAGESIZE)
+static const uint8_t g_table_area[TABLE_PAGES * SPM_PAGESIZE]
+    __attribute__((aligned(SPM_PAGESIZE), section(".progmem.qnav_table"), used)) = {0};
+
+/* Erase and write one flash page at byte address addr from bytes (SPM_PAGESIZE). In the
+ * boot loader section (.qnav_boot, placed by the image's linker script): a real ATmega128
+ * executes SPM only from there. Interrupts stay off: the vectors lie in the RWW section,
+ * which cannot be read while a page of it is erased or written (about 9 ms in all). */
+__attribute__((section(".qnav_boot"), noinline, used)) static void
+boot_write_page(uint32_t addr, const uint8_t *bytes)
+{
+    const uint8_t sreg = SREG;
+    uint16_t i;
+    cli();
+    eeprom_busy_wait();
+    boot_page_erase(addr);
+    boot_spm_busy_wait();
+    for (i = 0; i < SPM_PAGESIZE; i += 2u) {
+        boot_page_fill(addr + i, (uint16_t)(bytes[i] | ((uint16_t)bytes[i + 1u] << 8)));
+    }
+    boot_page_write(addr);
+    boot_spm_busy_wait();
+    boot_rww_enable();
+    SREG = sreg;
+}
+
+static uint8_t avr_table_write_page(void *ctx, uint16_t page, const uint8_t *bytes)
+{
+    const uint16_t first = (uint16_t)(page * SPM_PAGESIZE);
+    uint16_t i;
+    (void)ctx;
+    if (page >= TABLE_PAGES) {
+        return 0;
+    }
+    boot_write_page((uint32_t)(uintptr_t)&g_table_area[first], bytes);
+    for (i = 0; i < SPM_PAGESIZE; ++i) {
+        if (pgm_read_byte(&g_table_area[first + i]) != bytes[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 void qnav_tekbot_hal_avr_init(qnav_board_hal_t *hal)
 {
     /* Timer0: CTC, clk/64, 250 counts = 1 ms at 16 MHz */
@@ -273,5 +324,9 @@ void qnav_tekbot_hal_avr_init(qnav_board_hal_t *hal)
     hal->nvm_bytes = (uint16_t)(E2END + 1u);
     hal->uart_read = avr_uart_read;
     hal->uart_write = avr_uart_write;
+    hal->table_area = g_table_area;
+    hal->table_page_bytes = SPM_PAGESIZE;
+    hal->table_pages = (uint16_t)TABLE_PAGES;
+    hal->table_write_page = avr_table_write_page;
     sei();
 }

@@ -113,6 +113,9 @@ typedef enum {
 #define QNAV_LINK_STATE_STORED 0x10u    /* board: the running policy is an uploaded one (from
                                            non-volatile storage or just committed); clear:
                                            the built-in policy runs */
+#define QNAV_LINK_STATE_TABLE 0x20u     /* board: the controller reads the policy's key table
+                                           compiled into the board's table area (table
+                                           mode: a step cost no policy can raise) */
 
 /* Goal kinds (GOAL.kind). */
 #define QNAV_LINK_GOAL_BEARING 0u   /* a fixed bearing in the board's heading frame */

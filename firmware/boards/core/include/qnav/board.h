@@ -108,6 +108,42 @@ typedef struct {
     (QNAV_BOARD_STORE_HEADER_BYTES + QNAV_LINK_POLICY_WEIGHTS_MAX_BYTES)
 #define QNAV_BOARD_STORE_BYTES (2u * QNAV_BOARD_STORE_SLOT_BYTES)
 
+/*
+ * Table mode on the board (docs/hil.md, "Table mode on the board"). When the HAL has a
+ * table area and the running policy is a 2-input network, the core compiles the policy
+ * into the area, QNAV_BOARD_TABLE_KEYS_PER_WORK keys or one full page's write per call of
+ * qnav_board_table_work() (qnav_board_poll() calls it while that fits before the next
+ * tick), then switches the controller to table mode:
+ * the same decisions (table and network mode are bit identical), at a cost that no
+ * policy can raise. Until then the network step runs. Layout: QNAV_QTABLE_ENTRIES keys
+ * (native int16, level-major, as qnav_ctrl_build_table() writes them), then the record,
+ * four native u16: QNAV_BOARD_TABLE_MAGIC, format | rank << 8, the policy's CRC and the
+ * CRC-16 (qnav_link_crc16) of the key bytes. The record lies in the last page written,
+ * and at start-up the area is used only when the record names the running policy and
+ * rank, the keys' CRC matches, and one key of every level equals the network's own.
+ */
+#define QNAV_BOARD_TABLE_MAGIC 0x5451u
+#define QNAV_BOARD_TABLE_FORMAT 1u
+#define QNAV_BOARD_TABLE_KEY_BYTES ((uint16_t)(2u * QNAV_QTABLE_ENTRIES))
+#define QNAV_BOARD_TABLE_RECORD_BYTES 8u
+#define QNAV_BOARD_TABLE_BYTES ((uint16_t)(QNAV_BOARD_TABLE_KEY_BYTES + QNAV_BOARD_TABLE_RECORD_BYTES))
+#define QNAV_BOARD_TABLE_PAGE_MAX 256u
+/* Keys made per qnav_board_table_work() call, and the time before the next tick that
+ * qnav_board_poll() leaves free when it makes them or writes a full page (ATmega128: 4 keys
+ * take about 0.8 ms at H = 12 and 1 ms at H = 16; a page's erase and write about 9 ms).
+ * A step of the worst network (65 ms) and the tick's frames (about 23 ms at 57 600 baud)
+ * still leave room for both in every tick or two. */
+#define QNAV_BOARD_TABLE_KEYS_PER_WORK 4u
+#define QNAV_BOARD_TABLE_KEYS_MS 3u
+#define QNAV_BOARD_TABLE_WRITE_MS 12u
+
+/* Where the table area stands. */
+typedef enum {
+    QNAV_BOARD_TABLE_NONE = 0,     /* not used: no area, or a policy it does not take */
+    QNAV_BOARD_TABLE_BUILDING = 1, /* being compiled; the network step runs meanwhile */
+    QNAV_BOARD_TABLE_IN_USE = 2    /* the controller reads it (table mode) */
+} qnav_board_table_state_t;
+
 /* Counters for tests and the debugger. */
 typedef struct {
     uint32_t ticks;              /* control ticks run */
@@ -121,6 +157,9 @@ typedef struct {
     uint32_t commands;           /* offboard commands received */
     uint16_t last_command_seq;   /* scan_seq of the newest of them */
     uint16_t last_scan_seq;      /* link sequence number of the last scan sent */
+    uint32_t tables_built;       /* key tables compiled into the HAL's area */
+    uint32_t tables_reused;      /* new controllers whose table the area already held */
+    uint32_t table_writes_failed;/* builds given up on a failed page write (network runs) */
 } qnav_board_stats_t;
 
 /* Dead-reckoned pose. */
@@ -148,6 +187,11 @@ typedef struct {
     uint8_t store_slot;          /* slot the running stored policy is in (0/1), 0xFF none */
     uint8_t store_seq;           /* its sequence number */
     uint8_t ctrl_ready;
+    uint8_t table_state;         /* qnav_board_table_state_t */
+    uint16_t table_at;           /* the next byte of the area the build makes */
+    uint16_t table_done;         /* bytes of the area written so far */
+    uint16_t table_crc;          /* CRC-16 of the key bytes built so far */
+    uint8_t table_page[QNAV_BOARD_TABLE_PAGE_MAX]; /* the page being built */
     uint8_t mode;                /* QNAV_LINK_MODE_* last requested by the bridge (0 none) */
     uint8_t hold_stop;           /* a stop was commanded and not yet cleared */
     uint8_t link_ok;             /* a good frame arrived within link_timeout_ms */
@@ -202,7 +246,8 @@ QNAV_CHECK_RESULT qnav_board_status_t qnav_board_init(qnav_board_t *bot, const q
  */
 int qnav_board_set_map(qnav_board_t *bot, qnav_map_t *map);
 
-/* Drain the UART (qnav_board_receive) and run a control tick when tick_ms has passed. */
+/* Drain the UART (qnav_board_receive), run a control tick when tick_ms has passed, and
+ * do one piece of a table build when it fits before the next tick. */
 void qnav_board_poll(qnav_board_t *bot);
 
 /* Read and act on at most 128 waiting UART bytes. */
@@ -211,6 +256,20 @@ void qnav_board_receive(qnav_board_t *bot);
 /* One control tick now: odometry, sense, decide, drive, report (scan, heartbeat, pose,
  * onboard decision). */
 void qnav_board_tick(qnav_board_t *bot);
+
+/* One step of a table build (qnav/board.h, "Table mode on the board"):
+ * QNAV_BOARD_TABLE_KEYS_PER_WORK keys into the page being built, or, when it is full, its
+ * write; after the last page, the switch to table mode. Returns 1 while a build remains,
+ * else 0. qnav_board_poll() calls it; a platform that runs qnav_board_tick() itself calls
+ * it between ticks, when qnav_board_table_need_ms() fits. */
+uint8_t qnav_board_table_work(qnav_board_t *bot);
+
+/* The ms the next qnav_board_table_work() call may take (QNAV_BOARD_TABLE_KEYS_MS or
+ * QNAV_BOARD_TABLE_WRITE_MS); 0 when no build is under way. */
+uint16_t qnav_board_table_need_ms(const qnav_board_t *bot);
+
+/* Where the table area stands (qnav_board_table_state_t). */
+qnav_board_table_state_t qnav_board_table_state(const qnav_board_t *bot);
 
 /* Counters and the pose (read-only views). */
 const qnav_board_stats_t *qnav_board_stats(const qnav_board_t *bot);

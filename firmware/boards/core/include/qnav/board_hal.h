@@ -53,6 +53,20 @@ typedef struct {
     uint8_t (*nvm_read)(void *ctx, uint16_t addr, uint8_t *out, uint16_t n);
     uint8_t (*nvm_write)(void *ctx, uint16_t addr, const uint8_t *bytes, uint16_t n);
     uint16_t nvm_bytes; /* size of the storage, bytes */
+
+    /* A key table area, optional (table_area NULL: none): where the core compiles an
+     * uploaded 2-input network into its quality table, so that the step runs in table
+     * mode, whose cost does not depend on the policy (qnav/board.h, "Table mode on the
+     * board"). table_area is read the way the controller reads tables: program memory on
+     * an AVR built with QNAV_TABLES_IN_FLASH, else memory; 2-byte aligned, table_pages
+     * pages of table_page_bytes (even, at most QNAV_BOARD_TABLE_PAGE_MAX), together at
+     * least QNAV_BOARD_TABLE_BYTES. table_write_page erases page and writes its bytes;
+     * 1 on success (read back equal), 0 on failure. A power cut may leave any page half
+     * written: the core checks the area before it uses it. */
+    const uint8_t *table_area;
+    uint16_t table_page_bytes;
+    uint16_t table_pages;
+    uint8_t (*table_write_page)(void *ctx, uint16_t page, const uint8_t *bytes);
 } qnav_board_hal_t;
 
 #ifdef __cplusplus
