@@ -10,7 +10,9 @@
  * and link timeout mean what they say. --eeprom FILE is the MCU's EEPROM across runs
  * (loaded at start, saved at exit: a run is a power cycle); --power-cut-after N stops the
  * MCU dead once N bytes of its EEPROM have changed, as a power loss in the middle of a
- * write would, and saves what had been written by then.
+ * write would, and saves what had been written by then. --flash FILE keeps what the
+ * firmware wrote into its own flash with SPM (the board's table area) across runs the
+ * same way: saved at exit, and at start laid over the pages that are blank in the image.
  */
 #define _XOPEN_SOURCE 700
 #define _DEFAULT_SOURCE
@@ -324,10 +326,71 @@ static long eeprom_changed(avr_t *avr, const uint8_t *start)
     return n;
 }
 
+/* --flash: the flash as the firmware left it, saved at exit, and its pages laid at start
+ * over the image's blank pages (all 0x00 or all 0xFF: the board's table area, never code),
+ * so a run is a power cycle for what SPM wrote, while a rebuilt image keeps its code. */
+#define FLASH_PAGE 256u
+
+static int page_blank(const uint8_t *p)
+{
+    uint32_t i;
+    for (i = 1; i < FLASH_PAGE; ++i) {
+        if (p[i] != p[0]) {
+            return 0;
+        }
+    }
+    return p[0] == 0x00u || p[0] == 0xFFu;
+}
+
+/* 0, or -1 with one line. An absent FILE leaves the image as it is. */
+static int flash_load(avr_t *avr, const char *path)
+{
+    const uint32_t size = (uint32_t)avr->flashend + 1u;
+    uint8_t *saved;
+    FILE *f = fopen(path, "rb");
+    uint32_t at;
+    if (f == NULL) {
+        if (errno == ENOENT) {
+            return 0;
+        }
+        fprintf(stderr, "qnav-simavr-board: --flash %s: %s\n", path, strerror(errno));
+        return -1;
+    }
+    saved = malloc(size);
+    if (saved == NULL || fread(saved, 1, size, f) != size || fgetc(f) != EOF) {
+        fprintf(stderr, "qnav-simavr-board: --flash %s: not a %u-byte flash image\n", path,
+                (unsigned)size);
+        free(saved);
+        fclose(f);
+        return -1;
+    }
+    fclose(f);
+    for (at = 0; at + FLASH_PAGE <= size; at += FLASH_PAGE) {
+        if (page_blank(avr->flash + at)) {
+            memcpy(avr->flash + at, saved + at, FLASH_PAGE);
+        }
+    }
+    free(saved);
+    return 0;
+}
+
+static int flash_save(avr_t *avr, const char *path)
+{
+    const size_t size = (size_t)avr->flashend + 1u;
+    FILE *f = fopen(path, "wb");
+    if (f == NULL || fwrite(avr->flash, 1, size, f) != size || fclose(f) != 0) {
+        fprintf(stderr, "qnav-simavr-board: --flash %s: cannot save: %s\n", path,
+                strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
 /* Everything the command line says. */
 typedef struct {
     const char *robot_spec;
     const char *eeprom_path;
+    const char *flash_path;
     const char *elf;
     const char *link_path;
     long cut_after;
@@ -339,7 +402,7 @@ static void usage(void)
 {
     printf("usage: qnav-simavr-board --elf IMAGE [--robot NAME|FILE] [--link PATH]\n"
            "                         [--seconds S] [--baud N]\n"
-           "                         [--eeprom FILE [--power-cut-after N]]\n"
+           "                         [--eeprom FILE [--power-cut-after N]] [--flash FILE]\n"
            "  --elf FILE     the board's firmware image (tekbot-avr.elf, pioneer3dx-avr.elf)\n"
            "  --robot R      the robot profile the image must be built for (tekbot): a\n"
            "                 board reporting another configuration is refused\n"
@@ -349,6 +412,8 @@ static void usage(void)
            "                 (57600, the TekBot's)\n"
            "  --eeprom FILE  the EEPROM: loaded at start (absent: erased), saved at exit\n"
            "  --power-cut-after N  stop dead once N EEPROM bytes have changed\n"
+           "  --flash FILE   what the firmware wrote into its flash (its table area): laid\n"
+           "                 over the image's blank pages at start, saved at exit\n"
            "  --help, --version  this text; the version\n");
 }
 
@@ -392,7 +457,8 @@ static int parse_args(int argc, char **argv, options_t *o)
         {"baud", required_argument, NULL, 'b'},
         {"version", no_argument, NULL, 'V'},       {"eeprom", required_argument, NULL, 'E'},
         {"power-cut-after", required_argument, NULL, 'C'},
-        {"robot", required_argument, NULL, 'r'},   {NULL, 0, NULL, 0}};
+        {"robot", required_argument, NULL, 'r'},   {"flash", required_argument, NULL, 'F'},
+        {NULL, 0, NULL, 0}};
     int c;
     memset(o, 0, sizeof *o);
     o->robot_spec = "tekbot";
@@ -402,6 +468,7 @@ static int parse_args(int argc, char **argv, options_t *o)
         switch (c) {
         case 'e': o->elf = optarg; break;
         case 'E': o->eeprom_path = optarg; break;
+        case 'F': o->flash_path = optarg; break;
         case 'l': o->link_path = optarg; break;
         case 'r': o->robot_spec = optarg; break;
         case 'C':
@@ -619,6 +686,9 @@ int main(int argc, char **argv)
         return 2;
     }
     rc = attach_eeprom(&o, avr, &fw, ee_start);
+    if (rc == 0 && o.flash_path != NULL && flash_load(avr, o.flash_path) != 0) {
+        rc = 2;
+    }
     if (rc == 0) {
         rc = attach_io(&o, avr, &fw, &uart, &scene);
     }
@@ -632,6 +702,9 @@ int main(int argc, char **argv)
                                    : (g_quit ? "signal" : "done"));
     fflush(stdout);
     if (o.eeprom_path != NULL && eeprom_save(avr, o.eeprom_path) != 0) {
+        end.state = cpu_Crashed;
+    }
+    if (o.flash_path != NULL && flash_save(avr, o.flash_path) != 0) {
         end.state = cpu_Crashed;
     }
     /* only the link made here is removed, and only if it is still ours */

@@ -201,6 +201,51 @@ static void test_power_cut_during_the_first_write_leaves_the_built_in_policy(voi
     assert_null(strstr(nb, "uploaded"));
 }
 
+/* One power cycle of the simavr board keeping its EEPROM (ee) and what it wrote into its
+ * flash (fl), for `seconds` with navbridge onboard (uploading `upload` when not NULL);
+ * navbridge's stderr into nb_text. */
+static void flash_cycle(const char *ee, const char *fl, const char *seconds, const char *upload,
+                        char *nb_text, int cap)
+{
+    char link[300], path[300];
+    const char *board[] = {SIMAVR_BOARD_EXE, "--elf", TEKBOT_ELF, "--link", link, "--eeprom",
+                           ee, "--flash", fl, "--seconds", seconds, NULL};
+    const char *bridge[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://",
+                            "--mode", "onboard", "--timeout-ms", "3000",
+                            upload ? "--policy" : NULL, upload, "--upload", NULL};
+    snprintf(link, sizeof link, "%s/link", g_dir);
+    trial(board, link, bridge, "flash");
+    snprintf(path, sizeof path, "%s/flash-nb.err", g_dir);
+    assert_true(read_text(path, nb_text, cap) > 0);
+    print_message("%s", nb_text);
+}
+
+/* The table area in the ATmega128's flash across power cycles: a build the power cut
+ * short is not used (the next start-up builds it again), and a whole one is used from the
+ * first tick of the next start-up. */
+static void test_the_flash_table_survives_a_reset_and_a_cut_build_is_made_again(void **state)
+{
+    char ee[300], fl[300], nb[4096], want[160];
+    (void)state;
+    snprintf(ee, sizeof ee, "%s/table.eeprom", g_dir);
+    snprintf(fl, sizeof fl, "%s/table.flash", g_dir);
+    snprintf(want, sizeof want, "runs its uploaded policy (crc 0x%04x) from its compiled table",
+             g_crc1);
+    flash_cycle(ee, fl, "2", g_p1, nb, sizeof nb); /* the power goes mid-build */
+    assert_non_null(strstr(nb, "policy upload: ok"));
+    assert_null(strstr(nb, "table mode"));
+    flash_cycle(ee, fl, "9", NULL, nb, sizeof nb);
+    expect_runs(nb, "uploaded", g_crc1);            /* first: the network, the area refused */
+    assert_non_null(strstr(nb, want));              /* then: built again, table mode */
+    flash_cycle(ee, fl, "1.5", NULL, nb, sizeof nb);
+    snprintf(want, sizeof want,
+             "runs its uploaded policy (crc 0x%04x) from its compiled table (table mode)\n",
+             g_crc1);
+    assert_non_null(strstr(nb, want));
+    snprintf(want, sizeof want, "runs its uploaded policy (crc 0x%04x)\n", g_crc1);
+    assert_null(strstr(nb, want));                  /* never without the table */
+}
+
 /* ---- the same scan stream into the AVR image and into the SIL robot ---- */
 
 #define MAX_SCANS 4096
@@ -319,6 +364,7 @@ int main(void)
         cmocka_unit_test(test_power_cut_while_writing_a_policy_keeps_the_one_before),
         cmocka_unit_test(test_power_cut_during_the_first_write_leaves_the_built_in_policy),
         cmocka_unit_test(test_sil_robot_and_avr_image_command_alike_on_one_scan_stream),
+        cmocka_unit_test(test_the_flash_table_survives_a_reset_and_a_cut_build_is_made_again),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
