@@ -320,8 +320,8 @@ void qnav_board_poll(qnav_board_t *bot)
     }
     /* one piece of a table build per poll, so the UART is drained between pieces */
     if (bot->table_state == QNAV_BOARD_TABLE_BUILDING &&
-           (int32_t)(bot->next_tick_ms - bot->hal.millis(bot->hal.ctx)) >=
-               (int32_t)qnav_board_table_need_ms(bot)) {
+        (int32_t)(bot->next_tick_ms - bot->hal.millis(bot->hal.ctx)) >=
+            (int32_t)qnav_board_table_need_ms(bot)) {
         (void)qnav_board_table_work(bot);
     }
 }
