@@ -43,7 +43,7 @@ static uint16_t record_word(const qnav_board_t *bot, const qnav_ctrl_t *ctrl, ui
     case 0:
         return QNAV_BOARD_TABLE_MAGIC;
     case 1:
-        return (uint16_t)(QNAV_BOARD_TABLE_FORMAT | ((uint16_t)qnav_ctrl_rank(ctrl) << 8));
+        return (uint16_t)(QNAV_BOARD_TABLE_FORMAT | (uint16_t)qnav_ctrl_rank(ctrl) * 256u);
     case 2:
         return bot->policy_crc;
     default:
