@@ -91,16 +91,25 @@ static void trial(const char *const *robot, const char *link, const char *const 
 }
 
 /* One power cycle of the simavr board (EEPROM file ee, optional power cut after `cut`
- * changed bytes) for `seconds` simulated seconds with navbridge onboard (uploading
- * `upload` when not NULL). navbridge's stderr lands in nb_text, the board's stdout in
- * sa_text. */
-static void power_cycle(const char *ee, const char *cut, const char *seconds,
+ * changed bytes, optional flash file fl kept across cycles) for `seconds` simulated
+ * seconds with navbridge onboard (uploading `upload` when not NULL). navbridge's stderr
+ * lands in nb_text, the board's stdout in sa_text. */
+static void power_cycle(const char *ee, const char *cut, const char *fl, const char *seconds,
                         const char *upload, char *nb_text, char *sa_text, int cap)
 {
     char link[300], path[300];
-    const char *board[] = {SIMAVR_BOARD_EXE, "--elf", TEKBOT_ELF, "--link", link, "--eeprom",
-                           ee, "--seconds", seconds, cut ? "--power-cut-after" : NULL, cut,
-                           NULL};
+    const char *board[14] = {SIMAVR_BOARD_EXE, "--elf", TEKBOT_ELF, "--link", link, "--eeprom",
+                             ee, "--seconds", seconds};
+    int n = 9;
+    if (cut != NULL) {
+        board[n++] = "--power-cut-after";
+        board[n++] = cut;
+    }
+    if (fl != NULL) {
+        board[n++] = "--flash";
+        board[n++] = fl;
+    }
+    board[n] = NULL;
     const char *bridge[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://",
                             "--mode", "onboard", "--timeout-ms", "3000",
                             upload ? "--policy" : NULL, upload, "--upload", NULL};
@@ -140,11 +149,11 @@ static void test_committed_policy_survives_a_reset_of_the_avr(void **state)
     (void)state;
     snprintf(ee, sizeof ee, "%s/reset.eeprom", g_dir);
     snprintf(keep, sizeof keep, "%s/p1.eeprom", g_dir);
-    power_cycle(ee, NULL, "3", g_p1, nb, sa, sizeof nb);
+    power_cycle(ee, NULL, NULL, "3", g_p1, nb, sa, sizeof nb);
     expect_runs(nb, "built-in", g_builtin_crc);   /* a new board: erased EEPROM */
     assert_non_null(strstr(nb, "policy upload: ok"));
     expect_runs(nb, "uploaded", g_crc1);
-    power_cycle(ee, NULL, "1.5", NULL, nb, sa, sizeof nb);
+    power_cycle(ee, NULL, NULL, "1.5", NULL, nb, sa, sizeof nb);
     expect_runs(nb, "uploaded", g_crc1);          /* loaded from EEPROM at boot */
     assert_null(strstr(nb, "built-in"));
     copy_file(ee, keep);
@@ -168,7 +177,7 @@ static void test_corrupted_store_falls_back_to_the_built_in_policy(void **state)
     assert_int_equal(fseek(f, 20, SEEK_SET), 0);
     fputc(byte ^ 0x04, f);
     assert_int_equal(fclose(f), 0);
-    power_cycle(ee, NULL, "1.5", NULL, nb, sa, sizeof nb);
+    power_cycle(ee, NULL, NULL, "1.5", NULL, nb, sa, sizeof nb);
     expect_runs(nb, "built-in", g_builtin_crc);
     assert_null(strstr(nb, "uploaded"));
 }
@@ -182,9 +191,9 @@ static void test_power_cut_while_writing_a_policy_keeps_the_one_before(void **st
     assert_int_equal(access(keep, R_OK), 0);
     copy_file(keep, ee);
     /* uploading p2: the power goes after 12 of its ~110 bytes reached the EEPROM */
-    power_cycle(ee, "12", "3", g_p2, nb, sa, sizeof nb);
+    power_cycle(ee, "12", NULL, "3", g_p2, nb, sa, sizeof nb);
     assert_non_null(strstr(sa, "power cut after"));
-    power_cycle(ee, NULL, "1.5", NULL, nb, sa, sizeof nb);
+    power_cycle(ee, NULL, NULL, "1.5", NULL, nb, sa, sizeof nb);
     expect_runs(nb, "uploaded", g_crc1);
     assert_null(strstr(nb, "built-in"));
 }
@@ -194,30 +203,11 @@ static void test_power_cut_during_the_first_write_leaves_the_built_in_policy(voi
     char ee[300], nb[4096], sa[4096];
     (void)state;
     snprintf(ee, sizeof ee, "%s/first-cut.eeprom", g_dir);
-    power_cycle(ee, "40", "3", g_p2, nb, sa, sizeof nb);
+    power_cycle(ee, "40", NULL, "3", g_p2, nb, sa, sizeof nb);
     assert_non_null(strstr(sa, "power cut after"));
-    power_cycle(ee, NULL, "1.5", NULL, nb, sa, sizeof nb);
+    power_cycle(ee, NULL, NULL, "1.5", NULL, nb, sa, sizeof nb);
     expect_runs(nb, "built-in", g_builtin_crc);
     assert_null(strstr(nb, "uploaded"));
-}
-
-/* One power cycle of the simavr board keeping its EEPROM (ee) and what it wrote into its
- * flash (fl), for `seconds` with navbridge onboard (uploading `upload` when not NULL);
- * navbridge's stderr into nb_text. */
-static void flash_cycle(const char *ee, const char *fl, const char *seconds, const char *upload,
-                        char *nb_text, int cap)
-{
-    char link[300], path[300];
-    const char *board[] = {SIMAVR_BOARD_EXE, "--elf", TEKBOT_ELF, "--link", link, "--eeprom",
-                           ee, "--flash", fl, "--seconds", seconds, NULL};
-    const char *bridge[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://",
-                            "--mode", "onboard", "--timeout-ms", "3000",
-                            upload ? "--policy" : NULL, upload, "--upload", NULL};
-    snprintf(link, sizeof link, "%s/link", g_dir);
-    trial(board, link, bridge, "flash");
-    snprintf(path, sizeof path, "%s/flash-nb.err", g_dir);
-    assert_true(read_text(path, nb_text, cap) > 0);
-    print_message("%s", nb_text);
 }
 
 /* The table area in the ATmega128's flash across power cycles: a build the power cut
@@ -225,19 +215,19 @@ static void flash_cycle(const char *ee, const char *fl, const char *seconds, con
  * first tick of the next start-up. */
 static void test_the_flash_table_survives_a_reset_and_a_cut_build_is_made_again(void **state)
 {
-    char ee[300], fl[300], nb[4096], want[160];
+    char ee[300], fl[300], nb[4096], sa[4096], want[160];
     (void)state;
     snprintf(ee, sizeof ee, "%s/table.eeprom", g_dir);
     snprintf(fl, sizeof fl, "%s/table.flash", g_dir);
     snprintf(want, sizeof want, "runs its uploaded policy (crc 0x%04x) from its compiled table",
              g_crc1);
-    flash_cycle(ee, fl, "2", g_p1, nb, sizeof nb); /* the power goes mid-build */
+    power_cycle(ee, NULL, fl, "2", g_p1, nb, sa, sizeof nb); /* the power goes mid-build */
     assert_non_null(strstr(nb, "policy upload: ok"));
     assert_null(strstr(nb, "table mode"));
-    flash_cycle(ee, fl, "9", NULL, nb, sizeof nb);
+    power_cycle(ee, NULL, fl, "9", NULL, nb, sa, sizeof nb);
     expect_runs(nb, "uploaded", g_crc1);            /* first: the network, the area refused */
     assert_non_null(strstr(nb, want));              /* then: built again, table mode */
-    flash_cycle(ee, fl, "1.5", NULL, nb, sizeof nb);
+    power_cycle(ee, NULL, fl, "1.5", NULL, nb, sa, sizeof nb);
     snprintf(want, sizeof want,
              "runs its uploaded policy (crc 0x%04x) from its compiled table (table mode)\n",
              g_crc1);
