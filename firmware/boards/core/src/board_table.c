@@ -160,7 +160,7 @@ uint16_t qnav_board_table_need_ms(const qnav_board_t *bot)
 
 uint8_t qnav_board_table_work(qnav_board_t *bot)
 {
-    const qnav_ctrl_t *ctrl;
+    qnav_ctrl_t *ctrl;
     uint8_t keys = 0;
     if (bot == NULL || bot->table_state != QNAV_BOARD_TABLE_BUILDING) {
         return 0;
@@ -188,7 +188,7 @@ uint8_t qnav_board_table_work(qnav_board_t *bot)
         return 1;
     }
     bot->stats.tables_built++;
-    use_area(bot, qnav_nav_paths(&bot->nav));
+    use_area(bot, ctrl);
     return 0;
 }
 
