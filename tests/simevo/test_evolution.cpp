@@ -20,6 +20,7 @@ extern "C" {
 #include <string>
 #include <vector>
 
+#include "es.h"
 #include "evolution.h"
 #include "experiment.h"
 #include "fake_runner.h"
@@ -234,6 +235,95 @@ static void test_same_seed_gives_identical_evolution(void **state)
     assert_false(trace(1234) == trace(1235));
 }
 
+static EvolutionParams es_params()
+{
+    EvolutionParams p = small_params();
+    p.algorithm = EvolutionParams::Algorithm::Es;
+    p.es_pairs = 4;
+    p.es_sigma = 0.1;
+    p.es_step = 0.05;
+    return p;
+}
+
+/* An iteration is the centre, then θ + σε and θ − σε for each pair: every pair is
+ * symmetric about the centre (within the Q8.8 rounding of each side), the centre is
+ * the policy handed out, and nothing moves until the iteration's last outcome. */
+static void test_es_iteration_is_the_centre_then_antithetic_pairs(void **state)
+{
+    (void)state;
+    const EvolutionParams p = es_params();
+    EvolutionStrategy es(p, 5);
+    FakeRunner runner;
+    const uint64_t round = search_round_steps(p);
+    assert_int_equal(round, 9);
+    const qnav_policy_t start = es.best_policy();
+    std::vector<qnav_policy_t> cands;
+    for (uint64_t i = 0; i < round; ++i) {
+        const Candidate c = es.propose();
+        assert_int_equal(c.parent, -1); // nothing to re-evaluate
+        cands.push_back(c.policy);
+        const qnav_policy_t before = es.best_policy();
+        es.accept(c, runner.run(c.policy, 7), nullptr); // one episode seed: common worlds
+        if (i + 1 < round) {
+            assert_memory_equal(&before, &es.best_policy(), sizeof before);
+        }
+    }
+    assert_memory_equal(&cands[0], &start, sizeof start); // step 0 runs the centre
+    qnav_net_t centre = cands[0].u.net;
+    const uint16_t n = qnav_net_weight_count(&centre);
+    int moved = 0;
+    for (uint32_t j = 0; j < p.es_pairs; ++j) {
+        qnav_net_t plus = cands[1 + 2 * j].u.net, minus = cands[2 + 2 * j].u.net;
+        for (uint16_t k = 0; k < n; ++k) {
+            const int sum = *qnav_net_weight(&plus, k) + *qnav_net_weight(&minus, k);
+            assert_true(std::abs(sum - 2 * *qnav_net_weight(&centre, k)) <= 1);
+            moved += *qnav_net_weight(&plus, k) != *qnav_net_weight(&centre, k);
+        }
+    }
+    assert_true(moved > static_cast<int>(p.es_pairs * n) / 2); // σ = 25.6 Q8.8 steps
+    qnav_policy_t after = es.best_policy();
+    assert_true(std::memcmp(&after, &cands[0], sizeof after) != 0); // the update moved θ
+}
+
+/* The strategy climbs the fake task from a random start, and from a transfer source, and
+ * the same seed and outcomes give the same candidates (a journal replays). */
+static void test_es_climbs_the_fake_task_and_is_deterministic(void **state)
+{
+    (void)state;
+    const EvolutionParams p = es_params();
+    FakeRunner runner(0.0);
+    auto run = [&](Search &es, std::vector<uint32_t> *fps) {
+        for (uint64_t i = 0; i < 150 * search_round_steps(p); ++i) {
+            const Candidate c = es.propose();
+            if (fps != nullptr) {
+                fps->push_back(policy_fingerprint(c.policy));
+            }
+            es.accept(c, runner.run(c.policy, 1), nullptr);
+        }
+    };
+    EvolutionStrategy es(p, 9);
+    const double start = runner.run(es.best_policy(), 1).R;
+    std::vector<uint32_t> a, b;
+    run(es, &a);
+    const double end = runner.run(es.best_policy(), 1).R;
+    assert_true(end > start + 3.0);
+    assert_true(std::fabs(es.best_fitness() - end) < 1.0);
+    EvolutionStrategy again(p, 9);
+    run(again, &b);
+    assert_true(a == b);
+    EvolutionStrategy other(p, 10);
+    std::vector<uint32_t> c;
+    run(other, &c);
+    assert_false(a == c);
+
+    qnav_policy_t src;
+    qnav_policy_net_zero(&src, static_cast<uint8_t>(p.hidden));
+    const std::unique_ptr<Search> t = make_search(p, 9, &src);
+    assert_memory_equal(&t->best_policy(), &src, sizeof src);
+    run(*t, nullptr);
+    assert_true(runner.run(t->best_policy(), 1).R > runner.run(src, 1).R + 3.0);
+}
+
 static void test_evolution_improves_fitness_on_fake_task(void **state)
 {
     (void)state;
@@ -330,6 +420,12 @@ static void test_spec_parses_inheritance_and_presets(void **state)
     ExperimentSpec s = parse_experiment(kGoodSpec, "x.toml");
     assert_int_equal(s.runs, 3);
     assert_int_equal(s.evolution.population, 12);
+    assert_true(s.evolution.algorithm == EvolutionParams::Algorithm::EpsilonGreedy);
+    const ExperimentSpec es = parse_experiment(std::string(kGoodSpec).replace(
+        std::string(kGoodSpec).find("[evolution]\n"), 12, "[evolution]\nalgorithm = \"es\"\nes_pairs = 3\nes_sigma = 0.2\nes_step = 0.01\n"), "x.toml");
+    assert_true(es.evolution.algorithm == EvolutionParams::Algorithm::Es);
+    assert_int_equal(es.evolution.es_pairs, 3);
+    assert_true(es.evolution.es_sigma == 0.2 && es.evolution.es_step == 0.01);
     assert_int_equal(s.sources.size(), 1);
     assert_string_equal(s.sources[0].scenario.environment.c_str(), "open");
     assert_int_equal(s.sources[0].scenario.sectors, 8);
@@ -422,6 +518,10 @@ static void test_spec_errors_name_file_line_and_problem(void **state)
                         "x.toml:3: epsilon: 1.5 is outside [0, 1]");
     assert_string_equal(parse_error("name = \"t\"\n[evolution]\nfitness = \"survival\"\n").c_str(),
                         "x.toml:3: fitness: 'survival' is not one of progress, paper");
+    assert_string_equal(parse_error("name = \"t\"\n[evolution]\nalgorithm = \"cma\"\n").c_str(),
+                        "x.toml:3: algorithm: 'cma' is not one of epsilon-greedy, es");
+    assert_string_equal(parse_error("name = \"t\"\n[evolution]\nes_pairs = 0\n").c_str(),
+                        "x.toml:3: es_pairs: 0 is outside 1..10000");
     assert_string_equal(parse_error("name = \"t\"\n[evolution]\nfitness = 1\n").c_str(),
                         "x.toml:3: fitness: expected a string");
     assert_string_equal(parse_error("name = \"t\"\n[target]\n[[source]]\nlabel = \"a\"\n[evaluation]\ncheckpoints = [100, 50]\n").c_str(),
@@ -677,6 +777,8 @@ int main(void)
         cmocka_unit_test(test_transfer_population_is_source_plus_mutants_first_episode_random),
         cmocka_unit_test(test_same_seed_gives_identical_evolution),
         cmocka_unit_test(test_evolution_improves_fitness_on_fake_task),
+        cmocka_unit_test(test_es_iteration_is_the_centre_then_antithetic_pairs),
+        cmocka_unit_test(test_es_climbs_the_fake_task_and_is_deterministic),
         cmocka_unit_test(test_wilson_interval_matches_hand_values_and_stays_inside_0_1),
         cmocka_unit_test(test_t_critical_and_welch_match_tables),
         cmocka_unit_test(test_mann_whitney_separated_samples_are_significant),

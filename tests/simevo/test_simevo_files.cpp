@@ -202,6 +202,54 @@ static void test_candidate_and_parent_face_the_same_k_episodes_and_the_budget_co
     assert_true(seeds[24] != seeds[30]); // the next step has new start points
 }
 
+/* The evolution strategy as a task: every step of an iteration faces the iteration's k
+ * episodes, the budget rounds up to whole iterations, and a task stopped mid-iteration
+ * (with half a journal line) resumes to the uninterrupted bytes. */
+static void test_es_task_shares_worlds_per_iteration_and_resumes_to_identical_bytes(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::atomic<bool> never{false};
+    auto es_task = [&](const std::string &name) {
+        TaskDef t = fake_task(join_path(root, name));
+        t.evolution.algorithm = EvolutionParams::Algorithm::Es;
+        t.evolution.es_pairs = 3; // 7 steps an iteration
+        t.evolution.episodes_per_candidate = 2;
+        t.episodes = 60; // 30 steps, rounded up to 5 iterations
+        return t;
+    };
+    TaskDef a = es_task("a");
+    std::vector<uint64_t> seeds;
+    RunnerFactory logging = [&seeds](const Scenario &, uint64_t) -> std::unique_ptr<EpisodeRunner> {
+        return std::make_unique<SeedLoggingRunner>(&seeds);
+    };
+    assert_true(run_task(a, "", logging, TaskObserver{}, never));
+    assert_int_equal(read_journal(join_path(a.dir, "episodes.csv")).R.size(), 35);
+    assert_true(seeds.size() >= 35 * 2);
+    for (uint64_t step = 0; step < 35; ++step) {
+        for (uint64_t j = 0; j < 2; ++j) {
+            assert_true(seeds[step * 2 + j] == mix_seed(a.episode_seed_base, (step / 7) * 2 + j));
+        }
+    }
+    assert_true(slurp(join_path(a.dir, "task.txt")).find(" algorithm=es es_pairs=3 ") != std::string::npos);
+
+    TaskDef b = es_task("b");
+    std::atomic<bool> stop{false};
+    uint64_t seen = 0;
+    assert_false(run_task(b, "", fake_factory(), stop_after(37, seen, stop), stop));
+    FILE *f = std::fopen(join_path(b.dir, "episodes.csv").c_str(), "a");
+    std::fputs("19,-3.25", f);
+    std::fclose(f);
+    uint64_t replayed = 0;
+    TaskObserver obs2;
+    obs2.episodes_done = [&](uint64_t n, bool r) { replayed += r ? n : 0; };
+    assert_true(run_task(b, "", fake_factory(), obs2, never));
+    assert_int_equal(replayed, 38); // 19 steps of 2 from the journal, mid-iteration
+    for (const char *name : {"episodes.csv", "best.policy", "eval.csv", "task.txt", "done"}) {
+        assert_true(slurp(join_path(a.dir, name)) == slurp(join_path(b.dir, name)));
+    }
+}
+
 static void test_checkpoints_resume_to_identical_bytes_even_when_a_row_is_missing(void **state)
 {
     (void)state;
@@ -1166,6 +1214,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_task_stopped_and_resumed_matches_uninterrupted_bytes),
         cmocka_unit_test(test_candidate_and_parent_face_the_same_k_episodes_and_the_budget_counts_episodes),
         cmocka_unit_test(test_checkpoints_resume_to_identical_bytes_even_when_a_row_is_missing),
+        cmocka_unit_test(test_es_task_shares_worlds_per_iteration_and_resumes_to_identical_bytes),
         cmocka_unit_test(test_transfer_task_resumes_from_source_file_and_refuses_other_settings),
         cmocka_unit_test(test_experiment_results_do_not_depend_on_thread_count_and_summary_reads_them),
         cmocka_unit_test(test_program_rejects_bad_input_with_one_line),

@@ -38,6 +38,15 @@ const char *evolution_params_problem(const EvolutionParams &p)
     if (!(p.init_scale > 0.0 && p.init_scale <= 128.0)) {
         return "init_scale: must be in (0, 128]";
     }
+    if (p.es_pairs < 1 || p.es_pairs > 10000) {
+        return "es_pairs: must be 1..10000";
+    }
+    if (!(p.es_sigma > 0.0 && p.es_sigma <= 16.0)) {
+        return "es_sigma: must be in (0, 16]";
+    }
+    if (!(p.es_step > 0.0 && p.es_step <= 16.0)) {
+        return "es_step: must be in (0, 16]";
+    }
     return "";
 }
 
@@ -50,6 +59,22 @@ const char *init_kind_name(InitKind k)
         return "uniform";
     }
     return "cauchy";
+}
+
+const char *algorithm_name(EvolutionParams::Algorithm a)
+{
+    switch (a) {
+    case EvolutionParams::Algorithm::EpsilonGreedy:
+        return "epsilon-greedy";
+    case EvolutionParams::Algorithm::Es:
+        return "es";
+    }
+    return "epsilon-greedy";
+}
+
+uint64_t search_round_steps(const EvolutionParams &p)
+{
+    return p.algorithm == EvolutionParams::Algorithm::Es ? 2ull * p.es_pairs + 1 : 1;
 }
 
 const char *world_sets_name(EvolutionParams::WorldSets w)
@@ -117,27 +142,33 @@ uint32_t policy_fingerprint(const qnav_policy_t &policy)
     return static_cast<uint32_t>(h ^ (h >> 32));
 }
 
+void random_network(qnav_policy_t &policy, const EvolutionParams &params, Rng &rng)
+{
+    qnav_policy_net_zero_inputs(&policy, static_cast<uint8_t>(params.hidden), static_cast<uint8_t>(params.inputs));
+    qnav_net_t &net = policy.u.net;
+    const uint16_t n = weight_count(net);
+    for (uint16_t k = 0; k < n; ++k) {
+        double x = 0.0;
+        switch (params.init) {
+        case InitKind::Cauchy:
+            x = rng.cauchy_clipped(params.init_scale, params.mutation_clip);
+            break;
+        case InitKind::Uniform:
+            x = (2.0 * rng.uniform01() - 1.0) * params.init_scale;
+            break;
+        }
+        *qnav_net_weight(&net, k) = to_q8_8_saturated(x * QNAV_Q8_8_ONE);
+    }
+}
+
+qnav_q8_8_t weight_to_q8_8(double w) { return to_q8_8_saturated(w * QNAV_Q8_8_ONE); }
+
 Evolution::Evolution(const EvolutionParams &params, uint64_t seed)
     : params_(params), rng_(seed), pop_(params.population),
       best_so_far_(-std::numeric_limits<double>::infinity())
 {
     for (Member &m : pop_) {
-        qnav_policy_net_zero_inputs(&m.policy, static_cast<uint8_t>(params_.hidden),
-                                    static_cast<uint8_t>(params_.inputs));
-        qnav_net_t &net = m.policy.u.net;
-        const uint16_t n = weight_count(net);
-        for (uint16_t k = 0; k < n; ++k) {
-            double x = 0.0;
-            switch (params_.init) {
-            case InitKind::Cauchy:
-                x = rng_.cauchy_clipped(params_.init_scale, params_.mutation_clip);
-                break;
-            case InitKind::Uniform:
-                x = (2.0 * rng_.uniform01() - 1.0) * params_.init_scale;
-                break;
-            }
-            *qnav_net_weight(&net, k) = to_q8_8_saturated(x * QNAV_Q8_8_ONE);
-        }
+        random_network(m.policy, params_, rng_);
     }
     init_order_.resize(pop_.size());
     for (uint32_t i = 0; i < init_order_.size(); ++i) {

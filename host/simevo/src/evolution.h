@@ -10,7 +10,9 @@
 #ifndef QNAV_SIMEVO_EVOLUTION_H
 #define QNAV_SIMEVO_EVOLUTION_H
 
+#include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "qnav/policy.h"
@@ -72,7 +74,22 @@ struct EvolutionParams {
      * PerGeneration = every block of `population` steps the same k (one world set per
      * generation). docs/simevo.md, "Distributions of worlds". */
     enum class WorldSets { PerStep, PerGeneration } world_sets = WorldSets::PerStep;
+    /* The search: the paper's ε-greedy evolution (the fields above), or an evolution
+     * strategy (es.h; population, epsilon, the mutation and world_sets do not apply; every
+     * iteration scores its 2 * es_pairs + 1 networks on one common set of k episodes).
+     * docs/simevo.md, "Two searches". */
+    enum class Algorithm { EpsilonGreedy, Es } algorithm = Algorithm::EpsilonGreedy;
+    uint32_t es_pairs = 16; /* antithetic perturbation pairs per iteration */
+    double es_sigma = 0.1;  /* perturbation SD, weight units */
+    double es_step = 0.02;  /* Adam step, weight units */
 };
+
+/* "epsilon-greedy", "es" (experiment files and task settings spell them so). */
+const char *algorithm_name(EvolutionParams::Algorithm a);
+
+/* Steps of one round of the search that share their k episodes and whose results are used
+ * together: 2 * es_pairs + 1 for the evolution strategy, 1 for ε-greedy evolution. */
+uint64_t search_round_steps(const EvolutionParams &p);
 
 /* "cauchy", "uniform" (experiment files and task settings spell them so). */
 const char *init_kind_name(InitKind k);
@@ -85,6 +102,12 @@ const char *evolution_params_problem(const EvolutionParams &p);
 /* Add a clipped Cauchy sample (scale, clip in weight units) to every weight of net, round
  * to the nearest Q8.8 step (half away from zero) and saturate to [-128, 128 - 1/256]. */
 void mutate_network(qnav_net_t &net, Rng &rng, double scale, double clip);
+
+/* One random network of params' shape, drawn as params.init says (an initial member). */
+void random_network(qnav_policy_t &policy, const EvolutionParams &params, Rng &rng);
+
+/* A weight in weight units rounded to the nearest Q8.8 step (half away from zero), saturated. */
+qnav_q8_8_t weight_to_q8_8(double w);
 
 /* 32-bit fingerprint of a network's shape and weights (journal check). */
 uint32_t policy_fingerprint(const qnav_policy_t &policy);
@@ -105,7 +128,32 @@ struct Candidate {
     int32_t slot = -1;      /* member the result is stored in */
 };
 
-class Evolution {
+/* A search over network policies: proposes a candidate, is told its outcome, and knows the
+ * policy it would hand out now. Everything random comes from its seed, so a run resumes
+ * by replaying the journal's outcomes through propose()/accept(). */
+class Search {
+public:
+    virtual ~Search() = default;
+    virtual Candidate propose() = 0;
+    /* Record the candidate's outcome (must follow the matching propose()). parent_out,
+     * when not null, is the re-evaluation of candidate's parent member. */
+    virtual void accept(const Candidate &c, const EpisodeOutcome &out, const EpisodeOutcome *parent_out) = 0;
+    /* Steps (candidates scored) so far. */
+    virtual uint64_t episodes_done() const = 0;
+    /* The policy this search recommends now (best.policy, checkpoints) and its fitness. */
+    virtual const qnav_policy_t &best_policy() const = 0;
+    virtual double best_fitness() const = 0;
+    /* The fitness reported in the journal's best_fitness column (-inf before any). */
+    virtual double best_so_far() const = 0;
+    /* The policy of member i (a parent to re-evaluate). */
+    virtual const qnav_policy_t &member_policy(int32_t i) const = 0;
+};
+
+/* The search that params.algorithm names, from a random start or from source (transfer). */
+std::unique_ptr<Search> make_search(const EvolutionParams &params, uint64_t seed,
+                                    const qnav_policy_t *source);
+
+class Evolution : public Search {
 public:
     /* Random initial population (see InitKind). */
     Evolution(const EvolutionParams &params, uint64_t seed);
@@ -118,13 +166,16 @@ public:
      * that, Fig. 4: with probability ε a random member else the best, mutated; the
      * result replaces the worst member.
      */
-    Candidate propose();
-    /* Record the candidate's outcome (must follow the matching propose()). parent_out,
-     * when not null, is the re-evaluation of the parent (reevaluate_parent). */
+    Candidate propose() override;
+    /* parent_out: the re-evaluation of the parent (reevaluate_parent). */
     void accept(const Candidate &c, const EpisodeOutcome &out,
-                const EpisodeOutcome *parent_out = nullptr);
+                const EpisodeOutcome *parent_out = nullptr) override;
 
-    uint64_t episodes_done() const { return episode_; }
+    uint64_t episodes_done() const override { return episode_; }
+    /* Before any evaluation: member 0. */
+    const qnav_policy_t &best_policy() const override { return pop_[best_or_first()].policy; }
+    double best_fitness() const override { return pop_[best_or_first()].fitness; }
+    const qnav_policy_t &member_policy(int32_t i) const override { return pop_[static_cast<std::size_t>(i)].policy; }
     /* Index of the best evaluated member (ties: lowest index); -1 if none evaluated. */
     int32_t best_index() const;
     /* Index of the member to replace: an unevaluated one first, else the lowest fitness
@@ -132,10 +183,12 @@ public:
     int32_t worst_index() const;
     const std::vector<Member> &members() const { return pop_; }
     /* Fitness of the best member after the last accept() (-inf before any). */
-    double best_so_far() const { return best_so_far_; }
+    double best_so_far() const override { return best_so_far_; }
     const EvolutionParams &params() const { return params_; }
 
 private:
+    std::size_t best_or_first() const { return static_cast<std::size_t>(std::max<int32_t>(0, best_index())); }
+
     EvolutionParams params_;
     Rng rng_;
     std::vector<Member> pop_;

@@ -349,6 +349,18 @@ std::string worlds_md(const ExperimentSpec &spec, const HeldOut &H)
 
 } // namespace
 
+namespace {
+/* The search and its settings, as the summary's first paragraph names them. */
+std::string search_md(const EvolutionParams &e)
+{
+    if (e.algorithm == EvolutionParams::Algorithm::Es) {
+        return "evolution strategy (" + std::to_string(e.es_pairs) + " antithetic pairs an iteration, sigma " +
+               fmt(e.es_sigma, 3) + ", Adam step " + fmt(e.es_step, 3) + ")";
+    }
+    return "epsilon-greedy evolution (population " + std::to_string(e.population) + ", epsilon " + fmt(e.epsilon, 2) + ")";
+}
+} // namespace
+
 std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, const RunOptions &opt, bool plots,
                        const HeldOut &H)
 {
@@ -358,8 +370,8 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
       << "Preset `" << opt.preset << "`: " << spec.runs << " runs, " << spec.target_episodes
       << " target episodes per run (" << S.k << " per candidate), fitness rule `"
       << qnav_sim_fitness_rule_name(spec.target.fitness) << "`, controller `"
-      << controller_reading_name(spec.target.controller) << "`, population " << spec.evolution.population << ", epsilon "
-      << fmt(spec.evolution.epsilon, 2) << ", " << spec.evolution.hidden << " hidden units; final performance = each run's best policy over "
+      << controller_reading_name(spec.target.controller) << "`, " << search_md(spec.evolution) << ", "
+      << spec.evolution.hidden << " hidden units; final performance = each run's best policy over "
       << spec.eval_episodes << " held-out episodes (the same set for every run and condition).\n\n"
       << "Target: " << spec.target.describe() << "\n\n";
     if (spec.target.distribution) {
@@ -400,8 +412,10 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
          "'vfh' controller with its documented defaults, docs/architecture.md) are one policy or controller each, so "
          "their CIs are over episodes (arrival: Wilson score interval). "
          "Candidates' R = mean R of the networks evaluated (mutants, each on k episodes), binned by target episodes, mean over runs. "
-         "Best fitness = the population's best member's fitness (mean R of its episodes; biased upwards by selection), mean over runs. "
-         "Online R = mean R of all candidates of a run (the area under its learning curve; higher = learns faster and better). "
+      << (spec.evolution.algorithm == EvolutionParams::Algorithm::Es
+              ? "Best fitness = the evolution strategy's centre's R on its last iteration's k episodes (best.policy is that centre), mean over runs. "
+              : "Best fitness = the population's best member's fitness (mean R of its episodes; biased upwards by selection), mean over runs. ")
+      << "Online R = mean R of all candidates of a run (the area under its learning curve; higher = learns faster and better). "
          "Improvement = (mean_a − mean_b) / |mean_b| (n/a when |mean_b| < 1). Episodes to 90% = first bin at "
          "which the candidates' mean curve has covered 90% of its rise from its first to its last bin. "
          "The probabilistic policy's p-value is a one-sample t-test of the runs against its held-out mean.\n\n";

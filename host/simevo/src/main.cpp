@@ -552,6 +552,7 @@ struct EvolveCommand {
     uint64_t ev_episodes = 1000, ev_seed = 1;
     uint32_t ev_eval = 50;
     std::string fitness;
+    std::string algorithm = "epsilon-greedy";
     EvolutionParams ep;
 };
 
@@ -574,8 +575,13 @@ CLI::App *add_evolve_command(CLI::App &app, EvolveCommand &c)
     evolve->add_option("--hidden", c.ep.hidden, "hidden units of random networks")->capture_default_str();
     evolve->add_option("--mutation-scale", c.ep.mutation_scale, "Cauchy scale, weight units")->capture_default_str();
     evolve->add_option("--mutation-clip", c.ep.mutation_clip, "Cauchy clip, weight units")->capture_default_str();
-    evolve->add_option("--per-candidate", c.ep.episodes_per_candidate, "episodes averaged per fitness value")->capture_default_str();
+    evolve->add_option("--per-candidate,--episodes-per-candidate", c.ep.episodes_per_candidate, "episodes averaged per fitness value")->capture_default_str();
     evolve->add_flag("--reevaluate-parent", c.ep.reevaluate_parent, "also re-run the parent each step (noisy fitness)");
+    evolve->add_option("--algorithm", c.algorithm, "search: epsilon-greedy (the paper's) or es (evolution strategy)")
+        ->capture_default_str()->check(CLI::IsMember({"epsilon-greedy", "es"}));
+    evolve->add_option("--es-pairs", c.ep.es_pairs, "es: antithetic pairs per iteration")->capture_default_str();
+    evolve->add_option("--es-sigma", c.ep.es_sigma, "es: perturbation SD, weight units")->capture_default_str();
+    evolve->add_option("--es-step", c.ep.es_step, "es: Adam step, weight units")->capture_default_str();
     evolve->add_option("--out", c.out_dir, "output folder")->capture_default_str();
     return evolve;
 }
@@ -590,6 +596,7 @@ TaskDef evolve_task(const EvolveCommand &c)
     t.context_seed = c.ev_seed;
     t.episodes = c.ev_episodes;
     t.evolution = c.ep;
+    t.evolution.algorithm = c.algorithm == "es" ? EvolutionParams::Algorithm::Es : EvolutionParams::Algorithm::EpsilonGreedy;
     t.evolution_seed = mix_seed(c.ev_seed, 1);
     t.episode_seed_base = mix_seed(c.ev_seed, 2);
     t.eval_episodes = c.ev_eval;
@@ -601,7 +608,9 @@ TaskDef evolve_task(const EvolveCommand &c)
 int evolve_command(const EvolveCommand &c, bool &started)
 {
     if (const char *p = evolution_params_problem(c.ep); *p) {
-        throw UserError(std::string("--") + p);
+        std::string msg(p); // "field: problem", the field spelled as the option is
+        std::replace(msg.begin(), msg.begin() + static_cast<std::ptrdiff_t>(msg.find(':')), '_', '-');
+        throw UserError("--" + msg);
     }
     const TaskDef t = evolve_task(c);
     SimWorlds worlds;

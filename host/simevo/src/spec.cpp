@@ -346,6 +346,33 @@ void parse_scenario_rules(const Parser &p, const toml::table &t, ExperimentSpec 
     }
 }
 
+/* [evolution]'s choice of search and the evolution strategy's settings. Throws UserError. */
+void parse_search(const Parser &p, const toml::table &t, EvolutionParams &e)
+{
+    if (auto *v = t.get("algorithm")) {
+        const std::string s = p.str(*v, "algorithm");
+        bool known = false;
+        for (auto a : {EvolutionParams::Algorithm::EpsilonGreedy, EvolutionParams::Algorithm::Es}) {
+            if (s == algorithm_name(a)) {
+                e.algorithm = a;
+                known = true;
+            }
+        }
+        if (!known) {
+            p.fail(*v, "algorithm: '" + s + "' is not one of epsilon-greedy, es");
+        }
+    }
+    if (auto *v = t.get("es_pairs")) {
+        e.es_pairs = static_cast<uint32_t>(p.integer(*v, "es_pairs", 1, 10000));
+    }
+    if (auto *v = t.get("es_sigma")) {
+        e.es_sigma = p.number(*v, "es_sigma", 1e-6, 16.0);
+    }
+    if (auto *v = t.get("es_step")) {
+        e.es_step = p.number(*v, "es_step", 1e-6, 16.0);
+    }
+}
+
 /* [evolution]: the algorithm's settings, the fitness rule and the controller reading. Throws UserError. */
 void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &spec)
 {
@@ -353,7 +380,7 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
         const toml::table &t = p.table(*n, "evolution");
         p.only_keys(t, {"population", "epsilon", "hidden", "inputs", "mutation_scale", "mutation_clip",
                         "episodes_per_candidate", "reevaluate_parent", "init", "init_scale",
-                        "fitness", "controller", "world_sets"},
+                        "fitness", "controller", "world_sets", "algorithm", "es_pairs", "es_sigma", "es_step"},
                     "evolution");
         EvolutionParams &e = spec.evolution;
         if (auto *v = t.get("population")) {
@@ -413,6 +440,7 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
         if (auto *v = t.get("init_scale")) {
             e.init_scale = p.number(*v, "init_scale", 1e-6, 128.0);
         }
+        parse_search(p, t, e);
         parse_scenario_rules(p, t, spec);
     }
 }

@@ -297,10 +297,10 @@ public:
     CheckpointLog(const CheckpointLog &) = delete;
     CheckpointLog &operator=(const CheckpointLog &) = delete;
 
-    void reach(const Evolution &evo, uint64_t episodes)
+    void reach(const Search &evo, uint64_t episodes)
     {
         while (done_ < t_.checkpoints.size() && t_.checkpoints[done_] <= episodes) {
-            const qnav_policy_t &best = evo.members()[static_cast<std::size_t>(evo.best_index())].policy;
+            const qnav_policy_t &best = evo.best_policy();
             CheckpointRow r;
             r.checkpoint = t_.checkpoints[done_];
             r.episodes = episodes;
@@ -373,6 +373,21 @@ const char *task_kind_name(TaskKind k)
     return "evolve";
 }
 
+namespace {
+/* The evolution strategy's settings; "" for ε-greedy, so fingerprints from before it match. */
+std::string es_settings_text(const EvolutionParams &e)
+{
+    if (e.algorithm != EvolutionParams::Algorithm::Es) {
+        return "";
+    }
+    std::ostringstream o;
+    o.precision(17);
+    o << " algorithm=" << algorithm_name(e.algorithm) << " es_pairs=" << e.es_pairs << " es_sigma=" << e.es_sigma
+      << " es_step=" << e.es_step;
+    return o.str();
+}
+} // namespace
+
 std::string task_settings_text(const TaskDef &t, const std::string &source_fingerprint)
 {
     std::ostringstream o;
@@ -395,6 +410,7 @@ std::string task_settings_text(const TaskDef &t, const std::string &source_finge
           /* the default is left out, so fingerprints from before world sets still match */
           << (e.world_sets != EvolutionParams::WorldSets::PerStep ? std::string(" world_sets=") + world_sets_name(e.world_sets)
                                                                   : std::string())
+          << es_settings_text(e)
           << "\n"
           << "evolution_seed=" << t.evolution_seed << "\n"
           << "episode_seed_base=" << t.episode_seed_base << "\n"
@@ -414,9 +430,12 @@ std::string task_settings_text(const TaskDef &t, const std::string &source_finge
 
 uint64_t task_steps(const TaskDef &t)
 {
-    // Rounded up, so that every checkpoint within the budget is reached.
+    // Rounded up, so that every checkpoint within the budget is reached, and to whole
+    // rounds of the search (an evolution strategy's iterations).
     const uint64_t k = std::max<uint32_t>(1, t.evolution.episodes_per_candidate);
-    return std::max<uint64_t>(1, (t.episodes + k - 1) / k);
+    const uint64_t round = search_round_steps(t.evolution);
+    const uint64_t steps = std::max<uint64_t>(1, (t.episodes + k - 1) / k);
+    return (steps + round - 1) / round * round;
 }
 
 EpisodeOutcome run_reference(EpisodeRunner &runner, const ReferenceDecl &r, uint64_t episode_seed)
@@ -523,7 +542,7 @@ namespace {
 /* Replay the journal (if any) through evo: same proposals, recorded outcomes, no
  * simulation except checkpoints missing from their file. Returns the bytes of the journal
  * to keep (complete, matching lines). */
-std::size_t replay_journal(const TaskDef &t, const std::string &journal_path, Evolution &evo,
+std::size_t replay_journal(const TaskDef &t, const std::string &journal_path, Search &evo,
                            CheckpointLog &checkpoints, const TaskObserver &obs)
 {
     const uint32_t k = t.evolution.episodes_per_candidate;
@@ -557,9 +576,13 @@ std::size_t replay_journal(const TaskDef &t, const std::string &journal_path, Ev
         return true;
     });
 }
-/* Which k episodes step `step` runs: its own (paired with its parent), or its generation's. */
+/* Which k episodes step `step` runs: its own (paired with its parent), its generation's, or
+ * its evolution-strategy iteration's. */
 uint64_t step_episode_set(const EvolutionParams &e, uint64_t step)
 {
+    if (e.algorithm == EvolutionParams::Algorithm::Es) {
+        return step / search_round_steps(e);
+    }
     switch (e.world_sets) {
     case EvolutionParams::WorldSets::PerStep:
         return step;
@@ -571,7 +594,7 @@ uint64_t step_episode_set(const EvolutionParams &e, uint64_t step)
 
 /* Resume (replay) and continue an evolution to its budget, journaling each step and
  * evaluating the checkpoints. Returns false when stopped. */
-bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, EpisodeRunner &held_out_runner,
+bool evolve(const TaskDef &t, Search &evo, EpisodeRunner &runner, EpisodeRunner &held_out_runner,
             const std::string &journal_path, const TaskObserver &obs, const std::atomic<bool> &stop)
 {
     CheckpointLog checkpoints(t, held_out_runner, obs);
@@ -593,7 +616,7 @@ bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, EpisodeRunn
         StepOutcome po;
         char parent_r[40] = "";
         if (has_parent) {
-            po = run_k(runner, evo.members()[static_cast<std::size_t>(c.parent)].policy, t.episode_seed_base,
+            po = run_k(runner, evo.member_policy(c.parent), t.episode_seed_base,
                        episode_set, k);
             std::snprintf(parent_r, sizeof parent_r, "%.17g", po.o.R);
         }
@@ -616,13 +639,12 @@ bool evolve(const TaskDef &t, Evolution &evo, EpisodeRunner &runner, EpisodeRunn
 }
 /* The population's best member written to best_path, its comment naming the task, run,
  * episodes and fitness. Returns that policy. Throws UserError. */
-qnav_policy_t write_best_policy(const TaskDef &t, const Evolution &evo, const std::string &best_path)
+qnav_policy_t write_best_policy(const TaskDef &t, const Search &evo, const std::string &best_path)
 {
-    const int32_t b = evo.best_index();
-    const qnav_policy_t best = evo.members()[static_cast<std::size_t>(b)].policy;
+    const qnav_policy_t best = evo.best_policy();
     char comment[200];
     std::snprintf(comment, sizeof comment, "simevo %s run %u: best after %" PRIu64 " episodes, R = %.6f",
-                  t.label.c_str(), t.run + 1, t.episodes, evo.members()[static_cast<std::size_t>(b)].fitness);
+                  t.label.c_str(), t.run + 1, t.episodes, evo.best_fitness());
     char err[QNAV_POLICY_IO_ERRLEN] = {0};
     if (qnav_policy_write(best_path.c_str(), &best, comment, err, sizeof err) != 0) {
         throw UserError(err);
@@ -700,13 +722,12 @@ bool run_task(const TaskDef &t, const std::string &source_policy_path, const Run
         return true;
     }
 
-    Evolution evo = source_policy_path.empty()
-                        ? Evolution(t.evolution, t.evolution_seed)
-                        : Evolution(t.evolution, t.evolution_seed, source);
-    if (!evolve(t, evo, *runner, held_out, journal_path, obs, stop)) {
+    const std::unique_ptr<Search> evo =
+        make_search(t.evolution, t.evolution_seed, source_policy_path.empty() ? nullptr : &source);
+    if (!evolve(t, *evo, *runner, held_out, journal_path, obs, stop)) {
         return false;
     }
-    const qnav_policy_t best = write_best_policy(t, evo, best_path);
+    const qnav_policy_t best = write_best_policy(t, *evo, best_path);
     if (t.eval_episodes > 0) {
         if (!run_eval(held_out, best, t, obs, stop)) {
             return false;
