@@ -130,6 +130,27 @@ static RunnerFactory fake_factory()
     return [](const Scenario &, uint64_t) -> std::unique_ptr<EpisodeRunner> { return std::make_unique<FakeRunner>(); };
 }
 
+/* Runs task t until `stop_at` episodes are reported (it must stop incomplete), appends
+ * `torn` to its journal as a kill in the middle of a write leaves half a line, and resumes
+ * it to the end. Returns the episodes replayed from the journal. */
+static uint64_t stop_tear_and_resume(const TaskDef &t, uint64_t stop_at, const char *torn)
+{
+    std::atomic<bool> stop{false};
+    uint64_t seen = 0;
+    assert_false(run_task(t, "", fake_factory(), stop_after(stop_at, seen, stop), stop));
+    assert_false(file_exists(join_path(t.dir, "done")));
+    assert_false(file_exists(join_path(t.dir, "best.policy")));
+    FILE *f = std::fopen(join_path(t.dir, "episodes.csv").c_str(), "a");
+    std::fputs(torn, f);
+    std::fclose(f);
+    uint64_t replayed = 0;
+    TaskObserver obs;
+    obs.episodes_done = [&](uint64_t n, bool r) { replayed += r ? n : 0; };
+    const std::atomic<bool> never{false};
+    assert_true(run_task(t, "", fake_factory(), obs, never));
+    return replayed;
+}
+
 static void test_task_stopped_and_resumed_matches_uninterrupted_bytes(void **state)
 {
     (void)state;
@@ -139,20 +160,7 @@ static void test_task_stopped_and_resumed_matches_uninterrupted_bytes(void **sta
     assert_true(run_task(a, "", fake_factory(), TaskObserver{}, never));
 
     TaskDef b = fake_task(join_path(root, "b"));
-    std::atomic<bool> stop{false};
-    uint64_t seen = 0;
-    assert_false(run_task(b, "", fake_factory(), stop_after(137, seen, stop), stop));
-    assert_false(file_exists(join_path(b.dir, "done")));
-    assert_false(file_exists(join_path(b.dir, "best.policy")));
-    // A kill in the middle of a write leaves half a line behind.
-    FILE *f = std::fopen(join_path(b.dir, "episodes.csv").c_str(), "a");
-    std::fputs("137,-3.2500000", f);
-    std::fclose(f);
-    uint64_t replayed = 0;
-    TaskObserver obs2;
-    obs2.episodes_done = [&](uint64_t n, bool r) { replayed += r ? n : 0; };
-    assert_true(run_task(b, "", fake_factory(), obs2, never));
-    assert_int_equal(replayed, 137); // resumed from the journal, not re-simulated
+    assert_int_equal(stop_tear_and_resume(b, 137, "137,-3.2500000"), 137); // from the journal, not re-simulated
 
     for (const char *name : {"episodes.csv", "best.policy", "eval.csv", "task.txt", "done"}) {
         assert_true(slurp(join_path(a.dir, name)) == slurp(join_path(b.dir, name)));
@@ -234,17 +242,7 @@ static void test_es_task_shares_worlds_per_iteration_and_resumes_to_identical_by
     assert_true(slurp(join_path(a.dir, "task.txt")).find(" algorithm=es es_pairs=3 ") != std::string::npos);
 
     TaskDef b = es_task("b");
-    std::atomic<bool> stop{false};
-    uint64_t seen = 0;
-    assert_false(run_task(b, "", fake_factory(), stop_after(37, seen, stop), stop));
-    FILE *f = std::fopen(join_path(b.dir, "episodes.csv").c_str(), "a");
-    std::fputs("19,-3.25", f);
-    std::fclose(f);
-    uint64_t replayed = 0;
-    TaskObserver obs2;
-    obs2.episodes_done = [&](uint64_t n, bool r) { replayed += r ? n : 0; };
-    assert_true(run_task(b, "", fake_factory(), obs2, never));
-    assert_int_equal(replayed, 38); // 19 steps of 2 from the journal, mid-iteration
+    assert_int_equal(stop_tear_and_resume(b, 37, "19,-3.25"), 38); // 19 steps of 2, mid-iteration
     for (const char *name : {"episodes.csv", "best.policy", "eval.csv", "task.txt", "done"}) {
         assert_true(slurp(join_path(a.dir, name)) == slurp(join_path(b.dir, name)));
     }

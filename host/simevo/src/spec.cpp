@@ -8,6 +8,7 @@
 #include <algorithm>
 
 #include <cmath>
+#include <initializer_list>
 #include <set>
 #include <sstream>
 
@@ -346,21 +347,30 @@ void parse_scenario_rules(const Parser &p, const toml::table &t, ExperimentSpec 
     }
 }
 
+/* A value that must be one of `values`, spelled as name() spells them. Throws UserError
+ * "KEY: 'VALUE' is not one of A, B". */
+template <typename E>
+E parse_named(const Parser &p, const toml::node &v, const char *key, std::initializer_list<E> values,
+              const char *(*name)(E))
+{
+    const std::string s = p.str(v, key);
+    std::string known;
+    for (E e : values) {
+        if (s == name(e)) {
+            return e;
+        }
+        known += (known.empty() ? "" : ", ") + std::string(name(e));
+    }
+    p.fail(v, std::string(key) + ": '" + s + "' is not one of " + known);
+}
+
 /* [evolution]'s choice of search and the evolution strategy's settings. Throws UserError. */
 void parse_search(const Parser &p, const toml::table &t, EvolutionParams &e)
 {
     if (auto *v = t.get("algorithm")) {
-        const std::string s = p.str(*v, "algorithm");
-        bool known = false;
-        for (auto a : {EvolutionParams::Algorithm::EpsilonGreedy, EvolutionParams::Algorithm::Es}) {
-            if (s == algorithm_name(a)) {
-                e.algorithm = a;
-                known = true;
-            }
-        }
-        if (!known) {
-            p.fail(*v, "algorithm: '" + s + "' is not one of epsilon-greedy, es");
-        }
+        e.algorithm = parse_named(p, *v, "algorithm",
+                                  {EvolutionParams::Algorithm::EpsilonGreedy, EvolutionParams::Algorithm::Es},
+                                  algorithm_name);
     }
     if (auto *v = t.get("es_pairs")) {
         e.es_pairs = static_cast<uint32_t>(p.integer(*v, "es_pairs", 1, 10000));
@@ -412,30 +422,12 @@ void parse_evolution(const Parser &p, const toml::table &root, ExperimentSpec &s
             e.reevaluate_parent = *v->value<bool>();
         }
         if (auto *v = t.get("init")) {
-            const std::string s = p.str(*v, "init");
-            bool known = false;
-            for (InitKind k : {InitKind::Cauchy, InitKind::Uniform}) {
-                if (s == init_kind_name(k)) {
-                    e.init = k;
-                    known = true;
-                }
-            }
-            if (!known) {
-                p.fail(*v, "init: '" + s + "' is not one of cauchy, uniform");
-            }
+            e.init = parse_named(p, *v, "init", {InitKind::Cauchy, InitKind::Uniform}, init_kind_name);
         }
         if (auto *v = t.get("world_sets")) {
-            const std::string s = p.str(*v, "world_sets");
-            bool known = false;
-            for (auto w : {EvolutionParams::WorldSets::PerStep, EvolutionParams::WorldSets::PerGeneration}) {
-                if (s == world_sets_name(w)) {
-                    e.world_sets = w;
-                    known = true;
-                }
-            }
-            if (!known) {
-                p.fail(*v, "world_sets: '" + s + "' is not one of per-step, per-generation");
-            }
+            e.world_sets = parse_named(p, *v, "world_sets",
+                                       {EvolutionParams::WorldSets::PerStep, EvolutionParams::WorldSets::PerGeneration},
+                                       world_sets_name);
         }
         if (auto *v = t.get("init_scale")) {
             e.init_scale = p.number(*v, "init_scale", 1e-6, 128.0);
