@@ -5,7 +5,7 @@ Usage: plot_learning.py EXPERIMENT_DIR [OUT.png]
 
 Reads EXPERIMENT_DIR/curves.csv and summary.json (written by `simevo run`) and draws, per
 condition, the mean over runs with its 95% confidence band of (left) the population's best
-fitness, (middle) the R of the candidates (binned) and (right) the fraction of the
+fitness (an evolution strategy's centre's R), (middle) the R of the candidates (binned) and (right) the fraction of the
 candidates' episodes that reached the destination (binned); the references (summary.json
 "references": simevo's reference table, e.g. the probabilistic policy dashed and VFH+
 dotted) are horizontal bands (their mean and 95% CI on the held-out episodes). The legends and the arrival panel's title say which line is
@@ -41,9 +41,12 @@ def draw(summary, curves):
     for i, k in enumerate(transfer):
         colors[k] = palette[i % len(palette)]
     per_candidate = summary.get("episodes_per_candidate", 1)
+    es = summary.get("algorithm") == "es"  # an evolution strategy: a centre, no population
     panels = (
-        (axes[0], "best", "population's best fitness R (mean over runs)", "final_mean", 1.0,
-         "best fitness during evolution", "R on held-out episodes"),
+        (axes[0], "best", ("centre's R on its iteration's episodes" if es else "population's best fitness R")
+         + " (mean over runs)", "final_mean", 1.0,
+         "evolution strategy's centre during evolution" if es else "best fitness during evolution",
+         "R on held-out episodes"),
         (axes[1], "", f"candidates' R ({summary['curve_bin']}-episode bins, k = {per_candidate}, mean over runs)",
          "final_mean", 1.0, "candidates' R during evolution", "R on held-out episodes"),
         (axes[2], "arrival", "episodes that arrived (%)", "arrival", 100.0,
@@ -56,7 +59,8 @@ def draw(summary, curves):
             if k not in curves:
                 continue
             c = curves[k]
-            label = k.replace("transfer-", "transfer from ") if k != "direct" else "direct (random population)"
+            label = (k.replace("transfer-", "transfer from ") if k != "direct"
+                     else "direct (random network)" if es else "direct (random population)")
             if prefix == "arrival":
                 label += ": candidates"
             ax.plot(c["episode"], [v * scale for v in c[m_key]], color=colors[k], lw=1.8, label=label)

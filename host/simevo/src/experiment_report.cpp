@@ -172,7 +172,8 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
       << ",\n  \"figure\": " << json_str(spec.figure) << ",\n  \"preset\": " << json_str(opt.preset)
       << ",\n  \"runs\": " << spec.runs << ",\n  \"episodes\": " << spec.target_episodes
       << ",\n  \"eval_episodes\": " << spec.eval_episodes << ",\n  \"curve_bin\": " << spec.curve_bin
-      << ",\n  \"episodes_per_candidate\": " << S.k << ",\n  \"fitness\": "
+      << ",\n  \"episodes_per_candidate\": " << S.k
+      << ",\n  \"algorithm\": " << json_str(algorithm_name(spec.evolution.algorithm)) << ",\n  \"fitness\": "
       << json_str(qnav_sim_fitness_rule_name(spec.target.fitness))
       << ",\n  \"controller\": " << json_str(controller_reading_name(spec.target.controller))
       << ",\n  \"arrival_threshold\": " << json_num(S.arrival_threshold)
