@@ -12,8 +12,9 @@
  *   eval.csv      held-out episodes of the best (or probabilistic) policy (atomic)
  *   eval-vfh.csv  the reference task only: VFH+ on the same held-out episodes (atomic)
  *   done          written last (atomic): the task is complete
- * Resuming replays the journal through Evolution (same draws, recorded R values) without
- * simulating, so the finished files equal those of an uninterrupted run byte for byte.
+ * Resuming replays the journal through the search (evolution.h: same draws, recorded R
+ * values) without simulating, so the finished files equal those of an uninterrupted run
+ * byte for byte.
  */
 #ifndef QNAV_SIMEVO_TASK_H
 #define QNAV_SIMEVO_TASK_H
@@ -75,7 +76,7 @@ struct TaskDef {
     uint64_t episodes = 0;           /* evolution budget in simulated candidate episodes:
                                         task_steps() steps of k episodes each */
     EvolutionParams evolution;
-    uint64_t evolution_seed = 0;     /* seeds the Evolution's Rng */
+    uint64_t evolution_seed = 0;     /* seeds the search's Rng */
     uint64_t episode_seed_base = 0;  /* episode j of step s runs with mix_seed(base, s*k+j),
                                         for the candidate and the re-evaluated parent */
     int source_task = -1;            /* index of the task whose best.policy seeds this */
