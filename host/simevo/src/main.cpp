@@ -552,7 +552,7 @@ struct EvolveCommand {
     uint64_t ev_episodes = 1000, ev_seed = 1;
     uint32_t ev_eval = 50;
     std::string fitness;
-    std::string algorithm = "epsilon-greedy";
+    std::string algorithm = algorithm_name(EvolutionParams::Algorithm::EpsilonGreedy);
     EvolutionParams ep;
 };
 
@@ -578,7 +578,9 @@ CLI::App *add_evolve_command(CLI::App &app, EvolveCommand &c)
     evolve->add_option("--per-candidate,--episodes-per-candidate", c.ep.episodes_per_candidate, "episodes averaged per fitness value")->capture_default_str();
     evolve->add_flag("--reevaluate-parent", c.ep.reevaluate_parent, "also re-run the parent each step (noisy fitness)");
     evolve->add_option("--algorithm", c.algorithm, "search: epsilon-greedy (the paper's) or es (evolution strategy)")
-        ->capture_default_str()->check(CLI::IsMember({"epsilon-greedy", "es"}));
+        ->capture_default_str()
+        ->check(CLI::IsMember({algorithm_name(EvolutionParams::Algorithm::EpsilonGreedy),
+                               algorithm_name(EvolutionParams::Algorithm::Es)}));
     evolve->add_option("--es-pairs", c.ep.es_pairs, "es: antithetic pairs per iteration")->capture_default_str();
     evolve->add_option("--es-sigma", c.ep.es_sigma, "es: perturbation SD, weight units")->capture_default_str();
     evolve->add_option("--es-step", c.ep.es_step, "es: Adam step, weight units")->capture_default_str();
@@ -596,7 +598,9 @@ TaskDef evolve_task(const EvolveCommand &c)
     t.context_seed = c.ev_seed;
     t.episodes = c.ev_episodes;
     t.evolution = c.ep;
-    t.evolution.algorithm = c.algorithm == "es" ? EvolutionParams::Algorithm::Es : EvolutionParams::Algorithm::EpsilonGreedy;
+    t.evolution.algorithm = c.algorithm == algorithm_name(EvolutionParams::Algorithm::Es)
+                                ? EvolutionParams::Algorithm::Es
+                                : EvolutionParams::Algorithm::EpsilonGreedy;
     t.evolution_seed = mix_seed(c.ev_seed, 1);
     t.episode_seed_base = mix_seed(c.ev_seed, 2);
     t.eval_episodes = c.ev_eval;
