@@ -26,6 +26,7 @@
 #define STEP_SIDE 10u
 #define STEP_DIAG 14u
 #define NOT_QUEUED UINT16_C(0xFFFF)
+typedef char unreached_and_not_queued_are_all_ones[QNAV_MAP_UNREACHED == 0xFFFFu && NOT_QUEUED == 0xFFFFu ? 1 : -1];
 #define MAX_CELLS UINT32_C(65000)
 
 void qnav_map_config_default(qnav_map_config_t *cfg)
@@ -198,17 +199,12 @@ static int32_t direction_cdeg(int32_t x, int32_t y)
     return y < 0 ? (int32_t)(36000u - a) % 36000 : (int32_t)a;
 }
 
-/* The sector whose wedge holds robot-frame direction a (0.01 deg). */
+/* The sector whose wedge holds robot-frame direction a, 0..35999 (0.01 deg). */
 static uint16_t sector_of(const qnav_map_t *m, int32_t a_cdeg)
 {
-    int32_t a = a_cdeg % INT32_C(36000);
-    uint32_t k;
-    if (a < 0) {
-        a += INT32_C(36000);
-    }
-    /* sector k is centred on k * 360 / N: round a * N / 360 deg */
-    k = ((uint32_t)a * m->n_sectors + 18000u) / 36000u;
-    return (uint16_t)(k % m->n_sectors);
+    /* sector k is centred on k * 360 / N: round a * N / 360 deg (a in [0, 36000)) */
+    const uint32_t k = ((uint32_t)a_cdeg * m->n_sectors + 18000u) / 36000u;
+    return (uint16_t)(k == m->n_sectors ? 0u : k);
 }
 
 /* How far robot-frame direction a (0.01 deg) lies from sector k's centre, 0.01 deg. */
@@ -252,16 +248,28 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
     cell_of(m, pose->x_mm + reach, pose->y_mm + reach, &i1, &j1);
     for (j = j0; j <= j1; ++j) {
         const int32_t dy = centre_y(m, j) - pose->y_mm;
+        const int64_t dy2 = (int64_t)dy * dy;
+        int8_t *row = &m->evidence[at_cell(m, 0, j)];
+        int32_t dx = centre_x(m, i0) - pose->x_mm - (int32_t)m->cfg.cell_mm;
+        if (dy2 > reach2) {
+            continue;
+        }
         for (i = i0; i <= i1; ++i) {
-            const int32_t dx = centre_x(m, i) - pose->x_mm;
-            const int64_t d2 = (int64_t)dx * dx + (int64_t)dy * dy;
-            int8_t *c = &m->evidence[at_cell(m, i, j)];
+            int64_t d2;
+            int8_t *c = &row[i];
             uint16_t k;
             int32_t rc, tol, lo, rel;
+            dx += (int32_t)m->cfg.cell_mm;
+            if (*c == EVIDENCE_FREE_MIN || *c == EVIDENCE_REFUSED) {
+                continue; /* no reading changes it: free at its floor, or refused */
+            }
+            d2 = (int64_t)dx * dx + dy2;
             if (d2 > reach2 || d2 == 0) {
                 continue;
             }
+            /* heading is in [-18000, 18000): rel in (-18000, 54000) before the wrap */
             rel = direction_cdeg(dx, dy) - heading;
+            rel += rel < 0 ? INT32_C(36000) : (rel >= INT32_C(36000) ? -INT32_C(36000) : 0);
             k = sector_of(m, rel);
             rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
             if (ranges_mm[k] >= m->max_range_mm) {
@@ -293,16 +301,19 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
  */
 #define QUEUE_HEAD UINT16_C(0xFFFE) /* prev[] of the first cell of its bucket */
 #define QUEUE_END UINT16_C(0xFFFF)  /* next[] of the last cell of its bucket */
-#define BUCKETS (STEP_DIAG + 255u + 1u)
+typedef char buckets_fit_the_largest_step[QNAV_MAP_BUCKETS == STEP_DIAG + 255u + 1u ? 1 : -1];
 
-typedef struct {
-    uint16_t head[BUCKETS];
-    uint16_t count; /* buckets in use: the largest step + 1 */
-} buckets_t;
-
-static void queue_push(qnav_map_t *m, buckets_t *q, uint16_t cell)
+/* The bucket of a queued cost: costs queued lie in [q_cost, q_cost + q_count), and q_cost's
+ * bucket is q_slot (q_cost mod q_count, kept without a division). */
+static uint32_t bucket_of(const qnav_map_t *m, uint32_t cost)
 {
-    uint16_t *head = &q->head[m->cost[cell] % q->count];
+    const uint32_t b = m->q_slot + (cost - m->q_cost);
+    return b >= m->q_count ? b - m->q_count : b;
+}
+
+static void queue_push(qnav_map_t *m, uint16_t cell)
+{
+    uint16_t *head = &m->q_head[bucket_of(m, m->cost[cell])];
     m->next[cell] = *head;
     m->prev[cell] = QUEUE_HEAD;
     if (*head != QUEUE_END) {
@@ -311,11 +322,11 @@ static void queue_push(qnav_map_t *m, buckets_t *q, uint16_t cell)
     *head = cell;
 }
 
-static void queue_unlink(qnav_map_t *m, buckets_t *q, uint16_t cell)
+static void queue_unlink(qnav_map_t *m, uint16_t cell)
 {
     const uint16_t prev = m->prev[cell], next = m->next[cell];
     if (prev == QUEUE_HEAD) {
-        q->head[m->cost[cell] % q->count] = next;
+        m->q_head[bucket_of(m, m->cost[cell])] = next;
     } else {
         m->next[prev] = next;
     }
@@ -337,98 +348,206 @@ static void mark_blocked(qnav_map_t *m)
     const int32_t n = (outer + cell - 1) / cell;
     const int64_t r2 = (int64_t)m->inflate_mm * m->inflate_mm;
     const int64_t o2 = (int64_t)outer * outer;
+    const int32_t nx = (int32_t)m->nx, ny = (int32_t)m->ny;
     int32_t i, j, a, b;
     memset(m->blocked, 0, (size_t)cell_count(m));
-    for (j = 0; j < (int32_t)m->ny; ++j) {
-        for (i = 0; i < (int32_t)m->nx; ++i) {
+    for (j = 0; j < ny; ++j) {
+        for (i = 0; i < nx; ++i) {
+            /* the disc of radius n cells about (i, j), cut to the map */
+            const int32_t a0 = i < n ? -i : -n, a1 = nx - 1 - i < n ? nx - 1 - i : n;
+            const int32_t b0 = j < n ? -j : -n, b1 = ny - 1 - j < n ? ny - 1 - j : n;
             if (m->evidence[at_cell(m, i, j)] < QNAV_MAP_OCCUPIED) {
                 continue;
             }
-            for (b = -n; b <= n; ++b) {
-                for (a = -n; a <= n; ++a) {
-                    const int32_t ii = i + a, jj = j + b;
-                    const int64_t d2 = (int64_t)(a * a + b * b) * cell * cell;
-                    uint8_t *c;
-                    if (!in_map(m, ii, jj) ||
-                        d2 > o2) {
-                        continue;
+            for (b = b0; b <= b1; ++b) {
+                uint8_t *row = &m->blocked[at_cell(m, i, j + b)];
+                const int64_t bb = (int64_t)b * b * cell * cell;
+                for (a = a0; a <= a1; ++a) {
+                    const int64_t d2 = bb + (int64_t)a * a * cell * cell;
+                    if (d2 <= r2) {
+                        row[a] = BLOCKED;
+                    } else if (d2 <= o2 && row[a] < NEAR) {
+                        row[a] = NEAR;
                     }
-                    c = &m->blocked[at_cell(m, ii, jj)];
-                    *c = d2 <= r2 ? BLOCKED : (*c > NEAR ? *c : NEAR);
                 }
             }
         }
     }
 }
 
-void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
+/* A new plan: every cell unreached but the destination's, queued. Cells are settled by
+ * settle_one(), as far as they are needed. */
+static void plan_start(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
 {
-    buckets_t q;
-    uint32_t n, c, queued = 1u, d = 0u;
+    uint32_t n = cell_count(m), c;
     int32_t gi, gj;
-    if (m == NULL || m->cost == NULL) {
-        return;
-    }
-    n = cell_count(m);
     mark_blocked(m);
-    for (c = 0; c < n; ++c) {
-        m->cost[c] = QNAV_MAP_UNREACHED;
-        m->prev[c] = NOT_QUEUED;
-    }
-    q.count = (uint16_t)(STEP_DIAG + m->cfg.near_cost + 1u);
-    for (c = 0; c < q.count; ++c) {
-        q.head[c] = QUEUE_END;
+    /* every cost QNAV_MAP_UNREACHED, every cell NOT_QUEUED: both all ones */
+    memset(m->cost, 0xFF, (size_t)n * sizeof m->cost[0]);
+    memset(m->prev, 0xFF, (size_t)n * sizeof m->prev[0]);
+    m->q_count = (uint16_t)(STEP_DIAG + m->cfg.near_cost + 1u);
+    for (c = 0; c < m->q_count; ++c) {
+        m->q_head[c] = QUEUE_END;
     }
     cell_of(m, goal_x_mm, goal_y_mm, &gi, &gj);
     c = at_cell(m, gi, gj);
     m->cost[c] = 0u;
-    queue_push(m, &q, (uint16_t)c);
-    while (queued > 0u) {
-        uint16_t at;
-        int32_t i, j, a, b;
-        while (q.head[d % q.count] == QUEUE_END) {
-            d++;
-        }
-        at = q.head[d % q.count];
-        queue_unlink(m, &q, at);
-        queued--;
-        i = (int32_t)(at % m->nx);
-        j = (int32_t)(at / m->nx);
-        for (b = -1; b <= 1; ++b) {
-            for (a = -1; a <= 1; ++a) {
-                const int32_t ii = i + a, jj = j + b;
-                uint32_t to;
-                uint32_t nc;
-                if ((a == 0 && b == 0) || !in_map(m, ii, jj)) {
-                    continue;
-                }
-                to = at_cell(m, ii, jj);
-                if (m->blocked[to] == BLOCKED ||
-                    (a != 0 && b != 0 &&
-                     (m->blocked[at_cell(m, ii, j)] == BLOCKED ||
-                      m->blocked[at_cell(m, i, jj)] == BLOCKED))) {
-                    continue;
-                }
-                nc = (uint32_t)m->cost[at] + (a != 0 && b != 0 ? STEP_DIAG : STEP_SIDE) +
-                     (m->blocked[to] == NEAR ? m->cfg.near_cost : 0u);
-                if (nc >= m->cost[to]) {
-                    continue;
-                }
-                if (m->prev[to] != NOT_QUEUED) {
-                    queue_unlink(m, &q, (uint16_t)to);
-                    queued--;
-                }
-                m->cost[to] = (uint16_t)(nc >= QNAV_MAP_UNREACHED ? QNAV_MAP_UNREACHED - 1u : nc);
-                queue_push(m, &q, (uint16_t)to);
-                queued++;
-            }
-        }
-    }
+    m->q_cost = 0u;
+    m->q_slot = 0u;
+    queue_push(m, (uint16_t)c);
+    m->q_queued = 1u;
     m->goal_x_mm = goal_x_mm;
     m->goal_y_mm = goal_y_mm;
     m->planned = 1u;
     m->ticks = 0u;
     m->dirty = 0u;
+}
+
+/* Cell c's cost is final: taken from the queue. */
+static int settled(const qnav_map_t *m, uint32_t c)
+{
+    return m->cost[c] != QNAV_MAP_UNREACHED && m->prev[c] == NOT_QUEUED;
+}
+
+/* Lower cell 'to''s cost to 'here' + step (+ near_cost beside a wall) when that is less,
+ * and queue it; a blocked cell is never entered. */
+static inline void relax(qnav_map_t *m, uint32_t here, uint32_t to, uint32_t step)
+{
+    uint32_t nc;
+    if (m->blocked[to] == BLOCKED) {
+        return;
+    }
+    nc = here + step + (m->blocked[to] == NEAR ? m->cfg.near_cost : 0u);
+    if (nc >= m->cost[to]) {
+        return;
+    }
+    if (m->prev[to] != NOT_QUEUED) {
+        queue_unlink(m, (uint16_t)to);
+        m->q_queued--;
+    }
+    m->cost[to] = (uint16_t)(nc >= QNAV_MAP_UNREACHED ? QNAV_MAP_UNREACHED - 1u : nc);
+    queue_push(m, (uint16_t)to);
+    m->q_queued++;
+}
+
+/*
+ * One step of Dijkstra's from where the plan stopped: the cheapest queued cell, when its
+ * cost is at most 'bound', is taken from the queue (its cost final: *popped) and its 8
+ * neighbours relaxed (a diagonal only when neither cell it passes is blocked: no corner
+ * cutting); 0 when no queued cell costs that little. Cells leave the queue in order of
+ * cost, so when a cell is taken every cheaper cell has been: steepest descent from a taken
+ * cell sees the costs a whole plan would give.
+ */
+static inline int settle_one(qnav_map_t *m, uint32_t bound, uint16_t *popped)
+{
+    const uint32_t nx = m->nx;
+    uint32_t at, here, i, j;
+    int w, e, s, n;
+    if (m->q_queued == 0u) {
+        return 0;
+    }
+    while (m->q_head[m->q_slot] == QUEUE_END) {
+        m->q_cost++;
+        m->q_slot = (uint16_t)(m->q_slot + 1u == m->q_count ? 0u : m->q_slot + 1u);
+    }
+    if (m->q_cost > bound) {
+        return 0;
+    }
+    at = m->q_head[m->q_slot];
+    queue_unlink(m, (uint16_t)at);
+    m->q_queued--;
+    here = m->cost[at];
+    i = at % nx;
+    j = at / nx;
+    /* which neighbours exist, and which can be passed (for the diagonals) */
+    w = i > 0u;
+    e = i + 1u < nx;
+    s = j > 0u;
+    n = j + 1u < m->ny;
+    if (w) {
+        relax(m, here, at - 1u, STEP_SIDE);
+        w = m->blocked[at - 1u] != BLOCKED;
+    }
+    if (e) {
+        relax(m, here, at + 1u, STEP_SIDE);
+        e = m->blocked[at + 1u] != BLOCKED;
+    }
+    if (s) {
+        relax(m, here, at - nx, STEP_SIDE);
+        s = m->blocked[at - nx] != BLOCKED;
+    }
+    if (n) {
+        relax(m, here, at + nx, STEP_SIDE);
+        n = m->blocked[at + nx] != BLOCKED;
+    }
+    if (s && w) {
+        relax(m, here, at - nx - 1u, STEP_DIAG);
+    }
+    if (s && e) {
+        relax(m, here, at - nx + 1u, STEP_DIAG);
+    }
+    if (n && w) {
+        relax(m, here, at + nx - 1u, STEP_DIAG);
+    }
+    if (n && e) {
+        relax(m, here, at + nx + 1u, STEP_DIAG);
+    }
+    *popped = (uint16_t)at;
+    return 1;
+}
+
+/* The whole plan: every cell's cost final. */
+static void settle_all(qnav_map_t *m)
+{
+    uint16_t c;
+    while (settle_one(m, UINT32_MAX, &c)) {
+    }
+}
+
+/*
+ * Settle as much of the plan as the robot's cell (ri, rj) needs this tick: its own cost,
+ * or, when it is blocked (the robot stands near a wall) and so never reached, every cost
+ * cost_near() could choose in the 5 x 5 cells about it. Their least cost c is the first of
+ * them taken from the queue; cost_near() chooses at most c + 40 (4 cell sides away), and a
+ * cell costing more than c + 30 lies at least a side away, beyond c + 40: so cells up to
+ * c + 30 are settled, and cost_near() chooses as after a whole plan.
+ */
+static void settle_for(qnav_map_t *m, int32_t ri, int32_t rj)
+{
+    const uint32_t robot = at_cell(m, ri, rj);
+    uint32_t least = QNAV_MAP_UNREACHED;
+    uint16_t c;
+    int32_t a, b;
+    if (m->cost[robot] != QNAV_MAP_UNREACHED || m->blocked[robot] != BLOCKED) {
+        while (!settled(m, robot) && settle_one(m, UINT32_MAX, &c)) {
+        }
+        return; /* settled, or nothing queued: every cost final */
+    }
+    for (b = -2; b <= 2; ++b) {
+        for (a = -2; a <= 2; ++a) {
+            if (in_map(m, ri + a, rj + b) && settled(m, at_cell(m, ri + a, rj + b)) &&
+                m->cost[at_cell(m, ri + a, rj + b)] < least) {
+                least = m->cost[at_cell(m, ri + a, rj + b)];
+            }
+        }
+    }
+    while (least == QNAV_MAP_UNREACHED && settle_one(m, UINT32_MAX, &c)) {
+        const int32_t di = (int32_t)(c % m->nx) - ri, dj = (int32_t)(c / m->nx) - rj;
+        if (di >= -2 && di <= 2 && dj >= -2 && dj <= 2) {
+            least = m->cost[c];
+        }
+    }
+    while (least != QNAV_MAP_UNREACHED && settle_one(m, least + 3u * STEP_SIDE, &c)) {
+    }
+}
+
+void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
+{
+    if (m == NULL || m->cost == NULL) {
+        return;
+    }
+    plan_start(m, goal_x_mm, goal_y_mm);
+    settle_all(m);
 }
 
 /* The straight line between the centres of cells (i0, j0) and (i1, j1) crosses no blocked
@@ -491,10 +610,10 @@ static int plan_when_due(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
 {
     int again = 0;
     if (!m->planned || m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm) {
-        qnav_map_plan(m, goal_x_mm, goal_y_mm);
+        plan_start(m, goal_x_mm, goal_y_mm);
     } else if (++m->ticks >= m->cfg.plan_ticks) {
         if (m->dirty) {
-            qnav_map_plan(m, goal_x_mm, goal_y_mm);
+            plan_start(m, goal_x_mm, goal_y_mm);
             again = 1;
         }
         m->ticks = 0u;
@@ -590,6 +709,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     }
     replanned = plan_when_due(m, goal_x_mm, goal_y_mm);
     cell_of(m, pose->x_mm, pose->y_mm, &ri, &rj);
+    settle_for(m, ri, rj);
     cost = cost_near(m, ri, rj, &i, &j);
     if (cost == QNAV_MAP_UNREACHED) {
         m->last_mm = 0u;
@@ -657,8 +777,12 @@ int8_t qnav_map_evidence(const qnav_map_t *m, int32_t x_mm, int32_t y_mm)
     return k < 0 ? 0 : m->evidence[k];
 }
 
-uint16_t qnav_map_cost(const qnav_map_t *m, int32_t x_mm, int32_t y_mm)
+uint16_t qnav_map_cost(qnav_map_t *m, int32_t x_mm, int32_t y_mm)
 {
     const int32_t k = index_of(m, x_mm, y_mm);
-    return k < 0 ? QNAV_MAP_UNREACHED : m->cost[k];
+    if (k < 0) {
+        return QNAV_MAP_UNREACHED;
+    }
+    settle_all(m);
+    return m->cost[k];
 }

@@ -261,8 +261,12 @@ void Simulation::compute_scan() {
     scan_.prev_heading_cdeg = have_prev_ ? to_cdeg(prev_world_rad_ - hd) : 0;
     scan_.escape_clear = 0;
     scan_.escape_grow_mm = 0;
-    if (!map_mem_.empty()) guide_scan();
     if (profiling_) prof_.sonar_s += std::chrono::duration<double>(Clock::now() - t0).count();
+    if (!map_mem_.empty()) {
+        if (profiling_) t0 = Clock::now();
+        guide_scan();
+        if (profiling_) prof_.map_s += std::chrono::duration<double>(Clock::now() - t0).count();
+    }
 }
 
 // The map marks what this scan saw from the robot's pose and gives the controller the

@@ -34,6 +34,7 @@ struct SimConfig {
 // Where time went (only counted when profiling is on), seconds.
 struct SimProfile {
     double physics_s = 0, sonar_s = 0, controller_s = 0;
+    double map_s = 0;  // marking the map and planning over it (a profile with a map)
 };
 
 struct CollisionMark {

@@ -3,7 +3,7 @@
 // count and noise, prints the episode's figures (paper Eq. 1-3) and writes its picture;
 // `draw-env` draws an environment like the paper's Fig. 6; `gen-env` writes a world of a
 // family (worldgen.hpp) or a random environment of a given density; `bench` measures
-// episodes per second per core with the time split into physics, sonar and controller. Bad input: one line, non-zero exit.
+// episodes per second per core with the time split into physics, sonar, the map (when on) and controller. Bad input: one line, non-zero exit.
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -458,6 +458,19 @@ qnav_policy_t random_network(int hidden, std::uint64_t seed, std::uint64_t which
     return pol;
 }
 
+// The profiled pass's time split: shares of the wall time, then per tick.
+static void print_split(const qnav::SimProfile &p, double wall_p, std::uint64_t ticks) {
+    const double other = wall_p - p.physics_s - p.sonar_s - p.controller_s - p.map_s;
+    const double per_tick = 1e6 / static_cast<double>(ticks);
+    std::printf("time split (profiled pass, %.3f s): physics %.1f%%  sonar %.1f%%", wall_p,
+                100 * p.physics_s / wall_p, 100 * p.sonar_s / wall_p);
+    if (p.map_s > 0) std::printf("  map %.1f%%", 100 * p.map_s / wall_p);
+    std::printf("  controller %.1f%%  other %.1f%%\n", 100 * p.controller_s / wall_p, 100 * other / wall_p);
+    std::printf("per tick: physics %.2f us  sonar %.2f us", per_tick * p.physics_s, per_tick * p.sonar_s);
+    if (p.map_s > 0) std::printf("  map %.2f us", per_tick * p.map_s);
+    std::printf("  controller %.2f us\n", per_tick * p.controller_s);
+}
+
 int cmd_bench(const BenchOpts &o) {
     Loaded l;
     load(l, o.robot, o.env);
@@ -513,7 +526,6 @@ int cmd_bench(const BenchOpts &o) {
     double sum_r2;
     const double wall_p = pass(true, &ticks2, &sum_r2);
     const qnav::SimProfile p = sim.profile();
-    const double other = wall_p - p.physics_s - p.sonar_s - p.controller_s;
     std::printf("bench%s: robot %s  env %s  sectors %d  policy %s  controller %s mode  episodes %u  "
                 "noise %.3f/%.3f\n", o.reference ? " (reference: Box2D ray per degree, Box2D every tick)" : "",
                 o.robot.c_str(), sim.env().name.c_str(), o.sectors,
@@ -522,13 +534,7 @@ int cmd_bench(const BenchOpts &o) {
     std::printf("episodes/s per core: %.1f   (%.0f ticks/s, %.1f ticks/episode, %.2f us/tick, mean R %.3f)\n",
                 o.episodes / wall, static_cast<double>(ticks) / wall, static_cast<double>(ticks) / o.episodes,
                 1e6 * wall / static_cast<double>(ticks), sum_r / o.episodes);
-    std::printf("time split (profiled pass, %.3f s): physics %.1f%%  sonar %.1f%%  controller %.1f%%  "
-                "other %.1f%%\n",
-                wall_p, 100 * p.physics_s / wall_p, 100 * p.sonar_s / wall_p,
-                100 * p.controller_s / wall_p, 100 * other / wall_p);
-    std::printf("per tick: physics %.2f us  sonar %.2f us  controller %.2f us\n",
-                1e6 * p.physics_s / static_cast<double>(ticks2), 1e6 * p.sonar_s / static_cast<double>(ticks2),
-                1e6 * p.controller_s / static_cast<double>(ticks2));
+    print_split(p, wall_p, ticks2);
     if (o.fresh)
         std::printf("controller includes building each network (and its table): %.1f us/episode\n",
                     1e6 * build_s / o.episodes);

@@ -364,6 +364,96 @@ static void test_a_way_the_robot_cannot_take_is_refused_for_a_while(void **state
     assert_int_equal(ticks_until_unguided(0, &m), -1);
 }
 
+/* A copy of map src in buf (cells * 8 bytes): the same state, its own cells. */
+static void copy_map(qnav_map_t *dst, const qnav_map_t *src, uint16_t *buf)
+{
+    const size_t cells = (size_t)src->nx * src->ny;
+    *dst = *src;
+    dst->cost = buf;
+    dst->next = dst->cost + cells;
+    dst->prev = dst->next + cells;
+    dst->evidence = (int8_t *)(void *)(dst->prev + cells);
+    dst->blocked = (uint8_t *)(dst->evidence + cells);
+    memcpy(dst->cost, src->cost, cells * sizeof *src->cost);
+    memcpy(dst->next, src->next, cells * sizeof *src->next);
+    memcpy(dst->prev, src->prev, cells * sizeof *src->prev);
+    memcpy(dst->evidence, src->evidence, cells);
+    memcpy(dst->blocked, src->blocked, cells);
+}
+
+static uint16_t mem_full[CELLS_MAX * 4];
+
+/* A robot driven along a path that brushes past boxes (its own cell blocked, within the
+ * body's reach of what it has seen) decides every tick as it would from a whole plan:
+ * qnav_map_guide() settles the plan only as far as the robot's cell needs, and goes on
+ * from there on later ticks. The reference is a copy of the map taken each tick before
+ * the guide, its plan finished first (qnav_map_cost finishes it). */
+static void drive_against_a_whole_plan(uint8_t plan_ticks)
+{
+    static const box_t boxes[] = {{1000, 1000, 1800, 1600}, {2500, 2200, 3200, 2600},
+                                  {3800, 1000, 4400, 3200}, {1200, 3600, 2600, 4200},
+                                  {4000, 4200, 5200, 4700}};
+    static const int32_t path[][2] = {{500, 500},   {880, 1700},  {2400, 2080},
+                                      {3690, 2400}, {3690, 4000}, {2700, 4320},
+                                      {1100, 4300}, {3000, 5300}, {5400, 5400}};
+    qnav_map_t m, full;
+    qnav_ctrl_input_t in, in_full;
+    qnav_map_config_t mc;
+    size_t w, c, settled = 0;
+    int ticks = 0, guided = 0;
+    qnav_map_config_default(&mc);
+    mc.plan_ticks = plan_ticks;
+    map_from(&m, &mc);
+    memset(&in, 0, sizeof in);
+    in_full = in;
+    for (w = 0; w + 1 < sizeof path / sizeof path[0]; ++w) {
+        const int32_t dx = path[w + 1][0] - path[w][0], dy = path[w + 1][1] - path[w][1];
+        uint32_t length;
+        const int32_t heading = qnav_atan2_cdeg(dy, dx, &length);
+        const int32_t steps = ((int32_t)length + 79) / 80; /* 80 mm a tick */
+        int32_t s;
+        for (s = 0; s < steps; ++s) {
+            const qnav_map_pose_t p = {path[w][0] + dx * s / steps, path[w][1] + dy * s / steps,
+                                       heading};
+            qnav_mm_t ranges[N];
+            int got, got_full;
+            scan(boxes, sizeof boxes / sizeof boxes[0], &p, ranges);
+            qnav_map_observe(&m, ranges, &p);
+            copy_map(&full, &m, mem_full);
+            (void)qnav_map_cost(&full, 0, 0);
+            got = qnav_map_guide(&m, &p, 5600, 5600, &in);
+            got_full = qnav_map_guide(&full, &p, 5600, 5600, &in_full);
+            assert_int_equal(got, got_full);
+            assert_int_equal(in.goal_bearing_cdeg, in_full.goal_bearing_cdeg);
+            assert_int_equal(in.goal_range_mm, in_full.goal_range_mm);
+            assert_memory_equal(&in.escape, &in_full.escape, sizeof in.escape);
+            /* every cost the guide settled is the whole plan's (a white-box look: a
+             * settled cell has a cost and is out of the queue) */
+            copy_map(&full, &m, mem_full);
+            (void)qnav_map_cost(&full, 0, 0);
+            for (c = 0; c < (size_t)m.nx * m.ny; ++c) {
+                if (m.cost[c] != QNAV_MAP_UNREACHED && m.prev[c] == UINT16_C(0xFFFF)) {
+                    assert_int_equal(m.cost[c], full.cost[c]);
+                    settled++;
+                }
+            }
+            ticks++;
+            guided += (got & QNAV_MAP_GUIDED) != 0;
+        }
+    }
+    print_message("plan every %u ticks: %d ticks, %d guided, %.0f of %u cells settled a tick\n",
+                  plan_ticks, ticks, guided, (double)settled / ticks, (unsigned)m.nx * m.ny);
+    assert_true(guided > ticks / 2);
+    assert_true(settled < (size_t)ticks * m.nx * m.ny); /* the guide did not plan it all */
+}
+
+static void test_the_plan_is_settled_as_far_as_the_robot_needs(void **state)
+{
+    (void)state;
+    drive_against_a_whole_plan(1);
+    drive_against_a_whole_plan(10);
+}
+
 static void test_bad_maps_are_refused(void **state)
 {
     qnav_map_t m;
@@ -411,6 +501,7 @@ int main(void)
         cmocka_unit_test(test_the_destination_in_reach_is_flagged_direct),
         cmocka_unit_test(test_a_destination_walled_in_leaves_the_input_alone),
         cmocka_unit_test(test_a_way_the_robot_cannot_take_is_refused_for_a_while),
+        cmocka_unit_test(test_the_plan_is_settled_as_far_as_the_robot_needs),
         cmocka_unit_test(test_bad_maps_are_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

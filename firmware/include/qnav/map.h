@@ -68,6 +68,9 @@ typedef struct {
     int32_t heading_cdeg;  /* direction of the robot's straight ahead (sector 0), any value */
 } qnav_map_pose_t;
 
+/* Buckets of the plan's queue: the largest step (14 + near_cost) + 1. */
+#define QNAV_MAP_BUCKETS 270u
+
 /* One map. Private fields: read them through the functions below. */
 typedef struct {
     qnav_map_config_t cfg;
@@ -91,6 +94,13 @@ typedef struct {
     uint16_t stall_best_mm;   /* the least planned distance since the last refusal */
     uint16_t stall_ticks;     /* guided ticks since it last shrank by a cell */
     uint16_t refused_ticks;   /* ticks the refused cells have left; 0: none */
+    /* The plan's queue, kept between ticks: a plan settles cells only until the robot's
+     * is settled, and goes on from here when the robot stands on a cell not yet settled */
+    uint16_t q_head[QNAV_MAP_BUCKETS];
+    uint16_t q_count;         /* buckets in use */
+    uint16_t q_slot;          /* q_cost's bucket */
+    uint32_t q_cost;          /* the least cost still queued may be this */
+    uint32_t q_queued;        /* cells queued */
 } qnav_map_t;
 
 /* Evidence at or above this marks a cell occupied. */
@@ -122,7 +132,8 @@ void qnav_map_reset(qnav_map_t *m);
 void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *pose);
 
 /* Plan every cell's cost to the destination over what the map has seen (unknown cells
- * passable). At most 8 queue operations per cell. */
+ * passable). At most 8 queue operations per cell. (qnav_map_guide plans only as far as it
+ * needs: the same costs where it looks.) */
 void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm);
 
 /* What qnav_map_guide() did. */
@@ -153,9 +164,10 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
 uint16_t qnav_map_grown_mm(const qnav_map_t *m);
 
 /* A cell's evidence (< 0 free, >= QNAV_MAP_OCCUPIED occupied) and plan cost; for tests
- * and pictures. Out of the map: 0 and QNAV_MAP_UNREACHED. */
+ * and pictures. Out of the map: 0 and QNAV_MAP_UNREACHED. qnav_map_cost first finishes
+ * the plan qnav_map_guide() settled only as far as it needed. */
 int8_t qnav_map_evidence(const qnav_map_t *m, int32_t x_mm, int32_t y_mm);
-uint16_t qnav_map_cost(const qnav_map_t *m, int32_t x_mm, int32_t y_mm);
+uint16_t qnav_map_cost(qnav_map_t *m, int32_t x_mm, int32_t y_mm);
 
 #ifdef __cplusplus
 }
