@@ -24,6 +24,7 @@ extern "C" {
 #include "evolution.h"
 #include "experiment.h"
 #include "fake_runner.h"
+#include "fit.h"
 #include "heldout.h"
 #include "rng.h"
 #include "spec.h"
@@ -436,6 +437,56 @@ static void test_spec_parses_inheritance_and_presets(void **state)
     assert_int_equal(s.target_episodes, 10);
 }
 
+/* A fitted network holds the probabilistic policy's quality (the full fit, 8 starts of 6 000
+ * steps at 12 units, is within 0.004 rms: docs/simevo.md), the same settings give the
+ * same network, and another seed another. */
+static void test_fit_holds_the_probabilistic_policy_and_is_deterministic(void **state)
+{
+    (void)state;
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_config_default(&cfg);
+    qnav_policy_t prob;
+    qnav_policy_prob_default(&prob);
+    FitSettings fs;
+    fs.hidden = 6;
+    fs.starts = 2;
+    fs.iterations = 1500;
+    const FitResult a = fit_network(cfg, prob, fs);
+    print_message("fit: rms %.4f, max %.4f\n", a.rms, a.max);
+    assert_int_equal(a.policy.kind, QNAV_POLICY_NET);
+    assert_int_equal(a.policy.u.net.hidden, 6);
+    assert_true(a.rms < 0.02);
+    assert_true(a.max < 0.1);
+    const FitResult b = fit_network(cfg, prob, fs);
+    assert_memory_equal(&a.policy, &b.policy, sizeof a.policy);
+    fs.seed = 2;
+    const FitResult c = fit_network(cfg, prob, fs);
+    assert_memory_not_equal(&a.policy.u.net, &c.policy.u.net, sizeof a.policy.u.net);
+    fs.hidden = 0;
+    try {
+        (void)fit_network(cfg, prob, fs);
+        fail_msg("0 hidden units were accepted");
+    } catch (const UserError &) {
+    }
+}
+
+/* `[[source]] fit = "probabilistic"` is a source without evolution; another value, or a
+ * policy file beside it, is one line naming the file and line. */
+static void test_spec_fit_source_parses_and_bad_values_fail(void **state)
+{
+    (void)state;
+    const ExperimentSpec s = parse_experiment(
+        "name = \"t\"\n[target]\nepisodes = 9\n[[source]]\nlabel = \"prob\"\nfit = \"probabilistic\"\n", "x.toml");
+    assert_string_equal(s.sources[0].fit.c_str(), "probabilistic");
+    assert_false(s.sources[0].evolved());
+    assert_true(s.sources[0].describe().find("fitted") != std::string::npos);
+    assert_true(parse_error("name = \"t\"\n[target]\nepisodes = 9\n[[source]]\nlabel = \"p\"\nfit = \"vfh\"\n")
+                    .find("x.toml:6: fit: 'vfh' is not 'probabilistic'") != std::string::npos);
+    assert_true(parse_error("name = \"t\"\n[target]\nepisodes = 9\n[[source]]\nlabel = \"p\"\nfit = \"probabilistic\"\n"
+                            "policy = \"a.policy\"\n")
+                    .find("give 'policy' or 'fit', not both") != std::string::npos);
+}
+
 static void test_spec_fitness_rule_reaches_every_scenario(void **state)
 {
     (void)state;
@@ -783,6 +834,8 @@ int main(void)
         cmocka_unit_test(test_t_critical_and_welch_match_tables),
         cmocka_unit_test(test_mann_whitney_separated_samples_are_significant),
         cmocka_unit_test(test_spec_parses_inheritance_and_presets),
+        cmocka_unit_test(test_fit_holds_the_probabilistic_policy_and_is_deterministic),
+        cmocka_unit_test(test_spec_fit_source_parses_and_bad_values_fail),
         cmocka_unit_test(test_spec_fitness_rule_reaches_every_scenario),
         cmocka_unit_test(test_spec_controller_reading_reaches_every_scenario_and_bad_names_fail),
         cmocka_unit_test(test_every_controller_reading_is_a_policy_row_of_the_controller_table),

@@ -757,6 +757,42 @@ static void test_program_rejects_bad_input_with_one_line(void **state)
     assert_one_line_containing(e, "no preset 'nope'");
 }
 
+/* A `fit` source: the run writes the network fitted to the target robot's probabilistic
+ * policy into the experiment's folder, the transfer starts from it, the summary names it,
+ * and a rerun finds the same file. `simevo fit` writes one and never overwrites a file. */
+static void test_fit_source_is_written_once_and_transfers_start_from_it(void **state)
+{
+    (void)state;
+    const std::string root = make_tmp_dir();
+    const std::string spec = join_path(root, "fitted.toml");
+    write_file_atomic(spec, "name = \"fitted\"\nruns = 1\nseed = 5\ncurve_bin = 10\n[evolution]\npopulation = 6\n"
+                            "hidden = 2\n[target]\nenvironment = \"dense\"\nrobot = \"tekbot\"\nsectors = 16\n"
+                            "episodes = 20\nepisode_limit_s = 15\n[[source]]\nlabel = \"prob\"\n"
+                            "fit = \"probabilistic\"\n[evaluation]\nepisodes = 2\nworlds_episodes = 1\n");
+    for (int pass = 0; pass < 2; ++pass) {
+        assert_int_equal(wait_exit(spawn({"run", spec, "--out", root, "--no-plot"}, join_path(root, "run.err"))), 0);
+    }
+    qnav_policy_t fitted;
+    char err[QNAV_POLICY_IO_ERRLEN];
+    assert_int_equal(qnav_policy_read(join_path(root, "fitted/source-prob.policy").c_str(), &fitted, err, sizeof err), 0);
+    assert_int_equal(fitted.kind, QNAV_POLICY_NET);
+    assert_int_equal(fitted.u.net.hidden, 2);
+    assert_non_null(std::strstr(slurp(join_path(root, "fitted/settings.txt")).c_str(), "\nsource=source-prob.policy\n"));
+    assert_non_null(std::strstr(slurp(join_path(root, "fitted/summary.md")).c_str(),
+                                "the network fitted to the target robot's probabilistic policy"));
+
+    const std::string out = join_path(root, "fit.policy");
+    assert_int_equal(wait_exit(spawn({"fit", "--robot", "tekbot", "--hidden", "2", "--starts", "1", "--iterations", "50",
+                                      "--out", out},
+                                     join_path(root, "fit.err"))),
+                     0);
+    assert_int_equal(qnav_policy_read(out.c_str(), &fitted, err, sizeof err), 0);
+    int st = 0;
+    const std::string e = run_for_error({"fit", "--out", out}, st);
+    assert_int_equal(st, 2);
+    assert_one_line_containing(e, (out + ": exists; not overwritten").c_str());
+}
+
 /* Issue 20: a value that ends an #SBATCH line (a newline in --partition, --time or the
  * output folder) became a shell command in tasks.sbatch; each is refused with one line
  * before any file is written, and a folder with a space or '#' is quoted in --output. */
@@ -891,7 +927,7 @@ static void test_program_command_line_names_unknown_options_and_subcommands(void
     e = run_for_error({"bogus"}, st);
     assert_int_equal(st, 2);
     assert_string_equal(e.c_str(),
-                        "simevo: bogus: unknown subcommand (known: run, summarize, slurm, list, evolve, eval, quality) (see simevo --help)\n");
+                        "simevo: bogus: unknown subcommand (known: run, summarize, slurm, list, evolve, eval, quality, fit) (see simevo --help)\n");
     e = run_for_error({"eval", "prob", "--bogus"}, st);
     assert_int_equal(st, 2);
     assert_one_line_containing(e, "--bogus");
@@ -1220,6 +1256,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_shares_in_separate_processes_merge_to_the_local_run_byte_for_byte),
         cmocka_unit_test(test_slurm_scripts_run_stage_two_after_stage_one_and_keep_foreign_files),
         cmocka_unit_test(test_slurm_refuses_values_that_would_break_an_sbatch_line),
+        cmocka_unit_test(test_fit_source_is_written_once_and_transfers_start_from_it),
         cmocka_unit_test(test_table_mode_and_network_mode_give_identical_results),
         cmocka_unit_test(test_atomic_write_never_follows_a_planted_symlink),
         cmocka_unit_test(test_plot_child_dies_when_simevo_is_killed),

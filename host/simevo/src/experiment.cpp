@@ -7,6 +7,7 @@
  */
 #include "experiment.h"
 
+#include <cstdio>
 #include <set>
 
 #include <unistd.h>
@@ -14,6 +15,8 @@
 #include "experiment_outputs.h"
 #include "experiment_report.h"
 #include "files.h"
+#include "fit.h"
+#include "qnav/policy_io.h"
 #include "sim_runner.h"
 
 namespace qnav {
@@ -38,10 +41,13 @@ std::string settings_text(const ExperimentSpec &spec, const std::vector<TaskDef>
 {
     std::string settings = "# simevo experiment " + spec.name + ": the settings of every task\n";
     for (const TaskDef &t : tasks) {
-        // a transfer's source policy does not exist yet: name the task that will make it
-        const std::string source = t.source_task >= 0
-                                       ? "best policy of " + tasks[static_cast<std::size_t>(t.source_task)].dir.substr(exp_dir.size() + 1)
-                                       : t.source_policy_file;
+        // a transfer's source policy does not exist yet: name the task that will make it;
+        // a fitted source lies in the folder: named within it, so the folder can move
+        const std::string in_folder = exp_dir + "/";
+        const std::string source =
+            t.source_task >= 0 ? "best policy of " + tasks[static_cast<std::size_t>(t.source_task)].dir.substr(exp_dir.size() + 1)
+            : t.source_policy_file.compare(0, in_folder.size(), in_folder) == 0 ? t.source_policy_file.substr(in_folder.size())
+                                                                                 : t.source_policy_file;
         settings += "\n[" + t.dir.substr(exp_dir.size() + 1) + "]\n" + task_settings_text(t, source);
     }
     return settings;
@@ -68,6 +74,44 @@ void probe_inputs(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks,
     }
 }
 
+/* The text of a policy file holding p with comment. Throws UserError. */
+std::string policy_text(const qnav_policy_t &p, const std::string &comment)
+{
+    char err[QNAV_POLICY_IO_ERRLEN] = {0};
+    const int n = qnav_policy_format(&p, nullptr, comment.c_str(), nullptr, 0, err, sizeof err);
+    if (n < 0) {
+        throw UserError(err);
+    }
+    std::string text(static_cast<std::size_t>(n) + 1, '\0');
+    if (qnav_policy_format(&p, nullptr, comment.c_str(), text.data(), text.size(), err, sizeof err) != n) {
+        throw UserError(err);
+    }
+    text.resize(static_cast<std::size_t>(n));
+    return text;
+}
+
+/* Each `fit` source's network, fitted to the target robot's probabilistic policy with the
+ * experiment's hidden units, written once into the experiment's folder (and compared with
+ * what is there on a rerun: the same settings fit the same network). */
+void write_fitted_sources(const ExperimentSpec &spec, const std::string &exp_dir, SimWorlds &worlds, bool use_table)
+{
+    for (const SourceSpec &s : spec.sources) {
+        if (s.fit.empty()) {
+            continue;
+        }
+        const SimRunner target(worlds, picture_scenario(spec.target), spec.seed, use_table);
+        FitSettings fs;
+        fs.hidden = static_cast<int>(spec.evolution.hidden);
+        const FitResult fit = fit_network(target.ctrl_config(), target.probabilistic_policy(), fs);
+        char comment[200];
+        std::snprintf(comment, sizeof comment,
+                      "simevo: %d hidden units fitted to %s's probabilistic policy (quality error rms %.4f, max %.4f)",
+                      fs.hidden, spec.target.robot.c_str(), fit.rms, fit.max);
+        write_or_compare(fitted_source_path(exp_dir, s), policy_text(fit.policy, comment),
+                         spec.name + "'s fitted source '" + s.label + "' from other settings");
+    }
+}
+
 } // namespace
 
 std::vector<TaskDef> prepare_experiment(const ExperimentSpec &spec, const RunOptions &opt)
@@ -87,6 +131,7 @@ std::vector<TaskDef> prepare_experiment(const ExperimentSpec &spec, const RunOpt
     }
     SimWorlds worlds;
     probe_inputs(spec, tasks, worlds, opt.use_table);
+    write_fitted_sources(spec, exp_dir, worlds, opt.use_table);
     return tasks;
 }
 

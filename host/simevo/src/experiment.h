@@ -45,6 +45,9 @@ std::vector<uint64_t> checkpoint_grid(const ExperimentSpec &spec);
 /* Tasks of an experiment, in an order where every source precedes its transfers. */
 std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &exp_dir);
 
+/* Where a `fit` source's network is written in the experiment's folder. */
+std::string fitted_source_path(const std::string &exp_dir, const SourceSpec &s);
+
 /* Run tasks on `jobs` threads; a task with source_task waits for it. Each task is locked
  * (flock on its folder's .lock) while it runs. selected (empty = all) names the tasks to
  * run; the others belong to other processes, and a selected transfer whose source is not

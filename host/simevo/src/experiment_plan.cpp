@@ -43,6 +43,11 @@ std::vector<uint64_t> checkpoint_grid(const ExperimentSpec &spec)
     return std::vector<uint64_t>(g.begin(), g.end());
 }
 
+std::string fitted_source_path(const std::string &exp_dir, const SourceSpec &s)
+{
+    return join_path(exp_dir, "source-" + s.label + ".policy");
+}
+
 std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &exp_dir)
 {
     std::vector<TaskDef> tasks;
@@ -78,7 +83,7 @@ std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &e
         const uint64_t target_episodes_base = mix_seed(run_seed, label_hash("episodes:target"));
         for (const SourceSpec &s : spec.sources) {
             int src_index = -1;
-            if (s.policy_file.empty()) {
+            if (s.evolved()) {
                 const std::string label = "source-" + s.label;
                 tasks.push_back(evolve(label, s.scenario, s.episodes,
                                        mix_seed(run_seed, label_hash("episodes:" + label))));
@@ -86,7 +91,7 @@ std::vector<TaskDef> plan_tasks(const ExperimentSpec &spec, const std::string &e
             }
             TaskDef tr = evolve(condition_label(ConditionKind::Transfer, s.label), spec.target, spec.target_episodes, target_episodes_base);
             tr.source_task = src_index;
-            tr.source_policy_file = s.policy_file;
+            tr.source_policy_file = s.fit.empty() ? s.policy_file : fitted_source_path(exp_dir, s);
             held_out(tr);
             tasks.push_back(tr);
         }

@@ -183,8 +183,7 @@ std::string summary_json(const ExperimentSpec &spec, const ExperimentSummary &S,
     for (std::size_t i = 0; i < spec.sources.size(); ++i) {
         const SourceSpec &s = spec.sources[i];
         o << (i ? ", " : "") << "{\"label\": " << json_str(s.label) << ", \"scenario\": "
-          << json_str(s.policy_file.empty() ? s.scenario.describe() : "policy file " + s.policy_file)
-          << ", \"episodes\": " << (s.policy_file.empty() ? s.episodes : 0) << "}";
+          << json_str(s.describe()) << ", \"episodes\": " << (s.evolved() ? s.episodes : 0) << "}";
     }
     o << "],\n  \"conditions\": [\n";
     for (std::size_t i = 0; i < S.conditions.size(); ++i) {
@@ -383,8 +382,7 @@ std::string summary_md(const ExperimentSpec &spec, const ExperimentSummary &S, c
     }
     for (const SourceSpec &s : spec.sources) {
         o << "Source `" << s.label << "`: "
-          << (s.policy_file.empty() ? s.scenario.describe() + ", " + std::to_string(s.episodes) + " episodes"
-                                    : "policy file " + s.policy_file)
+          << (s.evolved() ? s.describe() + ", " + std::to_string(s.episodes) + " episodes" : s.describe())
           << "\n\n";
     }
     o << "| condition | final R held out (mean ± 95% CI) | arrival held out (95% CI) | recovery ticks per episode (95% CI) | sd of R | candidates' R, first "

@@ -26,6 +26,7 @@
 #include "cluster.h"
 #include "experiment.h"
 #include "files.h"
+#include "fit.h"
 #include "heldout.h"
 #include "qnav/policy_io.h"
 #include "sim_runner.h"
@@ -686,6 +687,48 @@ int eval_command(const EvalCommand &c, bool &started)
     return 0;
 }
 
+/* `simevo fit`'s options: a network fitted to a robot's probabilistic policy. */
+struct FitCommand {
+    std::string robot = "tekbot", out;
+    uint32_t sectors = 0;
+    FitSettings fit;
+};
+
+CLI::App *add_fit_command(CLI::App &app, FitCommand &c)
+{
+    auto *fit = app.add_subcommand("fit", "write the network fitted to a robot's probabilistic policy (a start for evolution)");
+    fit->add_option("--robot", c.robot, "robot profile (name or file)")->capture_default_str();
+    fit->add_option("--sectors", c.sectors, "sonar sectors (0 = the profile's)")->check(CLI::Range(0, 360));
+    fit->add_option("--hidden", c.fit.hidden, "hidden units")->capture_default_str()->check(CLI::Range(1, QNAV_MAX_HIDDEN));
+    fit->add_option("--starts", c.fit.starts, "random starts; the best fit is kept")->capture_default_str()->check(CLI::Range(1, 1000));
+    fit->add_option("--iterations", c.fit.iterations, "Adam steps per start")->capture_default_str()->check(CLI::Range(1, 1000000));
+    fit->add_option("--seed", c.fit.seed, "seed of the starts")->capture_default_str();
+    fit->add_option("--out", c.out, "policy file to write (must not exist)")->required();
+    return fit;
+}
+
+int fit_command(const FitCommand &c, bool &started)
+{
+    if (file_exists(c.out)) {
+        throw UserError(c.out + ": exists; not overwritten");
+    }
+    SimWorlds worlds;
+    const SimRunner runner(worlds, scenario_from("dense", c.robot, c.sectors, 0.0, -1, -1, ""), c.fit.seed, true);
+    started = true;
+    const FitResult r = fit_network(runner.ctrl_config(), runner.probabilistic_policy(), c.fit);
+    char comment[200], err[QNAV_POLICY_IO_ERRLEN] = {0};
+    std::snprintf(comment, sizeof comment,
+                  "fitted to %s's probabilistic policy by simevo fit: quality error rms %.4f, max %.4f",
+                  c.robot.c_str(), r.rms, r.max);
+    if (qnav_policy_write(c.out.c_str(), &r.policy, comment, err, sizeof err) != 0) {
+        throw UserError(err);
+    }
+    std::printf("%s: %d hidden units fitted to %s's probabilistic policy; quality error over %d levels x %d "
+                "dtheta: rms %.4f, max %.4f\n",
+                c.out.c_str(), c.fit.hidden, c.robot.c_str(), QNAV_DIST_LEVELS, QNAV_DTHETA_MAX + 1, r.rms, r.max);
+    return 0;
+}
+
 /* `simevo quality`'s options: Figs. 2-3 for any policy files. */
 struct QualityCommand {
     std::vector<std::string> q_policies;
@@ -779,6 +822,8 @@ int main(int argc, char **argv)
     CLI::App *evolve = add_evolve_command(app, evolve_c);
     CLI::App *eval = add_eval_command(app, eval_c);
     CLI::App *quality = add_quality_command(app, quality_c);
+    FitCommand fit_c;
+    CLI::App *fit = add_fit_command(app, fit_c);
 
     if (const int status = qnav::cli::parse(app, argc, argv, "simevo"); status >= 0) {
         return status;
@@ -808,6 +853,9 @@ int main(int argc, char **argv)
         }
         if (*eval) {
             return eval_command(eval_c, started);
+        }
+        if (*fit) {
+            return fit_command(fit_c, started);
         }
     } catch (const UserError &e) {
         std::fprintf(stderr, "simevo: %s\n", e.what());

@@ -108,6 +108,14 @@ std::string Scenario::describe() const
     return o.str();
 }
 
+std::string SourceSpec::describe() const
+{
+    if (!fit.empty()) {
+        return "the network fitted to the target robot's " + fit + " policy";
+    }
+    return policy_file.empty() ? scenario.describe() : "policy file " + policy_file;
+}
+
 namespace {
 
 class Parser {
@@ -587,12 +595,21 @@ void parse_sources(const Parser &p, const toml::table &root, ExperimentSpec &spe
                     if (s.policy_file.empty()) {
                         p.fail(v, "policy: must not be empty");
                     }
+                } else if (key == "fit") {
+                    s.fit = p.str(v, key);
+                    if (s.fit != "probabilistic") {
+                        p.fail(v, "fit: '" + s.fit + "' is not 'probabilistic' (the network fitted to the "
+                                  "target robot's probabilistic policy)");
+                    }
                 } else {
                     p.fail(v, "unknown key '" + key + "' in [[source]]");
                 }
             }
             if (!has_label) {
                 p.fail(el, "[[source]]: missing label");
+            }
+            if (!s.policy_file.empty() && !s.fit.empty()) {
+                p.fail(el, "[[source]] " + s.label + ": give 'policy' or 'fit', not both");
             }
             spec.sources.push_back(s);
         }

@@ -115,6 +115,12 @@ struct SourceSpec {
     Scenario scenario;        /* fields not given inherit from [target] */
     uint64_t episodes = 1000; /* evolution episodes in the source situation */
     std::string policy_file;  /* non-empty: transfer from this file, no source evolution */
+    std::string fit;          /* "probabilistic": transfer from the network fitted to the
+                                 target robot's probabilistic policy (fit.h), no evolution */
+    /* evolved: no policy file and no fit */
+    bool evolved() const { return policy_file.empty() && fit.empty(); }
+    /* What the source is, for summaries: its situation, a policy file or the fit. */
+    std::string describe() const;
 };
 
 struct Preset {
