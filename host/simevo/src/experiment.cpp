@@ -7,7 +7,6 @@
  */
 #include "experiment.h"
 
-#include <cstdio>
 #include <set>
 
 #include <unistd.h>
@@ -91,24 +90,26 @@ std::string policy_text(const qnav_policy_t &p, const std::string &comment)
 }
 
 /* Each `fit` source's network, fitted to the target robot's probabilistic policy with the
- * experiment's hidden units, written once into the experiment's folder (and compared with
- * what is there on a rerun: the same settings fit the same network). */
+ * experiment's hidden units (one fit for all of them), written once into the experiment's
+ * folder. A file already there was fitted with these settings (settings.txt, compared
+ * before, holds the robot and the hidden units), so a rerun or another share does not fit
+ * again. */
 void write_fitted_sources(const ExperimentSpec &spec, const std::string &exp_dir, SimWorlds &worlds, bool use_table)
 {
+    std::string text;
     for (const SourceSpec &s : spec.sources) {
-        if (s.fit.empty()) {
+        const std::string path = fitted_source_path(exp_dir, s);
+        if (s.fit.empty() || file_exists(path)) {
             continue;
         }
-        const SimRunner target(worlds, picture_scenario(spec.target), spec.seed, use_table);
-        FitSettings fs;
-        fs.hidden = static_cast<int>(spec.evolution.hidden);
-        const FitResult fit = fit_network(target.ctrl_config(), target.probabilistic_policy(), fs);
-        char comment[200];
-        std::snprintf(comment, sizeof comment,
-                      "simevo: %d hidden units fitted to %s's probabilistic policy (quality error rms %.4f, max %.4f)",
-                      fs.hidden, spec.target.robot.c_str(), fit.rms, fit.max);
-        write_or_compare(fitted_source_path(exp_dir, s), policy_text(fit.policy, comment),
-                         spec.name + "'s fitted source '" + s.label + "' from other settings");
+        if (text.empty()) {
+            const SimRunner target(worlds, picture_scenario(spec.target), spec.seed, use_table);
+            FitSettings fs;
+            fs.hidden = static_cast<int>(spec.evolution.hidden);
+            const FitResult fit = fit_network(target.ctrl_config(), target.probabilistic_policy(), fs);
+            text = policy_text(fit.policy, fit_comment(spec.target.robot, fit, "simevo"));
+        }
+        write_file_atomic(path, text);
     }
 }
 

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <vector>
 
@@ -57,11 +58,13 @@ struct Moments {
 /* One full-batch gradient g of the mean squared quality error over the grid; returns the
  * root mean square error. A hidden unit's activation at (level l, dtheta d) is
  * 1 / (1 + e^-(w_theta x_d) e^-(w_dist x_l + b)): two exponentials per row and column
- * instead of one per point. */
-double gradient(const Net &n, const std::vector<double> &target, std::vector<double> &g)
+ * instead of one per point. h, gz and z are the caller's scratch (hidden x points, points,
+ * points), kept across steps so that a step allocates nothing. */
+double gradient(const Net &n, const std::vector<double> &target, std::vector<double> &g, std::vector<double> &h,
+                std::vector<double> &gz, std::vector<double> &z)
 {
     const std::size_t hidden = n.w.size();
-    std::vector<double> h(hidden * kPoints), gz(kPoints), z(kPoints, n.b);
+    std::fill(z.begin(), z.end(), n.b);
     std::array<double, kDthetas> et{};
     std::array<double, QNAV_DIST_LEVELS> ed{};
     double sse = 0.0;
@@ -130,6 +133,14 @@ qnav_policy_t rounded(const Net &n)
 
 } // namespace
 
+std::string fit_comment(const std::string &robot, const FitResult &r, const char *by)
+{
+    char text[200];
+    std::snprintf(text, sizeof text, "%d hidden units fitted to %s's probabilistic policy by %s: quality error rms %.4f, max %.4f",
+                  static_cast<int>(r.policy.u.net.hidden), robot.c_str(), by, r.rms, r.max);
+    return text;
+}
+
 FitResult fit_network(const qnav_ctrl_config_t &cfg, const qnav_policy_t &target, const FitSettings &s)
 {
     if (s.hidden < 1 || s.hidden > QNAV_MAX_HIDDEN || s.starts < 1 || s.iterations < 1) {
@@ -141,6 +152,7 @@ FitResult fit_network(const qnav_ctrl_config_t &cfg, const qnav_policy_t &target
     Net best;
     double best_rms = INFINITY;
     std::vector<double> g(4 * static_cast<std::size_t>(s.hidden) + 1);
+    std::vector<double> h(static_cast<std::size_t>(s.hidden) * kPoints), gz(kPoints), z(kPoints);
     for (int start = 0; start < s.starts; ++start) {
         Net n;
         n.w.resize(static_cast<std::size_t>(s.hidden));
@@ -152,7 +164,7 @@ FitResult fit_network(const qnav_ctrl_config_t &cfg, const qnav_policy_t &target
         Moments mo{std::vector<double>(g.size()), std::vector<double>(g.size())};
         double rms = 0.0;
         for (int t = 1; t <= s.iterations; ++t) {
-            rms = gradient(n, q, g);
+            rms = gradient(n, q, g, h, gz, z);
             adam_step(n, mo, g, t);
         }
         if (rms < best_rms) {

@@ -8,6 +8,7 @@
 #define QNAV_SIMEVO_FIT_H
 
 #include <cstdint>
+#include <string>
 
 #include "qnav/ctrl.h"
 #include "qnav/policy.h"
@@ -33,6 +34,9 @@ struct FitResult {
  * 181 dtheta. The same settings give the same policy. Throws UserError on a bad policy or
  * configuration. */
 FitResult fit_network(const qnav_ctrl_config_t &cfg, const qnav_policy_t &target, const FitSettings &s);
+
+/* The policy file comment of a fit: its units, robot, maker ("simevo fit") and error. */
+std::string fit_comment(const std::string &robot, const FitResult &r, const char *by);
 
 } // namespace qnav
 

@@ -716,11 +716,8 @@ int fit_command(const FitCommand &c, bool &started)
     const SimRunner runner(worlds, scenario_from("dense", c.robot, c.sectors, 0.0, -1, -1, ""), c.fit.seed, true);
     started = true;
     const FitResult r = fit_network(runner.ctrl_config(), runner.probabilistic_policy(), c.fit);
-    char comment[200], err[QNAV_POLICY_IO_ERRLEN] = {0};
-    std::snprintf(comment, sizeof comment,
-                  "fitted to %s's probabilistic policy by simevo fit: quality error rms %.4f, max %.4f",
-                  c.robot.c_str(), r.rms, r.max);
-    if (qnav_policy_write(c.out.c_str(), &r.policy, comment, err, sizeof err) != 0) {
+    char err[QNAV_POLICY_IO_ERRLEN] = {0};
+    if (qnav_policy_write(c.out.c_str(), &r.policy, fit_comment(c.robot, r, "simevo fit").c_str(), err, sizeof err) != 0) {
         throw UserError(err);
     }
     std::printf("%s: %d hidden units fitted to %s's probabilistic policy; quality error over %d levels x %d "
