@@ -659,7 +659,7 @@ const char *qnav_status_str(qnav_status_t status)
     case QNAV_E_KEEP:
         return "keep_pct above 100";
     case QNAV_E_MAP:
-        return "map cell_mm outside 20..1000, plan_ticks 0, arc_pct above 100, more than 65 000 "
+        return "map cell_mm outside 20..1000, plan_ticks 0, arc_cdeg above 36000, more than 65 000 "
                "cells, or too little memory for them";
     }
     return "unknown status";

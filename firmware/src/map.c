@@ -41,7 +41,7 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->plan_ticks = 10u;
     cfg->noise_pct = 5u;
     cfg->near_mm = 200u;
-    cfg->arc_pct = 100u;
+    cfg->arc_cdeg = 2250u;
     cfg->sight = 1u;
     cfg->escape_grow = 1u;
     cfg->near_cost = 10u;
@@ -80,7 +80,7 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
     }
     cells = qnav_map_cells(width_mm, height_mm, cfg->cell_mm);
     if (cfg->cell_mm < 20u || cfg->cell_mm > 1000u || cfg->plan_ticks == 0u || cells == 0u ||
-        cfg->arc_pct > 100u || (cfg->refuse_ticks > 0u && cfg->refuse_life_ticks == 0u) ||
+        cfg->arc_cdeg > 36000u || (cfg->refuse_ticks > 0u && cfg->refuse_life_ticks == 0u) ||
         len < qnav_map_bytes(cells) || ((uintptr_t)buf & 1u) != 0u || ctrl->n_sectors == 0u ||
         ctrl->n_sectors > QNAV_MAX_SECTORS || ctrl->max_range_mm == 0u) {
         return QNAV_E_MAP;
@@ -243,7 +243,10 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
     three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
     reach2 = (int64_t)reach * reach;
     heading = qnav_wrap_cdeg(pose->heading_cdeg);
-    arc_half = (int32_t)(INT32_C(18000) * (int32_t)m->cfg.arc_pct / 100 / (int32_t)m->n_sectors);
+    arc_half = INT32_C(18000) / (int32_t)m->n_sectors; /* the whole wedge, or the set arc */
+    if ((int32_t)m->cfg.arc_cdeg / 2 < arc_half) {
+        arc_half = (int32_t)m->cfg.arc_cdeg / 2;
+    }
     cell_of(m, pose->x_mm - reach, pose->y_mm - reach, &i0, &j0);
     cell_of(m, pose->x_mm + reach, pose->y_mm + reach, &i1, &j1);
     for (j = j0; j <= j1; ++j) {

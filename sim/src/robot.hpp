@@ -63,7 +63,7 @@ struct RobotProfile {
     double map_plan_s = 1.0;        // time between plans, s
     double map_near_m = 0.2;        // cells this much beyond the body's reach of a wall...
     double map_near_cost = 1.0;     // ...cost this much more to cross, in cell sides
-    int map_arc_pct = 100;          // arcs marked in the central this % of the wedge
+    double map_arc_deg = 22.5;      // arcs marked within this angle about the wedge's centre
     bool map_sight = true;          // the sub-goal kept in a straight line's sight
     bool map_escape_grow = true;    // a longer plan grows the escape's distances with it
     double map_refuse_s = 3.0;      // no progress along the plan this long: its next cells refused

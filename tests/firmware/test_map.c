@@ -49,19 +49,19 @@ static void map_from(qnav_map_t *m, const qnav_map_config_t *mc)
                      QNAV_OK);
 }
 
-static void map_with(qnav_map_t *m, uint8_t plan_ticks, uint8_t arc_pct, uint8_t sight)
+static void map_with(qnav_map_t *m, uint8_t plan_ticks, uint16_t arc_cdeg, uint8_t sight)
 {
     qnav_map_config_t mc;
     qnav_map_config_default(&mc);
     mc.plan_ticks = plan_ticks;
-    mc.arc_pct = arc_pct;
+    mc.arc_cdeg = arc_cdeg;
     mc.sight = sight;
     map_from(m, &mc);
 }
 
 static void map_of(qnav_map_t *m, uint8_t plan_ticks)
 {
-    map_with(m, plan_ticks, 100, 1);
+    map_with(m, plan_ticks, 2250, 1);
 }
 
 static int inside(const box_t *boxes, size_t n, int32_t x, int32_t y)
@@ -109,7 +109,7 @@ static void clear_but_ahead(qnav_mm_t *ranges, qnav_mm_t ahead_mm)
     ranges[0] = ahead_mm;
 }
 
-/* arc_pct: the arc is marked only near the wedge's centre line. */
+/* arc_cdeg: the arc is marked only near the wedge's centre line. */
 static void test_arcs_are_marked_in_the_central_part_of_the_wedge(void **state)
 {
     qnav_map_t m;
@@ -117,14 +117,47 @@ static void test_arcs_are_marked_in_the_central_part_of_the_wedge(void **state)
     const qnav_map_pose_t p = {3050, 3050, 0};
     (void)state;
     clear_but_ahead(ranges, 1000); /* 1 120 mm from the centre; the wedge is +-11.25 deg */
-    map_with(&m, 10, 100, 1);
+    map_with(&m, 10, 2250, 1);
     qnav_map_observe(&m, ranges, &p);
     assert_int_equal(qnav_map_evidence(&m, 4170, 3050), 1); /* dead ahead */
     assert_int_equal(qnav_map_evidence(&m, 4150, 3250), 1); /* 10 deg off, on the arc */
-    map_with(&m, 10, 25, 1);                               /* +-2.8 deg */
+    map_with(&m, 10, 562, 1);                              /* +-2.8 deg */
     qnav_map_observe(&m, ranges, &p);
     assert_int_equal(qnav_map_evidence(&m, 4170, 3050), 1);
     assert_int_equal(qnav_map_evidence(&m, 4150, 3250), 0);
+}
+
+/* At 8 sectors a wedge is 45 deg wide, wider than the default arc (22.5 deg): its reading
+ * marks occupied only the arc's central cells, and still frees the whole wedge nearer. */
+static void test_a_wide_wedge_marks_only_the_default_arc(void **state)
+{
+    qnav_map_t m;
+    qnav_map_config_t mc;
+    qnav_ctrl_config_t cc;
+    qnav_mm_t ranges[8];
+    const qnav_map_pose_t p = {3050, 3050, 0};
+    int k;
+    (void)state;
+    sensor_config(&cc);
+    cc.n_sectors = 8;
+    for (k = 0; k < 8; ++k) {
+        ranges[k] = 2500;
+    }
+    ranges[0] = 1000; /* 1 120 mm from the centre */
+    qnav_map_config_default(&mc);
+    assert_int_equal(mc.arc_cdeg, 2250);
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
+                     QNAV_OK);
+    qnav_map_observe(&m, ranges, &p);
+    assert_int_equal(qnav_map_evidence(&m, 4170, 3050), 1); /* dead ahead */
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3250), 1); /* 10 deg off */
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3350), 0); /* 15 deg off: in the wedge, off the arc */
+    assert_true(qnav_map_evidence(&m, 3800, 3350) < 0);     /* 20 deg off, nearer: free */
+    mc.arc_cdeg = 4500;                                     /* the whole wedge, as before */
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
+                     QNAV_OK);
+    qnav_map_observe(&m, ranges, &p);
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3350), 1);
 }
 
 static void test_a_reading_frees_its_wedge_and_marks_its_arc(void **state)
@@ -263,11 +296,11 @@ static void test_the_sub_goal_is_not_behind_a_corner(void **state)
     (void)state;
     memset(&with, 0, sizeof with);
     memset(&without, 0, sizeof without);
-    map_with(&m, 1, 100, 0);
+    map_with(&m, 1, 2250, 0);
     observe_the_wall(&m);
     assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &without) & QNAV_MAP_GUIDED,
                      QNAV_MAP_GUIDED);
-    map_with(&m, 1, 100, 1);
+    map_with(&m, 1, 2250, 1);
     observe_the_wall(&m);
     assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &with) & QNAV_MAP_GUIDED,
                      QNAV_MAP_GUIDED);
@@ -479,9 +512,9 @@ static void test_bad_maps_are_refused(void **state)
     mc.plan_ticks = 0;
     assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
     mc.plan_ticks = 10;
-    mc.arc_pct = 101;
+    mc.arc_cdeg = 36001;
     assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
-    mc.arc_pct = 100;
+    mc.arc_cdeg = 36000;
     mc.refuse_life_ticks = 0; /* a refusal that would never lapse */
     assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
     mc.refuse_ticks = 0;
@@ -495,6 +528,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_a_reading_frees_its_wedge_and_marks_its_arc),
         cmocka_unit_test(test_arcs_are_marked_in_the_central_part_of_the_wedge),
+        cmocka_unit_test(test_a_wide_wedge_marks_only_the_default_arc),
         cmocka_unit_test(test_the_plan_leads_round_the_wall_to_its_gap),
         cmocka_unit_test(test_the_sub_goal_is_not_behind_a_corner),
         cmocka_unit_test(test_a_longer_plan_grows_the_escape_memory),

@@ -241,6 +241,26 @@ void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
                 std::string::npos);
 }
 
+// [map] arc_deg, the arc a reading marks, reaches the map in 0.01 deg (default 22.5 deg);
+// the former share of the wedge, arc_pct, is refused naming the key, and so is an angle
+// outside 0..360 (docs/architecture.md, "The arc a reading marks").
+void test_the_maps_arc_is_an_angle_from_the_profile(void **) {
+    const auto arc_of = [](const std::string &profile) {
+        char err[QNAV_SIM_ERRLEN] = "";
+        qnav_sim_robot_t *robot = nullptr;
+        if (qnav_sim_robot_parse(profile.data(), profile.size(), "arc.toml", &robot, err, sizeof err) != QNAV_SIM_OK)
+            fail_with("robot", err);
+        qnav_map_config_t cfg;
+        assert_int_equal(qnav_sim_robot_map_config(robot, &cfg), 1);
+        qnav_sim_robot_free(robot);
+        return cfg.arc_cdeg;
+    };
+    assert_int_equal(arc_of(tekbot_with("[map]\ncell_m = 0.1\n")), 2250);
+    assert_int_equal(arc_of(tekbot_with("[map]\ncell_m = 0.1\narc_deg = 11.25\n")), 1125);
+    assert_true(refusal(tekbot_with("[map]\ncell_m = 0.1\narc_pct = 50\n")).find("arc_pct") != std::string::npos);
+    assert_true(refusal(tekbot_with("[map]\ncell_m = 0.1\narc_deg = 361\n")).find("arc_deg") != std::string::npos);
+}
+
 }  // namespace
 
 int main() {
@@ -251,6 +271,7 @@ int main() {
         cmocka_unit_test(test_bad_odometry_settings_are_refused_by_field),
         cmocka_unit_test(test_a_maps_passing_distance_reaches_the_controller),
         cmocka_unit_test(test_name_plus_map_switches_on_the_profiles_own_map),
+        cmocka_unit_test(test_the_maps_arc_is_an_angle_from_the_profile),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

@@ -45,8 +45,11 @@ typedef struct {
     uint8_t near_cost;     /* extra plan cost of a cell within near_mm beyond the body's
                               reach of an occupied cell (10: one more cell side); default 10 */
     uint16_t near_mm;      /* mm; default 200 (measured: docs/architecture.md) */
-    uint8_t arc_pct;       /* a reading marks occupied only the arc cells within the central
-                              arc_pct % of its wedge, 0..100; default 100 */
+    uint16_t arc_cdeg;     /* a reading marks occupied only the arc cells within arc_cdeg / 2
+                              of its wedge's centre line (the whole wedge when that is
+                              narrower), 0.01 deg, 0..36000; default 2250: a wider wedge's
+                              reading says little about where across it the obstacle is
+                              (measured: docs/architecture.md, "The arc a reading marks") */
     uint8_t sight;         /* 1: the sub-goal stops where the straight line to it from the
                               robot's cell would cross a blocked cell; default 1 */
     uint8_t escape_grow;   /* 1: when a new plan is longer where the robot is (by less than
