@@ -326,6 +326,7 @@ static int board_map(robot_t *r, const options_t *o, const qnav_sim_robot_t *rob
     if (r->sim == NULL || !qnav_sim_robot_map_config(robot, &mc)) {
         return 0;
     }
+    mc.noise_pct = (uint8_t)lround(o->noise * 100.0); /* the sonar it simulates, as qnav-sim */
     qnav_sim_env_info(env, &ei);
     for (k = 0; k < 4; ++k) {
         double x, y;

@@ -36,8 +36,13 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->keep_pct = static_cast<std::uint8_t>(std::lround(p.prob_keep * 100.0));
 }
 
+std::uint8_t map_noise_pct(double sensor_noise) {
+    return static_cast<std::uint8_t>(std::lround(std::clamp(sensor_noise, 0.0, 1.0) * 100.0));
+}
+
 void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg) {
     qnav_map_config_default(cfg);
+    cfg->noise_pct = map_noise_pct(p.noise_sensor);
     cfg->cell_mm = to_mm(p.map_cell_m);
     cfg->reach_mm = to_mm(p.map_reach_m);
     cfg->look_mm = to_mm(p.map_look_m);
