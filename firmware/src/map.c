@@ -23,6 +23,11 @@
 #define EVIDENCE_FREE_MIN (-4)
 #define EVIDENCE_MAX 3
 #define EVIDENCE_REFUSED 100 /* a cell the robot could not pass: kept until the refusal lapses */
+/* An arc is marked occupied from 3/4 of a cell plus at most this many % of the reading
+ * nearer than the reading, however noisy the sonar: a noisy sonar's readings of one
+ * obstacle spread over its noise, and arcs as thick as that closed passages (measured:
+ * docs/architecture.md, "The map's range noise"). */
+#define OCCUPIED_BAND_PCT 5
 #define STEP_SIDE 10u
 #define STEP_DIAG 14u
 #define NOT_QUEUED UINT16_C(0xFFFF)
@@ -234,7 +239,7 @@ static void mark_clear(qnav_map_t *m, int8_t *c)
 
 void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *pose)
 {
-    int32_t i0, i1, j0, j1, i, j, reach, three_quarters, heading, arc_half;
+    int32_t i0, i1, j0, j1, i, j, reach, three_quarters, heading, arc_half, band_pct;
     int64_t reach2;
     if (m == NULL || m->cost == NULL || ranges_mm == NULL || pose == NULL) {
         return;
@@ -242,6 +247,7 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
     reach = (int32_t)m->cfg.reach_mm;
     three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
     reach2 = (int64_t)reach * reach;
+    band_pct = m->cfg.noise_pct < OCCUPIED_BAND_PCT ? (int32_t)m->cfg.noise_pct : OCCUPIED_BAND_PCT;
     heading = qnav_wrap_cdeg(pose->heading_cdeg);
     arc_half = INT32_C(18000) / (int32_t)m->n_sectors; /* the whole wedge, or the set arc */
     if ((int32_t)m->cfg.arc_cdeg / 2 < arc_half) {
@@ -261,7 +267,7 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
             int64_t d2;
             int8_t *c = &row[i];
             uint16_t k;
-            int32_t rc, tol, lo, rel;
+            int32_t rc, tol, lo, band, rel;
             dx += (int32_t)m->cfg.cell_mm;
             if (*c == EVIDENCE_FREE_MIN || *c == EVIDENCE_REFUSED) {
                 continue; /* no reading changes it: free at its floor, or refused */
@@ -280,12 +286,14 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
                 mark_clear(m, c);
                 continue;
             }
-            tol = three_quarters + rc * (int32_t)m->cfg.noise_pct / 100;
+            tol = three_quarters + rc * (int32_t)m->cfg.noise_pct / 100; /* not carved free */
+            band = rc - three_quarters - rc * band_pct / 100;                /* occupied from */
             lo = rc - tol;
             if (lo > 0 && d2 < (int64_t)lo * lo) {
                 mark_clear(m, c);
             } else if (*c >= 0 && *c < EVIDENCE_REFUSED &&
                        d2 <= (int64_t)(rc + three_quarters) * (rc + three_quarters) &&
+                       (band <= 0 || d2 >= (int64_t)band * band) &&
                        off_centre(m, rel, k) <= arc_half) {
                 *c = (int8_t)(*c + 1 > EVIDENCE_MAX ? EVIDENCE_MAX : *c + 1);
                 if (*c == QNAV_MAP_OCCUPIED) {

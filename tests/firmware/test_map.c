@@ -160,6 +160,31 @@ static void test_a_wide_wedge_marks_only_the_default_arc(void **state)
     assert_int_equal(qnav_map_evidence(&m, 4150, 3350), 1);
 }
 
+/* noise_pct: a noisy sonar's reading carves free only cells nearer than its noise, but marks
+ * occupied only a thin band at the reading (3/4 cell + at most 5 %), so that one
+ * obstacle's spread readings do not make it thick. */
+static void test_a_noisy_reading_keeps_its_arc_thin(void **state)
+{
+    qnav_map_t m;
+    qnav_map_config_t mc;
+    qnav_mm_t ranges[N];
+    const qnav_map_pose_t p = {3050, 3050, 0};
+    (void)state;
+    clear_but_ahead(ranges, 1000); /* 1 120 mm from the centre */
+    qnav_map_config_default(&mc);
+    assert_int_equal(mc.noise_pct, 5);
+    map_from(&m, &mc);
+    qnav_map_observe(&m, ranges, &p);
+    assert_true(qnav_map_evidence(&m, 3950, 3050) < 0);     /* 220 mm nearer: free */
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3050), 1); /* at the reading */
+    mc.noise_pct = 20;                                      /* free only 299 mm nearer */
+    map_from(&m, &mc);
+    qnav_map_observe(&m, ranges, &p);
+    assert_int_equal(qnav_map_evidence(&m, 3950, 3050), 0); /* neither free nor occupied */
+    assert_int_equal(qnav_map_evidence(&m, 3750, 3050), -1);
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3050), 1);
+}
+
 static void test_a_reading_frees_its_wedge_and_marks_its_arc(void **state)
 {
     qnav_map_t m;
@@ -529,6 +554,7 @@ int main(void)
         cmocka_unit_test(test_a_reading_frees_its_wedge_and_marks_its_arc),
         cmocka_unit_test(test_arcs_are_marked_in_the_central_part_of_the_wedge),
         cmocka_unit_test(test_a_wide_wedge_marks_only_the_default_arc),
+        cmocka_unit_test(test_a_noisy_reading_keeps_its_arc_thin),
         cmocka_unit_test(test_the_plan_leads_round_the_wall_to_its_gap),
         cmocka_unit_test(test_the_sub_goal_is_not_behind_a_corner),
         cmocka_unit_test(test_a_longer_plan_grows_the_escape_memory),
