@@ -39,6 +39,13 @@ class GapSweep(unittest.TestCase):
         self.assertLessEqual(float(w.group(4)), float(w.group(3)))
         self.assertIn("narrowest gap passed in >= 90% within the limit: 0.840 m", r.stdout)
 
+    def test_a_name_plus_map_reads_the_profiles_radius(self):
+        # NAME+map is the profile NAME with its map on: the same body, so the same widths
+        r = tool("--robot", "tekbot+map", "--clearances", "0.6", "--episodes", "1", "-j", "2")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("robot tekbot+map (radius 0.120 m)", r.stdout)
+        self.assertAlmostEqual(float(ROW.match(r.stdout.splitlines()[2]).group(1)), 0.84, places=3)
+
     def test_bad_input_is_one_line(self):
         # argparse's own refusals: usage, then one line naming the option
         for args, words in ((["--clearances", "abc"], "--clearances: not a list of numbers"),
