@@ -39,9 +39,10 @@ typedef struct {
     uint16_t jump_mm;      /* a plan longer by this than the last tick's clears the escape
                               memory (the way it was following is closed), mm; default 1000 */
     uint8_t plan_ticks;    /* ticks between plans, 1..255; default 10 */
-    uint8_t noise_pct;     /* the sonar's range noise: a cell nearer than the reading by
-                              less than this many % of it (plus 3/4 of a cell) is not marked
-                              clear; default 5 */
+    uint8_t noise_pct;     /* the sonar's range noise, its standard deviation in % of the
+                              reading: a cell nearer than the reading by less than this many %
+                              of it (plus 3/4 of a cell) is not marked clear; default 5; set
+                              the sonar's own (docs/architecture.md, "The map's range noise") */
     uint8_t near_cost;     /* extra plan cost of a cell within near_mm beyond the body's
                               reach of an occupied cell (10: one more cell side); default 10 */
     uint16_t near_mm;      /* mm; default 200 (measured: docs/architecture.md) */
