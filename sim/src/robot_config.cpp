@@ -20,8 +20,13 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->body_radius_mm = to_mm(p.radius_m);
     cfg->safety_mm = to_mm(p.safety_m);
     // a map's plan keeps the robot the safety distance off what it has seen, so the
-    // controller may pass readings nearer (docs/architecture.md, "Passing distance")
-    cfg->pass_mm = to_mm(p.map_cell_m > 0.0 ? p.map_pass_m.value_or(p.safety_m) : p.safety_m);
+    // controller may pass readings nearer (docs/architecture.md, "Passing distance"); not
+    // with wedges wider than 60 degrees, whose reading may lie anywhere across 72-90
+    // degrees: the TekBot touched something in about half its episodes at 4 and 5 sectors
+    // (docs/results.md, "Fewer sectors with the map")
+    constexpr std::uint16_t kPassNearerSectorsMin = 6;
+    const bool nearer = p.map_cell_m > 0.0 && cfg->n_sectors >= kPassNearerSectorsMin;
+    cfg->pass_mm = to_mm(nearer ? p.map_pass_m.value_or(p.safety_m) : p.safety_m);
     cfg->sensor_offset_mm = to_mm(p.sonar_offset_m);
     cfg->range_min_mm = to_mm(p.range_min_m);
     cfg->v_max_mm_s = to_mm(p.v_max_mps);

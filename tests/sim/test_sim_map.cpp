@@ -167,20 +167,20 @@ void test_bad_odometry_settings_are_refused_by_field(void **) {
 
 // The controller configuration a profile gives (qnav_sim_robot_ctrl_config, the one mapping
 // the simulator, the board headers and navbridge use); fails the test on a parse error.
-qnav_ctrl_config_t profile_config(const std::string &profile) {
+qnav_ctrl_config_t profile_config(const std::string &profile, std::uint16_t n_sectors = 0) {
     char err[QNAV_SIM_ERRLEN] = "";
     qnav_sim_robot_t *robot = nullptr;
     if (qnav_sim_robot_parse(profile.data(), profile.size(), "p.toml", &robot, err, sizeof err) != QNAV_SIM_OK)
         fail_with("robot", err);
     qnav_ctrl_config_t cc;
-    qnav_sim_robot_ctrl_config(robot, 0, &cc);
+    qnav_sim_robot_ctrl_config(robot, n_sectors, &cc);
     qnav_sim_robot_free(robot);
     return cc;
 }
 
 // [map] pass_m is the controller's passing distance while a map guides it; without it, or
-// without a map, the passing distance is the safety distance (docs/architecture.md,
-// "Passing distance"). A bad value is refused naming the key.
+// without a map, or with fewer than 6 sectors, the passing distance is the safety distance
+// (docs/architecture.md, "Passing distance"). A bad value is refused naming the key.
 void test_a_maps_passing_distance_reaches_the_controller(void **) {
     const qnav_ctrl_config_t plain = profile_config(tekbot_with(""));
     const qnav_ctrl_config_t map = profile_config(tekbot_with("[map]\ncell_m = 0.1\n"));
@@ -190,6 +190,9 @@ void test_a_maps_passing_distance_reaches_the_controller(void **) {
     assert_int_equal(map.pass_mm, map.safety_mm);
     assert_int_equal(pass.pass_mm, 10);
     assert_int_equal(pass.safety_mm, 50);
+    // wedges wider than 60 degrees keep the safety distance: 6 sectors pass nearer, 5 do not
+    assert_int_equal(profile_config(tekbot_with("[map]\ncell_m = 0.1\npass_m = 0.01\n"), 6).pass_mm, 10);
+    assert_int_equal(profile_config(tekbot_with("[map]\ncell_m = 0.1\npass_m = 0.01\n"), 5).pass_mm, 50);
     assert_true(refusal(tekbot_with("[map]\ncell_m = 0.1\npass_m = -0.01\n")).find("pass_m") != std::string::npos);
 }
 
