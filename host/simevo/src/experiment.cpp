@@ -7,6 +7,7 @@
  */
 #include "experiment.h"
 
+#include <optional>
 #include <set>
 
 #include <unistd.h>
@@ -15,7 +16,6 @@
 #include "experiment_report.h"
 #include "files.h"
 #include "fit.h"
-#include "qnav/policy_io.h"
 #include "sim_runner.h"
 
 namespace qnav {
@@ -73,22 +73,6 @@ void probe_inputs(const ExperimentSpec &spec, const std::vector<TaskDef> &tasks,
     }
 }
 
-/* The text of a policy file holding p with comment. Throws UserError. */
-std::string policy_text(const qnav_policy_t &p, const std::string &comment)
-{
-    char err[QNAV_POLICY_IO_ERRLEN] = {0};
-    const int n = qnav_policy_format(&p, nullptr, comment.c_str(), nullptr, 0, err, sizeof err);
-    if (n < 0) {
-        throw UserError(err);
-    }
-    std::string text(static_cast<std::size_t>(n) + 1, '\0');
-    if (qnav_policy_format(&p, nullptr, comment.c_str(), text.data(), text.size(), err, sizeof err) != n) {
-        throw UserError(err);
-    }
-    text.resize(static_cast<std::size_t>(n));
-    return text;
-}
-
 /* Each `fit` source's network, fitted to the target robot's probabilistic policy with the
  * experiment's hidden units (one fit for all of them), written once into the experiment's
  * folder. A file already there was fitted with these settings (settings.txt, compared
@@ -96,20 +80,19 @@ std::string policy_text(const qnav_policy_t &p, const std::string &comment)
  * again. */
 void write_fitted_sources(const ExperimentSpec &spec, const std::string &exp_dir, SimWorlds &worlds, bool use_table)
 {
-    std::string text;
+    std::optional<FitResult> fit;
     for (const SourceSpec &s : spec.sources) {
         const std::string path = fitted_source_path(exp_dir, s);
         if (s.fit.empty() || file_exists(path)) {
             continue;
         }
-        if (text.empty()) {
+        if (!fit) {
             const SimRunner target(worlds, picture_scenario(spec.target), spec.seed, use_table);
             FitSettings fs;
             fs.hidden = static_cast<int>(spec.evolution.hidden);
-            const FitResult fit = fit_network(target.ctrl_config(), target.probabilistic_policy(), fs);
-            text = policy_text(fit.policy, fit_comment(spec.target.robot, fit, "simevo"));
+            fit = fit_network(target.ctrl_config(), target.probabilistic_policy(), fs);
         }
-        write_file_atomic(path, text);
+        write_fit(path, spec.target.robot, *fit, "simevo");
     }
 }
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "evolution.h"
+#include "qnav/policy_io.h"
 #include "qnav/rng.hpp"
 #include "spec.h"
 
@@ -133,12 +134,15 @@ qnav_policy_t rounded(const Net &n)
 
 } // namespace
 
-std::string fit_comment(const std::string &robot, const FitResult &r, const char *by)
+void write_fit(const std::string &path, const std::string &robot, const FitResult &r, const char *by)
 {
-    char text[200];
-    std::snprintf(text, sizeof text, "%d hidden units fitted to %s's probabilistic policy by %s: quality error rms %.4f, max %.4f",
+    char comment[200];
+    std::snprintf(comment, sizeof comment, "%d hidden units fitted to %s's probabilistic policy by %s: quality error rms %.4f, max %.4f",
                   static_cast<int>(r.policy.u.net.hidden), robot.c_str(), by, r.rms, r.max);
-    return text;
+    char err[QNAV_POLICY_IO_ERRLEN] = {0};
+    if (qnav_policy_write(path.c_str(), &r.policy, comment, err, sizeof err) != 0) {
+        throw UserError(err);
+    }
 }
 
 FitResult fit_network(const qnav_ctrl_config_t &cfg, const qnav_policy_t &target, const FitSettings &s)

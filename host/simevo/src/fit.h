@@ -35,8 +35,9 @@ struct FitResult {
  * configuration. */
 FitResult fit_network(const qnav_ctrl_config_t &cfg, const qnav_policy_t &target, const FitSettings &s);
 
-/* The policy file comment of a fit: its units, robot, maker ("simevo fit") and error. */
-std::string fit_comment(const std::string &robot, const FitResult &r, const char *by);
+/* Writes fit r as a policy file at path (atomically), its comment naming its units, robot,
+ * maker (e.g. "simevo fit") and error. Throws UserError when it cannot. */
+void write_fit(const std::string &path, const std::string &robot, const FitResult &r, const char *by);
 
 } // namespace qnav
 

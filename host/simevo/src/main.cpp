@@ -716,10 +716,7 @@ int fit_command(const FitCommand &c, bool &started)
     const SimRunner runner(worlds, scenario_from("dense", c.robot, c.sectors, 0.0, -1, -1, ""), c.fit.seed, true);
     started = true;
     const FitResult r = fit_network(runner.ctrl_config(), runner.probabilistic_policy(), c.fit);
-    char err[QNAV_POLICY_IO_ERRLEN] = {0};
-    if (qnav_policy_write(c.out.c_str(), &r.policy, fit_comment(c.robot, r, "simevo fit").c_str(), err, sizeof err) != 0) {
-        throw UserError(err);
-    }
+    write_fit(c.out, c.robot, r, "simevo fit");
     std::printf("%s: %d hidden units fitted to %s's probabilistic policy; quality error over %d levels x %d "
                 "dtheta: rms %.4f, max %.4f\n",
                 c.out.c_str(), c.fit.hidden, c.robot.c_str(), QNAV_DIST_LEVELS, QNAV_DTHETA_MAX + 1, r.rms, r.max);
