@@ -1,11 +1,15 @@
 """tools/family-eval against the built qnav-sim: one world per family, its table's shape and
 sense (arrival at twice the limit never below arrival at the limit), several policies
-compared on the same worlds (the summary agrees with the rows it summarizes), and its
+compared on the same worlds (the summary agrees with the rows it summarizes), the listing
+of failed episodes (its commands draw an episode that missed the limit), a robot profile
+file of a robot not in data/robots (worlds sized for it, its own sector count), and its
 one-line errors for a bad family, a missing profile and a missing simulator."""
 import os
 import re
+import shlex
 import subprocess
 import sys
+import tempfile
 import unittest
 
 TOOL = os.path.join(os.environ["QNAV_TOOLS_DIR"], "family-eval")
@@ -63,10 +67,83 @@ class FamilyEval(unittest.TestCase):
             self.assertAlmostEqual(ref, per["reference"][i], delta=0.051)
             self.assertEqual(m.group(9), "above" if mean > ref else "below" if mean < ref else "level")
 
+    def test_failures_are_listed_with_commands_that_draw_them(self):
+        # the TekBot without a map misses the limit in these rooms (fixed seeds): every
+        # listed episode, run as listed, misses it, and arrives at twice it when listed so
+        r = tool("--worlds", "2", "--episodes", "2", "-j", "2", "--families", "rooms",
+                 "--seed-base", "5000007", "--failures")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        row = ROW.match(r.stdout.splitlines()[2])
+        self.assertLess(float(row.group(2)), 100.0, r.stdout)
+        listing = r.stdout.splitlines()[3:]
+        n = int(re.match(r"^(\d+) episodes missed the limit", listing[0]).group(1))
+        self.assertEqual(n, round(4 * (100.0 - float(row.group(2))) / 100), r.stdout)
+        kinds = set()
+        with tempfile.TemporaryDirectory() as tmp:
+            for line in listing[1:]:
+                world = re.match(r"^rooms (\d+): qnav-sim (gen-env .*)$", line)
+                if world:
+                    g = subprocess.run([SIM, *shlex.split(world.group(2))], cwd=tmp,
+                                       capture_output=True, text=True)
+                    self.assertEqual(g.returncode, 0, g.stderr)
+                    limit = float(re.search(r"limit (\d+(?:\.\d+)?) s", g.stdout).group(1))
+                    seed = world.group(1)
+                    continue
+                ep = re.match(r"^  episode (\d+) (arrived late|did not arrive at twice the limit): "
+                              r"qnav-sim (run .*)$", line)
+                self.assertTrue(ep, line)
+                n -= 1
+                kinds.add(ep.group(2))
+                e = subprocess.run([SIM, *shlex.split(ep.group(3))], cwd=tmp, capture_output=True,
+                                   text=True)
+                self.assertEqual(e.returncode, 0, e.stderr)
+                m = re.search(rf"^episode {ep.group(1)}: (reached|not reached) in (\d+) ticks",
+                              e.stdout, re.M)
+                self.assertTrue(m, e.stdout)
+                self.assertEqual(m.group(1) == "reached", ep.group(2) == "arrived late", e.stdout)
+                self.assertTrue(m.group(1) == "not reached" or int(m.group(2)) > 10 * limit, e.stdout)
+                self.assertTrue(os.path.getsize(os.path.join(tmp, f"rooms-{seed}-{ep.group(1)}.svg")))
+        self.assertEqual(n, 0, r.stdout)
+        self.assertEqual(kinds, {"arrived late", "did not arrive at twice the limit"}, r.stdout)
+
+    def test_a_profile_file_sizes_its_worlds_and_keeps_its_sectors(self):
+        # a robot not in data/robots: its worlds are sized from the file, and qnav-sim run is
+        # given no sector count unless --sectors asks for one (the profile's own, 12, then)
+        src = os.path.join(os.environ["QNAV_TOOLS_DIR"], "..", "data", "robots", "tekbot.toml")
+        with tempfile.TemporaryDirectory() as tmp:
+            prof = os.path.join(tmp, "wide.toml")
+            with open(src, encoding="utf-8") as f:
+                text = f.read().replace('name = "tekbot"', 'name = "widebot"')
+            text = re.sub(r"(?m)^radius_m = 0.12 ", "radius_m = 0.2 ", text)
+            text = re.sub(r"(?m)^default_sectors = 16 ", "default_sectors = 12 ", text)
+            with open(prof, "w", encoding="utf-8") as f:
+                f.write(text)
+            log = os.path.join(tmp, "argv")
+            wrap = os.path.join(tmp, "sim")
+            with open(wrap, "w", encoding="utf-8") as f:
+                f.write(f"#!/bin/sh\necho \"$*\" >> {shlex.quote(log)}\nexec {shlex.quote(SIM)} \"$@\"\n")
+            os.chmod(wrap, 0o755)
+            for extra, want in (([], None), (["--sectors", "12"], "12")):
+                open(log, "w").close()
+                r = subprocess.run([sys.executable, TOOL, "--sim", wrap, "--robot", prof, "--worlds", "1",
+                                    "--episodes", "1", "-j", "1", "--families", "gaps", *extra],
+                                   capture_output=True, text=True, timeout=600)
+                self.assertEqual(r.returncode, 0, r.stderr)
+                self.assertIn(f"worlds sized for {prof}", r.stdout)
+                with open(log, encoding="utf-8") as f:
+                    calls = f.read().splitlines()
+                gen = [c for c in calls if c.startswith("gen-env")]
+                run = [c for c in calls if c.startswith("run")]
+                self.assertEqual((len(gen), len(run)), (1, 1), calls)
+                self.assertIn(f"--robot {prof} ", gen[0] + " ")
+                m = re.search(r"--sectors (\d+)", run[0])
+                self.assertEqual(m.group(1) if m else None, want, run[0])
+
     def test_bad_input_is_one_line(self):
         for args, words in ((["--families", "bogus"], "unknown family 'bogus'"),
                             (["--robot", "/no/such/profile.toml"], "/no/such/profile.toml"),
-                            (["--worlds", "0"], "at least 1")):
+                            (["--worlds", "0"], "at least 1"),
+                            (["--sectors", "0"], "at least 1")):
             r = tool("--worlds", "1", *args) if args[0] != "--worlds" else tool(*args)
             self.assertNotEqual(r.returncode, 0)
             self.assertIn(words, r.stderr)
