@@ -160,7 +160,13 @@ static void test_mix_turns_counter_clockwise_with_the_right_wheel(void **state)
     assert_int_equal(r, 20000);
     qnav_board_mix(120, 20000, 60, &l, &r); /* beyond spin: turn in place */
     assert_int_equal(l, -r);
-    qnav_board_mix(45, 0, 60, &l, &r); /* no speed: no motion at all */
+    qnav_board_mix(45, 0, 60, &l, &r); /* no speed: a turn in place toward the heading */
+    assert_true(r > 0);
+    assert_int_equal(l, -r);
+    qnav_board_mix(-45, 0, 60, &l, &r);
+    assert_true(l > 0);
+    assert_int_equal(l, -r);
+    qnav_board_mix(0, 0, 60, &l, &r); /* no speed, no heading: no motion at all */
     assert_int_equal(l, 0);
     assert_int_equal(r, 0);
 }
@@ -270,6 +276,41 @@ static void test_stop_command_holds_until_the_bridge_clears_it(void **state)
     assert_false(moving());
     run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 300);
     assert_true(moving());
+}
+
+/* A decision of speed 0 toward a heading turns the robot in place, as the simulator's robot
+ * turns (the board used to stand still: a robot boxed in by near readings, whose controller
+ * can only turn, froze). Offboard and onboard; with the link lost it stops. */
+static void test_a_decision_of_speed_0_turns_in_place(void **state)
+{
+    uint16_t k;
+    uint32_t t;
+    (void)state;
+    bench_start(8);
+    goal(1, 0);
+    for (t = 0; t < 3; ++t) {
+        heartbeat(QNAV_LINK_MODE_OFFBOARD, 0);
+        command(120, 0, 0);
+        run_ms(100);
+    }
+    assert_int_equal(g.sim.drive_speed, 0);
+    assert_true(g.sim.right > 0);
+    assert_int_equal(g.sim.left, -g.sim.right);
+
+    bench_start(16);
+    for (k = 0; k < 16; ++k) {
+        g.sim.ranges_mm[k] = 60; /* boxed in: no path has room to move */
+    }
+    goal(1, 9000);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 500);
+    assert_true(g.telemetry > 0);
+    assert_int_equal(g.last_tel.speed, 0);
+    assert_true(g.last_tel.heading_deg != 0);
+    assert_false(g.last_tel.flags & QNAV_LINK_CMD_STOP);
+    assert_true(moving());
+    assert_int_equal(g.sim.left, -g.sim.right);
+    run_ms(1500); /* the link goes quiet: the board stops */
+    assert_false(moving());
 }
 
 static void test_corrupted_goal_is_not_acted_on(void **state)
@@ -870,6 +911,7 @@ int main(void)
         cmocka_unit_test(test_board_without_goal_stays_stopped),
         cmocka_unit_test(test_offboard_board_applies_commands_and_drops_stale_ones),
         cmocka_unit_test(test_stop_command_holds_until_the_bridge_clears_it),
+        cmocka_unit_test(test_a_decision_of_speed_0_turns_in_place),
         cmocka_unit_test(test_corrupted_goal_is_not_acted_on),
         cmocka_unit_test(test_uploaded_policy_is_used_and_a_bad_one_is_refused),
         cmocka_unit_test(test_an_uploaded_network_takes_the_row_shapes_it_carries),

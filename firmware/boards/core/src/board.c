@@ -77,15 +77,12 @@ void qnav_board_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_deg_t spin_
     if (left == NULL || right == NULL) {
         return;
     }
-    if (speed <= 0) {
-        *left = 0;
-        *right = 0;
-        return;
-    }
     if (spin_deg < 1) {
         spin_deg = 1;
     }
-    fwd = mag >= spin_deg ? 0 : ((int32_t)speed * (spin_deg - mag)) / spin_deg;
+    /* no speed: a turn in place toward the heading (none at heading 0), as the simulator's
+     * robot turns to a decision whatever its speed */
+    fwd = speed <= 0 || mag >= spin_deg ? 0 : ((int32_t)speed * (spin_deg - mag)) / spin_deg;
     turn = (mag >= 90 ? TURN_MAX : (TURN_MAX * mag) / 90) * (h < 0 ? -1 : 1);
     /* counter-clockwise (positive) heading: the right wheel runs faster */
     *left = sat_q15(fwd - turn);
@@ -512,6 +509,7 @@ void qnav_board_tick(qnav_board_t *bot)
     uint16_t k;
     uint16_t scan_seq;
     uint8_t was_ok;
+    uint8_t active;
     uint8_t moving;
 
     if (bot == NULL) {
@@ -546,14 +544,18 @@ void qnav_board_tick(qnav_board_t *bot)
 
     decide(bot, now, &in, &out);
     qnav_ctrl_carry_output(&bot->carry, &in, &out);
-    moving = (uint8_t)(bot->link_ok && !bot->hold_stop && bot->have_goal && bot->mode != 0u &&
-                       out.speed > 0);
-    if (!moving) {
+    active = (uint8_t)(bot->link_ok && !bot->hold_stop && bot->have_goal && bot->mode != 0u);
+    if (!active) {
         out.speed = 0;
+    }
+    /* a decision of speed 0 toward a heading is a turn in place (the escape's, the speed
+     * guard's): the robot moves, as the simulator's does */
+    moving = (uint8_t)(active && (out.speed > 0 || out.heading_deg != 0));
+    if (!moving) {
         bot->stats.stopped_ticks++;
     }
     /* act: the drive is set every tick, to 0 whenever anything is wrong */
-    bot->hal.drive(bot->hal.ctx, moving ? out.heading_deg : 0, out.speed);
+    bot->hal.drive(bot->hal.ctx, active ? out.heading_deg : 0, out.speed);
 
     /* report: heartbeat (before the decision, so the bridge labels it with the current
      * policy), pose (before the scan, so navbridge's offboard controller has this tick's
