@@ -23,7 +23,7 @@ static void parse_motion(const TomlReader &r, RobotProfile &p) {
 
     const toml::table &drive = r.table(root, "drive");
     r.only_keys(drive, {"v_max_mps", "accel_mps2", "decel_mps2", "turn_rate_max_dps",
-                        "heading_gain_per_s", "limits", "full_speed_quality"});
+                        "heading_gain_per_s", "limits", "full_speed_quality", "model"});
     p.v_max_mps = r.number(drive, "v_max_mps", 0.01, 20.0);
     p.full_speed_quality = r.number(drive, "full_speed_quality", 0.01, 1.0);
     p.accel_mps2 = r.number(drive, "accel_mps2", 0.01, 100.0);
@@ -35,6 +35,14 @@ static void parse_motion(const TomlReader &r, RobotProfile &p) {
         if (limits != "wheel" && limits != "body")
             r.fail(*drive.get("limits"), "'limits' must be \"wheel\" or \"body\"");
         p.body_limits = limits == "body";
+    }
+    if (drive.get("model")) {
+        const std::string model = r.string(drive, "model");
+        if (model != "heading" && model != "mix")
+            r.fail(*drive.get("model"), "'model' must be \"heading\" or \"mix\"");
+        p.drive_mix = model == "mix";
+        if (p.drive_mix && p.body_limits)
+            r.fail(*drive.get("model"), "'model' \"mix\" drives each wheel: not with limits = \"body\"");
     }
 
     const toml::table &slip = r.table(root, "slip");

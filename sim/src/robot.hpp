@@ -29,6 +29,11 @@ struct RobotProfile {
     // the body's forward speed and turn rate separately (the Pioneer's ARCOS servo:
     // translational and rotational profiles, so braking does not wait for a turn)
     bool body_limits = false;       // [drive] limits = "wheel" (false) or "body" (true)
+    // [drive] model: "heading" (false), a heading controller turning the body to each
+    // decision; "mix" (true), each decision mixed into two wheel speeds open-loop as the
+    // board does (qnav_drive_mix; the TekBot's board drives its motors so), each wheel at
+    // accel / decel
+    bool drive_mix = false;
     double turn_rate_max_dps = 180; // turn-rate limit of the heading controller, deg/s
     double heading_gain_per_s = 4;  // heading controller: turn rate = gain * error, 1/s
     // slip

@@ -9,6 +9,7 @@
 #include <box2d/box2d.h>
 
 #include "error.hpp"
+#include "qnav/drive.h"
 #include "qnav/fixed_host.h"
 
 namespace qnav {
@@ -199,6 +200,7 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     collided_this_tick_ = false;
     l_m_ = 0;
     wheel_l_ = wheel_r_ = 0;
+    mix_l_ = mix_r_ = 0;
     cmd_heading_deg_ = cmd_speed_ = 0;
     escape_side_ = 0;
     have_prev_ = false;
@@ -422,8 +424,25 @@ void Simulation::recovery_wheels() {
 // Heading controller: turn rate proportional to the heading error, forward speed
 // reduced by cos(error) (no driving while facing away), then per-wheel acceleration
 // limits.
+// [drive] model "mix": the decision as the board turns it into wheel speeds, whole degrees
+// and Q1.15 as the board receives it, held for the tick.
+void Simulation::mix_targets(double heading_rad, double speed) {
+    const long deg = std::lround(wrap_pi(heading_rad) * 180.0 / kPi);
+    qnav_q1_15_t l = 0, r = 0;
+    qnav_drive_mix(static_cast<qnav_deg_t>(deg <= -180 ? deg + 360 : deg),
+                   static_cast<qnav_q1_15_t>(std::lround(std::clamp(speed, 0.0, 1.0) * 32767.0)),
+                   QNAV_DRIVE_SPIN_DEG, &l, &r);
+    mix_l_ = l / 32767.0 * robot_.v_max_mps;
+    mix_r_ = r / 32767.0 * robot_.v_max_mps;
+}
+
 void Simulation::heading_wheels(double dt) {
     const double b = robot_.wheel_base_m, vmax = robot_.v_max_mps;
+    if (robot_.drive_mix) {
+        wheel_l_ = approach(wheel_l_, mix_l_, robot_.accel_mps2, robot_.decel_mps2, dt);
+        wheel_r_ = approach(wheel_r_, mix_r_, robot_.accel_mps2, robot_.decel_mps2, dt);
+        return;
+    }
     const double e = wrap_pi(target_heading_ - heading_);
     const double wmax = robot_.turn_rate_max_dps * kPi / 180.0;
     const double omega_d = std::clamp(robot_.heading_gain_per_s * e, -wmax, wmax);
@@ -528,6 +547,7 @@ void Simulation::advance() {
         }
         target_heading_ = wrap_pi(heading_ + he);
         target_speed_ = sp;
+        if (robot_.drive_mix) mix_targets(he, sp);
     }
     const Vec2 before = pos_;
     const double dt = QNAV_SIM_TICK_S / kSubsteps;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "qnav/board.h"
+#include "qnav/drive.h"
 
 static uint32_t sim_millis(void *ctx)
 {
@@ -37,7 +38,7 @@ static void sim_drive(void *ctx, qnav_deg_t heading, qnav_q1_15_t speed)
     sim_hal_t *s = (sim_hal_t *)ctx;
     s->drive_heading = heading;
     s->drive_speed = speed;
-    qnav_board_mix(heading, speed, 60, &s->left, &s->right);
+    qnav_drive_mix(heading, speed, QNAV_DRIVE_SPIN_DEG, &s->left, &s->right);
     s->motor_calls++;
 }
 

@@ -14,6 +14,7 @@
 #include <cmocka.h>
 
 #include "bridge.h"
+#include "qnav/drive.h"
 #include "qnav/link.h"
 #include "qnav/tekbot.h"
 #include "qnav_odometry_t.h"
@@ -151,22 +152,22 @@ static void test_mix_turns_counter_clockwise_with_the_right_wheel(void **state)
 {
     qnav_q1_15_t l, r;
     (void)state;
-    qnav_board_mix(30, 20000, 60, &l, &r);
+    qnav_drive_mix(30, 20000, 60, &l, &r);
     assert_true(r > l);
-    qnav_board_mix(-30, 20000, 60, &l, &r);
+    qnav_drive_mix(-30, 20000, 60, &l, &r);
     assert_true(l > r);
-    qnav_board_mix(0, 20000, 60, &l, &r);
+    qnav_drive_mix(0, 20000, 60, &l, &r);
     assert_int_equal(l, 20000);
     assert_int_equal(r, 20000);
-    qnav_board_mix(120, 20000, 60, &l, &r); /* beyond spin: turn in place */
+    qnav_drive_mix(120, 20000, 60, &l, &r); /* beyond spin: turn in place */
     assert_int_equal(l, -r);
-    qnav_board_mix(45, 0, 60, &l, &r); /* no speed: a turn in place toward the heading */
+    qnav_drive_mix(45, 0, 60, &l, &r); /* no speed: a turn in place toward the heading */
     assert_true(r > 0);
     assert_int_equal(l, -r);
-    qnav_board_mix(-45, 0, 60, &l, &r);
+    qnav_drive_mix(-45, 0, 60, &l, &r);
     assert_true(l > 0);
     assert_int_equal(l, -r);
-    qnav_board_mix(0, 0, 60, &l, &r); /* no speed, no heading: no motion at all */
+    qnav_drive_mix(0, 0, 60, &l, &r); /* no speed, no heading: no motion at all */
     assert_int_equal(l, 0);
     assert_int_equal(r, 0);
 }

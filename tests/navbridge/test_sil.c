@@ -319,12 +319,15 @@ static void tekbot_with_map(const char *path, const char *cell_m)
 
 /* Issue 18: a profile's [map] is run by the board core itself (qnav_board_set_map), marked
  * from the board's own dead reckoning: behind a wall whose gap is far to one side, the
- * robot reaches a destination that the policy alone does not reach in the world's time;
- * a map too large for its cells is refused with one line. */
+ * robot reaches the destination at least 10 s sooner than the policy alone, which slides
+ * along the wall (and arrives within the world's 60 s, or not); a map too large for its
+ * cells is refused with one line. */
 static void test_sil_board_core_with_a_map_finds_the_far_gap(void **state)
 {
     char prof[300], fine[300], text[2048], err[2048];
     const char *eps[] = {"2", "3"}, *modes[] = {"offboard", "onboard"};
+    const char *at;
+    long with_map = 0, without = 0;
     const char *sil_fine[] = {SIL_EXE, "--robot", fine, "--env", WALL_GAP_ENV, NULL};
     size_t k;
     (void)state;
@@ -339,12 +342,17 @@ static void test_sil_board_core_with_a_map_finds_the_far_gap(void **state)
         assert_non_null(strstr(text, "reached yes, "));
         assert_non_null(strstr(text, " 0 collisions"));
         assert_non_null(strstr(err, "the board core plans over a map of 100 mm cells"));
+        if (k == 0) {
+            at = strstr(text, "reached yes, ");
+            with_map = strtol(at + strlen("reached yes, "), NULL, 10);
+        }
     }
-    /* the contrast: the same episode without the map times out sliding along the wall */
-    assert_int_equal(wall_gap_trial("tekbot", "2", "offboard", "-gap-nomap", text, sizeof text, err,
-                                    sizeof err), 1);
+    /* the contrast: the same episode without the map slides along the wall */
+    (void)wall_gap_trial("tekbot", "2", "offboard", "-gap-nomap", text, sizeof text, err, sizeof err);
     print_message("no map, episode 2: %s", text);
-    assert_non_null(strstr(text, "reached no, "));
+    at = strstr(text, "reached yes, ");
+    without = at != NULL ? strtol(at + strlen("reached yes, "), NULL, 10) : 100000L;
+    assert_true(with_map > 0 && without >= with_map + 100);
     assert_null(strstr(err, "plans over a map"));
 
     /* 4 cm cells over the arena's bounding box in the odometry frame: too many */

@@ -8,6 +8,8 @@
 
 #include <cmath>
 
+#include "qnav/drive.h"
+
 static const double kPiD = 3.14159265358979323846;
 
 static qnav_sim_state_t drive(qnav_sim_t *sim, double heading_deg, double speed, int ticks) {
@@ -158,6 +160,46 @@ static void test_body_limits_brake_at_decel_while_turning(void **state) {
     assert_true(d_wheel > d_body + 0.03);
 }
 
+// The TekBot's profile drives as its board mixes (model "mix"): a decision held each tick
+// (30 deg left at full speed) gives the wheels qnav_drive_mix()'s speeds, so the robot
+// circles at the forward part and turns at the wheels' difference; a turn in place at
+// speed 0 turns without moving; and a decision to turn 168 deg at speed 0 from full speed
+// brakes only the inner wheel (the outer one is already at the turn's full wheel speed), so
+// the body slows at half of decel, as the board's does (docs/sim.md, "Drive model").
+static void test_the_tekbot_drives_as_its_board_mixes(void **state) {
+    (void)state;
+    TestSim t;
+    make_test_sim(t, "tekbot", test_env_text(""), nullptr, 8, 0, 0);
+    qnav_q1_15_t l = 0, r = 0;
+    qnav_drive_mix(30, 32767, QNAV_DRIVE_SPIN_DEG, &l, &r);
+    const double v_l = l / 32767.0 * 0.5, v_r = r / 32767.0 * 0.5;  // v_max 0.5 m/s
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
+    qnav_sim_state_t a, b;
+    for (int i = 0; i < 10; ++i) a = drive(t.sim, 30.0, 1.0, 1);  // the wheels at their speeds
+    b = drive(t.sim, 30.0, 1.0, 1);
+    const double turn = std::remainder(b.heading_rad - a.heading_rad, 2 * kPiD) / 0.1;
+    const double v = 0.5 * (v_l + v_r), w = (v_r - v_l) / 0.18;  // wheel base 0.18 m
+    print_message("mix: %.4f m/s, %.3f rad/s; expected %.4f, %.3f less slip\n", b.speed_mps, turn, v, w);
+    assert_true(std::fabs(b.speed_mps - v) < 0.03 * v);  // the speed is read along the turned heading
+    assert_true(std::fabs(turn - w * (1.0 - 0.03 * v / 0.5)) < 0.02 * w);  // slip turn 0.03
+    // a turn in place: 90 deg left at speed 0, from standing
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
+    b = drive(t.sim, 90.0, 0.0, 3);
+    assert_true(b.heading_rad > 0.3);
+    assert_true(std::hypot(b.x_m - 5.0, b.y_m - 5.0) < 1e-6);
+    // from 0.5 m/s straight, a turn of 168 deg at speed 0: the inner wheel brakes at 2 m/s^2
+    // toward -0.5 m/s, the outer stays at 0.5
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
+    b = drive(t.sim, 0.0, 1.0, 10);
+    assert_true(std::fabs(b.speed_mps - 0.5) < 1e-3);
+    b = drive(t.sim, 168.0, 0.0, 1);
+    print_message("braking while turning: %.4f m/s after 0.1 s\n", b.speed_mps);
+    assert_true(std::fabs(b.speed_mps - (0.5 + (0.5 - 2.0 * 0.1)) / 2) < 0.01);
+}
+
 static void test_limits_key_is_checked(void **state) {
     (void)state;
     std::string text = read_text_file(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml");
@@ -168,6 +210,20 @@ static void test_limits_key_is_checked(void **state) {
     assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "r.toml", &robot, err, sizeof err),
                      QNAV_SIM_E_PARSE);
     assert_non_null(std::strstr(err, "'limits' must be \"wheel\" or \"body\""));
+    // the drive model: one of two, and a mix drives each wheel
+    std::string tek = read_text_file(QNAV_TEST_DATA_DIR "/robots/tekbot.toml");
+    const std::string mix = "model = \"mix\"";
+    assert_true(tek.find(mix) != std::string::npos);
+    std::string bad = tek;
+    bad.replace(bad.find(mix), mix.size(), "model = \"mixer\"");
+    assert_int_equal(qnav_sim_robot_parse(bad.data(), bad.size(), "r.toml", &robot, err, sizeof err),
+                     QNAV_SIM_E_PARSE);
+    assert_non_null(std::strstr(err, "'model' must be \"heading\" or \"mix\""));
+    bad = tek;
+    bad.replace(bad.find(mix), mix.size(), mix + "\nlimits = \"body\"");
+    assert_int_equal(qnav_sim_robot_parse(bad.data(), bad.size(), "r.toml", &robot, err, sizeof err),
+                     QNAV_SIM_E_PARSE);
+    assert_non_null(std::strstr(err, "not with limits = \"body\""));
 }
 
 int main(void) {
@@ -176,6 +232,7 @@ int main(void) {
         cmocka_unit_test(test_heading_controller_turns_to_the_commanded_heading_and_stays),
         cmocka_unit_test(test_slipping_robot_turns_less_at_speed_and_skids_outwards),
         cmocka_unit_test(test_body_limits_brake_at_decel_while_turning),
+        cmocka_unit_test(test_the_tekbot_drives_as_its_board_mixes),
         cmocka_unit_test(test_limits_key_is_checked),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -113,13 +113,20 @@ class FamilyEval(unittest.TestCase):
         return kinds, touches
 
     def test_failures_are_listed_with_commands_that_draw_them(self):
-        # fixed seeds: the TekBot without a map misses the limit in these rooms, and with
-        # the map touches something in this much denser clutter
+        # fixed seeds: the TekBot without a map misses the limit in these rooms, and one
+        # without its safety distance and speed guard touches something in denser clutter
         kinds, _ = self.listed("rooms", 2, "--seed-base", "5000007")
         self.assertTrue({"arrived late", "did not arrive at twice the limit"} <= kinds, kinds)
-        _, touches = self.listed("clutter", 3, "--seed-base", "3000000", "--difficulty", "0.8",
-                                 "--robot", "tekbot+map", "--sensor-noise", "0.05",
-                                 "--actuation-noise", "0.01")
+        src = os.path.join(os.environ["QNAV_TOOLS_DIR"], "..", "data", "robots", "tekbot.toml")
+        with open(src, encoding="utf-8") as f:
+            text = re.sub(r"(?m)^safety_m = .*$", "safety_m = 0.0", f.read())
+        text = re.sub(r"(?m)^speed_guard = .*$", "speed_guard = false", text)
+        with tempfile.TemporaryDirectory() as tmp:
+            prof = os.path.join(tmp, "reckless.toml")
+            with open(prof, "w", encoding="utf-8") as f:
+                f.write(text)
+            _, touches = self.listed("clutter", 3, "--seed-base", "3000000", "--difficulty", "0.8",
+                                     "--robot", prof)
         self.assertGreater(touches, 0)
 
     def test_a_profile_file_sizes_its_worlds_and_keeps_its_sectors(self):

@@ -15,9 +15,6 @@
 /* Most UART bytes handled per receive, so one poll never starves the tick. */
 #define UART_BURST 128u
 
-/* Turn part at |heading| >= 90 deg: half of full wheel speed, Q1.15. */
-#define TURN_MAX ((int32_t)16384)
-
 /* Ticks between configuration reports (1 s at 10 Hz; 66 bytes each). */
 #define CONFIG_EVERY 10u
 
@@ -54,39 +51,6 @@ void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t
     QNAV_BOARD_ROBOT_FIELDS(QNAV_BOARD_REPORT_FIELD)
 #undef QNAV_BOARD_REPORT_FIELD
     m->n = n;
-}
-
-static qnav_q1_15_t sat_q15(int32_t v)
-{
-    if (v > INT32_C(32767)) {
-        return 32767;
-    }
-    if (v < -INT32_C(32767)) {
-        return -32767;
-    }
-    return (qnav_q1_15_t)v;
-}
-
-void qnav_board_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_deg_t spin_deg,
-                    qnav_q1_15_t *left, qnav_q1_15_t *right)
-{
-    int32_t h = heading_deg;
-    int32_t mag = h < 0 ? -h : h;
-    int32_t fwd;
-    int32_t turn;
-    if (left == NULL || right == NULL) {
-        return;
-    }
-    if (spin_deg < 1) {
-        spin_deg = 1;
-    }
-    /* no speed: a turn in place toward the heading (none at heading 0), as the simulator's
-     * robot turns to a decision whatever its speed */
-    fwd = speed <= 0 || mag >= spin_deg ? 0 : ((int32_t)speed * (spin_deg - mag)) / spin_deg;
-    turn = (mag >= 90 ? TURN_MAX : (TURN_MAX * mag) / 90) * (h < 0 ? -1 : 1);
-    /* counter-clockwise (positive) heading: the right wheel runs faster */
-    *left = sat_q15(fwd - turn);
-    *right = sat_q15(fwd + turn);
 }
 
 /* The stored policy when one is whole and the controller takes it, else the built-in. */

@@ -27,6 +27,7 @@
 #include <avr/pgmspace.h>
 
 #include "qnav/board.h"
+#include "qnav/drive.h"
 #include "qnav/robots.h"
 
 #include "hal_avr.h"
@@ -50,10 +51,6 @@
 #define SONAR_BANK 8u
 #define SONAR_MAX 16u
 
-/* spin_deg of qnav_board_mix: at or beyond this |heading| the TekBot turns in place */
-#ifndef QNAV_TEKBOT_SPIN_DEG
-#define QNAV_TEKBOT_SPIN_DEG 60
-#endif
 
 /* Receive ring: it must hold what arrives at line rate while the main loop is busy with a
  * tick (the step, up to 100 000 cycles = 6.3 ms, and the polled transmit of scan, heartbeat
@@ -179,7 +176,7 @@ static void avr_drive(void *ctx, qnav_deg_t heading_deg, qnav_q1_15_t speed)
     qnav_q1_15_t left;
     qnav_q1_15_t right;
     (void)ctx;
-    qnav_board_mix(heading_deg, speed, QNAV_TEKBOT_SPIN_DEG, &left, &right);
+    qnav_drive_mix(heading_deg, speed, QNAV_DRIVE_SPIN_DEG, &left, &right);
     if (left >= 0) {
         PORTB |= _BV(PB0);
     } else {

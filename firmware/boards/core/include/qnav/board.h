@@ -276,11 +276,6 @@ const qnav_board_stats_t *qnav_board_stats(const qnav_board_t *bot);
 const qnav_board_pose_t *qnav_board_pose(const qnav_board_t *bot);
 qnav_board_policy_source_t qnav_board_policy_source(const qnav_board_t *bot);
 
-/* Differential drive from a decision: forward part falls linearly to 0 at spin_deg, the
- * turn part is proportional to heading and saturates at 90 deg, whatever the speed (speed
- * 0 with a heading turns in place; heading 0 and speed 0 stop). Outputs Q1.15, signed. */
-void qnav_board_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_deg_t spin_deg,
-                    qnav_q1_15_t *left, qnav_q1_15_t *right);
 
 
 #ifdef __cplusplus

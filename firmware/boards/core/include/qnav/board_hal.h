@@ -39,7 +39,7 @@ typedef struct {
     /* Drive: turn towards heading_deg (robot frame, deg, CCW, -179..180) at speed (Q1.15
      * fraction of full speed, 0..32767). Speed 0 with a heading turns in place toward it;
      * heading 0 and speed 0 stop. Called every tick. A differential-drive board turns it
-     * into wheel speeds with qnav_board_mix(). */
+     * into wheel speeds with qnav_drive_mix() (qnav/drive.h). */
     void (*drive)(void *ctx, qnav_deg_t heading_deg, qnav_q1_15_t speed);
 
     /* One received byte (0..255), or -1 when none is waiting. Never blocks. */
