@@ -421,9 +421,6 @@ void Simulation::recovery_wheels() {
     }
 }
 
-// Heading controller: turn rate proportional to the heading error, forward speed
-// reduced by cos(error) (no driving while facing away), then per-wheel acceleration
-// limits.
 // [drive] model "mix": the decision as the board turns it into wheel speeds, whole degrees
 // and Q1.15 as the board receives it, held for the tick.
 void Simulation::mix_targets(double heading_rad, double speed) {
@@ -436,6 +433,9 @@ void Simulation::mix_targets(double heading_rad, double speed) {
     mix_r_ = r / 32767.0 * robot_.v_max_mps;
 }
 
+// Heading controller: turn rate proportional to the heading error, forward speed
+// reduced by cos(error) (no driving while facing away), then per-wheel acceleration
+// limits; with model "mix" the wheels go to mix_targets()' speeds instead.
 void Simulation::heading_wheels(double dt) {
     const double b = robot_.wheel_base_m, vmax = robot_.v_max_mps;
     if (robot_.drive_mix) {
