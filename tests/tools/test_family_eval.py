@@ -166,7 +166,8 @@ class FamilyEval(unittest.TestCase):
         for args, words in ((["--families", "bogus"], "unknown family 'bogus'"),
                             (["--robot", "/no/such/profile.toml"], "/no/such/profile.toml"),
                             (["--worlds", "0"], "at least 1"),
-                            (["--sectors", "0"], "at least 1")):
+                            (["--sectors", "0"], "at least 1"),
+                            (["--failures", "--policy", "a", "--policy", "b"], "give --policy once")):
             r = tool("--worlds", "1", *args) if args[0] != "--worlds" else tool(*args)
             self.assertNotEqual(r.returncode, 0)
             self.assertIn(words, r.stderr)
