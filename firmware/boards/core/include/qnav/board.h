@@ -276,8 +276,6 @@ const qnav_board_stats_t *qnav_board_stats(const qnav_board_t *bot);
 const qnav_board_pose_t *qnav_board_pose(const qnav_board_t *bot);
 qnav_board_policy_source_t qnav_board_policy_source(const qnav_board_t *bot);
 
-
-
 #ifdef __cplusplus
 }
 #endif
