@@ -143,6 +143,17 @@ static void run_with_heartbeats(uint8_t mode, uint8_t state, uint32_t ms)
     }
 }
 
+/* Offboard for ticks ticks (100 ms each), a heartbeat and the same command every tick. */
+static void offboard_commands(qnav_deg_t heading, qnav_q1_15_t speed, uint32_t ticks)
+{
+    uint32_t t;
+    for (t = 0; t < ticks; ++t) {
+        heartbeat(QNAV_LINK_MODE_OFFBOARD, 0);
+        command(heading, speed, 0);
+        run_ms(100);
+    }
+}
+
 static int moving(void)
 {
     return g.sim.left != 0 || g.sim.right != 0;
@@ -247,11 +258,7 @@ static void test_offboard_board_applies_commands_and_drops_stale_ones(void **sta
     (void)state;
     bench_start(8);
     goal(1, 0);
-    for (t = 0; t < 5; ++t) {
-        heartbeat(QNAV_LINK_MODE_OFFBOARD, 0);
-        command(0, 16384, 0);
-        run_ms(100);
-    }
+    offboard_commands(0, 16384, 5);
     assert_int_equal(g.sim.left, 16384);
     assert_int_equal(g.sim.right, 16384);
     assert_int_equal(g.telemetry, 0); /* offboard: the board does not decide */
@@ -285,15 +292,10 @@ static void test_stop_command_holds_until_the_bridge_clears_it(void **state)
 static void test_a_decision_of_speed_0_turns_in_place(void **state)
 {
     uint16_t k;
-    uint32_t t;
     (void)state;
     bench_start(8);
     goal(1, 0);
-    for (t = 0; t < 3; ++t) {
-        heartbeat(QNAV_LINK_MODE_OFFBOARD, 0);
-        command(120, 0, 0);
-        run_ms(100);
-    }
+    offboard_commands(120, 0, 3);
     assert_int_equal(g.sim.drive_speed, 0);
     assert_true(g.sim.right > 0);
     assert_int_equal(g.sim.left, -g.sim.right);
