@@ -5,36 +5,60 @@
 
 #include <stddef.h>
 
-/* Full wheel speed, Q1.15: the turn part at |heading| >= 90 deg (measured: docs/sim.md,
- * "One drive for the simulated and the real TekBot"). */
-#define TURN_MAX ((int32_t)32767)
+#include "qnav/trig.h"
 
-static qnav_q1_15_t sat_q15(int32_t v)
-{
-    if (v > INT32_C(32767)) {
-        return 32767;
-    }
-    if (v < -INT32_C(32767)) {
-        return -32767;
-    }
-    return (qnav_q1_15_t)v;
-}
+/* Full wheel speed, Q1.15. */
+#define FULL ((int32_t)32767)
 
-void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_deg_t spin_deg,
+void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling,
                     qnav_q1_15_t *left, qnav_q1_15_t *right)
 {
     int32_t h = heading_deg;
     int32_t mag = h < 0 ? -h : h;
-    int32_t fwd;
-    int32_t turn;
+    int32_t fwd = 0;
+    int32_t turn = mag >= 90 ? FULL : (FULL * mag) / 90;
     if (left == NULL || right == NULL) {
         return;
     }
-    if (spin_deg < 1) {
-        spin_deg = 1;
+    if (speed > 0 && mag < 90) {
+        int16_t c;
+        int16_t s;
+        qnav_cos_sin_q14(mag * 100, &c, &s);
+        fwd = ((int32_t)speed * c) / 16384;
     }
-    fwd = speed <= 0 || mag >= spin_deg ? 0 : ((int32_t)speed * (spin_deg - mag)) / spin_deg;
-    turn = (mag >= 90 ? TURN_MAX : (TURN_MAX * mag) / 90) * (h < 0 ? -1 : 1);
-    *left = sat_q15(fwd - turn);
-    *right = sat_q15(fwd + turn);
+    if (fwd == 0 && rolling > QNAV_DRIVE_STOPPED) {
+        *left = 0; /* brake first (measured: docs/sim.md, "One drive for ...") */
+        *right = 0;
+        return;
+    }
+    if (fwd + turn > FULL) { /* one factor for both: the same arc, slower */
+        int32_t sum = fwd + turn;
+        fwd = (fwd * FULL) / sum;
+        turn = (turn * FULL) / sum;
+    }
+    if (h < 0) {
+        turn = -turn;
+    }
+    *left = (qnav_q1_15_t)(fwd - turn);
+    *right = (qnav_q1_15_t)(fwd + turn);
+}
+
+qnav_q1_15_t qnav_drive_rolling(int32_t travel_um, uint16_t tick_ms, uint16_t v_max_mm_s)
+{
+    /* mm/s * ms = um: full speed's travel in one tick */
+    uint32_t full = (uint32_t)tick_ms * v_max_mm_s;
+    uint32_t mag = travel_um < 0 ? 0u - (uint32_t)travel_um : (uint32_t)travel_um;
+    int32_t r;
+    if (full == 0u) {
+        return 0;
+    }
+    if (mag >= full) {
+        return (qnav_q1_15_t)(travel_um < 0 ? -FULL : FULL);
+    }
+    while (full > UINT32_C(65535)) { /* mag < full: mag * 32767 then fits 31 bits */
+        full >>= 1;
+        mag >>= 1;
+    }
+    r = (int32_t)((mag * (uint32_t)FULL) / full);
+    return (qnav_q1_15_t)(travel_um < 0 ? -r : r);
 }

@@ -116,9 +116,12 @@ static void hal_odometry(void *ctx, int32_t *left, int32_t *right)
     *right = (int32_t)(int64_t)floor(s->right_um / s->um_per_count);
 }
 
-static void hal_drive(void *ctx, qnav_deg_t heading, qnav_q1_15_t speed)
+/* The simulator mixes the decision with its own wheels' speed (the profile's [drive] model),
+ * so the board's encoder-measured rolling speed is not needed here. */
+static void hal_drive(void *ctx, qnav_deg_t heading, qnav_q1_15_t speed, qnav_q1_15_t rolling)
 {
     sil_hal_t *s = (sil_hal_t *)ctx;
+    (void)rolling;
     s->drive_heading = heading;
     s->drive_speed = speed;
 }

@@ -422,13 +422,16 @@ void Simulation::recovery_wheels() {
 }
 
 // [drive] model "mix": the decision as the board turns it into wheel speeds, whole degrees
-// and Q1.15 as the board receives it, held for the tick.
+// and Q1.15 as the board receives it, held for the tick; the rolling speed the board's
+// encoders measure is here the wheels' own (the board's is counts over a tick).
 void Simulation::mix_targets(double heading_rad, double speed) {
     const long deg = std::lround(wrap_pi(heading_rad) * 180.0 / kPi);
+    const auto q15 = [](double f) {
+        return static_cast<qnav_q1_15_t>(std::lround(std::clamp(f, -1.0, 1.0) * 32767.0));
+    };
     qnav_q1_15_t l = 0, r = 0;
-    qnav_drive_mix(static_cast<qnav_deg_t>(deg <= -180 ? deg + 360 : deg),
-                   static_cast<qnav_q1_15_t>(std::lround(std::clamp(speed, 0.0, 1.0) * 32767.0)),
-                   QNAV_DRIVE_SPIN_DEG, &l, &r);
+    qnav_drive_mix(static_cast<qnav_deg_t>(deg <= -180 ? deg + 360 : deg), q15(std::max(speed, 0.0)),
+                   q15((wheel_l_ + wheel_r_) / 2 / robot_.v_max_mps), &l, &r);
     mix_l_ = l / 32767.0 * robot_.v_max_mps;
     mix_r_ = r / 32767.0 * robot_.v_max_mps;
 }

@@ -33,12 +33,13 @@ static void sim_odometry(void *ctx, int32_t *left, int32_t *right)
     *right = s->right_counts;
 }
 
-static void sim_drive(void *ctx, qnav_deg_t heading, qnav_q1_15_t speed)
+static void sim_drive(void *ctx, qnav_deg_t heading, qnav_q1_15_t speed, qnav_q1_15_t rolling)
 {
     sim_hal_t *s = (sim_hal_t *)ctx;
     s->drive_heading = heading;
     s->drive_speed = speed;
-    qnav_drive_mix(heading, speed, QNAV_DRIVE_SPIN_DEG, &s->left, &s->right);
+    s->drive_rolling = rolling;
+    qnav_drive_mix(heading, speed, rolling, &s->left, &s->right);
     s->motor_calls++;
 }
 

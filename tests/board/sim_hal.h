@@ -26,7 +26,8 @@ typedef struct {
     int32_t left_counts, right_counts;
     qnav_deg_t drive_heading;       /* last drive */
     qnav_q1_15_t drive_speed;
-    qnav_q1_15_t left, right;       /* last drive mixed for a TekBot (spin 60 deg) */
+    qnav_q1_15_t drive_rolling;     /* the forward speed the core measured (encoders) */
+    qnav_q1_15_t left, right;       /* last drive mixed for a TekBot (qnav_drive_mix) */
     uint32_t motor_calls;
     uint8_t to_board[SIM_HAL_QUEUE];
     uint32_t to_board_head, to_board_tail;

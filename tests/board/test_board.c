@@ -159,30 +159,6 @@ static int moving(void)
     return g.sim.left != 0 || g.sim.right != 0;
 }
 
-static void test_mix_turns_counter_clockwise_with_the_right_wheel(void **state)
-{
-    qnav_q1_15_t l, r;
-    (void)state;
-    qnav_drive_mix(30, 20000, 60, &l, &r);
-    assert_true(r > l);
-    qnav_drive_mix(-30, 20000, 60, &l, &r);
-    assert_true(l > r);
-    qnav_drive_mix(0, 20000, 60, &l, &r);
-    assert_int_equal(l, 20000);
-    assert_int_equal(r, 20000);
-    qnav_drive_mix(120, 20000, 60, &l, &r); /* beyond spin: turn in place */
-    assert_int_equal(l, -r);
-    qnav_drive_mix(45, 0, 60, &l, &r); /* no speed: a turn in place toward the heading */
-    assert_true(r > 0);
-    assert_int_equal(l, -r);
-    qnav_drive_mix(-45, 0, 60, &l, &r);
-    assert_true(l > 0);
-    assert_int_equal(l, -r);
-    qnav_drive_mix(0, 0, 60, &l, &r); /* no speed, no heading: no motion at all */
-    assert_int_equal(l, 0);
-    assert_int_equal(r, 0);
-}
-
 static void test_board_is_stopped_until_it_hears_the_bridge(void **state)
 {
     (void)state;
@@ -314,6 +290,41 @@ static void test_a_decision_of_speed_0_turns_in_place(void **state)
     assert_int_equal(g.sim.left, -g.sim.right);
     run_ms(1500); /* the link goes quiet: the board stops */
     assert_false(moving());
+}
+
+/* The core measures how fast the robot rolls from the encoders (the last tick's mean
+ * travel) and gives it to the drive: a turn in place while the wheels still roll forward
+ * brakes first (both wheels 0), and turns once they have stopped. */
+static void test_a_turn_in_place_brakes_while_the_encoders_say_the_robot_rolls(void **state)
+{
+    int32_t full;
+    uint32_t t;
+    (void)state;
+    bench_start(8);
+    goal(1, 0);
+    /* counts a tick at v_max */
+    full = (int32_t)((uint32_t)g.bot.cfg.ctrl.v_max_mm_s * g.bot.cfg.tick_ms /
+                     g.bot.cfg.um_per_count);
+    assert_true(full >= 4);
+    for (t = 0; t < 3; ++t) { /* rolling at full speed, told to turn round at speed 0 */
+        g.sim.left_counts += full;
+        g.sim.right_counts += full;
+        heartbeat(QNAV_LINK_MODE_OFFBOARD, 0);
+        command(120, 0, 0);
+        run_ms(100);
+    }
+    assert_true(g.sim.drive_rolling > QNAV_DRIVE_STOPPED);
+    assert_int_equal(g.sim.drive_heading, 120);
+    assert_int_equal(g.sim.left, 0); /* braking */
+    assert_int_equal(g.sim.right, 0);
+    for (t = 0; t < 2; ++t) { /* the wheels have stopped: it turns in place */
+        heartbeat(QNAV_LINK_MODE_OFFBOARD, 0);
+        command(120, 0, 0);
+        run_ms(100);
+    }
+    assert_int_equal(g.sim.drive_rolling, 0);
+    assert_true(g.sim.right > 0);
+    assert_int_equal(g.sim.left, -g.sim.right);
 }
 
 static void test_corrupted_goal_is_not_acted_on(void **state)
@@ -906,7 +917,6 @@ static void test_board_reports_its_robot_configuration_field_by_field(void **sta
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_mix_turns_counter_clockwise_with_the_right_wheel),
         cmocka_unit_test(test_board_reports_its_robot_configuration_field_by_field),
         cmocka_unit_test(test_board_is_stopped_until_it_hears_the_bridge),
         cmocka_unit_test(test_onboard_board_drives_with_libqnav_decision),
@@ -915,6 +925,7 @@ int main(void)
         cmocka_unit_test(test_offboard_board_applies_commands_and_drops_stale_ones),
         cmocka_unit_test(test_stop_command_holds_until_the_bridge_clears_it),
         cmocka_unit_test(test_a_decision_of_speed_0_turns_in_place),
+        cmocka_unit_test(test_a_turn_in_place_brakes_while_the_encoders_say_the_robot_rolls),
         cmocka_unit_test(test_corrupted_goal_is_not_acted_on),
         cmocka_unit_test(test_uploaded_policy_is_used_and_a_bad_one_is_refused),
         cmocka_unit_test(test_an_uploaded_network_takes_the_row_shapes_it_carries),

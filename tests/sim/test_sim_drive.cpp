@@ -164,14 +164,14 @@ static void test_body_limits_brake_at_decel_while_turning(void **state) {
 // (30 deg left at full speed) gives the wheels qnav_drive_mix()'s speeds, so the robot
 // circles at the forward part and turns at the wheels' difference; a turn in place at
 // speed 0 turns without moving; and a decision to turn 168 deg at speed 0 from full speed
-// brakes only the inner wheel (the outer one is already at the turn's full wheel speed), so
-// the body slows at half of decel, as the board's does (docs/sim.md, "Drive model").
+// brakes both wheels at decel first and turns only once the robot has slowed below
+// QNAV_DRIVE_STOPPED, as the board's does (docs/sim.md, "Drive model").
 static void test_the_tekbot_drives_as_its_board_mixes(void **state) {
     (void)state;
     TestSim t;
     make_test_sim(t, "tekbot", test_env_text(""), nullptr, 8, 0, 0);
     qnav_q1_15_t l = 0, r = 0;
-    qnav_drive_mix(30, 32767, QNAV_DRIVE_SPIN_DEG, &l, &r);
+    qnav_drive_mix(30, 32767, 32767, &l, &r);
     const double v_l = l / 32767.0 * 0.5, v_r = r / 32767.0 * 0.5;  // v_max 0.5 m/s
     assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
     assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
@@ -189,15 +189,21 @@ static void test_the_tekbot_drives_as_its_board_mixes(void **state) {
     b = drive(t.sim, 90.0, 0.0, 3);
     assert_true(b.heading_rad > 0.3);
     assert_true(std::hypot(b.x_m - 5.0, b.y_m - 5.0) < 1e-6);
-    // from 0.5 m/s straight, a turn of 168 deg at speed 0: the inner wheel brakes at 2 m/s^2
-    // toward -0.5 m/s, the outer stays at 0.5
+    // from 0.5 m/s straight, a turn of 168 deg at speed 0: both wheels brake at 2 m/s^2
+    // (0.5, 0.3, 0.1 m/s: rolling until below 1/8 of v_max), then it turns in place
     assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
     assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
     b = drive(t.sim, 0.0, 1.0, 10);
     assert_true(std::fabs(b.speed_mps - 0.5) < 1e-3);
+    const double h0 = b.heading_rad;
     b = drive(t.sim, 168.0, 0.0, 1);
-    print_message("braking while turning: %.4f m/s after 0.1 s\n", b.speed_mps);
-    assert_true(std::fabs(b.speed_mps - (0.5 + (0.5 - 2.0 * 0.1)) / 2) < 0.01);
+    print_message("braking before the turn: %.4f m/s after 0.1 s\n", b.speed_mps);
+    assert_true(std::fabs(b.speed_mps - (0.5 - 2.0 * 0.1)) < 0.01);
+    assert_true(std::fabs(std::remainder(b.heading_rad - h0, 2 * kPiD)) < 0.01);  // not turning yet
+    b = drive(t.sim, 168.0, 0.0, 2);
+    assert_true(b.speed_mps < 0.0625);
+    b = drive(t.sim, 168.0, 0.0, 3);
+    assert_true(std::remainder(b.heading_rad - h0, 2 * kPiD) > 0.3);  // stopped: now it turns
 }
 
 static void test_limits_key_is_checked(void **state) {

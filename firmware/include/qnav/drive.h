@@ -7,23 +7,39 @@
 #ifndef QNAV_DRIVE_H
 #define QNAV_DRIVE_H
 
+#include <stdint.h>
+
 #include "qnav/fixed.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* At or beyond this |heading| a decision is a turn in place (the TekBot's board). */
-#define QNAV_DRIVE_SPIN_DEG 60
+/* A robot rolling forward slower than this (Q1.15 of full wheel speed: 1/8) counts as
+ * stopped: a turn in place may begin. */
+#define QNAV_DRIVE_STOPPED ((qnav_q1_15_t)4096)
 
-/* The forward part falls linearly from speed at heading 0 to 0 at spin_deg (none at speed
- * 0); the turn part is proportional to the heading, full wheel speed at 90 deg and beyond
- * (each wheel saturates at full speed), whatever the speed: speed 0 with a heading turns in place, heading 0 and speed 0
- * stop. left and right are Q1.15 fractions of full wheel speed, signed, forward positive;
- * a counter-clockwise (positive) heading runs the right wheel faster. spin_deg < 1 counts
- * as 1. */
-void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_deg_t spin_deg,
+/*
+ * The forward part is speed * cos(heading), none at 90 deg and beyond or at speed 0; the
+ * turn part is proportional to the heading, full wheel speed at 90 deg and beyond,
+ * whatever the speed. When the two together would run a wheel past full speed both
+ * shrink by one factor, so the robot drives the arc the decision asked for, slower. A
+ * decision without a forward part (a turn in place) while the robot still rolls forward
+ * faster than QNAV_DRIVE_STOPPED brakes both wheels to 0 first: spinning one wheel
+ * forward would keep the robot rolling toward what made it stop. rolling is the forward
+ * speed the wheels have now (the mean of the two, Q1.15 of full wheel speed; a board's
+ * from its encoders over the last tick, qnav_drive_rolling(); 0 when unknown). left and
+ * right are Q1.15 fractions of full wheel speed, signed, forward positive; a
+ * counter-clockwise (positive) heading runs the right wheel faster. Heading 0 and speed 0
+ * stop.
+ */
+void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling,
                     qnav_q1_15_t *left, qnav_q1_15_t *right);
+
+/* The forward speed of travel_um (the mean of the two wheels' travel, micrometres) over
+ * one tick of tick_ms, as a Q1.15 fraction of v_max_mm_s, saturated to +-32767 (0 when
+ * tick_ms or v_max_mm_s is 0). */
+qnav_q1_15_t qnav_drive_rolling(int32_t travel_um, uint16_t tick_ms, uint16_t v_max_mm_s);
 
 #ifdef __cplusplus
 }

@@ -6,6 +6,8 @@
  */
 #include "qnav/board.h"
 
+#include "qnav/drive.h"
+
 #include <stddef.h>
 #include <string.h>
 
@@ -106,7 +108,7 @@ qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t
     qnav_link_tx_init(&bot->tx);
     qnav_link_upload_init(&bot->upload);
     bot->cmd.flags = QNAV_LINK_CMD_STOP;
-    bot->hal.drive(bot->hal.ctx, 0, 0);
+    bot->hal.drive(bot->hal.ctx, 0, 0, bot->rolling);
     load_policy(bot);
     if (bot->hal.odometry_read != NULL) {
         bot->hal.odometry_read(bot->hal.ctx, &bot->odo_left, &bot->odo_right);
@@ -144,7 +146,7 @@ static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm
     int8_t status = qnav_link_upload_commit(&bot->upload, cm, &fresh);
 
     if (status == QNAV_LINK_ACK_OK) {
-        bot->hal.drive(bot->hal.ctx, 0, 0);
+        bot->hal.drive(bot->hal.ctx, 0, 0, bot->rolling);
         if (init_carried(bot, &fresh, qnav_link_blob_shapes(bot->upload.blob, cm->total)) ==
             QNAV_OK) {
             bot->policy = fresh;
@@ -307,6 +309,7 @@ static void update_pose(qnav_board_t *bot)
     bot->odo_left = l;
     bot->odo_right = r;
     step = (step * (int32_t)bot->cfg.um_per_count) / 2;
+    bot->rolling = qnav_drive_rolling(step, bot->cfg.tick_ms, bot->cfg.ctrl.v_max_mm_s);
     qnav_cos_sin_q14((int32_t)h0 + (int32_t)qnav_wrap_cdeg((int32_t)h - (int32_t)h0) / 2,
                        &c, &s);
     /* in pieces that keep piece * cos inside int32 (a long stall moves far in one tick) */
@@ -519,7 +522,7 @@ void qnav_board_tick(qnav_board_t *bot)
         bot->stats.stopped_ticks++;
     }
     /* act: the drive is set every tick, to 0 whenever anything is wrong */
-    bot->hal.drive(bot->hal.ctx, active ? out.heading_deg : 0, out.speed);
+    bot->hal.drive(bot->hal.ctx, active ? out.heading_deg : 0, out.speed, bot->rolling);
 
     /* report: heartbeat (before the decision, so the bridge labels it with the current
      * policy), pose (before the scan, so navbridge's offboard controller has this tick's

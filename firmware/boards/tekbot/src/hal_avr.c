@@ -171,12 +171,12 @@ static void avr_odometry(void *ctx, int32_t *left, int32_t *right)
     SREG = sreg;
 }
 
-static void avr_drive(void *ctx, qnav_deg_t heading_deg, qnav_q1_15_t speed)
+static void avr_drive(void *ctx, qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling)
 {
     qnav_q1_15_t left;
     qnav_q1_15_t right;
     (void)ctx;
-    qnav_drive_mix(heading_deg, speed, QNAV_DRIVE_SPIN_DEG, &left, &right);
+    qnav_drive_mix(heading_deg, speed, rolling, &left, &right);
     if (left >= 0) {
         PORTB |= _BV(PB0);
     } else {

@@ -204,6 +204,8 @@ typedef struct {
     uint32_t next_tick_ms;
     qnav_board_pose_t pose;
     int32_t odo_left, odo_right; /* encoder counts at the last tick */
+    qnav_q1_15_t rolling;        /* forward speed over the last tick, Q1.15 of v_max (0
+                                    without encoders): the HAL's drive brakes on it */
     qnav_mm_t ranges[QNAV_LINK_MAX_SECTORS];
     uint8_t wire[QNAV_LINK_MAX_WIRE(QNAV_LINK_MAX_PAYLOAD)];
     qnav_board_stats_t stats;

@@ -38,9 +38,11 @@ typedef struct {
 
     /* Drive: turn towards heading_deg (robot frame, deg, CCW, -179..180) at speed (Q1.15
      * fraction of full speed, 0..32767). Speed 0 with a heading turns in place toward it;
-     * heading 0 and speed 0 stop. Called every tick. A differential-drive board turns it
-     * into wheel speeds with qnav_drive_mix() (qnav/drive.h). */
-    void (*drive)(void *ctx, qnav_deg_t heading_deg, qnav_q1_15_t speed);
+     * heading 0 and speed 0 stop. rolling: the forward speed the encoders measured over
+     * the last tick (Q1.15 of full speed; 0 without odometry_read). Called every tick. A
+     * differential-drive board turns the three into wheel speeds with qnav_drive_mix()
+     * (qnav/drive.h), which brakes before a turn in place while the robot still rolls. */
+    void (*drive)(void *ctx, qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling);
 
     /* One received byte (0..255), or -1 when none is waiting. Never blocks. */
     int16_t (*uart_read)(void *ctx);

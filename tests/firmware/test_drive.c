@@ -1,0 +1,139 @@
+/*
+ * libqnav's mixer (qnav/drive.h): a decision as two wheel speeds, the forward part by the
+ * heading's cosine, one factor for both parts at a wheel's limit (the arc kept), a brake
+ * before a turn in place while the robot rolls, and the rolling speed from encoder travel.
+ */
+#define _DEFAULT_SOURCE
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "qnav/drive.h"
+
+static void mix(int h, int speed, int rolling, qnav_q1_15_t *l, qnav_q1_15_t *r)
+{
+    qnav_drive_mix((qnav_deg_t)h, (qnav_q1_15_t)speed, (qnav_q1_15_t)rolling, l, r);
+}
+
+static void test_a_counter_clockwise_heading_runs_the_right_wheel_faster(void **state)
+{
+    qnav_q1_15_t l, r;
+    (void)state;
+    mix(30, 20000, 0, &l, &r);
+    assert_true(r > l);
+    mix(-30, 20000, 0, &l, &r);
+    assert_true(l > r);
+    mix(0, 20000, 0, &l, &r);
+    assert_int_equal(l, 20000);
+    assert_int_equal(r, 20000);
+    mix(0, 0, 0, &l, &r); /* no speed, no heading: no motion at all */
+    assert_int_equal(l, 0);
+    assert_int_equal(r, 0);
+}
+
+/* The mean of the wheels is speed * cos(heading) below a wheel's limit, their difference
+ * heading / 90 of full speed; at 90 deg and beyond, and at speed 0, a turn in place. */
+static void test_forward_falls_with_the_cosine_and_the_turn_with_the_heading(void **state)
+{
+    int h;
+    qnav_q1_15_t l, r;
+    (void)state;
+    for (h = -180; h <= 180; ++h) {
+        int mag = abs(h);
+        double want_fwd = mag >= 90 ? 0.0 : 12000.0 * cos(mag * M_PI / 180.0);
+        double want_turn = (mag >= 90 ? 32767.0 : 32767.0 * mag / 90.0) * (h < 0 ? -1 : 1);
+        mix(h, 12000, 0, &l, &r);
+        if (want_fwd + fabs(want_turn) <= 32767.0) {
+            assert_true(fabs((l + r) / 2.0 - want_fwd) <= 3.0);
+            assert_true(fabs((r - l) / 2.0 - want_turn) <= 2.0);
+        }
+        if (mag >= 90) {
+            assert_int_equal(l, -r);
+        }
+        mix(h, 0, 0, &l, &r); /* no speed: a turn in place toward the heading */
+        assert_int_equal(l, -r);
+        assert_true(h > 0 ? r > 0 : (h < 0 ? l > 0 : r == 0));
+    }
+}
+
+/* Past a wheel's limit both parts shrink by one factor: the faster wheel at full speed,
+ * the ratio of turn to forward (the arc) as below the limit. */
+static void test_at_a_wheels_limit_the_arc_is_kept(void **state)
+{
+    int h;
+    qnav_q1_15_t l, r;
+    (void)state;
+    for (h = 1; h < 90; ++h) {
+        double fwd = 32767.0 * cos(h * M_PI / 180.0);
+        double turn = 32767.0 * h / 90.0;
+        mix(h, 32767, 0, &l, &r);
+        assert_true(r <= 32767 && l >= -32767);
+        if (fwd + turn > 32767.0) {
+            double got = (r - l) / (double)(r + l);
+            /* the cosine's 2/16384 and two counts of truncation in each part, relative */
+            double tol = (2.0 / 16384.0 / cos(h * M_PI / 180.0) + 4.0 / (r + l) + 4.0 / (r - l));
+            assert_true(r >= 32765);
+            if (fabs(got - turn / fwd) > tol * turn / fwd) {
+                print_message("heading %d: turn/forward %.4f, want %.4f\n", h, got, turn / fwd);
+            }
+            assert_true(fabs(got - turn / fwd) <= tol * turn / fwd);
+        }
+    }
+}
+
+/* A turn in place while the robot still rolls forward brakes both wheels first, then
+ * turns once it has slowed to QNAV_DRIVE_STOPPED; rolling backward does not brake. */
+static void test_a_turn_in_place_brakes_first_while_the_robot_rolls(void **state)
+{
+    qnav_q1_15_t l, r;
+    (void)state;
+    mix(120, 32767, QNAV_DRIVE_STOPPED + 1, &l, &r); /* beyond 90 deg */
+    assert_int_equal(l, 0);
+    assert_int_equal(r, 0);
+    mix(-45, 0, 30000, &l, &r); /* speed 0 */
+    assert_int_equal(l, 0);
+    assert_int_equal(r, 0);
+    mix(-45, 0, QNAV_DRIVE_STOPPED, &l, &r);
+    assert_true(l > 0);
+    assert_int_equal(l, -r);
+    mix(120, 0, -20000, &l, &r);
+    assert_true(r > 0);
+    assert_int_equal(l, -r);
+    mix(30, 20000, 30000, &l, &r); /* a forward part: no brake, an arc */
+    assert_true(r > l && l > 0);
+}
+
+static void test_rolling_is_the_travel_as_a_fraction_of_full_speed(void **state)
+{
+    (void)state;
+    /* 0.5 m/s, 100 ms: 50 000 um a tick is full speed */
+    assert_int_equal(qnav_drive_rolling(50000, 100, 500), 32767);
+    assert_int_equal(qnav_drive_rolling(25000, 100, 500), 16383);
+    assert_int_equal(qnav_drive_rolling(-25000, 100, 500), -16383);
+    assert_int_equal(qnav_drive_rolling(6250, 100, 500), 4095);
+    assert_int_equal(qnav_drive_rolling(0, 100, 500), 0);
+    assert_int_equal(qnav_drive_rolling(900000, 100, 500), 32767); /* saturated */
+    assert_int_equal(qnav_drive_rolling(INT32_MIN, 100, 500), -32767);
+    assert_int_equal(qnav_drive_rolling(1000, 0, 500), 0);
+    assert_int_equal(qnav_drive_rolling(1000, 100, 0), 0);
+    /* a full tick's travel above 65 535 um (1.5 m/s): within one part in 2^15 */
+    assert_true(abs(qnav_drive_rolling(75000, 100, 1500) - 16383) <= 1);
+    assert_true(abs(qnav_drive_rolling(-149999, 1000, 1500) + 3276) <= 1);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_a_counter_clockwise_heading_runs_the_right_wheel_faster),
+        cmocka_unit_test(test_forward_falls_with_the_cosine_and_the_turn_with_the_heading),
+        cmocka_unit_test(test_at_a_wheels_limit_the_arc_is_kept),
+        cmocka_unit_test(test_a_turn_in_place_brakes_first_while_the_robot_rolls),
+        cmocka_unit_test(test_rolling_is_the_travel_as_a_fraction_of_full_speed),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
