@@ -309,19 +309,13 @@ static void test_a_turn_in_place_brakes_while_the_encoders_say_the_robot_rolls(v
     for (t = 0; t < 3; ++t) { /* rolling at full speed, told to turn round at speed 0 */
         g.sim.left_counts += full;
         g.sim.right_counts += full;
-        heartbeat(QNAV_LINK_MODE_OFFBOARD, 0);
-        command(120, 0, 0);
-        run_ms(100);
+        offboard_commands(120, 0, 1);
     }
     assert_true(g.sim.drive_rolling > QNAV_DRIVE_STOPPED);
     assert_int_equal(g.sim.drive_heading, 120);
     assert_int_equal(g.sim.left, 0); /* braking */
     assert_int_equal(g.sim.right, 0);
-    for (t = 0; t < 2; ++t) { /* the wheels have stopped: it turns in place */
-        heartbeat(QNAV_LINK_MODE_OFFBOARD, 0);
-        command(120, 0, 0);
-        run_ms(100);
-    }
+    offboard_commands(120, 0, 2); /* the wheels have stopped: it turns in place */
     assert_int_equal(g.sim.drive_rolling, 0);
     assert_true(g.sim.right > 0);
     assert_int_equal(g.sim.left, -g.sim.right);
