@@ -107,7 +107,10 @@ static int16_t first_at_least(const uint8_t *lvl, int16_t from, int8_t s, uint8_
  * side (the lowest level from straight ahead round to straight behind), so the choice
  * moves with the boundary, not with the last command. From it, turning away from the
  * side, the first path whose level clears the follow level, or the nearest reading by a
- * step when that is farther (the boundary was lost: turn back toward it).
+ * step when that is farther (the boundary was lost: turn back toward it). A reading placed
+ * on the central part of its wedge (wedge_pct) may lie anywhere in the edge the placement
+ * left free, and a follow drives tangent to what it sees: the skirt keeps half that edge
+ * more away (docs/architecture.md, "The follow keeps half the shaved edge away").
  */
 static uint16_t skirt(const qnav_clearance_t *c, const uint8_t *lvl, int8_t s)
 {
@@ -127,6 +130,9 @@ static uint16_t skirt(const qnav_clearance_t *c, const uint8_t *lvl, int8_t s)
         /* nearer than half the follow level: a little more away from the boundary */
         uint8_t half = (uint8_t)(c->esc_free_level / 2u);
         int16_t off = lw < half ? (int16_t)((half - lw) * QNAV_ESCAPE_AWAY_DEG) : 0;
+        if (lw >= c->wedge_near_level) {
+            off = (int16_t)(off + (int16_t)(c->wedge_shrink / 2u));
+        }
         return wrap((int16_t)(w + s * (k + off)));
     }
     return wrap(180);

@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "clearance.h"
+#include "escape.h"
 #include "qnav/ctrl.h"
 
 #define N 16
@@ -424,6 +425,62 @@ static void test_the_follow_bearing_comes_from_the_boundary(void **state)
     assert_true(b.out.speed > 0);
 }
 
+/* The follow's bearing with the wall of the test above (300 mm on the right, the
+ * destination behind it) when readings block wedge_pct % of their wedge; *clear: the first
+ * path counter-clockwise from the wall's middle (-90 degrees) whose level clears the
+ * follow level, as signed degrees. */
+static int16_t follow_bearing(uint8_t wedge_pct, int16_t *clear, uint8_t *shaved)
+{
+    bot_t b;
+    qnav_ctrl_config_t cfg;
+    qnav_ctrl_t c;
+    qnav_escape_t e;
+    uint8_t lvl[QNAV_PATHS];
+    int16_t k;
+    uint16_t goal;
+    following_a_wall(&b);
+    e = b.out.escape;
+    assert_int_equal(e.side, 1);
+    test_config(&cfg, 20);
+    cfg.wedge_pct = wedge_pct;
+    assert_int_equal(qnav_ctrl_init(&c, &cfg, &b.p), QNAV_OK);
+    for (k = 0; k < N; ++k) {
+        b.r[k] = MAX_MM;
+    }
+    b.r[N / 4 * 3 - 1] = 300;
+    b.r[N / 4 * 3] = 300;
+    b.r[N / 4 * 3 + 1] = 300;
+    b.in.goal_bearing_cdeg = -9000;
+    b.in.escape = e;
+    (void)qnav_clearance_input_levels(&c.clr, &b.in, lvl);
+    for (k = -90; k < 90 && lvl[(k + QNAV_PATHS) % QNAV_PATHS] < c.clr.esc_free_level; ++k) {
+    }
+    *clear = k;
+    *shaved = c.clr.wedge_shrink;
+    goal = qnav_escape_goal(&c.clr, lvl, &b.in, &e);
+    assert_int_equal(e.side, 1);
+    return (int16_t)(goal >= QNAV_PATHS / 2u ? (int16_t)goal - (int16_t)QNAV_PATHS : (int16_t)goal);
+}
+
+/* A reading placed on the central part of its wedge (wedge_pct) may lie anywhere in the
+ * edge the placement left free, and a follow drives tangent to what it sees: its bearing
+ * keeps half that edge beyond the first path that clears the follow level (the Pioneer's
+ * touches at the ends of walls; docs/architecture.md, "The follow keeps half the shaved
+ * edge away"). Whole wedges leave no edge, and the bearing is that path. */
+static void test_a_follow_keeps_half_the_shaved_edge_away(void **state)
+{
+    int16_t clear;
+    uint8_t shaved;
+    int16_t bearing;
+    (void)state;
+    bearing = follow_bearing(100, &clear, &shaved);
+    assert_int_equal(shaved, 0);
+    assert_int_equal(bearing, clear);
+    bearing = follow_bearing(20, &clear, &shaved);
+    assert_true(shaved / 2 >= 4); /* 80 % of half a 22.5 degree wedge */
+    assert_int_equal(bearing, clear + shaved / 2);
+}
+
 /* Following round an island (a box in a room, the way to the destination beyond it never
  * opening): back at the place marked early in the follow (the destination's range and
  * bearing as they were), the robot has gone round, and it leaves once it is again as
@@ -622,6 +679,7 @@ int main(void)
         cmocka_unit_test(test_a_follow_leading_away_is_given_up_early),
         cmocka_unit_test(test_the_open_hand_is_read_alike_at_32_sectors),
         cmocka_unit_test(test_the_follow_bearing_comes_from_the_boundary),
+        cmocka_unit_test(test_a_follow_keeps_half_the_shaved_edge_away),
         cmocka_unit_test(test_round_an_island_leaves_at_its_nearest_place),
         cmocka_unit_test(test_a_new_obstacle_chooses_its_side_afresh),
         cmocka_unit_test(test_a_policy_of_zeros_does_not_freeze),
