@@ -782,22 +782,42 @@ static void test_recommended_policy_is_chosen_on_validation_not_training(void **
     ConditionSummary p;
     p.kind = ConditionKind::Probabilistic;
     p.label = "probabilistic";
-    p.final_per_run = {9.0};
-    p.arrival_per_run = {1.0};             // a reference is never recommended
+    p.final_per_run = {9.0, -1.0, 1.0, 3.0, -2.0};  // a reference's are its episodes'
+    p.arrival_per_run = {1.0, 0.0, 1.0, 1.0, 0.0};  // 60 %: behind run 2's 90 %
     S.conditions.push_back(p);
     HeldOutWorld w;
     w.label = "clutter";
     w.family = true;
     std::vector<WorldRow> rows = {{"direct", 1, "clutter", 10, 2.0, 0.5, 3, 0, 0.0},
-                                  {"direct", 2, "clutter", 10, 5.0, 0.5, 7, 4, 0.2}};
-    const Recommendation r = recommend(S, {w}, rows, 40);
+                                  {"direct", 2, "clutter", 10, 5.0, 0.5, 7, 4, 0.2},
+                                  {"probabilistic", 0, "clutter", 10, 4.0, 0.5, 9, 0, 0.0}};
+    Recommendation r = recommend(S, {w}, rows, 40);
     assert_true(r.valid);
     assert_string_equal(r.condition.c_str(), "direct");
     assert_int_equal(r.run, 2);
+    assert_false(r.reference());
     assert_true(r.validation_arrival == 0.9);
     assert_int_equal(r.test.size(), 1);
     assert_true(std::fabs(r.test[0].arrival.mean - 0.7) < 1e-12); // its own test row
     assert_true(std::fabs(r.test[0].tau_c.mean - 0.4) < 1e-12);
+    assert_true(r.has_other); // the reference on the same validation episodes, for the report
+    assert_string_equal(r.other_condition.c_str(), "probabilistic");
+    assert_true(std::fabs(r.other_arrival - 0.6) < 1e-12);
+    // the probabilistic policy ahead on validation (never on its test row): it is recommended
+    S.conditions[1].arrival_per_run = {1.0, 1.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, 1.0}; // 90 %,
+    S.conditions[1].final_per_run = {2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0};   // R 2 > 1
+    r = recommend(S, {w}, rows, 40);
+    assert_true(r.reference());
+    assert_string_equal(r.condition.c_str(), "probabilistic");
+    assert_true(std::fabs(r.validation_arrival - 0.9) < 1e-12);
+    assert_true(std::fabs(r.test[0].arrival.mean - 0.9) < 1e-12); // the reference's test row
+    assert_string_equal(r.other_condition.c_str(), "direct");
+    assert_int_equal(r.other_run, 2);
+    // level in arrival and behind in R: the evolved run stays
+    S.conditions[1].final_per_run.assign(10, 0.5);
+    r = recommend(S, {w}, rows, 40);
+    assert_false(r.reference());
+    assert_int_equal(r.run, 2);
     // and the runner view: the same two networks, training vs validation worlds disagree
     ExperimentSpec s = parse_experiment(kDistSpec, "x.toml");
     qnav_policy_t a{}, b{};

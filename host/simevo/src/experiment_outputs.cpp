@@ -19,6 +19,7 @@
 #include "experiment_report.h"
 #include "files.h"
 #include "qnav/ctrl.h"
+#include "qnav/policy_io.h"
 #include "rng.h"
 #include "worlds.h"
 
@@ -72,7 +73,16 @@ HeldOut evaluate_held_out(const ExperimentSpec &spec, const ExperimentSummary &S
     H.conditions = summarize_worlds(S, H.worlds, rows);
     if (spec.target.distribution) {
         H.recommended = recommend(S, H.worlds, rows, spec.eval_episodes);
-        if (H.recommended.valid) {
+        if (H.recommended.valid && H.recommended.reference()) {
+            const SimRunner robot(worlds, picture_scenario(spec.target), spec.seed, use_table);
+            const qnav_policy_t prob = robot.probabilistic_policy();
+            char err[QNAV_POLICY_IO_ERRLEN] = {0};
+            if (qnav_policy_write(recommended_policy_path(exp_dir).c_str(), &prob,
+                                  "simevo: the robot's probabilistic policy (no evolved run was ahead of it "
+                                  "on the validation worlds)", err, sizeof err) != 0) {
+                throw UserError(err);
+            }
+        } else if (H.recommended.valid) {
             const std::string from = join_path(join_path(run_dir(exp_dir, H.recommended.run - 1), H.recommended.condition),
                                                "best.policy");
             std::string text;

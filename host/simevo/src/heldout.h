@@ -67,16 +67,26 @@ std::vector<ConditionWorlds> summarize_worlds(const ExperimentSummary &S, const 
 
 /* The policy recommended across runs: of every evolved target condition's per-run best,
  * the one with the highest arrival in the validation worlds (its eval.csv), ties by their
- * mean R, then by condition order and run; its test figures per world (CIs over its
- * episodes). */
+ * mean R, then by condition order and run; but the robot's probabilistic policy (the
+ * reference on the same validation episodes) when no evolved policy arrived in more of
+ * them, or in as many with a higher R (docs/simevo.md, "The recommended policy"). Its
+ * test figures per world (CIs over its episodes). */
 struct Recommendation {
     bool valid = false;
-    std::string condition;
-    uint32_t run = 0;                /* 1-based */
+    std::string condition;           /* an evolved condition, or the reference's label */
+    uint32_t run = 0;                /* 1-based; 0: the probabilistic policy */
     double validation_arrival = 0;   /* fraction */
     double validation_R = 0;
     uint32_t validation_episodes = 0;
     std::vector<WorldCell> test;     /* per held-out world */
+    /* The candidate not recommended, on the same validation episodes: the probabilistic
+     * policy, or the best evolved run when the probabilistic policy is recommended. */
+    bool has_other = false;
+    std::string other_condition;
+    uint32_t other_run = 0;
+    double other_arrival = 0;
+    double other_R = 0;
+    bool reference() const { return run == 0; }
 };
 Recommendation recommend(const ExperimentSummary &S, const std::vector<HeldOutWorld> &worlds,
                          const std::vector<WorldRow> &rows, uint32_t validation_episodes);
