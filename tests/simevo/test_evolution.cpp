@@ -778,12 +778,14 @@ static void test_recommended_policy_is_chosen_on_validation_not_training(void **
     c.online_per_run = {5.0, -5.0};        // training: run 1 far ahead
     c.final_per_run = {-1.0, 1.0};         // validation R
     c.arrival_per_run = {0.1, 0.9};        // validation arrival
+    c.clean_per_run = {0.1, 0.9};          // ... without touching anything
     S.conditions.push_back(c);
     ConditionSummary p;
     p.kind = ConditionKind::Probabilistic;
     p.label = "probabilistic";
     p.final_per_run = {9.0, -1.0, 1.0, 3.0, -2.0};  // a reference's are its episodes'
     p.arrival_per_run = {1.0, 0.0, 1.0, 1.0, 0.0};  // 60 %: behind run 2's 90 %
+    p.clean_per_run = p.arrival_per_run;
     S.conditions.push_back(p);
     HeldOutWorld w;
     w.label = "clutter";
@@ -803,8 +805,17 @@ static void test_recommended_policy_is_chosen_on_validation_not_training(void **
     assert_true(r.has_other); // the reference on the same validation episodes, for the report
     assert_string_equal(r.other_condition.c_str(), "probabilistic");
     assert_true(std::fabs(r.other_arrival - 0.6) < 1e-12);
+    // run 2 arrives in more, but touches something in 4 of its 9 arrivals: the probabilistic
+    // policy, which arrives in fewer without touching, is the one to flash
+    S.conditions[0].clean_per_run = {0.1, 0.5};
+    r = recommend(S, {w}, rows, 40);
+    assert_true(r.reference());
+    assert_true(std::fabs(r.validation_clean - 0.6) < 1e-12);
+    assert_true(std::fabs(r.other_clean - 0.5) < 1e-12);
+    S.conditions[0].clean_per_run = {0.1, 0.9};
     // the probabilistic policy ahead on validation (never on its test row): it is recommended
     S.conditions[1].arrival_per_run = {1.0, 1.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, 1.0}; // 90 %,
+    S.conditions[1].clean_per_run = S.conditions[1].arrival_per_run;
     S.conditions[1].final_per_run = {2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0};   // R 2 > 1
     r = recommend(S, {w}, rows, 40);
     assert_true(r.reference());

@@ -698,6 +698,7 @@ static void test_generalist_quick_run_writes_the_recommended_policy_and_its_test
     } else {
         assert_true(condition == "direct" || condition == "transfer-easy");
         assert_true(rec == slurp(join_path(join_path(join_path(dir, "run-001"), condition), "best.policy")));
+        assert_non_null(std::strstr(text.c_str(), "without touching anything, R "));
         assert_non_null(std::strstr(text.c_str(), "; the probabilistic policy "));
     }
     for (const char *w : {"family clutter:", "family gaps:", "family corridor:", "family pocket:", "family rooms:",

@@ -126,6 +126,8 @@ struct ConditionSummary {
      * run (probabilistic: per episode), with 95% CIs (runs: Student t over runs, clamped
      * to [0, 1]; probabilistic arrival: Wilson score interval). */
     std::vector<double> arrival_per_run, tau_c_per_run;
+    std::vector<double> clean_per_run; /* arrived without a recovery (touching nothing), as
+                                          arrival_per_run */
     Interval arrival, tau_c;
     std::vector<double> arrival_curve_mean, arrival_curve_ci; /* candidates' episodes that
                                                  arrived: per bin, mean over runs */

@@ -148,11 +148,13 @@ std::string worlds_json(const HeldOut &H)
     if (H.recommended.valid) {
         const Recommendation &r = H.recommended;
         o << ",\n  \"recommended\": {\"condition\": " << json_str(r.condition) << ", \"run\": " << r.run
+          << ", \"validation_clean\": " << json_num(r.validation_clean)
           << ", \"validation_arrival\": " << json_num(r.validation_arrival)
           << ", \"validation_R\": " << json_num(r.validation_R)
           << ", \"validation_episodes\": " << r.validation_episodes;
         if (r.has_other) {
             o << ", \"other\": {\"condition\": " << json_str(r.other_condition) << ", \"run\": " << r.other_run
+              << ", \"validation_clean\": " << json_num(r.other_clean)
               << ", \"validation_arrival\": " << json_num(r.other_arrival)
               << ", \"validation_R\": " << json_num(r.other_R) << "}";
         }
@@ -340,14 +342,16 @@ std::string worlds_md(const ExperimentSpec &spec, const HeldOut &H)
         o << "## Recommended policy\n\n`recommended.policy` = "
           << (r.reference() ? "the " + r.condition + " policy" : r.condition + " run " + std::to_string(r.run))
           << ": of every run's best policy of every evolved condition and the robot's probabilistic policy, the "
-             "highest arrival in the "
+             "one that arrived without touching anything in the most of the "
           << r.validation_episodes << " validation episodes (worlds seeded from " << kValidationSeedBase
-          << ", disjoint from training and test; never training scores; ties by R): "
-          << fmt(100.0 * r.validation_arrival, 1) << "%, R " << fmt(r.validation_R);
+          << ", disjoint from training and test; never training scores; ties by arrival, then R): "
+          << fmt(100.0 * r.validation_clean, 1) << "% (arrival " << fmt(100.0 * r.validation_arrival, 1)
+          << "%), R " << fmt(r.validation_R);
         if (r.has_other) {
             o << " (" << (r.other_run == 0 ? "the " + r.other_condition + " policy"
                                            : "the best evolved, " + r.other_condition + " run " + std::to_string(r.other_run))
-              << ": " << fmt(100.0 * r.other_arrival, 1) << "%, R " << fmt(r.other_R) << ")";
+              << ": " << fmt(100.0 * r.other_clean, 1) << "% (arrival " << fmt(100.0 * r.other_arrival, 1)
+              << "%), R " << fmt(r.other_R) << ")";
         }
         o << ". Its test figures (95% CI over its episodes):\n\n"
           << "| world | arrival (95% CI) | recovery ticks per episode (95% CI) | R (95% CI) |\n|---|---|---|---|\n";

@@ -39,10 +39,11 @@ namespace {
 void add_eval(ConditionSummary &c, const std::vector<EpisodeOutcome> &ev, uint64_t &reached, uint64_t &evals)
 {
     std::vector<double> r;
-    double arrived = 0, tau = 0;
+    double arrived = 0, clean = 0, tau = 0;
     for (const auto &o : ev) {
         r.push_back(o.R);
         arrived += o.reached ? 1 : 0;
+        clean += o.reached && o.tau_c == 0 ? 1 : 0;
         tau += o.tau_c;
     }
     reached += static_cast<uint64_t>(arrived);
@@ -50,6 +51,7 @@ void add_eval(ConditionSummary &c, const std::vector<EpisodeOutcome> &ev, uint64
     c.final_per_run.push_back(mean_of(r));
     const double n = ev.empty() ? 1.0 : static_cast<double>(ev.size());
     c.arrival_per_run.push_back(arrived / n);
+    c.clean_per_run.push_back(clean / n);
     c.tau_c_per_run.push_back(tau / n);
 }
 
@@ -196,6 +198,7 @@ ConditionSummary summarize_reference(const std::vector<TaskDef> &tasks, Conditio
         for (const auto &o : ev) {
             prob.final_per_run.push_back(o.R);
             prob.arrival_per_run.push_back(o.reached ? 1.0 : 0.0);
+            prob.clean_per_run.push_back(o.reached && o.tau_c == 0 ? 1.0 : 0.0);
             prob.tau_c_per_run.push_back(o.tau_c);
             reached += o.reached ? 1 : 0;
         }

@@ -268,54 +268,89 @@ std::vector<ConditionWorlds> summarize_worlds(const ExperimentSummary &S, const 
     return out;
 }
 
+namespace {
+/* One candidate for the recommendation: its validation figures. */
+struct RecCandidate {
+    std::string condition;
+    uint32_t run = 0; /* 0: the reference */
+    double clean = 0, arrival = 0, R = 0;
+};
+
+/* a ahead of b: more validation episodes that arrived without touching anything, then
+ * more that arrived, then a higher mean R (fractions of whole episodes compared with a
+ * tolerance: they are summed differently). */
+bool ahead(const RecCandidate &a, const RecCandidate &b)
+{
+    const double same = 1e-9;
+    if (std::fabs(a.clean - b.clean) > same) {
+        return a.clean > b.clean;
+    }
+    if (std::fabs(a.arrival - b.arrival) > same) {
+        return a.arrival > b.arrival;
+    }
+    return a.R > b.R;
+}
+
+/* A per-run figure, or the arrival's where the summary has none (summaries of runs that
+ * recorded no per-episode touches). */
+double clean_at(const ConditionSummary &c, std::size_t r)
+{
+    return r < c.clean_per_run.size() ? c.clean_per_run[r] : c.arrival_per_run[r];
+}
+} // namespace
+
 Recommendation recommend(const ExperimentSummary &S, const std::vector<HeldOutWorld> &worlds,
                          const std::vector<WorldRow> &rows, uint32_t validation_episodes)
 {
     Recommendation best;
+    RecCandidate pick;
+    bool have = false;
     for (const ConditionSummary &c : S.conditions) {
         if (!condition_decl(c.kind).evolved) {
             continue;
         }
         for (std::size_t r = 0; r < c.arrival_per_run.size(); ++r) {
-            const double a = c.arrival_per_run[r], R = c.final_per_run[r];
-            if (best.valid && (a < best.validation_arrival || (a == best.validation_arrival && R <= best.validation_R))) {
-                continue;
+            const RecCandidate k{c.label, static_cast<uint32_t>(r + 1), clean_at(c, r), c.arrival_per_run[r],
+                              c.final_per_run[r]};
+            if (!have || ahead(k, pick)) {
+                pick = k;
+                have = true;
             }
-            best.valid = true;
-            best.condition = c.label;
-            best.run = static_cast<uint32_t>(r + 1);
-            best.validation_arrival = a;
-            best.validation_R = R;
         }
     }
-    if (!best.valid) {
+    if (!have) {
         return best;
     }
+    RecCandidate other;
     for (const ConditionSummary &c : S.conditions) {
         if (c.kind != ConditionKind::Probabilistic || c.arrival_per_run.empty()) {
             continue;
         }
         /* a reference's per-run figures are its episodes' */
-        const double a = mean_of(c.arrival_per_run), R = mean_of(c.final_per_run);
+        std::vector<double> clean;
+        for (std::size_t e = 0; e < c.arrival_per_run.size(); ++e) {
+            clean.push_back(clean_at(c, e));
+        }
+        const RecCandidate ref{c.label, 0, mean_of(clean), mean_of(c.arrival_per_run), mean_of(c.final_per_run)};
         best.has_other = true;
-        const double same = 1e-9; /* fractions of whole episodes, summed differently */
-        if (a > best.validation_arrival + same ||
-            (std::fabs(a - best.validation_arrival) <= same && R > best.validation_R)) {
-            best.other_condition = best.condition;
-            best.other_run = best.run;
-            best.other_arrival = best.validation_arrival;
-            best.other_R = best.validation_R;
-            best.condition = c.label;
-            best.run = 0;
-            best.validation_arrival = a;
-            best.validation_R = R;
+        if (ahead(ref, pick)) {
+            other = pick;
+            pick = ref;
         } else {
-            best.other_condition = c.label;
-            best.other_run = 0;
-            best.other_arrival = a;
-            best.other_R = R;
+            other = ref;
         }
     }
+    best.valid = true;
+    best.condition = pick.condition;
+    best.run = pick.run;
+    best.validation_clean = pick.clean;
+    best.validation_arrival = pick.arrival;
+    best.validation_R = pick.R;
+    best.other_condition = other.condition;
+    best.other_run = other.run;
+    best.other_clean = other.clean;
+    best.other_arrival = other.arrival;
+    best.other_R = other.R;
     best.validation_episodes = validation_episodes;
     for (const HeldOutWorld &w : worlds) {
         for (const WorldRow &r : rows) {
@@ -340,18 +375,20 @@ std::vector<std::string> recommendation_lines(const std::string &name, const Rec
     if (r.reference()) {
         std::snprintf(b, sizeof b,
                       "%s: recommended policy %s (the %s policy: no evolved run was ahead of it in the %u "
-                      "validation episodes; it arrived in %.1f%%, R %.2f, the best evolved, %s run %u, in "
-                      "%.1f%%, R %.2f)",
+                      "validation episodes; it arrived in %.1f%%, %.1f%% without touching anything, R %.2f, "
+                      "the best evolved, %s run %u, in %.1f%%, %.1f%%, R %.2f)",
                       name.c_str(), recommended_policy_path(exp_dir).c_str(), r.condition.c_str(),
-                      r.validation_episodes, 100.0 * r.validation_arrival, r.validation_R,
-                      r.other_condition.c_str(), r.other_run, 100.0 * r.other_arrival, r.other_R);
+                      r.validation_episodes, 100.0 * r.validation_arrival, 100.0 * r.validation_clean,
+                      r.validation_R, r.other_condition.c_str(), r.other_run, 100.0 * r.other_arrival,
+                      100.0 * r.other_clean, r.other_R);
     } else if (r.has_other) {
         std::snprintf(b, sizeof b,
                       "%s: recommended policy %s (%s run %u, chosen on validation worlds: arrival %.1f%% of %u, "
-                      "R %.2f; the %s policy %.1f%%, R %.2f)",
+                      "%.1f%% without touching anything, R %.2f; the %s policy %.1f%%, %.1f%%, R %.2f)",
                       name.c_str(), recommended_policy_path(exp_dir).c_str(), r.condition.c_str(), r.run,
-                      100.0 * r.validation_arrival, r.validation_episodes, r.validation_R,
-                      r.other_condition.c_str(), 100.0 * r.other_arrival, r.other_R);
+                      100.0 * r.validation_arrival, r.validation_episodes, 100.0 * r.validation_clean,
+                      r.validation_R, r.other_condition.c_str(), 100.0 * r.other_arrival,
+                      100.0 * r.other_clean, r.other_R);
     } else {
         std::snprintf(b, sizeof b,
                       "%s: recommended policy %s (%s run %u, chosen on validation worlds: arrival %.0f%% of %u, R %.2f)",

@@ -66,15 +66,16 @@ std::vector<ConditionWorlds> summarize_worlds(const ExperimentSummary &S, const 
                                               const std::vector<WorldRow> &rows);
 
 /* The policy recommended across runs: of every evolved target condition's per-run best,
- * the one with the highest arrival in the validation worlds (its eval.csv), ties by their
- * mean R, then by condition order and run; but the robot's probabilistic policy (the
- * reference on the same validation episodes) when no evolved policy arrived in more of
- * them, or in as many with a higher R (docs/simevo.md, "The recommended policy"). Its
- * test figures per world (CIs over its episodes). */
+ * the one that arrived without touching anything in the most validation episodes (its
+ * eval.csv), ties by arrival, then by mean R, then by condition order and run; but the
+ * robot's probabilistic policy (the reference on the same validation episodes) when no
+ * evolved policy is ahead of it by the same order (docs/simevo.md, "The recommended
+ * policy"). Its test figures per world (CIs over its episodes). */
 struct Recommendation {
     bool valid = false;
     std::string condition;           /* an evolved condition, or the reference's label */
     uint32_t run = 0;                /* 1-based; 0: the probabilistic policy */
+    double validation_clean = 0;     /* fraction that arrived without touching anything */
     double validation_arrival = 0;   /* fraction */
     double validation_R = 0;
     uint32_t validation_episodes = 0;
@@ -84,6 +85,7 @@ struct Recommendation {
     bool has_other = false;
     std::string other_condition;
     uint32_t other_run = 0;
+    double other_clean = 0;
     double other_arrival = 0;
     double other_R = 0;
     bool reference() const { return run == 0; }
