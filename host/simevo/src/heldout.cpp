@@ -290,13 +290,6 @@ bool ahead(const RecCandidate &a, const RecCandidate &b)
     }
     return a.R > b.R;
 }
-
-/* A per-run figure, or the arrival's where the summary has none (summaries of runs that
- * recorded no per-episode touches). */
-double clean_at(const ConditionSummary &c, std::size_t r)
-{
-    return r < c.clean_per_run.size() ? c.clean_per_run[r] : c.arrival_per_run[r];
-}
 } // namespace
 
 Recommendation recommend(const ExperimentSummary &S, const std::vector<HeldOutWorld> &worlds,
@@ -310,7 +303,7 @@ Recommendation recommend(const ExperimentSummary &S, const std::vector<HeldOutWo
             continue;
         }
         for (std::size_t r = 0; r < c.arrival_per_run.size(); ++r) {
-            const RecCandidate k{c.label, static_cast<uint32_t>(r + 1), clean_at(c, r), c.arrival_per_run[r],
+            const RecCandidate k{c.label, static_cast<uint32_t>(r + 1), c.clean_per_run.at(r), c.arrival_per_run[r],
                               c.final_per_run[r]};
             if (!have || ahead(k, pick)) {
                 pick = k;
@@ -327,11 +320,8 @@ Recommendation recommend(const ExperimentSummary &S, const std::vector<HeldOutWo
             continue;
         }
         /* a reference's per-run figures are its episodes' */
-        std::vector<double> clean;
-        for (std::size_t e = 0; e < c.arrival_per_run.size(); ++e) {
-            clean.push_back(clean_at(c, e));
-        }
-        const RecCandidate ref{c.label, 0, mean_of(clean), mean_of(c.arrival_per_run), mean_of(c.final_per_run)};
+        const RecCandidate ref{c.label, 0, mean_of(c.clean_per_run), mean_of(c.arrival_per_run),
+                               mean_of(c.final_per_run)};
         best.has_other = true;
         if (ahead(ref, pick)) {
             other = pick;
@@ -381,19 +371,18 @@ std::vector<std::string> recommendation_lines(const std::string &name, const Rec
                       r.validation_episodes, 100.0 * r.validation_arrival, 100.0 * r.validation_clean,
                       r.validation_R, r.other_condition.c_str(), r.other_run, 100.0 * r.other_arrival,
                       100.0 * r.other_clean, r.other_R);
-    } else if (r.has_other) {
+    } else {
+        char other[160] = "";
+        if (r.has_other) {
+            std::snprintf(other, sizeof other, "; the %s policy %.1f%%, %.1f%%, R %.2f", r.other_condition.c_str(),
+                          100.0 * r.other_arrival, 100.0 * r.other_clean, r.other_R);
+        }
         std::snprintf(b, sizeof b,
                       "%s: recommended policy %s (%s run %u, chosen on validation worlds: arrival %.1f%% of %u, "
-                      "%.1f%% without touching anything, R %.2f; the %s policy %.1f%%, %.1f%%, R %.2f)",
+                      "%.1f%% without touching anything, R %.2f%s)",
                       name.c_str(), recommended_policy_path(exp_dir).c_str(), r.condition.c_str(), r.run,
                       100.0 * r.validation_arrival, r.validation_episodes, 100.0 * r.validation_clean,
-                      r.validation_R, r.other_condition.c_str(), 100.0 * r.other_arrival,
-                      100.0 * r.other_clean, r.other_R);
-    } else {
-        std::snprintf(b, sizeof b,
-                      "%s: recommended policy %s (%s run %u, chosen on validation worlds: arrival %.0f%% of %u, R %.2f)",
-                      name.c_str(), recommended_policy_path(exp_dir).c_str(), r.condition.c_str(), r.run,
-                      100.0 * r.validation_arrival, r.validation_episodes, r.validation_R);
+                      r.validation_R, other);
     }
     lines.push_back(b);
     for (const WorldCell &c : r.test) {
