@@ -21,6 +21,7 @@
 #include <stdint.h>
 #include <util/delay_basic.h>
 
+#include "avr_clock.h"
 #include "bench_grid.h"
 #include "qnav/vfh.h"
 #include "target_io.h"
@@ -32,82 +33,22 @@
 #include "bench_tables.h"
 #endif
 
-/* Text from flash: 4 KB of RAM has no room for this program's messages. */
-static void put_flash(const char *s)
-{
-    char c[2];
-    c[1] = '\0';
-    while ((c[0] = (char)pgm_read_byte(s++)) != '\0') {
-        qnav_target_put(c);
-    }
-}
-#define PUT(s) put_flash(PSTR(s))
-
-static volatile uint16_t overflows;
-
-ISR(TIMER1_OVF_vect)
-{
-    ++overflows;
-}
-
-static void timer_start(void)
-{
-    TCCR1B = 0;
-    TCCR1A = 0;
-    TCNT1 = 0;
-    overflows = 0;
-    TIFR = _BV(TOV1);
-    TIMSK |= _BV(TOIE1);
-    sei();
-    TCCR1B = _BV(CS10); /* clk/1 */
-}
-
-/* Read the count while the timer still runs (simavr only updates TCNT1 from the cycle
- * counter while it is clocked), then stop it. An overflow flagged but not yet serviced
- * belongs before the count read when the count is small. */
-static uint32_t timer_stop(void)
-{
-    uint16_t c;
-    cli();
-    c = TCNT1;
-    TCCR1B = 0;
-    if ((TIFR & _BV(TOV1)) && c < 0x8000u) {
-        TIFR = _BV(TOV1);
-        ++overflows;
-    }
-    return ((uint32_t)overflows << 16) + c;
-}
-
 static uint32_t overhead;
 static uint16_t peak_stack[QNAV_BENCH_MODES];
 static uint32_t steps[QNAV_BENCH_MODES];
 
-extern uint8_t __heap_start;
-extern const uint8_t __ctors_start[];
-#define PAINT 0xA5u
-
-/* Paint from the end of .bss to a little below the stack pointer, time one step, and
- * record how many bytes below this frame's stack pointer it wrote. */
+/* Paint free RAM, time one step, and record how many bytes below this frame's stack
+ * pointer it wrote. */
 static uint32_t measure(const qnav_ctrl_t *c, const qnav_ctrl_input_t *in,
                         qnav_ctrl_output_t *out, uint8_t mode)
 {
-    uint8_t *p = &__heap_start;
-    uint16_t sp = SP;
-    uint8_t *stop = (uint8_t *)(sp - 16u);
+    const uint16_t sp = qnav_avr_paint();
     uint32_t cycles;
     uint16_t used;
-    while (p < stop) {
-        *(volatile uint8_t *)p = PAINT;
-        ++p;
-    }
-    timer_start();
+    qnav_avr_timer_start();
     qnav_ctrl_step(c, in, out, 0);
-    cycles = timer_stop() - overhead;
-    p = &__heap_start;
-    while (p < stop && *(volatile uint8_t *)p == PAINT) {
-        ++p;
-    }
-    used = (uint16_t)(sp - (uint16_t)p + 1u);
+    cycles = qnav_avr_timer_stop() - overhead;
+    used = qnav_avr_stack_used(sp);
     if (used > peak_stack[mode]) {
         peak_stack[mode] = used;
     }
@@ -131,24 +72,6 @@ static const qnav_qkey_t *flash_table(uint8_t index, const qnav_policy_t *p, uin
 #endif
 
 #if !QNAV_BENCH_TABLE_GROUP
-/* "<cycles> cycles (<ms> ms at 16 MHz)" */
-static void put_cycles(uint32_t cycles)
-{
-    uint32_t us = (cycles + F_CPU / 2000000ul) / (F_CPU / 1000000ul);
-    uint32_t frac = us % 1000u;
-    qnav_target_put_u32(cycles);
-    PUT(" cycles (");
-    qnav_target_put_u32(us / 1000u);
-    if (frac < 10u) {
-        PUT(".00");
-    } else if (frac < 100u) {
-        PUT(".0");
-    } else {
-        PUT(".");
-    }
-    qnav_target_put_u32(frac);
-    PUT(" ms at 16 MHz)");
-}
 
 /* ---- naive float network, for the ratio ---------------------------------------------- */
 
@@ -247,10 +170,10 @@ static uint8_t init_times_of(uint8_t hidden, uint8_t carried, uint32_t *t)
                         qnav_ctrl_shapes_save(c, p, shapes) != QNAV_OK)) {
             continue;
         }
-        timer_start();
+        qnav_avr_timer_start();
         st = carried ? qnav_ctrl_init_carried(c, &cfg, p, shapes, sizeof shapes)
                      : qnav_ctrl_init(c, &cfg, p);
-        t[count] = timer_stop() - overhead;
+        t[count] = qnav_avr_timer_stop() - overhead;
         if (carried && !qnav_ctrl_shapes_carried(c)) {
             PUT("init: carried shapes not taken: ");
             qnav_target_put(id);
@@ -288,11 +211,11 @@ static void init_times(void)
             PUT(" (");
             qnav_target_put_u32(count);
             PUT(" policies): min ");
-            put_cycles(t[0]);
+            qnav_avr_put_cycles(t[0]);
             PUT(", median ");
-            put_cycles(t[(count - 1u) / 2u]);
+            qnav_avr_put_cycles(t[(count - 1u) / 2u]);
             PUT(", max ");
-            put_cycles(t[count - 1u]);
+            qnav_avr_put_cycles(t[count - 1u]);
             PUT("\n");
         }
     }
@@ -335,14 +258,14 @@ static void naive_comparison(void)
         }
         in.ranges_mm = r;
         in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
-        timer_start();
+        qnav_avr_timer_start();
         naive_heading = naive_float_step(r, 32u, (float)in.goal_bearing_cdeg / 100.0f,
                                (float)qnav_bench_max_range_mm());
-        t = timer_stop() - overhead;
+        t = qnav_avr_timer_stop() - overhead;
         naive += t;
-        timer_start();
+        qnav_avr_timer_start();
         qnav_ctrl_step(c, &in, &out, 0);
-        fixed += timer_stop() - overhead;
+        fixed += qnav_avr_timer_stop() - overhead;
         ++scans;
     }
     (void)naive_heading;
@@ -351,9 +274,9 @@ static void naive_comparison(void)
     PUT(", mean of ");
     qnav_target_put_u32(scans);
     PUT(" dense 32-sector scans: ");
-    put_cycles(naive / scans);
+    qnav_avr_put_cycles(naive / scans);
     PUT("; fixed-point network step ");
-    put_cycles(fixed / scans);
+    qnav_avr_put_cycles(fixed / scans);
     PUT("; ratio ");
     qnav_target_put_u32((naive + fixed / 2u) / fixed);
     PUT(".");
@@ -391,23 +314,23 @@ static void escape_cost(void)
         }
         in.ranges_mm = r;
         in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
-        timer_start();
+        qnav_avr_timer_start();
         qnav_ctrl_step(c, &in, &out, 0);
-        off = timer_stop() - overhead;
+        off = qnav_avr_timer_stop() - overhead;
         in.goal_range_mm = 3000u;
         in.escape.best_mm = 2000u;
         in.escape.hit_mm = 2000u;
         in.escape.side = 1;
         in.escape.last_side = 1;
-        timer_start();
+        qnav_avr_timer_start();
         qnav_ctrl_step(c, &in, &out, 0);
-        follow = timer_stop() - overhead;
+        follow = qnav_avr_timer_stop() - overhead;
         in.escape.side = 0;
         in.escape.last_side = 0;
         in.escape.ticks = (uint16_t)(cfg.escape_stall_ticks - 1u);
-        timer_start();
+        qnav_avr_timer_start();
         qnav_ctrl_step(c, &in, &out, 0);
-        enter = timer_stop() - overhead;
+        enter = qnav_avr_timer_stop() - overhead;
         follow = follow > off ? follow - off : 0u;
         enter = enter > off ? enter - off : 0u;
         follow_sum += follow;
@@ -418,7 +341,7 @@ static void escape_cost(void)
     PUT("escape memory on the ");
     qnav_target_put_u32(n);
     PUT(" 32-sector scans, probabilistic policy: following adds mean ");
-    put_cycles(follow_sum / n);
+    qnav_avr_put_cycles(follow_sum / n);
     PUT(", max ");
     qnav_target_put_u32(follow_max);
     PUT(" cycles; the tick a follow begins adds max ");
@@ -459,9 +382,9 @@ static void keep_cost_of(const qnav_policy_t *p, const char *label)
         in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
         for (keep = 0; keep < 2u; ++keep) {
             c->keep_pct = (uint8_t)(keep ? 15u : 0u);
-            timer_start();
+            qnav_avr_timer_start();
             qnav_ctrl_step(c, &in, &out, 0);
-            cost[keep] = timer_stop() - overhead;
+            cost[keep] = qnav_avr_timer_stop() - overhead;
         }
         cost[1] = cost[1] > cost[0] ? cost[1] - cost[0] : 0u;
         add_sum += cost[1];
@@ -473,7 +396,7 @@ static void keep_cost_of(const qnav_policy_t *p, const char *label)
     PUT(" 32-sector scans, ");
     qnav_target_put(label);
     PUT(": adds mean ");
-    put_cycles(add_sum / n);
+    qnav_avr_put_cycles(add_sum / n);
     PUT(", max ");
     qnav_target_put_u32(add_max);
     PUT(" cycles\n");
@@ -526,9 +449,9 @@ static void vfh_comparison(void)
         in.ranges_mm = r;
         in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
         qnav_vfh_state_reset(&vstate);
-        timer_start();
+        qnav_avr_timer_start();
         qnav_vfh_step(&vfh, &vstate, &in, &out);
-        c = timer_stop() - overhead;
+        c = qnav_avr_timer_stop() - overhead;
         sum += c;
         lo = c < lo ? c : lo;
         hi = c > hi ? c : hi;
@@ -537,7 +460,7 @@ static void vfh_comparison(void)
     PUT("VFH+ (default config) on the ");
     qnav_target_put_u32(n);
     PUT(" 32-sector scans: mean ");
-    put_cycles(sum / n);
+    qnav_avr_put_cycles(sum / n);
     PUT(", min ");
     qnav_target_put_u32(lo);
     PUT(", max ");
@@ -555,15 +478,11 @@ int main(void)
     uint32_t c;
     uint8_t mode;
 
-    if (pgm_get_far_address(__ctors_start) > 0x10000ul) {
-        /* .progmem ends where the constructors begin: past 64 KB, LPM reads wrap */
-        PUT("program-memory data end past 64 KB (at ");
-        qnav_target_put_u32(pgm_get_far_address(__ctors_start));
-        PUT("): fewer fixtures per image\n");
+    if (qnav_avr_flash_data_too_far()) {
         qnav_target_exit(1u);
     }
-    timer_start();
-    overhead = timer_stop();
+    qnav_avr_timer_start();
+    overhead = qnav_avr_timer_stop();
     PUT("qnav AVR benchmark: ATmega128, 16 MHz, simavr; image ");
     qnav_target_put_u32(QNAV_BENCH_TABLE_GROUP);
     if (QNAV_BENCH_TABLE_GROUP) {
@@ -574,9 +493,9 @@ int main(void)
     PUT("timer overhead subtracted: ");
     qnav_target_put_u32(overhead);
     PUT(" cycles\n");
-    timer_start();
+    qnav_avr_timer_start();
     _delay_loop_2(50000u); /* 4 cycles per count: 200000 */
-    c = timer_stop() - overhead;
+    c = qnav_avr_timer_stop() - overhead;
     PUT("check: _delay_loop_2(50000), 200000 cycles by the datasheet, measured ");
     qnav_target_put_u32(c);
     PUT("\n");

@@ -7,7 +7,7 @@ execute_process(COMMAND ${GEN} ${ROOT} ${OUT} RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "${GEN} failed (${rc})")
 endif()
-foreach(f bench_policies.h bench_scans.h bench_tables.h)
+foreach(f bench_policies.h bench_scans.h bench_tables.h bench_map_trace.h)
   execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${OUT}/${f} ${ROOT}/bench/fixtures/${f}
                   RESULT_VARIABLE diff)
   if(NOT diff EQUAL 0)

@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "fixture_io.h"
+#include "map_trace.h"
 #include "qnav/sim.h"
 #include "vector_policy.h"
 
@@ -347,5 +348,6 @@ int main(int argc, char **argv)
     write_policies(argv[2]);
     write_scans(argv[1], argv[2]);
     write_tables(argv[2]);
+    qnav_fx_write_map_trace(argv[1], argv[2], header_note);
     return 0;
 }

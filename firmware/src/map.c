@@ -15,12 +15,14 @@
  */
 #include "qnav/map.h"
 
+#include <stddef.h>
 #include <string.h>
 
 #include "escape.h"
+#include "map_compact.h"
 #include "qnav/trig.h"
 
-#define EVIDENCE_FREE_MIN (-4)
+#define EVIDENCE_FREE_MIN QNAV_MAP_FREE_FLOOR
 #define EVIDENCE_MAX 3
 #define EVIDENCE_REFUSED 100 /* a cell the robot could not pass: kept until the refusal lapses */
 /* An arc is marked occupied from 3/4 of a cell plus at most this many % of the reading
@@ -33,6 +35,15 @@
 #define NOT_QUEUED UINT16_C(0xFFFF)
 typedef char unreached_and_not_queued_are_all_ones[QNAV_MAP_UNREACHED == 0xFFFFu && NOT_QUEUED == 0xFFFFu ? 1 : -1];
 #define MAX_CELLS UINT32_C(65000)
+#define MAX_REACH_MM 40000u
+/* The full layout's memory holds uint16_t (1 on an AVR, 2 elsewhere); the compact one,
+ * bytes. */
+typedef struct {
+    char c;
+    uint16_t u;
+} u16_alignment_t;
+/* Buckets of the plan's queue: the largest step (14 + near_cost) + 1. */
+#define BUCKETS 270u
 
 void qnav_map_config_default(qnav_map_config_t *cfg)
 {
@@ -52,6 +63,8 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->near_cost = 10u;
     cfg->refuse_ticks = 30u;
     cfg->refuse_life_ticks = 200u;
+    cfg->compact = 0u;
+    cfg->grow_steps = 16u;
 }
 
 uint32_t qnav_map_cells(uint32_t width_mm, uint32_t height_mm, uint16_t cell_mm)
@@ -68,10 +81,22 @@ uint32_t qnav_map_cells(uint32_t width_mm, uint32_t height_mm, uint16_t cell_mm)
     return nx * ny;
 }
 
-size_t qnav_map_bytes(uint32_t cells)
+size_t qnav_map_size(const qnav_map_config_t *cfg, uint32_t width_mm, uint32_t height_mm)
 {
-    /* cost, next, prev: 2 bytes each; evidence, blocked: 1 */
-    return (size_t)cells * 8u;
+    uint32_t cells;
+    if (cfg == NULL) {
+        return 0u;
+    }
+    cells = qnav_map_cells(width_mm, height_mm, cfg->cell_mm);
+    if (cells == 0u) {
+        return 0u;
+    }
+    if (cfg->compact) {
+        const uint32_t nx = (width_mm + cfg->cell_mm - 1u) / cfg->cell_mm;
+        return qnav_cmap_bytes(nx, cells / nx);
+    }
+    /* the queue's heads, then cost, next, prev: 2 bytes each; evidence, blocked: 1 */
+    return (size_t)BUCKETS * 2u + (size_t)cells * 8u;
 }
 
 qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
@@ -85,16 +110,30 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
     }
     cells = qnav_map_cells(width_mm, height_mm, cfg->cell_mm);
     if (cfg->cell_mm < 20u || cfg->cell_mm > 1000u || cfg->plan_ticks == 0u || cells == 0u ||
+        cfg->reach_mm > MAX_REACH_MM ||
         cfg->arc_cdeg > 36000u || (cfg->refuse_ticks > 0u && cfg->refuse_life_ticks == 0u) ||
-        len < qnav_map_bytes(cells) || ((uintptr_t)buf & 1u) != 0u || ctrl->n_sectors == 0u ||
-        ctrl->n_sectors > QNAV_MAX_SECTORS || ctrl->max_range_mm == 0u) {
+        len < qnav_map_size(cfg, width_mm, height_mm) ||
+        (!cfg->compact && (uintptr_t)buf % offsetof(u16_alignment_t, u) != 0u) ||
+        ctrl->n_sectors == 0u || ctrl->n_sectors > QNAV_MAX_SECTORS || ctrl->max_range_mm == 0u) {
+        return QNAV_E_MAP;
+    }
+    /* the compact layout blocks occupied cells only, and has no bits for refusals and
+     * near costs */
+    if (cfg->compact > 1u ||
+        (cfg->compact && (cfg->refuse_ticks != 0u || cfg->near_cost != 0u ||
+                          (uint32_t)ctrl->body_radius_mm + ctrl->safety_mm >= cfg->cell_mm ||
+                          (width_mm + cfg->cell_mm - 1u) / cfg->cell_mm >
+                              8u * QNAV_CMAP_ROW_BYTES_MAX))) {
         return QNAV_E_MAP;
     }
     if (buf == NULL) {
         return QNAV_E_NULL;
     }
-    memset(m, 0, sizeof *m);
-    m->cfg = *cfg;
+    {
+        const qnav_map_config_t keep = *cfg; /* cfg may be m's own */
+        memset(m, 0, sizeof *m);
+        m->cfg = keep;
+    }
     m->n_sectors = ctrl->n_sectors;
     m->max_range_mm = ctrl->max_range_mm;
     m->offset_mm = ctrl->sensor_offset_mm;
@@ -105,11 +144,16 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
     m->y0_mm = y0_mm;
     m->nx = (uint16_t)((width_mm + cfg->cell_mm - 1u) / cfg->cell_mm);
     m->ny = (uint16_t)(cells / m->nx);
-    m->cost = (uint16_t *)(void *)p;
-    m->next = m->cost + cells;
-    m->prev = m->next + cells;
-    m->evidence = (int8_t *)(void *)(m->prev + cells);
-    m->blocked = (uint8_t *)(m->evidence + cells);
+    if (cfg->compact) {
+        qnav_cmap_attach(m, buf);
+    } else {
+        m->q_head = (uint16_t *)(void *)p;
+        m->cost = m->q_head + BUCKETS;
+        m->next = m->cost + cells;
+        m->prev = m->next + cells;
+        m->evidence = (int8_t *)(void *)(m->prev + cells);
+        m->blocked = (uint8_t *)(m->evidence + cells);
+    }
     qnav_map_reset(m);
     return QNAV_OK;
 }
@@ -119,17 +163,27 @@ static uint32_t cell_count(const qnav_map_t *m)
     return (uint32_t)m->nx * m->ny;
 }
 
+/* qnav_map_init() made m (a map it refused, or never saw, has no cells). */
+static int ready(const qnav_map_t *m)
+{
+    return m != NULL && m->nx != 0u;
+}
+
 void qnav_map_reset(qnav_map_t *m)
 {
     uint32_t i, n;
-    if (m == NULL || m->cost == NULL) {
+    if (!ready(m)) {
         return;
     }
     n = cell_count(m);
-    memset(m->evidence, 0, (size_t)n);
-    memset(m->blocked, 0, (size_t)n);
-    for (i = 0; i < n; ++i) {
-        m->cost[i] = QNAV_MAP_UNREACHED;
+    if (m->cfg.compact) {
+        qnav_cmap_reset(m);
+    } else {
+        memset(m->evidence, 0, (size_t)n);
+        memset(m->blocked, 0, (size_t)n);
+        for (i = 0; i < n; ++i) {
+            m->cost[i] = QNAV_MAP_UNREACHED;
+        }
     }
     m->ticks = 0u;
     m->last_mm = 0u;
@@ -154,18 +208,6 @@ static void cell_of(const qnav_map_t *m, int32_t x_mm, int32_t y_mm, int32_t *i,
     }
     *i = a < 0 ? 0 : (a >= (int32_t)m->nx ? (int32_t)m->nx - 1 : a);
     *j = b < 0 ? 0 : (b >= (int32_t)m->ny ? (int32_t)m->ny - 1 : b);
-}
-
-/* (i, j) is a cell of the map. */
-static int in_map(const qnav_map_t *m, int32_t i, int32_t j)
-{
-    return i >= 0 && j >= 0 && i < (int32_t)m->nx && j < (int32_t)m->ny;
-}
-
-/* The index of cell (i, j) of the map. */
-static uint32_t at_cell(const qnav_map_t *m, int32_t i, int32_t j)
-{
-    return (uint32_t)j * m->nx + (uint32_t)i;
 }
 
 static int32_t centre_x(const qnav_map_t *m, int32_t i)
@@ -224,10 +266,23 @@ static int32_t off_centre(const qnav_map_t *m, int32_t a_cdeg, uint16_t k)
     return d < 0 ? -d : d;
 }
 
-/* Seen free: any occupied evidence is dropped, free evidence grows to its floor. */
-static void mark_clear(qnav_map_t *m, int8_t *c)
+/* Cell (i, j)'s evidence: < 0 seen free (EVIDENCE_FREE_MIN: at its floor), 0 unknown, then
+ * the arcs' counts; EVIDENCE_REFUSED refused. */
+static int8_t evidence_at(const qnav_map_t *m, int32_t i, int32_t j)
 {
-    const int8_t v = (int8_t)((*c > 0 ? 0 : *c) - 1);
+    return m->cfg.compact ? qnav_cmap_evidence(m, i, j) : m->evidence[qnav_map_at(m, i, j)];
+}
+
+/* Seen free: any occupied evidence is dropped, free evidence grows to its floor. */
+static void mark_clear(qnav_map_t *m, int32_t i, int32_t j)
+{
+    int8_t *c, v;
+    if (m->cfg.compact) {
+        qnav_cmap_clear(m, i, j);
+        return;
+    }
+    c = &m->evidence[qnav_map_at(m, i, j)];
+    v = (int8_t)((*c > 0 ? 0 : *c) - 1);
     if (*c == EVIDENCE_REFUSED) {
         return;
     }
@@ -237,16 +292,37 @@ static void mark_clear(qnav_map_t *m, int8_t *c)
     *c = v < EVIDENCE_FREE_MIN ? (int8_t)EVIDENCE_FREE_MIN : v;
 }
 
+/* One more arc's evidence on a cell never seen free. */
+static void mark_arc(qnav_map_t *m, int32_t i, int32_t j)
+{
+    int8_t *c;
+    if (m->cfg.compact) {
+        qnav_cmap_arc(m, i, j);
+        return;
+    }
+    c = &m->evidence[qnav_map_at(m, i, j)];
+    *c = (int8_t)(*c + 1 > EVIDENCE_MAX ? EVIDENCE_MAX : *c + 1);
+    if (*c == QNAV_MAP_OCCUPIED) {
+        m->dirty = 1u;
+    }
+}
+
+/*
+ * Squares are unsigned 32-bit (a 64-bit product costs an AVR hundreds of cycles): with
+ * reach_mm at most MAX_REACH_MM and cells at most 1 000 mm, a cell's offset from the robot
+ * is at most 41 000 mm along each axis, and the squared distance of a cell within reach at
+ * most 2 x 41 000^2 < 2^32. A distance beyond the reach is compared as such, not squared.
+ */
 void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *pose)
 {
     int32_t i0, i1, j0, j1, i, j, reach, three_quarters, heading, arc_half, band_pct;
-    int64_t reach2;
-    if (m == NULL || m->cost == NULL || ranges_mm == NULL || pose == NULL) {
+    uint32_t reach2;
+    if (!ready(m) || ranges_mm == NULL || pose == NULL) {
         return;
     }
     reach = (int32_t)m->cfg.reach_mm;
     three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
-    reach2 = (int64_t)reach * reach;
+    reach2 = (uint32_t)reach * (uint32_t)reach;
     band_pct = m->cfg.noise_pct < OCCUPIED_BAND_PCT ? (int32_t)m->cfg.noise_pct : OCCUPIED_BAND_PCT;
     heading = qnav_wrap_cdeg(pose->heading_cdeg);
     arc_half = INT32_C(18000) / (int32_t)m->n_sectors; /* the whole wedge, or the set arc */
@@ -257,22 +333,21 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
     cell_of(m, pose->x_mm + reach, pose->y_mm + reach, &i1, &j1);
     for (j = j0; j <= j1; ++j) {
         const int32_t dy = centre_y(m, j) - pose->y_mm;
-        const int64_t dy2 = (int64_t)dy * dy;
-        int8_t *row = &m->evidence[at_cell(m, 0, j)];
+        const uint32_t dy2 = (uint32_t)(dy < 0 ? -dy : dy) * (uint32_t)(dy < 0 ? -dy : dy);
         int32_t dx = centre_x(m, i0) - pose->x_mm - (int32_t)m->cfg.cell_mm;
         if (dy2 > reach2) {
             continue;
         }
         for (i = i0; i <= i1; ++i) {
-            int64_t d2;
-            int8_t *c = &row[i];
+            uint32_t d2;
+            const int8_t c = evidence_at(m, i, j);
             uint16_t k;
             int32_t rc, tol, lo, band, rel;
             dx += (int32_t)m->cfg.cell_mm;
-            if (*c == EVIDENCE_FREE_MIN || *c == EVIDENCE_REFUSED) {
+            if (c == EVIDENCE_FREE_MIN || c == EVIDENCE_REFUSED) {
                 continue; /* no reading changes it: free at its floor, or refused */
             }
-            d2 = (int64_t)dx * dx + dy2;
+            d2 = (uint32_t)(dx < 0 ? -dx : dx) * (uint32_t)(dx < 0 ? -dx : dx) + dy2;
             if (d2 > reach2 || d2 == 0) {
                 continue;
             }
@@ -283,22 +358,20 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
             rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
             if (ranges_mm[k] >= m->max_range_mm) {
                 /* nothing in the wedge: free out to the reach */
-                mark_clear(m, c);
+                mark_clear(m, i, j);
                 continue;
             }
             tol = three_quarters + rc * (int32_t)m->cfg.noise_pct / 100; /* not carved free */
             band = rc - three_quarters - rc * band_pct / 100;                /* occupied from */
             lo = rc - tol;
-            if (lo > 0 && d2 < (int64_t)lo * lo) {
-                mark_clear(m, c);
-            } else if (*c >= 0 && *c < EVIDENCE_REFUSED &&
-                       d2 <= (int64_t)(rc + three_quarters) * (rc + three_quarters) &&
-                       (band <= 0 || d2 >= (int64_t)band * band) &&
+            if (lo > 0 && (lo > reach || d2 < (uint32_t)lo * (uint32_t)lo)) {
+                mark_clear(m, i, j);
+            } else if (c >= 0 && c < EVIDENCE_REFUSED &&
+                       (rc + three_quarters > reach ||
+                        d2 <= (uint32_t)(rc + three_quarters) * (uint32_t)(rc + three_quarters)) &&
+                       (band <= 0 || (band <= reach && d2 >= (uint32_t)band * (uint32_t)band)) &&
                        off_centre(m, rel, k) <= arc_half) {
-                *c = (int8_t)(*c + 1 > EVIDENCE_MAX ? EVIDENCE_MAX : *c + 1);
-                if (*c == QNAV_MAP_OCCUPIED) {
-                    m->dirty = 1u;
-                }
+                mark_arc(m, i, j);
             }
         }
     }
@@ -312,7 +385,7 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
  */
 #define QUEUE_HEAD UINT16_C(0xFFFE) /* prev[] of the first cell of its bucket */
 #define QUEUE_END UINT16_C(0xFFFF)  /* next[] of the last cell of its bucket */
-typedef char buckets_fit_the_largest_step[QNAV_MAP_BUCKETS == STEP_DIAG + 255u + 1u ? 1 : -1];
+typedef char buckets_fit_the_largest_step[BUCKETS == STEP_DIAG + 255u + 1u ? 1 : -1];
 
 /* The bucket of a queued cost: costs queued lie in [q_cost, q_cost + q_count), and q_cost's
  * bucket is q_slot (q_cost mod q_count, kept without a division). */
@@ -367,11 +440,11 @@ static void mark_blocked(qnav_map_t *m)
             /* the disc of radius n cells about (i, j), cut to the map */
             const int32_t a0 = i < n ? -i : -n, a1 = nx - 1 - i < n ? nx - 1 - i : n;
             const int32_t b0 = j < n ? -j : -n, b1 = ny - 1 - j < n ? ny - 1 - j : n;
-            if (m->evidence[at_cell(m, i, j)] < QNAV_MAP_OCCUPIED) {
+            if (m->evidence[qnav_map_at(m, i, j)] < QNAV_MAP_OCCUPIED) {
                 continue;
             }
             for (b = b0; b <= b1; ++b) {
-                uint8_t *row = &m->blocked[at_cell(m, i, j + b)];
+                uint8_t *row = &m->blocked[qnav_map_at(m, i, j + b)];
                 const int64_t bb = (int64_t)b * b * cell * cell;
                 for (a = a0; a <= a1; ++a) {
                     const int64_t d2 = bb + (int64_t)a * a * cell * cell;
@@ -392,6 +465,16 @@ static void plan_start(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
 {
     uint32_t n = cell_count(m), c;
     int32_t gi, gj;
+    m->goal_x_mm = goal_x_mm;
+    m->goal_y_mm = goal_y_mm;
+    m->planned = 1u;
+    m->ticks = 0u;
+    m->dirty = 0u;
+    cell_of(m, goal_x_mm, goal_y_mm, &gi, &gj);
+    if (m->cfg.compact) {
+        qnav_cmap_plan_start(m, qnav_map_at(m, gi, gj));
+        return;
+    }
     mark_blocked(m);
     /* every cost QNAV_MAP_UNREACHED, every cell NOT_QUEUED: both all ones */
     memset(m->cost, 0xFF, (size_t)n * sizeof m->cost[0]);
@@ -400,18 +483,12 @@ static void plan_start(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
     for (c = 0; c < m->q_count; ++c) {
         m->q_head[c] = QUEUE_END;
     }
-    cell_of(m, goal_x_mm, goal_y_mm, &gi, &gj);
-    c = at_cell(m, gi, gj);
+    c = qnav_map_at(m, gi, gj);
     m->cost[c] = 0u;
     m->q_cost = 0u;
     m->q_slot = 0u;
     queue_push(m, (uint16_t)c);
     m->q_queued = 1u;
-    m->goal_x_mm = goal_x_mm;
-    m->goal_y_mm = goal_y_mm;
-    m->planned = 1u;
-    m->ticks = 0u;
-    m->dirty = 0u;
 }
 
 /* Cell c's cost is final: taken from the queue. */
@@ -507,38 +584,64 @@ static inline int settle_one(qnav_map_t *m, uint32_t bound, uint16_t *popped)
     return 1;
 }
 
+/* The compact layout's plan as far as cell (ri, rj) needs (all of it: ri < 0). Its step
+ * counts modulo 3 lead the way exactly when grown over one state of the cells, so a plan
+ * whose growth is not bounded starts again when it must grow after a cell became or
+ * stopped being occupied (1: it did). A bounded growth (grow_steps) goes on over the
+ * ticks it takes: starting again could starve it while the robot keeps seeing new cells,
+ * and a way misread where a cell changed meanwhile lasts until the next plan (the walks
+ * along it are bounded: map_compact.c). */
+static int settle_compact(qnav_map_t *m, int32_t ri, int32_t rj)
+{
+    int again = 0;
+    if (m->dirty && (ri < 0 || m->cfg.grow_steps == 0u) && qnav_cmap_needs_growth(m, ri, rj)) {
+        plan_start(m, m->goal_x_mm, m->goal_y_mm);
+        again = 1;
+    }
+    qnav_cmap_settle(m, ri, rj);
+    return again;
+}
+
 /* The whole plan: every cell's cost final. */
 static void settle_all(qnav_map_t *m)
 {
     uint16_t c;
+    if (m->cfg.compact) {
+        (void)settle_compact(m, -1, 0);
+        return;
+    }
     while (settle_one(m, UINT32_MAX, &c)) {
     }
 }
 
 /*
- * Settle as much of the plan as the robot's cell (ri, rj) needs this tick: its own cost,
+ * Settle as much of the plan as the robot's cell (ri, rj) needs this tick (1: the plan
+ * started again for it, compact layout only): its own cost,
  * or, when it is blocked (the robot stands near a wall) and so never reached, every cost
  * cost_near() could choose in the 5 x 5 cells about it. Their least cost c is the first of
  * them taken from the queue; cost_near() chooses at most c + 40 (4 cell sides away), and a
  * cell costing more than c + 30 lies at least a side away, beyond c + 40: so cells up to
  * c + 30 are settled, and cost_near() chooses as after a whole plan.
  */
-static void settle_for(qnav_map_t *m, int32_t ri, int32_t rj)
+static int settle_for(qnav_map_t *m, int32_t ri, int32_t rj)
 {
-    const uint32_t robot = at_cell(m, ri, rj);
+    const uint32_t robot = qnav_map_at(m, ri, rj);
     uint32_t least = QNAV_MAP_UNREACHED;
     uint16_t c;
     int32_t a, b;
+    if (m->cfg.compact) {
+        return settle_compact(m, ri, rj);
+    }
     if (m->cost[robot] != QNAV_MAP_UNREACHED || m->blocked[robot] != BLOCKED) {
         while (!settled(m, robot) && settle_one(m, UINT32_MAX, &c)) {
         }
-        return; /* settled, or nothing queued: every cost final */
+        return 0; /* settled, or nothing queued: every cost final */
     }
     for (b = -2; b <= 2; ++b) {
         for (a = -2; a <= 2; ++a) {
-            if (in_map(m, ri + a, rj + b) && settled(m, at_cell(m, ri + a, rj + b)) &&
-                m->cost[at_cell(m, ri + a, rj + b)] < least) {
-                least = m->cost[at_cell(m, ri + a, rj + b)];
+            if (qnav_map_in(m, ri + a, rj + b) && settled(m, qnav_map_at(m, ri + a, rj + b)) &&
+                m->cost[qnav_map_at(m, ri + a, rj + b)] < least) {
+                least = m->cost[qnav_map_at(m, ri + a, rj + b)];
             }
         }
     }
@@ -550,15 +653,22 @@ static void settle_for(qnav_map_t *m, int32_t ri, int32_t rj)
     }
     while (least != QNAV_MAP_UNREACHED && settle_one(m, least + 3u * STEP_SIDE, &c)) {
     }
+    return 0;
 }
 
 void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
 {
-    if (m == NULL || m->cost == NULL) {
+    if (!ready(m)) {
         return;
     }
     plan_start(m, goal_x_mm, goal_y_mm);
     settle_all(m);
+}
+
+/* Cell (i, j) cannot hold the robot's centre. */
+static int blocked_at(const qnav_map_t *m, int32_t i, int32_t j)
+{
+    return m->cfg.compact ? qnav_cmap_blocked(m, i, j) : m->blocked[qnav_map_at(m, i, j)] == BLOCKED;
 }
 
 /* The straight line between the centres of cells (i0, j0) and (i1, j1) crosses no blocked
@@ -573,7 +683,7 @@ static int in_sight(const qnav_map_t *m, int32_t i0, int32_t j0, int32_t i1, int
         /* cell of the point t / n along, rounded to the nearest */
         const int32_t i = i0 + (2 * di * t + (di >= 0 ? n : -n)) / (2 * n);
         const int32_t j = j0 + (2 * dj * t + (dj >= 0 ? n : -n)) / (2 * n);
-        if (m->blocked[at_cell(m, i, j)] == BLOCKED) {
+        if (blocked_at(m, i, j)) {
             return 0;
         }
     }
@@ -586,19 +696,22 @@ static uint32_t cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi
 {
     uint32_t best = QNAV_MAP_UNREACHED;
     int32_t a, b;
+    if (m->cfg.compact) {
+        return qnav_cmap_cost_near(m, i, j, bi, bj);
+    }
     *bi = i;
     *bj = j;
-    if (m->cost[at_cell(m, i, j)] != QNAV_MAP_UNREACHED) {
-        return m->cost[at_cell(m, i, j)];
+    if (m->cost[qnav_map_at(m, i, j)] != QNAV_MAP_UNREACHED) {
+        return m->cost[qnav_map_at(m, i, j)];
     }
     for (b = -2; b <= 2; ++b) {
         for (a = -2; a <= 2; ++a) {
             const int32_t ii = i + a, jj = j + b;
             uint32_t c;
-            if (!in_map(m, ii, jj)) {
+            if (!qnav_map_in(m, ii, jj)) {
                 continue;
             }
-            c = m->cost[at_cell(m, ii, jj)];
+            c = m->cost[qnav_map_at(m, ii, jj)];
             if (c == QNAV_MAP_UNREACHED) {
                 continue;
             }
@@ -636,12 +749,16 @@ static int plan_when_due(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
  * neighbour (8), when cheaper; 0 when none is. */
 static int descend(const qnav_map_t *m, int32_t *i, int32_t *j)
 {
-    uint16_t here = m->cost[at_cell(m, *i, *j)];
+    uint16_t here;
     int32_t a, b, ni = *i, nj = *j;
+    if (m->cfg.compact) {
+        return qnav_cmap_descend(m, i, j);
+    }
+    here = m->cost[qnav_map_at(m, *i, *j)];
     for (b = -1; b <= 1; ++b) {
         for (a = -1; a <= 1; ++a) {
-            if (in_map(m, *i + a, *j + b) && m->cost[at_cell(m, *i + a, *j + b)] < here) {
-                here = m->cost[at_cell(m, *i + a, *j + b)];
+            if (qnav_map_in(m, *i + a, *j + b) && m->cost[qnav_map_at(m, *i + a, *j + b)] < here) {
+                here = m->cost[qnav_map_at(m, *i + a, *j + b)];
                 ni = *i + a;
                 nj = *j + b;
             }
@@ -694,9 +811,9 @@ static void refuse_when_stalled(qnav_map_t *m, int32_t ri, int32_t rj, uint16_t 
     /* refused cells lie more than the body's reach and a cell along the plan, so that the
      * robot's own cell stays unblocked and the plan starts where the robot stands */
     from = ((int32_t)m->inflate_mm + (int32_t)m->cfg.cell_mm - 1) / (int32_t)m->cfg.cell_mm + 1;
-    for (k = 0; k < steps && descend(m, &i, &j) && m->cost[at_cell(m, i, j)] != 0u; ++k) {
+    for (k = 0; k < steps && descend(m, &i, &j) && m->cost[qnav_map_at(m, i, j)] != 0u; ++k) {
         if (k >= from) {
-            m->evidence[at_cell(m, i, j)] = EVIDENCE_REFUSED;
+            m->evidence[qnav_map_at(m, i, j)] = EVIDENCE_REFUSED;
         }
     }
     m->dirty = 1u;
@@ -706,13 +823,23 @@ static void refuse_when_stalled(qnav_map_t *m, int32_t ri, int32_t rj, uint16_t 
     m->stall_ticks = 0u;
 }
 
+/* The input's goal bearing: toward (x, y), seen from pose (unchanged when there). */
+static void aim(qnav_ctrl_input_t *in, const qnav_map_pose_t *pose, int32_t x_mm, int32_t y_mm)
+{
+    if (x_mm != pose->x_mm || y_mm != pose->y_mm) {
+        in->goal_bearing_cdeg =
+            qnav_wrap_cdeg((int32_t)qnav_atan2_cdeg(y_mm - pose->y_mm, x_mm - pose->x_mm, NULL) -
+                           qnav_wrap_cdeg(pose->heading_cdeg));
+    }
+}
+
 int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
                    int32_t goal_y_mm, qnav_ctrl_input_t *in)
 {
     int32_t i, j, ri, rj, steps, sx, sy;
     uint32_t cost, mm;
     int jumped, replanned, direct = 0, grew = 0;
-    if (m == NULL || m->cost == NULL || pose == NULL || in == NULL) {
+    if (!ready(m) || pose == NULL || in == NULL) {
         return 0;
     }
     if (m->refused_ticks > 0u && --m->refused_ticks == 0u) {
@@ -720,8 +847,16 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     }
     replanned = plan_when_due(m, goal_x_mm, goal_y_mm);
     cell_of(m, pose->x_mm, pose->y_mm, &ri, &rj);
-    settle_for(m, ri, rj);
+    replanned |= settle_for(m, ri, rj);
     cost = cost_near(m, ri, rj, &i, &j);
+    if (cost == QNAV_MAP_UNREACHED && m->cfg.compact && m->q_queued && m->last_mm != 0u) {
+        /* a compact plan still growing toward the robot (grow_steps a tick): the last
+         * sub-goal stands */
+        aim(in, pose, m->sub_x_mm, m->sub_y_mm);
+        in->goal_range_mm = (qnav_mm_t)m->last_mm;
+        m->grown_mm = 0u;
+        return QNAV_MAP_GUIDED | m->sub_direct;
+    }
     if (cost == QNAV_MAP_UNREACHED) {
         m->last_mm = 0u;
         m->grown_mm = 0u;
@@ -736,7 +871,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
         i = ni;
         j = nj;
     }
-    if (m->cost[at_cell(m, i, j)] == 0u) {
+    if (m->cfg.compact ? qnav_map_at(m, i, j) == m->goal_cell : m->cost[qnav_map_at(m, i, j)] == 0u) {
         sx = goal_x_mm; /* the plan ends in the destination's cell: aim at the destination */
         sy = goal_y_mm;
         direct = QNAV_MAP_DIRECT;
@@ -744,11 +879,10 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
         sx = centre_x(m, i);
         sy = centre_y(m, j);
     }
-    if (sx != pose->x_mm || sy != pose->y_mm) {
-        in->goal_bearing_cdeg =
-            qnav_wrap_cdeg((int32_t)qnav_atan2_cdeg(sy - pose->y_mm, sx - pose->x_mm, NULL) -
-                           qnav_wrap_cdeg(pose->heading_cdeg));
-    }
+    aim(in, pose, sx, sy);
+    m->sub_x_mm = sx;
+    m->sub_y_mm = sy;
+    m->sub_direct = (uint8_t)direct;
     mm = cost * m->cfg.cell_mm / STEP_SIDE;
     mm = mm == 0u ? 1u : (mm > 65535u ? 65535u : mm);
     jumped = m->last_mm != 0u && mm > (uint32_t)m->last_mm + m->cfg.jump_mm;
@@ -769,7 +903,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
 static int32_t index_of(const qnav_map_t *m, int32_t x_mm, int32_t y_mm)
 {
     int32_t i, j;
-    if (m == NULL || m->cost == NULL || x_mm < m->x0_mm || y_mm < m->y0_mm) {
+    if (!ready(m) || x_mm < m->x0_mm || y_mm < m->y0_mm) {
         return -1;
     }
     i = (x_mm - m->x0_mm) / (int32_t)m->cfg.cell_mm;
@@ -785,7 +919,10 @@ uint16_t qnav_map_grown_mm(const qnav_map_t *m)
 int8_t qnav_map_evidence(const qnav_map_t *m, int32_t x_mm, int32_t y_mm)
 {
     const int32_t k = index_of(m, x_mm, y_mm);
-    return k < 0 ? 0 : m->evidence[k];
+    if (k < 0) {
+        return 0;
+    }
+    return evidence_at(m, k % (int32_t)m->nx, k / (int32_t)m->nx);
 }
 
 uint16_t qnav_map_cost(qnav_map_t *m, int32_t x_mm, int32_t y_mm)
@@ -795,5 +932,8 @@ uint16_t qnav_map_cost(qnav_map_t *m, int32_t x_mm, int32_t y_mm)
         return QNAV_MAP_UNREACHED;
     }
     settle_all(m);
+    if (m->cfg.compact) {
+        return (uint16_t)qnav_cmap_cost(m, k % (int32_t)m->nx, k / (int32_t)m->nx);
+    }
     return m->cost[k];
 }

@@ -346,7 +346,7 @@ static int board_map(robot_t *r, const options_t *o, const qnav_sim_robot_t *rob
                 o->robot, (unsigned)mc.cell_mm, w_mm / 1000.0, h_mm / 1000.0);
         return 2;
     }
-    bytes = qnav_map_bytes(cells);
+    bytes = qnav_map_size(&mc, w_mm, h_mm);
     r->map_mem = malloc(bytes);
     if (r->map_mem == NULL ||
         qnav_map_init(&r->map, &mc, &bc->ctrl, (int32_t)floor(x0), (int32_t)floor(y0), w_mm,

@@ -125,7 +125,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
     if (root.get("map")) {
         const toml::table &mp = r.table(root, "map");
         r.only_keys(mp, {"on", "cell_m", "reach_m", "look_m", "plan_s", "near_m", "near_cost", "arc_deg", "sight",
-                         "escape_grow", "refuse_s", "refuse_life_s", "pass_m"});
+                         "escape_grow", "refuse_s", "refuse_life_s", "pass_m", "compact", "grow_steps"});
         bool on = true;
         if (const toml::node *o = mp.get("on")) {
             if (!o->is_boolean()) r.fail(*o, "'on' must be true or false");
@@ -136,7 +136,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
             p.map_off_cell_m = p.map_cell_m;
             p.map_cell_m = 0.0;
         }
-        p.map_reach_m = r.number(mp, "reach_m", 0.1, 65.0, true, p.map_reach_m);
+        p.map_reach_m = r.number(mp, "reach_m", 0.1, 40.0, true, p.map_reach_m);
         p.map_look_m = r.number(mp, "look_m", 0.0, 65.0, true, p.map_look_m);
         p.map_plan_s = r.number(mp, "plan_s", 0.1, 25.5, true, p.map_plan_s);
         p.map_near_m = r.number(mp, "near_m", 0.0, 65.0, true, p.map_near_m);
@@ -147,6 +147,25 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         p.map_refuse_s = r.number(mp, "refuse_s", 0.0, 25.5, true, p.map_refuse_s);
         p.map_refuse_life_s = r.number(mp, "refuse_life_s", 0.1, 6553.5, true, p.map_refuse_life_s);
         if (mp.get("pass_m")) p.map_pass_m = r.number(mp, "pass_m", 0.0, 10.0);
+        if (const toml::node *c = mp.get("compact")) {
+            if (!c->is_boolean()) r.fail(*c, "'compact' must be true or false");
+            p.map_compact = c->value_or(false);
+        }
+        if (const toml::node *g = mp.get("grow_steps"); g && !p.map_compact)
+            r.fail(*g, "'grow_steps' is a compact map's (compact = true)");
+        if (p.map_compact) {  // 4 bits a cell: no bits for near costs and refusals
+            for (const char *k : {"near_cost", "refuse_s"})
+                if (const toml::node *n = mp.get(k); n && n->value_or(0.0) != 0.0)
+                    r.fail(*n, std::string("'") + k + "' must be 0 in a compact map (it has no bits for it)");
+            p.map_near_cost = 0.0;
+            p.map_refuse_s = 0.0;
+            if (mp.get("grow_steps"))
+                p.map_grow_steps = static_cast<std::uint8_t>(r.integer(mp, "grow_steps", 0, 255));
+            const double cell = p.map_cell_m > 0 ? p.map_cell_m : p.map_off_cell_m;
+            if (cell <= p.radius_m + p.safety_m)
+                r.fail(*mp.get("cell_m"), "a compact map's 'cell_m' must exceed [body] radius_m + [clearance] "
+                                          "safety_m (a cell is blocked when it is occupied)");
+        }
     }
 
     const toml::table &rec = r.table(root, "recovery");

@@ -73,6 +73,8 @@ struct RobotProfile {
     bool map_escape_grow = true;    // a longer plan grows the escape's distances with it
     double map_refuse_s = 3.0;      // no progress along the plan this long: its next cells refused
     double map_refuse_life_s = 20.0;  // for this long
+    bool map_compact = false;       // 4 bits a cell (qnav_map_config_t.compact)
+    std::uint8_t map_grow_steps = 16;  // compact: plan steps grown a tick at most (0: no bound)
     std::optional<double> map_pass_m;  // the controller's passing distance (the enlargement's,
                                        // qnav_ctrl_config_t.pass_mm) when the map guides it,
                                        // m; none: safety_m, as without a map

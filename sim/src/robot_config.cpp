@@ -60,6 +60,8 @@ void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg) {
     cfg->refuse_ticks = static_cast<std::uint8_t>(std::clamp(std::lround(p.map_refuse_s / QNAV_SIM_TICK_S), 0L, 255L));
     cfg->refuse_life_ticks =
         static_cast<std::uint16_t>(std::clamp(std::lround(p.map_refuse_life_s / QNAV_SIM_TICK_S), 1L, 65535L));
+    cfg->compact = p.map_compact ? 1 : 0;
+    cfg->grow_steps = p.map_grow_steps;
 }
 
 }  // namespace qnav

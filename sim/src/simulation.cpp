@@ -91,15 +91,15 @@ Simulation::Simulation(const RobotProfile &robot, const Environment &env, const 
     odom_on_ = !map_mem_.empty() && has_odometry_errors(robot_);
 }
 
-// The profile's [map] over the whole arena (libqnav qnav/map.h; 8 bytes a cell), told the
+// The profile's [map] over the whole arena (libqnav qnav/map.h; 8 bytes a cell, or half a
+// byte with [map] compact), told the
 // range noise of the sonar this run simulates.
 void Simulation::init_map() {
     qnav_map_config_t mc;
     robot_map_config(robot_, &mc);
     mc.noise_pct = map_noise_pct(cfg_.sensor_noise);  // the sonar this run draws
     const auto mm = [](double m) { return static_cast<std::uint32_t>(std::ceil(m * 1000.0)); };
-    const std::uint32_t cells = qnav_map_cells(mm(env_.width_m), mm(env_.height_m), mc.cell_mm);
-    map_mem_.assign((qnav_map_bytes(cells) + 1) / 2, 0);
+    map_mem_.assign((qnav_map_size(&mc, mm(env_.width_m), mm(env_.height_m)) + 1) / 2, 0);
     qnav_ctrl_config_t cc;
     robot_ctrl_config(robot_, cfg_.n_sectors, &cc);
     const qnav_status_t st = qnav_map_init(&map_, &mc, &cc, 0, 0, mm(env_.width_m), mm(env_.height_m),

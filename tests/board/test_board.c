@@ -608,7 +608,7 @@ static void test_position_goal_bearing_comes_from_the_pose(void **state)
  * without one, straight at it. The scripted robot stands at the origin facing +x. */
 static void test_a_board_with_a_map_steers_round_what_it_has_seen(void **state)
 {
-    static uint16_t mem[60 * 60 * 4];
+    static uint16_t mem[60 * 60 * 4 + 270];
     qnav_map_t map;
     qnav_map_config_t mc;
     qnav_link_goal_t gl = {9, 0, 0, QNAV_LINK_GOAL_POSITION, 3000, 0};
@@ -624,7 +624,7 @@ static void test_a_board_with_a_map_steers_round_what_it_has_seen(void **state)
         (qnav_mm_t)(1000 - g.bot.cfg.ctrl.sensor_offset_mm);
     qnav_map_config_default(&mc);
     mc.plan_ticks = 1;
-    assert_true(qnav_map_bytes(qnav_map_cells(6000, 6000, mc.cell_mm)) <= sizeof mem);
+    assert_true(qnav_map_size(&mc, 6000, 6000) <= sizeof mem);
     assert_int_equal(qnav_map_init(&map, &mc, &g.bot.cfg.ctrl, -3000, -3000, 6000, 6000, mem,
                                    sizeof mem),
                      QNAV_OK);

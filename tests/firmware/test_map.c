@@ -221,13 +221,28 @@ static void observe_the_wall(qnav_map_t *m)
     }
 }
 
-static void test_the_plan_leads_round_the_wall_to_its_gap(void **state)
+/* The compact layout at cell_mm (wider than the sensor's body, 170 mm), planning every
+ * plan_ticks, growing its plan by grow_steps a tick (0: as far as it needs). */
+static void compact_map(qnav_map_t *m, uint16_t cell_mm, uint8_t plan_ticks, uint8_t grow_steps)
 {
-    qnav_map_t m;
+    qnav_map_config_t mc;
+    qnav_map_config_default(&mc);
+    mc.compact = 1;
+    mc.cell_mm = cell_mm;
+    mc.plan_ticks = plan_ticks;
+    mc.grow_steps = grow_steps;
+    mc.near_cost = 0;
+    mc.refuse_ticks = 0;
+    map_from(m, &mc);
+}
+
+/* m, empty, leads round the wall to its gap once it has seen the wall. */
+static void plan_round_the_wall(qnav_map_t *m)
+{
+    qnav_map_t *const mp = m;
     qnav_ctrl_input_t in;
     const qnav_map_pose_t p = {1500, 1500, 9000}; /* facing the wall (+y) */
-    (void)state;
-    map_of(&m, 1);
+#define m (*mp)
     /* nothing seen yet: the plan is the straight line */
     memset(&in, 0, sizeof in);
     assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &in), QNAV_MAP_GUIDED);
@@ -262,6 +277,162 @@ static void test_the_plan_leads_round_the_wall_to_its_gap(void **state)
     in.escape.side = 1;
     assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &in), QNAV_MAP_GUIDED);
     assert_int_equal(in.escape.side, 1);
+#undef m
+}
+
+static void test_the_plan_leads_round_the_wall_to_its_gap(void **state)
+{
+    qnav_map_t m;
+    (void)state;
+    map_of(&m, 1);
+    plan_round_the_wall(&m);
+}
+
+/* The compact layout (4 bits a cell) plans the same way round at 400 mm cells. */
+static void test_the_compact_plan_leads_round_the_wall_to_its_gap(void **state)
+{
+    qnav_map_t m;
+    (void)state;
+    compact_map(&m, 400, 1, 0);
+    assert_int_equal(qnav_map_size(&m.cfg, WORLD_MM, WORLD_MM), 4u * 15u * 2u);
+    plan_round_the_wall(&m);
+}
+
+/* A plan that grows by at most grow_steps a tick (the board's bound on a tick's cost)
+ * holds the last sub-goal while it has not reached the robot, then gives what a plan
+ * grown at once gives. */
+static void test_a_compact_plan_grown_a_few_steps_a_tick_holds_its_last_sub_goal(void **state)
+{
+    static qnav_map_t bounded, whole;
+    static uint16_t whole_mem[64];
+    qnav_ctrl_config_t cc;
+    qnav_ctrl_input_t a, b;
+    const qnav_map_pose_t p = {1500, 1500, 9000};
+    int t, held = 0, got;
+    (void)state;
+    compact_map(&bounded, 400, 1, 3);
+    /* the same map in memory of its own */
+    sensor_config(&cc);
+    whole.cfg = bounded.cfg;
+    whole.cfg.grow_steps = 0;
+    assert_int_equal(qnav_map_init(&whole, &whole.cfg, &cc, 0, 0, WORLD_MM, WORLD_MM, whole_mem,
+                                   sizeof whole_mem),
+                     QNAV_OK);
+    memset(&a, 0, sizeof a);
+    /* 9 steps away: no sub-goal yet for two ticks, then the straight way */
+    assert_int_equal(qnav_map_guide(&bounded, &p, 1500, 5000, &a), 0);
+    assert_int_equal(qnav_map_guide(&bounded, &p, 1500, 5000, &a), 0);
+    assert_int_equal(qnav_map_guide(&bounded, &p, 1500, 5000, &a), QNAV_MAP_GUIDED);
+    observe_the_wall(&bounded);
+    observe_the_wall(&whole);
+    memset(&b, 0, sizeof b);
+    assert_int_equal(qnav_map_guide(&whole, &p, 1500, 5000, &b) & QNAV_MAP_GUIDED, QNAV_MAP_GUIDED);
+    /* the new plan, round the wall, is some 20 steps long: the old sub-goal stands for
+     * ticks, then the two agree */
+    a.goal_bearing_cdeg = 0;
+    a.goal_range_mm = 0;
+    got = qnav_map_guide(&bounded, &p, 1500, 5000, &a);
+    assert_int_equal(got, QNAV_MAP_GUIDED);
+    assert_true(a.goal_bearing_cdeg > -1000 && a.goal_bearing_cdeg < 1000);
+    assert_true(a.goal_range_mm > 3300 && a.goal_range_mm < 3700);
+    for (t = 0; t < 20 && a.goal_range_mm < 7000; ++t) {
+        got = qnav_map_guide(&bounded, &p, 1500, 5000, &a);
+        ++held;
+    }
+    print_message("the new plan reached the robot after %d ticks\n", held);
+    assert_true(held >= 4);
+    assert_int_equal(a.goal_bearing_cdeg, b.goal_bearing_cdeg);
+    assert_int_equal(a.goal_range_mm, b.goal_range_mm);
+}
+
+/* Boxes to drive among: the wall with its gap, a pillar, a U open to the south. */
+static const box_t among[] = {{0, 2950, 4500, 3050},    {5300, 2950, WORLD_MM, 3050},
+                              {2600, 1200, 3000, 1600}, {600, 4000, 700, 5400},
+                              {600, 5300, 2200, 5400},  {2100, 4000, 2200, 5400}};
+
+/* A robot driven among the boxes, both layouts marking its scans: the compact layout
+ * holds what the full one says of every cell (occupied, seen free, neither), and its
+ * plan is a breadth-first search over its occupied cells (8 neighbours, no corner cut):
+ * a cell is reached exactly when such a search reaches it, and its way to the destination
+ * is that search's step count long (each step 10 or 14). */
+static void test_the_compact_layout_marks_as_the_full_one_and_plans_breadth_first(void **state)
+{
+    static qnav_map_t full, small;
+    static int32_t steps[(WORLD_MM / 300) * (WORLD_MM / 300)];
+    static int32_t queue[(WORLD_MM / 300) * (WORLD_MM / 300)];
+    static uint16_t mem_small[2000];
+    qnav_map_config_t mc;
+    qnav_ctrl_config_t cc;
+    qnav_mm_t ranges[N];
+    const int32_t cell = 300, n = WORLD_MM / cell;
+    int32_t t, i, j, head = 0, tail = 0, reached = 0;
+    (void)state;
+    qnav_map_config_default(&mc);
+    mc.cell_mm = (uint16_t)cell;
+    mc.near_cost = 0;
+    mc.refuse_ticks = 0;
+    map_from(&full, &mc);
+    mc.compact = 1;
+    sensor_config(&cc);
+    assert_true(qnav_map_size(&mc, WORLD_MM, WORLD_MM) <= sizeof mem_small);
+    assert_int_equal(qnav_map_init(&small, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem_small,
+                                   sizeof mem_small),
+                     QNAV_OK);
+    /* a loop round the pillar and along the wall, turning as it goes */
+    for (t = 0; t < 120; ++t) {
+        const qnav_map_pose_t p = {900 + (t % 40) * 110, 700 + (t / 40) * 600, t * 1700};
+        scan(among, sizeof among / sizeof among[0], &p, ranges);
+        qnav_map_observe(&full, ranges, &p);
+        qnav_map_observe(&small, ranges, &p);
+    }
+    for (j = 0; j < n; ++j) {
+        for (i = 0; i < n; ++i) {
+            const int32_t x = i * cell + cell / 2, y = j * cell + cell / 2;
+            const int8_t a = qnav_map_evidence(&full, x, y), b = qnav_map_evidence(&small, x, y);
+            assert_int_equal(a >= QNAV_MAP_OCCUPIED, b >= QNAV_MAP_OCCUPIED);
+            assert_int_equal(a < 0, b < 0);
+            steps[j * n + i] = -1;
+        }
+    }
+    /* the search, from the destination's cell (3, 17) */
+    qnav_map_plan(&small, 3 * cell + 100, 17 * cell + 100);
+    steps[17 * n + 3] = 0;
+    queue[tail++] = 17 * n + 3;
+    while (head < tail) {
+        const int32_t c = queue[head++], ci = c % n, cj = c / n;
+        int32_t a, b;
+        for (b = -1; b <= 1; ++b) {
+            for (a = -1; a <= 1; ++a) {
+                const int32_t ti = ci + a, tj = cj + b;
+                if (ti < 0 || tj < 0 || ti >= n || tj >= n || steps[tj * n + ti] >= 0 ||
+                    qnav_map_evidence(&small, ti * cell, tj * cell) >= QNAV_MAP_OCCUPIED) {
+                    continue;
+                }
+                if (a != 0 && b != 0 &&
+                    (qnav_map_evidence(&small, ti * cell, cj * cell) >= QNAV_MAP_OCCUPIED ||
+                     qnav_map_evidence(&small, ci * cell, tj * cell) >= QNAV_MAP_OCCUPIED)) {
+                    continue;
+                }
+                steps[tj * n + ti] = steps[c] + 1;
+                queue[tail++] = tj * n + ti;
+            }
+        }
+    }
+    for (j = 0; j < n; ++j) {
+        for (i = 0; i < n; ++i) {
+            const int32_t s = steps[j * n + i];
+            const uint16_t cost = qnav_map_cost(&small, i * cell, j * cell);
+            if (s < 0) {
+                assert_int_equal(cost, QNAV_MAP_UNREACHED);
+                continue;
+            }
+            reached++;
+            assert_true(cost >= 10 * s && cost <= 14 * s);
+        }
+    }
+    print_message("%d of %d cells reached, %d not (occupied, or walled in)\n", reached, n * n,
+                  n * n - reached);
+    assert_true(reached > n * n / 2 && reached < n * n);
 }
 
 /* Left of the gap, the destination straight beyond the wall: once the wall is seen the way
@@ -422,21 +593,22 @@ static void test_a_way_the_robot_cannot_take_is_refused_for_a_while(void **state
     assert_int_equal(ticks_until_unguided(0, &m), -1);
 }
 
-/* A copy of map src in buf (cells * 8 bytes): the same state, its own cells. */
+/* A copy of full-layout map src in buf: the same state, its own cells (its memory starts
+ * at the queue's heads). */
 static void copy_map(qnav_map_t *dst, const qnav_map_t *src, uint16_t *buf)
 {
-    const size_t cells = (size_t)src->nx * src->ny;
+    const size_t bytes = qnav_map_size(&src->cfg, (uint32_t)src->nx * src->cfg.cell_mm,
+                                       (uint32_t)src->ny * src->cfg.cell_mm);
+    const uint8_t *base = (const uint8_t *)src->q_head;
+    uint8_t *to = (uint8_t *)buf;
     *dst = *src;
-    dst->cost = buf;
-    dst->next = dst->cost + cells;
-    dst->prev = dst->next + cells;
-    dst->evidence = (int8_t *)(void *)(dst->prev + cells);
-    dst->blocked = (uint8_t *)(dst->evidence + cells);
-    memcpy(dst->cost, src->cost, cells * sizeof *src->cost);
-    memcpy(dst->next, src->next, cells * sizeof *src->next);
-    memcpy(dst->prev, src->prev, cells * sizeof *src->prev);
-    memcpy(dst->evidence, src->evidence, cells);
-    memcpy(dst->blocked, src->blocked, cells);
+    memcpy(to, base, bytes);
+    dst->q_head = (uint16_t *)(void *)(to + ((const uint8_t *)src->q_head - base));
+    dst->cost = (uint16_t *)(void *)(to + ((const uint8_t *)src->cost - base));
+    dst->next = (uint16_t *)(void *)(to + ((const uint8_t *)src->next - base));
+    dst->prev = (uint16_t *)(void *)(to + ((const uint8_t *)src->prev - base));
+    dst->evidence = (int8_t *)(void *)(to + ((const uint8_t *)src->evidence - base));
+    dst->blocked = to + (src->blocked - base);
 }
 
 static uint16_t mem_full[CELLS_MAX * 4];
@@ -512,6 +684,13 @@ static void test_the_plan_is_settled_as_far_as_the_robot_needs(void **state)
     drive_against_a_whole_plan(10);
 }
 
+/* A map of 1 000 mm square with configuration mc. */
+static qnav_status_t square_metre(qnav_map_t *m, const qnav_map_config_t *mc,
+                                  const qnav_ctrl_config_t *cc)
+{
+    return qnav_map_init(m, mc, cc, 0, 0, 1000, 1000, mem, sizeof mem);
+}
+
 static void test_bad_maps_are_refused(void **state)
 {
     qnav_map_t m;
@@ -524,26 +703,54 @@ static void test_bad_maps_are_refused(void **state)
                      QNAV_E_NULL);
     assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, NULL, sizeof mem),
                      QNAV_E_NULL);
-    /* too little memory for 6 000 mm square at 100 mm: 3 600 cells, 8 bytes each */
+    /* too little memory for 6 000 mm square at 100 mm: 3 600 cells, 8 bytes each, and the
+     * plan's queue */
+    assert_int_equal(qnav_map_size(&mc, WORLD_MM, WORLD_MM), 3600u * 8u + 540u);
     assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem,
-                                   qnav_map_bytes(3600) - 1),
+                                   qnav_map_size(&mc, WORLD_MM, WORLD_MM) - 1),
                      QNAV_E_MAP);
     assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem,
-                                   qnav_map_bytes(3600)),
+                                   qnav_map_size(&mc, WORLD_MM, WORLD_MM)),
                      QNAV_OK);
     mc.cell_mm = 10;
-    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
+    assert_int_equal(square_metre(&m, &mc, &cc), QNAV_E_MAP);
     mc.cell_mm = 100;
     mc.plan_ticks = 0;
-    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
+    assert_int_equal(square_metre(&m, &mc, &cc), QNAV_E_MAP);
     mc.plan_ticks = 10;
     mc.arc_cdeg = 36001;
-    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
+    assert_int_equal(square_metre(&m, &mc, &cc), QNAV_E_MAP);
     mc.arc_cdeg = 36000;
+    mc.reach_mm = 40001; /* distances are squared in 32 bits */
+    assert_int_equal(square_metre(&m, &mc, &cc), QNAV_E_MAP);
+    mc.reach_mm = 40000;
     mc.refuse_life_ticks = 0; /* a refusal that would never lapse */
-    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_E_MAP);
+    assert_int_equal(square_metre(&m, &mc, &cc), QNAV_E_MAP);
     mc.refuse_ticks = 0;
-    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 1000, 1000, mem, sizeof mem), QNAV_OK);
+    assert_int_equal(square_metre(&m, &mc, &cc), QNAV_OK);
+    /* the compact layout: half a byte a cell, rows of whole bytes; no bits for near costs
+     * and refusals, and a cell must be wider than the body's reach (170 mm) */
+    mc.compact = 1;
+    mc.near_cost = 0;
+    mc.cell_mm = 400;
+    assert_int_equal(qnav_map_size(&mc, 3300, 1000), 4u * 3u * 2u); /* 9 x 3 cells */
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 3300, 1000, mem, 23), QNAV_E_MAP);
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 3300, 1000, mem, 24), QNAV_OK);
+    mc.cell_mm = 170;
+    assert_int_equal(square_metre(&m, &mc, &cc), QNAV_E_MAP);
+    mc.cell_mm = 171;
+    assert_int_equal(square_metre(&m, &mc, &cc), QNAV_OK);
+    mc.near_cost = 1;
+    assert_int_equal(square_metre(&m, &mc, &cc), QNAV_E_MAP);
+    mc.near_cost = 0;
+    mc.refuse_ticks = 1;
+    assert_int_equal(square_metre(&m, &mc, &cc), QNAV_E_MAP);
+    mc.refuse_ticks = 0;
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 192u * 171u, 1000, mem, sizeof mem), QNAV_OK);
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, 193u * 171u, 1000, mem, sizeof mem),
+                     QNAV_E_MAP); /* more than 192 cells across */
+    mc.compact = 2;
+    assert_int_equal(square_metre(&m, &mc, &cc), QNAV_E_MAP);
     assert_int_equal(qnav_map_cells(100000000u, 100000000u, 100), 0);
     assert_string_not_equal(qnav_status_str(QNAV_E_MAP), "unknown status");
 }
@@ -556,6 +763,9 @@ int main(void)
         cmocka_unit_test(test_a_wide_wedge_marks_only_the_default_arc),
         cmocka_unit_test(test_a_noisy_reading_keeps_its_arc_thin),
         cmocka_unit_test(test_the_plan_leads_round_the_wall_to_its_gap),
+        cmocka_unit_test(test_the_compact_plan_leads_round_the_wall_to_its_gap),
+        cmocka_unit_test(test_a_compact_plan_grown_a_few_steps_a_tick_holds_its_last_sub_goal),
+        cmocka_unit_test(test_the_compact_layout_marks_as_the_full_one_and_plans_breadth_first),
         cmocka_unit_test(test_the_sub_goal_is_not_behind_a_corner),
         cmocka_unit_test(test_a_longer_plan_grows_the_escape_memory),
         cmocka_unit_test(test_the_destination_in_reach_is_flagged_direct),

@@ -239,7 +239,13 @@ void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
         qnav_ctrl_config_t plain, with;
         assert_int_equal(loaded_map(robot, &off, &plain), 0);
         assert_int_equal(loaded_map((std::string(robot) + "+map").c_str(), &on, &with), 1);
-        assert_int_equal(on.cell_mm, 100);
+        /* the TekBot's is the map its ATmega128 holds: 4 bits a cell of 0.4 m */
+        const bool tekbot = std::string(robot) == "tekbot";
+        assert_int_equal(on.cell_mm, tekbot ? 400 : 100);
+        assert_int_equal(on.compact, tekbot ? 1 : 0);
+        assert_int_equal(on.grow_steps, 16);
+        assert_int_equal(on.near_cost, tekbot ? 0 : 10);
+        assert_int_equal(on.refuse_ticks, tekbot ? 0 : 30);
         assert_int_equal(with.safety_mm, plain.safety_mm);
         assert_int_equal(with.n_sectors, plain.n_sectors);
         assert_int_equal(with.max_range_mm, plain.max_range_mm);
@@ -263,6 +269,16 @@ void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
     assert_int_equal(std::remove(file.c_str()), 0);
     assert_int_equal(rmdir(dir), 0);
     assert_true(refusal(tekbot_with("[map]\non = 1\ncell_m = 0.1\n")).find("'on' must be true or false") !=
+                std::string::npos);
+    /* a compact map: cells wider than the body's reach, no near costs or refusals, and
+     * grow_steps only with it */
+    assert_true(refusal(tekbot_with("[map]\ncompact = true\ncell_m = 0.15\n")).find("'cell_m' must exceed") !=
+                std::string::npos);
+    assert_true(refusal(tekbot_with("[map]\ncompact = true\ncell_m = 0.4\nnear_cost = 1\n"))
+                    .find("'near_cost' must be 0 in a compact map") != std::string::npos);
+    assert_true(refusal(tekbot_with("[map]\ncompact = 1\ncell_m = 0.4\n")).find("'compact' must be true or false") !=
+                std::string::npos);
+    assert_true(refusal(tekbot_with("[map]\ncell_m = 0.4\ngrow_steps = 4\n")).find("'grow_steps' is a compact map's") !=
                 std::string::npos);
 }
 

@@ -8,7 +8,7 @@
  * of the destination itself. The controller, its policy and its escape memory are
  * unchanged: the map only rewrites the input's goal bearing and range.
  *
- * Fixed point, no heap: the caller gives the memory (qnav_map_bytes()) and keeps it; the
+ * Fixed point, no heap: the caller gives the memory (qnav_map_size()) and keeps it; the
  * robot's pose (millimetres, 0.01 deg, in the frame the destination is given in) comes from
  * the caller's odometry or the simulator. One map per destination and world: reset it
  * when either changes.
@@ -34,7 +34,7 @@ extern "C" {
 typedef struct {
     uint16_t cell_mm;      /* a cell's side, mm, 20..1000; default 100 */
     uint16_t reach_mm;     /* readings mark cells out to this distance from the robot's
-                              centre, mm; default 2000 */
+                              centre, mm, at most 40 000; default 2000 */
     uint16_t look_mm;      /* the sub-goal lies this far along the plan, mm; default 1000 */
     uint16_t jump_mm;      /* a plan longer by this than the last tick's clears the escape
                               memory (the way it was following is closed), mm; default 1000 */
@@ -63,6 +63,18 @@ typedef struct {
                               cannot take; 0: never; default 30 */
     uint16_t refuse_life_ticks; /* ticks a refusal lasts (every refused cell then unknown
                               again), 1..65535; default 200 */
+    uint8_t compact;       /* 1: 4 bits a cell instead of 8 bytes, for a board of a few KB
+                              (docs/architecture.md, "A map in 4 bits a cell"): what a cell
+                              was seen as in 2 bits, a breadth-first plan in 2 (each cell's
+                              step count from the destination modulo 3). Needs cells wider
+                              than the body's radius and safety distance (a cell is blocked
+                              when it is occupied), at most 192 cells across, refuse_ticks 0
+                              and near_cost 0; the plan counts a diagonal step as one.
+                              Default 0 */
+    uint8_t grow_steps;    /* compact: a tick grows the plan by at most this many steps
+                              (its cost is bounded: docs/performance.md); while it has not
+                              reached the robot, the last sub-goal stands. 0: no bound.
+                              Default 16 */
 } qnav_map_config_t;
 
 /* The robot's pose in the destination's frame. */
@@ -71,9 +83,6 @@ typedef struct {
     int32_t y_mm;
     int32_t heading_cdeg;  /* direction of the robot's straight ahead (sector 0), any value */
 } qnav_map_pose_t;
-
-/* Buckets of the plan's queue: the largest step (14 + near_cost) + 1. */
-#define QNAV_MAP_BUCKETS 270u
 
 /* One map. Private fields: read them through the functions below. */
 typedef struct {
@@ -84,11 +93,22 @@ typedef struct {
     uint16_t inflate_mm;      /* body radius + safety distance */
     int32_t x0_mm, y0_mm;     /* the world corner of cell (0, 0) */
     uint16_t nx, ny;
+    /* the full layout (cfg.compact 0), in the caller's memory; NULL in the compact one */
     int8_t *evidence;         /* per cell: < 0 seen free, >= QNAV_MAP_OCCUPIED occupied */
     uint16_t *cost;           /* per cell: plan cost to the destination, 10 per cell side */
     uint16_t *next;           /* per cell: the next cell in its plan queue bucket */
     uint16_t *prev;           /* per cell: the previous one, or not queued */
     uint8_t *blocked;         /* per cell: too near an occupied cell for the body */
+    uint16_t *q_head;         /* the plan queue's buckets */
+    /* the compact layout: 4 bit planes of ny rows of row_bytes bytes, cell i of a row in
+     * bit i % 8 of byte i / 8: what the cell was seen as (2), its plan step count modulo 3
+     * plus 1, 0 unreached (2); NULL in the full layout */
+    uint8_t *planes;
+    uint16_t row_bytes;
+    uint16_t layer;           /* the plan's last settled step count (compact) */
+    uint16_t goal_cell;       /* the destination's cell (compact) */
+    int32_t sub_x_mm, sub_y_mm; /* the last guided tick's sub-goal */
+    uint8_t sub_direct;       /* ... was the destination (QNAV_MAP_DIRECT) */
     int32_t goal_x_mm, goal_y_mm;
     uint16_t ticks;           /* observations since the last plan */
     uint16_t last_mm;         /* the last guided tick's planned distance; 0: none */
@@ -100,7 +120,6 @@ typedef struct {
     uint16_t refused_ticks;   /* ticks the refused cells have left; 0: none */
     /* The plan's queue, kept between ticks: a plan settles cells only until the robot's
      * is settled, and goes on from here when the robot stands on a cell not yet settled */
-    uint16_t q_head[QNAV_MAP_BUCKETS];
     uint16_t q_count;         /* buckets in use */
     uint16_t q_slot;          /* q_cost's bucket */
     uint32_t q_cost;          /* the least cost still queued may be this */
@@ -116,13 +135,16 @@ void qnav_map_config_default(qnav_map_config_t *cfg);
 
 /* Cells of a width_mm x height_mm world at cell_mm; 0 when too many (> 65 000) or cell_mm 0. */
 uint32_t qnav_map_cells(uint32_t width_mm, uint32_t height_mm, uint16_t cell_mm);
-/* Bytes of memory a map of that many cells needs (8 per cell). */
-size_t qnav_map_bytes(uint32_t cells);
+/* Bytes of memory a map of that world with configuration cfg needs: 8 a cell and 540 for
+ * the plan's queue, or with cfg->compact half a byte a cell (each row of cells a whole
+ * number of bytes); 0 when it has too many cells. */
+size_t qnav_map_size(const qnav_map_config_t *cfg, uint32_t width_mm, uint32_t height_mm);
 
 /*
  * A map of the world [x0, x0 + width) x [y0, y0 + height) mm for a robot whose controller
  * is configured by ctrl (sectors, sonar range and offset, body): buf holds len bytes,
- * at least qnav_map_bytes(), aligned for uint16_t. Starts empty (every cell unknown).
+ * at least qnav_map_size(), aligned for uint16_t (the compact layout: any address).
+ * Starts empty (every cell unknown).
  */
 QNAV_CHECK_RESULT qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
                                               const qnav_ctrl_config_t *ctrl, int32_t x0_mm,

@@ -226,8 +226,9 @@ void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t
 QNAV_CHECK_RESULT qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t *cfg,
                                     const qnav_board_hal_t *hal);
 
-/* Whether the board core can use a map: not on an AVR (8 bytes a cell: no map an ATmega
- * fits, and its code would cost 10 KB of flash); -DQNAV_BOARD_WITH_MAP=0/1 decides. */
+/* Whether the board core can use a map: not on an AVR yet (the compact layout, half a byte a
+ * cell, fits an ATmega128, but its firmware does not place one: docs/performance.md, "The
+ * compact map on the ATmega128"); -DQNAV_BOARD_WITH_MAP=0/1 decides. */
 #ifndef QNAV_BOARD_WITH_MAP
 #ifdef __AVR__
 #define QNAV_BOARD_WITH_MAP 0
@@ -241,8 +242,9 @@ QNAV_CHECK_RESULT qnav_board_status_t qnav_board_init(qnav_board_t *bot, const q
  * docs/architecture.md, "A map and a plan"): each tick marks the map from the pose and
  * gives the controller the plan's sub-goal and planned distance (also reported as the
  * POSE frame's goal distance). The caller initialises the map over the part of the
- * odometry frame the robot may reach, in memory it keeps (qnav_map_bytes(): 8 bytes a
- * cell, more than an ATmega128 has for any useful area), and resets it for a new world.
+ * odometry frame the robot may reach, in memory it keeps (qnav_map_size(): 8 bytes a
+ * cell, more than an ATmega128 has for any useful area, or half a byte in the compact
+ * layout), and resets it for a new world.
  * NULL turns it off. Bearing goals are never planned. Returns 1, or 0 (and keeps no map)
  * in a build without QNAV_BOARD_WITH_MAP.
  */

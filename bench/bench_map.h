@@ -1,0 +1,31 @@
+/*
+ * Types of the map's benchmark trace (bench_map_trace.h, written by bench/map_trace.c):
+ * one tick is the robot's pose, its scan, and what the host's map made of them.
+ */
+#ifndef QNAV_BENCH_MAP_H
+#define QNAV_BENCH_MAP_H
+
+#include <stdint.h>
+
+#include "qnav/flash.h"
+
+#define QNAV_BENCH_MAP_MAX_SECTORS 16u
+
+typedef struct {
+    int16_t x_mm, y_mm;        /* the robot's centre in the world (the map's frame), mm */
+    int16_t heading_cdeg;      /* its heading, 0.01 deg */
+    uint16_t ranges_mm[QNAV_BENCH_MAP_MAX_SECTORS]; /* the sonar's scan */
+    int16_t bearing_cdeg;      /* the host's qnav_map_guide(): the sub-goal's bearing, */
+    uint16_t range_mm;         /* the planned distance, */
+    uint8_t flags;             /* its return value */
+} qnav_bench_map_tick_t;
+
+typedef struct {
+    const char *name;
+    uint32_t width_mm, height_mm; /* the map covers the arena */
+    int32_t goal_x_mm, goal_y_mm;
+    const qnav_bench_map_tick_t *ticks; /* in flash */
+    uint16_t n_ticks;
+} qnav_bench_map_world_t;
+
+#endif

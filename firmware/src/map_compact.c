@@ -1,0 +1,384 @@
+/*
+ * The map in 4 bits a cell (map_compact.h; docs/architecture.md, "A map in 4 bits a cell").
+ *
+ * Four bit planes, a row of cells a whole number of bytes in each, cell i of a row in bit
+ * i % 8 of byte i / 8:
+ *   seen (2 planes): 00 unknown, 01 one arc's evidence, 10 occupied, 11 seen free. These
+ *     are the full layout's evidence values as its marking uses them: a free cell takes no
+ *     arc evidence whatever its count, and occupied at 2 or 3 behaves the same.
+ *   plan (2 planes): 0 not reached, else the cell's step count from the destination's
+ *     cell modulo 3, plus 1. A breadth-first plan (8 neighbours, a diagonal only past two
+ *     passable cells, every step one) grows one step count at a time over whole rows, 8
+ *     cells a byte operation; a neighbour a step nearer has the count one less modulo 3,
+ *     and no other neighbour can, so the way to the destination is found from the counts
+ *     modulo 3 alone. That holds for counts grown over one state of the cells: a plan is
+ *     grown further only while no cell became or stopped being occupied since it began
+ *     (else map.c starts it again).
+ */
+#include "map_compact.h"
+
+#include <string.h>
+
+enum { SEEN_LO, SEEN_HI, PLAN_LO, PLAN_HI, PLANES };
+
+#define SEEN_UNKNOWN 0u
+#define SEEN_ONCE 1u
+#define SEEN_OCCUPIED 2u
+#define SEEN_FREE 3u
+#define STEP_SIDE 10u
+#define STEP_DIAG 14u
+
+size_t qnav_cmap_bytes(uint32_t nx, uint32_t ny)
+{
+    return (size_t)((uint32_t)PLANES * ny * ((nx + 7u) / 8u));
+}
+
+static uint8_t *plane(const qnav_map_t *m, unsigned k, int32_t j)
+{
+    return m->planes + ((size_t)k * m->ny + (size_t)j) * m->row_bytes;
+}
+
+/* Bit i % 8 of a byte (an AVR shifts one place a cycle: a table is quicker). */
+static const uint8_t bit_of[8] = {1u, 2u, 4u, 8u, 16u, 32u, 64u, 128u};
+
+static unsigned bit2(const qnav_map_t *m, unsigned lo, int32_t i, int32_t j)
+{
+    const uint8_t *p = plane(m, lo, j) + ((unsigned)i >> 3);
+    const uint8_t bit = bit_of[(unsigned)i & 7u];
+    const size_t stride = (size_t)m->ny * m->row_bytes; /* plane lo + 1 */
+    return ((p[0] & bit) != 0u ? 1u : 0u) | ((p[stride] & bit) != 0u ? 2u : 0u);
+}
+
+static void set2(const qnav_map_t *m, unsigned lo, int32_t i, int32_t j, unsigned v)
+{
+    const unsigned b = (unsigned)i >> 3;
+    const uint8_t bit = bit_of[(unsigned)i & 7u];
+    uint8_t *p0 = &plane(m, lo, j)[b], *p1 = &plane(m, lo + 1u, j)[b];
+    *p0 = (uint8_t)((v & 1u) ? (*p0 | bit) : (*p0 & (uint8_t)~bit));
+    *p1 = (uint8_t)((v & 2u) ? (*p1 | bit) : (*p1 & (uint8_t)~bit));
+}
+
+void qnav_cmap_attach(qnav_map_t *m, void *buf)
+{
+    m->planes = (uint8_t *)buf;
+    m->row_bytes = (uint16_t)((m->nx + 7u) / 8u);
+}
+
+void qnav_cmap_reset(qnav_map_t *m)
+{
+    memset(m->planes, 0, qnav_cmap_bytes(m->nx, m->ny));
+}
+
+int8_t qnav_cmap_evidence(const qnav_map_t *m, int32_t i, int32_t j)
+{
+    const unsigned v = bit2(m, SEEN_LO, i, j);
+    return v == SEEN_FREE ? (int8_t)QNAV_MAP_FREE_FLOOR : (int8_t)v;
+}
+
+void qnav_cmap_clear(qnav_map_t *m, int32_t i, int32_t j)
+{
+    if (bit2(m, SEEN_LO, i, j) == SEEN_OCCUPIED) {
+        m->dirty = 1u;
+    }
+    set2(m, SEEN_LO, i, j, SEEN_FREE);
+}
+
+void qnav_cmap_arc(qnav_map_t *m, int32_t i, int32_t j)
+{
+    const unsigned v = bit2(m, SEEN_LO, i, j);
+    if (v == SEEN_UNKNOWN || v == SEEN_ONCE) {
+        set2(m, SEEN_LO, i, j, v + 1u);
+        m->dirty = (uint8_t)(m->dirty | (v == SEEN_ONCE));
+    }
+}
+
+int qnav_cmap_blocked(const qnav_map_t *m, int32_t i, int32_t j)
+{
+    return bit2(m, SEEN_LO, i, j) == SEEN_OCCUPIED;
+}
+
+/* The plan's label of step count d: d modulo 3, plus 1. */
+static unsigned label_of(uint32_t d)
+{
+    return (unsigned)(d % 3u) + 1u;
+}
+
+void qnav_cmap_plan_start(qnav_map_t *m, uint32_t c)
+{
+    memset(plane(m, PLAN_LO, 0), 0, (size_t)2u * m->ny * m->row_bytes);
+    set2(m, PLAN_LO, (int32_t)(c % m->nx), (int32_t)(c / m->nx), label_of(0u));
+    m->goal_cell = (uint16_t)c;
+    m->layer = 0u;
+    m->q_queued = 1u; /* the last step count reached a cell: the plan may grow */
+}
+
+/* One row's cells as the growth reads them, a byte of 8 cells each, with an empty byte at
+ * both ends: the cells labelled with the last step count, and the passable ones (not
+ * occupied, and on the map). */
+typedef struct {
+    uint8_t last[QNAV_CMAP_ROW_BYTES_MAX + 2u];
+    uint8_t pass[QNAV_CMAP_ROW_BYTES_MAX + 2u];
+} row_t;
+
+static void load_row(const qnav_map_t *m, int32_t j, unsigned t, row_t *r)
+{
+    const uint16_t n = m->row_bytes;
+    uint16_t b;
+    r->last[0] = r->pass[0] = r->last[n + 1u] = r->pass[n + 1u] = 0u;
+    if (j < 0 || j >= (int32_t)m->ny) {
+        memset(r, 0, sizeof *r);
+        return;
+    }
+    {
+        const uint8_t *lo = plane(m, PLAN_LO, j), *hi = plane(m, PLAN_HI, j);
+        const uint8_t *sl = plane(m, SEEN_LO, j), *sh = plane(m, SEEN_HI, j);
+        const uint8_t flip_lo = (t & 1u) ? 0u : 0xFFu, flip_hi = (t & 2u) ? 0u : 0xFFu;
+        for (b = 0; b < n; ++b) {
+            r->last[b + 1u] = (uint8_t)((lo[b] ^ flip_lo) & (hi[b] ^ flip_hi));
+            r->pass[b + 1u] = (uint8_t)(sl[b] | (uint8_t)~sh[b]);
+        }
+    }
+    if ((m->nx & 7u) != 0u) {
+        r->pass[n] &= (uint8_t)((1u << (m->nx & 7u)) - 1u); /* no cell beyond the row */
+    }
+}
+
+/* Byte b of a row_t array seen one cell over: cell i takes cell i - 1's bit (WEST) or
+ * i + 1's (EAST). */
+#define WEST(v, b) ((uint8_t)((uint8_t)((v)[b] << 1) | ((v)[(b) - 1u] >> 7)))
+#define EAST(v, b) ((uint8_t)(((v)[b] >> 1) | (uint8_t)((v)[(b) + 1u] << 7)))
+
+/* One more step count: every passable cell not yet reached a step from the last count's
+ * cells takes the next count (8 neighbours; a diagonal only past the two cells beside it,
+ * both passable). 0 when none did (the plan is whole). Rows are read a row ahead, so a
+ * row's new cells (label next, not t) do not change what the rows after it see. */
+static int grow(qnav_map_t *m)
+{
+    row_t rows[3];
+    row_t *up = &rows[0], *here = &rows[1], *down = &rows[2];
+    const unsigned t = label_of(m->layer), next = label_of(m->layer + 1u);
+    const uint16_t n = m->row_bytes;
+    uint8_t any = 0u;
+    int32_t j;
+    uint16_t b;
+    if (!m->q_queued) {
+        return 0;
+    }
+    load_row(m, -1, t, up);
+    load_row(m, 0, t, here);
+    for (j = 0; j < (int32_t)m->ny; ++j) {
+        uint8_t *lo = plane(m, PLAN_LO, j), *hi = plane(m, PLAN_HI, j);
+        const uint8_t *ul = up->last, *up_ = up->pass, *hl = here->last, *hp = here->pass;
+        const uint8_t *dl = down->last, *dp = down->pass;
+        row_t *spare = up;
+        load_row(m, j + 1, t, down);
+        for (b = 1; b <= n; ++b) {
+            const uint8_t pw = WEST(hp, b), pe = EAST(hp, b);
+            uint8_t r = (uint8_t)(WEST(hl, b) | EAST(hl, b) | ul[b] | dl[b]);
+            uint8_t add;
+            r |= (uint8_t)((WEST(ul, b) & pw) | (EAST(ul, b) & pe)) & up_[b];
+            r |= (uint8_t)((WEST(dl, b) & pw) | (EAST(dl, b) & pe)) & dp[b];
+            add = (uint8_t)(r & hp[b] & (uint8_t)~(lo[b - 1u] | hi[b - 1u]));
+            if (add != 0u) {
+                if (next & 1u) {
+                    lo[b - 1u] |= add;
+                }
+                if (next & 2u) {
+                    hi[b - 1u] |= add;
+                }
+                any = 1u;
+            }
+        }
+        up = here;
+        here = down;
+        down = spare;
+    }
+    m->layer++;
+    m->q_queued = any;
+    return any;
+}
+
+static unsigned plan_label(const qnav_map_t *m, int32_t i, int32_t j)
+{
+    return bit2(m, PLAN_LO, i, j);
+}
+
+/* A cell of the 5 x 5 about (ri, rj) is settled. */
+static int window_settled(const qnav_map_t *m, int32_t ri, int32_t rj)
+{
+    int32_t a, b;
+    for (b = -2; b <= 2; ++b) {
+        for (a = -2; a <= 2; ++a) {
+            if (qnav_map_in(m, ri + a, rj + b) && plan_label(m, ri + a, rj + b) != 0u) {
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
+int qnav_cmap_needs_growth(const qnav_map_t *m, int32_t ri, int32_t rj)
+{
+    return m->q_queued && (ri < 0 || plan_label(m, ri, rj) == 0u);
+}
+
+/* grow(), while *budget lasts (0: none left; a budget of 0 from the start: no bound). */
+static int grow_within(qnav_map_t *m, uint16_t *budget, int bounded)
+{
+    if (bounded) {
+        if (*budget == 0u) {
+            return 0;
+        }
+        --*budget;
+    }
+    return grow(m);
+}
+
+void qnav_cmap_settle(qnav_map_t *m, int32_t ri, int32_t rj)
+{
+    uint16_t budget = m->cfg.grow_steps;
+    const int bounded = ri >= 0 && budget != 0u;
+    int k;
+    if (ri < 0) {
+        while (grow(m)) {
+        }
+        return;
+    }
+    if (plan_label(m, ri, rj) != 0u) {
+        return;
+    }
+    if (!qnav_cmap_blocked(m, ri, rj)) {
+        while (plan_label(m, ri, rj) == 0u && grow_within(m, &budget, bounded)) {
+        }
+        return;
+    }
+    /* the robot stands on a blocked cell: settle the window's nearest cells, and two
+     * step counts more (a cell two further is never chosen: qnav_cmap_cost_near) in the
+     * tick that reaches the window */
+    if (window_settled(m, ri, rj)) {
+        return;
+    }
+    while (!window_settled(m, ri, rj) && grow_within(m, &budget, bounded)) {
+    }
+    for (k = 0; k < 2 && grow_within(m, &budget, bounded); ++k) {
+    }
+}
+
+int qnav_cmap_descend(const qnav_map_t *m, int32_t *i, int32_t *j)
+{
+    const int32_t gi = (int32_t)(m->goal_cell % m->nx), gj = (int32_t)(m->goal_cell / m->nx);
+    const unsigned here = plan_label(m, *i, *j);
+    const unsigned want = here == 1u ? 3u : here - 1u;
+    int32_t best = INT32_MAX; /* squared cells: at most 2 x 192^2 */
+    int32_t a, b, ni = *i, nj = *j;
+    if (here == 0u || qnav_map_at(m, *i, *j) == m->goal_cell) {
+        return 0;
+    }
+    for (b = -1; b <= 1; ++b) {
+        for (a = -1; a <= 1; ++a) {
+            const int32_t ti = *i + a, tj = *j + b;
+            int32_t d2;
+            if ((a == 0 && b == 0) || !qnav_map_in(m, ti, tj) || plan_label(m, ti, tj) != want) {
+                continue;
+            }
+            if (a != 0 && b != 0 && (qnav_cmap_blocked(m, ti, *j) || qnav_cmap_blocked(m, *i, tj))) {
+                continue; /* no corner cutting, as the plan grew */
+            }
+            /* of the cells a step nearer, the one nearest the destination: a straight way */
+            d2 = (gi - ti) * (gi - ti) + (gj - tj) * (gj - tj);
+            if (d2 < best) {
+                best = d2;
+                ni = ti;
+                nj = tj;
+            }
+        }
+    }
+    if (best == INT32_MAX) {
+        return 0;
+    }
+    *i = ni;
+    *j = nj;
+    return 1;
+}
+
+/* The plan's cost from settled cell (i, j): its way to the destination, 10 a side and 14 a
+ * diagonal. A way cut by a cell that became occupied since the plan (the next plan mends
+ * it) counts the rest as the straight octile distance. */
+static uint32_t way_cost(const qnav_map_t *m, int32_t i, int32_t j)
+{
+    const int32_t gi = (int32_t)(m->goal_cell % m->nx), gj = (int32_t)(m->goal_cell / m->nx);
+    uint32_t cost = 0u, di, dj, steps;
+    /* a way is at most the plan's step count long; a corner that opened since the plan
+     * can show a cell two steps further as one nearer, so the walk is bounded */
+    for (steps = 0u; steps <= m->layer; ++steps) {
+        const int32_t pi = i, pj = j;
+        if (!qnav_cmap_descend(m, &i, &j)) {
+            break;
+        }
+        cost += (pi != i && pj != j) ? STEP_DIAG : STEP_SIDE;
+    }
+    di = (uint32_t)(gi > i ? gi - i : i - gi);
+    dj = (uint32_t)(gj > j ? gj - j : j - gj);
+    cost += di > dj ? STEP_DIAG * dj + STEP_SIDE * (di - dj) : STEP_DIAG * di + STEP_SIDE * (dj - di);
+    return cost >= QNAV_MAP_UNREACHED ? QNAV_MAP_UNREACHED - 1u : cost;
+}
+
+uint32_t qnav_cmap_cost(const qnav_map_t *m, int32_t i, int32_t j)
+{
+    return plan_label(m, i, j) != 0u ? way_cost(m, i, j) : QNAV_MAP_UNREACHED;
+}
+
+/* Steps from cell (i, j) to the destination's on an empty map (8 neighbours). */
+static uint32_t chebyshev(const qnav_map_t *m, int32_t i, int32_t j)
+{
+    const int32_t di = (int32_t)(m->goal_cell % m->nx) - i, dj = (int32_t)(m->goal_cell / m->nx) - j;
+    const uint32_t ai = (uint32_t)(di < 0 ? -di : di), aj = (uint32_t)(dj < 0 ? -dj : dj);
+    return ai > aj ? ai : aj;
+}
+
+uint32_t qnav_cmap_cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi, int32_t *bj)
+{
+    uint32_t best = QNAV_MAP_UNREACHED, visited = 0u;
+    int32_t a, b;
+    *bi = i;
+    *bj = j;
+    if (plan_label(m, i, j) != 0u) {
+        return way_cost(m, i, j);
+    }
+    if (m->q_queued && !qnav_cmap_blocked(m, i, j)) {
+        return QNAV_MAP_UNREACHED; /* the plan has not grown as far as the cell yet */
+    }
+    /* to a cell: 10 a side, as the full layout; its way from there is at least 10 a step
+     * of its Chebyshev distance to the destination, so a cell whose bound is no better
+     * than the best found is not walked (each walk is up to the plan's length) */
+    for (;;) {
+        uint32_t lower = QNAV_MAP_UNREACHED, c;
+        int32_t ni = 0, nj = 0;
+        for (b = -2; b <= 2; ++b) {
+            for (a = -2; a <= 2; ++a) {
+                if (!qnav_map_in(m, i + a, j + b) || plan_label(m, i + a, j + b) == 0u ||
+                    (visited & ((uint32_t)1u << (unsigned)((b + 2) * 5 + a + 2))) != 0u) {
+                    continue;
+                }
+                c = ((uint32_t)((a < 0 ? -a : a) + (b < 0 ? -b : b)) + chebyshev(m, i + a, j + b)) *
+                    STEP_SIDE;
+                if (c < lower) {
+                    lower = c;
+                    ni = a;
+                    nj = b;
+                }
+            }
+        }
+        if (lower >= best) {
+            return best;
+        }
+        visited |= (uint32_t)1u << (unsigned)((nj + 2) * 5 + ni + 2);
+        c = way_cost(m, i + ni, j + nj) +
+            (uint32_t)((ni < 0 ? -ni : ni) + (nj < 0 ? -nj : nj)) * STEP_SIDE;
+        if (c < best) {
+            best = c;
+            *bi = i + ni;
+            *bj = j + nj;
+        }
+    }
+}
