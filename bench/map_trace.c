@@ -52,6 +52,44 @@ static uint32_t mm(double m)
     return (uint32_t)ceil(m * 1000.0);
 }
 
+/* World k's ticks: each pose's scan (the robot placed there again) and what the map made
+ * of it, as the header's array map_ticks_k. */
+static void write_ticks(FILE *f, unsigned k, qnav_sim_t *sim, qnav_map_t *map,
+                        const qnav_sim_env_info_t *ei, const poses_t *poses)
+{
+    uint32_t t;
+    fprintf(f, "static const qnav_bench_map_tick_t map_ticks_%u[%u] QNAV_FLASH = {\n", k,
+            (unsigned)poses->n);
+    for (t = 0; t < poses->n; ++t) {
+        const qnav_map_pose_t p = {poses->pose[t].x_mm, poses->pose[t].y_mm,
+                                   poses->pose[t].heading_cdeg};
+        qnav_sim_scan_t sc;
+        qnav_ctrl_input_t in;
+        int got;
+        uint16_t i;
+        if (qnav_sim_place(sim, poses->pose[t].x_mm / 1000.0, poses->pose[t].y_mm / 1000.0,
+                           poses->pose[t].heading_cdeg * PI / 18000.0) != QNAV_SIM_OK ||
+            qnav_sim_scan(sim, &sc) != QNAV_SIM_OK) {
+            qnav_fx_fail(2, "%s tick %u: %s", worlds[k], (unsigned)t, qnav_sim_last_error(sim));
+        }
+        if (sc.n_sectors != QNAV_BENCH_MAP_MAX_SECTORS) {
+            qnav_fx_fail(2, "%s: %u sectors (the trace holds %u)", worlds[k], (unsigned)sc.n_sectors,
+                         (unsigned)QNAV_BENCH_MAP_MAX_SECTORS);
+        }
+        memset(&in, 0, sizeof in);
+        in.ranges_mm = sc.ranges_mm;
+        qnav_map_observe(map, sc.ranges_mm, &p);
+        got = qnav_map_guide(map, &p, (int32_t)lround(ei->dest_x_m * 1000.0),
+                             (int32_t)lround(ei->dest_y_m * 1000.0), &in);
+        fprintf(f, "    {%ld, %ld, %ld, {", (long)p.x_mm, (long)p.y_mm,
+                (long)qnav_wrap_cdeg(p.heading_cdeg));
+        for (i = 0; i < sc.n_sectors; ++i) {
+            fprintf(f, "%s%u", i ? ", " : "", (unsigned)sc.ranges_mm[i]);
+        }
+        fprintf(f, "}, %d, %u, %d},\n", (int)in.goal_bearing_cdeg, (unsigned)in.goal_range_mm, got);
+    }
+}
+
 /* One world's episode, replayed through a fresh map, written as world k of the header. */
 static size_t one_world(FILE *f, const char *root, unsigned k, qnav_map_config_t *mc,
                         qnav_ctrl_config_t *cc)
@@ -69,14 +107,13 @@ static size_t one_world(FILE *f, const char *root, unsigned k, qnav_map_config_t
     qnav_policy_t pol;
     qnav_map_t map;
     size_t bytes;
-    uint32_t t;
     snprintf(spec, sizeof spec, "%s/data/robots/tekbot.toml+map", root);
     if (qnav_sim_robot_load(spec, &robot, err, sizeof err) != QNAV_SIM_OK ||
         qnav_sim_env_load(worlds[k], &env, err, sizeof err) != QNAV_SIM_OK) {
         qnav_fx_fail(2, "%s", err);
     }
-    if (!qnav_sim_robot_map_config(robot, mc)) {
-        qnav_fx_fail(2, "%s: no [map]", spec);
+    if (!qnav_sim_robot_map_config(robot, mc) || mc->compact != 1u) {
+        qnav_fx_fail(2, "%s: the benchmark is of a compact [map]", spec);
     }
     qnav_sim_config_default(&cfg);
     if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK) {
@@ -100,42 +137,10 @@ static size_t one_world(FILE *f, const char *root, unsigned k, qnav_map_config_t
     }
     fprintf(f, "/* %s: %u ticks of episode 1 (%s in the simulator) */\n", worlds[k],
             (unsigned)poses.n, res.reached ? "reached" : "not reached");
-    if (qnav_sim_robot_map_config(robot, mc) && mc->compact != 1u) {
-        qnav_fx_fail(2, "%s: the benchmark is of the compact map", spec);
-    }
     if (mm(ei.width_m) > 32767u || mm(ei.height_m) > 32767u) {
         qnav_fx_fail(2, "%s: larger than 32.7 m (the trace keeps poses in 16 bits)", worlds[k]);
     }
-    fprintf(f, "static const qnav_bench_map_tick_t map_ticks_%u[%u] QNAV_FLASH = {\n", k,
-            (unsigned)poses.n);
-    for (t = 0; t < poses.n; ++t) {
-        const qnav_map_pose_t p = {poses.pose[t].x_mm, poses.pose[t].y_mm,
-                                   poses.pose[t].heading_cdeg};
-        qnav_sim_scan_t sc;
-        qnav_ctrl_input_t in;
-        int got;
-        uint16_t i;
-        if (qnav_sim_place(sim, poses.pose[t].x_mm / 1000.0, poses.pose[t].y_mm / 1000.0,
-                           poses.pose[t].heading_cdeg * PI / 18000.0) != QNAV_SIM_OK ||
-            qnav_sim_scan(sim, &sc) != QNAV_SIM_OK) {
-            qnav_fx_fail(2, "%s tick %u: %s", worlds[k], (unsigned)t, qnav_sim_last_error(sim));
-        }
-        if (sc.n_sectors != QNAV_BENCH_MAP_MAX_SECTORS) {
-            qnav_fx_fail(2, "%s: %u sectors (the trace holds %u)", spec, (unsigned)sc.n_sectors,
-                         (unsigned)QNAV_BENCH_MAP_MAX_SECTORS);
-        }
-        memset(&in, 0, sizeof in);
-        in.ranges_mm = sc.ranges_mm;
-        qnav_map_observe(&map, sc.ranges_mm, &p);
-        got = qnav_map_guide(&map, &p, (int32_t)lround(ei.dest_x_m * 1000.0),
-                             (int32_t)lround(ei.dest_y_m * 1000.0), &in);
-        fprintf(f, "    {%ld, %ld, %ld, {", (long)p.x_mm, (long)p.y_mm,
-                (long)qnav_wrap_cdeg(p.heading_cdeg));
-        for (i = 0; i < sc.n_sectors; ++i) {
-            fprintf(f, "%s%u", i ? ", " : "", (unsigned)sc.ranges_mm[i]);
-        }
-        fprintf(f, "}, %d, %u, %d},\n", (int)in.goal_bearing_cdeg, (unsigned)in.goal_range_mm, got);
-    }
+    write_ticks(f, k, sim, &map, &ei, &poses);
     fprintf(f, "};\n\n");
     fprintf(f, "#define QNAV_BENCH_MAP_WORLD_%u {\"%s\", %lu, %lu, %ld, %ld, map_ticks_%u, %u}\n\n", k,
             worlds[k], (unsigned long)mm(ei.width_m), (unsigned long)mm(ei.height_m),
