@@ -648,6 +648,65 @@ static void test_a_board_with_a_map_steers_round_what_it_has_seen(void **state)
     assert_int_equal(g.pose_clears + g.pose_grown_mm, 0);
 }
 
+/* A board that places its own maps (qnav_board_place_maps, the compact map a TekBot
+ * holds): at each new position goal a map afresh over the square midway to it, steering
+ * round the wall as a map the caller gives does; a goal too far for the memory gets none.
+ * The scripted robot stands at the origin facing +x, a wall 1 m ahead. */
+static void test_a_board_places_a_map_for_each_goal(void **state)
+{
+    static uint8_t mem[512];
+    static qnav_map_t map;
+    qnav_map_config_t mc;
+    qnav_link_goal_t gl = {9, 0, 0, QNAV_LINK_GOAL_POSITION, 3000, 0};
+    uint8_t p[QNAV_LINK_GOAL_BYTES];
+    uint16_t k;
+    (void)state;
+    bench_start(16);
+    for (k = 0; k < 16; ++k) {
+        g.sim.ranges_mm[k] = g.bot.cfg.ctrl.max_range_mm;
+    }
+    g.sim.ranges_mm[15] = g.sim.ranges_mm[0] = g.sim.ranges_mm[1] =
+        (qnav_mm_t)(1000 - g.bot.cfg.ctrl.sensor_offset_mm);
+    qnav_map_config_default(&mc);
+    mc.compact = 1;
+    mc.cell_mm = 400;
+    mc.near_cost = 0;
+    mc.refuse_ticks = 0;
+    mc.plan_ticks = 1;
+    assert_int_equal(qnav_board_place_maps(&g.bot, &map, &mc, mem, sizeof mem), 1);
+    to_board(QNAV_LINK_MSG_GOAL, p, qnav_link_goal_pack(&gl, p, sizeof p));
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 500);
+    /* 512 bytes: 32 x 32 cells of 400 mm, 12.8 m square about (1500, 0) */
+    assert_int_equal(map.nx, 32);
+    assert_int_equal(map.ny, 32);
+    assert_int_equal(map.x0_mm, 1500 - 6400);
+    assert_int_equal(map.y0_mm, -6400);
+    assert_true(qnav_map_evidence(&map, 1000, 50) >= QNAV_MAP_OCCUPIED);
+    assert_true(g.last_scan.goal_bearing_cdeg > 2000 || g.last_scan.goal_bearing_cdeg < -2000);
+    /* 20 m away: no square of those cells holds both; straight at it */
+    gl.goal_id = 10;
+    gl.x_mm = 20000;
+    to_board(QNAV_LINK_MSG_GOAL, p, qnav_link_goal_pack(&gl, p, sizeof p));
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 300);
+    assert_int_equal(g.last_scan.goal_bearing_cdeg, 0);
+    /* a new goal near again: a map afresh about the new midpoint */
+    gl.goal_id = 11;
+    gl.x_mm = 2000;
+    gl.y_mm = 1000;
+    to_board(QNAV_LINK_MSG_GOAL, p, qnav_link_goal_pack(&gl, p, sizeof p));
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 300);
+    assert_int_equal(map.x0_mm, 1000 - 6400);
+    assert_int_equal(map.y0_mm, 500 - 6400);
+    assert_true(qnav_map_evidence(&map, 1000, 50) >= QNAV_MAP_OCCUPIED);
+    /* off: straight at the goal again */
+    assert_int_equal(qnav_board_place_maps(&g.bot, NULL, NULL, NULL, 0), 1);
+    run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 200);
+    /* atan2(1000, 2000) = 26.57 deg, the CORDIC's within 1 cdeg */
+    assert_true(g.last_scan.goal_bearing_cdeg >= 2656 && g.last_scan.goal_bearing_cdeg <= 2658);
+    assert_int_equal(qnav_board_place_maps(NULL, &map, &mc, mem, sizeof mem), 0);
+    assert_int_equal(qnav_board_place_maps(&g.bot, &map, NULL, mem, sizeof mem), 0);
+}
+
 /* ---- the board against navbridge's core, in one process ---- */
 
 static int bridge_write(void *user, const uint8_t *bytes, size_t n)
@@ -929,6 +988,7 @@ int main(void)
         cmocka_unit_test(test_pose_integrates_wheel_travel_along_the_heading),
         cmocka_unit_test(test_position_goal_bearing_comes_from_the_pose),
         cmocka_unit_test(test_a_board_with_a_map_steers_round_what_it_has_seen),
+        cmocka_unit_test(test_a_board_places_a_map_for_each_goal),
         cmocka_unit_test(test_board_and_bridge_drive_together_in_both_modes),
         cmocka_unit_test(test_route_from_lcm_advances_within_the_radius_and_stops_at_its_end),
         cmocka_unit_test(test_bridge_takes_lcm_goals_only_on_a_token_of_letters_and_digits),

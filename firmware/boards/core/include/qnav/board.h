@@ -181,7 +181,13 @@ typedef struct {
     qnav_ctrl_carry_t carry;     /* the escape memory (cleared with every new goal) and the
                                     last decision, carried from tick to tick as navbridge
                                     and its replay carry them (qnav_ctrl_carry_input) */
-    qnav_map_t *map;             /* the caller's map (qnav_board_set_map), or NULL */
+    qnav_map_t *map;             /* the map in use (qnav_board_set_map, or placed), or NULL */
+    qnav_map_t *place_map;       /* placed afresh for each position goal
+                                    (qnav_board_place_maps), or NULL */
+    const qnav_map_config_t *place_cfg;
+    void *place_buf;
+    size_t place_len;
+    uint16_t placed_goal;        /* the goal id the map was placed for (0: none yet) */
     uint16_t policy_crc;
     uint8_t policy_source;       /* qnav_board_policy_source_t */
     uint8_t store_slot;          /* slot the running stored policy is in (0/1), 0xFF none */
@@ -249,6 +255,19 @@ QNAV_CHECK_RESULT qnav_board_status_t qnav_board_init(qnav_board_t *bot, const q
  * in a build without QNAV_BOARD_WITH_MAP.
  */
 int qnav_board_set_map(qnav_board_t *bot, qnav_map_t *map);
+
+/*
+ * A map the core places itself, for a board that knows neither its room nor its goals
+ * beforehand: at each new position goal it starts map afresh (qnav_map_init with cfg, in
+ * the len bytes at buf, all the caller's and kept by it) over the largest square of cfg's
+ * cells those bytes hold, centred midway between the robot and the goal. A goal too far
+ * for that square (the robot or the goal within a cell of its edge) is steered to without
+ * a map. 512 bytes hold 32 x 32 compact cells: 12.8 m at 0.4 m. map NULL turns it off;
+ * qnav_board_set_map() and this replace each other. Returns 1, or 0 (and places nothing)
+ * in a build without QNAV_BOARD_WITH_MAP or with a NULL argument besides map.
+ */
+int qnav_board_place_maps(qnav_board_t *bot, qnav_map_t *map, const qnav_map_config_t *cfg,
+                          void *buf, size_t len);
 
 /* Drain the UART (qnav_board_receive), run a control tick when tick_ms has passed, and
  * do one piece of a table build when it fits before the next tick. */
