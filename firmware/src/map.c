@@ -254,10 +254,10 @@ static uint16_t sector_of(const qnav_map_t *m, int32_t a_cdeg)
     return (uint16_t)(k == m->n_sectors ? 0u : k);
 }
 
-/* How far robot-frame direction a (0.01 deg) lies from sector k's centre, 0.01 deg. */
-static int32_t off_centre(const qnav_map_t *m, int32_t a_cdeg, uint16_t k)
+/* How far robot-frame direction a (0.01 deg) lies from a sector's centre, 0.01 deg. */
+static int32_t off_centre(int32_t a_cdeg, int32_t centre_cdeg)
 {
-    int32_t d = (a_cdeg - (int32_t)((uint32_t)k * 36000u / m->n_sectors)) % INT32_C(36000);
+    int32_t d = a_cdeg - centre_cdeg; /* both in [0, 36000) */
     if (d < -INT32_C(18000)) {
         d += INT32_C(36000);
     } else if (d >= INT32_C(18000)) {
@@ -317,9 +317,17 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
 {
     int32_t i0, i1, j0, j1, i, j, reach, three_quarters, heading, arc_half, band_pct;
     uint32_t reach2;
+    /* the last sector's reading and what follows from it: cells in a row often share a
+     * sector, and each costs divisions (an AVR's are hundreds of cycles) */
+    struct {
+        uint16_t k;
+        int32_t rc, lo, band, centre;
+    } last;
     if (!ready(m) || ranges_mm == NULL || pose == NULL) {
         return;
     }
+    last.k = UINT16_MAX;
+    last.rc = last.lo = last.band = last.centre = 0;
     reach = (int32_t)m->cfg.reach_mm;
     three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
     reach2 = (uint32_t)reach * (uint32_t)reach;
@@ -355,22 +363,30 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
             rel = direction_cdeg(dx, dy) - heading;
             rel += rel < 0 ? INT32_C(36000) : (rel >= INT32_C(36000) ? -INT32_C(36000) : 0);
             k = sector_of(m, rel);
-            rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
             if (ranges_mm[k] >= m->max_range_mm) {
                 /* nothing in the wedge: free out to the reach */
                 mark_clear(m, i, j);
                 continue;
             }
-            tol = three_quarters + rc * (int32_t)m->cfg.noise_pct / 100; /* not carved free */
-            band = rc - three_quarters - rc * band_pct / 100;                /* occupied from */
-            lo = rc - tol;
+            if (k != last.k) {
+                last.k = k;
+                last.rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
+                /* not carved free within tol of the reading, occupied from band */
+                tol = three_quarters + last.rc * (int32_t)m->cfg.noise_pct / 100;
+                last.band = last.rc - three_quarters - last.rc * band_pct / 100;
+                last.lo = last.rc - tol;
+                last.centre = (int32_t)((uint32_t)k * 36000u / m->n_sectors);
+            }
+            rc = last.rc;
+            lo = last.lo;
+            band = last.band;
             if (lo > 0 && (lo > reach || d2 < (uint32_t)lo * (uint32_t)lo)) {
                 mark_clear(m, i, j);
             } else if (c >= 0 && c < EVIDENCE_REFUSED &&
                        (rc + three_quarters > reach ||
                         d2 <= (uint32_t)(rc + three_quarters) * (uint32_t)(rc + three_quarters)) &&
                        (band <= 0 || (band <= reach && d2 >= (uint32_t)band * (uint32_t)band)) &&
-                       off_centre(m, rel, k) <= arc_half) {
+                       off_centre(rel, last.centre) <= arc_half) {
                 mark_arc(m, i, j);
             }
         }
