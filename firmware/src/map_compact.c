@@ -176,8 +176,8 @@ static int grow(qnav_map_t *m)
             const uint8_t pw = WEST(hp, b), pe = EAST(hp, b);
             uint8_t r = (uint8_t)(WEST(hl, b) | EAST(hl, b) | ul[b] | dl[b]);
             uint8_t add;
-            r |= (uint8_t)((WEST(ul, b) & pw) | (EAST(ul, b) & pe)) & up_[b];
-            r |= (uint8_t)((WEST(dl, b) & pw) | (EAST(dl, b) & pe)) & dp[b];
+            r |= (uint8_t)(((WEST(ul, b) & pw) | (EAST(ul, b) & pe)) & up_[b]);
+            r |= (uint8_t)(((WEST(dl, b) & pw) | (EAST(dl, b) & pe)) & dp[b]);
             add = (uint8_t)(r & hp[b] & (uint8_t)~(lo[b - 1u] | hi[b - 1u]));
             if (add != 0u) {
                 if (next & 1u) {
