@@ -41,6 +41,31 @@ long qnav_robot_board_udeg_per_count(const qnav_board_config_t *cfg)
     return lround((double)cfg->um_per_count / (1000.0 * cfg->track_mm) * (180.0 / 3.14159265358979323846) * 1e6);
 }
 
+/* With the profile's [map] on: the map the board places at each position goal, as a
+ * qnav_map_config_t initialiser (nothing when the map is off). */
+static void put_map(FILE *out, const qnav_sim_robot_t *robot, const char *up)
+{
+    qnav_map_config_t mc;
+    if (!qnav_sim_robot_map_config(robot, &mc)) {
+        return;
+    }
+    fprintf(out,
+            "/* The profile's [map], on: the map the board places at each position goal\n"
+            " * (qnav_board_place_maps), a qnav_map_config_t. */\n"
+            "#define QNAV_ROBOT_%s_MAP_CONFIG \\\n"
+            "    { \\\n"
+            "        .cell_mm = %u, .reach_mm = %u, .look_mm = %u, .jump_mm = %u, \\\n"
+            "        .plan_ticks = %u, .noise_pct = %u, .near_cost = %u, .near_mm = %u, \\\n"
+            "        .arc_cdeg = %u, .sight = %u, .escape_grow = %u, .refuse_ticks = %u, \\\n"
+            "        .refuse_life_ticks = %u, .compact = %u, .grow_steps = %u \\\n"
+            "    }\n\n",
+            up, (unsigned)mc.cell_mm, (unsigned)mc.reach_mm, (unsigned)mc.look_mm,
+            (unsigned)mc.jump_mm, (unsigned)mc.plan_ticks, (unsigned)mc.noise_pct,
+            (unsigned)mc.near_cost, (unsigned)mc.near_mm, (unsigned)mc.arc_cdeg,
+            (unsigned)mc.sight, (unsigned)mc.escape_grow, (unsigned)mc.refuse_ticks,
+            (unsigned)mc.refuse_life_ticks, (unsigned)mc.compact, (unsigned)mc.grow_steps);
+}
+
 int qnav_robot_board_header(const qnav_sim_robot_t *robot, FILE *out)
 {
     qnav_board_config_t cfg;
@@ -82,9 +107,10 @@ int qnav_robot_board_header(const qnav_sim_robot_t *robot, FILE *out)
             "        .link_timeout_ms = %u, \\\n"
             "        .nvm_offset = %u, \\\n"
             "        .controller = \"%s\" \\\n"
-            "    }\n\n"
-            "#endif /* QNAV_ROBOT_%s_H */\n",
-            (unsigned)cfg.link_timeout_ms, (unsigned)cfg.nvm_offset, cfg.controller, up);
+            "    }\n\n",
+            (unsigned)cfg.link_timeout_ms, (unsigned)cfg.nvm_offset, cfg.controller);
+    put_map(out, robot, up);
+    fprintf(out, "#endif /* QNAV_ROBOT_%s_H */\n", up);
     return fflush(out) == 0 && !ferror(out) ? 0 : -1;
 }
 

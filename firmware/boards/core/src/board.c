@@ -435,11 +435,6 @@ static void decide(qnav_board_t *bot, uint32_t now, const qnav_ctrl_input_t *in,
     }
 }
 
-/* With a map and a position goal: mark this tick's readings, and steer to the plan's
- * sub-goal (in's goal bearing and range; *dist_mm the planned distance). The map clears or
- * grows in's escape memory when its plan jumps or grows; esc gets the same verdict for the
- * POSE, for an offboard controller whose memory the map cannot touch. */
-#if QNAV_BOARD_WITH_MAP
 /* Cells across the largest square map of cfg that len bytes hold (0: none). */
 static uint32_t square_cells(const qnav_map_config_t *cfg, size_t len)
 {
@@ -480,19 +475,23 @@ static void place_map(qnav_board_t *bot)
         bot->map = bot->place_map;
     }
 }
-#endif
 
-static void guide_by_map(qnav_board_t *bot, qnav_ctrl_input_t *in, uint32_t *dist_mm,
-                         qnav_link_pose_t *esc)
+/* With a map and a position goal: mark this tick's readings, and steer to the plan's
+ * sub-goal (in's goal bearing and range; *dist_mm the planned distance). The map clears or
+ * grows in's escape memory when its plan jumps or grows; esc gets the same verdict for the
+ * POSE, for an offboard controller whose memory the map cannot touch. Reached through
+ * bot->map_tick, which only qnav_board_set_map and qnav_board_place_maps set: a firmware
+ * that calls neither links no map code. */
+static void map_tick(void *board, qnav_ctrl_input_t *in, uint32_t *dist_mm, qnav_link_pose_t *esc)
 {
-#if QNAV_BOARD_WITH_MAP
+    qnav_board_t *bot = (qnav_board_t *)board;
     if (bot->place_map != NULL && bot->have_goal && bot->goal.kind == QNAV_LINK_GOAL_POSITION &&
         bot->goal.goal_id != bot->placed_goal) {
         place_map(bot);
     }
     if (bot->map != NULL && bot->have_goal && bot->goal.kind == QNAV_LINK_GOAL_POSITION) {
         const qnav_map_pose_t pose = {bot->pose.x_um / (int32_t)1000, bot->pose.y_um / (int32_t)1000,
-                                  bot->pose.heading_cdeg};
+                                      bot->pose.heading_cdeg};
         int got;
         qnav_map_observe(bot->map, bot->ranges, &pose);
         got = qnav_map_guide(bot->map, &pose, bot->goal.x_mm, bot->goal.y_mm, in);
@@ -502,12 +501,6 @@ static void guide_by_map(qnav_board_t *bot, qnav_ctrl_input_t *in, uint32_t *dis
         esc->escape_clear = (uint8_t)((got & QNAV_MAP_ESCAPE_CLEARED) != 0);
         esc->escape_grow_mm = (got & QNAV_MAP_ESCAPE_GROWN) != 0 ? qnav_map_grown_mm(bot->map) : 0u;
     }
-#else
-    (void)bot;
-    (void)in;
-    (void)dist_mm;
-    (void)esc;
-#endif
 }
 
 void qnav_board_tick(qnav_board_t *bot)
@@ -554,7 +547,9 @@ void qnav_board_tick(qnav_board_t *bot)
     /* the previous decision, seen from where the robot points now (3-input policies), the
      * distance to a position goal (0 for a bearing goal: no escape) and the memory */
     qnav_ctrl_carry_input(&bot->carry, bot->have_goal ? bot->goal.goal_id : 0u, dist_mm, &in);
-    guide_by_map(bot, &in, &dist_mm, &esc);
+    if (bot->map_tick != NULL) {
+        bot->map_tick(bot, &in, &dist_mm, &esc);
+    }
 
     decide(bot, now, &in, &out);
     qnav_ctrl_carry_output(&bot->carry, &in, &out);
@@ -590,18 +585,19 @@ void qnav_board_tick(qnav_board_t *bot)
 
 int qnav_board_set_map(qnav_board_t *bot, qnav_map_t *map)
 {
-    if (bot == NULL || !QNAV_BOARD_WITH_MAP) {
+    if (bot == NULL) {
         return 0;
     }
     bot->map = map;
     bot->place_map = NULL;
+    bot->map_tick = map != NULL ? map_tick : NULL;
     return 1;
 }
 
 int qnav_board_place_maps(qnav_board_t *bot, qnav_map_t *map, const qnav_map_config_t *cfg,
                           void *buf, size_t len)
 {
-    if (bot == NULL || !QNAV_BOARD_WITH_MAP || (map != NULL && (cfg == NULL || buf == NULL))) {
+    if (bot == NULL || (map != NULL && (cfg == NULL || buf == NULL))) {
         return 0;
     }
     bot->place_map = map;
@@ -610,6 +606,7 @@ int qnav_board_place_maps(qnav_board_t *bot, qnav_map_t *map, const qnav_map_con
     bot->place_len = len;
     bot->placed_goal = 0u;
     bot->map = NULL;
+    bot->map_tick = map != NULL ? map_tick : NULL;
     return 1;
 }
 

@@ -2,13 +2,25 @@
  * Firmware entry point of an ATmega128 board: hardware layer, board core, loop. The
  * robot's configuration is the one generated from its profile (qnav/robots.h: the TekBot
  * by default, -DQNAV_BOARD_ROBOT_PIONEER3DX for the Pioneer 3-DX). The board and its
- * controller live in one static (no heap).
+ * controller live in one static (no heap), and with the profile's map on, the map and its
+ * memory in two more.
  */
 #include "hal_avr.h"
 #include "qnav/board.h"
 #include "qnav/robots.h"
 
 static qnav_board_t g_bot;
+
+#ifdef QNAV_BOARD_ROBOT_MAP_CONFIG
+/* The profile's map, placed by the core at each position goal: 512 bytes hold 32 x 32
+ * compact cells, 12.8 m at 0.4 m (docs/hil.md). */
+#ifndef QNAV_BOARD_MAP_BYTES
+#define QNAV_BOARD_MAP_BYTES 512u
+#endif
+static qnav_map_t g_map;
+static uint8_t g_map_mem[QNAV_BOARD_MAP_BYTES];
+static const qnav_map_config_t g_map_cfg = QNAV_BOARD_ROBOT_MAP_CONFIG;
+#endif
 
 int main(void)
 {
@@ -23,6 +35,9 @@ int main(void)
         for (;;) {
         }
     }
+#ifdef QNAV_BOARD_ROBOT_MAP_CONFIG
+    (void)qnav_board_place_maps(&g_bot, &g_map, &g_map_cfg, g_map_mem, sizeof g_map_mem);
+#endif
     /* QNAV_BOARD_E_CTRL: no controller (a stored policy it refuses), but the link runs:
      * the heartbeat's state lacks QNAV_LINK_STATE_POLICY, the drive stays at 0, and an
      * upload installs a policy */

@@ -188,6 +188,9 @@ typedef struct {
     void *place_buf;
     size_t place_len;
     uint16_t placed_goal;        /* the goal id the map was placed for (0: none yet) */
+    /* a tick's map work, set by qnav_board_set_map / qnav_board_place_maps (NULL: none),
+     * so that a firmware calling neither links no map code */
+    void (*map_tick)(void *bot, qnav_ctrl_input_t *in, uint32_t *dist_mm, qnav_link_pose_t *esc);
     uint16_t policy_crc;
     uint8_t policy_source;       /* qnav_board_policy_source_t */
     uint8_t store_slot;          /* slot the running stored policy is in (0/1), 0xFF none */
@@ -232,16 +235,6 @@ void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t
 QNAV_CHECK_RESULT qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t *cfg,
                                     const qnav_board_hal_t *hal);
 
-/* Whether the board core can use a map: not on an AVR yet (the compact layout, half a byte a
- * cell, fits an ATmega128, but its firmware does not place one: docs/performance.md, "The
- * compact map on the ATmega128"); -DQNAV_BOARD_WITH_MAP=0/1 decides. */
-#ifndef QNAV_BOARD_WITH_MAP
-#ifdef __AVR__
-#define QNAV_BOARD_WITH_MAP 0
-#else
-#define QNAV_BOARD_WITH_MAP 1
-#endif
-#endif
 
 /*
  * Reach position goals through a map of what the sonar has seen (qnav/map.h;
@@ -251,8 +244,8 @@ QNAV_CHECK_RESULT qnav_board_status_t qnav_board_init(qnav_board_t *bot, const q
  * odometry frame the robot may reach, in memory it keeps (qnav_map_size(): 8 bytes a
  * cell, more than an ATmega128 has for any useful area, or half a byte in the compact
  * layout), and resets it for a new world.
- * NULL turns it off. Bearing goals are never planned. Returns 1, or 0 (and keeps no map)
- * in a build without QNAV_BOARD_WITH_MAP.
+ * NULL turns it off. Bearing goals are never planned. Returns 1 (0 for a NULL bot). A
+ * firmware that calls neither this nor qnav_board_place_maps links no map code.
  */
 int qnav_board_set_map(qnav_board_t *bot, qnav_map_t *map);
 
@@ -264,7 +257,7 @@ int qnav_board_set_map(qnav_board_t *bot, qnav_map_t *map);
  * for that square (the robot or the goal within a cell of its edge) is steered to without
  * a map. 512 bytes hold 32 x 32 compact cells: 12.8 m at 0.4 m. map NULL turns it off;
  * qnav_board_set_map() and this replace each other. Returns 1, or 0 (and places nothing)
- * in a build without QNAV_BOARD_WITH_MAP or with a NULL argument besides map.
+ * with a NULL argument besides map.
  */
 int qnav_board_place_maps(qnav_board_t *bot, qnav_map_t *map, const qnav_map_config_t *cfg,
                           void *buf, size_t len);
