@@ -663,6 +663,22 @@ static run_end_t run_board(const options_t *o, avr_t *avr, const elf_firmware_t 
     return end;
 }
 
+/* How deep the stack went: RAM above .data and .bss starts zero and the firmware never
+ * writes it but through the stack, so the lowest byte written there is the stack's deepest
+ * point (a zero pushed exactly there would read as untouched: an estimate within a few
+ * bytes). */
+static void put_stack_reach(const avr_t *avr, const elf_firmware_t *fw)
+{
+    const uint32_t start = 0x100u + fw->datasize + fw->bsssize; /* ATmega128 SRAM from 0x100 */
+    uint32_t a = start;
+    while (a <= avr->ramend && avr->data[a] == 0u) {
+        ++a;
+    }
+    printf("qnav-simavr-board: the stack reached %u bytes below the top of RAM; %u bytes above "
+           ".data and .bss were never written\n",
+           (unsigned)(avr->ramend + 1u - a), (unsigned)(a - start));
+}
+
 int main(int argc, char **argv)
 {
     static options_t o;
@@ -700,6 +716,7 @@ int main(int argc, char **argv)
            (double)avr->cycle / (double)fw.frequency,
            end.refused ? "refused" : end.state == cpu_Crashed ? "crashed"
                                    : (g_quit ? "signal" : "done"));
+    put_stack_reach(avr, &fw);
     fflush(stdout);
     if (o.eeprom_path != NULL && eeprom_save(avr, o.eeprom_path) != 0) {
         end.state = cpu_Crashed;
