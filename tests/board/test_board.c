@@ -604,6 +604,19 @@ static void test_position_goal_bearing_comes_from_the_pose(void **state)
     assert_int_equal(g.last_scan.goal_bearing_cdeg, -4500);
 }
 
+/* A 16-sector board whose sonar sees a wall 1 m ahead across the three sectors round
+ * straight ahead, and nothing else. */
+static void start_before_a_wall(void)
+{
+    uint16_t k;
+    bench_start(16);
+    for (k = 0; k < 16; ++k) {
+        g.sim.ranges_mm[k] = g.bot.cfg.ctrl.max_range_mm;
+    }
+    g.sim.ranges_mm[15] = g.sim.ranges_mm[0] = g.sim.ranges_mm[1] =
+        (qnav_mm_t)(1000 - g.bot.cfg.ctrl.sensor_offset_mm);
+}
+
 /* With a map, a position goal behind a wall the sonar keeps seeing is steered round it;
  * without one, straight at it. The scripted robot stands at the origin facing +x. */
 static void test_a_board_with_a_map_steers_round_what_it_has_seen(void **state)
@@ -613,15 +626,8 @@ static void test_a_board_with_a_map_steers_round_what_it_has_seen(void **state)
     qnav_map_config_t mc;
     qnav_link_goal_t gl = {9, 0, 0, QNAV_LINK_GOAL_POSITION, 3000, 0};
     uint8_t p[QNAV_LINK_GOAL_BYTES];
-    uint16_t k;
     (void)state;
-    bench_start(16);
-    for (k = 0; k < 16; ++k) {
-        g.sim.ranges_mm[k] = g.bot.cfg.ctrl.max_range_mm;
-    }
-    /* a wall 1 m ahead across the three sectors round straight ahead */
-    g.sim.ranges_mm[15] = g.sim.ranges_mm[0] = g.sim.ranges_mm[1] =
-        (qnav_mm_t)(1000 - g.bot.cfg.ctrl.sensor_offset_mm);
+    start_before_a_wall();
     qnav_map_config_default(&mc);
     mc.plan_ticks = 1;
     assert_true(qnav_map_size(&mc, 6000, 6000) <= sizeof mem);
@@ -659,14 +665,8 @@ static void test_a_board_places_a_map_for_each_goal(void **state)
     qnav_map_config_t mc;
     qnav_link_goal_t gl = {9, 0, 0, QNAV_LINK_GOAL_POSITION, 3000, 0};
     uint8_t p[QNAV_LINK_GOAL_BYTES];
-    uint16_t k;
     (void)state;
-    bench_start(16);
-    for (k = 0; k < 16; ++k) {
-        g.sim.ranges_mm[k] = g.bot.cfg.ctrl.max_range_mm;
-    }
-    g.sim.ranges_mm[15] = g.sim.ranges_mm[0] = g.sim.ranges_mm[1] =
-        (qnav_mm_t)(1000 - g.bot.cfg.ctrl.sensor_offset_mm);
+    start_before_a_wall();
     qnav_map_config_default(&mc);
     mc.compact = 1;
     mc.cell_mm = 400;
