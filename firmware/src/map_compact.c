@@ -109,6 +109,7 @@ void qnav_cmap_plan_start(qnav_map_t *m, uint32_t c)
     set2(m, PLAN_LO, (int32_t)(c % m->nx), (int32_t)(c / m->nx), label_of(0u));
     m->goal_cell = (uint16_t)c;
     m->layer = 0u;
+    m->rows_from = m->rows_to = (uint16_t)(c / m->nx);
     m->q_queued = 1u; /* the last step count reached a cell: the plan may grow */
 }
 
@@ -151,22 +152,26 @@ static void load_row(const qnav_map_t *m, int32_t j, unsigned t, row_t *r)
 /* One more step count: every passable cell not yet reached a step from the last count's
  * cells takes the next count (8 neighbours; a diagonal only past the two cells beside it,
  * both passable). 0 when none did (the plan is whole). Rows are read a row ahead, so a
- * row's new cells (label next, not t) do not change what the rows after it see. */
+ * row's new cells (label next, not t) do not change what the rows after it see. Only the
+ * rows next to the last count's rows (m->rows_from..rows_to) can take new cells. */
 static int grow(qnav_map_t *m)
 {
     row_t rows[3];
     row_t *up = &rows[0], *here = &rows[1], *down = &rows[2];
     const unsigned t = label_of(m->layer), next = label_of(m->layer + 1u);
     const uint16_t n = m->row_bytes;
+    const int32_t first = m->rows_from > 0u ? (int32_t)m->rows_from - 1 : 0;
+    const int32_t last = (int32_t)m->rows_to + 1 < (int32_t)m->ny ? (int32_t)m->rows_to + 1
+                                                                   : (int32_t)m->ny - 1;
     uint8_t any = 0u;
     int32_t j;
     uint16_t b;
     if (!m->q_queued) {
         return 0;
     }
-    load_row(m, -1, t, up);
-    load_row(m, 0, t, here);
-    for (j = 0; j < (int32_t)m->ny; ++j) {
+    load_row(m, first - 1, t, up);
+    load_row(m, first, t, here);
+    for (j = first; j <= last; ++j) {
         uint8_t *lo = plane(m, PLAN_LO, j), *hi = plane(m, PLAN_HI, j);
         const uint8_t *ul = up->last, *up_ = up->pass, *hl = here->last, *hp = here->pass;
         const uint8_t *dl = down->last, *dp = down->pass;
@@ -186,6 +191,10 @@ static int grow(qnav_map_t *m)
                 if (next & 2u) {
                     hi[b - 1u] |= add;
                 }
+                if (!any) {
+                    m->rows_from = (uint16_t)j;
+                }
+                m->rows_to = (uint16_t)j;
                 any = 1u;
             }
         }

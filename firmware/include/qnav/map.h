@@ -107,6 +107,7 @@ typedef struct {
     uint16_t row_bytes;
     uint16_t layer;           /* the plan's last settled step count (compact) */
     uint16_t goal_cell;       /* the destination's cell (compact) */
+    uint16_t rows_from, rows_to; /* the rows holding the last step count's cells (compact) */
     int32_t sub_x_mm, sub_y_mm; /* the last guided tick's sub-goal */
     uint8_t sub_direct;       /* ... was the destination (QNAV_MAP_DIRECT) */
     int32_t goal_x_mm, goal_y_mm;
