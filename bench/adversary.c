@@ -240,24 +240,6 @@ static void fixture_scans(pool_t *p, uint16_t n)
     }
 }
 
-/* Poses along an episode, one every WORLD_EVERY_TICKS ticks (its trace). */
-typedef struct {
-    double pose[WORLD_MAX_SCANS][3]; /* x, y (m), heading (rad), world frame */
-    uint32_t tick[WORLD_MAX_SCANS];
-    unsigned count;
-} poses_t;
-
-static void keep_pose(void *user, const qnav_sim_sample_t *s)
-{
-    poses_t *p = user;
-    if (s->tick % WORLD_EVERY_TICKS == 0u && p->count < WORLD_MAX_SCANS) {
-        p->pose[p->count][0] = s->x_m;
-        p->pose[p->count][1] = s->y_m;
-        p->pose[p->count][2] = s->heading_rad;
-        p->tick[p->count++] = s->tick;
-    }
-}
-
 /* One episode of driver in world (noise: the TekBot's typical), then the scan at every
  * kept pose (qnav_sim_place + qnav_sim_scan, as the fixtures' dense scans). */
 static void world_episode(pool_t *p, uint16_t n, const char *world, const seed_t *driver,
@@ -271,7 +253,8 @@ static void world_episode(pool_t *p, uint16_t n, const char *world, const seed_t
     qnav_sim_result_t res;
     qnav_ctrl_config_t ccfg;
     qnav_ctrl_t ctrl;
-    static poses_t poses;
+    static qnav_fx_pose_t poses[WORLD_MAX_SCANS];
+    unsigned kept;
     if (qnav_sim_env_load(world, &env, err, sizeof err) != QNAV_SIM_OK) {
         qnav_fx_fail(2, "%s", err);
     }
@@ -284,23 +267,20 @@ static void world_episode(pool_t *p, uint16_t n, const char *world, const seed_t
         qnav_fx_fail(2, "%s: %s", world, err);
     }
     qnav_sim_ctrl_config(sim, &ccfg);
-    poses.count = 0;
-    if (qnav_ctrl_init(&ctrl, &ccfg, &driver->policy) != QNAV_OK ||
-        qnav_sim_run_episode(sim, &ctrl, 1u, &res, keep_pose, &poses) != QNAV_SIM_OK) {
+    if (qnav_ctrl_init(&ctrl, &ccfg, &driver->policy) != QNAV_OK) {
         qnav_fx_fail(2, "%s: cannot run %s", world, driver->id);
     }
-    for (unsigned k = 0; k < poses.count; ++k) {
+    kept = qnav_fx_episode_poses(sim, &ctrl, 1u, WORLD_EVERY_TICKS, poses, WORLD_MAX_SCANS, &res,
+                                 world);
+    for (unsigned k = 0; k < kept; ++k) {
         qnav_sim_scan_t sc;
         char origin[96];
-        if (qnav_sim_place(sim, poses.pose[k][0], poses.pose[k][1], poses.pose[k][2]) != QNAV_SIM_OK ||
-            qnav_sim_scan(sim, &sc) != QNAV_SIM_OK) {
-            qnav_fx_fail(2, "%s: %s", world, qnav_sim_last_error(sim));
-        }
+        qnav_fx_scan_at(sim, poses[k].x_m, poses[k].y_m, poses[k].heading_rad, &sc, world);
         if (sc.max_range_mm != qnav_bench_max_range_mm()) {
             qnav_fx_fail(2, "%s: the simulator's range %u mm is not the benchmark's", world,
                          (unsigned)sc.max_range_mm);
         }
-        snprintf(origin, sizeof origin, "%s tick %u (%s)", world, (unsigned)poses.tick[k], driver->id);
+        snprintf(origin, sizeof origin, "%s tick %u (%s)", world, (unsigned)poses[k].tick, driver->id);
         scan_t *s = pool_add(p, n, origin);
         memcpy(s->r, sc.ranges_mm, n * sizeof sc.ranges_mm[0]);
         s->bearing = sc.goal_bearing_cdeg;

@@ -306,3 +306,40 @@ void qnav_fx_write_scans(const char *dir, const char *about, const qnav_fx_scan_
     fputs("};\n\n#endif /* QNAV_BENCH_SCANS_H */\n", o.f);
     qnav_fx_close(&o);
 }
+
+typedef struct {
+    qnav_fx_pose_t *out;
+    unsigned max, n;
+    uint32_t every;
+} pose_keeper_t;
+
+static void keep_pose(void *user, const qnav_sim_sample_t *s)
+{
+    pose_keeper_t *k = (pose_keeper_t *)user;
+    if (s->tick % k->every == 0u && k->n < k->max) {
+        k->out[k->n].x_m = s->x_m;
+        k->out[k->n].y_m = s->y_m;
+        k->out[k->n].heading_rad = s->heading_rad;
+        k->out[k->n++].tick = s->tick;
+    }
+}
+
+unsigned qnav_fx_episode_poses(qnav_sim_t *sim, const qnav_ctrl_t *ctrl, uint64_t episode_seed,
+                               uint32_t every, qnav_fx_pose_t *out, unsigned max,
+                               qnav_sim_result_t *res, const char *what)
+{
+    pose_keeper_t k = {out, max, 0u, every};
+    if (qnav_sim_run_episode(sim, ctrl, episode_seed, res, keep_pose, &k) != QNAV_SIM_OK) {
+        qnav_fx_fail(2, "%s: %s", what, qnav_sim_last_error(sim));
+    }
+    return k.n;
+}
+
+void qnav_fx_scan_at(qnav_sim_t *sim, double x_m, double y_m, double heading_rad,
+                     qnav_sim_scan_t *scan, const char *what)
+{
+    if (qnav_sim_place(sim, x_m, y_m, heading_rad) != QNAV_SIM_OK ||
+        qnav_sim_scan(sim, scan) != QNAV_SIM_OK) {
+        qnav_fx_fail(2, "%s: %s", what, qnav_sim_last_error(sim));
+    }
+}

@@ -2,7 +2,8 @@
  * What the benchmark's generators share (host only): the policy list format of
  * bench/fixtures/policies.txt and the C headers of policies and scans that the benchmark
  * programs compile (bench_fixtures.h's types, QNAV_FLASH data). gen_fixtures.c writes the
- * fixtures with them, adversary.c the adversarial set. Bad input: one line
+ * fixtures with them, adversary.c the adversarial set; both drive the simulator along
+ * episodes and take its scans at the poses they kept. Bad input: one line
  * "FILE:LINE: problem" on stderr, exit 2; a failed write: exit 1.
  */
 #ifndef QNAV_BENCH_FIXTURE_IO_H
@@ -12,6 +13,7 @@
 #include <stdio.h>
 
 #include "bench_fixtures.h"
+#include "qnav/sim.h"
 
 /* One policy of a list: what its header entry says. */
 typedef struct {
@@ -71,5 +73,23 @@ void qnav_fx_write_policies(const char *dir, const char *about, const qnav_fx_po
  * qnav_bench_scans[], under a comment that begins with `about`. */
 void qnav_fx_write_scans(const char *dir, const char *about, const qnav_fx_scan_t *s,
                          unsigned n, const int32_t *ranges, unsigned max_range_mm);
+
+/* A pose of an episode: the robot's centre (m) and heading (rad) in the world, its tick. */
+typedef struct {
+    double x_m, y_m, heading_rad;
+    uint32_t tick;
+} qnav_fx_pose_t;
+
+/* Episode episode_seed of ctrl in sim, keeping the pose of every every-th tick (from tick
+ * 0), at most max of them, in out; the episode's figures in *res. Returns how many were
+ * kept; a failed episode fails (exit 2) naming what. */
+unsigned qnav_fx_episode_poses(qnav_sim_t *sim, const qnav_ctrl_t *ctrl, uint64_t episode_seed,
+                               uint32_t every, qnav_fx_pose_t *out, unsigned max,
+                               qnav_sim_result_t *res, const char *what);
+
+/* The simulator's scan with the robot placed at (x, y, heading), as the fixtures' dense
+ * scans; a refused place fails (exit 2) naming what. */
+void qnav_fx_scan_at(qnav_sim_t *sim, double x_m, double y_m, double heading_rad,
+                     qnav_sim_scan_t *scan, const char *what);
 
 #endif /* QNAV_BENCH_FIXTURE_IO_H */

@@ -27,26 +27,6 @@ static const char *const worlds[] = {"gen:rooms:41:0.5:tekbot", "gen:gaps:42:0.5
 #define MAX_TICKS 300u
 #define PI 3.14159265358979323846
 
-typedef struct {
-    int32_t x_mm, y_mm, heading_cdeg;
-} pose_t;
-
-typedef struct {
-    pose_t pose[MAX_TICKS + 1u];
-    uint32_t n;
-} poses_t;
-
-static void keep_pose(void *user, const qnav_sim_sample_t *s)
-{
-    poses_t *p = (poses_t *)user;
-    if (p->n < MAX_TICKS) {
-        p->pose[p->n].x_mm = (int32_t)lround(s->x_m * 1000.0);
-        p->pose[p->n].y_mm = (int32_t)lround(s->y_m * 1000.0);
-        p->pose[p->n].heading_cdeg = (int32_t)lround(s->heading_rad * 18000.0 / PI);
-        p->n++;
-    }
-}
-
 static uint32_t mm(double m)
 {
     return (uint32_t)ceil(m * 1000.0);
@@ -55,23 +35,22 @@ static uint32_t mm(double m)
 /* World k's ticks: each pose's scan (the robot placed there again) and what the map made
  * of it, as the header's array map_ticks_k. */
 static void write_ticks(FILE *f, unsigned k, qnav_sim_t *sim, qnav_map_t *map,
-                        const qnav_sim_env_info_t *ei, const poses_t *poses)
+                        const qnav_sim_env_info_t *ei, const qnav_fx_pose_t *poses, unsigned n)
 {
     uint32_t t;
     fprintf(f, "static const qnav_bench_map_tick_t map_ticks_%u[%u] QNAV_FLASH = {\n", k,
-            (unsigned)poses->n);
-    for (t = 0; t < poses->n; ++t) {
-        const qnav_map_pose_t p = {poses->pose[t].x_mm, poses->pose[t].y_mm,
-                                   poses->pose[t].heading_cdeg};
+            n);
+    for (t = 0; t < n; ++t) {
+        /* the pose in whole mm and 0.01 deg, as the target reads it */
+        const qnav_map_pose_t p = {(int32_t)lround(poses[t].x_m * 1000.0),
+                                   (int32_t)lround(poses[t].y_m * 1000.0),
+                                   (int32_t)lround(poses[t].heading_rad * 18000.0 / PI)};
         qnav_sim_scan_t sc;
         qnav_ctrl_input_t in;
         int got;
         uint16_t i;
-        if (qnav_sim_place(sim, poses->pose[t].x_mm / 1000.0, poses->pose[t].y_mm / 1000.0,
-                           poses->pose[t].heading_cdeg * PI / 18000.0) != QNAV_SIM_OK ||
-            qnav_sim_scan(sim, &sc) != QNAV_SIM_OK) {
-            qnav_fx_fail(2, "%s tick %u: %s", worlds[k], (unsigned)t, qnav_sim_last_error(sim));
-        }
+        qnav_fx_scan_at(sim, p.x_mm / 1000.0, p.y_mm / 1000.0, p.heading_cdeg * PI / 18000.0, &sc,
+                        worlds[k]);
         if (sc.n_sectors != QNAV_BENCH_MAP_MAX_SECTORS) {
             qnav_fx_fail(2, "%s: %u sectors (the trace holds %u)", worlds[k], (unsigned)sc.n_sectors,
                          (unsigned)QNAV_BENCH_MAP_MAX_SECTORS);
@@ -94,7 +73,8 @@ static void write_ticks(FILE *f, unsigned k, qnav_sim_t *sim, qnav_map_t *map,
 static size_t one_world(FILE *f, const char *root, unsigned k, qnav_map_config_t *mc,
                         qnav_ctrl_config_t *cc)
 {
-    static poses_t poses;
+    static qnav_fx_pose_t poses[MAX_TICKS];
+    unsigned n;
     static uint16_t mem[40000];
     char err[QNAV_SIM_ERRLEN], spec[1100];
     qnav_sim_robot_t *robot = NULL;
@@ -124,10 +104,7 @@ static size_t one_world(FILE *f, const char *root, unsigned k, qnav_map_config_t
     if (qnav_ctrl_init(&ctrl, cc, &pol) != QNAV_OK) {
         qnav_fx_fail(2, "%s: the profile's controller does not start", spec);
     }
-    poses.n = 0;
-    if (qnav_sim_run_episode(sim, &ctrl, 1u, &res, keep_pose, &poses) != QNAV_SIM_OK) {
-        qnav_fx_fail(2, "%s: %s", worlds[k], qnav_sim_last_error(sim));
-    }
+    n = qnav_fx_episode_poses(sim, &ctrl, 1u, 1u, poses, MAX_TICKS, &res, worlds[k]);
     qnav_sim_env_info(env, &ei);
     bytes = qnav_map_size(mc, mm(ei.width_m), mm(ei.height_m));
     if (bytes == 0u || bytes > sizeof mem ||
@@ -136,15 +113,15 @@ static size_t one_world(FILE *f, const char *root, unsigned k, qnav_map_config_t
         qnav_fx_fail(2, "%s: no map of %.1f x %.1f m", worlds[k], ei.width_m, ei.height_m);
     }
     fprintf(f, "/* %s: %u ticks of episode 1 (%s in the simulator) */\n", worlds[k],
-            (unsigned)poses.n, res.reached ? "reached" : "not reached");
+            n, res.reached ? "reached" : "not reached");
     if (mm(ei.width_m) > 32767u || mm(ei.height_m) > 32767u) {
         qnav_fx_fail(2, "%s: larger than 32.7 m (the trace keeps poses in 16 bits)", worlds[k]);
     }
-    write_ticks(f, k, sim, &map, &ei, &poses);
+    write_ticks(f, k, sim, &map, &ei, poses, n);
     fprintf(f, "};\n\n");
     fprintf(f, "#define QNAV_BENCH_MAP_WORLD_%u {\"%s\", %lu, %lu, %ld, %ld, map_ticks_%u, %u}\n\n", k,
             worlds[k], (unsigned long)mm(ei.width_m), (unsigned long)mm(ei.height_m),
-            lround(ei.dest_x_m * 1000.0), lround(ei.dest_y_m * 1000.0), k, (unsigned)poses.n);
+            lround(ei.dest_x_m * 1000.0), lround(ei.dest_y_m * 1000.0), k, n);
     qnav_sim_destroy(sim);
     qnav_sim_env_free(env);
     qnav_sim_robot_free(robot);
