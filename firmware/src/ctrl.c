@@ -574,10 +574,10 @@ void qnav_ctrl_step(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
     decide(ctrl, lvl, goal, prev, flags, &best, out);
 }
 
-qnav_cdeg_t qnav_ctrl_prev_heading(qnav_deg_t last_heading_deg, qnav_cdeg_t last_goal_cdeg,
-                                   qnav_cdeg_t goal_cdeg)
+qnav_cdeg_t qnav_ctrl_prev_heading(qnav_deg_t last_heading_deg, qnav_cdeg_t last_yaw_cdeg,
+                                   qnav_cdeg_t yaw_cdeg)
 {
-    int32_t a = (int32_t)last_heading_deg * 100 + ((int32_t)goal_cdeg - last_goal_cdeg);
+    int32_t a = (int32_t)last_heading_deg * 100 - ((int32_t)yaw_cdeg - last_yaw_cdeg);
     a %= 36000;
     if (a < -18000) {
         a += 36000;
@@ -592,32 +592,32 @@ void qnav_ctrl_carry_reset(qnav_ctrl_carry_t *c)
     qnav_escape_clear(&c->escape);
     c->goal_id = 0u;
     c->last_heading_deg = 0;
-    c->last_goal_cdeg = 0;
+    c->last_yaw_cdeg = 0;
+    c->yaw_cdeg = 0;
     c->have_last = 0u;
 }
 
 void qnav_ctrl_carry_input(qnav_ctrl_carry_t *c, uint16_t goal_id, uint32_t range_mm,
-                           qnav_ctrl_input_t *in)
+                           qnav_cdeg_t yaw_cdeg, qnav_ctrl_input_t *in)
 {
     if (goal_id != c->goal_id) {
         qnav_escape_clear(&c->escape); /* a new destination: nothing learnt holds */
         c->goal_id = goal_id;
     }
+    c->yaw_cdeg = yaw_cdeg;
     in->prev_heading_cdeg = c->have_last ? qnav_ctrl_prev_heading(c->last_heading_deg,
-                                                                  c->last_goal_cdeg,
-                                                                  in->goal_bearing_cdeg)
+                                                                  c->last_yaw_cdeg, yaw_cdeg)
                                          : 0;
     in->goal_range_mm = (qnav_mm_t)(range_mm > 65535u ? 65535u : range_mm);
     in->escape = c->escape;
 }
 
-void qnav_ctrl_carry_output(qnav_ctrl_carry_t *c, const qnav_ctrl_input_t *in,
-                            const qnav_ctrl_output_t *out)
+void qnav_ctrl_carry_output(qnav_ctrl_carry_t *c, const qnav_ctrl_output_t *out)
 {
     c->escape = out->escape;
     if (!(out->flags & QNAV_FLAG_NOT_READY)) {
         c->last_heading_deg = out->heading_deg;
-        c->last_goal_cdeg = in->goal_bearing_cdeg;
+        c->last_yaw_cdeg = c->yaw_cdeg;
         c->have_last = 1u;
     }
 }

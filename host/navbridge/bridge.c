@@ -96,12 +96,12 @@ static int bridge_ctrl_sync(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan)
 }
 
 void qnav_bridge_ctrl_input(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan, uint32_t range_mm,
-                            qnav_nav_input_t *rec)
+                            qnav_cdeg_t yaw_cdeg, qnav_nav_input_t *rec)
 {
     qnav_ctrl_input_t in = {0};
     (void)bridge_ctrl_sync(bc, scan);
     in.goal_bearing_cdeg = scan->goal_bearing_cdeg;
-    qnav_ctrl_carry_input(&bc->carry, (uint16_t)scan->goal_id, range_mm, &in);
+    qnav_ctrl_carry_input(&bc->carry, (uint16_t)scan->goal_id, range_mm, yaw_cdeg, &in);
     memset(rec, 0, sizeof *rec);
     rec->utime = scan->utime;
     rec->scan_seq = scan->seq;
@@ -144,8 +144,11 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
     }
     in.ranges_mm = ranges;
     in.goal_bearing_cdeg = scan->goal_bearing_cdeg;
+    /* the heading qnav_bridge_ctrl_input was given (live), kept for the next tick's previous
+     * heading; a logged record brings the previous heading itself */
     qnav_ctrl_carry_input(&bc->carry, (uint16_t)scan->goal_id,
-                          rec->goal_range_mm < 0 ? 0u : (uint32_t)rec->goal_range_mm, &in);
+                          rec->goal_range_mm < 0 ? 0u : (uint32_t)rec->goal_range_mm,
+                          bc->carry.yaw_cdeg, &in);
     in.prev_heading_cdeg = rec->prev_heading_cdeg; /* as recorded (the same, live) */
     qnav_escape_follow_plan(&in.escape, rec->escape_clear,
                             (uint16_t)(rec->escape_grow_mm < 0        ? 0
@@ -165,7 +168,7 @@ void qnav_bridge_ctrl_step(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan,
     } else {
         qnav_nav_step(&bc->nav, &in, &out);
     }
-    qnav_ctrl_carry_output(&bc->carry, &in, &out);
+    qnav_ctrl_carry_output(&bc->carry, &out);
     fill_command(bc, scan, &out, cmd);
 }
 
@@ -375,7 +378,9 @@ static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
     }
     b->last_scan_ms = b->now_ms;
     b->scan_seq = f->seq;
-    b->scan_goal_cdeg = ls.goal_bearing_cdeg;
+    /* the robot's heading in the scan's tick, for the previous heading: the board's, from
+     * its pose report (after a lost report the last one, a tick older); 0 before any */
+    b->scan_yaw_cdeg = b->have_pose ? b->pose_heading_cdeg : 0;
     memset(&s, 0, sizeof s);
     s.utime = qnav_bridge_utime();
     s.seq = f->seq;
@@ -387,7 +392,7 @@ static void on_scan(qnav_bridge_t *b, const qnav_link_frame_t *f)
     for (k = 0; k < ls.n_sectors; ++k) {
         s.ranges_mm[k] = ls.ranges_mm[k];
     }
-    qnav_bridge_ctrl_input(&b->bc, &s, scan_goal_range(b, &ls), &rec);
+    qnav_bridge_ctrl_input(&b->bc, &s, scan_goal_range(b, &ls), b->scan_yaw_cdeg, &rec);
     scan_escape_verdict(b, &ls, &rec);
     if (b->cfg.mode == QNAV_LINK_MODE_ONBOARD && b->cfg.check_config == NULL) {
         rec.config_crc = -1; /* the board decides with a configuration nobody checked */
@@ -445,7 +450,7 @@ static void on_board_command(qnav_bridge_t *b, const qnav_link_frame_t *f)
         /* the board decided: its decision, not the bridge's own (shown only), is the
          * previous heading the next QNAV_NAV_INPUT records, as the board reads it */
         b->bc.carry.last_heading_deg = lc.heading_deg;
-        b->bc.carry.last_goal_cdeg = b->scan_goal_cdeg;
+        b->bc.carry.last_yaw_cdeg = b->scan_yaw_cdeg;
         b->bc.carry.have_last = 1u;
     }
 }
@@ -525,6 +530,7 @@ static void on_pose(qnav_bridge_t *b, const qnav_link_frame_t *f)
     b->have_pose = 1;
     b->pose_goal_id = lp.goal_id;
     b->pose_goal_distance_mm = lp.goal_distance_mm;
+    b->pose_heading_cdeg = lp.heading_cdeg;
     b->pose_board_ms = lp.board_ms;
     b->pose_escape_clear = lp.escape_clear;
     b->pose_escape_grow_mm = lp.escape_grow_mm;

@@ -122,9 +122,10 @@ void qnav_bridge_ctrl_init(qnav_bridge_ctrl_t *bc, const qnav_ctrl_config_t *cfg
                            const char *controller, const qnav_policy_t *policy);
 /* What the controller is given for scan besides the scan, into rec (the QNAV_NAV_INPUT
  * record): range_mm to the destination (0: bearing-only goal or unknown: no escape), the
- * previous heading, the configuration's CRC. */
+ * previous heading (from the robot's heading yaw_cdeg, the board's pose report of the
+ * scan's tick; 0 when unknown), the configuration's CRC. */
 void qnav_bridge_ctrl_input(qnav_bridge_ctrl_t *bc, const qnav_scan_t *scan, uint32_t range_mm,
-                            qnav_nav_input_t *rec);
+                            qnav_cdeg_t yaw_cdeg, qnav_nav_input_t *rec);
 /* Run the controller on an LCM scan with rec (qnav_bridge_ctrl_input's, or a logged one;
  * its escape_clear and escape_grow_mm, what the board's map did to the escape memory this
  * tick, applied to the carried memory as the board's map applies them onboard);
@@ -213,9 +214,10 @@ typedef struct {
      * distance */
     int have_pose;
     uint16_t scan_seq;                /* the board's last scan: its link sequence number */
-    qnav_cdeg_t scan_goal_cdeg;       /* and the destination's bearing it reported */
+    qnav_cdeg_t scan_yaw_cdeg;        /* and the robot's heading its tick's pose reported */
     uint16_t pose_goal_id;
     uint32_t pose_goal_distance_mm;
+    qnav_cdeg_t pose_heading_cdeg;    /* the robot's heading (the previous heading's frame) */
     uint32_t pose_board_ms;           /* its board clock: the scan of the same tick has it */
     uint8_t pose_escape_clear;        /* what the board's map did to the escape memory that */
     uint16_t pose_escape_grow_mm;     /* tick (qnav_link_pose_t), until a scan takes it */

@@ -61,8 +61,8 @@ static void on_scan(replay_t *r, const lcm_eventlog_event_t *ev)
         r->res->with_input++;
     } else {
         /* a log from before QNAV_NAV_INPUT: no goal distance (no escape), the previous
-         * heading from the replay's own last decision */
-        qnav_bridge_ctrl_input(&r->bc, &scan, 0u, &rec);
+         * heading the replay's own last decision (no heading known: not turned) */
+        qnav_bridge_ctrl_input(&r->bc, &scan, 0u, 0, &rec);
     }
     r->have_rec = 0;
     p->used = 1;

@@ -1484,14 +1484,14 @@ static void test_carry_clears_escape_memory_only_for_a_new_goal(void **state)
     qnav_ctrl_output_t out;
     (void)state;
     carry_fresh(&c, &in, &out);
-    qnav_ctrl_carry_input(&c, 7u, 3000u, &in);
+    qnav_ctrl_carry_input(&c, 7u, 3000u, 0, &in);
     out.escape.side = 1;
     out.escape.ticks = 42u;
-    qnav_ctrl_carry_output(&c, &in, &out);
-    qnav_ctrl_carry_input(&c, 7u, 2900u, &in);
+    qnav_ctrl_carry_output(&c, &out);
+    qnav_ctrl_carry_input(&c, 7u, 2900u, 0, &in);
     assert_int_equal(in.escape.side, 1);
     assert_int_equal(in.escape.ticks, 42);
-    qnav_ctrl_carry_input(&c, 8u, 2900u, &in);
+    qnav_ctrl_carry_input(&c, 8u, 2900u, 0, &in);
     assert_int_equal(in.escape.side, 0);
     assert_int_equal(in.escape.ticks, 0);
 }
@@ -1504,14 +1504,15 @@ static void test_carry_saturates_goal_range(void **state)
     (void)state;
     memset(&in, 0, sizeof in);
     qnav_ctrl_carry_reset(&c);
-    qnav_ctrl_carry_input(&c, 1u, 70000u, &in);
+    qnav_ctrl_carry_input(&c, 1u, 70000u, 0, &in);
     assert_int_equal(in.goal_range_mm, 65535);
-    qnav_ctrl_carry_input(&c, 1u, 0u, &in);
+    qnav_ctrl_carry_input(&c, 1u, 0u, 0, &in);
     assert_int_equal(in.goal_range_mm, 0);
 }
 
-/* The carry: the previous heading is the last ready decision seen from the new bearing; a
- * not-ready output leaves it as it was. */
+/* The carry: the previous heading is the last ready decision seen from the robot's new
+ * heading, whatever the goal bearing did (a map moves it to its sub-goal); a not-ready
+ * output leaves it as it was; the turn wraps across +-180 deg. */
 static void test_carry_gives_previous_heading_of_last_ready_decision(void **state)
 {
     qnav_ctrl_carry_t c;
@@ -1520,16 +1521,20 @@ static void test_carry_gives_previous_heading_of_last_ready_decision(void **stat
     (void)state;
     carry_fresh(&c, &in, &out);
     in.goal_bearing_cdeg = 1000;
-    qnav_ctrl_carry_input(&c, 1u, 0u, &in);
+    qnav_ctrl_carry_input(&c, 1u, 0u, 17900, &in);
     assert_int_equal(in.prev_heading_cdeg, 0);
     out.heading_deg = 30;
-    qnav_ctrl_carry_output(&c, &in, &out);
+    qnav_ctrl_carry_output(&c, &out);
     out.heading_deg = -90;
     out.flags = QNAV_FLAG_NOT_READY;
-    qnav_ctrl_carry_output(&c, &in, &out);
-    in.goal_bearing_cdeg = 500; /* the robot turned 5 deg left since */
-    qnav_ctrl_carry_input(&c, 1u, 0u, &in);
+    qnav_ctrl_carry_output(&c, &out);
+    in.goal_bearing_cdeg = -4000;                      /* a sub-goal elsewhere: no matter */
+    qnav_ctrl_carry_input(&c, 1u, 0u, -17600, &in);    /* the robot turned 5 deg left since */
     assert_int_equal(in.prev_heading_cdeg, 2500);
+    out.flags = 0;
+    qnav_ctrl_carry_output(&c, &out);                  /* decided -90 at heading -176 */
+    qnav_ctrl_carry_input(&c, 1u, 0u, 17600, &in);     /* then turned 8 deg right */
+    assert_int_equal(in.prev_heading_cdeg, -8200);
 }
 
 int main(void)

@@ -256,13 +256,13 @@ static void escape_model(const qnav_policy_t *p, int clear_at, int grow_at, int 
         (void)escape_scan(i, buf, &s);
         in.ranges_mm = s.ranges_mm;
         in.goal_bearing_cdeg = s.goal_bearing_cdeg;
-        qnav_ctrl_carry_input(&carry, 1u, ESC_GOAL_MM, &in);
+        qnav_ctrl_carry_input(&carry, 1u, ESC_GOAL_MM, 0, &in); /* the pose reports heading 0 */
         if (i == clear_at || i == stale_at) {
             memset(&in.escape, 0, sizeof in.escape);
         }
         qnav_escape_grow(&in.escape, i == grow_at ? 400u : 0u);
         qnav_ctrl_step(&c, &in, &outs[i], NULL);
-        qnav_ctrl_carry_output(&carry, &in, &outs[i]);
+        qnav_ctrl_carry_output(&carry, &outs[i]);
     }
 }
 

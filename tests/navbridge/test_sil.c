@@ -239,19 +239,19 @@ static void refused_in_one_line(const char *const *argv, const char *tag, const 
     assert_ptr_equal(strchr(text, '\n'), text + strlen(text) - 1); /* one line */
 }
 
-/* One lockstep TekBot trial in the committed U-pocket world (pocket_tekbot.toml), navbridge
- * in mode ("offboard" or "onboard") with --robot tekbot logging to log: the robot must
- * reach its destination. */
-static void pocket_trial(const char *mode, const char *log)
+/* One lockstep trial of robot (a TekBot spec) in the committed U-pocket world
+ * (pocket_tekbot.toml), navbridge in mode ("offboard" or "onboard") with --robot robot
+ * logging to log: the robot must reach its destination. */
+static void pocket_trial(const char *robot, const char *mode, const char *log)
 {
-    char link[300], tag[32], text[2048], goal[64];
-    const char *sil[] = {SIL_EXE, "--robot", "tekbot", "--env", POCKET_ENV, "--lockstep",
+    char link[300], tag[48], text[2048], goal[64];
+    const char *sil[] = {SIL_EXE, "--robot", robot, "--env", POCKET_ENV, "--lockstep",
                          "--reply-ms", "3000", "--link", link, NULL};
     const char *nb[] = {NAVBRIDGE_EXE, "--device", link, "--lcm-url", "memq://", "--log", log,
-                        "--goal-at", goal, "--robot", "tekbot", "--mode", mode, NULL};
+                        "--goal-at", goal, "--robot", robot, "--mode", mode, NULL};
     trial_files_t f;
-    snprintf(link, sizeof link, "%s/link-pocket-%s", g_dir, mode);
-    snprintf(tag, sizeof tag, "-pocket-%s", mode);
+    snprintf(link, sizeof link, "%s/link-pocket-%s-%s", g_dir, robot, mode);
+    snprintf(tag, sizeof tag, "-pocket-%s-%s", robot, mode);
     assert_int_equal(drive_trial(sil, nb, tag, goal, sizeof goal, &f), 0);
     assert_true(read_text(f.sil_out, text, sizeof text) > 0);
     print_message("%s: %s", mode, text);
@@ -260,8 +260,9 @@ static void pocket_trial(const char *mode, const char *log)
 
 /* Issues 17 and 18: in a U-pocket facing the start, the offboard robot leaves the dead end
  * as the onboard one does (navbridge runs the board's escape, fed the board's distance to
- * the goal); both logs replay identically with the logged goal distance and previous
- * heading on every scan; a replay that does not say which robot is refused. */
+ * the goal); both logs, and one of a board running its map, replay identically with the
+ * logged goal distance and previous heading on every scan; a replay that does not say
+ * which robot is refused. */
 static void test_sil_offboard_leaves_a_pocket_as_onboard_does_and_replays_identically(
     void **state)
 {
@@ -269,11 +270,17 @@ static void test_sil_offboard_leaves_a_pocket_as_onboard_does_and_replays_identi
     const char *no_robot[] = {NAVBRIDGE_EXE, "--replay", log, NULL};
     (void)state;
     snprintf(log, sizeof log, "%s/pocket-onboard.lcmlog", g_dir);
-    pocket_trial("onboard", log);
+    pocket_trial("tekbot", "onboard", log);
     replay_robot_is_identical(log, "tekbot");
     snprintf(log, sizeof log, "%s/pocket-offboard.lcmlog", g_dir);
-    pocket_trial("offboard", log);
+    pocket_trial("tekbot", "offboard", log);
     replay_robot_is_identical(log, "tekbot");
+    /* a board running its map: the goal bearing is the sub-goal's, the previous heading
+     * still the robot's own (162 of 183 decisions replayed otherwise when it followed the
+     * goal bearing) */
+    snprintf(log, sizeof log, "%s/pocket-map-onboard.lcmlog", g_dir);
+    pocket_trial("tekbot+map", "onboard", log);
+    replay_robot_is_identical(log, "tekbot+map");
 
     refused_in_one_line(no_robot, "pocket-norobot", "--robot NAME|FILE missing");
 }

@@ -49,14 +49,15 @@ typedef enum {
 } qnav_status_t;
 
 /*
- * The previous tick's heading seen in this tick's robot frame, for a caller without a
- * compass: the turn made since is taken from how the destination's bearing moved (exact
- * for a distant destination). last_heading_deg: the previous output's heading;
- * last_goal_cdeg, goal_cdeg: the destination's bearing then and now. Board, bridge and
- * replay compute it alike, so a replayed log decides as the board did.
+ * The previous tick's heading seen in this tick's robot frame: the last decision turned back
+ * by the robot's own turn since, read from its heading (odometry's: any fixed frame), as the
+ * simulator gives it from its heading. last_heading_deg: the previous output's heading;
+ * last_yaw_cdeg, yaw_cdeg: the robot's heading then and now, 0.01 deg, counter-clockwise.
+ * Board, bridge and replay compute it alike, so a replayed log decides as the board did;
+ * it does not depend on the goal bearing, which a map moves to its sub-goal.
  */
-qnav_cdeg_t qnav_ctrl_prev_heading(qnav_deg_t last_heading_deg, qnav_cdeg_t last_goal_cdeg,
-                                   qnav_cdeg_t goal_cdeg);
+qnav_cdeg_t qnav_ctrl_prev_heading(qnav_deg_t last_heading_deg, qnav_cdeg_t last_yaw_cdeg,
+                                   qnav_cdeg_t yaw_cdeg);
 
 /* One line of text for a status ("ok", "n_sectors outside 1..360", ...); never null. */
 const char *qnav_status_str(qnav_status_t status);
@@ -239,7 +240,8 @@ typedef struct {
     qnav_escape_t escape;        /* the last output's escape memory */
     uint16_t goal_id;            /* the destination it belongs to (0: none) */
     qnav_deg_t last_heading_deg; /* the last decision's heading, robot frame then, degrees */
-    qnav_cdeg_t last_goal_cdeg;  /* the destination's bearing it saw, 0.01 deg */
+    qnav_cdeg_t last_yaw_cdeg;   /* the robot's heading when it was made, 0.01 deg */
+    qnav_cdeg_t yaw_cdeg;        /* the robot's heading this tick (qnav_ctrl_carry_input's) */
     uint8_t have_last;           /* a decision was made since the reset */
 } qnav_ctrl_carry_t;
 
@@ -248,17 +250,16 @@ void qnav_ctrl_carry_reset(qnav_ctrl_carry_t *c);
 
 /*
  * Fill in's prev_heading_cdeg, goal_range_mm and escape for a tick toward destination
- * goal_id (a new id clears the escape memory) at bearing in->goal_bearing_cdeg (set it
- * first) and range_mm away (0: a bearing-only goal or no distance known: no escape;
- * beyond 65535 saturates).
+ * goal_id (a new id clears the escape memory) range_mm away (0: a bearing-only goal or no
+ * distance known: no escape; beyond 65535 saturates), the robot heading yaw_cdeg (its
+ * odometry's, 0.01 deg; kept for qnav_ctrl_carry_output).
  */
 void qnav_ctrl_carry_input(qnav_ctrl_carry_t *c, uint16_t goal_id, uint32_t range_mm,
-                           qnav_ctrl_input_t *in);
+                           qnav_cdeg_t yaw_cdeg, qnav_ctrl_input_t *in);
 
-/* Keep what the next tick needs from this tick's input and output (a not-ready output
- * leaves the last decision as it was). */
-void qnav_ctrl_carry_output(qnav_ctrl_carry_t *c, const qnav_ctrl_input_t *in,
-                            const qnav_ctrl_output_t *out);
+/* Keep what the next tick needs from this tick's output and the heading its input was
+ * given (a not-ready output leaves the last decision as it was). */
+void qnav_ctrl_carry_output(qnav_ctrl_carry_t *c, const qnav_ctrl_output_t *out);
 
 /* Derived, per-hidden-unit network parameters (docs/qformats.md, "network step"). */
 typedef struct {

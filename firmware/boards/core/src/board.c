@@ -546,13 +546,14 @@ void qnav_board_tick(qnav_board_t *bot)
     in.goal_bearing_cdeg = goal_bearing(bot, &dist_mm);
     /* the previous decision, seen from where the robot points now (3-input policies), the
      * distance to a position goal (0 for a bearing goal: no escape) and the memory */
-    qnav_ctrl_carry_input(&bot->carry, bot->have_goal ? bot->goal.goal_id : 0u, dist_mm, &in);
+    qnav_ctrl_carry_input(&bot->carry, bot->have_goal ? bot->goal.goal_id : 0u, dist_mm,
+                          bot->pose.heading_cdeg, &in);
     if (bot->map_tick != NULL) {
         bot->map_tick(bot, &in, &dist_mm, &esc);
     }
 
     decide(bot, now, &in, &out);
-    qnav_ctrl_carry_output(&bot->carry, &in, &out);
+    qnav_ctrl_carry_output(&bot->carry, &out);
     active = (uint8_t)(bot->link_ok && !bot->hold_stop && bot->have_goal && bot->mode != 0u);
     if (!active) {
         out.speed = 0;
