@@ -839,21 +839,43 @@ static void refuse_when_stalled(qnav_map_t *m, int32_t ri, int32_t rj, uint16_t 
     m->stall_ticks = 0u;
 }
 
-/* The input's goal bearing: toward (x, y), seen from pose (unchanged when there). */
-static void aim(qnav_ctrl_input_t *in, const qnav_map_pose_t *pose, int32_t x_mm, int32_t y_mm)
+/* The input's goal bearing and planned distance: toward (x, y), a sub-goal whose own way
+ * to the destination is via_mm, seen from pose (the bearing unchanged when there). The
+ * straight part makes the distance shrink as the robot drives within a cell: a cell's own
+ * cost stands still across it (a 0.4 m cell is a second of driving), and the escape took
+ * that for a stall (docs/architecture.md, "The planned distance"). */
+static void aim(qnav_ctrl_input_t *in, const qnav_map_pose_t *pose, int32_t x_mm, int32_t y_mm,
+                uint32_t via_mm)
 {
+    uint32_t d = 0u;
     if (x_mm != pose->x_mm || y_mm != pose->y_mm) {
         in->goal_bearing_cdeg =
-            qnav_wrap_cdeg((int32_t)qnav_atan2_cdeg(y_mm - pose->y_mm, x_mm - pose->x_mm, NULL) -
+            qnav_wrap_cdeg((int32_t)qnav_atan2_cdeg(y_mm - pose->y_mm, x_mm - pose->x_mm, &d) -
                            qnav_wrap_cdeg(pose->heading_cdeg));
     }
+    d += via_mm;
+    in->goal_range_mm = (qnav_mm_t)(d == 0u ? 1u : (d > 65535u ? 65535u : d));
+}
+
+/* The cost of the cell a plan step from (i, j) to (ni, nj) reaches, from cost, the way's
+ * from (i, j): the full layout keeps it; the compact one's way from (i, j) is its steps
+ * (qnav_cmap_descend), 10 a side and 14 a diagonal. */
+static uint32_t step_cost(const qnav_map_t *m, uint32_t cost, int32_t i, int32_t j, int32_t ni,
+                          int32_t nj)
+{
+    uint32_t step;
+    if (!m->cfg.compact) {
+        return m->cost[qnav_map_at(m, ni, nj)];
+    }
+    step = (ni != i && nj != j) ? STEP_DIAG : STEP_SIDE;
+    return cost > step ? cost - step : 0u;
 }
 
 int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
                    int32_t goal_y_mm, qnav_ctrl_input_t *in)
 {
     int32_t i, j, ri, rj, steps, sx, sy;
-    uint32_t cost, mm;
+    uint32_t cost, mm, sub, straight_mm;
     int jumped, replanned, direct = 0, grew = 0;
     if (!ready(m) || pose == NULL || in == NULL) {
         return 0;
@@ -861,6 +883,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     if (m->refused_ticks > 0u && --m->refused_ticks == 0u) {
         refusal_lapses(m);
     }
+    straight_mm = in->goal_range_mm;
     replanned = plan_when_due(m, goal_x_mm, goal_y_mm);
     cell_of(m, pose->x_mm, pose->y_mm, &ri, &rj);
     replanned |= settle_for(m, ri, rj);
@@ -868,8 +891,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     if (cost == QNAV_MAP_UNREACHED && m->cfg.compact && m->q_queued && m->last_mm != 0u) {
         /* a compact plan still growing toward the robot (grow_steps a tick): the last
          * sub-goal stands */
-        aim(in, pose, m->sub_x_mm, m->sub_y_mm);
-        in->goal_range_mm = (qnav_mm_t)m->last_mm;
+        aim(in, pose, m->sub_x_mm, m->sub_y_mm, m->sub_mm);
         m->grown_mm = 0u;
         return QNAV_MAP_GUIDED | m->sub_direct;
     }
@@ -879,11 +901,13 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
         return 0;
     }
     /* steepest descent for look_mm */
+    sub = cost;
     for (steps = (int32_t)(m->cfg.look_mm / m->cfg.cell_mm); steps > 0; --steps) {
         int32_t ni = i, nj = j;
         if (!descend(m, &ni, &nj) || (m->cfg.sight && !in_sight(m, ri, rj, ni, nj))) {
             break;
         }
+        sub = step_cost(m, sub, i, j, ni, nj);
         i = ni;
         j = nj;
     }
@@ -891,26 +915,35 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
         sx = goal_x_mm; /* the plan ends in the destination's cell: aim at the destination */
         sy = goal_y_mm;
         direct = QNAV_MAP_DIRECT;
+        sub = 0u;
     } else {
         sx = centre_x(m, i);
         sy = centre_y(m, j);
     }
-    aim(in, pose, sx, sy);
+    sub = sub * m->cfg.cell_mm / STEP_SIDE;
+    sub = sub > 65535u ? 65535u : sub;
+    aim(in, pose, sx, sy, sub);
     m->sub_x_mm = sx;
     m->sub_y_mm = sy;
+    m->sub_mm = (uint16_t)sub;
     m->sub_direct = (uint8_t)direct;
-    mm = cost * m->cfg.cell_mm / STEP_SIDE;
-    mm = mm == 0u ? 1u : (mm > 65535u ? 65535u : mm);
+    mm = in->goal_range_mm;
     jumped = m->last_mm != 0u && mm > (uint32_t)m->last_mm + m->cfg.jump_mm;
     m->grown_mm = 0u;
     if (!jumped && replanned && m->cfg.escape_grow && m->last_mm != 0u && mm > m->last_mm) {
         /* a new plan, longer (by less than a jump) where the robot is */
         m->grown_mm = (uint16_t)(mm - m->last_mm);
         grew = QNAV_MAP_ESCAPE_GROWN;
+    } else if (m->cfg.escape_grow && m->last_mm == 0u && straight_mm != 0u && mm > straight_mm) {
+        /* the first guided tick (a compact plan reaches the robot a few ticks after it
+         * starts): the escape has measured the straight distance until now, and the plan's
+         * longer way is no step back (in an empty arena the escape took it for a stall and
+         * followed the walls) */
+        m->grown_mm = (uint16_t)(mm - straight_mm);
+        grew = QNAV_MAP_ESCAPE_GROWN;
     }
     qnav_escape_follow_plan(&in->escape, jumped, m->grown_mm);
     m->last_mm = (uint16_t)mm;
-    in->goal_range_mm = (qnav_mm_t)mm;
     refuse_when_stalled(m, ri, rj, (uint16_t)mm, jumped);
     return QNAV_MAP_GUIDED | (jumped ? QNAV_MAP_ESCAPE_CLEARED : grew) | direct;
 }

@@ -77,11 +77,14 @@ std::string resolve_data_spec(const char *spec, const char *kind) {
     return qnav::resource_dir("QNAV_DATA_DIR", "data", QNAV_SIM_DATA_DIR) + "/" + kind + "/" + s + ".toml";
 }
 
-bool robot_spec_with_map(const std::string &spec, std::string *base) {
-    static const std::string kMap = "+map";
-    if (spec.size() <= kMap.size() || spec.compare(spec.size() - kMap.size(), kMap.size(), kMap) != 0) return false;
-    *base = spec.substr(0, spec.size() - kMap.size());
-    return true;
+int robot_spec_map(const std::string &spec, std::string *base) {
+    static const std::string kMap = "map";  // after a '+' or a '-'
+    const std::size_t n = kMap.size() + 1;
+    if (spec.size() <= n || spec.compare(spec.size() - kMap.size(), kMap.size(), kMap) != 0) return 0;
+    const char sign = spec[spec.size() - n];
+    if (sign != '+' && sign != '-') return 0;
+    *base = spec.substr(0, spec.size() - n);
+    return sign == '+' ? 1 : -1;
 }
 }  // namespace qnav
 
@@ -104,13 +107,19 @@ qnav_sim_status_t qnav_sim_robot_parse(const char *text, size_t len, const char 
 
 qnav_sim_status_t qnav_sim_robot_load(const char *spec, qnav_sim_robot_t **out, char *err,
                                       size_t errlen) {
-    // NAME+map: the profile with its [map] (written with on = false) switched on
+    // NAME+map: the profile with its [map] switched on; NAME-map: without a map (the paper's
+    // robot, and the ablation), its [map] kept described as with on = false
     std::string base;
-    if (!spec || !qnav::robot_spec_with_map(spec, &base))
-        return load_spec(spec, "robots", "robot", qnav_sim_robot_parse, out, err, errlen);
+    const int sw = spec ? qnav::robot_spec_map(spec, &base) : 0;
+    if (sw == 0) return load_spec(spec, "robots", "robot", qnav_sim_robot_parse, out, err, errlen);
     const qnav_sim_status_t st = load_spec(base.c_str(), "robots", "robot", qnav_sim_robot_parse, out, err, errlen);
     if (st != QNAV_SIM_OK) return st;
     qnav::RobotProfile &p = (*out)->profile;
+    if (sw < 0) {
+        if (p.map_cell_m > 0.0) p.map_off_cell_m = p.map_cell_m;
+        p.map_cell_m = 0.0;
+        return QNAV_SIM_OK;
+    }
     if (p.map_cell_m <= 0.0 && p.map_off_cell_m <= 0.0) {
         qnav_sim_robot_free(*out);
         *out = nullptr;

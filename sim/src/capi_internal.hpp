@@ -23,7 +23,8 @@ struct qnav_sim {
 namespace qnav {
 // Resolve a robot/env spec: a path is kept, a bare name becomes <data>/<kind>/<name>.toml.
 std::string resolve_data_spec(const char *spec, const char *kind);
-// A robot spec NAME+map (the profile with its [map] switched on): true and NAME in *base;
-// false (base untouched) for any other spec.
-bool robot_spec_with_map(const std::string &spec, std::string *base);
+// A robot spec's map switch: NAME+map (the profile with its [map] switched on) gives +1,
+// NAME-map (the profile without a map, its [map] kept described) -1, both with NAME in
+// *base; 0 (base untouched) for any other spec.
+int robot_spec_map(const std::string &spec, std::string *base);
 }  // namespace qnav

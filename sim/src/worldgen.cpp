@@ -744,8 +744,8 @@ Environment generate_world(const WorldSpec &w, const RobotProfile &robot, WorldN
 
 Environment load_world(std::string_view spec, WorldNotes *notes) {
     const WorldSpec w = parse_world_spec(spec);
-    std::string base = w.robot;  // worlds are sized for the body: NAME+map as NAME
-    robot_spec_with_map(w.robot, &base);
+    std::string base = w.robot;  // worlds are sized for the body: NAME+map and NAME-map as NAME
+    robot_spec_map(w.robot, &base);
     const std::string path = resolve_data_spec(base.c_str(), "robots");
     RobotProfile robot;
     try {

@@ -67,13 +67,20 @@ inline void fail_with(const char *what, const char *err) {
     fail();
 }
 
-// robot: a profile name in data/robots; env_text: TOML, or empty to use env_name.
+// robot: a profile name in data/robots, or NAME+map / NAME-map (its map on / off); env_text:
+// TOML, or empty to use env_name.
 inline void make_test_sim(TestSim &t, const char *robot, const std::string &env_text,
                           const char *env_name, uint16_t sectors, double ps, double pa,
                           uint64_t seed = 1,
                           qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS) {
     char err[QNAV_SIM_ERRLEN] = "";
-    const std::string rpath = std::string(QNAV_TEST_DATA_DIR) + "/robots/" + robot + ".toml";
+    std::string name = robot, sw;
+    const std::size_t at = name.size() > 4 ? name.size() - 4 : 0;
+    if (name.compare(at, 4, "+map") == 0 || name.compare(at, 4, "-map") == 0) {
+        sw = name.substr(at);
+        name.resize(at);
+    }
+    const std::string rpath = std::string(QNAV_TEST_DATA_DIR) + "/robots/" + name + ".toml" + sw;
     if (qnav_sim_robot_load(rpath.c_str(), &t.robot, err, sizeof err) != QNAV_SIM_OK)
         fail_with("robot", err);
     if (!env_text.empty()) {

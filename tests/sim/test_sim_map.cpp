@@ -97,6 +97,34 @@ void test_the_map_finds_the_gap_the_policy_alone_misses(void **) {
     assert_int_equal(with.collisions, 0);
 }
 
+// In an empty arena a map changes nothing: the TekBot with its compact map arrives in every
+// episode, as without. Its plan reaches the robot a few ticks after the start, and until
+// then the escape measured the straight distance; the plan's longer way looked like a
+// stall, and the robot followed the walls in 6 of 50 episodes (docs/architecture.md, "The
+// planned distance").
+void test_an_empty_arena_with_the_compact_map_is_no_dead_end(void **) {
+    for (const char *robot : {"tekbot+map", "tekbot-map"}) {
+        TestSim t;
+        make_test_sim(t, robot, "", "open", 16, 0.05, 0.01, 77);
+        qnav_ctrl_config_t cc;
+        qnav_sim_ctrl_config(t.sim, &cc);
+        qnav_policy_t p;
+        qnav_sim_robot_prob_policy(t.robot, &p);
+        qnav_ctrl_t ctrl;
+        assert_int_equal(qnav_ctrl_init(&ctrl, &cc, &p), QNAV_OK);
+        unsigned reached = 0, collisions = 0;
+        for (uint64_t e = 0; e < 50; ++e) {
+            qnav_sim_result_t res;
+            assert_int_equal(qnav_sim_run_episode(t.sim, &ctrl, e, &res, nullptr, nullptr), QNAV_SIM_OK);
+            reached += res.reached ? 1u : 0u;
+            collisions += res.collisions;
+        }
+        print_message("open, %s: %u/50 arrive within 30 s, %u collisions\n", robot, reached, collisions);
+        assert_int_equal(reached, 50);
+        assert_int_equal(collisions, 0);
+    }
+}
+
 // The step API gives a caller who keeps the escape memory what the map did to it: cleared
 // (escape_clear) or grown with a longer plan (escape_grow_mm). Applied, the episodes are
 // the simulator's own, tick for tick; the wall makes the plan grow.
@@ -307,6 +335,7 @@ void test_the_maps_arc_is_an_angle_from_the_profile(void **) {
 int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_the_map_finds_the_gap_the_policy_alone_misses),
+        cmocka_unit_test(test_an_empty_arena_with_the_compact_map_is_no_dead_end),
         cmocka_unit_test(test_the_step_api_carries_what_the_map_did_to_the_escape),
         cmocka_unit_test(test_odometry_errors_move_the_maps_pose_only_when_drawn),
         cmocka_unit_test(test_bad_odometry_settings_are_refused_by_field),

@@ -109,6 +109,7 @@ typedef struct {
     uint16_t goal_cell;       /* the destination's cell (compact) */
     uint16_t rows_from, rows_to; /* the rows holding the last step count's cells (compact) */
     int32_t sub_x_mm, sub_y_mm; /* the last guided tick's sub-goal */
+    uint16_t sub_mm;          /* ... its own way to the destination, mm */
     uint8_t sub_direct;       /* ... was the destination (QNAV_MAP_DIRECT) */
     int32_t goal_x_mm, goal_y_mm;
     uint16_t ticks;           /* observations since the last plan */
@@ -178,7 +179,8 @@ void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm);
  * One tick, after qnav_map_observe(): plan again when plan_ticks have passed or the
  * destination moved, and when the robot's cell has a way to the destination, replace
  * in->goal_bearing_cdeg with the bearing of the point look_mm along it (seen from pose)
- * and in->goal_range_mm with the planned distance, clearing in->escape when that grew by
+ * and in->goal_range_mm with the planned distance (straight to that point, then its way
+ * along the plan), clearing in->escape when that grew by
  * jump_mm since the last guided tick (the way the escape was following has closed), and
  * growing in->escape's distances by what a new plan added when it grew by less.
  * Returns QNAV_MAP_* flags; 0 when the map knows no way (the input stays as it was).
