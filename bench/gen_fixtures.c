@@ -191,7 +191,9 @@ static void dense_scans(const char *root, uint16_t n)
     qnav_sim_env_t *env = NULL;
     qnav_sim_t *sim = NULL;
     qnav_sim_config_t cfg;
-    snprintf(path, sizeof path, "%s/data/robots/tekbot.toml", root);
+    /* the TekBot without its map (NAME-map): the step's own inputs, the paper's robot; the
+     * map's are qnav_bench_avr_map's (bench/map_trace.c) */
+    snprintf(path, sizeof path, "%s/data/robots/tekbot.toml-map", root);
     if (qnav_sim_robot_load(path, &robot, err, sizeof err) != QNAV_SIM_OK) {
         qnav_fx_fail(2, "%s", err);
     }

@@ -306,7 +306,7 @@ static int wall_gap_trial(const char *prof, const char *ep, const char *mode, co
     return status;
 }
 
-/* The TekBot's profile with a [map] of cell_m cells (in place of its own, which is off and
+/* The TekBot's profile with a [map] of cell_m cells (in place of its own, which is
  * last), written to path. */
 static void tekbot_with_map(const char *path, const char *cell_m)
 {
@@ -355,7 +355,7 @@ static void test_sil_board_core_with_a_map_finds_the_far_gap(void **state)
         }
     }
     /* the contrast: the same episode without the map slides along the wall */
-    (void)wall_gap_trial("tekbot", "2", "offboard", "-gap-nomap", text, sizeof text, err, sizeof err);
+    (void)wall_gap_trial("tekbot-map", "2", "offboard", "-gap-nomap", text, sizeof text, err, sizeof err);
     print_message("no map, episode 2: %s", text);
     at = strstr(text, "reached yes, ");
     without = at != NULL ? strtol(at + strlen("reached yes, "), NULL, 10) : 100000L;

@@ -20,7 +20,7 @@ const char *const kPocket =
 // Episodes (of 20) that arrive, and the most recovery ticks of one.
 unsigned arrivals(bool escape, unsigned *worst_tau_c) {
     TestSim t;
-    make_test_sim(t, "tekbot", kPocket, nullptr, 16, 0.0, 0.0, 11);
+    make_test_sim(t, "tekbot-map", kPocket, nullptr, 16, 0.0, 0.0, 11);
     qnav_ctrl_config_t cfg;
     qnav_sim_ctrl_config(t.sim, &cfg);
     assert_true(cfg.escape_stall_ticks > 0);  // the profile turns it on

@@ -365,7 +365,7 @@ static void test_the_picture_draws_the_maps_cells(void **state) {
     std::string out;
     assert_int_equal(run_tool("run --robot " + robot + rest, &out), 0);
     assert_true(read_text_file(svg).find(cell) != std::string::npos);
-    assert_int_equal(run_tool("run --robot tekbot" + rest, &out), 0);
+    assert_int_equal(run_tool("run --robot tekbot-map" + rest, &out), 0);
     assert_true(read_text_file(svg).find("#d62728") == std::string::npos);
     std::remove(svg.c_str());
     std::remove(robot.c_str());

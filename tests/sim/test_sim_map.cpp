@@ -257,29 +257,33 @@ void test_the_map_is_told_the_runs_sensor_noise(void **) {
     assert_int_equal(mc.noise_pct, 1);
 }
 
-// The committed profiles describe each robot's map with on = false (their boards have no
-// RAM for it, and every figure without a map stays as measured); NAME+map switches it on,
-// as written, and nothing else. A profile with no [map] has nothing to switch on: refused
-// naming the file. 'on' takes only true or false.
+// The TekBot's profile runs its map (on = true: the compact map its ATmega128 holds); the
+// Pioneer's describes one with on = false. NAME+map switches the profile's own map on, as
+// written, and nothing else; NAME-map switches it off (the robot of the paper's
+// experiments). A profile with no [map] has nothing to switch on: refused naming the file;
+// NAME-map of it is the profile itself. 'on' takes only true or false.
 void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
     for (const char *robot : {"tekbot", "pioneer3dx"}) {
-        qnav_map_config_t off, on;
-        qnav_ctrl_config_t plain, with;
-        assert_int_equal(loaded_map(robot, &off, &plain), 0);
+        const bool tekbot = std::string(robot) == "tekbot";
+        qnav_map_config_t off, on, plain_map;
+        qnav_ctrl_config_t plain, with, without;
+        assert_int_equal(loaded_map(robot, &plain_map, &plain), tekbot ? 1 : 0);
+        assert_int_equal(loaded_map((std::string(robot) + "-map").c_str(), &off, &without), 0);
         assert_int_equal(loaded_map((std::string(robot) + "+map").c_str(), &on, &with), 1);
         /* the TekBot's is the map its ATmega128 holds: 4 bits a cell of 0.4 m */
-        const bool tekbot = std::string(robot) == "tekbot";
         assert_int_equal(on.cell_mm, tekbot ? 400 : 100);
         assert_int_equal(on.compact, tekbot ? 1 : 0);
         assert_int_equal(on.grow_steps, 16);
         assert_int_equal(on.near_cost, tekbot ? 0 : 10);
         assert_int_equal(on.refuse_ticks, tekbot ? 0 : 30);
-        assert_int_equal(with.safety_mm, plain.safety_mm);
-        assert_int_equal(with.n_sectors, plain.n_sectors);
-        assert_int_equal(with.max_range_mm, plain.max_range_mm);
-        assert_int_equal(on.reach_mm, std::string(robot) == "pioneer3dx" ? 3000 : 2000);
-        assert_int_equal(with.pass_mm, std::string(robot) == "tekbot" ? 10 : plain.safety_mm);
-        assert_int_equal(plain.pass_mm, plain.safety_mm);
+        if (tekbot) assert_true(on.cell_mm == plain_map.cell_mm && on.compact == plain_map.compact);
+        assert_int_equal(with.safety_mm, without.safety_mm);
+        assert_int_equal(with.n_sectors, without.n_sectors);
+        assert_int_equal(with.max_range_mm, without.max_range_mm);
+        assert_int_equal(on.reach_mm, tekbot ? 2000 : 3000);
+        assert_int_equal(with.pass_mm, tekbot ? 10 : without.safety_mm);
+        assert_int_equal(plain.pass_mm, tekbot ? with.pass_mm : without.pass_mm);
+        assert_int_equal(without.pass_mm, without.safety_mm);
     }
     char dir[] = "/tmp/qnav_map_test_XXXXXX";
     assert_non_null(mkdtemp(dir));
@@ -294,6 +298,8 @@ void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
     assert_null(robot);
     print_message("%s\n", err);
     assert_true(std::string(err).find(file + " has no [map]") != std::string::npos);
+    assert_int_equal(qnav_sim_robot_load((file + "-map").c_str(), &robot, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_robot_free(robot);
     assert_int_equal(std::remove(file.c_str()), 0);
     assert_int_equal(rmdir(dir), 0);
     assert_true(refusal(tekbot_with("[map]\non = 1\ncell_m = 0.1\n")).find("'on' must be true or false") !=

@@ -45,6 +45,10 @@ static qnav_sim_robot_t *profile(const char *robot, bool guard) {
     const std::size_t at = text.find(key);
     assert_true(at != std::string::npos);
     text.replace(at, key.size(), std::string("speed_guard = ") + (guard ? "true" : "false"));
+    // the controller's guard alone: a map's plan would steer round the wall (the TekBot's
+    // profile runs its map)
+    const std::size_t map_on = text.find("\non = true");
+    if (map_on != std::string::npos) text.replace(map_on, 10, "\non = false");
     qnav_sim_robot_t *r = nullptr;
     char err[QNAV_SIM_ERRLEN] = "";
     const std::string file = std::string(robot) + "-guard.toml";

@@ -35,13 +35,23 @@
         .ctrl.escape_follow_s = 20, \
         .ctrl.keep_pct = 15, \
         .ctrl.range_min_mm = 30, \
-        .ctrl.pass_mm = 50, \
+        .ctrl.pass_mm = 10, \
         .tick_ms = 100, \
         .track_mm = 180, \
         .um_per_count = 6872, \
         .link_timeout_ms = 300, \
         .nvm_offset = 0, \
         .controller = "body" \
+    }
+
+/* The profile's [map], on: the map the board places at each position goal
+ * (qnav_board_place_maps), a qnav_map_config_t. */
+#define QNAV_ROBOT_TEKBOT_MAP_CONFIG \
+    { \
+        .cell_mm = 400, .reach_mm = 2000, .look_mm = 1000, .jump_mm = 1000, \
+        .plan_ticks = 10, .noise_pct = 5, .near_cost = 0, .near_mm = 200, \
+        .arc_cdeg = 2250, .sight = 1, .escape_grow = 1, .refuse_ticks = 0, \
+        .refuse_life_ticks = 200, .compact = 1, .grow_steps = 16 \
     }
 
 #endif /* QNAV_ROBOT_TEKBOT_H */
