@@ -637,6 +637,28 @@ static void test_spec_distribution_parses_and_sources_name_their_own(void **stat
     assert_true(s.sources[1].scenario.describe().rfind("environment=open robot=tekbot", 0) == 0);
 }
 
+/* [evaluation] robot: held-out episodes (validation, test, named environments) with
+ * another robot than evolution's, e.g. the TekBot with its map while evolution runs without
+ * it; the target's and every source's; part of the fingerprint only when given. */
+static void test_spec_held_out_robot_reaches_validation_and_test_only(void **state)
+{
+    (void)state;
+    const ExperimentSpec plain = parse_experiment(kDistSpec, "x.toml");
+    const ExperimentSpec s =
+        parse_experiment(std::string(kDistSpec) + "[evaluation]\nrobot = \"tekbot+map\"\n", "x.toml");
+    assert_string_equal(s.target.robot.c_str(), "tekbot");
+    assert_string_equal(validation_scenario(s.target).robot.c_str(), "tekbot+map");
+    assert_string_equal(validation_scenario(s.sources[0].scenario).robot.c_str(), "tekbot+map");
+    assert_string_equal(validation_scenario(plain.target).robot.c_str(), "tekbot");
+    for (const HeldOutWorld &h : held_out_worlds(s.target)) {
+        assert_string_equal(h.scenario.robot.c_str(), "tekbot+map");
+    }
+    assert_true(s.target.describe() != plain.target.describe());
+    assert_true(plain.target.describe().find("held_out_robot") == std::string::npos);
+    assert_string_equal(parse_error(std::string(kDistSpec) + "[evaluation]\nrobot = \"\"\n").c_str(),
+                        "x.toml:24: robot: must not be empty");
+}
+
 static void test_spec_distribution_errors_name_the_line(void **state)
 {
     (void)state;
@@ -875,6 +897,7 @@ int main(void)
         cmocka_unit_test(test_spec_errors_name_file_line_and_problem),
         cmocka_unit_test(test_spec_distribution_parses_and_sources_name_their_own),
         cmocka_unit_test(test_spec_distribution_errors_name_the_line),
+        cmocka_unit_test(test_spec_held_out_robot_reaches_validation_and_test_only),
         cmocka_unit_test(test_world_draws_are_deterministic_weighted_and_inside_their_ranges),
         cmocka_unit_test(test_no_training_world_is_ever_in_a_held_out_set),
         cmocka_unit_test(test_recommended_policy_is_chosen_on_validation_not_training),

@@ -307,7 +307,9 @@ std::string worlds_md(const ExperimentSpec &spec, const HeldOut &H)
       << "Each evolved condition's best policy of every run and the references, " << H.episodes
       << " episodes in the test worlds of every world family (new seeds from " << kTestSeedBase
       << ", difficulty drawn in [0, 1], never trained on) and in every named environment of data/envs/ "
-         "(new start points), with the target's robot, sectors and noise; the same episodes in every experiment. "
+         "(new start points), with the target's "
+      << (spec.target.held_out_robot.empty() ? "robot" : "held-out robot " + spec.target.held_out_robot)
+      << ", sectors and noise; the same episodes in every experiment. "
          "Evolved: 95% CI over runs; references: over episodes (arrival: Wilson).\n\n"
       << "| condition | world | arrival (95% CI) | recovery ticks per episode (95% CI) | R (95% CI) |\n"
       << "|---|---|---|---|---|\n";

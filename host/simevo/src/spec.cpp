@@ -103,6 +103,9 @@ std::string Scenario::describe() const
     if (limit_factor != 1.0) {
         o << " limit_factor=" << limit_factor; /* absent at 1: old fingerprints unchanged */
     }
+    if (!held_out_robot.empty()) {
+        o << " held_out_robot=" << held_out_robot; /* absent unset: the same */
+    }
     o << " fitness=" << qnav_sim_fitness_rule_name(fitness)
       << " controller=" << controller_reading_name(controller);
     return o.str();
@@ -625,8 +628,19 @@ void parse_evaluation(const Parser &p, const toml::table &root, ExperimentSpec &
     if (auto *n = root.get("evaluation")) {
         const toml::table &t = p.table(*n, "evaluation");
         p.only_keys(t, {"episodes", "seed", "checkpoints", "checkpoint_every", "checkpoint_episodes",
-                        "arrival_threshold", "worlds_episodes"},
+                        "arrival_threshold", "worlds_episodes", "robot"},
                     "evaluation");
+        if (auto *v = t.get("robot")) {
+            /* held-out episodes with this robot: the target's and every source's */
+            const std::string robot = p.str(*v, "robot");
+            if (robot.empty()) {
+                p.fail(*v, "robot: must not be empty");
+            }
+            spec.target.held_out_robot = robot;
+            for (SourceSpec &src : spec.sources) {
+                src.scenario.held_out_robot = robot;
+            }
+        }
         if (auto *v = t.get("episodes")) {
             spec.eval_episodes = static_cast<uint32_t>(p.integer(*v, "episodes", 1, 1000000));
         }

@@ -104,6 +104,10 @@ struct Scenario {
      * worlds of `worlds`; the episode seed fixes the world and the start point. */
     std::shared_ptr<const Distribution> distribution;
     WorldSet worlds = WorldSet::Training;
+    /* The robot of held-out episodes (validation, test, named environments, checkpoints):
+     * [evaluation] robot, e.g. the robot with its map while evolution runs without it;
+     * "" = robot. */
+    std::string held_out_robot;
 
     /* Canonical one-line description (also part of task fingerprints). */
     std::string describe() const;

@@ -185,6 +185,9 @@ std::vector<HeldOutWorld> held_out_worlds(const Scenario &target)
     Scenario base = target;
     base.distribution.reset();
     base.worlds = WorldSet::Training;
+    if (!base.held_out_robot.empty()) {
+        base.robot = base.held_out_robot;
+    }
     std::vector<HeldOutWorld> v;
     for (const std::string &f : world_families()) {
         auto d = std::make_shared<Distribution>();
@@ -226,6 +229,9 @@ Scenario validation_scenario(const Scenario &s)
     Scenario v = s;
     if (v.distribution) {
         v.worlds = WorldSet::Validation;
+    }
+    if (!v.held_out_robot.empty()) {
+        v.robot = v.held_out_robot;
     }
     return v;
 }

@@ -83,11 +83,12 @@ struct HeldOutWorld {
 inline constexpr const char *kTwiceLimitSuffix = "@2x";
 /* Every family's test worlds, then (a distribution target) every family's test worlds at
  * twice each world's time limit ("clutter@2x"), then every named environment, for
- * target's robot. */
+ * target's held-out robot ([evaluation] robot, else its robot). */
 std::vector<HeldOutWorld> held_out_worlds(const Scenario &target);
 
 /* A scenario's held-out version: a distribution's validation worlds (the scenario itself
- * when it has no distribution: its held-out episodes are new start points). */
+ * when it has no distribution: its held-out episodes are new start points), with its
+ * held-out robot when it has one. */
 Scenario validation_scenario(const Scenario &s);
 
 } // namespace qnav
