@@ -1,8 +1,9 @@
 /*
  * The compact map on an ATmega128 at 16 MHz, under simavr (docs/performance.md, "The map
  * on the ATmega128"): the TekBot's episodes of bench_map_trace.h (the simulator's poses and
- * scans in generated worlds of three families) replayed through qnav_map_observe() and
- * qnav_map_guide() as a board does each tick. Prints, per world, the cycles of each call
+ * scans in generated worlds of three families) replayed through qnav_map_follow(),
+ * qnav_map_observe() and qnav_map_guide() as a board does each tick, over the map the board
+ * places in its [map] bytes. Prints, per world, the cycles of each call
  * and of the tick (min / median / max), the peak stack below the caller and the map's
  * bytes; a tick whose sub-goal, planned distance or flags differ from the host's prints a
  * MISMATCH line, and the program exits 1.
@@ -18,8 +19,10 @@
 static const qnav_bench_map_world_t worlds[QNAV_BENCH_MAP_WORLDS] = QNAV_BENCH_MAP_WORLD_LIST;
 static uint16_t map_mem[(QNAV_BENCH_MAP_BYTES + 1u) / 2u];
 static qnav_map_t map;
-/* a tick's cycles / 16 for the medians (at most 300 ticks a world) */
-static uint16_t obs_c[300], guide_c[300], tick_c[300];
+/* a tick's cycles / 16 in each call for the medians (at most 300 ticks a world); the
+ * tick's are their sums (a third array would leave the stack too little of the 4 KB beside
+ * the board's 512-byte map) */
+static uint16_t obs_c[300], guide_c[300];
 static uint32_t overhead;
 
 static void sort16(uint16_t *v, uint16_t n)
@@ -34,22 +37,75 @@ static void sort16(uint16_t *v, uint16_t n)
     }
 }
 
-/* "name min / median / max cycles" of n values kept / 16, with the exact min and max */
-static void put_spread(const char *name_flash, uint16_t *v, uint16_t n, uint32_t lo, uint32_t hi)
+/* The median of a[k] + b[k] over k < n (the lower one, as sorting gives), found by rank
+ * without a third array. */
+static uint32_t median_of_sums(const uint16_t *a, const uint16_t *b, uint16_t n)
 {
-    sort16(v, n);
+    const uint16_t want = (uint16_t)((n - 1u) / 2u);
+    uint16_t i, j;
+    for (i = 0; i < n; ++i) {
+        const uint32_t s = (uint32_t)a[i] + b[i];
+        uint16_t less = 0u, same = 0u;
+        for (j = 0; j < n; ++j) {
+            const uint32_t t = (uint32_t)a[j] + b[j];
+            less = (uint16_t)(less + (t < s));
+            same = (uint16_t)(same + (t == s));
+        }
+        if (less <= want && want < less + same) {
+            return s;
+        }
+    }
+    return 0u;
+}
+
+/* "name min / median / max cycles": the exact min and max, the median of values kept / 16 */
+static void put_spread(const char *name_flash, uint32_t median16, uint32_t lo, uint32_t hi)
+{
     qnav_avr_put_flash(name_flash);
     qnav_target_put_u32(lo);
     PUT(" / ");
-    qnav_target_put_u32((uint32_t)v[(n - 1u) / 2u] * 16u);
+    qnav_target_put_u32(median16 * 16u);
     PUT(" / ");
     qnav_avr_put_cycles(hi);
     PUT("\n");
 }
 
+static uint32_t sorted_median(uint16_t *v, uint16_t n)
+{
+    sort16(v, n);
+    return v[(n - 1u) / 2u];
+}
+
 static uint32_t timed_end(void)
 {
     return qnav_avr_timer_stop() - overhead;
+}
+
+/* A replayed world's spreads, then the follow's move timed with the robot at the map's
+ * corner cell (every cell moves: the most a tick can add). */
+static void put_world(const qnav_bench_map_world_t *w, const qnav_map_config_t *mc,
+                      const uint32_t *lo, const uint32_t *hi, uint16_t *peak)
+{
+    const qnav_map_pose_t corner = {map.x0_mm + (int32_t)mc->cell_mm / 2,
+                                    map.y0_mm + (int32_t)mc->cell_mm / 2, 0};
+    const uint32_t tick16 = median_of_sums(obs_c, guide_c, w->n_ticks);
+    uint32_t c;
+    uint16_t sp, used;
+    int moved;
+    put_spread(PSTR("  follow + observe min / median / max: "), sorted_median(obs_c, w->n_ticks),
+               lo[0], hi[0]);
+    put_spread(PSTR("  guide            min / median / max: "),
+               sorted_median(guide_c, w->n_ticks), lo[1], hi[1]);
+    put_spread(PSTR("  tick             min / median / max: "), tick16, lo[2], hi[2]);
+    sp = qnav_avr_paint();
+    qnav_avr_timer_start();
+    moved = qnav_map_follow(&map, &corner, w->goal_x_mm, w->goal_y_mm);
+    c = timed_end();
+    used = qnav_avr_stack_used(sp);
+    *peak = used > *peak ? used : *peak;
+    PUT("  the map moved by the follow (the robot at its corner): ");
+    qnav_avr_put_cycles(moved ? c : 0u);
+    PUT("\n");
 }
 
 /* One world's episode; the number of ticks that differ from the host's. */
@@ -61,7 +117,8 @@ static uint16_t replay(const qnav_bench_map_world_t *w, const qnav_map_config_t 
     uint32_t lo[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX}, hi[3] = {0, 0, 0};
     uint16_t k, bad = 0;
     const qnav_status_t st =
-        qnav_map_init(&map, mc, cc, 0, 0, w->width_mm, w->height_mm, map_mem, sizeof map_mem);
+        qnav_map_init(&map, mc, cc, w->x0_mm, w->y0_mm, w->side_mm, w->side_mm, map_mem,
+                      QNAV_BENCH_MAP_BYTES);
     if (st != QNAV_OK) {
         PUT("the map does not start: ");
         qnav_target_put(qnav_status_str(st));
@@ -85,6 +142,7 @@ static uint16_t replay(const qnav_bench_map_world_t *w, const qnav_map_config_t 
         in.ranges_mm = ranges;
         sp = qnav_avr_paint();
         qnav_avr_timer_start();
+        (void)qnav_map_follow(&map, &p, w->goal_x_mm, w->goal_y_mm); /* as the board */
         qnav_map_observe(&map, ranges, &p);
         c[0] = timed_end();
         qnav_avr_timer_start();
@@ -99,7 +157,6 @@ static uint16_t replay(const qnav_bench_map_world_t *w, const qnav_map_config_t 
         }
         obs_c[k] = (uint16_t)(c[0] / 16u > 0xFFFFu ? 0xFFFFu : c[0] / 16u);
         guide_c[k] = (uint16_t)(c[1] / 16u > 0xFFFFu ? 0xFFFFu : c[1] / 16u);
-        tick_c[k] = (uint16_t)(c[2] / 16u > 0xFFFFu ? 0xFFFFu : c[2] / 16u);
         if (in.goal_bearing_cdeg != t.bearing_cdeg || in.goal_range_mm != t.range_mm ||
             got != t.flags) {
             PUT("MISMATCH tick ");
@@ -116,9 +173,7 @@ static uint16_t replay(const qnav_bench_map_world_t *w, const qnav_map_config_t 
             ++bad;
         }
     }
-    put_spread(PSTR("  observe min / median / max: "), obs_c, w->n_ticks, lo[0], hi[0]);
-    put_spread(PSTR("  guide   min / median / max: "), guide_c, w->n_ticks, lo[1], hi[1]);
-    put_spread(PSTR("  tick    min / median / max: "), tick_c, w->n_ticks, lo[2], hi[2]);
+    put_world(w, mc, lo, hi, peak);
     return bad;
 }
 
@@ -148,11 +203,11 @@ int main(void)
         PUT(": ");
         qnav_target_put_u32(worlds[k].n_ticks);
         PUT(" ticks, ");
-        qnav_target_put_u32(qnav_map_size(&mc, worlds[k].width_mm, worlds[k].height_mm));
+        qnav_target_put_u32(qnav_map_size(&mc, worlds[k].side_mm, worlds[k].side_mm));
         PUT(" bytes of map\n");
         bad = (uint16_t)(bad + replay(&worlds[k], &mc, &cc, &peak));
     }
-    PUT("map peak stack (observe, guide): ");
+    PUT("map peak stack (follow, observe, guide): ");
     qnav_target_put_u32(peak);
     PUT(" bytes; sizeof(qnav_map_t) ");
     qnav_target_put_u32(sizeof(qnav_map_t));

@@ -22,7 +22,8 @@ typedef struct {
 
 typedef struct {
     const char *name;
-    uint32_t width_mm, height_mm; /* the map covers the arena */
+    int32_t x0_mm, y0_mm;         /* the map's square, placed as the board places it */
+    uint32_t side_mm;             /* (qnav_map_place: midway between start and goal) */
     int32_t goal_x_mm, goal_y_mm;
     const qnav_bench_map_tick_t *ticks; /* in flash */
     uint16_t n_ticks;

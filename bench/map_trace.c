@@ -57,6 +57,8 @@ static void write_ticks(FILE *f, unsigned k, qnav_sim_t *sim, qnav_map_t *map,
         }
         memset(&in, 0, sizeof in);
         in.ranges_mm = sc.ranges_mm;
+        (void)qnav_map_follow(map, &p, (int32_t)lround(ei->dest_x_m * 1000.0),
+                              (int32_t)lround(ei->dest_y_m * 1000.0)); /* as the board */
         qnav_map_observe(map, sc.ranges_mm, &p);
         got = qnav_map_guide(map, &p, (int32_t)lround(ei->dest_x_m * 1000.0),
                              (int32_t)lround(ei->dest_y_m * 1000.0), &in);
@@ -87,13 +89,18 @@ static size_t one_world(FILE *f, const char *root, unsigned k, qnav_map_config_t
     qnav_policy_t pol;
     qnav_map_t map;
     size_t bytes;
+    int32_t x0, y0;
+    uint32_t side;
     snprintf(spec, sizeof spec, "%s/data/robots/tekbot.toml+map", root);
     if (qnav_sim_robot_load(spec, &robot, err, sizeof err) != QNAV_SIM_OK ||
         qnav_sim_env_load(worlds[k], &env, err, sizeof err) != QNAV_SIM_OK) {
         qnav_fx_fail(2, "%s", err);
     }
-    if (!qnav_sim_robot_map_config(robot, mc) || mc->compact != 1u) {
-        qnav_fx_fail(2, "%s: the benchmark is of a compact [map]", spec);
+    bytes = qnav_sim_robot_map_bytes(robot);
+    if (!qnav_sim_robot_map_config(robot, mc) || mc->compact != 1u || bytes == 0u ||
+        bytes > sizeof mem) {
+        qnav_fx_fail(2, "%s: the benchmark is of a compact [map] in the board's [map] bytes",
+                     spec);
     }
     qnav_sim_config_default(&cfg);
     if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK) {
@@ -106,11 +113,14 @@ static size_t one_world(FILE *f, const char *root, unsigned k, qnav_map_config_t
     }
     n = qnav_fx_episode_poses(sim, &ctrl, 1u, 1u, poses, MAX_TICKS, &res, worlds[k]);
     qnav_sim_env_info(env, &ei);
-    bytes = qnav_map_size(mc, mm(ei.width_m), mm(ei.height_m));
-    if (bytes == 0u || bytes > sizeof mem ||
-        qnav_map_init(&map, mc, cc, 0, 0, mm(ei.width_m), mm(ei.height_m), mem, sizeof mem) !=
-            QNAV_OK) {
-        qnav_fx_fail(2, "%s: no map of %.1f x %.1f m", worlds[k], ei.width_m, ei.height_m);
+    /* the map the board places at the goal, from the start (the simulator's, too) */
+    if (n == 0u ||
+        !qnav_map_place(mc, bytes, (int32_t)lround(poses[0].x_m * 1000.0),
+                        (int32_t)lround(poses[0].y_m * 1000.0), (int32_t)lround(ei.dest_x_m * 1000.0),
+                        (int32_t)lround(ei.dest_y_m * 1000.0), &x0, &y0, &side) ||
+        qnav_map_init(&map, mc, cc, x0, y0, side, side, mem, bytes) != QNAV_OK) {
+        qnav_fx_fail(2, "%s: no map of %lu bytes placed between start and goal", worlds[k],
+                     (unsigned long)bytes);
     }
     fprintf(f, "/* %s: %u ticks of episode 1 (%s in the simulator) */\n", worlds[k],
             n, res.reached ? "reached" : "not reached");
@@ -119,8 +129,8 @@ static size_t one_world(FILE *f, const char *root, unsigned k, qnav_map_config_t
     }
     write_ticks(f, k, sim, &map, &ei, poses, n);
     fprintf(f, "};\n\n");
-    fprintf(f, "#define QNAV_BENCH_MAP_WORLD_%u {\"%s\", %lu, %lu, %ld, %ld, map_ticks_%u, %u}\n\n", k,
-            worlds[k], (unsigned long)mm(ei.width_m), (unsigned long)mm(ei.height_m),
+    fprintf(f, "#define QNAV_BENCH_MAP_WORLD_%u {\"%s\", %ld, %ld, %lu, %ld, %ld, map_ticks_%u, %u}\n\n", k,
+            worlds[k], (long)x0, (long)y0, (unsigned long)side,
             lround(ei.dest_x_m * 1000.0), lround(ei.dest_y_m * 1000.0), k, n);
     qnav_sim_destroy(sim);
     qnav_sim_env_free(env);
@@ -150,7 +160,7 @@ void qnav_fx_write_map_trace(const char *root, const char *out_dir, const char *
     for (k = 0; k < N_WORLDS; ++k) {
         fprintf(f, "%sQNAV_BENCH_MAP_WORLD_%u", k ? ", " : "", k);
     }
-    fprintf(f, "}\n/* The largest world's map, bytes */\n#define QNAV_BENCH_MAP_BYTES %lu\n\n",
+    fprintf(f, "}\n/* The board's memory for the map ([map] bytes) */\n#define QNAV_BENCH_MAP_BYTES %lu\n\n",
             (unsigned long)most);
     fprintf(f, "/* The profile's map and the controller fields it reads (qnav/map.h) */\n");
     fprintf(f, "#define QNAV_BENCH_MAP_CONFIG {%u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u}\n",

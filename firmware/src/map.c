@@ -99,6 +99,56 @@ size_t qnav_map_size(const qnav_map_config_t *cfg, uint32_t width_mm, uint32_t h
     return (size_t)BUCKETS * 2u + (size_t)cells * 8u;
 }
 
+/* Cells across the largest square map of cfg that len bytes hold (0: none). */
+static uint32_t square_cells(const qnav_map_config_t *cfg, size_t len)
+{
+    uint32_t lo = 0u, hi = 256u; /* lo fits (or is 0), hi does not */
+    while (hi - lo > 1u) {
+        const uint32_t n = (lo + hi) / 2u, side = n * cfg->cell_mm;
+        const size_t need = qnav_map_size(cfg, side, side);
+        if (need != 0u && need <= len) {
+            lo = n;
+        } else {
+            hi = n;
+        }
+    }
+    return lo;
+}
+
+static int32_t abs32(int32_t v)
+{
+    return v < 0 ? -v : v;
+}
+
+/* The placement rule along one axis: the corner of a map side_mm across midway between the
+ * robot at r and the goal at g; 0 when the two do not both lie a cell inside it. */
+static int place_axis(int32_t r, int32_t g, int32_t side, int32_t cell, int32_t *corner)
+{
+    if (abs32(g - r) > side - 2 * cell) {
+        return 0;
+    }
+    *corner = r / 2 + g / 2 - side / 2;
+    return 1;
+}
+
+int qnav_map_place(const qnav_map_config_t *cfg, size_t len, int32_t rx_mm, int32_t ry_mm,
+                   int32_t gx_mm, int32_t gy_mm, int32_t *x0_mm, int32_t *y0_mm,
+                   uint32_t *side_mm)
+{
+    int32_t cell, side;
+    if (cfg == NULL || x0_mm == NULL || y0_mm == NULL || side_mm == NULL || cfg->cell_mm == 0u) {
+        return 0;
+    }
+    cell = (int32_t)cfg->cell_mm;
+    side = (int32_t)square_cells(cfg, len) * cell;
+    if (side == 0 || !place_axis(rx_mm, gx_mm, side, cell, x0_mm) ||
+        !place_axis(ry_mm, gy_mm, side, cell, y0_mm)) {
+        return 0;
+    }
+    *side_mm = (uint32_t)side;
+    return 1;
+}
+
 qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
                             const qnav_ctrl_config_t *ctrl, int32_t x0_mm, int32_t y0_mm,
                             uint32_t width_mm, uint32_t height_mm, void *buf, size_t len)
@@ -193,6 +243,72 @@ void qnav_map_reset(qnav_map_t *m)
     m->stall_best_mm = 0u;
     m->stall_ticks = 0u;
     m->refused_ticks = 0u;
+}
+
+/* The full layout's qnav_cmap_shift: cell (i, j) takes cell (i + di, j + dj)'s evidence
+ * (unknown from outside the map; refusals forgotten). The plan's blocked cells and costs
+ * are made again by the next plan. */
+static void shift_evidence(qnav_map_t *m, int32_t di, int32_t dj)
+{
+    const int32_t nx = (int32_t)m->nx, ny = (int32_t)m->ny;
+    const int32_t istep = di > 0 ? 1 : -1, jstep = dj > 0 ? 1 : -1;
+    int32_t i, j, k, l;
+    for (l = 0, j = dj > 0 ? 0 : ny - 1; l < ny; ++l, j += jstep) {
+        for (k = 0, i = di > 0 ? 0 : nx - 1; k < nx; ++k, i += istep) {
+            const int32_t si = i + di, sj = j + dj;
+            int8_t e = qnav_map_in(m, si, sj) ? m->evidence[qnav_map_at(m, si, sj)] : 0;
+            m->evidence[qnav_map_at(m, i, j)] = e == EVIDENCE_REFUSED ? 0 : e;
+        }
+    }
+}
+
+/* The cell index of coordinate v in a map whose cells start at v0; -1 for any before it. */
+static int32_t index_along(int32_t v, int32_t v0, int32_t cell)
+{
+    return v >= v0 ? (v - v0) / cell : -1;
+}
+
+/* Whole cells from corner a to corner b (rounded to the nearest). */
+static int32_t cells_between(int32_t a, int32_t b, int32_t cell)
+{
+    const int32_t d = b - a;
+    return d >= 0 ? (d + cell / 2) / cell : -((-d + cell / 2) / cell);
+}
+
+int qnav_map_follow(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
+                    int32_t goal_y_mm)
+{
+    int32_t cell, edge, ri, rj, x0, y0, di, dj;
+    if (!ready(m) || pose == NULL) {
+        return 0;
+    }
+    cell = (int32_t)m->cfg.cell_mm;
+    /* the cells the readings mark (reach_mm) stay inside the map */
+    edge = ((int32_t)m->cfg.reach_mm + cell - 1) / cell;
+    ri = index_along(pose->x_mm, m->x0_mm, cell);
+    rj = index_along(pose->y_mm, m->y0_mm, cell);
+    if (ri >= edge && rj >= edge && ri < (int32_t)m->nx - edge && rj < (int32_t)m->ny - edge) {
+        return 0;
+    }
+    if (!place_axis(pose->x_mm, goal_x_mm, (int32_t)m->nx * cell, cell, &x0) ||
+        !place_axis(pose->y_mm, goal_y_mm, (int32_t)m->ny * cell, cell, &y0)) {
+        return 0;
+    }
+    di = cells_between(m->x0_mm, x0, cell);
+    dj = cells_between(m->y0_mm, y0, cell);
+    if (di == 0 && dj == 0) {
+        return 0;
+    }
+    if (m->cfg.compact) {
+        qnav_cmap_shift(m, di, dj);
+    } else {
+        shift_evidence(m, di, dj);
+    }
+    m->x0_mm += di * cell;
+    m->y0_mm += dj * cell;
+    m->planned = 0u; /* plan again over the moved map */
+    m->refused_ticks = 0u;
+    return 1;
 }
 
 /* The cell holding world point (x, y), clamped into the map. */

@@ -92,6 +92,46 @@ void qnav_cmap_arc(qnav_map_t *m, int32_t i, int32_t j)
     }
 }
 
+/* Row sj of plane k with cell i taking cell i + di, into out (unknown, 0, from outside the
+ * map): a byte at a time from the two source bytes it straddles. */
+static void shifted_row(const qnav_map_t *m, unsigned k, int32_t sj, int32_t di, uint8_t *out)
+{
+    const int32_t n = (int32_t)m->row_bytes;
+    const uint8_t *src;
+    int32_t b;
+    if (sj < 0 || sj >= (int32_t)m->ny) {
+        memset(out, 0, (size_t)n);
+        return;
+    }
+    src = plane(m, k, sj);
+    for (b = 0; b < n; ++b) {
+        const int32_t first = 8 * b + di; /* the source cell of the byte's first */
+        const int32_t q = first >= 0 ? first / 8 : -((7 - first) / 8);
+        const unsigned off = (unsigned)(first - 8 * q);
+        const unsigned lo = q >= 0 && q < n ? src[q] : 0u;
+        const unsigned hi = q + 1 >= 0 && q + 1 < n ? src[q + 1] : 0u;
+        out[b] = (uint8_t)((lo >> off) | (hi << (8u - off)));
+    }
+    if ((m->nx & 7u) != 0u) { /* the last byte's cells past the row stay unknown */
+        out[n - 1] = (uint8_t)(out[n - 1] & ((1u << (m->nx & 7u)) - 1u));
+    }
+}
+
+void qnav_cmap_shift(qnav_map_t *m, int32_t di, int32_t dj)
+{
+    /* rows in the order that reads each source row before it is written over */
+    uint8_t row[QNAV_CMAP_ROW_BYTES_MAX];
+    const int32_t ny = (int32_t)m->ny, step = dj > 0 ? 1 : -1;
+    int32_t j, l;
+    unsigned k;
+    for (l = 0, j = dj > 0 ? 0 : ny - 1; l < ny; ++l, j += step) {
+        for (k = SEEN_LO; k <= SEEN_HI; ++k) {
+            shifted_row(m, k, j + dj, di, row);
+            memcpy(plane(m, k, j), row, m->row_bytes);
+        }
+    }
+}
+
 int qnav_cmap_blocked(const qnav_map_t *m, int32_t i, int32_t j)
 {
     return bit2(m, SEEN_LO, i, j) == SEEN_OCCUPIED;

@@ -47,6 +47,10 @@ void qnav_cmap_arc(qnav_map_t *m, int32_t i, int32_t j);
 /* The cell cannot hold the robot's centre (occupied: cells are wider than its reach). */
 int qnav_cmap_blocked(const qnav_map_t *m, int32_t i, int32_t j);
 
+/* Cell (i, j) takes what cell (i + di, j + dj) was seen as (unknown when that lies outside
+ * the map): the map moved by (di, dj) cells. The plan is left as it was: start another. */
+void qnav_cmap_shift(qnav_map_t *m, int32_t di, int32_t dj);
+
 /* A new plan toward the destination's cell c (nothing settled but it). */
 void qnav_cmap_plan_start(qnav_map_t *m, uint32_t c);
 /* The plan must grow for the robot's cell (ri, rj) (or to be whole, ri < 0). */

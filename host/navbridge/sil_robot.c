@@ -249,6 +249,7 @@ typedef struct {
     qnav_sim_t *sim;
     lcm_t *lcm;
     qnav_map_t map;           /* the board core's map, with a profile's [map] */
+    qnav_map_config_t map_cfg; /* its configuration (a board placing maps keeps a pointer) */
     void *map_mem;
     uint32_t missed;          /* offboard ticks whose scan got no answer within reply_ms */
     uint32_t ticks;
@@ -310,10 +311,12 @@ static void print_destination(robot_t *r, qnav_sim_env_t *env)
            "--goal-at %.3f:%.3f)\n", x / 1000.0, y / 1000.0, x / 1000.0, y / 1000.0);
 }
 
-/* A profile with a [map] gives the board core a map (qnav_board_set_map), as a board with
- * the memory for one would run it: over the arena's bounding box in the odometry frame
- * (plus 1 m for drift), marked from the board's own dead reckoning. 0, or 2 after one line
- * when the area needs more cells than a map holds. */
+/* A profile with a [map] gives the board core a map, marked from the board's own dead
+ * reckoning. With [map] bytes, as the board made from the profile runs it: those bytes,
+ * placed at each position goal (qnav_board_place_maps). Without, as a board with the memory
+ * for one would: over the arena's bounding box in the odometry frame (plus 1 m for drift;
+ * qnav_board_set_map). 0, or 2 after one line when the area needs more cells than a map
+ * holds. */
 static int board_map(robot_t *r, const options_t *o, const qnav_sim_robot_t *robot,
                      qnav_sim_env_t *env, const qnav_board_config_t *bc)
 {
@@ -327,6 +330,20 @@ static int board_map(robot_t *r, const options_t *o, const qnav_sim_robot_t *rob
         return 0;
     }
     mc.noise_pct = (uint8_t)lround(o->noise * 100.0); /* the sonar it simulates, as qnav-sim */
+    r->map_cfg = mc;
+    bytes = qnav_sim_robot_map_bytes(robot);
+    if (bytes != 0u) {
+        r->map_mem = malloc(bytes);
+        if (r->map_mem == NULL ||
+            !qnav_board_place_maps(&r->bot, &r->map, &r->map_cfg, r->map_mem, bytes)) {
+            fprintf(stderr, "qnav-sil-robot: --robot %s: the board core cannot keep a map of "
+                            "%lu bytes\n", o->robot, (unsigned long)bytes);
+            return 2;
+        }
+        fprintf(stderr, "qnav-sil-robot: the board core places a map of %u mm cells in %lu "
+                        "bytes at each position goal\n", (unsigned)mc.cell_mm, (unsigned long)bytes);
+        return 0;
+    }
     qnav_sim_env_info(env, &ei);
     for (k = 0; k < 4; ++k) {
         double x, y;

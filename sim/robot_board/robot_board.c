@@ -64,6 +64,13 @@ static void put_map(FILE *out, const qnav_sim_robot_t *robot, const char *up)
             (unsigned)mc.near_cost, (unsigned)mc.near_mm, (unsigned)mc.arc_cdeg,
             (unsigned)mc.sight, (unsigned)mc.escape_grow, (unsigned)mc.refuse_ticks,
             (unsigned)mc.refuse_life_ticks, (unsigned)mc.compact, (unsigned)mc.grow_steps);
+    if (qnav_sim_robot_map_bytes(robot) != 0u) {
+        fprintf(out,
+                "/* The profile's [map] bytes: the board's memory for that map, the largest\n"
+                " * square of its cells they hold placed at each goal (qnav_map_place). */\n"
+                "#define QNAV_ROBOT_%s_MAP_BYTES %luu\n\n",
+                up, (unsigned long)qnav_sim_robot_map_bytes(robot));
+    }
 }
 
 int qnav_robot_board_header(const qnav_sim_robot_t *robot, FILE *out)

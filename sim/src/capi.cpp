@@ -311,6 +311,10 @@ int qnav_sim_robot_map_config(const qnav_sim_robot_t *robot, qnav_map_config_t *
     return 1;
 }
 
+uint32_t qnav_sim_robot_map_bytes(const qnav_sim_robot_t *robot) {
+    return robot && robot->profile.map_cell_m > 0.0 ? robot->profile.map_bytes : 0u;
+}
+
 qnav_sim_status_t qnav_sim_run_episode(qnav_sim_t *sim, const qnav_ctrl_t *ctrl,
                                        uint64_t episode_seed, qnav_sim_result_t *res,
                                        qnav_sim_trace_fn trace, void *user) {

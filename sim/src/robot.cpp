@@ -125,7 +125,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
     if (root.get("map")) {
         const toml::table &mp = r.table(root, "map");
         r.only_keys(mp, {"on", "cell_m", "reach_m", "look_m", "plan_s", "near_m", "near_cost", "arc_deg", "sight",
-                         "escape_grow", "refuse_s", "refuse_life_s", "pass_m", "compact", "grow_steps"});
+                         "escape_grow", "refuse_s", "refuse_life_s", "pass_m", "compact", "grow_steps", "bytes"});
         bool on = true;
         if (const toml::node *o = mp.get("on")) {
             if (!o->is_boolean()) r.fail(*o, "'on' must be true or false");
@@ -147,6 +147,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         p.map_refuse_s = r.number(mp, "refuse_s", 0.0, 25.5, true, p.map_refuse_s);
         p.map_refuse_life_s = r.number(mp, "refuse_life_s", 0.1, 6553.5, true, p.map_refuse_life_s);
         if (mp.get("pass_m")) p.map_pass_m = r.number(mp, "pass_m", 0.0, 10.0);
+        if (mp.get("bytes")) p.map_bytes = static_cast<std::uint32_t>(r.integer(mp, "bytes", 1, 16777216));
         if (const toml::node *c = mp.get("compact")) {
             if (!c->is_boolean()) r.fail(*c, "'compact' must be true or false");
             p.map_compact = c->value_or(false);

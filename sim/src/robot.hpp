@@ -75,6 +75,8 @@ struct RobotProfile {
     double map_refuse_life_s = 20.0;  // for this long
     bool map_compact = false;       // 4 bits a cell (qnav_map_config_t.compact)
     std::uint8_t map_grow_steps = 16;  // compact: plan steps grown a tick at most (0: no bound)
+    std::uint32_t map_bytes = 0;    // the board's memory for the map, placed at each goal as the
+                                    // board places it (qnav_map_place); 0: over the whole arena
     std::optional<double> map_pass_m;  // the controller's passing distance (the enlargement's,
                                        // qnav_ctrl_config_t.pass_mm) when the map guides it,
                                        // m; none: safety_m, as without a map

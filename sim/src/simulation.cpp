@@ -99,9 +99,14 @@ void Simulation::init_map() {
     robot_map_config(robot_, &mc);
     mc.noise_pct = map_noise_pct(cfg_.sensor_noise);  // the sonar this run draws
     const auto mm = [](double m) { return static_cast<std::uint32_t>(std::ceil(m * 1000.0)); };
+    robot_ctrl_config(robot_, cfg_.n_sectors, &map_ctrl_);
+    map_cfg_ = mc;
+    if (robot_.map_bytes > 0) {  // the board's memory, placed at each start (place_map)
+        map_mem_.assign((robot_.map_bytes + 1) / 2, 0);
+        return;
+    }
     map_mem_.assign((qnav_map_size(&mc, mm(env_.width_m), mm(env_.height_m)) + 1) / 2, 0);
-    qnav_ctrl_config_t cc;
-    robot_ctrl_config(robot_, cfg_.n_sectors, &cc);
+    const qnav_ctrl_config_t &cc = map_ctrl_;
     const qnav_status_t st = qnav_map_init(&map_, &mc, &cc, 0, 0, mm(env_.width_m), mm(env_.height_m),
                                            map_mem_.data(), map_mem_.size() * 2);
     if (st != QNAV_OK) {
@@ -110,6 +115,24 @@ void Simulation::init_map() {
             << env_.height_m << " m arena: " << qnav_status_str(st);
         throw SimError(QNAV_SIM_E_PARAM, why.str());
     }
+}
+
+// A board with [map] bytes of memory for its map starts it afresh at each goal over the
+// square those bytes hold, midway between the robot and the goal (qnav_map_place), or
+// steers without one when the goal lies too far for it: the robot the board is.
+void Simulation::place_map() {
+    const auto mm = [](double m) { return static_cast<std::int32_t>(std::lround(m * 1000.0)); };
+    map_ = qnav_map_t{};
+    std::int32_t x0 = 0, y0 = 0;
+    std::uint32_t side = 0;
+    if (!qnav_map_place(&map_cfg_, robot_.map_bytes, mm(pos_.x), mm(pos_.y), mm(env_.dest_x_m),
+                        mm(env_.dest_y_m), &x0, &y0, &side))
+        return;
+    const qnav_status_t st =
+        qnav_map_init(&map_, &map_cfg_, &map_ctrl_, x0, y0, side, side, map_mem_.data(), robot_.map_bytes);
+    if (st != QNAV_OK)
+        throw SimError(QNAV_SIM_E_PARAM, robot_.name + ": [map] placed over " + std::to_string(side) +
+                                             " mm: " + qnav_status_str(st));
 }
 
 Simulation::~Simulation() = default;
@@ -210,7 +233,10 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     vel_ = {0, 0};
     body_stale_ = false;
     if (!map_mem_.empty()) {
-        qnav_map_reset(&map_);
+        if (robot_.map_bytes > 0)
+            place_map();
+        else
+            qnav_map_reset(&map_);
         // the odometry's frame is the world's at the start (the destination's bearing and
         // range place it there each tick: anchor_goal)
         odom_pos_ = odom_last_pos_ = pos_;
@@ -284,9 +310,10 @@ void Simulation::guide_scan() {
     const Vec2 at = odom_on_ ? odom_pos_ : pos_;
     const double hd = odom_on_ ? odom_heading_ : heading_;
     const qnav_map_pose_t pose{mm(at.x), mm(at.y), to_cdeg(hd)};
+    const Vec2 goal = odom_on_ ? anchor_goal(at, hd) : Vec2{env_.dest_x_m, env_.dest_y_m};
+    if (robot_.map_bytes > 0) qnav_map_follow(&map_, &pose, mm(goal.x), mm(goal.y));  // as the board's
     qnav_map_observe(&map_, scan_.ranges_mm, &pose);
     const qnav_map_pose_t seen{pose.x_mm, pose.y_mm, odom_on_ ? pose.heading_cdeg : to_cdeg(sensed_heading_)};
-    const Vec2 goal = odom_on_ ? anchor_goal(at, hd) : Vec2{env_.dest_x_m, env_.dest_y_m};
     qnav_ctrl_input_t in{};
     in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
     in.goal_range_mm = scan_.goal_range_mm;

@@ -98,6 +98,7 @@ private:
     void build_world();
     void compute_scan();
     void init_map();
+    void place_map();
     void guide_scan();
     void drive_substep(double dt);
     void recovery_wheels();
@@ -112,6 +113,8 @@ private:
     // the profile's [map] (libqnav qnav/map.h): what the sonar has seen and a plan over it,
     // giving the scan a sub-goal; map_mem_ empty: none
     qnav_map_t map_{};
+    qnav_map_config_t map_cfg_{};   // the profile's map, for place_map
+    qnav_ctrl_config_t map_ctrl_{};
     std::vector<std::uint16_t> map_mem_;
     SimConfig cfg_;
     SonarRing sonar_;

@@ -691,6 +691,99 @@ static qnav_status_t square_metre(qnav_map_t *m, const qnav_map_config_t *mc,
     return qnav_map_init(m, mc, cc, 0, 0, 1000, 1000, mem, sizeof mem);
 }
 
+/* The evidence of every 100 mm point of [x0, x1) x [y0, y1) into e (at most 64 x 64). */
+static void evidence_grid(const qnav_map_t *m, int32_t x0, int32_t y0, int32_t x1, int32_t y1,
+                          int8_t *e)
+{
+    int32_t x, y, k = 0;
+    for (y = y0; y < y1; y += 100) {
+        for (x = x0; x < x1; x += 100) {
+            e[k++] = qnav_map_evidence(m, x, y);
+        }
+    }
+}
+
+/* Where a board places its map, and the map following the robot: what it saw stays where
+ * it was in the world, and what moved in is unknown, in either layout. */
+static void placed_map_follows(uint8_t compact)
+{
+    static int8_t before[64 * 64], after[64 * 64];
+    qnav_map_config_t mc;
+    qnav_ctrl_config_t cc;
+    qnav_map_t m;
+    qnav_ctrl_input_t in;
+    int32_t x0, y0;
+    uint32_t side;
+    const size_t len = compact ? 512u : 32u * 32u * 8u + 540u;
+    qnav_map_pose_t p = {1500, 1500, 9000};
+    qnav_map_config_default(&mc);
+    mc.cell_mm = 400;
+    mc.compact = compact;
+    mc.near_cost = 0;
+    mc.refuse_ticks = 0;
+    sensor_config(&cc);
+    /* the largest square the bytes hold (32 cells), midway between robot and goal */
+    assert_int_equal(qnav_map_place(&mc, len, 1500, 1500, 1500, 5000, &x0, &y0, &side), 1);
+    assert_int_equal(side, 12800);
+    assert_int_equal(x0, 750 + 750 - 6400);
+    assert_int_equal(y0, 750 + 2500 - 6400);
+    /* a goal less than a cell inside the square, or too few bytes: no map */
+    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 12001, 0, &x0, &y0, &side), 0);
+    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 0, -12001, &x0, &y0, &side), 0);
+    assert_int_equal(qnav_map_place(&mc, 3, 0, 0, 100, 100, &x0, &y0, &side), 0);
+    assert_int_equal(qnav_map_place(&mc, len, 1500, 1500, 1500, 5000, &x0, &y0, &side), 1);
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, x0, y0, side, side, mem, len), QNAV_OK);
+    observe_the_wall(&m);
+    /* the readings (2 m) stay 5 cells inside: the map stays put */
+    assert_int_equal(qnav_map_follow(&m, &p, 1500, 5000), 0);
+    evidence_grid(&m, -2000, 100, 4400, 6500, before);
+    /* near the east edge (x 7 900): the map moves east by whole cells, 2.4 m */
+    p.x_mm = 6000;
+    assert_int_equal(qnav_map_follow(&m, &p, 1500, 5000), 1);
+    assert_int_equal(m.x0_mm, -4900 + 2400);
+    assert_int_equal(m.y0_mm, -3150);
+    assert_int_equal(qnav_map_follow(&m, &p, 1500, 5000), 0);
+    evidence_grid(&m, -2000, 100, 4400, 6500, after);
+    assert_memory_equal(before, after, 64 * 64);
+    assert_true(qnav_map_evidence(&m, 2050, 2950) >= QNAV_MAP_OCCUPIED ||
+                qnav_map_evidence(&m, 2050, 3050) >= QNAV_MAP_OCCUPIED);
+    assert_int_equal(qnav_map_evidence(&m, 10000, 3000), 0); /* moved in: unknown */
+    assert_int_equal(qnav_map_evidence(&m, -4800, 3000), 0); /* moved out: no cell */
+    /* and back west past its other edge: what both squares hold is kept again */
+    p.x_mm = -600;
+    assert_int_equal(qnav_map_follow(&m, &p, 1500, 5000), 1);
+    assert_int_equal(m.x0_mm, -2500 - 9 * 400);
+    evidence_grid(&m, -2000, 100, 4400, 6500, after);
+    assert_memory_equal(before, after, 64 * 64);
+    /* north and east at once, then south */
+    p.x_mm = 1500;
+    p.y_mm = 8000;
+    assert_int_equal(qnav_map_follow(&m, &p, 1500, 5000), 1);
+    assert_int_equal(m.x0_mm, -4900);
+    assert_int_equal(m.y0_mm, -3150 + 8 * 400);
+    evidence_grid(&m, -2000, 100, 4400, 6500, after);
+    assert_memory_equal(before, after, 64 * 64);
+    p.y_mm = 1000;
+    assert_int_equal(qnav_map_follow(&m, &p, 1500, 5000), 1);
+    assert_int_equal(m.x0_mm, -4900);
+    assert_int_equal(m.y0_mm, 50 - 9 * 400);
+    evidence_grid(&m, -2000, 100, 4400, 6500, after);
+    assert_memory_equal(before, after, 64 * 64);
+    /* the plan made again over the moved map still goes round the wall (by its gap, or
+     * past its west end, which the moved map now holds) */
+    p.x_mm = 1500;
+    memset(&in, 0, sizeof in);
+    assert_true(qnav_map_guide(&m, &p, 1500, 5000, &in) & QNAV_MAP_GUIDED);
+    assert_true(in.goal_range_mm > 3500 + 1000);
+}
+
+static void test_a_placed_map_follows_the_robot(void **state)
+{
+    (void)state;
+    placed_map_follows(1);
+    placed_map_follows(0);
+}
+
 static void test_bad_maps_are_refused(void **state)
 {
     qnav_map_t m;
@@ -772,6 +865,7 @@ int main(void)
         cmocka_unit_test(test_a_destination_walled_in_leaves_the_input_alone),
         cmocka_unit_test(test_a_way_the_robot_cannot_take_is_refused_for_a_while),
         cmocka_unit_test(test_the_plan_is_settled_as_far_as_the_robot_needs),
+        cmocka_unit_test(test_a_placed_map_follows_the_robot),
         cmocka_unit_test(test_bad_maps_are_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -143,6 +143,18 @@ uint32_t qnav_map_cells(uint32_t width_mm, uint32_t height_mm, uint16_t cell_mm)
 size_t qnav_map_size(const qnav_map_config_t *cfg, uint32_t width_mm, uint32_t height_mm);
 
 /*
+ * Where a robot at (rx, ry) going to (gx, gy), mm, places a map of cfg in len bytes when it
+ * knows neither its room nor its goals beforehand (a board: qnav_board_place_maps; the
+ * simulator with a profile's [map] bytes): the largest square of cfg's cells that len bytes
+ * hold, *side_mm across, its corner at (*x0_mm, *y0_mm), centred midway between the robot
+ * and the goal. Returns 1, or 0 (nothing written) when no square fits in len or the two do
+ * not both lie a cell inside it (a goal too far: steered to without a map).
+ */
+int qnav_map_place(const qnav_map_config_t *cfg, size_t len, int32_t rx_mm, int32_t ry_mm,
+                   int32_t gx_mm, int32_t gy_mm, int32_t *x0_mm, int32_t *y0_mm,
+                   uint32_t *side_mm);
+
+/*
  * A map of the world [x0, x0 + width) x [y0, y0 + height) mm for a robot whose controller
  * is configured by ctrl (sectors, sonar range and offset, body): buf holds len bytes,
  * at least qnav_map_size(), aligned for uint16_t (the compact layout: any address).
@@ -152,6 +164,17 @@ QNAV_CHECK_RESULT qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_conf
                                               const qnav_ctrl_config_t *ctrl, int32_t x0_mm,
                                               int32_t y0_mm, uint32_t width_mm,
                                               uint32_t height_mm, void *buf, size_t len);
+
+/*
+ * A placed map (qnav_map_place) that follows the robot: once the cells its readings mark
+ * (reach_mm) would reach past the map's edge, the map moves, by whole cells, to where qnav_map_place would put
+ * it now (midway between the robot at pose and the goal), keeping what it saw where the old
+ * and the new square overlap, and plans again. Nothing when the goal would not fit the new
+ * square, or the move is less than a cell. Call before qnav_map_observe(). Returns 1 when
+ * the map moved. At most one pass over the cells.
+ */
+int qnav_map_follow(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
+                    int32_t goal_y_mm);
 
 /* Forget everything seen (a new world or start). */
 void qnav_map_reset(qnav_map_t *m);

@@ -212,6 +212,11 @@ void qnav_sim_robot_ctrl_config(const qnav_sim_robot_t *robot, uint16_t n_sector
  * profile then plan over it), 0 and cfg left alone when it has none. */
 int qnav_sim_robot_map_config(const qnav_sim_robot_t *robot, qnav_map_config_t *cfg);
 
+/* The board's memory for that map ([map] bytes): it places the map afresh at each goal
+ * over the largest square the bytes hold (qnav_map_place), and so do the simulator and the
+ * SIL robot; 0 when the profile gives none (the map then covers the whole arena). */
+uint32_t qnav_sim_robot_map_bytes(const qnav_sim_robot_t *robot);
+
 /* The episode's figures (paper Eq. 1-3; definitions in docs/sim.md). */
 typedef struct {
     qnav_sim_fitness_rule_t fitness; /* the rule f1, f2 and R were computed with */

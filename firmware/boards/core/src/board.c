@@ -435,43 +435,20 @@ static void decide(qnav_board_t *bot, uint32_t now, const qnav_ctrl_input_t *in,
     }
 }
 
-/* Cells across the largest square map of cfg that len bytes hold (0: none). */
-static uint32_t square_cells(const qnav_map_config_t *cfg, size_t len)
-{
-    uint32_t lo = 0u, hi = 256u; /* lo fits (or is 0), hi does not */
-    while (hi - lo > 1u) {
-        const uint32_t n = (lo + hi) / 2u, side = n * cfg->cell_mm;
-        const size_t need = qnav_map_size(cfg, side, side);
-        if (need != 0u && need <= len) {
-            lo = n;
-        } else {
-            hi = n;
-        }
-    }
-    return lo;
-}
-
-static int32_t abs32(int32_t v)
-{
-    return v < 0 ? -v : v;
-}
-
 /* A new position goal with qnav_board_place_maps: the map afresh over the square midway
- * between the robot and the goal, or none when they do not both fit a cell inside it. */
+ * between the robot and the goal (qnav_map_place), or none when they do not both fit a cell
+ * inside it. */
 static void place_map(qnav_board_t *bot)
 {
-    const int32_t cell = (int32_t)bot->place_cfg->cell_mm;
-    const int32_t side = (int32_t)square_cells(bot->place_cfg, bot->place_len) * cell;
-    const int32_t rx = bot->pose.x_um / 1000, ry = bot->pose.y_um / 1000;
-    const int32_t gx = bot->goal.x_mm, gy = bot->goal.y_mm;
+    int32_t x0, y0;
+    uint32_t side;
     bot->placed_goal = bot->goal.goal_id;
     bot->map = NULL;
-    if (abs32(gx - rx) > side - 2 * cell || abs32(gy - ry) > side - 2 * cell) {
-        return;
-    }
-    if (qnav_map_init(bot->place_map, bot->place_cfg, &bot->cfg.ctrl, rx / 2 + gx / 2 - side / 2,
-                      ry / 2 + gy / 2 - side / 2, (uint32_t)side, (uint32_t)side, bot->place_buf,
-                      bot->place_len) == QNAV_OK) {
+    if (qnav_map_place(bot->place_cfg, bot->place_len, bot->pose.x_um / 1000,
+                       bot->pose.y_um / 1000, bot->goal.x_mm, bot->goal.y_mm, &x0, &y0,
+                       &side) &&
+        qnav_map_init(bot->place_map, bot->place_cfg, &bot->cfg.ctrl, x0, y0, side, side,
+                      bot->place_buf, bot->place_len) == QNAV_OK) {
         bot->map = bot->place_map;
     }
 }
@@ -493,6 +470,9 @@ static void map_tick(void *board, qnav_ctrl_input_t *in, uint32_t *dist_mm, qnav
         const qnav_map_pose_t pose = {bot->pose.x_um / (int32_t)1000, bot->pose.y_um / (int32_t)1000,
                                       bot->pose.heading_cdeg};
         int got;
+        if (bot->place_map != NULL) { /* a placed map follows the robot */
+            (void)qnav_map_follow(bot->map, &pose, bot->goal.x_mm, bot->goal.y_mm);
+        }
         qnav_map_observe(bot->map, bot->ranges, &pose);
         got = qnav_map_guide(bot->map, &pose, bot->goal.x_mm, bot->goal.y_mm, in);
         if (got != 0) {

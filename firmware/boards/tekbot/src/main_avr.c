@@ -12,13 +12,13 @@
 static qnav_board_t g_bot;
 
 #ifdef QNAV_BOARD_ROBOT_MAP_CONFIG
-/* The profile's map, placed by the core at each position goal: 512 bytes hold 32 x 32
- * compact cells, 12.8 m at 0.4 m (docs/hil.md). */
-#ifndef QNAV_BOARD_MAP_BYTES
-#define QNAV_BOARD_MAP_BYTES 512u
+/* The profile's map, placed by the core at each position goal in the profile's [map] bytes
+ * (the TekBot's 512 hold 32 x 32 compact cells, 12.8 m at 0.4 m: docs/hil.md). */
+#ifndef QNAV_BOARD_ROBOT_MAP_BYTES
+#error "the robot's profile has its [map] on but gives it no bytes: the board's memory for it"
 #endif
 static qnav_map_t g_map;
-static uint8_t g_map_mem[QNAV_BOARD_MAP_BYTES];
+static uint8_t g_map_mem[QNAV_BOARD_ROBOT_MAP_BYTES];
 static const qnav_map_config_t g_map_cfg = QNAV_BOARD_ROBOT_MAP_CONFIG;
 #endif
 

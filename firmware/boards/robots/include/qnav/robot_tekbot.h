@@ -54,4 +54,8 @@
         .refuse_life_ticks = 200, .compact = 1, .grow_steps = 16 \
     }
 
+/* The profile's [map] bytes: the board's memory for that map, the largest
+ * square of its cells they hold placed at each goal (qnav_map_place). */
+#define QNAV_ROBOT_TEKBOT_MAP_BYTES 512u
+
 #endif /* QNAV_ROBOT_TEKBOT_H */

@@ -4,7 +4,8 @@
  * builds for the Pioneer 3-DX; the default is the TekBot. Gives QNAV_BOARD_ROBOT_NAME,
  * QNAV_BOARD_ROBOT_CONFIG (a qnav_board_config_t initialiser) and
  * QNAV_BOARD_ROBOT_UDEG_PER_COUNT (heading per differential encoder count, 1e-6 deg), and
- * QNAV_BOARD_ROBOT_MAP_CONFIG (a qnav_map_config_t initialiser) when its profile's [map]
+ * QNAV_BOARD_ROBOT_MAP_CONFIG (a qnav_map_config_t initialiser) and
+ * QNAV_BOARD_ROBOT_MAP_BYTES (the memory the board places it in) when its profile's [map]
  * is on.
  */
 #ifndef QNAV_ROBOTS_H
@@ -20,12 +21,18 @@
 #ifdef QNAV_ROBOT_PIONEER3DX_MAP_CONFIG
 #define QNAV_BOARD_ROBOT_MAP_CONFIG QNAV_ROBOT_PIONEER3DX_MAP_CONFIG
 #endif
+#ifdef QNAV_ROBOT_PIONEER3DX_MAP_BYTES
+#define QNAV_BOARD_ROBOT_MAP_BYTES QNAV_ROBOT_PIONEER3DX_MAP_BYTES
+#endif
 #else
 #define QNAV_BOARD_ROBOT_NAME QNAV_ROBOT_TEKBOT_NAME
 #define QNAV_BOARD_ROBOT_CONFIG QNAV_ROBOT_TEKBOT_CONFIG
 #define QNAV_BOARD_ROBOT_UDEG_PER_COUNT QNAV_ROBOT_TEKBOT_UDEG_PER_COUNT
 #ifdef QNAV_ROBOT_TEKBOT_MAP_CONFIG
 #define QNAV_BOARD_ROBOT_MAP_CONFIG QNAV_ROBOT_TEKBOT_MAP_CONFIG
+#endif
+#ifdef QNAV_ROBOT_TEKBOT_MAP_BYTES
+#define QNAV_BOARD_ROBOT_MAP_BYTES QNAV_ROBOT_TEKBOT_MAP_BYTES
 #endif
 #endif
 
