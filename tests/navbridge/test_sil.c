@@ -239,9 +239,10 @@ static void refused_in_one_line(const char *const *argv, const char *tag, const 
     assert_ptr_equal(strchr(text, '\n'), text + strlen(text) - 1); /* one line */
 }
 
-/* One lockstep trial of robot (a TekBot spec) in the committed U-pocket world
+/* One lockstep trial of robot (a TekBot spec with its map) in the committed U-pocket world
  * (pocket_tekbot.toml), navbridge in mode ("offboard" or "onboard") with --robot robot
- * logging to log: the robot must reach its destination. */
+ * logging to log: the robot must reach its destination, its board core running the map
+ * the board would. */
 static void pocket_trial(const char *robot, const char *mode, const char *log)
 {
     char link[300], tag[48], text[2048], goal[64];
@@ -256,6 +257,9 @@ static void pocket_trial(const char *robot, const char *mode, const char *log)
     assert_true(read_text(f.sil_out, text, sizeof text) > 0);
     print_message("%s: %s", mode, text);
     assert_non_null(strstr(text, "reached yes"));
+    /* the TekBot's map as its board runs it: the profile's 512 bytes, placed at the goal */
+    assert_true(read_text(f.sil_err, text, sizeof text) > 0);
+    assert_non_null(strstr(text, "the board core places a map of 400 mm cells in 512 bytes"));
 }
 
 /* Issues 17 and 18: in a U-pocket facing the start, the offboard robot leaves the dead end
