@@ -92,7 +92,7 @@ static void hash_episode(qnav_sim_t *sim, uint64_t seed, Fnv *f, qnav_sim_result
 
 static uint64_t batch_hash(void) {
     TestSim t;
-    make_test_sim(t, "pioneer3dx", "", "dense", 16, 0.05, 0.05, 2024, QNAV_SIM_FITNESS_PAPER);
+    make_test_sim(t, "pioneer3dx-map", "", "dense", 16, 0.05, 0.05, 2024, QNAV_SIM_FITNESS_PAPER);
     Fnv f;
     for (uint64_t e = 0; e < 12; ++e) hash_episode(t.sim, e, &f, nullptr);
     return f.h;

@@ -224,13 +224,14 @@ void test_a_maps_passing_distance_reaches_the_controller(void **) {
     assert_true(refusal(tekbot_with("[map]\ncell_m = 0.1\npass_m = -0.01\n")).find("pass_m") != std::string::npos);
 }
 
-// A loaded robot spec's map configuration: 1 and cfg when its map is on, 0 when off; the
-// test fails if the spec does not load.
-int loaded_map(const char *spec, qnav_map_config_t *cfg, qnav_ctrl_config_t *cc) {
+// A loaded robot spec's map configuration: 1 and cfg when its map is on, 0 when off (and
+// in *bytes the board's memory for it); the test fails if the spec does not load.
+int loaded_map(const char *spec, qnav_map_config_t *cfg, qnav_ctrl_config_t *cc, uint32_t *bytes = nullptr) {
     char err[QNAV_SIM_ERRLEN] = "";
     qnav_sim_robot_t *robot = nullptr;
     if (qnav_sim_robot_load(spec, &robot, err, sizeof err) != QNAV_SIM_OK) fail_with(spec, err);
     const int on = qnav_sim_robot_map_config(robot, cfg);
+    if (bytes) *bytes = qnav_sim_robot_map_bytes(robot);
     qnav_sim_robot_ctrl_config(robot, 0, cc);
     qnav_sim_robot_free(robot);
     return on;
@@ -257,9 +258,9 @@ void test_the_map_is_told_the_runs_sensor_noise(void **) {
     assert_int_equal(mc.noise_pct, 1);
 }
 
-// The TekBot's profile runs its map (on = true: the compact map its ATmega128 holds); the
-// Pioneer's describes one with on = false. NAME+map switches the profile's own map on, as
-// written, and nothing else; NAME-map switches it off (the robot of the paper's
+// Both robots' profiles run their maps (on = true: the compact map their ATmega128 holds,
+// the TekBot's of 0.4 m cells, the Pioneer's of 0.5 m). NAME+map switches the profile's own
+// map on, as written, and nothing else; NAME-map switches it off (the robot of the paper's
 // experiments). A profile with no [map] has nothing to switch on: refused naming the file;
 // NAME-map of it is the profile itself. 'on' takes only true or false.
 void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
@@ -267,22 +268,25 @@ void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
         const bool tekbot = std::string(robot) == "tekbot";
         qnav_map_config_t off, on, plain_map;
         qnav_ctrl_config_t plain, with, without;
-        assert_int_equal(loaded_map(robot, &plain_map, &plain), tekbot ? 1 : 0);
-        assert_int_equal(loaded_map((std::string(robot) + "-map").c_str(), &off, &without), 0);
+        uint32_t bytes = 0, off_bytes = 1;
+        assert_int_equal(loaded_map(robot, &plain_map, &plain, &bytes), 1);
+        assert_int_equal(bytes, 512); /* placed as the board places it */
+        assert_int_equal(loaded_map((std::string(robot) + "-map").c_str(), &off, &without, &off_bytes), 0);
+        assert_int_equal(off_bytes, 0);
         assert_int_equal(loaded_map((std::string(robot) + "+map").c_str(), &on, &with), 1);
-        /* the TekBot's is the map its ATmega128 holds: 4 bits a cell of 0.4 m */
-        assert_int_equal(on.cell_mm, tekbot ? 400 : 100);
-        assert_int_equal(on.compact, tekbot ? 1 : 0);
+        /* the map their ATmega128 holds: 4 bits a cell of 0.4 m (TekBot) or 0.5 m */
+        assert_int_equal(on.cell_mm, tekbot ? 400 : 500);
+        assert_int_equal(on.compact, 1);
         assert_int_equal(on.grow_steps, 16);
-        assert_int_equal(on.near_cost, tekbot ? 0 : 10);
-        assert_int_equal(on.refuse_ticks, tekbot ? 0 : 30);
-        if (tekbot) assert_true(on.cell_mm == plain_map.cell_mm && on.compact == plain_map.compact);
+        assert_int_equal(on.near_cost, 0);
+        assert_int_equal(on.refuse_ticks, 0);
+        assert_true(on.cell_mm == plain_map.cell_mm && on.compact == plain_map.compact);
         assert_int_equal(with.safety_mm, without.safety_mm);
         assert_int_equal(with.n_sectors, without.n_sectors);
         assert_int_equal(with.max_range_mm, without.max_range_mm);
         assert_int_equal(on.reach_mm, tekbot ? 2000 : 3000);
         assert_int_equal(with.pass_mm, tekbot ? 10 : without.safety_mm);
-        assert_int_equal(plain.pass_mm, tekbot ? with.pass_mm : without.pass_mm);
+        assert_int_equal(plain.pass_mm, with.pass_mm);
         assert_int_equal(without.pass_mm, without.safety_mm);
     }
     char dir[] = "/tmp/qnav_map_test_XXXXXX";

@@ -44,4 +44,18 @@
         .controller = "body" \
     }
 
+/* The profile's [map], on: the map the board places at each position goal
+ * (qnav_board_place_maps), a qnav_map_config_t. */
+#define QNAV_ROBOT_PIONEER3DX_MAP_CONFIG \
+    { \
+        .cell_mm = 500, .reach_mm = 3000, .look_mm = 1000, .jump_mm = 1000, \
+        .plan_ticks = 10, .noise_pct = 1, .near_cost = 0, .near_mm = 200, \
+        .arc_cdeg = 2250, .sight = 1, .escape_grow = 1, .refuse_ticks = 0, \
+        .refuse_life_ticks = 200, .compact = 1, .grow_steps = 16 \
+    }
+
+/* The profile's [map] bytes: the board's memory for that map, the largest
+ * square of its cells they hold placed at each goal (qnav_map_place). */
+#define QNAV_ROBOT_PIONEER3DX_MAP_BYTES 512u
+
 #endif /* QNAV_ROBOT_PIONEER3DX_H */
