@@ -120,14 +120,30 @@ static int32_t abs32(int32_t v)
     return v < 0 ? -v : v;
 }
 
-/* The placement rule along one axis: the corner of a map side_mm across midway between the
- * robot at r and the goal at g; 0 when the two do not both lie a cell inside it. */
-static int place_axis(int32_t r, int32_t g, int32_t side, int32_t cell, int32_t *corner)
+/* Cells between a placed map's edge and the robot: the cells its readings mark (reach_mm)
+ * stay inside the map. */
+static int32_t edge_cells(const qnav_map_config_t *cfg)
 {
-    if (abs32(g - r) > side - 2 * cell) {
+    return ((int32_t)cfg->reach_mm + (int32_t)cfg->cell_mm - 1) / (int32_t)cfg->cell_mm;
+}
+
+/* The placement rule along one axis: the corner of a map side_mm across midway between the
+ * robot at r and the goal at g when both lie a cell inside it; else the robot a cell more
+ * than the readings' reach inside it and the rest toward the goal (the plan then leads to
+ * the edge cell nearest the goal, and the map follows the robot there). 0 when the map is
+ * too small to keep the robot that far in. */
+static int place_axis(const qnav_map_config_t *cfg, int32_t r, int32_t g, int32_t side,
+                      int32_t *corner)
+{
+    const int32_t cell = (int32_t)cfg->cell_mm, in = (edge_cells(cfg) + 1) * cell;
+    if (abs32(g - r) <= side - 2 * cell) {
+        *corner = r / 2 + g / 2 - side / 2;
+        return 1;
+    }
+    if (2 * in > side) {
         return 0;
     }
-    *corner = r / 2 + g / 2 - side / 2;
+    *corner = g > r ? r - in : r + in - side;
     return 1;
 }
 
@@ -141,8 +157,8 @@ int qnav_map_place(const qnav_map_config_t *cfg, size_t len, int32_t rx_mm, int3
     }
     cell = (int32_t)cfg->cell_mm;
     side = (int32_t)square_cells(cfg, len) * cell;
-    if (side == 0 || !place_axis(rx_mm, gx_mm, side, cell, x0_mm) ||
-        !place_axis(ry_mm, gy_mm, side, cell, y0_mm)) {
+    if (side == 0 || !place_axis(cfg, rx_mm, gx_mm, side, x0_mm) ||
+        !place_axis(cfg, ry_mm, gy_mm, side, y0_mm)) {
         return 0;
     }
     *side_mm = (uint32_t)side;
@@ -283,15 +299,14 @@ int qnav_map_follow(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_m
         return 0;
     }
     cell = (int32_t)m->cfg.cell_mm;
-    /* the cells the readings mark (reach_mm) stay inside the map */
-    edge = ((int32_t)m->cfg.reach_mm + cell - 1) / cell;
+    edge = edge_cells(&m->cfg);
     ri = index_along(pose->x_mm, m->x0_mm, cell);
     rj = index_along(pose->y_mm, m->y0_mm, cell);
     if (ri >= edge && rj >= edge && ri < (int32_t)m->nx - edge && rj < (int32_t)m->ny - edge) {
         return 0;
     }
-    if (!place_axis(pose->x_mm, goal_x_mm, (int32_t)m->nx * cell, cell, &x0) ||
-        !place_axis(pose->y_mm, goal_y_mm, (int32_t)m->ny * cell, cell, &y0)) {
+    if (!place_axis(&m->cfg, pose->x_mm, goal_x_mm, (int32_t)m->nx * cell, &x0) ||
+        !place_axis(&m->cfg, pose->y_mm, goal_y_mm, (int32_t)m->ny * cell, &y0)) {
         return 0;
     }
     di = cells_between(m->x0_mm, x0, cell);

@@ -656,8 +656,9 @@ static void test_a_board_with_a_map_steers_round_what_it_has_seen(void **state)
 
 /* A board that places its own maps (qnav_board_place_maps, the compact map a TekBot
  * holds): at each new position goal a map afresh over the square midway to it, steering
- * round the wall as a map the caller gives does; a goal too far for the memory gets none.
- * The scripted robot stands at the origin facing +x, a wall 1 m ahead. */
+ * round the wall as a map the caller gives does; a goal too far for the square gets one
+ * that reaches toward it from the robot. The scripted robot stands at the origin facing
+ * +x, a wall 1 m ahead. */
 static void test_a_board_places_a_map_for_each_goal(void **state)
 {
     static uint8_t mem[512];
@@ -683,12 +684,15 @@ static void test_a_board_places_a_map_for_each_goal(void **state)
     assert_int_equal(map.y0_mm, -6400);
     assert_true(qnav_map_evidence(&map, 1000, 50) >= QNAV_MAP_OCCUPIED);
     assert_true(g.last_scan.goal_bearing_cdeg > 2000 || g.last_scan.goal_bearing_cdeg < -2000);
-    /* 20 m away: no square of those cells holds both; straight at it */
+    /* 20 m away: no square of those cells holds both; the robot 2.4 m (the readings' 2 m
+     * and a cell) inside its west edge, the square toward the goal, and round the wall */
     gl.goal_id = 10;
     gl.x_mm = 20000;
     to_board(QNAV_LINK_MSG_GOAL, p, qnav_link_goal_pack(&gl, p, sizeof p));
     run_with_heartbeats(QNAV_LINK_MODE_ONBOARD, 0, 300);
-    assert_int_equal(g.last_scan.goal_bearing_cdeg, 0);
+    assert_int_equal(map.x0_mm, -2400);
+    assert_int_equal(map.y0_mm, -6400);
+    assert_true(g.last_scan.goal_bearing_cdeg > 2000 || g.last_scan.goal_bearing_cdeg < -2000);
     /* a new goal near again: a map afresh about the new midpoint */
     gl.goal_id = 11;
     gl.x_mm = 2000;

@@ -703,6 +703,32 @@ static void evidence_grid(const qnav_map_t *m, int32_t x0, int32_t y0, int32_t x
     }
 }
 
+/* A goal too far for the square: the robot the readings' reach and a cell (6 cells of
+ * 400 mm) inside it, the rest toward the goal; too few bytes, or a square too small to keep
+ * the robot that far in: no map. */
+static void test_a_map_reaches_toward_a_goal_too_far_for_it(void **state)
+{
+    qnav_map_config_t mc;
+    int32_t x0, y0;
+    uint32_t side;
+    const size_t len = 512u;
+    (void)state;
+    qnav_map_config_default(&mc);
+    mc.cell_mm = 400;
+    mc.compact = 1;
+    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 12001, 0, &x0, &y0, &side), 1);
+    assert_int_equal(side, 12800);
+    assert_int_equal(x0, -2400);
+    assert_int_equal(y0, -6400);
+    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 0, -12001, &x0, &y0, &side), 1);
+    assert_int_equal(x0, -6400);
+    assert_int_equal(y0, 2400 - 12800);
+    assert_int_equal(qnav_map_place(&mc, 3, 0, 0, 100, 100, &x0, &y0, &side), 0);
+    mc.reach_mm = 6001; /* 16 cells: 2 x 17 do not fit in 32 */
+    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 12001, 0, &x0, &y0, &side), 0);
+    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 1000, 0, &x0, &y0, &side), 1);
+}
+
 /* Where a board places its map, and the map following the robot: what it saw stays where
  * it was in the world, and what moved in is unknown, in either layout. */
 static void placed_map_follows(uint8_t compact)
@@ -727,11 +753,6 @@ static void placed_map_follows(uint8_t compact)
     assert_int_equal(side, 12800);
     assert_int_equal(x0, 750 + 750 - 6400);
     assert_int_equal(y0, 750 + 2500 - 6400);
-    /* a goal less than a cell inside the square, or too few bytes: no map */
-    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 12001, 0, &x0, &y0, &side), 0);
-    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 0, -12001, &x0, &y0, &side), 0);
-    assert_int_equal(qnav_map_place(&mc, 3, 0, 0, 100, 100, &x0, &y0, &side), 0);
-    assert_int_equal(qnav_map_place(&mc, len, 1500, 1500, 1500, 5000, &x0, &y0, &side), 1);
     assert_int_equal(qnav_map_init(&m, &mc, &cc, x0, y0, side, side, mem, len), QNAV_OK);
     observe_the_wall(&m);
     /* the readings (2 m) stay 5 cells inside: the map stays put */
@@ -865,6 +886,7 @@ int main(void)
         cmocka_unit_test(test_a_destination_walled_in_leaves_the_input_alone),
         cmocka_unit_test(test_a_way_the_robot_cannot_take_is_refused_for_a_while),
         cmocka_unit_test(test_the_plan_is_settled_as_far_as_the_robot_needs),
+        cmocka_unit_test(test_a_map_reaches_toward_a_goal_too_far_for_it),
         cmocka_unit_test(test_a_placed_map_follows_the_robot),
         cmocka_unit_test(test_bad_maps_are_refused),
     };

@@ -147,8 +147,11 @@ size_t qnav_map_size(const qnav_map_config_t *cfg, uint32_t width_mm, uint32_t h
  * knows neither its room nor its goals beforehand (a board: qnav_board_place_maps; the
  * simulator with a profile's [map] bytes): the largest square of cfg's cells that len bytes
  * hold, *side_mm across, its corner at (*x0_mm, *y0_mm), centred midway between the robot
- * and the goal. Returns 1, or 0 (nothing written) when no square fits in len or the two do
- * not both lie a cell inside it (a goal too far: steered to without a map).
+ * and the goal. Along an axis where the two do not both lie a cell inside it (a goal too
+ * far), the robot lies the readings' reach and a cell inside the square and the rest of it
+ * toward the goal: the plan leads to the edge cell nearest the goal, and qnav_map_follow()
+ * moves the map on as the robot gets there. Returns 1, or 0 (nothing written) when no
+ * square fits in len or it is too small to keep the robot that far inside.
  */
 int qnav_map_place(const qnav_map_config_t *cfg, size_t len, int32_t rx_mm, int32_t ry_mm,
                    int32_t gx_mm, int32_t gy_mm, int32_t *x0_mm, int32_t *y0_mm,
