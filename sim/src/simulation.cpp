@@ -23,6 +23,9 @@ constexpr double kTouchSlack_m = 0.012;  // Box2D keeps ~0.01 m polygon skin; to
                                          // means within the body radius plus this
 constexpr double kEta1 = 1.0, kEta2 = 10.0;
 
+// A world coordinate, m -> the map's whole mm (libqnav qnav/map.h).
+std::int32_t map_mm(double m) { return static_cast<std::int32_t>(std::lround(m * 1000.0)); }
+
 // Robot-frame degrees -> (-180, 180] in centidegrees as the controller wants them.
 qnav_cdeg_t to_cdeg(double rad) {
     double cd = std::round(wrap_pi(rad) * 18000.0 / kPi);
@@ -121,12 +124,11 @@ void Simulation::init_map() {
 // square those bytes hold, midway between the robot and the goal (qnav_map_place), or
 // steers without one when the goal lies too far for it: the robot the board is.
 void Simulation::place_map() {
-    const auto mm = [](double m) { return static_cast<std::int32_t>(std::lround(m * 1000.0)); };
     map_ = qnav_map_t{};
     std::int32_t x0 = 0, y0 = 0;
     std::uint32_t side = 0;
-    if (!qnav_map_place(&map_cfg_, robot_.map_bytes, mm(pos_.x), mm(pos_.y), mm(env_.dest_x_m),
-                        mm(env_.dest_y_m), &x0, &y0, &side))
+    if (!qnav_map_place(&map_cfg_, robot_.map_bytes, map_mm(pos_.x), map_mm(pos_.y), map_mm(env_.dest_x_m),
+                        map_mm(env_.dest_y_m), &x0, &y0, &side))
         return;
     const qnav_status_t st =
         qnav_map_init(&map_, &map_cfg_, &map_ctrl_, x0, y0, side, side, map_mem_.data(), robot_.map_bytes);
@@ -305,19 +307,18 @@ void Simulation::compute_scan() {
 // the robot's frame with the heading the map knows: the sensed one on the true pose, the
 // odometry's own in its frame.
 void Simulation::guide_scan() {
-    const auto mm = [](double m) { return static_cast<std::int32_t>(std::lround(m * 1000.0)); };
     if (odom_on_) odometry();
     const Vec2 at = odom_on_ ? odom_pos_ : pos_;
     const double hd = odom_on_ ? odom_heading_ : heading_;
-    const qnav_map_pose_t pose{mm(at.x), mm(at.y), to_cdeg(hd)};
+    const qnav_map_pose_t pose{map_mm(at.x), map_mm(at.y), to_cdeg(hd)};
     const Vec2 goal = odom_on_ ? anchor_goal(at, hd) : Vec2{env_.dest_x_m, env_.dest_y_m};
-    if (robot_.map_bytes > 0) qnav_map_follow(&map_, &pose, mm(goal.x), mm(goal.y));  // as the board's
+    if (robot_.map_bytes > 0) qnav_map_follow(&map_, &pose, map_mm(goal.x), map_mm(goal.y));  // as the board's
     qnav_map_observe(&map_, scan_.ranges_mm, &pose);
     const qnav_map_pose_t seen{pose.x_mm, pose.y_mm, odom_on_ ? pose.heading_cdeg : to_cdeg(sensed_heading_)};
     qnav_ctrl_input_t in{};
     in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
     in.goal_range_mm = scan_.goal_range_mm;
-    const int got = qnav_map_guide(&map_, &seen, mm(goal.x), mm(goal.y), &in);
+    const int got = qnav_map_guide(&map_, &seen, map_mm(goal.x), map_mm(goal.y), &in);
     scan_.escape_clear = (got & QNAV_MAP_ESCAPE_CLEARED) ? 1 : 0;
     scan_.escape_grow_mm = (got & QNAV_MAP_ESCAPE_GROWN) ? qnav_map_grown_mm(&map_) : 0;
     if (odom_on_ && (got & QNAV_MAP_DIRECT)) return;  // the destination in sight: its sensed bearing
