@@ -493,3 +493,14 @@ void qnav_escape_keep_moving(const qnav_clearance_t *c, const uint8_t *lvl,
         out->quality = out->speed;
     }
 }
+
+void qnav_escape_hold_turn(uint16_t prev, qnav_ctrl_output_t *out)
+{
+    const qnav_deg_t p = qnav_signed_deg(prev);
+    const qnav_deg_t h = out->heading_deg;
+    if (p > 0 && h < -90 && p - h > 180) {
+        out->heading_deg = 179;
+    } else if (p < 0 && h > 90 && h - p > 180) {
+        out->heading_deg = -179;
+    }
+}

@@ -52,4 +52,14 @@ void qnav_escape_clear(qnav_escape_t *e);
 void qnav_escape_keep_moving(const qnav_clearance_t *c, const uint8_t *lvl,
                              const qnav_escape_t *e, uint16_t goal, qnav_ctrl_output_t *out);
 
+/*
+ * A turn keeps its way round. When this decision lies more than 90 degrees off straight
+ * ahead and the last one (prev, whole degrees 0..359, in this tick's frame) on the other
+ * side, and the shorter way from one to the other passes behind the robot, the decision
+ * becomes a turn the same way round as the last one (179 or -179 degrees). Without it a
+ * robot turning in place toward a path behind it, whose scan changes with every degree it
+ * turns, can be sent left and right on alternate ticks and stand where it is.
+ */
+void qnav_escape_hold_turn(uint16_t prev, qnav_ctrl_output_t *out);
+
 #endif /* QNAV_ESCAPE_H */

@@ -30,6 +30,10 @@ typedef struct {
     uint32_t read_upto;           /* bytes of from_board already decoded */
     uint32_t scans, telemetry, acks;
     qnav_link_command_t last_tel;
+    qnav_link_command_t prev_tel;     /* the onboard decision before last_tel */
+    qnav_cdeg_t pose_heading_cdeg;    /* the last POSE frame's heading */
+    qnav_cdeg_t tel_yaw_cdeg;         /* the heading last_tel was decided at (its tick's POSE) */
+    qnav_cdeg_t prev_tel_yaw_cdeg;    /* and prev_tel's */
     uint16_t last_scan_seq;
     qnav_link_scan_t last_scan;
     qnav_link_policy_ack_t last_ack;
@@ -37,6 +41,15 @@ typedef struct {
 } bench_t;
 
 static bench_t g;
+
+/* The previous decision as the board's step saw it with last_tel's scan (its carry, from
+ * the decision before and the turn made since): a reference step gets the same. */
+static qnav_cdeg_t tel_prev_heading(void)
+{
+    return g.telemetry > 1u ? qnav_ctrl_prev_heading(g.prev_tel.heading_deg, g.prev_tel_yaw_cdeg,
+                                                     g.tel_yaw_cdeg)
+                            : 0;
+}
 
 /* The bench with `sectors` sonar sectors; with_table: the HAL has a table area. */
 static void bench_start_with(uint16_t sectors, int with_table)
@@ -108,11 +121,15 @@ static void read_board(void)
             g.last_scan_seq = f.seq;
             g.scans++;
         } else if (f.msg_id == QNAV_LINK_MSG_COMMAND) {
+            g.prev_tel = g.last_tel;
+            g.prev_tel_yaw_cdeg = g.tel_yaw_cdeg;
+            g.tel_yaw_cdeg = g.pose_heading_cdeg; /* a tick's POSE comes before its decision */
             assert_int_equal(qnav_link_command_unpack(f.payload, f.len, &g.last_tel), 0);
             g.telemetry++;
         } else if (f.msg_id == QNAV_LINK_MSG_POSE) {
             qnav_link_pose_t ps;
             assert_int_equal(qnav_link_pose_unpack(f.payload, f.len, &ps), 0);
+            g.pose_heading_cdeg = ps.heading_cdeg;
             g.pose_clears += ps.escape_clear;
             g.pose_grown_mm += ps.escape_grow_mm;
         } else if (f.msg_id == QNAV_LINK_MSG_POLICY_ACK) {
@@ -192,6 +209,7 @@ static void test_onboard_board_drives_with_libqnav_decision(void **state)
     assert_int_equal(qnav_ctrl_init(&c, &cc, &p), QNAV_OK);
     in.ranges_mm = g.last_scan.ranges_mm;
     in.goal_bearing_cdeg = g.last_scan.goal_bearing_cdeg;
+    in.prev_heading_cdeg = tel_prev_heading();
     qnav_ctrl_step(&c, &in, &want, NULL);
     assert_int_equal(g.last_tel.heading_deg, want.heading_deg);
     assert_int_equal(g.last_tel.speed, want.speed);
@@ -471,6 +489,7 @@ static void test_an_uploaded_network_is_compiled_into_the_table_area(void **stat
     assert_memory_equal(g.sim.table, want, sizeof want);
     in.ranges_mm = g.last_scan.ranges_mm;
     in.goal_bearing_cdeg = g.last_scan.goal_bearing_cdeg;
+    in.prev_heading_cdeg = tel_prev_heading();
     qnav_ctrl_step(&ref, &in, &out, NULL);
     assert_int_equal(g.last_tel.heading_deg, out.heading_deg);
     assert_int_equal(g.last_tel.speed, out.speed);

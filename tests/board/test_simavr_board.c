@@ -31,6 +31,7 @@
 #include "qnav/policy_io.h"
 #include "qnav/sim.h"
 #include "qnav_command_t.h"
+#include "qnav_nav_input_t.h"
 #include "qnav_scan_t.h"
 
 static char g_dir[256];
@@ -98,6 +99,8 @@ static unsigned compare_with_simulator(const char *log_path, const char *robot,
     static qnav_ctrl_t ctrl;
     static qnav_scan_t scans[64];
     static int32_t seqs[64];
+    static qnav_cdeg_t prevs[64]; /* each scan's previous heading, as the board read it */
+    qnav_nav_input_t rec;
     unsigned next = 0, compared = 0;
     lcm_eventlog_t *log;
     lcm_eventlog_event_t *ev;
@@ -108,11 +111,18 @@ static unsigned compare_with_simulator(const char *log_path, const char *robot,
     qnav_sim_ctrl_config(sim, &cc);
     assert_int_equal(qnav_ctrl_init(&ctrl, &cc, p), QNAV_OK);
     memset(seqs, 0xFF, sizeof seqs);
+    memset(&rec, 0, sizeof rec);
+    rec.scan_seq = -1;
     log = lcm_eventlog_create(log_path, "r");
     assert_non_null(log);
     while ((ev = lcm_eventlog_read_next_event(log)) != NULL) {
-        if (strcmp(ev->channel, "QNAV_SCAN") == 0) {
+        if (strcmp(ev->channel, "QNAV_NAV_INPUT") == 0) {
+            /* published just before its scan */
+            assert_true(qnav_nav_input_t_decode(ev->data, 0, ev->datalen, &rec) >= 0);
+        } else if (strcmp(ev->channel, "QNAV_SCAN") == 0) {
             assert_true(qnav_scan_t_decode(ev->data, 0, ev->datalen, &scans[next]) >= 0);
+            assert_int_equal(rec.scan_seq, scans[next].seq);
+            prevs[next] = (qnav_cdeg_t)rec.prev_heading_cdeg;
             /* the board scans with the profile's sonar */
             assert_int_equal(scans[next].n_sectors, cc.n_sectors);
             assert_int_equal(scans[next].max_range_mm, cc.max_range_mm);
@@ -136,7 +146,7 @@ static unsigned compare_with_simulator(const char *log_path, const char *robot,
                 }
                 in.ranges_mm = ranges;
                 in.goal_bearing_cdeg = scans[k].goal_bearing_cdeg;
-                in.prev_heading_cdeg = 0; /* a 2-input network does not read it */
+                in.prev_heading_cdeg = prevs[k];
                 qnav_ctrl_step(&ctrl, &in, &out, NULL);
                 assert_int_equal(out.heading_deg, c.heading_deg);
                 assert_int_equal(out.speed, c.speed_q15);

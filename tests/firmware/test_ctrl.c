@@ -295,6 +295,45 @@ static qnav_deg_t heading_with_prev(const qnav_ctrl_t *c, const qnav_mm_t *range
     return out.heading_deg;
 }
 
+/* The decision h is the turn that keeps the way round of the last decision prev. */
+static int kept_turn(int prev, qnav_deg_t h)
+{
+    return (h == 179 && prev > 0) || (h == -179 && prev < 0);
+}
+
+/* A decision more than 90 degrees off straight ahead, on the other side from the last one,
+ * with the shorter way between the two behind the robot, turns the same way round as the
+ * last one: a robot turning in place toward a way behind it is not sent left and right on
+ * alternate ticks (escape.h, qnav_escape_hold_turn). */
+static void test_a_turn_keeps_its_way_round(void **state)
+{
+    (void)state;
+    qnav_ctrl_t c;
+    qnav_policy_t p;
+    qnav_mm_t ranges[16];
+    qnav_ctrl_output_t out;
+    qnav_policy_prob_default(&p);
+    init_or_fail(&c, 16, 5000, &p);
+    fill(ranges, 16, 5000);
+    for (int side = -1; side <= 1; side += 2) {
+        qnav_ctrl_input_t in = {ranges, (qnav_cdeg_t)(-side * 15000)};
+        const int expect[][2] = {
+            {0, -side * 150},           /* the first tick: the destination's way */
+            {-side * 120, -side * 150}, /* the last turn went that way round too */
+            {side * 20, -side * 150},   /* the shorter way from the last passes in front */
+            {side * 30, -side * 150},   /* 180 either way round: not held */
+            {side * 31, side * 179},    /* the shorter way passes behind, by a degree */
+            {side * 120, side * 179},   /* behind: keep turning the last way round */
+            {side * 179, side * 179},
+        };
+        for (size_t k = 0; k < sizeof expect / sizeof expect[0]; ++k) {
+            in.prev_heading_cdeg = (qnav_cdeg_t)(expect[k][0] * 100);
+            qnav_ctrl_step(&c, &in, &out, NULL);
+            assert_int_equal(out.heading_deg, expect[k][1]);
+        }
+    }
+}
+
 static void test_holding_keeps_the_previous_of_two_equal_ways(void **state)
 {
     (void)state;
@@ -338,6 +377,9 @@ static void test_holding_preactivation_keys_within_a_margin_of_z(void **state)
         int prev = (int)rng_range(-179, 180);
         qnav_deg_t h_off = heading_with_prev(&off, ranges, (qnav_cdeg_t)(prev * 100));
         qnav_deg_t h_on = heading_with_prev(&on, ranges, (qnav_cdeg_t)(prev * 100));
+        if (kept_turn(prev, h_off) || kept_turn(prev, h_on)) {
+            continue; /* a turn kept its way round (its own test below): no path's key */
+        }
         (void)qnav_ctrl_path_levels(&on, ranges, lvl);
         qnav_qkey_t kp = qnav_ctrl_key(&on, lvl[(prev + 360) % 360], (uint8_t)(prev < 0 ? -prev : prev));
         qnav_qkey_t kb = qnav_ctrl_key(&on, lvl[(h_off + 360) % 360], (uint8_t)(h_off < 0 ? -h_off : h_off));
@@ -1548,6 +1590,7 @@ int main(void)
         cmocka_unit_test(test_level_maps_zero_and_max_range_to_the_ends),
         cmocka_unit_test(test_ctrl_drives_at_goal_in_open_space),
         cmocka_unit_test(test_ctrl_turns_away_from_near_obstacle),
+        cmocka_unit_test(test_a_turn_keeps_its_way_round),
         cmocka_unit_test(test_holding_keeps_the_previous_of_two_equal_ways),
         cmocka_unit_test(test_holding_preactivation_keys_within_a_margin_of_z),
         cmocka_unit_test(test_ctrl_prefers_goal_over_far_obstacle),

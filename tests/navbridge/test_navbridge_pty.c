@@ -74,8 +74,10 @@ static uint16_t scan_payload(int i, uint16_t n, uint8_t *out, qnav_link_scan_t *
     return (uint16_t)qnav_link_scan_pack(s, out, QNAV_LINK_MAX_PAYLOAD);
 }
 
+/* The command libqnav gives for scan s after the decision whose heading was prev_deg (the
+ * bridge carries it from tick to tick; these scans turn the robot by nothing). */
 static void expected_command(const qnav_policy_t *p, const qnav_link_scan_t *s,
-                             qnav_ctrl_output_t *out)
+                             qnav_deg_t prev_deg, qnav_ctrl_output_t *out)
 {
     qnav_ctrl_config_t cfg;
     qnav_ctrl_t c;
@@ -86,6 +88,7 @@ static void expected_command(const qnav_policy_t *p, const qnav_link_scan_t *s,
     assert_int_equal(qnav_ctrl_init(&c, &cfg, p), QNAV_OK);
     in.ranges_mm = s->ranges_mm;
     in.goal_bearing_cdeg = s->goal_bearing_cdeg;
+    in.prev_heading_cdeg = (qnav_cdeg_t)(prev_deg * 100);
     qnav_ctrl_step(&c, &in, out, NULL);
 }
 
@@ -170,6 +173,7 @@ static void test_offboard_commands_equal_libqnav_and_replay_identically(void **s
     qnav_policy_t policy;
     char perr[QNAV_POLICY_IO_ERRLEN];
     int i;
+    qnav_deg_t prev = 0;
     (void)state;
     snprintf(log, sizeof log, "%s/trial.lcmlog", g_dir);
     snprintf(bad_log, sizeof bad_log, "%s/tampered.lcmlog", g_dir);
@@ -188,7 +192,8 @@ static void test_offboard_commands_equal_libqnav_and_replay_identically(void **s
         uint16_t n = scan_payload(i, i < 20 ? 16 : 32, p, &s);
         assert_int_equal(fakeboard_send(&fb, QNAV_LINK_MSG_SCAN, p, n), 0);
         assert_int_equal(wait_command_for(&fb, seq, &c), 0);
-        expected_command(&policy, &s, &want);
+        expected_command(&policy, &s, prev, &want);
+        prev = want.heading_deg;
         assert_int_equal(c.heading_deg, want.heading_deg);
         assert_int_equal(c.speed, want.speed);
         assert_int_equal(c.quality, want.quality);
