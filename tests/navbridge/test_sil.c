@@ -259,7 +259,7 @@ static void pocket_trial(const char *robot, const char *mode, const char *log)
     assert_non_null(strstr(text, "reached yes"));
     /* the TekBot's map as its board runs it: the profile's 512 bytes, placed at the goal */
     assert_true(read_text(f.sil_err, text, sizeof text) > 0);
-    assert_non_null(strstr(text, "the board core places a map of 400 mm cells in 512 bytes"));
+    assert_non_null(strstr(text, "the board core places a map of 350 mm cells in 512 bytes"));
 }
 
 /* Issues 17 and 18: in a U-pocket facing the start, the offboard robot leaves the dead end

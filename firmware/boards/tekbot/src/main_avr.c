@@ -13,7 +13,7 @@ static qnav_board_t g_bot;
 
 #ifdef QNAV_BOARD_ROBOT_MAP_CONFIG
 /* The profile's map, placed by the core at each position goal in the profile's [map] bytes
- * (the TekBot's 512 hold 32 x 32 compact cells, 12.8 m at 0.4 m: docs/hil.md). */
+ * (the TekBot's 512 hold 32 x 32 compact cells, 11.2 m at 0.35 m: docs/hil.md). */
 #ifndef QNAV_BOARD_ROBOT_MAP_BYTES
 #error "the robot's profile has its [map] on but gives it no bytes: the board's memory for it"
 #endif

@@ -255,7 +255,7 @@ int qnav_board_set_map(qnav_board_t *bot, qnav_map_t *map);
  * the len bytes at buf, all the caller's and kept by it) over the largest square of cfg's
  * cells those bytes hold, centred midway between the robot and the goal, or reaching toward
  * a goal too far for it (qnav_map_place), and moves it with the robot each tick
- * (qnav_map_follow). 512 bytes hold 32 x 32 compact cells: 12.8 m at 0.4 m. map NULL
+ * (qnav_map_follow). 512 bytes hold 32 x 32 compact cells: 11.2 m at 0.35 m. map NULL
  * turns it off;
  * qnav_board_set_map() and this replace each other. Returns 1, or 0 (and places nothing)
  * with a NULL argument besides map.
