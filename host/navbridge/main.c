@@ -151,18 +151,21 @@ static int parse_route(const char *s, qnav_waypoints_t *w)
 typedef struct {
     const char *name;
     qnav_board_config_t expected;
+    qnav_board_map_info_t expected_map;
 } robot_check_t;
 
 static int check_board_config(void *user, const qnav_link_config_t *m, char *line, size_t len)
 {
-    return qnav_robot_board_diff(m, &((robot_check_t *)user)->expected, line, len);
+    const robot_check_t *rc = (const robot_check_t *)user;
+    return qnav_robot_board_diff(m, &rc->expected, &rc->expected_map, line, len);
 }
 
 /* Load --robot into rc and cfg (controller configuration, check); 0 or 2 after one line. */
 static int use_robot(const char *spec, robot_check_t *rc, qnav_bridge_config_t *cfg)
 {
     char err[QNAV_SIM_ERRLEN];
-    if (qnav_robot_board_load(spec, &rc->expected, err, sizeof err) != QNAV_SIM_OK) {
+    if (qnav_robot_board_load(spec, &rc->expected, &rc->expected_map, err, sizeof err) !=
+        QNAV_SIM_OK) {
         fprintf(stderr, "navbridge: --robot: %s\n", err);
         return 2;
     }

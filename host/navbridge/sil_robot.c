@@ -329,7 +329,7 @@ static int board_map(robot_t *r, const options_t *o, const qnav_sim_robot_t *rob
     if (r->sim == NULL || !qnav_sim_robot_map_config(robot, &mc)) {
         return 0;
     }
-    mc.noise_pct = (uint8_t)lround(o->noise * 100.0); /* the sonar it simulates, as qnav-sim */
+    /* the profile's, as the board's header has it (the sonar's range noise it assumes) */
     r->map_cfg = mc;
     bytes = qnav_sim_robot_map_bytes(robot);
     if (bytes != 0u) {

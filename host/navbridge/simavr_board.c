@@ -79,6 +79,7 @@ typedef struct {
 typedef struct {
     qnav_link_rx_t rx;
     const qnav_board_config_t *expected;
+    qnav_board_map_info_t expected_map;
     int checked;                  /* a report matched */
     int refused;                  /* a report differed: diff says how */
     char diff[96];
@@ -92,7 +93,8 @@ static void watch_byte(config_watch_t *w, uint8_t b)
     qnav_link_config_t m;
     if (qnav_link_rx_feed(&w->rx, b, &f) && f.msg_id == QNAV_LINK_MSG_CONFIG &&
         qnav_link_config_unpack(f.payload, f.len, &m) == QNAV_LINK_OK) {
-        if (qnav_robot_board_diff(&m, w->expected, w->diff, sizeof w->diff) == 0) {
+        if (qnav_robot_board_diff(&m, w->expected, &w->expected_map, w->diff, sizeof w->diff) ==
+            0) {
             w->checked = 1;
         } else {
             w->refused = 1;
@@ -498,7 +500,8 @@ static int parse_args(int argc, char **argv, options_t *o)
 static int load_robot(const char *spec, qnav_board_config_t *expected, int *sectors)
 {
     char rerr[QNAV_SIM_ERRLEN];
-    if (qnav_robot_board_load(spec, expected, rerr, sizeof rerr) != QNAV_SIM_OK) {
+    if (qnav_robot_board_load(spec, expected, &g_watch.expected_map, rerr, sizeof rerr) !=
+        QNAV_SIM_OK) {
         fprintf(stderr, "qnav-simavr-board: --robot: %s\n", rerr);
         return 2;
     }

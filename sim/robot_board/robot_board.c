@@ -19,8 +19,8 @@ void qnav_robot_board_config(const qnav_sim_robot_t *robot, qnav_board_config_t 
     cfg->um_per_count = (uint16_t)ri.um_per_count;
 }
 
-qnav_sim_status_t qnav_robot_board_load(const char *spec, qnav_board_config_t *cfg, char *err,
-                                        size_t errlen)
+qnav_sim_status_t qnav_robot_board_load(const char *spec, qnav_board_config_t *cfg,
+                                        qnav_board_map_info_t *map, char *err, size_t errlen)
 {
     qnav_sim_robot_t *robot = NULL;
     qnav_sim_status_t st = qnav_sim_robot_load(spec, &robot, err, errlen);
@@ -28,8 +28,18 @@ qnav_sim_status_t qnav_robot_board_load(const char *spec, qnav_board_config_t *c
         return st;
     }
     qnav_robot_board_config(robot, cfg);
+    if (map != NULL) {
+        qnav_robot_board_map_info(robot, map);
+    }
     qnav_sim_robot_free(robot);
     return QNAV_SIM_OK;
+}
+
+void qnav_robot_board_map_info(const qnav_sim_robot_t *robot, qnav_board_map_info_t *info)
+{
+    qnav_map_config_t mc;
+    const int on = qnav_sim_robot_map_config(robot, &mc);
+    qnav_board_map_info(on ? &mc : NULL, (uint32_t)qnav_sim_robot_map_bytes(robot), info);
 }
 
 long qnav_robot_board_udeg_per_count(const qnav_board_config_t *cfg)
@@ -121,24 +131,42 @@ int qnav_robot_board_header(const qnav_sim_robot_t *robot, FILE *out)
     return fflush(out) == 0 && !ferror(out) ? 0 : -1;
 }
 
-int qnav_robot_board_diff(const qnav_link_config_t *reported, const qnav_board_config_t *expected,
-                          char *line, size_t len)
+/* 1, with the line, when field id is missing from the report or differs from want. */
+static int field_differs(const qnav_link_config_t *reported, uint8_t id, const char *name,
+                         int32_t want, char *line, size_t len)
 {
     uint8_t i;
+    for (i = 0; i < reported->n && reported->key[i] != id; ++i) {
+    }
+    if (i == reported->n) {
+        snprintf(line, len, "%s not reported", name);
+        return 1;
+    }
+    if (reported->value[i] != want) {
+        snprintf(line, len, "%s %ld != %ld", name, (long)reported->value[i], (long)want);
+        return 1;
+    }
+    return 0;
+}
+
+int qnav_robot_board_diff(const qnav_link_config_t *reported, const qnav_board_config_t *expected,
+                          const qnav_board_map_info_t *expected_map, char *line, size_t len)
+{
 #define QNAV_ROBOT_BOARD_CHECK(id, name, member)                                           \
-    for (i = 0; i < reported->n && reported->key[i] != (id); ++i) {                        \
-    }                                                                                       \
-    if (i == reported->n) {                                                                 \
-        snprintf(line, len, "%s not reported", #name);                                      \
-        return 1;                                                                           \
-    }                                                                                       \
-    if (reported->value[i] != (int32_t)expected->member) {                                  \
-        snprintf(line, len, "%s %ld != %ld", #name, (long)reported->value[i],               \
-                 (long)expected->member);                                                   \
+    if (field_differs(reported, (uint8_t)(id), #name, (int32_t)expected->member, line, len)) { \
         return 1;                                                                           \
     }
     QNAV_BOARD_ROBOT_FIELDS(QNAV_ROBOT_BOARD_CHECK)
 #undef QNAV_ROBOT_BOARD_CHECK
+#define QNAV_ROBOT_BOARD_CHECK_MAP(id, name, member)                                       \
+    if (field_differs(reported, (uint8_t)(id), #name, (int32_t)expected_map->member, line,  \
+                      len)) {                                                               \
+        return 1;                                                                           \
+    }
+    if (expected_map != NULL) {
+        QNAV_BOARD_MAP_FIELDS(QNAV_ROBOT_BOARD_CHECK_MAP)
+    }
+#undef QNAV_ROBOT_BOARD_CHECK_MAP
     if (len > 0) {
         line[0] = '\0';
     }
@@ -150,5 +178,5 @@ int qnav_robot_board_config_diff(const qnav_board_config_t *a, const qnav_board_
 {
     qnav_link_config_t m;
     qnav_board_config_report(a, &m);
-    return qnav_robot_board_diff(&m, b, line, len);
+    return qnav_robot_board_diff(&m, b, NULL, line, len);
 }

@@ -26,10 +26,16 @@ extern "C" {
  * wheel_base_m, um_per_count = [odometry] um_per_count. */
 void qnav_robot_board_config(const qnav_sim_robot_t *robot, qnav_board_config_t *cfg);
 
-/* The same from a robot spec (a profile's path or name, as qnav_sim_robot_load takes it):
- * QNAV_SIM_OK, or the loader's status with its message in err. */
+/* The map robot's board runs (its profile's [map] when on, in its [map] bytes), as the
+ * board's CONFIG report gives it (qnav_board_map_info). */
+void qnav_robot_board_map_info(const qnav_sim_robot_t *robot, qnav_board_map_info_t *info);
+
+/* The same from a robot spec (a profile's path or name, as qnav_sim_robot_load takes it),
+ * and its map when map is not NULL: QNAV_SIM_OK, or the loader's status with its message in
+ * err. */
 QNAV_CHECK_RESULT qnav_sim_status_t qnav_robot_board_load(const char *spec,
-                                                          qnav_board_config_t *cfg, char *err,
+                                                          qnav_board_config_t *cfg,
+                                                          qnav_board_map_info_t *map, char *err,
                                                           size_t errlen);
 
 /* The heading change per differential encoder count (right minus left), micro-degrees:
@@ -43,12 +49,13 @@ long qnav_robot_board_udeg_per_count(const qnav_board_config_t *cfg);
  * failed. */
 int qnav_robot_board_header(const qnav_sim_robot_t *robot, FILE *out);
 
-/* Compare a board's CONFIG report with the configuration expected. Returns 0 when every
- * QNAV_BOARD_ROBOT_FIELDS field is reported with the expected value, else 1 with
+/* Compare a board's CONFIG report with the configuration expected, and with the map
+ * expected unless expected_map is NULL. Returns 0 when every QNAV_BOARD_ROBOT_FIELDS field
+ * (then every QNAV_BOARD_MAP_FIELDS field) is reported with the expected value, else 1 with
  * "FIELD REPORTED != EXPECTED" (or "FIELD not reported") in line: the first field that
- * differs, in the list's order. */
+ * differs, in the lists' order. */
 int qnav_robot_board_diff(const qnav_link_config_t *reported, const qnav_board_config_t *expected,
-                          char *line, size_t len);
+                          const qnav_board_map_info_t *expected_map, char *line, size_t len);
 
 /* The same between two configurations (field by field, in the list's order). */
 int qnav_robot_board_config_diff(const qnav_board_config_t *a, const qnav_board_config_t *b,

@@ -95,12 +95,11 @@ Simulation::Simulation(const RobotProfile &robot, const Environment &env, const 
 }
 
 // The profile's [map] over the whole arena (libqnav qnav/map.h; 8 bytes a cell, or half a
-// byte with [map] compact), told the
-// range noise of the sonar this run simulates.
+// byte with [map] compact), as the board runs it: its range noise is the profile's [noise]
+// sensor, whatever this run draws (a board cannot know its sonar is noisier or quieter).
 void Simulation::init_map() {
     qnav_map_config_t mc;
     robot_map_config(robot_, &mc);
-    mc.noise_pct = map_noise_pct(cfg_.sensor_noise);  // the sonar this run draws
     const auto mm = [](double m) { return static_cast<std::uint32_t>(std::ceil(m * 1000.0)); };
     robot_ctrl_config(robot_, cfg_.n_sectors, &map_ctrl_);
     map_cfg_ = mc;

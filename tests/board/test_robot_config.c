@@ -99,8 +99,68 @@ static void test_a_configuration_that_differs_is_named_by_its_field(void **state
     /* a board of an older build that does not report a field */
     qnav_board_config_report(&g_tekbot, &m);
     m.n = 5;
-    assert_int_equal(qnav_robot_board_diff(&m, &g_tekbot, line, sizeof line), 1);
+    assert_int_equal(qnav_robot_board_diff(&m, &g_tekbot, NULL, line, sizeof line), 1);
     assert_string_equal(line, "sensor_offset_mm not reported");
+}
+
+/* The map a board reports (its generated header's, in its bytes) is its profile's, and a
+ * board whose map differs is named by the field, the CRC standing for the rest. */
+static void test_a_map_that_differs_is_named_by_its_field(void **state)
+{
+    static const qnav_map_config_t header_map = QNAV_ROBOT_TEKBOT_MAP_CONFIG;
+    qnav_map_config_t other_map = header_map;
+    qnav_board_map_info_t profile, board;
+    qnav_board_config_t bc;
+    qnav_link_config_t m;
+    char err[QNAV_SIM_ERRLEN], line[128];
+    (void)state;
+    assert_int_equal(qnav_robot_board_load("tekbot", &bc, &profile, err, sizeof err), QNAV_SIM_OK);
+    assert_int_equal(profile.on, 1);
+    assert_int_equal(profile.bytes, QNAV_ROBOT_TEKBOT_MAP_BYTES);
+    assert_int_equal(profile.cell_mm, header_map.cell_mm);
+    qnav_board_map_info(&header_map, QNAV_ROBOT_TEKBOT_MAP_BYTES, &board);
+    assert_memory_equal(&board, &profile, sizeof board);
+    qnav_board_config_report(&g_tekbot, &m);
+    qnav_board_map_report(&board, &m);
+    assert_int_equal(qnav_robot_board_diff(&m, &g_tekbot, &profile, line, sizeof line), 0);
+    /* cells of another size */
+    other_map.cell_mm = 400;
+    qnav_board_map_info(&other_map, QNAV_ROBOT_TEKBOT_MAP_BYTES, &board);
+    qnav_board_config_report(&g_tekbot, &m);
+    qnav_board_map_report(&board, &m);
+    assert_int_equal(qnav_robot_board_diff(&m, &g_tekbot, &profile, line, sizeof line), 1);
+    assert_string_equal(line, "map_cell_mm 400 != 350");
+    /* a field without a name of its own: the CRC differs */
+    other_map = header_map;
+    other_map.look_mm = (uint16_t)(header_map.look_mm + 100u);
+    qnav_board_map_info(&other_map, QNAV_ROBOT_TEKBOT_MAP_BYTES, &board);
+    assert_true(board.crc != profile.crc);
+    qnav_board_config_report(&g_tekbot, &m);
+    qnav_board_map_report(&board, &m);
+    assert_int_equal(qnav_robot_board_diff(&m, &g_tekbot, &profile, line, sizeof line), 1);
+    assert_non_null(strstr(line, "map_config_crc "));
+    /* more bytes, no map at all, a board of link protocol 4 that does not report one */
+    qnav_board_map_info(&header_map, 2048u, &board);
+    qnav_board_config_report(&g_tekbot, &m);
+    qnav_board_map_report(&board, &m);
+    assert_int_equal(qnav_robot_board_diff(&m, &g_tekbot, &profile, line, sizeof line), 1);
+    assert_string_equal(line, "map_bytes 2048 != 512");
+    qnav_board_map_info(NULL, 0u, &board);
+    qnav_board_config_report(&g_tekbot, &m);
+    qnav_board_map_report(&board, &m);
+    assert_int_equal(qnav_robot_board_diff(&m, &g_tekbot, &profile, line, sizeof line), 1);
+    assert_string_equal(line, "map_on 0 != 1");
+    qnav_board_config_report(&g_tekbot, &m);
+    assert_int_equal(qnav_robot_board_diff(&m, &g_tekbot, &profile, line, sizeof line), 1);
+    assert_string_equal(line, "map_on not reported");
+    /* the robot without a map expects none */
+    assert_int_equal(qnav_robot_board_load("tekbot-map", &bc, &profile, err, sizeof err),
+                     QNAV_SIM_OK);
+    assert_int_equal(profile.on, 0);
+    qnav_board_map_info(NULL, 0u, &board);
+    qnav_board_config_report(&g_tekbot, &m);
+    qnav_board_map_report(&board, &m);
+    assert_int_equal(qnav_robot_board_diff(&m, &g_tekbot, &profile, line, sizeof line), 0);
 }
 
 int main(void)
@@ -109,6 +169,7 @@ int main(void)
         cmocka_unit_test(test_tekbot_simulator_and_board_configurations_are_identical),
         cmocka_unit_test(test_pioneer3dx_simulator_and_board_configurations_are_identical),
         cmocka_unit_test(test_a_configuration_that_differs_is_named_by_its_field),
+        cmocka_unit_test(test_a_map_that_differs_is_named_by_its_field),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

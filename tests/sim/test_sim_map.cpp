@@ -237,19 +237,20 @@ int loaded_map(const char *spec, qnav_map_config_t *cfg, qnav_ctrl_config_t *cc,
     return on;
 }
 
-// The map is told the range noise of the sonar the run simulates, not the profile's typical
-// level: a run at 20 % noise goes tick for tick the same whatever level the profile states,
-// and the map's tolerance is what makes the difference at that noise (docs/architecture.md,
-// "The map's range noise").
-void test_the_map_is_told_the_runs_sensor_noise(void **) {
+// The map is told the profile's typical range noise, as the board made from the profile is
+// (its generated header), not the noise the run draws, which a board cannot know: a run at
+// 20 % noise goes differently when the profile states 20 % than when it states 5 %, the
+// sonar's samples being the same (docs/architecture.md, "The map's range noise").
+void test_the_map_is_told_the_profiles_sensor_noise(void **) {
     std::string stated = tekbot_with("[map]\ncell_m = 0.1\n");
     const std::size_t at = stated.find("\nsensor = 0.05");
     assert_true(at != std::string::npos);
     stated.replace(at, 14, "\nsensor = 0.20");
     const Run typical = run(tekbot_with("[map]\ncell_m = 0.1\n"), 6, 0.2);
     const Run high = run(stated, 6, 0.2);
-    assert_int_equal(typical.ticks, high.ticks);
-    assert_int_equal(typical.reached, high.reached);
+    print_message("at 20 %% noise, 6 episodes: %u ticks with the profile's 5 %%, %u with 20 %%\n",
+                  typical.ticks, high.ticks);
+    assert_true(typical.ticks != high.ticks);
     qnav_map_config_t mc;
     qnav_ctrl_config_t cc;
     assert_int_equal(loaded_map("tekbot+map", &mc, &cc), 1);
@@ -351,7 +352,7 @@ int main() {
         cmocka_unit_test(test_bad_odometry_settings_are_refused_by_field),
         cmocka_unit_test(test_a_maps_passing_distance_reaches_the_controller),
         cmocka_unit_test(test_name_plus_map_switches_on_the_profiles_own_map),
-        cmocka_unit_test(test_the_map_is_told_the_runs_sensor_noise),
+        cmocka_unit_test(test_the_map_is_told_the_profiles_sensor_noise),
         cmocka_unit_test(test_the_maps_arc_is_an_angle_from_the_profile),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);

@@ -114,13 +114,15 @@ class FamilyEval(unittest.TestCase):
 
     def test_failures_are_listed_with_commands_that_draw_them(self):
         # fixed seeds: the TekBot without a map misses the limit in these rooms, and one
-        # without its safety distance and speed guard touches something in denser clutter
+        # without its safety distance, speed guard and passing distance touches something in
+        # denser clutter
         kinds, _ = self.listed("rooms", 2, "--seed-base", "5000007", "--robot", "tekbot-map")
         self.assertTrue({"arrived late", "did not arrive at twice the limit"} <= kinds, kinds)
         src = os.path.join(os.environ["QNAV_TOOLS_DIR"], "..", "data", "robots", "tekbot.toml")
         with open(src, encoding="utf-8") as f:
             text = re.sub(r"(?m)^safety_m = .*$", "safety_m = 0.0", f.read())
         text = re.sub(r"(?m)^speed_guard = .*$", "speed_guard = false", text)
+        text = re.sub(r"(?m)^pass_m = .*$", "pass_m = 0.0", text)
         with tempfile.TemporaryDirectory() as tmp:
             prof = os.path.join(tmp, "reckless.toml")
             with open(prof, "w", encoding="utf-8") as f:

@@ -55,6 +55,68 @@ void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t
     m->n = n;
 }
 
+/* v little-endian at p; the byte after it. */
+static uint8_t *put_le16(uint8_t *p, uint16_t v)
+{
+    p[0] = (uint8_t)v;
+    p[1] = (uint8_t)(v >> 8);
+    return p + 2;
+}
+
+void qnav_board_map_info(const qnav_map_config_t *cfg, uint32_t bytes,
+                         qnav_board_map_info_t *info)
+{
+    /* every field, little-endian, in the struct's order: the CRC's bytes */
+    uint8_t b[22];
+    uint8_t *p = b;
+    if (info == NULL) {
+        return;
+    }
+    memset(info, 0, sizeof *info);
+    if (cfg == NULL) {
+        return;
+    }
+    info->on = 1u;
+    info->bytes = bytes;
+    info->cell_mm = cfg->cell_mm;
+    info->reach_mm = cfg->reach_mm;
+    info->compact = cfg->compact;
+    p = put_le16(p, cfg->cell_mm);
+    p = put_le16(p, cfg->reach_mm);
+    p = put_le16(p, cfg->look_mm);
+    p = put_le16(p, cfg->jump_mm);
+    *p++ = cfg->plan_ticks;
+    *p++ = cfg->noise_pct;
+    *p++ = cfg->near_cost;
+    p = put_le16(p, cfg->near_mm);
+    p = put_le16(p, cfg->arc_cdeg);
+    *p++ = cfg->sight;
+    *p++ = cfg->escape_grow;
+    *p++ = cfg->refuse_ticks;
+    p = put_le16(p, cfg->refuse_life_ticks);
+    *p++ = cfg->compact;
+    *p++ = cfg->grow_steps;
+    info->crc = qnav_link_crc16(0xFFFFu, b, (uint16_t)(p - b));
+}
+
+void qnav_board_map_report(const qnav_board_map_info_t *info, qnav_link_config_t *m)
+{
+    uint8_t n;
+    if (info == NULL || m == NULL) {
+        return;
+    }
+    n = m->n;
+#define QNAV_BOARD_REPORT_MAP_FIELD(id, name, member)                                      \
+    if (n < QNAV_LINK_CONFIG_MAX_FIELDS) {                                                  \
+        m->key[n] = (uint8_t)(id);                                                         \
+        m->value[n] = (int32_t)info->member;                                                \
+        ++n;                                                                                \
+    }
+    QNAV_BOARD_MAP_FIELDS(QNAV_BOARD_REPORT_MAP_FIELD)
+#undef QNAV_BOARD_REPORT_MAP_FIELD
+    m->n = n;
+}
+
 /* The stored policy when one is whole and the controller takes it, else the built-in. */
 static void load_policy(qnav_board_t *bot)
 {
@@ -409,8 +471,16 @@ static void send_status(qnav_board_t *bot, uint32_t now, uint8_t moving, uint32_
 static void send_config(qnav_board_t *bot)
 {
     qnav_link_config_t m;
+    qnav_board_map_info_t map;
     uint8_t p[QNAV_LINK_CONFIG_MAX_BYTES];
     qnav_board_config_report(&bot->cfg, &m);
+    /* the map it runs: placed at each goal, laid out by the caller, or none */
+    if (bot->place_map != NULL) {
+        qnav_board_map_info(bot->place_cfg, (uint32_t)bot->place_len, &map);
+    } else {
+        qnav_board_map_info(bot->map != NULL ? &bot->map->cfg : NULL, 0u, &map);
+    }
+    qnav_board_map_report(&map, &m);
     send(bot, QNAV_LINK_MSG_CONFIG, p, qnav_link_config_pack(&m, p, sizeof p));
 }
 

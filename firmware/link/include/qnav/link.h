@@ -53,8 +53,10 @@ extern "C" {
  * byte, position goals and the board's POSE; version 3 (issue 17) adds the board's CONFIG
  * report, so that a bridge refuses a board built for another robot; version 4 (issue 18)
  * adds to the POSE what the board's map did to the escape memory this tick, so that an
- * offboard controller keeps its memory as the onboard one does. */
-#define QNAV_LINK_PROTOCOL_VERSION 4u
+ * offboard controller keeps its memory as the onboard one does; version 5 adds the board's map
+ * to its CONFIG report (up to 26 fields), so that a bridge refuses a board whose map is not
+ * its robot's. */
+#define QNAV_LINK_PROTOCOL_VERSION 5u
 
 /* Message ids. Direction: B->H board to host (navbridge), H->B host to board. */
 typedef enum {
@@ -81,7 +83,7 @@ typedef enum {
 #define QNAV_LINK_HEARTBEAT_MAX_BYTES 32u /* longest a later version may send */
 #define QNAV_LINK_POSE_BYTES 23u
 /* CONFIG: [count u8] then count x ([key u8][value i32]); at most this many fields. */
-#define QNAV_LINK_CONFIG_MAX_FIELDS 20u
+#define QNAV_LINK_CONFIG_MAX_FIELDS 26u
 #define QNAV_LINK_CONFIG_MAX_BYTES (1u + 5u * QNAV_LINK_CONFIG_MAX_FIELDS)
 
 /* Largest payload this build accepts: a full scan or a full chunk, whichever is larger. */

@@ -229,6 +229,37 @@ void qnav_board_config_default(qnav_board_config_t *cfg);
 /* The CONFIG report of cfg: every QNAV_BOARD_ROBOT_FIELDS field as (key, value). */
 void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t *m);
 
+/*
+ * The map a board runs, as its CONFIG report gives it after the robot fields (link
+ * protocol 5): whether it has one, the bytes it places it in at each goal (0: a map the
+ * caller laid out, qnav_board_set_map), the cell, the readings' reach, the layout, and a
+ * CRC-16 over every qnav_map_config_t field (qnav_board_map_info), so that a bridge
+ * refuses a board whose map is not its profile's, naming the field or the CRC.
+ */
+typedef struct {
+    uint8_t on;
+    uint32_t bytes;
+    uint16_t cell_mm;
+    uint16_t reach_mm;
+    uint8_t compact;
+    uint16_t crc;
+} qnav_board_map_info_t;
+
+#define QNAV_BOARD_MAP_FIELDS(X)                                                            \
+    X(48, map_on, on)                                                                       \
+    X(49, map_bytes, bytes)                                                                 \
+    X(50, map_cell_mm, cell_mm)                                                             \
+    X(51, map_reach_mm, reach_mm)                                                           \
+    X(52, map_compact, compact)                                                             \
+    X(53, map_config_crc, crc)
+
+/* info of the map cfg (NULL: no map) placed in bytes (0: laid out by the caller). */
+void qnav_board_map_info(const qnav_map_config_t *cfg, uint32_t bytes,
+                         qnav_board_map_info_t *info);
+
+/* Append info's QNAV_BOARD_MAP_FIELDS to the report m (as far as it has room). */
+void qnav_board_map_report(const qnav_board_map_info_t *info, qnav_link_config_t *m);
+
 /* Check cfg and hal, start the link, load the newest whole policy from storage (the
  * built-in policy when there is none or it is corrupt), start the controller; the drive
  * is set to 0. Returns QNAV_BOARD_OK, _E_NULL, _E_CONFIG or _E_CTRL. */
