@@ -38,21 +38,25 @@ void qnav_board_config_default(qnav_board_config_t *cfg)
     cfg->controller = "body";
 }
 
+/* One more (key, value) in the report m, as far as it has room. */
+static void report_field(qnav_link_config_t *m, uint8_t key, int32_t value)
+{
+    if (m->n < QNAV_LINK_CONFIG_MAX_FIELDS) {
+        m->key[m->n] = key;
+        m->value[m->n] = value;
+        m->n++;
+    }
+}
+
 void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t *m)
 {
-    uint8_t n = 0;
     if (cfg == NULL || m == NULL) {
         return;
     }
-#define QNAV_BOARD_REPORT_FIELD(id, name, member)                                          \
-    if (n < QNAV_LINK_CONFIG_MAX_FIELDS) {                                                  \
-        m->key[n] = (uint8_t)(id);                                                         \
-        m->value[n] = (int32_t)cfg->member;                                                 \
-        ++n;                                                                                \
-    }
+    m->n = 0;
+#define QNAV_BOARD_REPORT_FIELD(id, name, member) report_field(m, (uint8_t)(id), (int32_t)cfg->member);
     QNAV_BOARD_ROBOT_FIELDS(QNAV_BOARD_REPORT_FIELD)
 #undef QNAV_BOARD_REPORT_FIELD
-    m->n = n;
 }
 
 /* v little-endian at p; the byte after it. */
@@ -101,20 +105,12 @@ void qnav_board_map_info(const qnav_map_config_t *cfg, uint32_t bytes,
 
 void qnav_board_map_report(const qnav_board_map_info_t *info, qnav_link_config_t *m)
 {
-    uint8_t n;
     if (info == NULL || m == NULL) {
         return;
     }
-    n = m->n;
-#define QNAV_BOARD_REPORT_MAP_FIELD(id, name, member)                                      \
-    if (n < QNAV_LINK_CONFIG_MAX_FIELDS) {                                                  \
-        m->key[n] = (uint8_t)(id);                                                         \
-        m->value[n] = (int32_t)info->member;                                                \
-        ++n;                                                                                \
-    }
+#define QNAV_BOARD_REPORT_MAP_FIELD(id, name, member) report_field(m, (uint8_t)(id), (int32_t)info->member);
     QNAV_BOARD_MAP_FIELDS(QNAV_BOARD_REPORT_MAP_FIELD)
 #undef QNAV_BOARD_REPORT_MAP_FIELD
-    m->n = n;
 }
 
 /* The stored policy when one is whole and the controller takes it, else the built-in. */
