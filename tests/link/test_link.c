@@ -761,6 +761,23 @@ static void test_config_report_round_trips_and_bad_lengths_are_dropped(void **st
     assert_int_equal(rx.stats.dropped[QNAV_LINK_DROP_LENGTH], 1);
     m.n = QNAV_LINK_CONFIG_MAX_FIELDS + 1u;
     assert_int_equal(qnav_link_config_pack(&m, p, sizeof p), QNAV_LINK_E_VALUE);
+    /* pairs appended one at a time pack as the struct does, up to the maximum and the room */
+    {
+        uint8_t q[QNAV_LINK_CONFIG_MAX_BYTES];
+        m.n = QNAV_LINK_CONFIG_MAX_FIELDS;
+        q[0] = 0;
+        for (i = 0; i < (int32_t)QNAV_LINK_CONFIG_MAX_FIELDS; ++i) {
+            m.key[i] = (uint8_t)(i + 1);
+            m.value[i] = -1000 * i;
+            assert_int_equal(qnav_link_config_append(q, sizeof q, m.key[i], m.value[i]), 6 + 5 * i);
+        }
+        assert_int_equal(qnav_link_config_pack(&m, p, sizeof p), (int32_t)sizeof q);
+        assert_memory_equal(p, q, sizeof q);
+        assert_int_equal(qnav_link_config_append(q, sizeof q, 99, 1), QNAV_LINK_E_VALUE);
+        q[0] = 0;
+        assert_int_equal(qnav_link_config_append(q, 5, 1, 1), QNAV_LINK_E_SPACE);
+        assert_int_equal(q[0], 0);
+    }
 }
 
 static void test_heartbeat_carries_the_protocol_version_and_reads_version_1(void **state)

@@ -939,26 +939,43 @@ uint16_t qnav_link_policy_crc(const qnav_policy_t *policy)
     return n > 0 ? qnav_link_crc16(QNAV_LINK_CRC16_INIT, blob, (uint16_t)n) : 0u;
 }
 
+int32_t qnav_link_config_append(uint8_t *out, uint16_t cap, uint8_t key, int32_t value)
+{
+    uint16_t at;
+    if (out == NULL || cap < 1u) {
+        return out == NULL ? QNAV_LINK_E_NULL : QNAV_LINK_E_SPACE;
+    }
+    if (out[0] >= QNAV_LINK_CONFIG_MAX_FIELDS) {
+        return QNAV_LINK_E_VALUE;
+    }
+    at = (uint16_t)(1u + 5u * out[0]);
+    if (cap < at + 5u) {
+        return QNAV_LINK_E_SPACE;
+    }
+    out[at] = key;
+    put_u32(&out[at + 1u], (uint32_t)value);
+    out[0]++;
+    return (int32_t)(at + 5u);
+}
+
 int32_t qnav_link_config_pack(const qnav_link_config_t *m, uint8_t *out, uint16_t cap)
 {
     uint8_t k;
-    uint16_t need;
+    int32_t len = 1;
     if (m == NULL || out == NULL) {
         return QNAV_LINK_E_NULL;
     }
     if (m->n > QNAV_LINK_CONFIG_MAX_FIELDS) {
         return QNAV_LINK_E_VALUE;
     }
-    need = (uint16_t)(1u + 5u * m->n);
-    if (cap < need) {
+    if (cap < (uint16_t)(1u + 5u * m->n)) {
         return QNAV_LINK_E_SPACE;
     }
-    out[0] = m->n;
+    out[0] = 0;
     for (k = 0; k < m->n; ++k) {
-        out[1u + 5u * k] = m->key[k];
-        put_u32(&out[2u + 5u * k], (uint32_t)m->value[k]);
+        len = qnav_link_config_append(out, cap, m->key[k], m->value[k]);
     }
-    return (int32_t)need;
+    return len;
 }
 
 int32_t qnav_link_config_unpack(const uint8_t *p, uint16_t len, qnav_link_config_t *m)

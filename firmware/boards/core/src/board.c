@@ -38,25 +38,51 @@ void qnav_board_config_default(qnav_board_config_t *cfg)
     cfg->controller = "body";
 }
 
-/* One more (key, value) in the report m, as far as it has room. */
-static void report_field(qnav_link_config_t *m, uint8_t key, int32_t value)
+/* Where a CONFIG report goes: the pairs of a qnav_link_config_t (m), or straight into a
+ * packed payload (p, cap bytes: the board's own report, without a struct on its stack). */
+typedef struct {
+    qnav_link_config_t *m;
+    uint8_t *p;
+    uint16_t cap;
+} report_t;
+
+/* One more (key, value) in the report, as far as it has room. */
+static void report_field(report_t *r, uint8_t key, int32_t value)
 {
-    if (m->n < QNAV_LINK_CONFIG_MAX_FIELDS) {
-        m->key[m->n] = key;
-        m->value[m->n] = value;
-        m->n++;
+    if (r->p != NULL) {
+        (void)qnav_link_config_append(r->p, r->cap, key, value);
+    } else if (r->m->n < QNAV_LINK_CONFIG_MAX_FIELDS) {
+        r->m->key[r->m->n] = key;
+        r->m->value[r->m->n] = value;
+        r->m->n++;
     }
+}
+
+static void report_robot(const qnav_board_config_t *cfg, report_t *r)
+{
+#define QNAV_BOARD_REPORT_FIELD(id, name, member) report_field(r, (uint8_t)(id), (int32_t)cfg->member);
+    QNAV_BOARD_ROBOT_FIELDS(QNAV_BOARD_REPORT_FIELD)
+#undef QNAV_BOARD_REPORT_FIELD
+}
+
+static void report_map(const qnav_board_map_info_t *info, report_t *r)
+{
+#define QNAV_BOARD_REPORT_MAP_FIELD(id, name, member) report_field(r, (uint8_t)(id), (int32_t)info->member);
+    QNAV_BOARD_MAP_FIELDS(QNAV_BOARD_REPORT_MAP_FIELD)
+#undef QNAV_BOARD_REPORT_MAP_FIELD
 }
 
 void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t *m)
 {
+    report_t r;
     if (cfg == NULL || m == NULL) {
         return;
     }
+    r.m = m;
+    r.p = NULL;
+    r.cap = 0u;
     m->n = 0;
-#define QNAV_BOARD_REPORT_FIELD(id, name, member) report_field(m, (uint8_t)(id), (int32_t)cfg->member);
-    QNAV_BOARD_ROBOT_FIELDS(QNAV_BOARD_REPORT_FIELD)
-#undef QNAV_BOARD_REPORT_FIELD
+    report_robot(cfg, &r);
 }
 
 /* v little-endian at p; the byte after it. */
@@ -105,12 +131,14 @@ void qnav_board_map_info(const qnav_map_config_t *cfg, uint32_t bytes,
 
 void qnav_board_map_report(const qnav_board_map_info_t *info, qnav_link_config_t *m)
 {
+    report_t r;
     if (info == NULL || m == NULL) {
         return;
     }
-#define QNAV_BOARD_REPORT_MAP_FIELD(id, name, member) report_field(m, (uint8_t)(id), (int32_t)info->member);
-    QNAV_BOARD_MAP_FIELDS(QNAV_BOARD_REPORT_MAP_FIELD)
-#undef QNAV_BOARD_REPORT_MAP_FIELD
+    r.m = m;
+    r.p = NULL;
+    r.cap = 0u;
+    report_map(info, &r);
 }
 
 /* The stored policy when one is whole and the controller takes it, else the built-in. */
@@ -466,18 +494,22 @@ static void send_status(qnav_board_t *bot, uint32_t now, uint8_t moving, uint32_
  * every CONFIG_EVERY ticks for a bridge that attached while the link stayed up. */
 static void send_config(qnav_board_t *bot)
 {
-    qnav_link_config_t m;
     qnav_board_map_info_t map;
     uint8_t p[QNAV_LINK_CONFIG_MAX_BYTES];
-    qnav_board_config_report(&bot->cfg, &m);
+    report_t r;
+    r.m = NULL;
+    r.p = p;
+    r.cap = (uint16_t)sizeof p;
+    p[0] = 0u; /* no pairs yet */
+    report_robot(&bot->cfg, &r);
     /* the map it runs: placed at each goal, laid out by the caller, or none */
     if (bot->place_map != NULL) {
         qnav_board_map_info(bot->place_cfg, (uint32_t)bot->place_len, &map);
     } else {
         qnav_board_map_info(bot->map != NULL ? &bot->map->cfg : NULL, 0u, &map);
     }
-    qnav_board_map_report(&map, &m);
-    send(bot, QNAV_LINK_MSG_CONFIG, p, qnav_link_config_pack(&m, p, sizeof p));
+    report_map(&map, &r);
+    send(bot, QNAV_LINK_MSG_CONFIG, p, (int32_t)(1u + 5u * p[0]));
 }
 
 /* This tick's decision: the controller's (onboard) or navbridge's fresh command

@@ -361,6 +361,11 @@ int32_t qnav_link_pose_pack(const qnav_link_pose_t *m, uint8_t *out, uint16_t ca
 int32_t qnav_link_pose_unpack(const uint8_t *p, uint16_t len, qnav_link_pose_t *m);
 int32_t qnav_link_config_pack(const qnav_link_config_t *m, uint8_t *out, uint16_t cap);
 int32_t qnav_link_config_unpack(const uint8_t *p, uint16_t len, qnav_link_config_t *m);
+/* Append (key, value) to a CONFIG payload packed in out (cap bytes; start with out[0] = 0,
+ * no pairs): the payload's length after it, or QNAV_LINK_E_NULL, QNAV_LINK_E_VALUE (it holds
+ * QNAV_LINK_CONFIG_MAX_FIELDS pairs already) or QNAV_LINK_E_SPACE. For a board that packs
+ * its report without a qnav_link_config_t on its stack. */
+int32_t qnav_link_config_append(uint8_t *out, uint16_t cap, uint8_t key, int32_t value);
 
 /* ---- Policy blobs (what an upload carries) -------------------------------------------- */
 
