@@ -72,15 +72,23 @@ static void report_map(const qnav_board_map_info_t *info, report_t *r)
 #undef QNAV_BOARD_REPORT_MAP_FIELD
 }
 
+/* A report into the pairs of m (appended to those it holds). */
+static report_t into_struct(qnav_link_config_t *m)
+{
+    report_t r;
+    r.m = m;
+    r.p = NULL;
+    r.cap = 0u;
+    return r;
+}
+
 void qnav_board_config_report(const qnav_board_config_t *cfg, qnav_link_config_t *m)
 {
     report_t r;
     if (cfg == NULL || m == NULL) {
         return;
     }
-    r.m = m;
-    r.p = NULL;
-    r.cap = 0u;
+    r = into_struct(m);
     m->n = 0;
     report_robot(cfg, &r);
 }
@@ -135,9 +143,7 @@ void qnav_board_map_report(const qnav_board_map_info_t *info, qnav_link_config_t
     if (info == NULL || m == NULL) {
         return;
     }
-    r.m = m;
-    r.p = NULL;
-    r.cap = 0u;
+    r = into_struct(m);
     report_map(info, &r);
 }
 
