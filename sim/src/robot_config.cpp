@@ -47,7 +47,7 @@ std::uint8_t map_noise_pct(double sensor_noise) {
 
 void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg) {
     qnav_map_config_default(cfg);
-    cfg->noise_pct = map_noise_pct(p.noise_sensor);
+    cfg->noise_pct = map_noise_pct(p.map_noise >= 0.0 ? p.map_noise : p.noise_sensor);
     cfg->cell_mm = to_mm(p.map_cell_m);
     cfg->reach_mm = to_mm(p.map_reach_m);
     cfg->look_mm = to_mm(p.map_look_m);

@@ -254,7 +254,7 @@ void test_the_map_is_told_the_profiles_sensor_noise(void **) {
     qnav_map_config_t mc;
     qnav_ctrl_config_t cc;
     assert_int_equal(loaded_map("tekbot+map", &mc, &cc), 1);
-    assert_int_equal(mc.noise_pct, 5); /* the profile's typical level, 0.05 */
+    assert_int_equal(mc.noise_pct, 10); /* the profile's [map] noise, 0.10 (its [noise] sensor is 0.05) */
     assert_int_equal(loaded_map("pioneer3dx+map", &mc, &cc), 1);
     assert_int_equal(mc.noise_pct, 1);
 }
