@@ -121,12 +121,8 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
 
 // The map's configuration a profile's [map] gives (libqnav qnav/map.h), beside the
 // controller's; cell_mm 0 when the profile has none. Its range noise (noise_pct) is the
-// profile's typical sensor noise; a run at another level gives the map that level instead
-// (map_noise_pct; docs/architecture.md, "The map's range noise").
+// profile's [map] noise, else its [noise] sensor, whatever a run draws: the board made from
+// the profile is told the same (docs/architecture.md, "The map's range noise").
 void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg);
-
-// qnav_map_config_t.noise_pct for a sonar whose range noise is sensor_noise (the standard
-// deviation as a fraction of the range, the simulator's p_s): that many per cent.
-std::uint8_t map_noise_pct(double sensor_noise);
 
 }  // namespace qnav

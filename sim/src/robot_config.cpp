@@ -41,9 +41,15 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->keep_pct = static_cast<std::uint8_t>(std::lround(p.prob_keep * 100.0));
 }
 
+namespace {
+
+// qnav_map_config_t.noise_pct for a range noise of sensor_noise (the standard deviation as a
+// fraction of the range): that many per cent.
 std::uint8_t map_noise_pct(double sensor_noise) {
     return static_cast<std::uint8_t>(std::lround(std::clamp(sensor_noise, 0.0, 1.0) * 100.0));
 }
+
+}  // namespace
 
 void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg) {
     qnav_map_config_default(cfg);

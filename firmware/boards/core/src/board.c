@@ -134,7 +134,7 @@ void qnav_board_map_info(const qnav_map_config_t *cfg, uint32_t bytes,
     p = put_le16(p, cfg->refuse_life_ticks);
     *p++ = cfg->compact;
     *p++ = cfg->grow_steps;
-    info->crc = qnav_link_crc16(0xFFFFu, b, (uint16_t)(p - b));
+    info->crc = qnav_link_crc16(QNAV_LINK_CRC16_INIT, b, (uint16_t)(p - b));
 }
 
 void qnav_board_map_report(const qnav_board_map_info_t *info, qnav_link_config_t *m)
