@@ -278,6 +278,31 @@ static void shift_evidence(qnav_map_t *m, int32_t di, int32_t dj)
     }
 }
 
+/*
+ * The plan is whole and no way leads from the robot to the destination: what the arcs
+ * marked closes every door. An arc marks the cells across a wide wedge, and from afar it
+ * marks a doorway's cells for the wall beside it; a cell seen free stays free, but a
+ * doorway seen only from afar never is. The robot was placed where the destination can
+ * be reached (or a user's room would not be asked of it): forget every cell not seen free
+ * (refusals too), so the plan goes through them again and the robot sees them afresh
+ * from where it then stands (docs/architecture.md, "A map that closed every way").
+ */
+static void forget_occupied(qnav_map_t *m)
+{
+    uint32_t c, n = cell_count(m);
+    if (m->cfg.compact) {
+        qnav_cmap_forget_occupied(m);
+        return;
+    }
+    for (c = 0; c < n; ++c) {
+        if (m->evidence[c] > 0) {
+            m->evidence[c] = 0;
+        }
+    }
+    m->refused_ticks = 0u;
+    m->dirty = 1u;
+}
+
 /* The cell index of coordinate v in a map whose cells start at v0; -1 for any before it. */
 static int32_t index_along(int32_t v, int32_t v0, int32_t cell)
 {
@@ -1027,6 +1052,10 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
         return QNAV_MAP_GUIDED | m->sub_direct;
     }
     if (cost == QNAV_MAP_UNREACHED) {
+        if (m->q_queued == 0u) {
+            forget_occupied(m);
+            plan_start(m, goal_x_mm, goal_y_mm);
+        }
         m->last_mm = 0u;
         m->grown_mm = 0u;
         return 0;

@@ -132,6 +132,18 @@ void qnav_cmap_shift(qnav_map_t *m, int32_t di, int32_t dj)
     }
 }
 
+void qnav_cmap_forget_occupied(qnav_map_t *m)
+{
+    /* 11 (free) stays; 01 and 10 become 00: each plane takes lo & hi */
+    uint8_t *lo = plane(m, SEEN_LO, 0), *hi = plane(m, SEEN_HI, 0);
+    const size_t n = (size_t)m->ny * m->row_bytes;
+    size_t b;
+    for (b = 0; b < n; ++b) {
+        lo[b] = hi[b] = (uint8_t)(lo[b] & hi[b]);
+    }
+    m->dirty = 1u;
+}
+
 int qnav_cmap_blocked(const qnav_map_t *m, int32_t i, int32_t j)
 {
     return bit2(m, SEEN_LO, i, j) == SEEN_OCCUPIED;

@@ -44,6 +44,8 @@ int8_t qnav_cmap_evidence(const qnav_map_t *m, int32_t i, int32_t j);
  * cell became or stopped being occupied. */
 void qnav_cmap_clear(qnav_map_t *m, int32_t i, int32_t j);
 void qnav_cmap_arc(qnav_map_t *m, int32_t i, int32_t j);
+/* Every cell not seen free becomes unknown: what an arc marked, and one arc's evidence. */
+void qnav_cmap_forget_occupied(qnav_map_t *m);
 /* The cell cannot hold the robot's centre (occupied: cells are wider than its reach). */
 int qnav_cmap_blocked(const qnav_map_t *m, int32_t i, int32_t j);
 

@@ -520,53 +520,89 @@ static void test_the_destination_in_reach_is_flagged_direct(void **state)
     assert_true(in.goal_range_mm >= 600 && in.goal_range_mm <= 800);
 }
 
-static void test_a_destination_walled_in_leaves_the_input_alone(void **state)
+/* A wall the robot saw closed, seen from below with the destination beyond it: the plan
+ * finds no way and leaves the input alone, and the map forgets what the arcs marked (the
+ * robot was placed where the destination can be reached), so the next plan leads through
+ * the wall's cells again; cells seen free stay free. Both layouts. */
+static void walled_in_forgets(qnav_map_t *m)
 {
-    qnav_map_t m;
-    qnav_ctrl_input_t in;
     static const box_t closed[] = {{0, 2950, WORLD_MM, 3050}};
+    qnav_ctrl_input_t in;
     qnav_mm_t ranges[N];
     const qnav_map_pose_t p = {1500, 1500, 9000};
     int32_t x;
-    (void)state;
-    map_of(&m, 1);
+    int t, got = 0;
     for (x = 300; x <= 5700; x += 200) {
         const qnav_map_pose_t q = {x, 1500, 9000};
         scan(closed, 1, &q, ranges);
-        qnav_map_observe(&m, ranges, &q);
+        qnav_map_observe(m, ranges, &q);
     }
+    assert_true(qnav_map_evidence(m, 1500, 2960) >= QNAV_MAP_OCCUPIED);
+    assert_true(qnav_map_evidence(m, 1500, 2200) < 0);
     memset(&in, 0, sizeof in);
     in.goal_bearing_cdeg = 1234;
     in.goal_range_mm = 3500;
-    assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &in), 0);
+    for (t = 0; t < 40 && got == 0 && qnav_map_evidence(m, 1500, 2960) != 0; ++t) {
+        got = qnav_map_guide(m, &p, 1500, 5000, &in);
+    }
+    assert_int_equal(got, 0);
     assert_int_equal(in.goal_bearing_cdeg, 1234);
     assert_int_equal(in.goal_range_mm, 3500);
+    for (x = 300; x <= 5700; x += 200) {
+        assert_int_equal(qnav_map_evidence(m, x, 2960), 0);
+    }
+    assert_true(qnav_map_evidence(m, 1500, 2200) < 0);
+    for (t = 0; t < 40 && got == 0; ++t) {
+        got = qnav_map_guide(m, &p, 1500, 5000, &in);
+    }
+    assert_int_equal(got & QNAV_MAP_GUIDED, QNAV_MAP_GUIDED);
+    assert_true(in.goal_bearing_cdeg > -1500 && in.goal_bearing_cdeg < 1500);
 }
 
-/* Below the gap, the destination beyond it, the robot makes no progress (a controller that
- * will not pass where the plan leads): after refuse_ticks guided ticks the plan's cells
- * ahead are refused, so the plan no longer leads through the gap (here there is no other
- * way: the input is left alone); after refuse_life_ticks the refusal lapses and the plan
- * leads through the gap again. With refuse_ticks 0, never. */
-static int ticks_until_unguided(uint8_t refuse_ticks, qnav_map_t *m)
+static void test_a_map_that_closed_every_way_forgets_what_it_marked(void **state)
+{
+    qnav_map_t m;
+    (void)state;
+    map_of(&m, 1);
+    walled_in_forgets(&m);
+    compact_map(&m, 400, 1, 16);
+    walled_in_forgets(&m);
+}
+
+/* The wall with its gap at x 4500..5300, and a second gap at x 200..1800. */
+static const box_t wall_with_two_gaps[] = {
+    {0, 2950, 200, 3050}, {1800, 2950, 4500, 3050}, {5300, 2950, WORLD_MM, 3050}};
+
+/* Below the near gap, the destination beyond it, the robot makes no progress (a controller
+ * that will not pass where the plan leads): after refuse_ticks guided ticks the plan's
+ * cells ahead are refused, so the plan seeks another way. Returns the guided tick whose
+ * sub-goal no longer lies ahead through the near gap (-1: none in 100), with the last
+ * tick's input in *in. With refuse_ticks 0, never. */
+static int ticks_until_refused(uint8_t refuse_ticks, const box_t *wall, size_t n,
+                               qnav_map_t *m, qnav_ctrl_input_t *in, int *got)
 {
     qnav_map_config_t mc;
-    qnav_ctrl_input_t in;
+    qnav_mm_t ranges[N];
     const qnav_map_pose_t p = {4900, 2300, 9000};
+    int32_t x;
     int t;
     qnav_map_config_default(&mc);
     mc.plan_ticks = 1;
     mc.refuse_ticks = refuse_ticks;
-    mc.refuse_life_ticks = 50;
+    mc.refuse_life_ticks = 20;
     map_from(m, &mc);
-    observe_the_wall(m);
+    for (x = 500; x <= 5500; x += 250) {
+        const qnav_map_pose_t q = {x, 1500, 9000};
+        scan(wall, n, &q, ranges);
+        qnav_map_observe(m, ranges, &q);
+    }
     assert_true(qnav_map_evidence(m, 4950, 3050) < QNAV_MAP_OCCUPIED); /* the gap is open */
     for (t = 0; t < 100; ++t) {
-        memset(&in, 0, sizeof in);
-        if (qnav_map_guide(m, &p, 4900, 5000, &in) == 0) {
+        memset(in, 0, sizeof *in);
+        *got = qnav_map_guide(m, &p, 4900, 5000, in);
+        if (*got == 0 || in->goal_bearing_cdeg < -1500 || in->goal_bearing_cdeg > 1500) {
             return t;
         }
-        assert_true(in.goal_bearing_cdeg > -1500 && in.goal_bearing_cdeg < 1500);
     }
     return -1;
 }
@@ -576,21 +612,39 @@ static void test_a_way_the_robot_cannot_take_is_refused_for_a_while(void **state
     qnav_map_t m;
     qnav_ctrl_input_t in;
     const qnav_map_pose_t p = {4900, 2300, 9000};
-    int t;
+    int t, got;
     (void)state;
     /* the first tick plans and starts the count; refused on the 31st; planned again on the
-     * 32nd, without a way */
-    assert_int_equal(ticks_until_unguided(30, &m), 31);
+     * 32nd, toward the far gap (to the robot's left) */
+    assert_int_equal(ticks_until_refused(30, wall_with_two_gaps, 3, &m, &in, &got), 31);
+    assert_int_equal(got & QNAV_MAP_GUIDED, QNAV_MAP_GUIDED);
+    assert_true(in.goal_bearing_cdeg > 3000);
     assert_true(qnav_map_evidence(&m, 4950, 3050) >= QNAV_MAP_OCCUPIED);
     assert_true(qnav_map_evidence(&m, 4950, 2550) < QNAV_MAP_OCCUPIED); /* not at the robot */
-    for (t = 0; t < 48; ++t) {
+    for (t = 0; t < 18; ++t) {
         memset(&in, 0, sizeof in);
-        assert_int_equal(qnav_map_guide(&m, &p, 4900, 5000, &in), 0);
+        assert_int_equal(qnav_map_guide(&m, &p, 4900, 5000, &in) & QNAV_MAP_GUIDED, QNAV_MAP_GUIDED);
+        assert_true(in.goal_bearing_cdeg > 3000);
     }
+    /* the refusal lapses after refuse_life_ticks (20): through the near gap again */
+    for (t = 0; t < 5; ++t) {
+        memset(&in, 0, sizeof in);
+        got = qnav_map_guide(&m, &p, 4900, 5000, &in);
+        if ((got & QNAV_MAP_GUIDED) && in.goal_bearing_cdeg > -1500 && in.goal_bearing_cdeg < 1500) {
+            break;
+        }
+    }
+    assert_true(t < 5);
+    assert_true(qnav_map_evidence(&m, 4950, 3050) < QNAV_MAP_OCCUPIED);
+    assert_int_equal(ticks_until_refused(0, wall_with_two_gaps, 3, &m, &in, &got), -1);
+    /* the only way refused: no way, so the map forgets the refusal with every arc, and the
+     * plan leads through the gap again */
+    assert_int_equal(ticks_until_refused(30, wall_with_gap, 2, &m, &in, &got), 31);
+    assert_int_equal(got, 0);
+    assert_int_equal(qnav_map_evidence(&m, 4950, 3050), 0);
     memset(&in, 0, sizeof in);
     assert_int_equal(qnav_map_guide(&m, &p, 4900, 5000, &in) & QNAV_MAP_GUIDED, QNAV_MAP_GUIDED);
-    assert_true(qnav_map_evidence(&m, 4950, 3050) < QNAV_MAP_OCCUPIED);
-    assert_int_equal(ticks_until_unguided(0, &m), -1);
+    assert_true(in.goal_bearing_cdeg > -1500 && in.goal_bearing_cdeg < 1500);
 }
 
 /* A copy of full-layout map src in buf: the same state, its own cells (its memory starts
@@ -883,7 +937,7 @@ int main(void)
         cmocka_unit_test(test_the_sub_goal_is_not_behind_a_corner),
         cmocka_unit_test(test_a_longer_plan_grows_the_escape_memory),
         cmocka_unit_test(test_the_destination_in_reach_is_flagged_direct),
-        cmocka_unit_test(test_a_destination_walled_in_leaves_the_input_alone),
+        cmocka_unit_test(test_a_map_that_closed_every_way_forgets_what_it_marked),
         cmocka_unit_test(test_a_way_the_robot_cannot_take_is_refused_for_a_while),
         cmocka_unit_test(test_the_plan_is_settled_as_far_as_the_robot_needs),
         cmocka_unit_test(test_a_map_reaches_toward_a_goal_too_far_for_it),

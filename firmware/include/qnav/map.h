@@ -209,7 +209,10 @@ void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm);
  * along the plan), clearing in->escape when that grew by
  * jump_mm since the last guided tick (the way the escape was following has closed), and
  * growing in->escape's distances by what a new plan added when it grew by less.
- * Returns QNAV_MAP_* flags; 0 when the map knows no way (the input stays as it was).
+ * Returns QNAV_MAP_* flags; 0 when the map knows no way (the input stays as it was). A
+ * whole plan with no way from the robot means the arcs closed every door (the robot was
+ * placed where the destination can be reached): the map forgets every cell not seen free,
+ * refusals too, and plans again (docs/architecture.md, "A map that closed every way").
  */
 int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
                    int32_t goal_y_mm, qnav_ctrl_input_t *in);
