@@ -23,23 +23,37 @@ void qnav_vfh_config_default(qnav_vfh_config_t *cfg)
     }
     qnav_ctrl_config_default(&cfg->body);
     cfg->sector_deg = 5u;
-    cfg->blocked_mm = 1000u;
-    cfg->clear_mm = 1400u;
+    cfg->blocked_mm = 0u; /* scaled with the body at init */
+    cfg->clear_mm = 0u;
     cfg->wide_sectors = 16u;
     cfg->mu_goal = 5u;
     cfg->mu_current = 2u;
     cfg->mu_prev = 2u;
-    cfg->slow_mm = 2000u;
+    cfg->slow_mm = 0u;
 }
+
+/* tau_high scaled with the body (QNAV_VFH_BLOCKED_BODIES), at least 100 mm. */
+static uint32_t body_blocked_mm(const qnav_ctrl_config_t *body)
+{
+    const uint32_t b = ((uint32_t)body->body_radius_mm + body->safety_mm) * QNAV_VFH_BLOCKED_BODIES / 10u;
+    return b < 100u ? 100u : b;
+}
+
 
 static uint8_t level_at(const qnav_clearance_t *c, qnav_mm_t mm)
 {
     return qnav_clearance_level_of(c, mm > c->max_range_mm ? c->max_range_mm : mm);
 }
 
+static qnav_mm_t clamp_mm(uint32_t mm)
+{
+    return (qnav_mm_t)(mm > UINT16_MAX ? UINT16_MAX : mm);
+}
+
 qnav_status_t qnav_vfh_init(qnav_vfh_t *vfh, const qnav_vfh_config_t *cfg)
 {
     qnav_status_t st;
+    uint32_t blocked, clear, slow;
     if (vfh == 0) {
         return QNAV_E_NULL;
     }
@@ -54,16 +68,18 @@ qnav_status_t qnav_vfh_init(qnav_vfh_t *vfh, const qnav_vfh_config_t *cfg)
     if (st != QNAV_OK) {
         return st;
     }
+    blocked = cfg->blocked_mm != 0u ? cfg->blocked_mm : body_blocked_mm(&cfg->body);
+    clear = cfg->clear_mm != 0u ? cfg->clear_mm : blocked * 14u / 10u;
+    slow = cfg->slow_mm != 0u ? cfg->slow_mm : blocked * 2u;
     if (cfg->sector_deg < 1u || cfg->sector_deg > 30u || QNAV_PATHS % cfg->sector_deg != 0u ||
-        cfg->clear_mm < cfg->blocked_mm || cfg->wide_sectors < 1u || cfg->wide_sectors > 180u ||
-        cfg->slow_mm == 0u) {
+        clear < blocked || cfg->wide_sectors < 1u || cfg->wide_sectors > 180u) {
         return QNAV_E_VFH_PARAM;
     }
     vfh->sector_deg = cfg->sector_deg;
     vfh->n_hist = (uint16_t)(QNAV_PATHS / cfg->sector_deg);
-    vfh->level_blocked = level_at(&vfh->clr, cfg->blocked_mm);
-    vfh->level_clear = level_at(&vfh->clr, cfg->clear_mm);
-    vfh->level_slow = level_at(&vfh->clr, cfg->slow_mm);
+    vfh->level_blocked = level_at(&vfh->clr, clamp_mm(blocked));
+    vfh->level_clear = level_at(&vfh->clr, clamp_mm(clear));
+    vfh->level_slow = level_at(&vfh->clr, clamp_mm(slow));
     if (vfh->level_slow == 0u) {
         vfh->level_slow = 1u;
     }

@@ -62,7 +62,8 @@ static void test_vfh_init_rejects_bad_parameters(void **state)
     cfg.sector_deg = 7; /* does not divide 360 */
     assert_int_equal(qnav_vfh_init(&v, &cfg), QNAV_E_VFH_PARAM);
     qnav_vfh_config_default(&cfg);
-    cfg.clear_mm = (qnav_mm_t)(cfg.blocked_mm - 1u);
+    cfg.blocked_mm = 1000u;
+    cfg.clear_mm = 999u;
     assert_int_equal(qnav_vfh_init(&v, &cfg), QNAV_E_VFH_PARAM);
     qnav_vfh_config_default(&cfg);
     cfg.body.n_sectors = 0;
@@ -86,7 +87,7 @@ static void test_vfh_steers_around_an_obstacle_on_the_goal_line(void **state)
     fixture_t f;
     (void)state;
     setup(&f, 5000);
-    f.r[0] = 600; /* straight ahead, 0.6 m */
+    f.r[0] = 300; /* straight ahead, 0.3 m (tau_high 0.43 m) */
     step(&f);
     assert_true(f.out.heading_deg > 20 || f.out.heading_deg < -20);
     assert_true(f.out.heading_deg < 90 && f.out.heading_deg > -90);
@@ -101,14 +102,14 @@ static void test_vfh_drives_at_a_destination_in_front_of_an_obstacle(void **stat
     fixture_t f;
     (void)state;
     setup(&f, 5000);
-    f.r[0] = 600; /* straight ahead, 0.6 m: the destination 0.2 m short of it */
-    f.in.goal_range_mm = 200;
+    f.r[0] = 300; /* straight ahead, 0.3 m: the destination 0.2 m short of it */
+    f.in.goal_range_mm = 100;
     step(&f);
     assert_int_equal(f.out.heading_deg, 0);
     assert_true(f.out.speed > 0);
     setup(&f, 5000);
-    f.r[0] = 600;
-    f.in.goal_range_mm = 590; /* as far as the obstacle: the body would touch it first */
+    f.r[0] = 300;
+    f.in.goal_range_mm = 290; /* as far as the obstacle: the body would touch it first */
     step(&f);
     assert_true(f.out.heading_deg > 20 || f.out.heading_deg < -20);
 }
@@ -120,16 +121,16 @@ static void test_vfh_hysteresis_keeps_a_sector_blocked_between_the_thresholds(vo
     qnav_ctrl_output_t forgot;
     (void)state;
     setup(&f, 5000);
-    f.r[0] = 700; /* blocked: nearer than 1.0 m */
+    f.r[0] = 350; /* blocked: nearer than tau_high (0.43 m: 2.5 x (0.12 + 0.05) m) */
     step(&f);
     assert_true(f.out.heading_deg != 0);
-    f.r[0] = 1200; /* between tau_high (1.0 m) and tau_low (1.4 m) */
+    f.r[0] = 500; /* between tau_high (0.43 m) and tau_low (0.60 m) */
     step(&f);
     assert_true(f.out.heading_deg != 0); /* the goal's sector is still blocked */
     qnav_vfh_state_reset(&fresh);
     qnav_vfh_step(&f.v, &fresh, &f.in, &forgot);
     assert_int_equal(forgot.heading_deg, 0); /* a fresh state sees it free */
-    f.r[0] = 2000; /* beyond tau_low: free again */
+    f.r[0] = 800; /* beyond tau_low: free again */
     step(&f);
     assert_int_equal(f.out.heading_deg, 0);
 }
@@ -140,7 +141,7 @@ static void test_vfh_previous_direction_breaks_a_symmetric_choice(void **state)
     qnav_deg_t left;
     (void)state;
     setup(&f, 5000);
-    f.r[0] = 600;
+    f.r[0] = 300;
     f.in.prev_heading_cdeg = 6000;
     step(&f);
     left = f.out.heading_deg;
@@ -156,13 +157,42 @@ static void test_vfh_slows_near_obstacles_and_stops_when_boxed_in(void **state)
 {
     fixture_t f;
     (void)state;
-    setup(&f, 1500); /* free everywhere (beyond 1.4 m) but nearer than slow_mm */
+    setup(&f, 700); /* free everywhere (beyond tau_low, 0.6 m) but nearer than slow_mm (0.85 m) */
     step(&f);
     assert_true(f.out.speed > 0 && f.out.speed < QNAV_Q1_15_MAX);
     fill(f.r, 16, 300);
     step(&f);
     assert_int_equal(f.out.speed, 0);
     assert_true((f.out.flags & QNAV_FLAG_NO_PATH) != 0);
+}
+
+/* tau_high is 2.5 body enlargements (radius + safety distance) unless set: readings at
+ * 0.5 m all round leave a TekBot-sized body (0.17 m, tau_high 0.43 m) a way, and block
+ * every sector of a Pioneer-sized one (0.28 m, 0.70 m); a tau_high set in mm is kept. */
+static void test_vfh_thresholds_scale_with_the_body(void **state)
+{
+    fixture_t f;
+    qnav_vfh_config_t cfg;
+    (void)state;
+    setup(&f, 500);
+    step(&f);
+    assert_true(f.out.speed > 0);
+    qnav_vfh_config_default(&cfg);
+    cfg.body.body_radius_mm = 260u;
+    cfg.body.safety_mm = 20u;
+    assert_int_equal(qnav_vfh_init(&f.v, &cfg), QNAV_OK);
+    qnav_vfh_state_reset(&f.st);
+    step(&f);
+    assert_int_equal(f.out.speed, 0);
+    assert_true((f.out.flags & QNAV_FLAG_NO_PATH) != 0);
+    qnav_vfh_config_default(&cfg);
+    cfg.blocked_mm = 600u;
+    assert_int_equal(qnav_vfh_init(&f.v, &cfg), QNAV_OK);
+    qnav_vfh_state_reset(&f.st);
+    step(&f);
+    assert_int_equal(f.out.speed, 0);
+    cfg.clear_mm = 599u;
+    assert_int_equal(qnav_vfh_init(&f.v, &cfg), QNAV_E_VFH_PARAM);
 }
 
 static void test_vfh_without_init_or_state_commands_stop(void **state)
@@ -274,6 +304,7 @@ int main(void)
         cmocka_unit_test(test_vfh_hysteresis_keeps_a_sector_blocked_between_the_thresholds),
         cmocka_unit_test(test_vfh_previous_direction_breaks_a_symmetric_choice),
         cmocka_unit_test(test_vfh_slows_near_obstacles_and_stops_when_boxed_in),
+        cmocka_unit_test(test_vfh_thresholds_scale_with_the_body),
         cmocka_unit_test(test_vfh_without_init_or_state_commands_stop),
         cmocka_unit_test(test_table_selects_controllers_by_name),
         cmocka_unit_test(test_literal_entry_applies_the_literal_reading),

@@ -24,6 +24,11 @@
 extern "C" {
 #endif
 
+/* Default tau_high in tenths of the body's enlargement (radius + safety distance): 2.5 of
+ * them, 0.43 m for the TekBot and 0.70 m for the Pioneer 3-DX (until 0.13.1 1.0 m for
+ * every robot, an assumption: docs/architecture.md, "VFH+"). */
+#define QNAV_VFH_BLOCKED_BODIES 25u
+
 /* Largest number of histogram sectors (alpha = 1 degree). */
 #define QNAV_VFH_MAX_SECTORS 360u
 
@@ -35,10 +40,13 @@ typedef struct {
     uint8_t sector_deg;       /* histogram sector width alpha, degrees, divides 360, 1..30;
                                  default 5 (VFH+ paper) */
     qnav_mm_t blocked_mm;     /* tau_high: a sector whose nearest enlarged reading is nearer
-                                 than this is blocked, mm; default 1000 (assumed) */
+                                 than this is blocked, mm; default 0: scaled with the body,
+                                 QNAV_VFH_BLOCKED_BODIES tenths of body_radius_mm +
+                                 safety_mm (at least 100 mm; measured: docs/architecture.md,
+                                 "VFH+") */
     qnav_mm_t clear_mm;       /* tau_low: a sector is free again only beyond this, mm;
                                  >= blocked_mm; in between it keeps last tick's value.
-                                 Default 1400 (assumed) */
+                                 Default 0: 1.4 times blocked_mm */
     uint8_t wide_sectors;     /* s_max: a gap of more sectors is wide, 1..180;
                                  default 16 (VFH+ paper: 16 sectors of 5 deg) */
     uint8_t mu_goal;          /* cost weight of the angle to the goal; default 5 (VFH+ paper,
@@ -48,7 +56,7 @@ typedef struct {
                                  default 2 */
     qnav_mm_t slow_mm;        /* full speed when the chosen direction is clear this far,
                                  linearly less nearer (VFH's V = Vmax (1 - h_c / h_m));
-                                 default 2000 (assumed) */
+                                 default 0: twice blocked_mm */
 } qnav_vfh_config_t;
 
 /* Derived parameters. Caller-owned, private fields; only read by the step. */
