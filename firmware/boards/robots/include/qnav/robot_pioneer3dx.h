@@ -33,7 +33,7 @@
         .ctrl.escape_stall_ticks = 20, \
         .ctrl.escape_follow_mm = 800, \
         .ctrl.escape_follow_s = 20, \
-        .ctrl.keep_pct = 25, \
+        .ctrl.keep_pct = 15, \
         .ctrl.range_min_mm = 100, \
         .ctrl.pass_mm = 20, \
         .tick_ms = 100, \
