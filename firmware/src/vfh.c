@@ -35,10 +35,10 @@ void qnav_vfh_config_default(qnav_vfh_config_t *cfg)
 /* tau_high scaled with the body (QNAV_VFH_BLOCKED_BODIES), at least 100 mm. */
 static uint32_t body_blocked_mm(const qnav_ctrl_config_t *body)
 {
-    const uint32_t b = ((uint32_t)body->body_radius_mm + body->safety_mm) * QNAV_VFH_BLOCKED_BODIES / 10u;
+    const uint32_t enlarge = (uint32_t)body->body_radius_mm + body->safety_mm;
+    const uint32_t b = enlarge * QNAV_VFH_BLOCKED_BODIES / 10u;
     return b < 100u ? 100u : b;
 }
-
 
 static uint8_t level_at(const qnav_clearance_t *c, qnav_mm_t mm)
 {

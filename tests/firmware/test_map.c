@@ -623,14 +623,16 @@ static void test_a_way_the_robot_cannot_take_is_refused_for_a_while(void **state
     assert_true(qnav_map_evidence(&m, 4950, 2550) < QNAV_MAP_OCCUPIED); /* not at the robot */
     for (t = 0; t < 18; ++t) {
         memset(&in, 0, sizeof in);
-        assert_int_equal(qnav_map_guide(&m, &p, 4900, 5000, &in) & QNAV_MAP_GUIDED, QNAV_MAP_GUIDED);
+        got = qnav_map_guide(&m, &p, 4900, 5000, &in);
+        assert_int_equal(got & QNAV_MAP_GUIDED, QNAV_MAP_GUIDED);
         assert_true(in.goal_bearing_cdeg > 3000);
     }
     /* the refusal lapses after refuse_life_ticks (20): through the near gap again */
     for (t = 0; t < 5; ++t) {
         memset(&in, 0, sizeof in);
         got = qnav_map_guide(&m, &p, 4900, 5000, &in);
-        if ((got & QNAV_MAP_GUIDED) && in.goal_bearing_cdeg > -1500 && in.goal_bearing_cdeg < 1500) {
+        if ((got & QNAV_MAP_GUIDED) && in.goal_bearing_cdeg > -1500 &&
+            in.goal_bearing_cdeg < 1500) {
             break;
         }
     }
