@@ -65,6 +65,7 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->refuse_life_ticks = 200u;
     cfg->compact = 0u;
     cfg->grow_steps = 16u;
+    cfg->forget_reach_mm = 0u;
 }
 
 uint32_t qnav_map_cells(uint32_t width_mm, uint32_t height_mm, uint16_t cell_mm)
@@ -259,6 +260,7 @@ void qnav_map_reset(qnav_map_t *m)
     m->stall_best_mm = 0u;
     m->stall_ticks = 0u;
     m->refused_ticks = 0u;
+    m->forgot = 0u;
 }
 
 /* The full layout's qnav_cmap_shift: cell (i, j) takes cell (i + di, j + dj)'s evidence
@@ -290,6 +292,7 @@ static void shift_evidence(qnav_map_t *m, int32_t di, int32_t dj)
 static void forget_occupied(qnav_map_t *m)
 {
     uint32_t c, n = cell_count(m);
+    m->forgot = 1u;
     if (m->cfg.compact) {
         qnav_cmap_forget_occupied(m);
         return;
@@ -463,6 +466,13 @@ static void mark_arc(qnav_map_t *m, int32_t i, int32_t j)
     }
 }
 
+/* Readings this near the robot's centre mark cells: after a forget only those within
+ * forget_reach_mm (the map's "Marking near after a forget"), else every one. */
+static int32_t marks_within(const qnav_map_t *m)
+{
+    return m->forgot && m->cfg.forget_reach_mm != 0u ? (int32_t)m->cfg.forget_reach_mm : INT32_MAX;
+}
+
 /*
  * Squares are unsigned 32-bit (a 64-bit product costs an AVR hundreds of cycles): with
  * reach_mm at most MAX_REACH_MM and cells at most 1 000 mm, a cell's offset from the robot
@@ -471,7 +481,7 @@ static void mark_arc(qnav_map_t *m, int32_t i, int32_t j)
  */
 void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *pose)
 {
-    int32_t i0, i1, j0, j1, i, j, reach, three_quarters, heading, arc_half, band_pct;
+    int32_t i0, i1, j0, j1, i, j, reach, mark_reach, three_quarters, heading, arc_half, band_pct;
     uint32_t reach2;
     /* the last sector's reading and what follows from it: cells in a row often share a
      * sector, and each costs divisions (an AVR's are hundreds of cycles) */
@@ -487,6 +497,7 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
     reach = (int32_t)m->cfg.reach_mm;
     three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
     reach2 = (uint32_t)reach * (uint32_t)reach;
+    mark_reach = marks_within(m);
     band_pct = m->cfg.noise_pct < OCCUPIED_BAND_PCT ? (int32_t)m->cfg.noise_pct : OCCUPIED_BAND_PCT;
     heading = qnav_wrap_cdeg(pose->heading_cdeg);
     arc_half = INT32_C(18000) / (int32_t)m->n_sectors; /* the whole wedge, or the set arc */
@@ -538,7 +549,7 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
             band = last.band;
             if (lo > 0 && (lo > reach || d2 < (uint32_t)lo * (uint32_t)lo)) {
                 mark_clear(m, i, j);
-            } else if (c >= 0 && c < EVIDENCE_REFUSED &&
+            } else if (c >= 0 && c < EVIDENCE_REFUSED && rc <= mark_reach &&
                        (rc + three_quarters > reach ||
                         d2 <= (uint32_t)(rc + three_quarters) * (uint32_t)(rc + three_quarters)) &&
                        (band <= 0 || (band <= reach && d2 >= (uint32_t)band * (uint32_t)band)) &&
@@ -905,6 +916,9 @@ static uint32_t cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi
 static int plan_when_due(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
 {
     int again = 0;
+    if (m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm) {
+        m->forgot = 0u; /* a new destination: marked from afar again until the next forget */
+    }
     if (!m->planned || m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm) {
         plan_start(m, goal_x_mm, goal_y_mm);
     } else if (++m->ticks >= m->cfg.plan_ticks) {

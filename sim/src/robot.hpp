@@ -71,6 +71,7 @@ struct RobotProfile {
     double map_noise = -1.0;        // [map] noise: the range noise the map allows for (its
                                     // noise_pct); < 0: [noise] sensor
     double map_arc_deg = 22.5;      // arcs marked within this angle about the wedge's centre
+    double map_forget_reach_m = 0.0;  // after a forget, only readings this near mark; 0: all
     bool map_sight = true;          // the sub-goal kept in a straight line's sight
     bool map_escape_grow = true;    // a longer plan grows the escape's distances with it
     double map_refuse_s = 3.0;      // no progress along the plan this long: its next cells refused

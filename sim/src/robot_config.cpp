@@ -68,6 +68,7 @@ void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg) {
         static_cast<std::uint16_t>(std::clamp(std::lround(p.map_refuse_life_s / QNAV_SIM_TICK_S), 1L, 65535L));
     cfg->compact = p.map_compact ? 1 : 0;
     cfg->grow_steps = p.map_grow_steps;
+    cfg->forget_reach_mm = to_mm(p.map_forget_reach_m);
 }
 
 }  // namespace qnav

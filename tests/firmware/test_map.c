@@ -569,6 +569,65 @@ static void test_a_map_that_closed_every_way_forgets_what_it_marked(void **state
     walled_in_forgets(&m);
 }
 
+/* The map of walled_in_forgets with forget_reach_mm 1200, after the forget: the wall seen
+ * again from 1.45 m (farther than 1 200 mm) is not marked, from 0.75 m it is; a new
+ * destination marks from afar again. */
+static void near_marks_after_a_forget(qnav_map_t *m)
+{
+    static const box_t closed[] = {{0, 2950, WORLD_MM, 3050}};
+    qnav_ctrl_input_t in;
+    qnav_mm_t ranges[N];
+    int32_t x, y;
+    walled_in_forgets(m);
+    for (y = 1500; y <= 2200; y += 700) {
+        for (x = 300; x <= 5700; x += 200) {
+            const qnav_map_pose_t q = {x, y, 9000};
+            scan(closed, 1, &q, ranges);
+            qnav_map_observe(m, ranges, &q);
+        }
+        for (x = 500; x <= 5500; x += 500) {
+            if (y == 1500) {
+                assert_int_equal(qnav_map_evidence(m, x, 2960), 0);
+            } else {
+                assert_true(qnav_map_evidence(m, x, 2960) >= QNAV_MAP_OCCUPIED);
+            }
+        }
+    }
+    /* forgotten again (the wall is marked from near); then a new destination: a reading
+     * from afar marks again */
+    walled_in_forgets(m);
+    memset(&in, 0, sizeof in);
+    {
+        const qnav_map_pose_t p = {1500, 1500, 9000};
+        scan(closed, 1, &p, ranges);
+        qnav_map_observe(m, ranges, &p);
+        assert_int_equal(qnav_map_evidence(m, 1500, 2960), 0);
+        (void)qnav_map_guide(m, &p, 1600, 5000, &in);
+        qnav_map_observe(m, ranges, &p);
+        qnav_map_observe(m, ranges, &p);
+        assert_true(qnav_map_evidence(m, 1500, 2960) >= QNAV_MAP_OCCUPIED);
+    }
+}
+
+static void test_after_a_forget_only_near_readings_mark(void **state)
+{
+    qnav_map_config_t mc;
+    qnav_map_t m;
+    (void)state;
+    qnav_map_config_default(&mc);
+    mc.plan_ticks = 1;
+    mc.forget_reach_mm = 1200;
+    map_from(&m, &mc);
+    near_marks_after_a_forget(&m);
+    mc.compact = 1;
+    mc.cell_mm = 400;
+    mc.grow_steps = 16;
+    mc.near_cost = 0;
+    mc.refuse_ticks = 0;
+    map_from(&m, &mc);
+    near_marks_after_a_forget(&m);
+}
+
 /* The wall with its gap at x 4500..5300, and a second gap at x 200..1800. */
 static const box_t wall_with_two_gaps[] = {
     {0, 2950, 200, 3050}, {1800, 2950, 4500, 3050}, {5300, 2950, WORLD_MM, 3050}};
@@ -940,6 +999,7 @@ int main(void)
         cmocka_unit_test(test_a_longer_plan_grows_the_escape_memory),
         cmocka_unit_test(test_the_destination_in_reach_is_flagged_direct),
         cmocka_unit_test(test_a_map_that_closed_every_way_forgets_what_it_marked),
+        cmocka_unit_test(test_after_a_forget_only_near_readings_mark),
         cmocka_unit_test(test_a_way_the_robot_cannot_take_is_refused_for_a_while),
         cmocka_unit_test(test_the_plan_is_settled_as_far_as_the_robot_needs),
         cmocka_unit_test(test_a_map_reaches_toward_a_goal_too_far_for_it),

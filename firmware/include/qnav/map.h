@@ -75,6 +75,13 @@ typedef struct {
                               (its cost is bounded: docs/performance.md); while it has not
                               reached the robot, the last sub-goal stands. 0: no bound.
                               Default 16 */
+    uint16_t forget_reach_mm; /* once the map has forgotten what closed every way (until the
+                              destination changes), only readings within this distance of
+                              the robot's centre mark cells occupied, mm; farther ones still
+                              free cells. A near arc is narrower than a cell, so a gap the
+                              far arcs closed is seen as it is before it is marked again
+                              (docs/architecture.md, "Marking near after a forget"). 0: no
+                              limit; default 0 */
 } qnav_map_config_t;
 
 /* The robot's pose in the destination's frame. */
@@ -120,6 +127,7 @@ typedef struct {
     uint16_t stall_best_mm;   /* the least planned distance since the last refusal */
     uint16_t stall_ticks;     /* guided ticks since it last shrank by a cell */
     uint16_t refused_ticks;   /* ticks the refused cells have left; 0: none */
+    uint8_t forgot;           /* forgot what closed every way since the destination was set */
     /* The plan's queue, kept between ticks: a plan settles cells only until the robot's
      * is settled, and goes on from here when the robot stands on a cell not yet settled */
     uint16_t q_count;         /* buckets in use */
