@@ -223,16 +223,24 @@ static void observe_the_wall(qnav_map_t *m)
 
 /* The compact layout at cell_mm (wider than the sensor's body, 170 mm), planning every
  * plan_ticks, growing its plan by grow_steps a tick (0: as far as it needs). */
+/* mc made compact: cells of cell_mm, no near cost or refusal (a compact map has no bits
+ * for them). */
+static void make_compact(qnav_map_config_t *mc, uint16_t cell_mm, uint8_t plan_ticks,
+                         uint8_t grow_steps)
+{
+    mc->compact = 1;
+    mc->cell_mm = cell_mm;
+    mc->plan_ticks = plan_ticks;
+    mc->grow_steps = grow_steps;
+    mc->near_cost = 0;
+    mc->refuse_ticks = 0;
+}
+
 static void compact_map(qnav_map_t *m, uint16_t cell_mm, uint8_t plan_ticks, uint8_t grow_steps)
 {
     qnav_map_config_t mc;
     qnav_map_config_default(&mc);
-    mc.compact = 1;
-    mc.cell_mm = cell_mm;
-    mc.plan_ticks = plan_ticks;
-    mc.grow_steps = grow_steps;
-    mc.near_cost = 0;
-    mc.refuse_ticks = 0;
+    make_compact(&mc, cell_mm, plan_ticks, grow_steps);
     map_from(m, &mc);
 }
 
@@ -619,11 +627,7 @@ static void test_after_a_forget_only_near_readings_mark(void **state)
     mc.forget_reach_mm = 1200;
     map_from(&m, &mc);
     near_marks_after_a_forget(&m);
-    mc.compact = 1;
-    mc.cell_mm = 400;
-    mc.grow_steps = 16;
-    mc.near_cost = 0;
-    mc.refuse_ticks = 0;
+    make_compact(&mc, 400, 1, 16);
     map_from(&m, &mc);
     near_marks_after_a_forget(&m);
 }
