@@ -78,7 +78,7 @@ typedef struct {
     uint16_t forget_reach_mm; /* once the map has forgotten what closed every way (until the
                               destination changes), only readings within this distance of
                               the robot's centre mark cells occupied, mm; farther ones still
-                              free cells. A near arc is narrower than a cell, so a gap the
+                              clear cells. A near arc is narrower than a cell, so a gap the
                               far arcs closed is seen as it is before it is marked again
                               (docs/architecture.md, "Marking near after a forget"). 0: no
                               limit; default 0 */
