@@ -916,10 +916,11 @@ static uint32_t cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi
 static int plan_when_due(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
 {
     int again = 0;
-    if (m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm) {
-        m->forgot = 0u; /* a new destination: marked from afar again until the next forget */
+    const int new_goal = m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm;
+    if (new_goal) {
+        m->forgot = 0u; /* marked from afar again until the next forget */
     }
-    if (!m->planned || m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm) {
+    if (!m->planned || new_goal) {
         plan_start(m, goal_x_mm, goal_y_mm);
     } else if (++m->ticks >= m->cfg.plan_ticks) {
         if (m->dirty) {
