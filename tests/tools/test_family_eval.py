@@ -18,9 +18,9 @@ ROW = re.compile(r"^(\w+)\s+([\d.]+)% \[\s*([\d.]+),\s*([\d.]+)\]\s+([\d.]+)% \[
                  r"\s+(\d+)/(\d+)\s+([\d.]+)\s+([\d.]+)$")
 
 
-def tool(*args):
+def tool(*args, env=None):
     return subprocess.run([sys.executable, TOOL, "--sim", SIM, *args], capture_output=True,
-                          text=True, timeout=600)
+                          text=True, timeout=600, env=env)
 
 
 class FamilyEval(unittest.TestCase):
@@ -67,11 +67,11 @@ class FamilyEval(unittest.TestCase):
             self.assertAlmostEqual(ref, per["reference"][i], delta=0.051)
             self.assertEqual(m.group(9), "above" if mean > ref else "below" if mean < ref else "level")
 
-    def listed(self, family, worlds, *args):
+    def listed(self, family, worlds, *args, env=None):
         """Run with --failures; run every listed command and check the episode does what its
         line says. The set of what the lines say, and the touches listed."""
         r = tool("--worlds", str(worlds), "--episodes", "2", "-j", "2", "--families", family,
-                 "--failures", *args)
+                 "--failures", *args, env=env)
         self.assertEqual(r.returncode, 0, r.stderr)
         row = ROW.match(r.stdout.splitlines()[2])
         listing = r.stdout.splitlines()[3:]
@@ -114,22 +114,40 @@ class FamilyEval(unittest.TestCase):
 
     def test_failures_are_listed_with_commands_that_draw_them(self):
         # fixed seeds: the TekBot without a map misses the limit in these rooms, and one
-        # without its safety distance, speed guard and passing distance touches something in
-        # denser clutter
+        # without its safety distance, speed guard and passing distance (--set: the listed
+        # commands drive the edited copy) touches something in denser clutter
         kinds, _ = self.listed("rooms", 2, "--seed-base", "5000007", "--robot", "tekbot-map")
         self.assertTrue({"arrived late", "did not arrive at twice the limit"} <= kinds, kinds)
+        with tempfile.TemporaryDirectory() as tmp:
+            _, touches = self.listed("clutter", 3, "--seed-base", "3000000", "--difficulty", "0.8",
+                                     "--set", "clearance.safety_m=0.0",
+                                     "--set", "clearance.speed_guard=false", "--set", "map.pass_m=0.0",
+                                     env=dict(os.environ, TMPDIR=tmp))
+        self.assertGreater(touches, 0)
+
+    def test_set_drives_an_edited_copy_of_the_profile(self):
+        # map.on=false is the robot tekbot-map names: the same episodes; a key the profile
+        # lacks is added to its section; data/robots is not touched
         src = os.path.join(os.environ["QNAV_TOOLS_DIR"], "..", "data", "robots", "tekbot.toml")
         with open(src, encoding="utf-8") as f:
-            text = re.sub(r"(?m)^safety_m = .*$", "safety_m = 0.0", f.read())
-        text = re.sub(r"(?m)^speed_guard = .*$", "speed_guard = false", text)
-        text = re.sub(r"(?m)^pass_m = .*$", "pass_m = 0.0", text)
+            before = f.read()
         with tempfile.TemporaryDirectory() as tmp:
-            prof = os.path.join(tmp, "reckless.toml")
-            with open(prof, "w", encoding="utf-8") as f:
-                f.write(text)
-            _, touches = self.listed("clutter", 3, "--seed-base", "3000000", "--difficulty", "0.8",
-                                     "--robot", prof)
-        self.assertGreater(touches, 0)
+            env = dict(os.environ, TMPDIR=tmp)
+            args = ("--worlds", "2", "--episodes", "2", "-j", "2", "--families", "rooms,clutter",
+                    "--seed-base", "5000007")
+            edited = tool(*args, "--set", "map.on=false", "--set", "map.look_m=1.0", env=env)
+            named = tool(*args, "--robot", "tekbot-map")
+            self.assertEqual(edited.returncode, 0, edited.stderr)
+            self.assertEqual(named.returncode, 0, named.stderr)
+            self.assertEqual(edited.stdout.splitlines()[1:], named.stdout.splitlines()[1:])
+            prof = re.match(r"^robot (\S+), worlds sized for tekbot,", edited.stdout).group(1)
+            self.assertTrue(prof.startswith(tmp), prof)
+            with open(prof, encoding="utf-8") as f:
+                copy = f.read()
+        self.assertRegex(copy, r"(?m)^on = false +# ")
+        self.assertRegex(copy, r"(?m)^\[map\] .*\n( +#.*\n)*look_m = 1.0\ncompact = true ")
+        with open(src, encoding="utf-8") as f:
+            self.assertEqual(f.read(), before)
 
     def test_a_profile_file_sizes_its_worlds_and_keeps_its_sectors(self):
         # a robot not in data/robots: its worlds are sized from the file, and qnav-sim run is
@@ -169,7 +187,11 @@ class FamilyEval(unittest.TestCase):
                             (["--robot", "/no/such/profile.toml"], "/no/such/profile.toml"),
                             (["--worlds", "0"], "at least 1"),
                             (["--sectors", "0"], "at least 1"),
-                            (["--failures", "--policy", "a", "--policy", "b"], "give --policy once")):
+                            (["--failures", "--policy", "a", "--policy", "b"], "give --policy once"),
+                            (["--set", "map.cell_m"], "expected SECTION.KEY=VALUE"),
+                            (["--set", "nosuch.k=1"], "no [nosuch] section"),
+                            (["--set", "drive.model=mix"], "--set drive.model=mix: the value is not TOML"),
+                            (["--robot", "tekbot-map", "--set", "map.on=true"], "--set map.on=false")):
             r = tool("--worlds", "1", *args) if args[0] != "--worlds" else tool(*args)
             self.assertNotEqual(r.returncode, 0)
             self.assertIn(words, r.stderr)
