@@ -188,12 +188,7 @@ int main(void)
     }
     qnav_avr_timer_start();
     overhead = qnav_avr_timer_stop();
-    qnav_ctrl_config_default(&cc);
-    cc.n_sectors = QNAV_BENCH_MAP_SECTORS;
-    cc.max_range_mm = QNAV_BENCH_MAP_RANGE_MM;
-    cc.sensor_offset_mm = QNAV_BENCH_MAP_OFFSET_MM;
-    cc.body_radius_mm = QNAV_BENCH_MAP_RADIUS_MM;
-    cc.safety_mm = QNAV_BENCH_MAP_SAFETY_MM;
+    QNAV_BENCH_MAP_CTRL_CONFIG(&cc);
     PUT("qnav AVR map benchmark: ATmega128, 16 MHz, simavr; compact map, cells of ");
     qnav_target_put_u32(mc.cell_mm);
     PUT(" mm\n");

@@ -29,4 +29,16 @@ typedef struct {
     uint16_t n_ticks;
 } qnav_bench_map_world_t;
 
+/* The controller configuration of the trace's robot (bench_map_trace.h's QNAV_BENCH_MAP_*),
+ * which the map takes its body and sonar from: cc a qnav_ctrl_config_t pointer. */
+#define QNAV_BENCH_MAP_CTRL_CONFIG(cc)                       \
+    do {                                                     \
+        qnav_ctrl_config_default(cc);                        \
+        (cc)->n_sectors = QNAV_BENCH_MAP_SECTORS;            \
+        (cc)->max_range_mm = QNAV_BENCH_MAP_RANGE_MM;        \
+        (cc)->sensor_offset_mm = QNAV_BENCH_MAP_OFFSET_MM;   \
+        (cc)->body_radius_mm = QNAV_BENCH_MAP_RADIUS_MM;     \
+        (cc)->safety_mm = QNAV_BENCH_MAP_SAFETY_MM;          \
+    } while (0)
+
 #endif

@@ -10,21 +10,8 @@
 #include <stdint.h>
 
 #include "bench_grid.h"
+#include "cm4_markers.h"
 #include "target_io.h"
-
-/* The markers: not inlined, not merged, kept by --gc-sections. */
-__attribute__((noinline, used)) void qnav_bench_begin(void);
-__attribute__((noinline, used)) void qnav_bench_end(void);
-
-__attribute__((noinline, used)) void qnav_bench_begin(void)
-{
-    __asm__ volatile("");
-}
-
-__attribute__((noinline, used)) void qnav_bench_end(void)
-{
-    __asm__ volatile("");
-}
 
 static uint32_t measure(const qnav_ctrl_t *ctrl, const qnav_ctrl_input_t *in,
                         qnav_ctrl_output_t *out, uint8_t mode)
