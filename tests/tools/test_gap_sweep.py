@@ -1,10 +1,11 @@
 """tools/gap-sweep against the built qnav-sim: a gap narrower than the body is never passed
 (refused as walled in, or no arrival), a wide one is, the rows are in width order with
-their intervals, and bad input gets one line."""
+their intervals, --set sweeps an edited copy of the profile, and bad input gets one line."""
 import os
 import re
 import subprocess
 import sys
+import tempfile
 import unittest
 
 TOOL = os.path.join(os.environ["QNAV_TOOLS_DIR"], "gap-sweep")
@@ -14,9 +15,9 @@ ROW = re.compile(r"^\s*([\d.]+)\s+(-?[\d.]+)\s+([\d.]+)% \[\s*([\d.]+),\s*([\d.]
 REFUSED = re.compile(r"^\s*([\d.]+)\s+(-?[\d.]+)\s+refused by qnav-sim")
 
 
-def tool(*args):
+def tool(*args, env=None):
     return subprocess.run([sys.executable, TOOL, "--sim", SIM, *args], capture_output=True,
-                          text=True, timeout=600)
+                          text=True, timeout=600, env=env)
 
 
 class GapSweep(unittest.TestCase):
@@ -46,6 +47,19 @@ class GapSweep(unittest.TestCase):
         self.assertIn("robot tekbot+map (radius 0.120 m)", r.stdout)
         self.assertAlmostEqual(float(ROW.match(r.stdout.splitlines()[2]).group(1)), 0.84, places=3)
 
+    def test_set_sweeps_an_edited_copy(self):
+        # the widths follow the copy's body (0.2 m: 0.4 + 0.3); the copy is kept where the
+        # header says, in TMPDIR
+        with tempfile.TemporaryDirectory() as tmp:
+            r = tool("--set", "body.radius_m=0.2", "--set", "clearance.safety_m=0.02", "--clearances",
+                     "0.3", "--episodes", "1", "-j", "1", env=dict(os.environ, TMPDIR=tmp))
+            self.assertEqual(r.returncode, 0, r.stderr)
+            head = re.match(r"^robot (\S+) \(radius 0.200 m\)", r.stdout)
+            self.assertTrue(head and head.group(1).startswith(tmp), r.stdout)
+            with open(head.group(1), encoding="utf-8") as f:
+                self.assertRegex(f.read(), r"(?m)^safety_m = 0.02 +#")
+        self.assertAlmostEqual(float(ROW.match(r.stdout.splitlines()[2]).group(1)), 0.7, places=3)
+
     def test_bad_input_is_one_line(self):
         # argparse's own refusals: usage, then one line naming the option
         for args, words in ((["--clearances", "abc"], "--clearances: not a list of numbers"),
@@ -57,7 +71,9 @@ class GapSweep(unittest.TestCase):
         # the tool's own: exactly one line
         for args, words in ((["--robot", "/no/such/profile.toml"], "/no/such/profile.toml"),
                             (["--clearances", "12"], "fit the 10 m wall"),
-                            (["--sim", "/no/such/qnav-sim"], "not an executable qnav-sim")):
+                            (["--sim", "/no/such/qnav-sim"], "not an executable qnav-sim"),
+                            (["--set", "clearance.safety_m=x"], "--set clearance.safety_m=x: the value is not TOML"),
+                            (["--set", "safety_m=0"], "expected SECTION.KEY=VALUE")):
             r = tool(*args)
             self.assertEqual(r.returncode, 1, args)
             self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
