@@ -30,16 +30,21 @@ def run(cmd):
     return r.stdout + r.stderr
 
 
+def named_profile(name):
+    """data/robots/NAME.toml (QNAV_DATA_DIR's data, else the source tree's)."""
+    data = os.environ.get("QNAV_DATA_DIR",
+                          os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data"))
+    return os.path.join(data, "robots", name + ".toml")
+
+
 def profile_file(prog, robot):
-    """The profile file --robot names: itself, or data/robots/NAME.toml (QNAV_DATA_DIR's)."""
+    """The profile file --robot names: itself, or data/robots/NAME.toml."""
     if os.path.isfile(robot):
         return robot
     if not re.fullmatch(r"[A-Za-z0-9_]+", robot):
         sys.exit(f"{prog}: --set edits a profile: name one in data/robots or a file "
                  f"({robot!r} is neither; for the map, --set map.on=false)")
-    data = os.environ.get("QNAV_DATA_DIR",
-                          os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data"))
-    path = os.path.join(data, "robots", robot + ".toml")
+    path = named_profile(robot)
     if not os.path.isfile(path):
         sys.exit(f"{prog}: {robot}: no such robot profile in data/robots")
     return os.path.normpath(path)
