@@ -10,24 +10,46 @@
 /* Full wheel speed, Q1.15. */
 #define FULL ((int32_t)32767)
 
+/* The decision's forward part, Q1.15: speed * cos(heading), 0 at 90 deg and beyond. */
+static int32_t forward_part(int32_t mag, qnav_q1_15_t speed)
+{
+    int16_t c;
+    int16_t s;
+    if (speed <= 0 || mag >= 90) {
+        return 0;
+    }
+    qnav_cos_sin_q14(mag * 100, &c, &s);
+    return ((int32_t)speed * c) / 16384;
+}
+
+static int32_t magnitude(qnav_deg_t heading_deg)
+{
+    const int32_t h = heading_deg;
+    return h < 0 ? -h : h;
+}
+
+/* No forward part while the robot rolls: brake, then turn. */
+static int brakes(int32_t fwd, qnav_q1_15_t rolling)
+{
+    return fwd == 0 && rolling > QNAV_DRIVE_STOPPED;
+}
+
+int qnav_drive_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling)
+{
+    return brakes(forward_part(magnitude(heading_deg), speed), rolling);
+}
+
 void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling,
                     qnav_q1_15_t *left, qnav_q1_15_t *right)
 {
-    int32_t h = heading_deg;
-    int32_t mag = h < 0 ? -h : h;
-    int32_t fwd = 0;
+    const int32_t mag = magnitude(heading_deg);
+    int32_t fwd = forward_part(mag, speed);
     int32_t turn = mag >= 90 ? FULL : (FULL * mag) / 90;
     if (left == NULL || right == NULL) {
         return;
     }
-    if (speed > 0 && mag < 90) {
-        int16_t c;
-        int16_t s;
-        qnav_cos_sin_q14(mag * 100, &c, &s);
-        fwd = ((int32_t)speed * c) / 16384;
-    }
-    if (fwd == 0 && rolling > QNAV_DRIVE_STOPPED) {
-        *left = 0; /* brake first (measured: docs/sim.md, "One drive for ...") */
+    if (brakes(fwd, rolling)) {
+        *left = 0; /* docs/sim.md, "Brake, then turn" */
         *right = 0;
         return;
     }
@@ -36,7 +58,7 @@ void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rol
         fwd = (fwd * FULL) / sum;
         turn = (turn * FULL) / sum;
     }
-    if (h < 0) {
+    if (heading_deg < 0) {
         turn = -turn;
     }
     *left = (qnav_q1_15_t)(fwd - turn);

@@ -23,7 +23,7 @@ static void parse_motion(const TomlReader &r, RobotProfile &p) {
 
     const toml::table &drive = r.table(root, "drive");
     r.only_keys(drive, {"v_max_mps", "accel_mps2", "decel_mps2", "turn_rate_max_dps",
-                        "heading_gain_per_s", "limits", "full_speed_quality", "model"});
+                        "heading_gain_per_s", "limits", "full_speed_quality", "model", "brake_first"});
     p.v_max_mps = r.number(drive, "v_max_mps", 0.01, 20.0);
     p.full_speed_quality = r.number(drive, "full_speed_quality", 0.01, 1.0);
     p.accel_mps2 = r.number(drive, "accel_mps2", 0.01, 100.0);
@@ -43,6 +43,12 @@ static void parse_motion(const TomlReader &r, RobotProfile &p) {
         p.drive_mix = model == "mix";
         if (p.drive_mix && p.body_limits)
             r.fail(*drive.get("model"), "'model' \"mix\" drives each wheel: not with limits = \"body\"");
+    }
+    if (const toml::node *bf = drive.get("brake_first")) {
+        if (!bf->is_boolean()) r.fail(*bf, "'brake_first' must be true or false");
+        p.brake_first = bf->value_or(true);
+        if (p.drive_mix && !p.brake_first)
+            r.fail(*bf, "'brake_first' = false is the heading model's ablation: the mix always brakes first");
     }
 
     const toml::table &slip = r.table(root, "slip");

@@ -34,6 +34,10 @@ struct RobotProfile {
     // board does (qnav_drive_mix; the TekBot's board drives its motors so), each wheel at
     // accel / decel
     bool drive_mix = false;
+    // [drive] brake_first (model "heading"): a decision without a forward part while the
+    // robot rolls faster than v_max / 8 holds the heading and brakes first, as the mix does
+    // (qnav_drive_brakes_first; docs/sim.md, "Brake, then turn"); false: the ablation
+    bool brake_first = true;
     double turn_rate_max_dps = 180; // turn-rate limit of the heading controller, deg/s
     double heading_gain_per_s = 4;  // heading controller: turn rate = gain * error, 1/s
     // slip

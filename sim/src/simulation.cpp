@@ -225,6 +225,7 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     l_m_ = 0;
     wheel_l_ = wheel_r_ = 0;
     mix_l_ = mix_r_ = 0;
+    braking_ = false;
     cmd_heading_deg_ = cmd_speed_ = 0;
     escape_side_ = 0;
     have_prev_ = false;
@@ -448,24 +449,41 @@ void Simulation::recovery_wheels() {
     }
 }
 
-// [drive] model "mix": the decision as the board turns it into wheel speeds, whole degrees
-// and Q1.15 as the board receives it, held for the tick; the rolling speed the board's
-// encoders measure is here the wheels' own (the board's is counts over a tick).
-void Simulation::mix_targets(double heading_rad, double speed) {
+// The decision (robot-frame heading, rad; speed fraction) in whole degrees and Q1.15 as a
+// board receives it, and the rolling speed the board's encoders measure, here the wheels'
+// own (the board's is counts over a tick).
+struct BoardDecision {
+    qnav_deg_t deg;
+    qnav_q1_15_t speed, rolling;
+};
+
+static qnav_q1_15_t q15(double f) {
+    return static_cast<qnav_q1_15_t>(std::lround(std::clamp(f, -1.0, 1.0) * 32767.0));
+}
+
+static BoardDecision board_decision(double heading_rad, double speed, double rolling_frac) {
     const long deg = std::lround(wrap_pi(heading_rad) * 180.0 / kPi);
-    const auto q15 = [](double f) {
-        return static_cast<qnav_q1_15_t>(std::lround(std::clamp(f, -1.0, 1.0) * 32767.0));
-    };
+    return {static_cast<qnav_deg_t>(deg <= -180 ? deg + 360 : deg), q15(std::max(speed, 0.0)), q15(rolling_frac)};
+}
+
+// [drive] model "mix": the decision as the board turns it into wheel speeds, held for the
+// tick. Model "heading": whether this tick brakes before it turns, as the mix would.
+void Simulation::drive_targets(double heading_rad, double speed) {
+    const BoardDecision d =
+        board_decision(heading_rad, speed, (wheel_l_ + wheel_r_) / 2 / robot_.v_max_mps);
+    if (!robot_.drive_mix) {
+        braking_ = robot_.brake_first && qnav_drive_brakes_first(d.deg, d.speed, d.rolling) != 0;
+        return;
+    }
     qnav_q1_15_t l = 0, r = 0;
-    qnav_drive_mix(static_cast<qnav_deg_t>(deg <= -180 ? deg + 360 : deg), q15(std::max(speed, 0.0)),
-                   q15((wheel_l_ + wheel_r_) / 2 / robot_.v_max_mps), &l, &r);
+    qnav_drive_mix(d.deg, d.speed, d.rolling, &l, &r);
     mix_l_ = l / 32767.0 * robot_.v_max_mps;
     mix_r_ = r / 32767.0 * robot_.v_max_mps;
 }
 
 // Heading controller: turn rate proportional to the heading error, forward speed
 // reduced by cos(error) (no driving while facing away), then per-wheel acceleration
-// limits; with model "mix" the wheels go to mix_targets()' speeds instead.
+// limits; with model "mix" the wheels go to drive_targets()' speeds instead.
 void Simulation::heading_wheels(double dt) {
     const double b = robot_.wheel_base_m, vmax = robot_.v_max_mps;
     if (robot_.drive_mix) {
@@ -473,10 +491,11 @@ void Simulation::heading_wheels(double dt) {
         wheel_r_ = approach(wheel_r_, mix_r_, robot_.accel_mps2, robot_.decel_mps2, dt);
         return;
     }
-    const double e = wrap_pi(target_heading_ - heading_);
+    // braking before a turn: no turn and no forward speed asked until the tick's end
+    const double e = braking_ ? 0.0 : wrap_pi(target_heading_ - heading_);
     const double wmax = robot_.turn_rate_max_dps * kPi / 180.0;
     const double omega_d = std::clamp(robot_.heading_gain_per_s * e, -wmax, wmax);
-    const double v_d = target_speed_ * vmax * std::max(0.0, std::cos(e));
+    const double v_d = braking_ ? 0.0 : target_speed_ * vmax * std::max(0.0, std::cos(e));
     double tl = v_d - omega_d * b / 2, tr = v_d + omega_d * b / 2;
     const double over = std::max(std::fabs(tl), std::fabs(tr)) / vmax;
     if (over > 1.0) {
@@ -577,7 +596,7 @@ void Simulation::advance() {
         }
         target_heading_ = wrap_pi(heading_ + he);
         target_speed_ = sp;
-        if (robot_.drive_mix) mix_targets(he, sp);
+        drive_targets(he, sp);
     }
     const Vec2 before = pos_;
     const double dt = QNAV_SIM_TICK_S / kSubsteps;

@@ -103,7 +103,7 @@ private:
     void drive_substep(double dt);
     void recovery_wheels();
     void heading_wheels(double dt);
-    void mix_targets(double heading_rad, double speed);
+    void drive_targets(double heading_rad, double speed);
     void move_body(double omega_a, double v_lat, double dt);
     bool touching(Vec2 *contact);
     void start_recovery(Vec2 contact);
@@ -153,6 +153,7 @@ private:
     bool have_prev_ = false;      // a command was given since reset
     double target_heading_ = 0, target_speed_ = 0;  // this tick, with actuation noise
     double mix_l_ = 0, mix_r_ = 0;  // [drive] model "mix": this tick's wheel targets, m/s
+    bool braking_ = false;  // model "heading": this tick brakes before a turn (brake_first)
     std::vector<double> true_dist_;  // centre distances of the last scan before noise, m
     qnav_sim_scan_t scan_{};
     std::vector<CollisionMark> marks_;

@@ -108,6 +108,37 @@ static void test_a_turn_in_place_brakes_first_while_the_robot_rolls(void **state
     assert_true(r > l && l > 0);
 }
 
+/* qnav_drive_brakes_first() is the mixer's own brake: for every heading, several speeds
+ * and rolling speeds either side of QNAV_DRIVE_STOPPED, it says 1 exactly when the mixer
+ * stops both wheels of a robot that rolls, and never for one that does not. */
+static void test_brakes_first_is_when_the_mixer_brakes(void **state)
+{
+    static const int speeds[] = {0, 1, 2, 100, 12000, 32767};
+    static const int rolls[] = {-32767, 0, QNAV_DRIVE_STOPPED, QNAV_DRIVE_STOPPED + 1, 32767};
+    int h, s, k, braked = 0;
+    qnav_q1_15_t l, r;
+    (void)state;
+    for (h = -180; h <= 180; ++h) {
+        for (s = 0; s < (int)(sizeof speeds / sizeof speeds[0]); ++s) {
+            for (k = 0; k < (int)(sizeof rolls / sizeof rolls[0]); ++k) {
+                const int b = qnav_drive_brakes_first((qnav_deg_t)h, (qnav_q1_15_t)speeds[s],
+                                                      (qnav_q1_15_t)rolls[k]);
+                mix(h, speeds[s], rolls[k], &l, &r);
+                if (rolls[k] > QNAV_DRIVE_STOPPED) {
+                    assert_int_equal(b, l == 0 && r == 0);
+                } else {
+                    assert_int_equal(b, 0);
+                }
+                braked += b;
+            }
+        }
+    }
+    /* at both rolling speeds above the threshold: the 182 headings at 90 deg and beyond at
+     * every speed; the 179 others at speed 0; at speed 1 those but straight ahead (1 x cos
+     * rounds to nothing); at speed 2 the 58 beyond 60 deg (cos below one half) */
+    assert_int_equal(braked, 2 * (182 * 6 + 179 + 178 + 58));
+}
+
 static void test_rolling_is_the_travel_as_a_fraction_of_full_speed(void **state)
 {
     (void)state;
@@ -133,6 +164,7 @@ int main(void)
         cmocka_unit_test(test_forward_falls_with_the_cosine_and_the_turn_with_the_heading),
         cmocka_unit_test(test_at_a_wheels_limit_the_arc_is_kept),
         cmocka_unit_test(test_a_turn_in_place_brakes_first_while_the_robot_rolls),
+        cmocka_unit_test(test_brakes_first_is_when_the_mixer_brakes),
         cmocka_unit_test(test_rolling_is_the_travel_as_a_fraction_of_full_speed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

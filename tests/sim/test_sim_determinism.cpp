@@ -23,8 +23,10 @@
 // The committed hash (Pioneer, dense, 16 sectors, p_s = p_a = 0.05, seed 2024, episodes 0-11,
 // fitness rule "paper": the value predates the progress rule, and the trajectories it
 // hashes do not depend on the rule). Changed when the Pioneer's acceleration limits moved
-// from its wheels to its body ([drive] limits = "body", docs/sim.md "Drive model").
-static const uint64_t kCommittedHash = 0xf8a2e002ff1138a6ull;
+// from its wheels to its body ([drive] limits = "body", docs/sim.md "Drive model"), and
+// when its heading model began to brake before a turn in place ([drive] brake_first,
+// docs/sim.md "Brake, then turn").
+static const uint64_t kCommittedHash = 0xae6800362de9ba55ull;
 
 struct Fnv {
     uint64_t h = 1469598103934665603ull;

@@ -107,17 +107,14 @@ static void test_slipping_robot_turns_less_at_speed_and_skids_outwards(void **st
     assert_true(lat_slip < lat_grip);
 }
 
-// Slowing to a tenth of full speed while turning 40 deg left (commanded afresh every tick,
-// so the turn never ends) from 0.5 m/s, for 6 ticks, on the Pioneer's profile with its
-// [drive] limits replaced: the speed at the end, the distance covered and the turn.
-static void brake_while_turning(const char *limits, double *speed, double *dist, double *turned) {
+// The Pioneer's profile with its line `line` replaced by `by`, placed at (1, 2) facing +x and
+// brought up to 1 m/s.
+static void pioneer_at_full_speed(TestSim &t, const std::string &line, const std::string &by) {
     std::string text = read_text_file(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml");
-    const std::string key = "limits = \"body\"";
-    const size_t at = text.find(key);
+    const size_t at = text.find(line);
     assert_true(at != std::string::npos);
-    text.replace(at, key.size(), std::string("limits = \"") + limits + "\"");
+    text.replace(at, line.size(), by);
     char err[QNAV_SIM_ERRLEN];
-    TestSim t;
     const std::string et = test_env_text("");
     assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "r.toml", &t.robot, err, sizeof err), QNAV_SIM_OK);
     assert_int_equal(qnav_sim_env_parse(et.data(), et.size(), "e.toml", &t.env, err, sizeof err), QNAV_SIM_OK);
@@ -126,8 +123,17 @@ static void brake_while_turning(const char *limits, double *speed, double *dist,
     assert_int_equal(qnav_sim_create(t.robot, t.env, &cfg, &t.sim, err, sizeof err), QNAV_SIM_OK);
     assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
     assert_int_equal(qnav_sim_place(t.sim, 1.0, 2.0, 0.0), QNAV_SIM_OK);
-    drive(t.sim, 0.0, 1.0, 40);                              // up to 1 m/s
-    const qnav_sim_state_t a = drive(t.sim, 0.0, 0.5, 10);  // and down to 0.5 m/s
+    const qnav_sim_state_t st = drive(t.sim, 0.0, 1.0, 40);
+    assert_true(std::fabs(st.speed_mps - 1.0) < 1e-3);
+}
+
+// Slowing to a tenth of full speed while turning 40 deg left (commanded afresh every tick,
+// so the turn never ends) from 0.5 m/s, for 6 ticks, on the Pioneer's profile with its
+// [drive] limits replaced: the speed at the end, the distance covered and the turn.
+static void brake_while_turning(const char *limits, double *speed, double *dist, double *turned) {
+    TestSim t;
+    pioneer_at_full_speed(t, "limits = \"body\"", std::string("limits = \"") + limits + "\"");
+    const qnav_sim_state_t a = drive(t.sim, 0.0, 0.5, 10);  // down to 0.5 m/s
     assert_true(std::fabs(a.speed_mps - 0.5) < 1e-3);
     qnav_sim_state_t b = a;
     *dist = 0;
@@ -206,6 +212,34 @@ static void test_the_tekbot_drives_as_its_board_mixes(void **state) {
     assert_true(std::remainder(b.heading_rad - h0, 2 * kPiD) > 0.3);  // stopped: now it turns
 }
 
+// The heading model brakes before a turn in place as the mixer does ([drive] brake_first,
+// qnav_drive_brakes_first): the Pioneer at 1 m/s told to turn 170 deg at speed 0 holds its
+// heading and brakes at 0.6 m/s^2 in a straight line while it rolls faster than 1/8 of
+// v_max (15 ticks: 1.0 - 15 x 0.06 = 0.1 m/s), and turns after; brake_first = false turns
+// at once while it brakes, and its momentum carries it off the line toward the turn.
+static void test_the_pioneer_brakes_before_a_turn_in_place(void **state) {
+    (void)state;
+    TestSim on, off;
+    pioneer_at_full_speed(on, "brake_first = true", "brake_first = true");
+    pioneer_at_full_speed(off, "brake_first = true", "brake_first = false");
+    qnav_sim_state_t a = drive(on.sim, 170.0, 0.0, 14);
+    print_message("brake first: %.3f m/s, heading %.4f rad, y %.4f m after 1.4 s\n", a.speed_mps,
+                  a.heading_rad, a.y_m);
+    assert_true(std::fabs(a.speed_mps - (1.0 - 14 * 0.06)) < 1e-3);
+    assert_true(std::fabs(a.heading_rad) < 1e-9);  // not a degree turned yet
+    assert_true(std::fabs(a.y_m - 2.0) < 1e-6);    // a straight line
+    a = drive(on.sim, 170.0, 0.0, 1);
+    assert_true(a.speed_mps < 0.125 && std::fabs(a.heading_rad) < 1e-9);
+    a = drive(on.sim, 170.0, 0.0, 10);
+    assert_true(a.heading_rad > 0.5);  // stopped: now it turns
+    const qnav_sim_state_t b = drive(off.sim, 170.0, 0.0, 3);
+    print_message("turning at once: heading %.3f rad after 0.3 s\n", b.heading_rad);
+    assert_true(b.heading_rad > 0.05);  // the turn gets what the wheels have left
+    const qnav_sim_state_t c = drive(off.sim, 170.0, 0.0, 7);
+    print_message("and off the line: y %.3f m after 1 s\n", c.y_m);
+    assert_true(c.y_m > 2.05);
+}
+
 static void test_limits_key_is_checked(void **state) {
     (void)state;
     std::string text = read_text_file(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml");
@@ -230,6 +264,18 @@ static void test_limits_key_is_checked(void **state) {
     assert_int_equal(qnav_sim_robot_parse(bad.data(), bad.size(), "r.toml", &robot, err, sizeof err),
                      QNAV_SIM_E_PARSE);
     assert_non_null(std::strstr(err, "not with limits = \"body\""));
+    // brake_first: a boolean, and the mix always brakes first
+    bad = tek;
+    bad.replace(bad.find(mix), mix.size(), mix + "\nbrake_first = false");
+    assert_int_equal(qnav_sim_robot_parse(bad.data(), bad.size(), "r.toml", &robot, err, sizeof err),
+                     QNAV_SIM_E_PARSE);
+    assert_non_null(std::strstr(err, "the mix always brakes first"));
+    text = read_text_file(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml");
+    const std::string bf = "brake_first = true";
+    text.replace(text.find(bf), bf.size(), "brake_first = 1");
+    assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "r.toml", &robot, err, sizeof err),
+                     QNAV_SIM_E_PARSE);
+    assert_non_null(std::strstr(err, "'brake_first' must be true or false"));
 }
 
 int main(void) {
@@ -239,6 +285,7 @@ int main(void) {
         cmocka_unit_test(test_slipping_robot_turns_less_at_speed_and_skids_outwards),
         cmocka_unit_test(test_body_limits_brake_at_decel_while_turning),
         cmocka_unit_test(test_the_tekbot_drives_as_its_board_mixes),
+        cmocka_unit_test(test_the_pioneer_brakes_before_a_turn_in_place),
         cmocka_unit_test(test_limits_key_is_checked),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -36,6 +36,17 @@ extern "C" {
 void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling,
                     qnav_q1_15_t *left, qnav_q1_15_t *right);
 
+/*
+ * 1 when a drive must brake before it carries out this decision: the decision has no
+ * forward part (a turn in place: |heading| >= 90 deg, or speed 0, or a forward part that
+ * rounds to nothing) while the robot still rolls forward faster than QNAV_DRIVE_STOPPED.
+ * The drive then holds its heading and brakes to a stop, and turns on a later tick: a
+ * robot that turned while it rolled on would carry its momentum toward the side it turns
+ * to (docs/sim.md, "Brake, then turn"). qnav_drive_mix() applies it; a drive that servoes
+ * a heading (the simulator's model "heading", a Pioneer's ARCOS) asks it each tick.
+ */
+int qnav_drive_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling);
+
 /* The forward speed of travel_um (the mean of the two wheels' travel, micrometres) over
  * one tick of tick_ms, as a Q1.15 fraction of v_max_mm_s, saturated to +-32767 (0 when
  * tick_ms or v_max_mm_s is 0). */
