@@ -40,11 +40,12 @@ int qnav_drive_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_
 }
 
 void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling,
-                    qnav_q1_15_t *left, qnav_q1_15_t *right)
+                    uint16_t turn_full_deg, qnav_q1_15_t *left, qnav_q1_15_t *right)
 {
     const int32_t mag = magnitude(heading_deg);
+    const int32_t full_at = turn_full_deg == 0u ? 1 : (int32_t)turn_full_deg;
     int32_t fwd = forward_part(mag, speed);
-    int32_t turn = mag >= 90 ? FULL : (FULL * mag) / 90;
+    int32_t turn = mag >= full_at ? FULL : (FULL * mag) / full_at;
     if (left == NULL || right == NULL) {
         return;
     }

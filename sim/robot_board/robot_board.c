@@ -17,6 +17,7 @@ void qnav_robot_board_config(const qnav_sim_robot_t *robot, qnav_board_config_t 
     cfg->tick_ms = (uint16_t)ri.tick_ms;
     cfg->track_mm = (uint16_t)lround(fmin(65535.0, ri.wheel_base_m * 1000.0));
     cfg->um_per_count = (uint16_t)ri.um_per_count;
+    cfg->turn_full_deg = ri.turn_full_deg;
 }
 
 qnav_sim_status_t qnav_robot_board_load(const char *spec, qnav_board_config_t *cfg,
@@ -112,12 +113,15 @@ int qnav_robot_board_header(const qnav_sim_robot_t *robot, FILE *out)
             "/* Heading change per differential encoder count (right minus left), 1e-6 deg:\n"
             " * um_per_count / track_mm rad. */\n"
             "#define QNAV_ROBOT_%s_UDEG_PER_COUNT %ldL\n\n"
+            "/* Where its mixer turns at full wheel speed (qnav_drive_mix), deg: 2 v_max /\n"
+            " * (track x heading_gain_per_s) rad. */\n"
+            "#define QNAV_ROBOT_%s_TURN_FULL_DEG %uu\n\n"
             "/* A qnav_board_config_t (qnav/board.h): the fields of QNAV_BOARD_ROBOT_FIELDS from the\n"
             " * profile, the rest qnav_board_config_default()'s. */\n"
             "#define QNAV_ROBOT_%s_CONFIG \\\n"
             "    { \\\n",
             ri.name, ri.name, ri.name, ri.name, up, up, up, ri.name, up,
-            qnav_robot_board_udeg_per_count(&cfg), up);
+            qnav_robot_board_udeg_per_count(&cfg), up, (unsigned)cfg.turn_full_deg, up);
 #define QNAV_ROBOT_BOARD_PRINT(id, name, member) \
     fprintf(out, "        .%s = %ld, \\\n", #member, (long)cfg.member);
     QNAV_BOARD_ROBOT_FIELDS(QNAV_ROBOT_BOARD_PRINT)

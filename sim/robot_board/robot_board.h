@@ -43,7 +43,7 @@ QNAV_CHECK_RESULT qnav_sim_status_t qnav_robot_board_load(const char *spec,
 long qnav_robot_board_udeg_per_count(const qnav_board_config_t *cfg);
 
 /* Write the generated C header for robot: QNAV_ROBOT_<NAME>_CONFIG (a complete
- * qnav_board_config_t initialiser), _NAME and _UDEG_PER_COUNT. The text depends on the
+ * qnav_board_config_t initialiser), _NAME, _UDEG_PER_COUNT and _TURN_FULL_DEG. The text depends on the
  * profile only (its comment names the canonical command and committed path,
  * firmware/boards/robots/include/qnav/robot_<name>.h). Returns 0, or -1 when writing
  * failed. */

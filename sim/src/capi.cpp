@@ -183,6 +183,7 @@ void qnav_sim_robot_info(const qnav_sim_robot_t *robot, qnav_sim_robot_info_t *i
     info->tick_ms = p.tick_ms;
     info->sensor_noise = p.noise_sensor;
     info->actuation_noise = p.noise_actuation;
+    info->turn_full_deg = p.turn_full_deg;
 }
 
 void qnav_sim_robot_prob_policy(const qnav_sim_robot_t *robot, qnav_policy_t *policy) {

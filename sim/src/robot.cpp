@@ -30,6 +30,12 @@ static void parse_motion(const TomlReader &r, RobotProfile &p) {
     p.decel_mps2 = r.number(drive, "decel_mps2", 0.01, 100.0);
     p.turn_rate_max_dps = r.number(drive, "turn_rate_max_dps", 1.0, 3600.0);
     p.heading_gain_per_s = r.number(drive, "heading_gain_per_s", 0.1, 100.0);
+    // the mixer's full turn: a degree of heading asks heading_gain_per_s of turn rate, but
+    // never a full-wheel-speed turn short of 90 deg (a slow robot keeps the measured mixer:
+    // docs/sim.md, "A turn in the robot's own units")
+    p.turn_full_deg = static_cast<std::uint16_t>(std::clamp(
+        std::lround(2.0 * p.v_max_mps / (p.wheel_base_m * p.heading_gain_per_s) * 180.0 / 3.14159265358979323846), 90L,
+        360L));
     if (drive.get("limits")) {
         const std::string limits = r.string(drive, "limits");
         if (limits != "wheel" && limits != "body")

@@ -40,6 +40,10 @@ struct RobotProfile {
     bool brake_first = true;
     double turn_rate_max_dps = 180; // turn-rate limit of the heading controller, deg/s
     double heading_gain_per_s = 4;  // heading controller: turn rate = gain * error, 1/s
+    // model "mix": where the mixer's turn part reaches full wheel speed, deg: the heading
+    // whose turn rate at heading_gain_per_s is full wheel speed's, 2 v_max / (b gain) rad,
+    // 90..360 (docs/sim.md, "A turn in the robot's own units")
+    std::uint16_t turn_full_deg = 90;
     // slip
     double slip_turn = 0.0;         // fraction of the wheel turn rate lost at full speed
     double slip_lateral_s = 0.0;    // sideways skid speed per (speed * turn rate), s

@@ -476,7 +476,7 @@ void Simulation::drive_targets(double heading_rad, double speed) {
         return;
     }
     qnav_q1_15_t l = 0, r = 0;
-    qnav_drive_mix(d.deg, d.speed, d.rolling, &l, &r);
+    qnav_drive_mix(d.deg, d.speed, d.rolling, robot_.turn_full_deg, &l, &r);
     mix_l_ = l / 32767.0 * robot_.v_max_mps;
     mix_r_ = r / 32767.0 * robot_.v_max_mps;
 }

@@ -7,6 +7,7 @@
 
 #include "qnav/board.h"
 #include "qnav/drive.h"
+#include "qnav/robot_tekbot.h"
 
 static uint32_t sim_millis(void *ctx)
 {
@@ -39,7 +40,7 @@ static void sim_drive(void *ctx, qnav_deg_t heading, qnav_q1_15_t speed, qnav_q1
     s->drive_heading = heading;
     s->drive_speed = speed;
     s->drive_rolling = rolling;
-    qnav_drive_mix(heading, speed, rolling, &s->left, &s->right);
+    qnav_drive_mix(heading, speed, rolling, QNAV_ROBOT_TEKBOT_TURN_FULL_DEG, &s->left, &s->right);
     s->motor_calls++;
 }
 

@@ -17,7 +17,7 @@
 
 static void mix(int h, int speed, int rolling, qnav_q1_15_t *l, qnav_q1_15_t *r)
 {
-    qnav_drive_mix((qnav_deg_t)h, (qnav_q1_15_t)speed, (qnav_q1_15_t)rolling, l, r);
+    qnav_drive_mix((qnav_deg_t)h, (qnav_q1_15_t)speed, (qnav_q1_15_t)rolling, 90, l, r);
 }
 
 static void test_a_counter_clockwise_heading_runs_the_right_wheel_faster(void **state)
@@ -108,6 +108,31 @@ static void test_a_turn_in_place_brakes_first_while_the_robot_rolls(void **state
     assert_true(r > l && l > 0);
 }
 
+/* The turn part reaches full wheel speed at turn_full_deg: at 180 (a robot twice as fast
+ * as one at 90, on the same track) every heading below 90 deg asks half the turn part it
+ * asks at 90, so both turn at the same rate; 0 is taken as 1 (full at any heading). */
+static void test_the_turn_is_full_at_turn_full_deg(void **state)
+{
+    int h;
+    qnav_q1_15_t l90, r90, l180, r180;
+    (void)state;
+    for (h = -180; h <= 180; ++h) {
+        qnav_drive_mix((qnav_deg_t)h, 0, 0, 90, &l90, &r90);
+        qnav_drive_mix((qnav_deg_t)h, 0, 0, 180, &l180, &r180);
+        assert_int_equal(r180, (h < 0 ? -1 : 1) * (32767 * abs(h) / 180));
+        if (abs(h) < 90) {
+            assert_true(abs(r180 - r90 / 2) <= 1);
+        }
+        assert_int_equal(l180, -r180);
+    }
+    qnav_drive_mix(180, 0, 0, 180, &l180, &r180);
+    assert_int_equal(r180, 32767);
+    qnav_drive_mix(1, 0, 0, 0, &l90, &r90);
+    assert_int_equal(r90, 32767);
+    qnav_drive_mix(-30, 0, 0, 360, &l90, &r90);
+    assert_int_equal(l90, 32767 * 30 / 360);
+}
+
 /* qnav_drive_brakes_first() is the mixer's own brake: for every heading, several speeds
  * and rolling speeds either side of QNAV_DRIVE_STOPPED, it says 1 exactly when the mixer
  * stops both wheels of a robot that rolls, and never for one that does not. */
@@ -165,6 +190,7 @@ int main(void)
         cmocka_unit_test(test_at_a_wheels_limit_the_arc_is_kept),
         cmocka_unit_test(test_a_turn_in_place_brakes_first_while_the_robot_rolls),
         cmocka_unit_test(test_brakes_first_is_when_the_mixer_brakes),
+        cmocka_unit_test(test_the_turn_is_full_at_turn_full_deg),
         cmocka_unit_test(test_rolling_is_the_travel_as_a_fraction_of_full_speed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -177,7 +177,7 @@ static void test_the_tekbot_drives_as_its_board_mixes(void **state) {
     TestSim t;
     make_test_sim(t, "tekbot", test_env_text(""), nullptr, 8, 0, 0);
     qnav_q1_15_t l = 0, r = 0;
-    qnav_drive_mix(30, 32767, 32767, &l, &r);
+    qnav_drive_mix(30, 32767, 32767, 90, &l, &r);
     const double v_l = l / 32767.0 * 0.5, v_r = r / 32767.0 * 0.5;  // v_max 0.5 m/s
     assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
     assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
@@ -240,6 +240,37 @@ static void test_the_pioneer_brakes_before_a_turn_in_place(void **state) {
     assert_true(c.y_m > 2.05);
 }
 
+// The mixer's full turn comes from the profile (qnav_sim_robot_info().turn_full_deg): the
+// TekBot's 90 deg; twice its v_max on the same track, 180 (the same turn rate for a degree
+// of heading); a slower one keeps 90 (never a full turn short of it); the Pioneer 116.
+static unsigned turn_full_with(const char *v_max) {
+    std::string text = read_text_file(QNAV_TEST_DATA_DIR "/robots/tekbot.toml");
+    const std::string key = "v_max_mps = 0.5";
+    text.replace(text.find(key), key.size(), std::string("v_max_mps = ") + v_max);
+    char err[QNAV_SIM_ERRLEN];
+    qnav_sim_robot_t *robot = nullptr;
+    assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "r.toml", &robot, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_robot_info_t ri;
+    qnav_sim_robot_info(robot, &ri);
+    qnav_sim_robot_free(robot);
+    return ri.turn_full_deg;
+}
+
+static void test_the_mixers_full_turn_keeps_the_turn_rate_per_degree(void **state) {
+    (void)state;
+    assert_int_equal(turn_full_with("0.5"), 90);
+    assert_int_equal(turn_full_with("1.0"), 180);
+    assert_int_equal(turn_full_with("1.5"), 270);
+    assert_int_equal(turn_full_with("0.3"), 90);
+    qnav_sim_robot_t *robot = nullptr;
+    char err[QNAV_SIM_ERRLEN];
+    assert_int_equal(qnav_sim_robot_load(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml", &robot, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_robot_info_t ri;
+    qnav_sim_robot_info(robot, &ri);
+    qnav_sim_robot_free(robot);
+    assert_int_equal(ri.turn_full_deg, 116);  // 2 x 1.0 / (0.33 x 3.0) rad
+}
+
 static void test_limits_key_is_checked(void **state) {
     (void)state;
     std::string text = read_text_file(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml");
@@ -286,6 +317,7 @@ int main(void) {
         cmocka_unit_test(test_body_limits_brake_at_decel_while_turning),
         cmocka_unit_test(test_the_tekbot_drives_as_its_board_mixes),
         cmocka_unit_test(test_the_pioneer_brakes_before_a_turn_in_place),
+        cmocka_unit_test(test_the_mixers_full_turn_keeps_the_turn_rate_per_degree),
         cmocka_unit_test(test_limits_key_is_checked),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

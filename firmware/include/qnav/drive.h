@@ -21,8 +21,11 @@ extern "C" {
 
 /*
  * The forward part is speed * cos(heading), none at 90 deg and beyond or at speed 0; the
- * turn part is proportional to the heading, full wheel speed at 90 deg and beyond,
- * whatever the speed. When the two together would run a wheel past full speed both
+ * turn part is proportional to the heading, full wheel speed at turn_full_deg and beyond,
+ * whatever the speed. turn_full_deg is the robot's (its profile's 2 v_max / (track x
+ * heading_gain_per_s) radians, so that a degree of heading asks the same turn rate of a
+ * slow and a fast robot: docs/sim.md, "A turn in the robot's own units"); the TekBot's is 90;
+ * 0 is taken as 1. When the two together would run a wheel past full speed both
  * shrink by one factor, so the robot drives the arc the decision asked for, slower. A
  * decision without a forward part (a turn in place) while the robot still rolls forward
  * faster than QNAV_DRIVE_STOPPED brakes both wheels to 0 first: spinning one wheel
@@ -34,7 +37,7 @@ extern "C" {
  * stop.
  */
 void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling,
-                    qnav_q1_15_t *left, qnav_q1_15_t *right);
+                    uint16_t turn_full_deg, qnav_q1_15_t *left, qnav_q1_15_t *right);
 
 /*
  * 1 when a drive must brake before it carries out this decision: the decision has no

@@ -118,6 +118,8 @@ typedef struct {
     uint32_t tick_ms;          /* control tick, ms (QNAV_SIM_TICK_S) */
     double sensor_noise;       /* the profile's typical p_s (qnav-sim's default) */
     double actuation_noise;    /* the profile's typical p_a (qnav-sim's default) */
+    uint16_t turn_full_deg;    /* where a mixer turns at full wheel speed (qnav_drive_mix), deg:
+                                  2 v_max / (wheel_base x heading_gain_per_s) rad, 90..360 */
 } qnav_sim_robot_info_t;
 void qnav_sim_robot_info(const qnav_sim_robot_t *robot, qnav_sim_robot_info_t *info);
 

@@ -34,6 +34,7 @@ void qnav_board_config_default(qnav_board_config_t *cfg)
     cfg->link_timeout_ms = 300;
     cfg->track_mm = 180;
     cfg->um_per_count = 1000;
+    cfg->turn_full_deg = 90;
     cfg->nvm_offset = 0;
     cfg->controller = "body";
 }

@@ -176,7 +176,7 @@ static void avr_drive(void *ctx, qnav_deg_t heading_deg, qnav_q1_15_t speed, qna
     qnav_q1_15_t left;
     qnav_q1_15_t right;
     (void)ctx;
-    qnav_drive_mix(heading_deg, speed, rolling, &left, &right);
+    qnav_drive_mix(heading_deg, speed, rolling, QNAV_BOARD_ROBOT_TURN_FULL_DEG, &left, &right);
     if (left >= 0) {
         PORTB |= _BV(PB0);
     } else {

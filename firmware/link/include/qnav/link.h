@@ -55,8 +55,10 @@ extern "C" {
  * adds to the POSE what the board's map did to the escape memory this tick, so that an
  * offboard controller keeps its memory as the onboard one does; version 5 adds the board's map
  * to its CONFIG report (up to 26 fields), so that a bridge refuses a board whose map is not
- * its robot's. */
-#define QNAV_LINK_PROTOCOL_VERSION 5u
+ * its robot's; version 6 adds where its drive's mixer turns at full wheel speed
+ * (turn_full_deg, up to 28 fields), so that a bridge refuses a board that turns other than
+ * its robot's profile. */
+#define QNAV_LINK_PROTOCOL_VERSION 6u
 
 /* Message ids. Direction: B->H board to host (navbridge), H->B host to board. */
 typedef enum {
@@ -83,7 +85,7 @@ typedef enum {
 #define QNAV_LINK_HEARTBEAT_MAX_BYTES 32u /* longest a later version may send */
 #define QNAV_LINK_POSE_BYTES 23u
 /* CONFIG: [count u8] then count x ([key u8][value i32]); at most this many fields. */
-#define QNAV_LINK_CONFIG_MAX_FIELDS 26u
+#define QNAV_LINK_CONFIG_MAX_FIELDS 28u
 #define QNAV_LINK_CONFIG_MAX_BYTES (1u + 5u * QNAV_LINK_CONFIG_MAX_FIELDS)
 
 /* Largest payload this build accepts: a full scan or a full chunk, whichever is larger. */

@@ -61,6 +61,8 @@ typedef struct {
     uint16_t track_mm;           /* distance between the drive wheels, mm (the HAL's heading
                                     from encoder counts; reported, not used by the core) */
     uint16_t um_per_count;       /* wheel travel per encoder count, micrometres (> 0) */
+    uint16_t turn_full_deg;      /* where the drive's mixer turns at full wheel speed, deg
+                                    (qnav_drive_mix; reported, not used by the core) */
     uint16_t nvm_offset;         /* first byte of the policy store in the HAL's storage;
                                     it takes QNAV_BOARD_STORE_BYTES bytes */
     const char *controller;      /* a name in libqnav's controller table (qnav/nav.h;
@@ -94,7 +96,8 @@ typedef struct {
     X(17, pass_mm, ctrl.pass_mm)                                                            \
     X(32, tick_ms, tick_ms)                                                                 \
     X(33, track_mm, track_mm)                                                               \
-    X(34, um_per_count, um_per_count)
+    X(34, um_per_count, um_per_count)                                                       \
+    X(35, turn_full_deg, turn_full_deg)
 
 /* The policy store: two slots, each [magic 'Q' 'P'][format 1][sequence u8][blob length
  * u16][CRC-16 u16 over format, sequence, length and blob][blob]. A commit writes the slot

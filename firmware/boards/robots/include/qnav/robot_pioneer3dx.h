@@ -15,6 +15,10 @@
  * um_per_count / track_mm rad. */
 #define QNAV_ROBOT_PIONEER3DX_UDEG_PER_COUNT 84207L
 
+/* Where its mixer turns at full wheel speed (qnav_drive_mix), deg: 2 v_max /
+ * (track x heading_gain_per_s) rad. */
+#define QNAV_ROBOT_PIONEER3DX_TURN_FULL_DEG 116u
+
 /* A qnav_board_config_t (qnav/board.h): the fields of QNAV_BOARD_ROBOT_FIELDS from the
  * profile, the rest qnav_board_config_default()'s. */
 #define QNAV_ROBOT_PIONEER3DX_CONFIG \
@@ -39,6 +43,7 @@
         .tick_ms = 100, \
         .track_mm = 330, \
         .um_per_count = 485, \
+        .turn_full_deg = 116, \
         .link_timeout_ms = 300, \
         .nvm_offset = 0, \
         .controller = "body" \
