@@ -85,7 +85,11 @@ def edited_profile(prog, robot, edits):
             lines = set_value(lines, e)
             tomllib.loads("\n".join(lines))
         except tomllib.TOMLDecodeError as err:
-            sys.exit(f"{prog}: {src}: --set {e}: the value is not TOML ({err})")
+            key, _, value = e.partition("=")
+            hint = ""
+            if value and value.replace("_", "").replace("-", "").isalpha() and value not in ("true", "false"):
+                hint = f"; a string takes quotes: --set '{key}=\"{value}\"'"
+            sys.exit(f"{prog}: {src}: --set {e}: the value is not TOML ({err}){hint}")
         except ValueError as err:
             sys.exit(f"{prog}: {src}: {err}")
     out = os.path.join(tempfile.mkdtemp(prefix=f"{prog}-set-"), os.path.basename(src))

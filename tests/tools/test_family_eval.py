@@ -191,6 +191,7 @@ class FamilyEval(unittest.TestCase):
                             (["--set", "map.cell_m"], "expected SECTION.KEY=VALUE"),
                             (["--set", "nosuch.k=1"], "no [nosuch] section"),
                             (["--set", "drive.model=mix"], "--set drive.model=mix: the value is not TOML"),
+                            (["--set", "drive.model=mix"], "a string takes quotes: --set 'drive.model=\"mix\"'"),
                             (["--robot", "tekbot-map", "--set", "map.on=true"], "--set map.on=false")):
             r = tool("--worlds", "1", *args) if args[0] != "--worlds" else tool(*args)
             self.assertNotEqual(r.returncode, 0)
