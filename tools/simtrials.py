@@ -10,6 +10,12 @@ import tempfile
 import tomllib
 
 
+def interval(lo, hi, width=13):
+    """A 95 % interval as the tables print it, "[9.7, 23.1]" right-aligned in width: always two
+    whitespace-separated fields, so that a script can take the table's columns by number."""
+    return f"[{lo:.1f}, {hi:.1f}]".rjust(width)
+
+
 def wilson(k, n, z=1.96):
     """95% Wilson score interval of k successes in n, as percentages."""
     if n == 0:

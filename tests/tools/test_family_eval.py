@@ -14,7 +14,7 @@ import unittest
 
 TOOL = os.path.join(os.environ["QNAV_TOOLS_DIR"], "family-eval")
 SIM = os.environ["QNAV_SIM_EXE"]
-ROW = re.compile(r"^(\w+)\s+([\d.]+)% \[\s*([\d.]+),\s*([\d.]+)\]\s+([\d.]+)% \[\s*([\d.]+),\s*([\d.]+)\]"
+ROW = re.compile(r"^(\w+)\s+([\d.]+)%\s+\[\s*([\d.]+),\s*([\d.]+)\]\s+([\d.]+)%\s+\[\s*([\d.]+),\s*([\d.]+)\]"
                  r"\s+(\d+)/(\d+)\s+([\d.]+)\s+([\d.]+)$")
 
 
@@ -37,6 +37,18 @@ class FamilyEval(unittest.TestCase):
             self.assertLessEqual(at1, hi1)
             self.assertGreaterEqual(at2, at1)
             self.assertEqual(m.group(9), "1")
+        # every row has the same whitespace-separated fields, whatever its interval (an
+        # interval padded inside its bracket, "[ 0.0,", used to add one below 10 %)
+        counts = {len(l.split()) for l in r.stdout.splitlines()[2:7]}
+        self.assertEqual(counts, {10}, r.stdout)
+
+    def test_an_interval_is_two_fields_at_any_value(self):
+        sys.path.insert(0, os.environ["QNAV_TOOLS_DIR"])
+        import simtrials
+        for lo, hi in ((0.0, 23.1), (9.7, 100.0), (100.0, 100.0), (34.2, 56.0)):
+            text = simtrials.interval(lo, hi)
+            self.assertEqual(text.split(), [f"[{lo:.1f},", f"{hi:.1f}]"], text)
+            self.assertGreaterEqual(len(text), 13)
 
     def test_policies_compared_on_the_same_worlds(self):
         fixtures = os.path.join(os.environ["QNAV_TOOLS_DIR"], "..", "bench", "fixtures", "policies")
@@ -55,7 +67,7 @@ class FamilyEval(unittest.TestCase):
         rows = {l.split()[0]: l for l in lines[7:]}
         self.assertEqual(list(rows), fams, r.stdout)
         for i, f in enumerate(fams):
-            m = re.match(r"^\w+\s+([\d.]+) \[\s*([\d.]+),\s*([\d.]+)\]\s+([\d.]+)\s+([\d.]+)\s+(\d)/2\s+([\d.]+)"
+            m = re.match(r"^\w+\s+([\d.]+)\s+\[\s*([\d.]+),\s*([\d.]+)\]\s+([\d.]+)\s+([\d.]+)\s+(\d)/2\s+([\d.]+)"
                          r"\s+p ([\d.e+-]+) \((above|below|level)\)$", rows[f])
             self.assertTrue(m, rows[f])
             mean, lo, hi, p10, low, n95, ref = (float(m.group(k)) for k in range(1, 8))

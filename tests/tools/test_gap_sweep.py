@@ -10,7 +10,7 @@ import unittest
 
 TOOL = os.path.join(os.environ["QNAV_TOOLS_DIR"], "gap-sweep")
 SIM = os.environ["QNAV_SIM_EXE"]
-ROW = re.compile(r"^\s*([\d.]+)\s+(-?[\d.]+)\s+([\d.]+)% \[\s*([\d.]+),\s*([\d.]+)\]\s+([\d.]+)% "
+ROW = re.compile(r"^\s*([\d.]+)\s+(-?[\d.]+)\s+([\d.]+)%\s+\[\s*([\d.]+),\s*([\d.]+)\]\s+([\d.]+)%\s+"
                  r"\[\s*([\d.]+),\s*([\d.]+)\]\s+([\d.]+)$")
 REFUSED = re.compile(r"^\s*([\d.]+)\s+(-?[\d.]+)\s+refused by qnav-sim")
 
