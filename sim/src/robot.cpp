@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "error.hpp"
+#include "geometry.hpp"
 #include "tomlread.hpp"
 #include "qnav/sim.h"
 
@@ -34,7 +35,7 @@ static void parse_motion(const TomlReader &r, RobotProfile &p) {
     // never a full-wheel-speed turn short of 90 deg (a slow robot keeps the measured mixer:
     // docs/sim.md, "A turn in the robot's own units")
     p.turn_full_deg = static_cast<std::uint16_t>(std::clamp(
-        std::lround(2.0 * p.v_max_mps / (p.wheel_base_m * p.heading_gain_per_s) * 180.0 / 3.14159265358979323846), 90L,
+        std::lround(2.0 * p.v_max_mps / (p.wheel_base_m * p.heading_gain_per_s) * 180.0 / kPi), 90L,
         360L));
     if (drive.get("limits")) {
         const std::string limits = r.string(drive, "limits");
