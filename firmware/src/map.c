@@ -1042,12 +1042,37 @@ static uint32_t step_cost(const qnav_map_t *m, uint32_t cost, int32_t i, int32_t
     return cost > step ? cost - step : 0u;
 }
 
+/* What the escape memory grows by on this guided tick, mm (0: nothing), the planned
+ * distance being mm and the straight one straight_mm:
+ * - a new plan, longer where the robot is (by less than a jump: the caller drops a jump).
+ *   A plan begun on an earlier tick is new on the first tick it guides from: a compact
+ *   plan grows grow_steps a tick and may reach the robot ticks after it began
+ *   (docs/architecture.md, "A plan that reaches the robot late");
+ * - the first guided tick: the escape has measured the straight distance until now, and
+ *   the plan's longer way is no step back (in an empty arena the escape took it for a stall
+ *   and followed the walls). */
+static uint16_t plan_growth(qnav_map_t *m, uint32_t mm, uint32_t straight_mm)
+{
+    const uint8_t replanned = m->replan_owed;
+    m->replan_owed = 0u;
+    if (!m->cfg.escape_grow) {
+        return 0u;
+    }
+    if (replanned && m->last_mm != 0u && mm > m->last_mm) {
+        return (uint16_t)(mm - m->last_mm);
+    }
+    if (m->last_mm == 0u && straight_mm != 0u && mm > straight_mm) {
+        return (uint16_t)(mm - straight_mm);
+    }
+    return 0u;
+}
+
 int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
                    int32_t goal_y_mm, qnav_ctrl_input_t *in)
 {
     int32_t i, j, ri, rj, steps, sx, sy;
     uint32_t cost, mm, sub, straight_mm;
-    int jumped, replanned, direct = 0, grew = 0;
+    int jumped, direct = 0;
     if (!ready(m) || pose == NULL || in == NULL) {
         return 0;
     }
@@ -1055,9 +1080,9 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
         refusal_lapses(m);
     }
     straight_mm = in->goal_range_mm;
-    replanned = plan_when_due(m, goal_x_mm, goal_y_mm);
+    m->replan_owed = (uint8_t)(m->replan_owed | plan_when_due(m, goal_x_mm, goal_y_mm));
     cell_of(m, pose->x_mm, pose->y_mm, &ri, &rj);
-    replanned |= settle_for(m, ri, rj);
+    m->replan_owed = (uint8_t)(m->replan_owed | settle_for(m, ri, rj));
     cost = cost_near(m, ri, rj, &i, &j);
     if (cost == QNAV_MAP_UNREACHED && m->cfg.compact && m->q_queued && m->last_mm != 0u) {
         /* a compact plan still growing toward the robot (grow_steps a tick): the last
@@ -1104,23 +1129,15 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
     m->sub_direct = (uint8_t)direct;
     mm = in->goal_range_mm;
     jumped = m->last_mm != 0u && mm > (uint32_t)m->last_mm + m->cfg.jump_mm;
-    m->grown_mm = 0u;
-    if (!jumped && replanned && m->cfg.escape_grow && m->last_mm != 0u && mm > m->last_mm) {
-        /* a new plan, longer (by less than a jump) where the robot is */
-        m->grown_mm = (uint16_t)(mm - m->last_mm);
-        grew = QNAV_MAP_ESCAPE_GROWN;
-    } else if (m->cfg.escape_grow && m->last_mm == 0u && straight_mm != 0u && mm > straight_mm) {
-        /* the first guided tick (a compact plan reaches the robot a few ticks after it
-         * starts): the escape has measured the straight distance until now, and the plan's
-         * longer way is no step back (in an empty arena the escape took it for a stall and
-         * followed the walls) */
-        m->grown_mm = (uint16_t)(mm - straight_mm);
-        grew = QNAV_MAP_ESCAPE_GROWN;
+    m->grown_mm = plan_growth(m, mm, straight_mm);
+    if (jumped) {
+        m->grown_mm = 0u;
     }
     qnav_escape_follow_plan(&in->escape, jumped, m->grown_mm);
     m->last_mm = (uint16_t)mm;
     refuse_when_stalled(m, ri, rj, (uint16_t)mm, jumped);
-    return QNAV_MAP_GUIDED | (jumped ? QNAV_MAP_ESCAPE_CLEARED : grew) | direct;
+    return QNAV_MAP_GUIDED | direct |
+           (jumped ? QNAV_MAP_ESCAPE_CLEARED : (m->grown_mm != 0u ? QNAV_MAP_ESCAPE_GROWN : 0));
 }
 
 /* The index of the cell holding (x, y); -1 outside the map. */

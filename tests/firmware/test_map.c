@@ -489,6 +489,44 @@ static void test_a_longer_plan_grows_the_escape_memory(void **state)
     assert_int_equal(in.escape.stall_mm, 3200);
 }
 
+/* The same with the compact layout growing its plan 2 steps a tick: the longer plan reaches
+ * the robot ticks after it began, and the escape memory grows on the tick it first guides
+ * from, by what the plan grew (before 0.15.1 the tick that began the plan was the only one
+ * that counted, so a late plan looked like a step back and set off a follow). */
+static void test_a_longer_plan_that_reaches_the_robot_late_grows_the_escape_memory(void **state)
+{
+    qnav_map_t m;
+    qnav_ctrl_input_t in;
+    const qnav_map_pose_t p = {4300, 1500, 9000};
+    uint16_t before;
+    int t, got = 0, late = 0;
+    (void)state;
+    compact_map(&m, 400, 1, 2);
+    memset(&in, 0, sizeof in);
+    for (t = 0; t < 10 && got == 0; ++t) {
+        got = qnav_map_guide(&m, &p, 4300, 5000, &in);
+    }
+    assert_int_equal(got & QNAV_MAP_GUIDED, QNAV_MAP_GUIDED);
+    before = in.goal_range_mm;
+    observe_the_wall(&m);
+    in.escape.best_mm = 3000;
+    in.escape.ticks = 7;
+    for (t = 0; t < 20 && in.goal_range_mm <= before; ++t) {
+        got = qnav_map_guide(&m, &p, 4300, 5000, &in);
+        late += in.goal_range_mm <= before;
+    }
+    print_message("plan %u -> %u mm after %d ticks, flags %d\n", before, in.goal_range_mm, late, got);
+    assert_true(late >= 1); /* the plan did reach the robot late */
+    assert_true(in.goal_range_mm > before + 100 && in.goal_range_mm < before + 1000);
+    assert_int_equal(got, QNAV_MAP_GUIDED | QNAV_MAP_ESCAPE_GROWN);
+    assert_int_equal(in.escape.best_mm, 3000 + in.goal_range_mm - before);
+    assert_int_equal(in.escape.ticks, 7);
+    /* the next tick, the same plan: nothing grows */
+    before = in.goal_range_mm;
+    got = qnav_map_guide(&m, &p, 4300, 5000, &in);
+    assert_int_equal(got & QNAV_MAP_ESCAPE_GROWN, 0);
+}
+
 /* Below the wall, left of its gap, with the destination beyond the wall to the left: the
  * plan turns round the gap's edge within the look-ahead. With sight the sub-goal stays
  * where the robot sees it past the edge (further right); without, it lies behind it. */
@@ -1001,6 +1039,7 @@ int main(void)
         cmocka_unit_test(test_the_compact_layout_marks_as_the_full_one_and_plans_breadth_first),
         cmocka_unit_test(test_the_sub_goal_is_not_behind_a_corner),
         cmocka_unit_test(test_a_longer_plan_grows_the_escape_memory),
+        cmocka_unit_test(test_a_longer_plan_that_reaches_the_robot_late_grows_the_escape_memory),
         cmocka_unit_test(test_the_destination_in_reach_is_flagged_direct),
         cmocka_unit_test(test_a_map_that_closed_every_way_forgets_what_it_marked),
         cmocka_unit_test(test_after_a_forget_only_near_readings_mark),

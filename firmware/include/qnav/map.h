@@ -128,6 +128,8 @@ typedef struct {
     uint16_t stall_ticks;     /* guided ticks since it last shrank by a cell */
     uint16_t refused_ticks;   /* ticks the refused cells have left; 0: none */
     uint8_t forgot;           /* forgot what closed every way since the destination was set */
+    uint8_t replan_owed;      /* a plan began since the last guided tick: a compact plan may reach
+                                 the robot ticks after it begins, and is new on the tick it does */
     /* The plan's queue, kept between ticks: a plan settles cells only until the robot's
      * is settled, and goes on from here when the robot stands on a cell not yet settled */
     uint16_t q_count;         /* buckets in use */
