@@ -545,6 +545,41 @@ void build_rooms(Ctx &c, Environment &env) {
     scatter(c, env, grid, 0, 0, env.width_m, env.height_m, 0.08 * c.d, 800, {});
 }
 
+// shelves: rows of shelving across the arena (a store room, a warehouse), each broken by
+// 1-2 openings of 4.5 (difficulty 0) to 3 (difficulty 1) robot diameters anywhere along
+// it, at its ends too; aisles of 5 -> 3 diameters between rows; boxes left in
+// the aisles (covered fraction 0.01 -> 0.04). The way runs along aisles to openings that
+// a robot heading for its goal does not see: a search over long parallel walls, which no
+// other family has.
+void build_shelves(Ctx &c, Environment &env) {
+    env.width_m = c.uni(9, 14) * c.s;
+    env.height_m = c.uni(9, 14) * c.s;
+    bottom_zones(c, env, 1 + c.pick(2));
+    top_destination(c, env);
+    double ztop = 0;
+    for (const StartZone &z : env.start_zones) ztop = std::max(ztop, z.y_m + z.h_m);
+    const double lo = ztop + c.radius * 2 + 0.4 * c.s;
+    const double hi = env.dest_y_m - env.dest_radius_m - c.radius * 2 - 0.4 * c.s;
+    for (double y = lo + c.uni(0, 0.3) * c.s;;) {
+        const double depth = c.uni(0.4, 0.8) * c.s;
+        if (y + depth > hi) break;
+        const int n = 1 + (c.rng.uniform01() < 0.6 * (1.0 - c.d) ? 1 : 0);
+        double from = 0;           // the row's next piece begins here
+        for (int k = 0; k < n; ++k) {
+            const double g = c.widths(4.5 - 1.5 * c.d);
+            const double slot = (env.width_m - from) / (n - k);
+            const double at = from + c.uni(0, std::max(0.0, slot - g));
+            if (at - from > 0.05) env.boxes.push_back({(from + at) / 2, y + depth / 2, at - from, depth, 0});
+            from = at + g;
+        }
+        if (env.width_m - from > 0.05)
+            env.boxes.push_back({(from + env.width_m) / 2, y + depth / 2, env.width_m - from, depth, 0});
+        y += depth + c.widths(5.0 - 2.0 * c.d);
+    }
+    PassGrid grid = grid_for(c, env);
+    scatter(c, env, grid, 0, 0, env.width_m, env.height_m, 0.01 + 0.03 * c.d, 800, {});
+}
+
 // ---- the family table and the symmetry ------------------------------------------------
 
 struct Family {
@@ -558,6 +593,7 @@ constexpr Family kFamilies[] = {
     {"corridor", build_corridor, 0x636f7272},
     {"pocket", build_pocket, 0x706f636b},
     {"rooms", build_rooms, 0x726f6f6d},
+    {"shelves", build_shelves, 0x7368656c},
 };
 
 const Family *find_family(std::string_view name) {

@@ -21,7 +21,7 @@
 #include "geometry.hpp"
 #include "worldgen.hpp"
 
-static const char *const kFamilies[] = {"clutter", "gaps", "corridor", "pocket", "rooms"};
+static const char *const kFamilies[] = {"clutter", "gaps", "corridor", "pocket", "rooms", "shelves"};
 static const char *const kRobots[] = {"tekbot", "pioneer3dx"};
 static const char *const kDifficulties[] = {"0", "0.5", "1"};
 
@@ -113,7 +113,7 @@ static void test_bad_specs_give_one_line_naming_the_field(void **state) {
     };
     const std::string fams = qnav_sim_world_families();
     const Case cases[] = {
-        {"gen:maze:1", "world spec 'gen:maze:1': unknown family 'maze' (families: clutter, gaps, corridor, pocket, rooms)"},
+        {"gen:maze:1", "world spec 'gen:maze:1': unknown family 'maze' (families: clutter, gaps, corridor, pocket, rooms, shelves)"},
         {"gen:gaps", "world spec 'gen:gaps': expected gen:FAMILY:SEED[:DIFFICULTY[:ROBOT]] (no seed)"},
         {"gen:", "world spec 'gen:': expected gen:FAMILY:SEED[:DIFFICULTY[:ROBOT]] (no seed)"},
         {"gen::1", "world spec 'gen::1': family is empty (expected gen:FAMILY:SEED[:DIFFICULTY[:ROBOT]])"},
@@ -129,7 +129,7 @@ static void test_bad_specs_give_one_line_naming_the_field(void **state) {
         {"gen:gaps:1:-0", "world spec 'gen:gaps:1:-0': difficulty '-0' is not a number in [0, 1] with at most 3 decimals"},
         {"gen:gaps:1:0.", "world spec 'gen:gaps:1:0.': difficulty '0.' is not a number in [0, 1] with at most 3 decimals"},
     };
-    assert_string_equal(fams.c_str(), "clutter, gaps, corridor, pocket, rooms");
+    assert_string_equal(fams.c_str(), "clutter, gaps, corridor, pocket, rooms, shelves");
     for (const Case &c : cases) {
         char err[QNAV_SIM_ERRLEN] = "";
         qnav_sim_env_t *env = reinterpret_cast<qnav_sim_env_t *>(0x1);
@@ -238,7 +238,7 @@ static void test_gen_env_writes_the_world_the_spec_loads_and_refuses_bad_names(v
     assert_true(read_text_file(std::string(dir) + "/p.svg").find("</svg>") != std::string::npos);
     // Bad input: one line, exit 2, nothing written.
     assert_int_equal(run_tool("gen-env --family maze --seed 1 --out " + std::string(dir) + "/x.toml", &out), 2);
-    assert_string_equal(out.c_str(), "world spec 'gen:maze:1:0.5:tekbot': unknown family 'maze' (families: clutter, gaps, corridor, pocket, rooms)\n");
+    assert_string_equal(out.c_str(), "world spec 'gen:maze:1:0.5:tekbot': unknown family 'maze' (families: clutter, gaps, corridor, pocket, rooms, shelves)\n");
     assert_int_equal(run_tool("gen-env --family gaps --density 0.2 --out " + std::string(dir) + "/x.toml", &out), 2);
     assert_string_equal(out.c_str(), "--density: not with --family (use --difficulty)\n");
     assert_int_equal(run_tool("gen-env --difficulty 0.2 --out " + std::string(dir) + "/x.toml", &out), 2);

@@ -664,7 +664,7 @@ static void test_spec_distribution_errors_name_the_line(void **state)
     (void)state;
     const std::string head = "name = \"t\"\n[distribution.a]\n";
     assert_string_equal(parse_error(head + "families = [ { family = \"nosuch\" } ]\n").c_str(),
-                        "x.toml:3: family: 'nosuch' is not one of clutter, gaps, corridor, pocket, rooms");
+                        "x.toml:3: family: 'nosuch' is not one of clutter, gaps, corridor, pocket, rooms, shelves");
     assert_string_equal(parse_error(head + "families = []\n").c_str(),
                         "x.toml:3: distribution.a: families: expected a non-empty array of { family = ... } tables");
     assert_string_equal(parse_error(head + "families = [ { family = \"gaps\", environment = \"dense\" } ]\n").c_str(),

@@ -29,7 +29,7 @@ class FamilyEval(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         rows = [ROW.match(l) for l in r.stdout.splitlines()[2:]]
         self.assertEqual([m.group(1) for m in rows if m],
-                         ["clutter", "gaps", "corridor", "pocket", "rooms"], r.stdout)
+                         ["clutter", "gaps", "corridor", "pocket", "rooms", "shelves"], r.stdout)
         for m in rows:
             at1, lo1, hi1, at2 = (float(m.group(k)) for k in (2, 3, 4, 5))
             self.assertIn(at1, (0.0, 50.0, 100.0))
@@ -63,7 +63,7 @@ class FamilyEval(unittest.TestCase):
         self.assertEqual(sorted(per)[-1], "reference", r.stdout)
         evolved = [v for k, v in per.items() if k != "reference"]
         self.assertEqual(len(evolved), 2, r.stdout)
-        fams = ["clutter", "gaps", "corridor", "pocket", "rooms", "worst"]
+        fams = ["clutter", "gaps", "corridor", "pocket", "rooms", "shelves", "worst"]
         rows = {l.split()[0]: l for l in lines[7:]}
         self.assertEqual(list(rows), fams, r.stdout)
         for i, f in enumerate(fams):
