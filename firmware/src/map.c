@@ -919,6 +919,7 @@ static int plan_when_due(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
     const int new_goal = m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm;
     if (new_goal) {
         m->forgot = 0u; /* marked from afar again until the next forget */
+        m->replan_owed = 0u; /* the last goal's plan owes a new goal's escape nothing */
     }
     if (!m->planned || new_goal) {
         plan_start(m, goal_x_mm, goal_y_mm);

@@ -564,7 +564,7 @@ void build_shelves(Ctx &c, Environment &env) {
         const double depth = c.uni(0.4, 0.8) * c.s;
         if (y + depth > hi) break;
         const int n = 1 + (c.rng.uniform01() < 0.6 * (1.0 - c.d) ? 1 : 0);
-        double from = 0;           // the row's next piece begins here
+        double from = 0;  // the row's next piece begins here
         for (int k = 0; k < n; ++k) {
             const double g = c.widths(4.5 - 1.5 * c.d);
             const double slot = (env.width_m - from) / (n - k);
