@@ -184,10 +184,10 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
         ctrl->n_sectors == 0u || ctrl->n_sectors > QNAV_MAX_SECTORS || ctrl->max_range_mm == 0u) {
         return QNAV_E_MAP;
     }
-    /* the compact layout blocks occupied cells only, and has no bits for refusals and
-     * near costs */
+    /* the compact layout blocks occupied cells only, and has no bits for near costs (nor
+     * for refusals: it marks refused cells occupied, refuse_compact) */
     if (cfg->compact > 1u ||
-        (cfg->compact && (cfg->refuse_ticks != 0u || cfg->near_cost != 0u ||
+        (cfg->compact && (cfg->near_cost != 0u ||
                           (uint32_t)ctrl->body_radius_mm + ctrl->safety_mm >= cfg->cell_mm ||
                           (width_mm + cfg->cell_mm - 1u) / cfg->cell_mm >
                               8u * QNAV_CMAP_ROW_BYTES_MAX))) {
@@ -972,10 +972,26 @@ static void refusal_lapses(qnav_map_t *m)
     m->dirty = 1u;
 }
 
+/* The compact layout's refusal, from the robot's cell (i, j): it has no bits for one, so
+ * the plan's cells from 'from' steps to 'steps' steps ahead are marked occupied, until a
+ * forget (qnav_map_guide) clears them with every other occupied cell. Where the plan leads
+ * through a stretch of wall in a cell once seen clear (a cell seen clear takes no arc: that
+ * keeps the coarse cells' passages open) the robot stalls against the wall for good
+ * without it (docs/architecture.md, "A compact map's refusal"). */
+static void refuse_compact(qnav_map_t *m, int32_t i, int32_t j, int32_t steps, int32_t from)
+{
+    int32_t k;
+    for (k = 0; k < steps && qnav_cmap_cost(m, i, j) != 0u && descend(m, &i, &j); ++k) {
+        if (k + 1 >= from && qnav_cmap_cost(m, i, j) != 0u) {
+            qnav_cmap_occupy(m, i, j);
+        }
+    }
+}
+
 /* The robot made no progress along the plan for a long time though the plan kept its way:
  * the way is one the robot cannot take (a gap the controller will not pass). Refuse the
  * plan's cells from 'from' to look_mm ahead of the robot's cell, so the plan seeks another
- * way; the refusal lapses after a while. */
+ * way; the refusal lapses after a while (the compact layout's: refuse_compact). */
 static void refuse_when_stalled(qnav_map_t *m, int32_t ri, int32_t rj, uint16_t mm, int jumped)
 {
     int32_t i, j, steps, k, from;
@@ -999,14 +1015,18 @@ static void refuse_when_stalled(qnav_map_t *m, int32_t ri, int32_t rj, uint16_t 
     /* refused cells lie more than the body's reach and a cell along the plan, so that the
      * robot's own cell stays unblocked and the plan starts where the robot stands */
     from = ((int32_t)m->inflate_mm + (int32_t)m->cfg.cell_mm - 1) / (int32_t)m->cfg.cell_mm + 1;
-    for (k = 0; k < steps && descend(m, &i, &j) && m->cost[qnav_map_at(m, i, j)] != 0u; ++k) {
-        if (k >= from) {
-            m->evidence[qnav_map_at(m, i, j)] = EVIDENCE_REFUSED;
+    if (m->cfg.compact) {
+        refuse_compact(m, i, j, steps, from);
+    } else {
+        for (k = 0; k < steps && descend(m, &i, &j) && m->cost[qnav_map_at(m, i, j)] != 0u; ++k) {
+            if (k >= from) {
+                m->evidence[qnav_map_at(m, i, j)] = EVIDENCE_REFUSED;
+            }
         }
+        m->dirty = 1u;
+        m->refused_ticks = m->cfg.refuse_life_ticks;
     }
-    m->dirty = 1u;
     m->ticks = m->cfg.plan_ticks; /* plan again at once */
-    m->refused_ticks = m->cfg.refuse_life_ticks;
     m->stall_best_mm = 0u;
     m->stall_ticks = 0u;
 }

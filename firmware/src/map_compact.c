@@ -83,6 +83,12 @@ void qnav_cmap_clear(qnav_map_t *m, int32_t i, int32_t j)
     set2(m, SEEN_LO, i, j, SEEN_FREE);
 }
 
+void qnav_cmap_occupy(qnav_map_t *m, int32_t i, int32_t j)
+{
+    set2(m, SEEN_LO, i, j, SEEN_OCCUPIED);
+    m->dirty = 1u;
+}
+
 void qnav_cmap_arc(qnav_map_t *m, int32_t i, int32_t j)
 {
     const unsigned v = bit2(m, SEEN_LO, i, j);

@@ -63,6 +63,8 @@ void qnav_cmap_settle(qnav_map_t *m, int32_t ri, int32_t rj);
 /* The plan's cost from cell (i, j) (10 a side, 14 a diagonal, along its way);
  * QNAV_MAP_UNREACHED when the cell is not settled. */
 uint32_t qnav_cmap_cost(const qnav_map_t *m, int32_t i, int32_t j);
+/* Cell (i, j) occupied, whatever it was seen as (a refusal: refuse_compact in map.c). */
+void qnav_cmap_occupy(qnav_map_t *m, int32_t i, int32_t j);
 /* The plan's cost (10 a side, 14 a diagonal, along its way) from cell (i, j), or, when
  * (i, j) is not settled and is blocked or the plan is whole, from the best settled cell
  * within two (*bi, *bj: that cell); QNAV_MAP_UNREACHED when none is (or the plan is still

@@ -170,12 +170,11 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         }
         if (const toml::node *g = mp.get("grow_steps"); g && !p.map_compact)
             r.fail(*g, "'grow_steps' is a compact map's (compact = true)");
-        if (p.map_compact) {  // 4 bits a cell: no bits for near costs and refusals
-            for (const char *k : {"near_cost", "refuse_s"})
-                if (const toml::node *n = mp.get(k); n && n->value_or(0.0) != 0.0)
-                    r.fail(*n, std::string("'") + k + "' must be 0 in a compact map (it has no bits for it)");
+        if (p.map_compact) {  // 4 bits a cell: no bits for near costs; refused cells marked occupied
+            if (const toml::node *n = mp.get("near_cost"); n && n->value_or(0.0) != 0.0)
+                r.fail(*n, "'near_cost' must be 0 in a compact map (it has no bits for it)");
             p.map_near_cost = 0.0;
-            p.map_refuse_s = 0.0;
+            if (!mp.get("refuse_s")) p.map_refuse_s = 0.0;  // a compact map refuses only when told to
             if (mp.get("grow_steps"))
                 p.map_grow_steps = static_cast<std::uint8_t>(r.integer(mp, "grow_steps", 0, 255));
             const double cell = p.map_cell_m > 0 ? p.map_cell_m : p.map_off_cell_m;

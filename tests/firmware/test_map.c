@@ -679,8 +679,8 @@ static const box_t wall_with_two_gaps[] = {
  * cells ahead are refused, so the plan seeks another way. Returns the guided tick whose
  * sub-goal no longer lies ahead through the near gap (-1: none in 100), with the last
  * tick's input in *in. With refuse_ticks 0, never. */
-static int ticks_until_refused(uint8_t refuse_ticks, const box_t *wall, size_t n,
-                               qnav_map_t *m, qnav_ctrl_input_t *in, int *got)
+static int ticks_until_refused_in(uint16_t compact_cell_mm, uint8_t refuse_ticks, const box_t *wall,
+                                  size_t n, qnav_map_t *m, qnav_ctrl_input_t *in, int *got)
 {
     qnav_map_config_t mc;
     qnav_mm_t ranges[N];
@@ -689,6 +689,9 @@ static int ticks_until_refused(uint8_t refuse_ticks, const box_t *wall, size_t n
     int t;
     qnav_map_config_default(&mc);
     mc.plan_ticks = 1;
+    if (compact_cell_mm != 0u) {
+        make_compact(&mc, compact_cell_mm, 1, 0);
+    }
     mc.refuse_ticks = refuse_ticks;
     mc.refuse_life_ticks = 20;
     map_from(m, &mc);
@@ -706,6 +709,40 @@ static int ticks_until_refused(uint8_t refuse_ticks, const box_t *wall, size_t n
         }
     }
     return -1;
+}
+
+/* The same in the full layout (8 bytes a cell). */
+static int ticks_until_refused(uint8_t refuse_ticks, const box_t *wall, size_t n,
+                               qnav_map_t *m, qnav_ctrl_input_t *in, int *got)
+{
+    return ticks_until_refused_in(0u, refuse_ticks, wall, n, m, in, got);
+}
+
+/* The compact layout has no bits for a refusal: the refused cells are marked occupied and
+ * stay so (no lapse) until a forget. */
+static void test_a_compact_map_refuses_a_way_by_marking_it_occupied(void **state)
+{
+    qnav_map_t m;
+    qnav_ctrl_input_t in;
+    const qnav_map_pose_t p = {4900, 2300, 9000};
+    int t, got;
+    (void)state;
+    assert_int_equal(ticks_until_refused_in(400, 30, wall_with_two_gaps, 3, &m, &in, &got), 31);
+    assert_int_equal(got & QNAV_MAP_GUIDED, QNAV_MAP_GUIDED);
+    print_message("refused: bearing %d cdeg, flags %d\n", in.goal_bearing_cdeg, got);
+    assert_true(in.goal_bearing_cdeg > 1500); /* toward the far gap, to the robot's left */
+    assert_true(qnav_map_evidence(&m, 4950, 3050) >= QNAV_MAP_OCCUPIED);
+    assert_true(qnav_map_evidence(&m, 4950, 2550) < QNAV_MAP_OCCUPIED); /* not at the robot */
+    for (t = 0; t < 40; ++t) { /* twice the full layout's life: still refused */
+        memset(&in, 0, sizeof in);
+        got = qnav_map_guide(&m, &p, 4900, 5000, &in);
+        assert_int_equal(got & QNAV_MAP_GUIDED, QNAV_MAP_GUIDED);
+        assert_true(in.goal_bearing_cdeg > 1500);
+    }
+    assert_true(qnav_map_evidence(&m, 4950, 3050) >= QNAV_MAP_OCCUPIED);
+    /* never with refuse_ticks 0 (a forget clears refused cells with every other occupied
+     * one: test_a_map_that_closed_every_way_forgets_what_it_marked) */
+    assert_int_equal(ticks_until_refused_in(400, 0, wall_with_two_gaps, 3, &m, &in, &got), -1);
 }
 
 static void test_a_way_the_robot_cannot_take_is_refused_for_a_while(void **state)
@@ -1040,6 +1077,7 @@ int main(void)
         cmocka_unit_test(test_the_sub_goal_is_not_behind_a_corner),
         cmocka_unit_test(test_a_longer_plan_grows_the_escape_memory),
         cmocka_unit_test(test_a_longer_plan_that_reaches_the_robot_late_grows_the_escape_memory),
+        cmocka_unit_test(test_a_compact_map_refuses_a_way_by_marking_it_occupied),
         cmocka_unit_test(test_the_destination_in_reach_is_flagged_direct),
         cmocka_unit_test(test_a_map_that_closed_every_way_forgets_what_it_marked),
         cmocka_unit_test(test_after_a_forget_only_near_readings_mark),

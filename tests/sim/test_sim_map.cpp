@@ -280,7 +280,7 @@ void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
         assert_int_equal(on.compact, 1);
         assert_int_equal(on.grow_steps, 16);
         assert_int_equal(on.near_cost, 0);
-        assert_int_equal(on.refuse_ticks, 0);
+        assert_int_equal(on.refuse_ticks, tekbot ? 30 : 0); /* the TekBot's 3 s; a compact map refuses only when told to */
         assert_true(on.cell_mm == plain_map.cell_mm && on.compact == plain_map.compact);
         assert_int_equal(with.safety_mm, without.safety_mm);
         assert_int_equal(with.n_sectors, without.n_sectors);
@@ -309,12 +309,19 @@ void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
     assert_int_equal(rmdir(dir), 0);
     assert_true(refusal(tekbot_with("[map]\non = 1\ncell_m = 0.1\n")).find("'on' must be true or false") !=
                 std::string::npos);
-    /* a compact map: cells wider than the body's reach, no near costs or refusals, and
-     * grow_steps only with it */
+    /* a compact map: cells wider than the body's reach, no near costs (refusals mark cells
+     * occupied), and grow_steps only with it */
     assert_true(refusal(tekbot_with("[map]\ncompact = true\ncell_m = 0.15\n")).find("'cell_m' must exceed") !=
                 std::string::npos);
     assert_true(refusal(tekbot_with("[map]\ncompact = true\ncell_m = 0.4\nnear_cost = 1\n"))
                     .find("'near_cost' must be 0 in a compact map") != std::string::npos);
+    {
+        const std::string ok = tekbot_with("[map]\ncompact = true\ncell_m = 0.4\nrefuse_s = 2\n");
+        char why[QNAV_SIM_ERRLEN] = "";
+        qnav_sim_robot_t *r = nullptr;
+        assert_int_equal(qnav_sim_robot_parse(ok.data(), ok.size(), "ok.toml", &r, why, sizeof why), QNAV_SIM_OK);
+        qnav_sim_robot_free(r);
+    }
     assert_true(refusal(tekbot_with("[map]\ncompact = 1\ncell_m = 0.4\n")).find("'compact' must be true or false") !=
                 std::string::npos);
     assert_true(refusal(tekbot_with("[map]\ncell_m = 0.4\ngrow_steps = 4\n")).find("'grow_steps' is a compact map's") !=

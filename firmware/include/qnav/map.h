@@ -60,7 +60,8 @@ typedef struct {
                               which the plan's next cells (beyond the body's reach, up to
                               look_mm) are refused: marked occupied until the refusal
                               lapses, so the plan seeks another way than one the robot
-                              cannot take; 0: never; default 30 */
+                              cannot take (compact: marked occupied until a forget, as it
+                              has no bits for a refusal); 0: never; default 30 */
     uint16_t refuse_life_ticks; /* ticks a refusal lasts (every refused cell then unknown
                               again), 1..65535; default 200 */
     uint8_t compact;       /* 1: 4 bits a cell instead of 8 bytes, for a board of a few KB
@@ -68,8 +69,8 @@ typedef struct {
                               was seen as in 2 bits, a breadth-first plan in 2 (each cell's
                               step count from the destination modulo 3). Needs cells wider
                               than the body's radius and safety distance (a cell is blocked
-                              when it is occupied), at most 192 cells across, refuse_ticks 0
-                              and near_cost 0; the plan counts a diagonal step as one.
+                              when it is occupied), at most 192 cells across and near_cost
+                              0; the plan counts a diagonal step as one.
                               Default 0 */
     uint8_t grow_steps;    /* compact: a tick grows the plan by at most this many steps
                               (its cost is bounded: docs/performance.md); while it has not
