@@ -972,26 +972,31 @@ static void refusal_lapses(qnav_map_t *m)
     m->dirty = 1u;
 }
 
-/* The compact layout's refusal, from the robot's cell (i, j): it has no bits for one, so
- * the plan's cells from 'from' steps to 'steps' steps ahead are marked occupied, until a
- * forget (qnav_map_guide) clears them with every other occupied cell. Where the plan leads
- * through a stretch of wall in a cell once seen clear (a cell seen clear takes no arc: that
- * keeps the coarse cells' passages open) the robot stalls against the wall for good
- * without it (docs/architecture.md, "A compact map's refusal"). */
-static void refuse_compact(qnav_map_t *m, int32_t i, int32_t j, int32_t steps, int32_t from)
+/* Cell (i, j)'s plan cost (0: the destination's cell). */
+static uint32_t plan_cost(const qnav_map_t *m, int32_t i, int32_t j)
 {
-    int32_t k;
-    for (k = 0; k < steps && qnav_cmap_cost(m, i, j) != 0u && descend(m, &i, &j); ++k) {
-        if (k + 1 >= from && qnav_cmap_cost(m, i, j) != 0u) {
-            qnav_cmap_occupy(m, i, j);
-        }
+    return m->cfg.compact ? qnav_cmap_cost(m, i, j) : m->cost[qnav_map_at(m, i, j)];
+}
+
+/* Refuse cell (i, j). The full layout marks it refused until the refusal lapses. The
+ * compact layout has no bits for a refusal and marks it occupied, until a forget
+ * (qnav_map_guide) clears it with every other occupied cell: where the plan leads through a
+ * stretch of wall in a cell once seen clear (a cell seen clear takes no arc, which keeps the
+ * coarse cells' passages open) the robot stalled against the wall for good without it
+ * (docs/architecture.md, "A compact map's refusal"). */
+static void refuse_cell(qnav_map_t *m, int32_t i, int32_t j)
+{
+    if (m->cfg.compact) {
+        qnav_cmap_occupy(m, i, j);
+    } else {
+        m->evidence[qnav_map_at(m, i, j)] = EVIDENCE_REFUSED;
     }
 }
 
 /* The robot made no progress along the plan for a long time though the plan kept its way:
  * the way is one the robot cannot take (a gap the controller will not pass). Refuse the
  * plan's cells from 'from' to look_mm ahead of the robot's cell, so the plan seeks another
- * way; the refusal lapses after a while (the compact layout's: refuse_compact). */
+ * way; the refusal lapses after a while (the compact layout's when the map forgets). */
 static void refuse_when_stalled(qnav_map_t *m, int32_t ri, int32_t rj, uint16_t mm, int jumped)
 {
     int32_t i, j, steps, k, from;
@@ -1012,17 +1017,19 @@ static void refuse_when_stalled(qnav_map_t *m, int32_t ri, int32_t rj, uint16_t 
     }
     (void)cost_near(m, ri, rj, &i, &j);
     steps = (int32_t)(m->cfg.look_mm / m->cfg.cell_mm);
-    /* refused cells lie more than the body's reach and a cell along the plan, so that the
-     * robot's own cell stays unblocked and the plan starts where the robot stands */
-    from = ((int32_t)m->inflate_mm + (int32_t)m->cfg.cell_mm - 1) / (int32_t)m->cfg.cell_mm + 1;
-    if (m->cfg.compact) {
-        refuse_compact(m, i, j, steps, from);
-    } else {
-        for (k = 0; k < steps && descend(m, &i, &j) && m->cost[qnav_map_at(m, i, j)] != 0u; ++k) {
-            if (k >= from) {
-                m->evidence[qnav_map_at(m, i, j)] = EVIDENCE_REFUSED;
-            }
+    /* refused cells lie beyond the body's reach along the plan, so that the robot's own cell
+     * stays unblocked and the plan starts where the robot stands; the full layout blocks
+     * cells within the body's reach of a refused one, so its refusal starts a cell further
+     * (the compact one blocks the occupied cell only: its 1 m look-ahead holds two 0.35 m
+     * cells, and the second is refused) */
+    from = ((int32_t)m->inflate_mm + (int32_t)m->cfg.cell_mm - 1) / (int32_t)m->cfg.cell_mm +
+           (m->cfg.compact ? 0 : 1);
+    for (k = 0; k < steps && descend(m, &i, &j) && plan_cost(m, i, j) != 0u; ++k) {
+        if (k >= from) {
+            refuse_cell(m, i, j);
         }
+    }
+    if (!m->cfg.compact) { /* (a compact cell marked occupied makes the map dirty itself) */
         m->dirty = 1u;
         m->refused_ticks = m->cfg.refuse_life_ticks;
     }

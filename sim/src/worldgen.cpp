@@ -200,6 +200,18 @@ void top_destination(Ctx &c, Environment &env) {
     env.dest_y_m = env.height_m - c.uni(0.8, 1.4) * c.s;
 }
 
+// The band of the arena between the start zones (along the bottom) and the destination
+// (at the top), kept two robot radii and 0.4 m (times the size scale) from both: where
+// gaps' walls and shelves' rows go.
+struct Band {
+    double lo, hi;
+};
+Band band_between(const Ctx &c, const Environment &env) {
+    double ztop = 0;
+    for (const StartZone &z : env.start_zones) ztop = std::max(ztop, z.y_m + z.h_m);
+    return {ztop + c.radius * 2 + 0.4 * c.s, env.dest_y_m - env.dest_radius_m - c.radius * 2 - 0.4 * c.s};
+}
+
 // Scatter circles and boxes over [x0, x1] x [y0, y1] until they cover `coverage` of that
 // area or `tries` draws were made. An obstacle is kept only when it overlaps no other
 // obstacle, keeps 2 robot radii plus (1 - difficulty) x 0.6 m (times the size scale)
@@ -278,13 +290,9 @@ void build_gaps(Ctx &c, Environment &env) {
     env.height_m = c.uni(9, 14) * c.s;
     bottom_zones(c, env, 1 + c.pick(2));
     top_destination(c, env);
-    double zx = 0, ztop = 0;
-    for (const StartZone &z : env.start_zones) {
-        zx += zone_centre(z).x / static_cast<double>(env.start_zones.size());
-        ztop = std::max(ztop, z.y_m + z.h_m);
-    }
-    const double lo = ztop + c.radius * 2 + 0.4 * c.s;
-    const double hi = env.dest_y_m - env.dest_radius_m - c.radius * 2 - 0.4 * c.s;
+    double zx = 0;
+    for (const StartZone &z : env.start_zones) zx += zone_centre(z).x / static_cast<double>(env.start_zones.size());
+    const auto [lo, hi] = band_between(c, env);
     const int walls = std::clamp(1 + static_cast<int>(c.d * 2.5 + c.uni(0, 1.5)), 1,
                                  std::max(1, static_cast<int>((hi - lo) / (1.6 * c.s))));
     const double thick = c.uni(0.1, 0.25) * c.s;
@@ -556,24 +564,23 @@ void build_shelves(Ctx &c, Environment &env) {
     env.height_m = c.uni(9, 14) * c.s;
     bottom_zones(c, env, 1 + c.pick(2));
     top_destination(c, env);
-    double ztop = 0;
-    for (const StartZone &z : env.start_zones) ztop = std::max(ztop, z.y_m + z.h_m);
-    const double lo = ztop + c.radius * 2 + 0.4 * c.s;
-    const double hi = env.dest_y_m - env.dest_radius_m - c.radius * 2 - 0.4 * c.s;
+    const auto [lo, hi] = band_between(c, env);
     for (double y = lo + c.uni(0, 0.3) * c.s;;) {
         const double depth = c.uni(0.4, 0.8) * c.s;
         if (y + depth > hi) break;
+        const auto piece = [&](double x0, double x1) {  // shelving from x0 to x1, if any
+            if (x1 - x0 > 0.05) env.boxes.push_back({(x0 + x1) / 2, y + depth / 2, x1 - x0, depth, 0});
+        };
         const int n = 1 + (c.rng.uniform01() < 0.6 * (1.0 - c.d) ? 1 : 0);
         double from = 0;  // the row's next piece begins here
         for (int k = 0; k < n; ++k) {
             const double g = c.widths(4.5 - 1.5 * c.d);
             const double slot = (env.width_m - from) / (n - k);
             const double at = from + c.uni(0, std::max(0.0, slot - g));
-            if (at - from > 0.05) env.boxes.push_back({(from + at) / 2, y + depth / 2, at - from, depth, 0});
+            piece(from, at);
             from = at + g;
         }
-        if (env.width_m - from > 0.05)
-            env.boxes.push_back({(from + env.width_m) / 2, y + depth / 2, env.width_m - from, depth, 0});
+        piece(from, env.width_m);
         y += depth + c.widths(5.0 - 2.0 * c.d);
     }
     PassGrid grid = grid_for(c, env);
