@@ -100,6 +100,7 @@ int main(void)
     layouts[1].noise_pct = layouts[0].noise_pct;
     layouts[1].arc_cdeg = layouts[0].arc_cdeg;
     layouts[1].forget_reach_mm = layouts[0].forget_reach_mm;
+    layouts[1].opening_mm = layouts[0].opening_mm;
     QNAV_BENCH_MAP_CTRL_CONFIG(&cc);
     qnav_target_put("qnav Cortex-M4 map benchmark: QEMU mps2-an386; values are instructions of "
                     "a tick's follow, observe and guide (tools/cm4-icount)\n");

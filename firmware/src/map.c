@@ -66,6 +66,7 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->compact = 0u;
     cfg->grow_steps = 16u;
     cfg->forget_reach_mm = 0u;
+    cfg->opening_mm = 0u;
 }
 
 uint32_t qnav_map_cells(uint32_t width_mm, uint32_t height_mm, uint16_t cell_mm)
@@ -114,6 +115,21 @@ static uint32_t square_cells(const qnav_map_config_t *cfg, size_t len)
         }
     }
     return lo;
+}
+
+/* The range from which a range peak marks no arc: where a wedge of n sectors spans more
+ * than 2 opening_mm across, opening_mm / sin(180 deg / n), saturated; 0 when none is left
+ * out (opening_mm 0, or one sector: its neighbours are itself). */
+static uint16_t peak_range(uint16_t opening_mm, uint16_t n_sectors)
+{
+    int16_t c, s;
+    uint32_t r;
+    if (opening_mm == 0u || n_sectors < 2u) {
+        return 0u;
+    }
+    qnav_cos_sin_q14((int32_t)(INT32_C(18000) / (int32_t)n_sectors), &c, &s);
+    r = ((uint32_t)opening_mm << 14) / (uint32_t)(s > 0 ? s : 1);
+    return (uint16_t)(r > 65535u ? 65535u : (r == 0u ? 1u : r));
 }
 
 static int32_t abs32(int32_t v)
@@ -207,6 +223,7 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
     m->inflate_mm = (uint16_t)((uint32_t)ctrl->body_radius_mm + ctrl->safety_mm > 65535u
                                    ? 65535u
                                    : (uint32_t)ctrl->body_radius_mm + ctrl->safety_mm);
+    m->peak_mm = peak_range(cfg->opening_mm, ctrl->n_sectors);
     m->x0_mm = x0_mm;
     m->y0_mm = y0_mm;
     m->nx = (uint16_t)((width_mm + cfg->cell_mm - 1u) / cfg->cell_mm);
@@ -473,6 +490,44 @@ static int32_t marks_within(const qnav_map_t *m)
     return m->forgot && m->cfg.forget_reach_mm != 0u ? (int32_t)m->cfg.forget_reach_mm : INT32_MAX;
 }
 
+/* 1 when sector k's reading, rc from the robot's centre, may mark an arc: not a range
+ * peak (farther than both neighbouring sectors' readings) as far as peak_mm or farther,
+ * where a wide wedge reads an opening's two sides (qnav_map_config_t.opening_mm). */
+static int may_mark(const qnav_map_t *m, const qnav_mm_t *ranges_mm, uint16_t k, int32_t rc)
+{
+    const uint16_t n = m->n_sectors;
+    const qnav_mm_t r = ranges_mm[k];
+    if (m->peak_mm == 0u || rc < (int32_t)m->peak_mm) {
+        return 1;
+    }
+    return !(ranges_mm[k == 0u ? n - 1u : k - 1u] < r && ranges_mm[k + 1u == n ? 0u : k + 1u] < r);
+}
+
+/* One sector's reading and what follows from it for the cells in its wedge: cells in a row
+ * often share a sector, and each costs divisions (an AVR's are hundreds of cycles). */
+typedef struct {
+    uint16_t k;    /* the sector; UINT16_MAX: none yet */
+    int32_t rc;    /* the reading from the robot's centre, mm */
+    int32_t lo;    /* cells nearer than this are seen clear */
+    int32_t band;  /* cells from this to rc + 3/4 cell may take the arc */
+    int32_t centre; /* the wedge's centre line, robot frame, 0.01 deg */
+    int marks;     /* the reading may mark an arc: near enough (marks_within), and not a
+                      far range peak (may_mark) */
+} reading_t;
+
+static void read_sector(const qnav_map_t *m, const qnav_mm_t *ranges_mm, uint16_t k,
+                        int32_t three_quarters, int32_t band_pct, int32_t mark_reach,
+                        reading_t *r)
+{
+    r->k = k;
+    r->rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
+    /* not seen clear within 3/4 cell and the noise of the reading, occupied from band */
+    r->lo = r->rc - three_quarters - r->rc * (int32_t)m->cfg.noise_pct / 100;
+    r->band = r->rc - three_quarters - r->rc * band_pct / 100;
+    r->centre = (int32_t)((uint32_t)k * 36000u / m->n_sectors);
+    r->marks = r->rc <= mark_reach && may_mark(m, ranges_mm, k, r->rc);
+}
+
 /*
  * Squares are unsigned 32-bit (a 64-bit product costs an AVR hundreds of cycles): with
  * reach_mm at most MAX_REACH_MM and cells at most 1 000 mm, a cell's offset from the robot
@@ -483,17 +538,12 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
 {
     int32_t i0, i1, j0, j1, i, j, reach, mark_reach, three_quarters, heading, arc_half, band_pct;
     uint32_t reach2;
-    /* the last sector's reading and what follows from it: cells in a row often share a
-     * sector, and each costs divisions (an AVR's are hundreds of cycles) */
-    struct {
-        uint16_t k;
-        int32_t rc, lo, band, centre;
-    } last;
+    reading_t last;
     if (!ready(m) || ranges_mm == NULL || pose == NULL) {
         return;
     }
+    memset(&last, 0, sizeof last);
     last.k = UINT16_MAX;
-    last.rc = last.lo = last.band = last.centre = 0;
     reach = (int32_t)m->cfg.reach_mm;
     three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
     reach2 = (uint32_t)reach * (uint32_t)reach;
@@ -517,7 +567,7 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
             uint32_t d2;
             const int8_t c = evidence_at(m, i, j);
             uint16_t k;
-            int32_t rc, tol, lo, band, rel;
+            int32_t rel;
             dx += (int32_t)m->cfg.cell_mm;
             if (c == EVIDENCE_FREE_MIN || c == EVIDENCE_REFUSED) {
                 continue; /* no reading changes it: free at its floor, or refused */
@@ -536,23 +586,15 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
                 continue;
             }
             if (k != last.k) {
-                last.k = k;
-                last.rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
-                /* not carved free within tol of the reading, occupied from band */
-                tol = three_quarters + last.rc * (int32_t)m->cfg.noise_pct / 100;
-                last.band = last.rc - three_quarters - last.rc * band_pct / 100;
-                last.lo = last.rc - tol;
-                last.centre = (int32_t)((uint32_t)k * 36000u / m->n_sectors);
+                read_sector(m, ranges_mm, k, three_quarters, band_pct, mark_reach, &last);
             }
-            rc = last.rc;
-            lo = last.lo;
-            band = last.band;
-            if (lo > 0 && (lo > reach || d2 < (uint32_t)lo * (uint32_t)lo)) {
+            if (last.lo > 0 && (last.lo > reach || d2 < (uint32_t)last.lo * (uint32_t)last.lo)) {
                 mark_clear(m, i, j);
-            } else if (c >= 0 && c < EVIDENCE_REFUSED && rc <= mark_reach &&
-                       (rc + three_quarters > reach ||
-                        d2 <= (uint32_t)(rc + three_quarters) * (uint32_t)(rc + three_quarters)) &&
-                       (band <= 0 || (band <= reach && d2 >= (uint32_t)band * (uint32_t)band)) &&
+            } else if (last.marks && c >= 0 && c < EVIDENCE_REFUSED &&
+                       (last.rc + three_quarters > reach ||
+                        d2 <= (uint32_t)(last.rc + three_quarters) * (uint32_t)(last.rc + three_quarters)) &&
+                       (last.band <= 0 ||
+                        (last.band <= reach && d2 >= (uint32_t)last.band * (uint32_t)last.band)) &&
                        off_centre(rel, last.centre) <= arc_half) {
                 mark_arc(m, i, j);
             }

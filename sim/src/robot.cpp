@@ -139,7 +139,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         const toml::table &mp = r.table(root, "map");
         r.only_keys(mp, {"on", "cell_m", "reach_m", "look_m", "plan_s", "near_m", "near_cost", "arc_deg", "sight",
                          "escape_grow", "refuse_s", "refuse_life_s", "pass_m", "compact", "grow_steps", "bytes",
-                         "noise", "forget_reach_m"});
+                         "noise", "forget_reach_m", "opening_m"});
         bool on = true;
         if (const toml::node *o = mp.get("on")) {
             if (!o->is_boolean()) r.fail(*o, "'on' must be true or false");
@@ -157,6 +157,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         p.map_near_cost = r.number(mp, "near_cost", 0.0, 25.5, true, p.map_near_cost);
         p.map_arc_deg = r.number(mp, "arc_deg", 0.0, 360.0, true, p.map_arc_deg);
         p.map_forget_reach_m = r.number(mp, "forget_reach_m", 0.0, 65.0, true, p.map_forget_reach_m);
+        p.map_opening_m = r.number(mp, "opening_m", 0.0, 65.0, true, p.map_opening_m);
         if (mp.get("noise")) p.map_noise = r.number(mp, "noise", 0.0, 1.0);
         if (mp.get("sight")) p.map_sight = r.integer(mp, "sight", 0, 1) != 0;
         if (mp.get("escape_grow")) p.map_escape_grow = r.integer(mp, "escape_grow", 0, 1) != 0;

@@ -80,6 +80,7 @@ struct RobotProfile {
                                     // noise_pct); < 0: [noise] sensor
     double map_arc_deg = 22.5;      // arcs marked within this angle about the wedge's centre
     double map_forget_reach_m = 0.0;  // after a forget, only readings this near mark; 0: all
+    double map_opening_m = 0.0;       // a range peak whose wedge spans more than twice this marks no arc; 0: all mark
     bool map_sight = true;          // the sub-goal kept in a straight line's sight
     bool map_escape_grow = true;    // a longer plan grows the escape's distances with it
     double map_refuse_s = 3.0;      // no progress along the plan this long: its next cells refused

@@ -69,6 +69,7 @@ void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg) {
     cfg->compact = p.map_compact ? 1 : 0;
     cfg->grow_steps = p.map_grow_steps;
     cfg->forget_reach_mm = to_mm(p.map_forget_reach_m);
+    cfg->opening_mm = to_mm(p.map_opening_m);
 }
 
 }  // namespace qnav

@@ -160,6 +160,55 @@ static void test_a_wide_wedge_marks_only_the_default_arc(void **state)
     assert_int_equal(qnav_map_evidence(&m, 4150, 3350), 1);
 }
 
+/* A map for a ring of n sectors, every reading clear but ahead (sector 0) and its two
+ * neighbours, observed once from the centre facing +x. */
+static void observe_ahead(qnav_map_t *m, uint16_t n, uint16_t opening_mm, qnav_mm_t ahead_mm,
+                          qnav_mm_t left_mm, qnav_mm_t right_mm)
+{
+    qnav_map_config_t mc;
+    qnav_ctrl_config_t cc;
+    qnav_mm_t ranges[N];
+    const qnav_map_pose_t p = {3050, 3050, 0};
+    uint16_t k;
+    sensor_config(&cc);
+    cc.n_sectors = n;
+    for (k = 0; k < n; ++k) {
+        ranges[k] = 2500;
+    }
+    ranges[0] = ahead_mm;
+    ranges[1] = left_mm;
+    ranges[n - 1u] = right_mm;
+    qnav_map_config_default(&mc);
+    mc.opening_mm = opening_mm;
+    assert_int_equal(qnav_map_init(m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
+                     QNAV_OK);
+    qnav_map_observe(m, ranges, &p);
+}
+
+/* opening_mm: in an aisle a 45 deg wedge ahead reads the side walls where its edges meet
+ * them, nearer than anything ahead; the neighbouring wedges read the walls nearer still.
+ * Such a range peak marks no arc where the wedge spans more than 2 opening_mm across
+ * (270 mm: from 705 mm at 8 sectors, 1 384 mm at 16), so the way ahead stays open; it
+ * still frees the cells short of it. A reading that is no peak, or nearer, marks. */
+static void test_a_far_range_peak_in_a_wide_wedge_marks_no_arc(void **state)
+{
+    qnav_map_t m;
+    (void)state;
+    observe_ahead(&m, 8, 270, 1000, 500, 500); /* 1 120 mm from the centre */
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3050), 0); /* unmarked: maybe an opening */
+    assert_true(qnav_map_evidence(&m, 3750, 3050) < 0);     /* nearer: free */
+    observe_ahead(&m, 8, 0, 1000, 500, 500);                /* every reading marks */
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3050), 1);
+    observe_ahead(&m, 8, 270, 1000, 2500, 500);             /* no peak: a wall's end */
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3050), 1);
+    observe_ahead(&m, 8, 270, 1000, 500, 2500);
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3050), 1);
+    observe_ahead(&m, 8, 270, 500, 300, 300);               /* a peak 620 mm away */
+    assert_int_equal(qnav_map_evidence(&m, 3650, 3050), 1);
+    observe_ahead(&m, 16, 270, 1000, 500, 500);             /* a 22.5 deg wedge: 440 mm there */
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3050), 1);
+}
+
 /* noise_pct: a noisy sonar's reading carves free only cells nearer than its noise, but marks
  * occupied only a thin band at the reading (3/4 cell + at most 5 %), so that one
  * obstacle's spread readings do not make it thick. */
@@ -1069,6 +1118,7 @@ int main(void)
         cmocka_unit_test(test_a_reading_frees_its_wedge_and_marks_its_arc),
         cmocka_unit_test(test_arcs_are_marked_in_the_central_part_of_the_wedge),
         cmocka_unit_test(test_a_wide_wedge_marks_only_the_default_arc),
+        cmocka_unit_test(test_a_far_range_peak_in_a_wide_wedge_marks_no_arc),
         cmocka_unit_test(test_a_noisy_reading_keeps_its_arc_thin),
         cmocka_unit_test(test_the_plan_leads_round_the_wall_to_its_gap),
         cmocka_unit_test(test_the_compact_plan_leads_round_the_wall_to_its_gap),

@@ -328,24 +328,34 @@ void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
                 std::string::npos);
 }
 
+// The map configuration a profile gives (the test fails naming the profile's error).
+qnav_map_config_t map_config_of(const std::string &profile) {
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_robot_t *robot = nullptr;
+    if (qnav_sim_robot_parse(profile.data(), profile.size(), "map.toml", &robot, err, sizeof err) != QNAV_SIM_OK)
+        fail_with("robot", err);
+    qnav_map_config_t cfg;
+    assert_int_equal(qnav_sim_robot_map_config(robot, &cfg), 1);
+    qnav_sim_robot_free(robot);
+    return cfg;
+}
+
 // [map] arc_deg, the arc a reading marks, reaches the map in 0.01 deg (default 22.5 deg);
 // the former share of the wedge, arc_pct, is refused naming the key, and so is an angle
 // outside 0..360 (docs/architecture.md, "The arc a reading marks").
 void test_the_maps_arc_is_an_angle_from_the_profile(void **) {
-    const auto arc_of = [](const std::string &profile) {
-        char err[QNAV_SIM_ERRLEN] = "";
-        qnav_sim_robot_t *robot = nullptr;
-        if (qnav_sim_robot_parse(profile.data(), profile.size(), "arc.toml", &robot, err, sizeof err) != QNAV_SIM_OK)
-            fail_with("robot", err);
-        qnav_map_config_t cfg;
-        assert_int_equal(qnav_sim_robot_map_config(robot, &cfg), 1);
-        qnav_sim_robot_free(robot);
-        return cfg.arc_cdeg;
-    };
-    assert_int_equal(arc_of(tekbot_with("[map]\ncell_m = 0.1\n")), 2250);
-    assert_int_equal(arc_of(tekbot_with("[map]\ncell_m = 0.1\narc_deg = 11.25\n")), 1125);
+    assert_int_equal(map_config_of(tekbot_with("[map]\ncell_m = 0.1\n")).arc_cdeg, 2250);
+    assert_int_equal(map_config_of(tekbot_with("[map]\ncell_m = 0.1\narc_deg = 11.25\n")).arc_cdeg, 1125);
     assert_true(refusal(tekbot_with("[map]\ncell_m = 0.1\narc_pct = 50\n")).find("arc_pct") != std::string::npos);
     assert_true(refusal(tekbot_with("[map]\ncell_m = 0.1\narc_deg = 361\n")).find("arc_deg") != std::string::npos);
+}
+
+// [map] opening_m reaches the map in mm (default 0: every reading marks); a negative one is
+// refused naming the key (docs/architecture.md, "A reading that may be an opening").
+void test_the_maps_opening_comes_from_the_profile(void **) {
+    assert_int_equal(map_config_of(tekbot_with("[map]\ncell_m = 0.1\n")).opening_mm, 0);
+    assert_int_equal(map_config_of(tekbot_with("[map]\ncell_m = 0.1\nopening_m = 0.27\n")).opening_mm, 270);
+    assert_true(refusal(tekbot_with("[map]\ncell_m = 0.1\nopening_m = -1\n")).find("opening_m") != std::string::npos);
 }
 
 }  // namespace
@@ -361,6 +371,7 @@ int main() {
         cmocka_unit_test(test_name_plus_map_switches_on_the_profiles_own_map),
         cmocka_unit_test(test_the_map_is_told_the_profiles_sensor_noise),
         cmocka_unit_test(test_the_maps_arc_is_an_angle_from_the_profile),
+        cmocka_unit_test(test_the_maps_opening_comes_from_the_profile),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

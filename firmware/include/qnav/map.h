@@ -83,6 +83,14 @@ typedef struct {
                               far arcs closed is seen as it is before it is marked again
                               (docs/architecture.md, "Marking near after a forget"). 0: no
                               limit; default 0 */
+    uint16_t opening_mm;   /* a reading farther than both its neighbouring sectors' (a range
+                              peak) marks no arc where its wedge spans more than twice this
+                              across: it may be an opening whose two sides the wedge's edges
+                              read, and an arc at its centre line would shut a passage the
+                              robot fits through (a wide wedge in an aisle reads the side
+                              walls ahead); it still clears the cells short of it, mm. 0:
+                              every reading marks; default 0 (docs/architecture.md, "A
+                              reading that may be an opening") */
 } qnav_map_config_t;
 
 /* The robot's pose in the destination's frame. */
@@ -99,6 +107,8 @@ typedef struct {
     qnav_mm_t max_range_mm;
     qnav_mm_t offset_mm;      /* sensor offset: a reading r lies r + offset from the centre */
     uint16_t inflate_mm;      /* body radius + safety distance */
+    uint16_t peak_mm;         /* a range peak this far or farther marks no arc (cfg.opening_mm
+                                 over the half-wedge's sine); 0: none is left out */
     int32_t x0_mm, y0_mm;     /* the world corner of cell (0, 0) */
     uint16_t nx, ny;
     /* the full layout (cfg.compact 0), in the caller's memory; NULL in the compact one */
