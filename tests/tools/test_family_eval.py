@@ -137,6 +137,38 @@ class FamilyEval(unittest.TestCase):
                                      env=dict(os.environ, TMPDIR=tmp))
         self.assertGreater(touches, 0)
 
+    def test_lateness_accounts_for_every_missed_episode(self):
+        # the seeds of the listing test: the TekBot without a map misses the limit in these
+        # rooms, some episodes late and some not at all
+        r = tool("--worlds", "2", "--episodes", "2", "-j", "2", "--families", "rooms,corridor",
+                 "--seed-base", "5000007", "--robot", "tekbot-map", "--lateness")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        lines = r.stdout.splitlines()
+        rows = {m.group(1): m for m in map(ROW.match, lines[2:4]) if m}
+        self.assertEqual(sorted(rows), ["corridor", "rooms"], r.stdout)
+        self.assertTrue(lines[4].startswith("episodes that missed the limit"), r.stdout)
+        late = {}
+        for l in lines[6:8]:
+            m = re.match(r"^(\w+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\S+) \|\s+(\S+)"
+                         r"\s+(\S+) \|\s+(\S+)$", l)
+            self.assertTrue(m, l)
+            late[m.group(1)] = m
+        for f, row in rows.items():
+            m = late[f]
+            n, k1, k2 = 4, round(4 * float(row.group(2)) / 100), round(4 * float(row.group(5)) / 100)
+            missed, bins, never = int(m.group(2)), [int(m.group(k)) for k in range(3, 7)], int(m.group(7))
+            self.assertEqual(missed, n - k1, r.stdout)
+            self.assertEqual(sum(bins), k2 - k1, r.stdout)
+            self.assertEqual(never, n - k2, r.stdout)
+            for k in (8, 9):  # length over the straight line: at least 1, "-" with no episode
+                self.assertTrue(m.group(k) == "-" or float(m.group(k)) >= 1.0, l)
+            for k in (10, 11):  # a speed within the TekBot's 0.5 m/s
+                self.assertTrue(m.group(k) == "-" or 0.0 <= float(m.group(k)) <= 0.5, l)
+        self.assertGreater(int(late["rooms"].group(2)), 0, r.stdout)
+        two = tool("--worlds", "1", "--lateness", "--policy", "a.policy", "--policy", "b.policy")
+        self.assertNotEqual(two.returncode, 0)
+        self.assertIn("give --policy once", two.stderr)
+
     def test_set_drives_an_edited_copy_of_the_profile(self):
         # map.on=false is the robot tekbot-map names: the same episodes; a key the profile
         # lacks is added to its section; data/robots is not touched
