@@ -12,6 +12,7 @@
 #include "clearance.h"
 #include "escape.h"
 #include "qnav/ctrl.h"
+#include "test_rng.h"
 
 #define N 16
 #define MAX_MM 2500
@@ -462,6 +463,60 @@ static int16_t follow_bearing(uint8_t wedge_pct, int16_t *clear, uint8_t *shaved
     return (int16_t)(goal >= QNAV_PATHS / 2u ? (int16_t)goal - (int16_t)QNAV_PATHS : (int16_t)goal);
 }
 
+/* The follow's bearing from hand-made levels lvl in follow state e (side s), the
+ * destination on that side. */
+static uint16_t skirt_of(const bot_t *b, const qnav_escape_t *e, int8_t s, const uint8_t *lvl)
+{
+    qnav_ctrl_input_t in = b->in;
+    qnav_escape_t m = *e;
+    m.side = s;
+    in.escape = m;
+    in.goal_bearing_cdeg = (qnav_cdeg_t)(-9000 * s);
+    return qnav_escape_goal(&b->c.clr, lvl, &in, &m);
+}
+
+/* The follow skirts from the first path, walking its side's half outward from straight
+ * ahead, that has the half's lowest level: where several share it, the later ones do not
+ * matter. On random levels (few values, so that lowest levels repeat, often within
+ * sixteen paths) raising every later path of the lowest level by one leaves the bearing as
+ * it was, on either side; a walk that took another of them (the x86 windows' last hit
+ * instead of their first) turns from there and does not. */
+static void test_the_follow_skirts_from_the_first_nearest_path(void **state)
+{
+    static const uint8_t values[] = {4, 9, 14, 31};
+    bot_t b;
+    uint8_t lvl[QNAV_PATHS], raised[QNAV_PATHS];
+    unsigned t, moved = 0;
+    (void)state;
+    following_a_wall(&b);
+    for (t = 0; t < 4000; ++t) {
+        const int8_t s = (t & 1u) ? 1 : -1;
+        uint8_t lw = 255u;
+        int16_t k, first = -1;
+        for (k = 0; k < (int16_t)QNAV_PATHS; ++k) {
+            lvl[k] = values[rng_range(0, 3)];
+        }
+        for (k = 1; k < (int16_t)QNAV_DTHETA_MAX; ++k) { /* the half, walked outward */
+            uint16_t p = (uint16_t)(s < 0 ? k : (int16_t)QNAV_PATHS - k);
+            if (lvl[p] < lw) {
+                lw = lvl[p];
+                first = (int16_t)p;
+            }
+        }
+        memcpy(raised, lvl, sizeof raised);
+        for (k = 1; k < (int16_t)QNAV_DTHETA_MAX; ++k) {
+            uint16_t p = (uint16_t)(s < 0 ? k : (int16_t)QNAV_PATHS - k);
+            if (lvl[p] == lw && (int16_t)p != first) {
+                raised[p] = (uint8_t)(lw + 1u);
+                ++moved;
+            }
+        }
+        assert_int_equal(skirt_of(&b, &b.out.escape, s, lvl),
+                         skirt_of(&b, &b.out.escape, s, raised));
+    }
+    assert_true(moved > 4000u); /* the lowest level repeated in most cases */
+}
+
 /* A reading placed on the central part of its wedge (wedge_pct) may lie anywhere in the
  * edge the placement left free, and a follow drives tangent to what it sees: its bearing
  * keeps half that edge beyond the first path that clears the follow level (the Pioneer's
@@ -680,6 +735,7 @@ int main(void)
         cmocka_unit_test(test_the_open_hand_is_read_alike_at_32_sectors),
         cmocka_unit_test(test_the_follow_bearing_comes_from_the_boundary),
         cmocka_unit_test(test_a_follow_keeps_half_the_shaved_edge_away),
+        cmocka_unit_test(test_the_follow_skirts_from_the_first_nearest_path),
         cmocka_unit_test(test_round_an_island_leaves_at_its_nearest_place),
         cmocka_unit_test(test_a_new_obstacle_chooses_its_side_afresh),
         cmocka_unit_test(test_a_policy_of_zeros_does_not_freeze),
