@@ -91,21 +91,18 @@ static uint8_t nearest_on_side(const uint8_t *lvl, int8_t s, int16_t *at)
         return lw; /* as the byte walk: *at left as it was */
     }
     m = _mm_set1_epi8((char)lw);
-    if (s < 0) { /* upward: the lowest path that has it */
-        for (q = lo;; q = q + 16 < last ? q + 16 : last) {
-            unsigned hit = (unsigned)_mm_movemask_epi8(
-                _mm_cmpeq_epi8(_mm_loadu_si128((const __m128i *)(const void *)q), m));
-            if (hit != 0u) {
-                *at = (int16_t)((q - lvl) + __builtin_ctz(hit));
-                return lw;
-            }
-        }
-    }
-    for (q = last;; q = q - 16 > lo ? q - 16 : lo) { /* downward from 359: the highest */
-        unsigned hit = (unsigned)_mm_movemask_epi8(
+    /* upward (s < 0) the lowest path that has it, downward from 359 the highest; the
+     * windows cover the half, so one of them holds it */
+    for (q = s < 0 ? lo : last;; q = s < 0 ? (q + 16 < last ? q + 16 : last)
+                                          : (q - 16 > lo ? q - 16 : lo)) {
+        const unsigned hit = (unsigned)_mm_movemask_epi8(
             _mm_cmpeq_epi8(_mm_loadu_si128((const __m128i *)(const void *)q), m));
         if (hit != 0u) {
-            *at = (int16_t)((q - lvl) + (31 - __builtin_clz(hit)) - (int16_t)QNAV_PATHS);
+            *at = s < 0 ? (int16_t)((q - lvl) + __builtin_ctz(hit))
+                        : (int16_t)((q - lvl) + (31 - __builtin_clz(hit)) - (int16_t)QNAV_PATHS);
+            return lw;
+        }
+        if (q == (s < 0 ? last : lo)) {
             return lw;
         }
     }
