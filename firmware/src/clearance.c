@@ -329,10 +329,14 @@ static const uint8_t keep_mask[48] = {
     0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF,
 };
 
+static inline __m128i load16(const uint8_t *q)
+{
+    return _mm_loadu_si128((const __m128i *)(const void *)q);
+}
+
 static inline void lower16(uint8_t *q, __m128i bound)
 {
-    __m128i *w = (__m128i *)(void *)q;
-    _mm_storeu_si128(w, _mm_min_epu8(_mm_loadu_si128(w), bound));
+    _mm_storeu_si128((__m128i *)(void *)q, _mm_min_epu8(load16(q), bound));
 }
 
 static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
@@ -348,9 +352,7 @@ static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
     } else if (k != 0u) {
         uint16_t at = p + 16u <= QNAV_PATHS ? p : (uint16_t)(QNAV_PATHS - 16u);
         uint16_t s = (uint16_t)(p - at); /* the run is bytes s..s+k-1 of the window */
-        __m128i outside = _mm_or_si128(
-            _mm_loadu_si128((const __m128i *)(const void *)(keep_mask + 16u - s)),
-            _mm_loadu_si128((const __m128i *)(const void *)(keep_mask + 32u - s - k)));
+        __m128i outside = _mm_or_si128(load16(keep_mask + 16u - s), load16(keep_mask + 32u - s - k));
         lower16(lvl + at, _mm_max_epu8(bound, outside));
     }
 }
