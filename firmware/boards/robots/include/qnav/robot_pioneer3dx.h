@@ -53,7 +53,7 @@
  * (qnav_board_place_maps), a qnav_map_config_t. */
 #define QNAV_ROBOT_PIONEER3DX_MAP_CONFIG \
     { \
-        .cell_mm = 500, .reach_mm = 3000, .look_mm = 1000, .jump_mm = 1000, \
+        .cell_mm = 500, .reach_mm = 3000, .look_mm = 1500, .jump_mm = 1000, \
         .plan_ticks = 10, .noise_pct = 1, .near_cost = 0, .near_mm = 200, \
         .arc_cdeg = 2250, .sight = 1, .escape_grow = 1, .refuse_ticks = 20, \
         .refuse_life_ticks = 200, .compact = 1, .grow_steps = 16, \
