@@ -8,9 +8,6 @@
 #include "ctrl_internal.h"
 
 #include <string.h>
-#if !defined(__AVR__) && defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include "qnav/flash.h"
 
@@ -316,7 +313,7 @@ static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
                          : "memory");
     }
 }
-#elif defined(__SSE2__)
+#elif defined(QNAV_LEVELS_SSE2)
 /* Sixteen levels an instruction (x86-64 hosts: the simulator and evolution). Lowering a
  * byte twice leaves it as lowering it once, so a run of 16 or more ends with a window
  * that overlaps the one before it, and a shorter run is one window with the bytes outside
@@ -329,14 +326,9 @@ static const uint8_t keep_mask[48] = {
     0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF,
 };
 
-static inline __m128i load16(const uint8_t *q)
-{
-    return _mm_loadu_si128((const __m128i *)(const void *)q);
-}
-
 static inline void lower16(uint8_t *q, __m128i bound)
 {
-    _mm_storeu_si128((__m128i *)(void *)q, _mm_min_epu8(load16(q), bound));
+    _mm_storeu_si128((__m128i *)(void *)q, _mm_min_epu8(qnav_levels16(q), bound));
 }
 
 static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
@@ -352,7 +344,8 @@ static void lower(uint8_t *lvl, uint16_t p, uint16_t k, uint8_t level)
     } else if (k != 0u) {
         uint16_t at = p + 16u <= QNAV_PATHS ? p : (uint16_t)(QNAV_PATHS - 16u);
         uint16_t s = (uint16_t)(p - at); /* the run is bytes s..s+k-1 of the window */
-        __m128i outside = _mm_or_si128(load16(keep_mask + 16u - s), load16(keep_mask + 32u - s - k));
+        __m128i outside = _mm_or_si128(qnav_levels16(keep_mask + 16u - s),
+                                       qnav_levels16(keep_mask + 32u - s - k));
         lower16(lvl + at, _mm_max_epu8(bound, outside));
     }
 }

@@ -15,6 +15,19 @@
 
 #include "qnav/ctrl.h"
 
+/* On x86 hosts (SSE2) the level walks take 16 path levels at a time (clearance.c's
+ * painting, escape.c's nearest reading); the other targets keep their byte loops. */
+#if !defined(__AVR__) && defined(__SSE2__)
+#define QNAV_LEVELS_SSE2 1
+#include <emmintrin.h>
+
+/* The 16 path levels from q on, any alignment. */
+static inline __m128i qnav_levels16(const uint8_t *q)
+{
+    return _mm_loadu_si128((const __m128i *)(const void *)q);
+}
+#endif
+
 /* Check cfg's sensor fields and derive everything in c (init time; integer only).
  * Returns QNAV_OK, QNAV_E_SECTORS or QNAV_E_RANGE (c is then unusable). */
 QNAV_CHECK_RESULT qnav_status_t qnav_clearance_setup(qnav_clearance_t *c,

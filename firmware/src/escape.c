@@ -6,9 +6,6 @@
 #include "escape.h"
 
 #include <stddef.h>
-#if !defined(__AVR__) && defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include "clearance.h"
 #include "ctrl_internal.h"
@@ -67,25 +64,20 @@ static uint8_t blocked(const qnav_clearance_t *c, const uint8_t *lvl, int16_t p)
 /* The lowest level on side s's boundary half (from straight ahead round to straight
  * behind, ends excluded), and in *at the first path that has it (left as it was when the
  * half is all at 255). */
-#if !defined(__AVR__) && defined(__SSE2__)
+#if defined(QNAV_LEVELS_SSE2)
 /* On x86 hosts sixteen levels at a time: the half's lowest level by windows (the last
  * overlapping the one before it; a minimum does not mind a byte seen twice), then the
  * windows in the walk's order until one holds it, its first byte that does in that order.
  * The same level and path as the byte walk below (test_escape, the shared vectors). */
-static inline __m128i load16(const uint8_t *q)
-{
-    return _mm_loadu_si128((const __m128i *)(const void *)q);
-}
-
 static uint8_t nearest_on_side(const uint8_t *lvl, int8_t s, int16_t *at)
 {
     const uint8_t *lo = s < 0 ? lvl + 1 : lvl + QNAV_PATHS - (QNAV_DTHETA_MAX - 1u);
     const uint8_t *last = lo + (QNAV_DTHETA_MAX - 1u) - 16u; /* the last window */
     const uint8_t *q;
-    __m128i m = load16(last);
+    __m128i m = qnav_levels16(last);
     uint8_t lw;
     for (q = lo; q < last; q += 16) {
-        m = _mm_min_epu8(m, load16(q));
+        m = _mm_min_epu8(m, qnav_levels16(q));
     }
     m = _mm_min_epu8(m, _mm_srli_si128(m, 8));
     m = _mm_min_epu8(m, _mm_srli_si128(m, 4));
@@ -100,7 +92,7 @@ static uint8_t nearest_on_side(const uint8_t *lvl, int8_t s, int16_t *at)
      * windows cover the half, so one of them holds it */
     for (q = s < 0 ? lo : last;; q = s < 0 ? (q + 16 < last ? q + 16 : last)
                                           : (q - 16 > lo ? q - 16 : lo)) {
-        const unsigned hit = (unsigned)_mm_movemask_epi8(_mm_cmpeq_epi8(load16(q), m));
+        const unsigned hit = (unsigned)_mm_movemask_epi8(_mm_cmpeq_epi8(qnav_levels16(q), m));
         if (hit != 0u) {
             *at = s < 0 ? (int16_t)((q - lvl) + __builtin_ctz(hit))
                         : (int16_t)((q - lvl) + (31 - __builtin_clz(hit)) - (int16_t)QNAV_PATHS);
