@@ -151,12 +151,14 @@ std::string worlds_json(const HeldOut &H)
           << ", \"validation_clean\": " << json_num(r.validation_clean)
           << ", \"validation_arrival\": " << json_num(r.validation_arrival)
           << ", \"validation_R\": " << json_num(r.validation_R)
+          << ", \"validation_tau_c\": " << json_num(r.validation_tau_c)
           << ", \"validation_episodes\": " << r.validation_episodes;
         if (r.has_other) {
             o << ", \"other\": {\"condition\": " << json_str(r.other_condition) << ", \"run\": " << r.other_run
               << ", \"validation_clean\": " << json_num(r.other_clean)
               << ", \"validation_arrival\": " << json_num(r.other_arrival)
-              << ", \"validation_R\": " << json_num(r.other_R) << "}";
+              << ", \"validation_R\": " << json_num(r.other_R)
+              << ", \"validation_tau_c\": " << json_num(r.other_tau_c) << "}";
         }
         o << ", \"test\": [";
         for (std::size_t j = 0; j < r.test.size(); ++j) {
@@ -346,14 +348,16 @@ std::string worlds_md(const ExperimentSpec &spec, const HeldOut &H)
           << ": of every run's best policy of every evolved condition and the robot's probabilistic policy, the "
              "one that arrived without touching anything in the most of the "
           << r.validation_episodes << " validation episodes (worlds seeded from " << kValidationSeedBase
-          << ", disjoint from training and test; never training scores; ties by arrival, then R): "
+          << ", disjoint from training and test; never training scores; ties by arrival, then by fewer "
+             "recovery ticks; the probabilistic policy kept unless an evolved run is ahead by these, and "
+             "evolved runs level by them ranked by R): "
           << fmt(100.0 * r.validation_clean, 1) << "% (arrival " << fmt(100.0 * r.validation_arrival, 1)
-          << "%), R " << fmt(r.validation_R);
+          << "%, recovery ticks " << fmt(r.validation_tau_c) << " an episode), R " << fmt(r.validation_R);
         if (r.has_other) {
             o << " (" << (r.other_run == 0 ? "the " + r.other_condition + " policy"
                                            : "the best evolved, " + r.other_condition + " run " + std::to_string(r.other_run))
               << ": " << fmt(100.0 * r.other_clean, 1) << "% (arrival " << fmt(100.0 * r.other_arrival, 1)
-              << "%), R " << fmt(r.other_R) << ")";
+              << "%, recovery ticks " << fmt(r.other_tau_c) << " an episode), R " << fmt(r.other_R) << ")";
         }
         o << ". Its test figures (95% CI over its episodes):\n\n"
           << "| world | arrival (95% CI) | recovery ticks per episode (95% CI) | R (95% CI) |\n|---|---|---|---|\n";

@@ -78,6 +78,7 @@ struct Recommendation {
     double validation_clean = 0;     /* fraction that arrived without touching anything */
     double validation_arrival = 0;   /* fraction */
     double validation_R = 0;
+    double validation_tau_c = 0;     /* recovery ticks an episode */
     uint32_t validation_episodes = 0;
     std::vector<WorldCell> test;     /* per held-out world */
     /* The candidate not recommended, on the same validation episodes: the probabilistic
@@ -88,6 +89,7 @@ struct Recommendation {
     double other_clean = 0;
     double other_arrival = 0;
     double other_R = 0;
+    double other_tau_c = 0;
     bool reference() const { return run == 0; }
 };
 Recommendation recommend(const ExperimentSummary &S, const std::vector<HeldOutWorld> &worlds,
