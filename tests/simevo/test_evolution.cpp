@@ -848,12 +848,55 @@ static void test_recommended_policy_is_chosen_on_validation_not_training(void **
     assert_true(std::fabs(r.test[0].arrival.mean - 0.9) < 1e-12); // the reference's test row
     assert_string_equal(r.other_condition.c_str(), "direct");
     assert_int_equal(r.other_run, 2);
-    S.conditions[1].tau_c_per_run.assign(10, 0.0);
+    // and the runner view: the same two networks, training vs validation worlds disagree
+    ExperimentSpec s = parse_experiment(kDistSpec, "x.toml");
+    qnav_policy_t a{}, b{};
+    a.kind = b.kind = QNAV_POLICY_NET;
+    a.u.net.hidden = b.u.net.hidden = 2;
+    a.u.net.inputs = b.u.net.inputs = QNAV_NET_INPUTS_PAPER;
+    *qnav_net_weight(&a.u.net, 0) = 256;
+    *qnav_net_weight(&b.u.net, 0) = -256;
+    auto make = [](const Scenario &sc, uint64_t) -> std::unique_ptr<EpisodeRunner> {
+        return std::make_unique<WorldBiasedRunner>(sc);
+    };
+    s.target.distribution = std::make_shared<Distribution>(*s.sources[0].scenario.distribution);
+    DistributionRunner train(s.target, 1, make);
+    DistributionRunner val(validation_scenario(s.target), 1, make);
+    assert_true(train.run(a, 5).R > train.run(b, 5).R);
+    assert_true(val.run(a, 5).R < val.run(b, 5).R);
+}
+
+/* A tie on validation keeps the hand-tuned policy; recovery ticks count before R. */
+static void test_a_tie_on_validation_keeps_the_probabilistic_policy(void **state)
+{
+    (void)state;
+    ExperimentSummary S;
+    ConditionSummary c;
+    c.kind = ConditionKind::Direct;
+    c.label = "direct";
+    c.final_per_run = {0.5, 1.0};
+    c.arrival_per_run = {0.1, 0.9};
+    c.clean_per_run = {0.1, 0.9};
+    c.tau_c_per_run = {0.0, 0.0};
+    S.conditions.push_back(c);
+    ConditionSummary p;
+    p.kind = ConditionKind::Probabilistic;
+    p.label = "probabilistic";
+    p.arrival_per_run = {1.0, 1.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, 1.0}; // 90 %, as run 2
+    p.clean_per_run = p.arrival_per_run;
+    p.tau_c_per_run.assign(10, 0.0);
+    p.final_per_run.assign(10, 0.5);
+    S.conditions.push_back(p);
+    HeldOutWorld w;
+    w.label = "clutter";
+    w.family = true;
+    const std::vector<WorldRow> rows = {{"direct", 2, "clutter", 10, 5.0, 0.5, 7, 0, 0.0},
+                                        {"probabilistic", 0, "clutter", 10, 4.0, 0.5, 9, 0, 0.0}};
     // level in arrival and touches, the evolved run faster (R 1 > 0.5): no evidence it is
     // better, so the hand-tuned policy stays (the Pioneer's quick preset recommended such a
     // run, which touched 3.4 times as often held out: docs/simevo.md)
-    S.conditions[1].final_per_run.assign(10, 0.5);
-    r = recommend(S, {w}, rows, 40);
+    Recommendation r = recommend(S, {w}, rows, 40);
+    assert_true(r.valid);
     assert_true(r.reference());
     assert_int_equal(r.other_run, 2);
     // level in arrival, the reference with more recovery ticks (touches where it did not
@@ -878,22 +921,6 @@ static void test_recommended_policy_is_chosen_on_validation_not_training(void **
     r = recommend(S, {w}, rows, 40);
     assert_false(r.reference());
     assert_int_equal(r.run, 1);
-    // and the runner view: the same two networks, training vs validation worlds disagree
-    ExperimentSpec s = parse_experiment(kDistSpec, "x.toml");
-    qnav_policy_t a{}, b{};
-    a.kind = b.kind = QNAV_POLICY_NET;
-    a.u.net.hidden = b.u.net.hidden = 2;
-    a.u.net.inputs = b.u.net.inputs = QNAV_NET_INPUTS_PAPER;
-    *qnav_net_weight(&a.u.net, 0) = 256;
-    *qnav_net_weight(&b.u.net, 0) = -256;
-    auto make = [](const Scenario &sc, uint64_t) -> std::unique_ptr<EpisodeRunner> {
-        return std::make_unique<WorldBiasedRunner>(sc);
-    };
-    s.target.distribution = std::make_shared<Distribution>(*s.sources[0].scenario.distribution);
-    DistributionRunner train(s.target, 1, make);
-    DistributionRunner val(validation_scenario(s.target), 1, make);
-    assert_true(train.run(a, 5).R > train.run(b, 5).R);
-    assert_true(val.run(a, 5).R < val.run(b, 5).R);
 }
 
 int main(void)
@@ -928,6 +955,7 @@ int main(void)
         cmocka_unit_test(test_world_draws_are_deterministic_weighted_and_inside_their_ranges),
         cmocka_unit_test(test_no_training_world_is_ever_in_a_held_out_set),
         cmocka_unit_test(test_recommended_policy_is_chosen_on_validation_not_training),
+        cmocka_unit_test(test_a_tie_on_validation_keeps_the_probabilistic_policy),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
