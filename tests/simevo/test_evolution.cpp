@@ -789,31 +789,41 @@ private:
     bool held_out_ = false;
 };
 
+/* A condition's validation figures: R and arrival per run (a reference's: per episode),
+ * every arrival without touching anything, no recovery ticks. */
+static ConditionSummary validated(ConditionKind kind, const char *label, std::vector<double> R,
+                                  std::vector<double> arrival)
+{
+    ConditionSummary c;
+    c.kind = kind;
+    c.label = label;
+    c.final_per_run = std::move(R);
+    c.clean_per_run = arrival;
+    c.tau_c_per_run.assign(arrival.size(), 0.0);
+    c.arrival_per_run = std::move(arrival);
+    return c;
+}
+
+static HeldOutWorld clutter_family()
+{
+    HeldOutWorld w;
+    w.label = "clutter";
+    w.family = true;
+    return w;
+}
+
 static void test_recommended_policy_is_chosen_on_validation_not_training(void **state)
 {
     (void)state;
     // two runs' best policies: run 1 wins on training (its R there), run 2 on validation
     ExperimentSummary S;
-    ConditionSummary c;
-    c.kind = ConditionKind::Direct;
-    c.label = "direct";
-    c.online_per_run = {5.0, -5.0};        // training: run 1 far ahead
-    c.final_per_run = {-1.0, 1.0};         // validation R
-    c.arrival_per_run = {0.1, 0.9};        // validation arrival
-    c.clean_per_run = {0.1, 0.9};          // ... without touching anything
-    c.tau_c_per_run = {0.0, 0.0};          // recovery ticks an episode
+    ConditionSummary c = validated(ConditionKind::Direct, "direct", {-1.0, 1.0}, {0.1, 0.9});
+    c.online_per_run = {5.0, -5.0}; // training: run 1 far ahead
     S.conditions.push_back(c);
-    ConditionSummary p;
-    p.kind = ConditionKind::Probabilistic;
-    p.label = "probabilistic";
-    p.final_per_run = {9.0, -1.0, 1.0, 3.0, -2.0};  // a reference's are its episodes'
-    p.arrival_per_run = {1.0, 0.0, 1.0, 1.0, 0.0};  // 60 %: behind run 2's 90 %
-    p.clean_per_run = p.arrival_per_run;
-    p.tau_c_per_run = {0.0, 0.0, 0.0, 0.0, 0.0};
-    S.conditions.push_back(p);
-    HeldOutWorld w;
-    w.label = "clutter";
-    w.family = true;
+    // a reference's figures are its episodes': 60 %, behind run 2's 90 %
+    S.conditions.push_back(validated(ConditionKind::Probabilistic, "probabilistic", {9.0, -1.0, 1.0, 3.0, -2.0},
+                                     {1.0, 0.0, 1.0, 1.0, 0.0}));
+    const HeldOutWorld w = clutter_family();
     std::vector<WorldRow> rows = {{"direct", 1, "clutter", 10, 2.0, 0.5, 3, 0, 0.0},
                                   {"direct", 2, "clutter", 10, 5.0, 0.5, 7, 4, 0.2},
                                   {"probabilistic", 0, "clutter", 10, 4.0, 0.5, 9, 0, 0.0}};
@@ -871,25 +881,11 @@ static void test_a_tie_on_validation_keeps_the_probabilistic_policy(void **state
 {
     (void)state;
     ExperimentSummary S;
-    ConditionSummary c;
-    c.kind = ConditionKind::Direct;
-    c.label = "direct";
-    c.final_per_run = {0.5, 1.0};
-    c.arrival_per_run = {0.1, 0.9};
-    c.clean_per_run = {0.1, 0.9};
-    c.tau_c_per_run = {0.0, 0.0};
-    S.conditions.push_back(c);
-    ConditionSummary p;
-    p.kind = ConditionKind::Probabilistic;
-    p.label = "probabilistic";
-    p.arrival_per_run = {1.0, 1.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, 1.0}; // 90 %, as run 2
-    p.clean_per_run = p.arrival_per_run;
-    p.tau_c_per_run.assign(10, 0.0);
-    p.final_per_run.assign(10, 0.5);
-    S.conditions.push_back(p);
-    HeldOutWorld w;
-    w.label = "clutter";
-    w.family = true;
+    S.conditions.push_back(validated(ConditionKind::Direct, "direct", {0.5, 1.0}, {0.1, 0.9}));
+    // 90 %, as run 2, at R 0.5
+    S.conditions.push_back(validated(ConditionKind::Probabilistic, "probabilistic", std::vector<double>(10, 0.5),
+                                     {1.0, 1.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, 1.0}));
+    const HeldOutWorld w = clutter_family();
     const std::vector<WorldRow> rows = {{"direct", 2, "clutter", 10, 5.0, 0.5, 7, 0, 0.0},
                                         {"probabilistic", 0, "clutter", 10, 4.0, 0.5, 9, 0, 0.0}};
     // level in arrival and touches, the evolved run faster (R 1 > 0.5): no evidence it is
