@@ -544,8 +544,14 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
     }
     memset(&last, 0, sizeof last);
     last.k = UINT16_MAX;
-    reach = (int32_t)m->cfg.reach_mm;
     three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
+    /* no farther than a reading at the sonar's range clears (as any reading: 3/4 cell and
+     * its noise short of it): that reading clears its wedge out to the reach, and beyond
+     * it would clear cells no reading saw, forgetting walls marked from nearer
+     * (docs/architecture.md, "A reach beyond the sonar") */
+    reach = (int32_t)m->max_range_mm + (int32_t)m->offset_mm;
+    reach -= three_quarters + reach * (int32_t)m->cfg.noise_pct / 100;
+    reach = reach < 0 ? 0 : (reach < (int32_t)m->cfg.reach_mm ? reach : (int32_t)m->cfg.reach_mm);
     reach2 = (uint32_t)reach * (uint32_t)reach;
     mark_reach = marks_within(m);
     band_pct = m->cfg.noise_pct < OCCUPIED_BAND_PCT ? (int32_t)m->cfg.noise_pct : OCCUPIED_BAND_PCT;

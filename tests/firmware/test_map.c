@@ -258,6 +258,37 @@ static void test_a_reading_frees_its_wedge_and_marks_its_arc(void **state)
     assert_true(qnav_map_evidence(&m, 4150, 3050) <= 0);
 }
 
+/* A sonar shorter than the map's reach (1 m against 2 m): a reading at the range says
+ * nothing beyond it, so a wall marked from nearer stays marked when the robot backs off
+ * out of the sonar's sight; cells the sonar does see are still cleared. */
+static void test_a_reach_beyond_the_sonar_keeps_what_it_cannot_see(void **state)
+{
+    qnav_map_t m;
+    qnav_map_config_t mc;
+    qnav_ctrl_config_t cc;
+    qnav_mm_t ranges[N];
+    const qnav_map_pose_t near = {3000, 3000, 0}, back = {2500, 3000, 0};
+    int k;
+    (void)state;
+    qnav_map_config_default(&mc); /* reach 2 000 mm */
+    sensor_config(&cc);
+    cc.max_range_mm = 1000;
+    assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
+                     QNAV_OK);
+    for (k = 0; k < N; ++k) {
+        ranges[k] = 1000;
+    }
+    ranges[0] = 800; /* a wall 920 mm ahead of the centre */
+    qnav_map_observe(&m, ranges, &near);
+    qnav_map_observe(&m, ranges, &near);
+    assert_int_equal(qnav_map_evidence(&m, 3950, 3050), QNAV_MAP_OCCUPIED);
+    ranges[0] = 1000; /* 1.45 m away now: beyond the sonar's 1.12 m */
+    qnav_map_observe(&m, ranges, &back);
+    assert_int_equal(qnav_map_evidence(&m, 3950, 3050), QNAV_MAP_OCCUPIED);
+    assert_true(qnav_map_evidence(&m, 2550, 2150) < 0);  /* 0.85 m: seen clear */
+    assert_int_equal(qnav_map_evidence(&m, 2550, 1550), 0); /* 1.45 m: unknown */
+}
+
 /* The robot drives along y = 1500 facing the wall and observes it, then plans. */
 static void observe_the_wall(qnav_map_t *m)
 {
@@ -1116,6 +1147,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_a_reading_frees_its_wedge_and_marks_its_arc),
+        cmocka_unit_test(test_a_reach_beyond_the_sonar_keeps_what_it_cannot_see),
         cmocka_unit_test(test_arcs_are_marked_in_the_central_part_of_the_wedge),
         cmocka_unit_test(test_a_wide_wedge_marks_only_the_default_arc),
         cmocka_unit_test(test_a_far_range_peak_in_a_wide_wedge_marks_no_arc),

@@ -34,7 +34,9 @@ extern "C" {
 typedef struct {
     uint16_t cell_mm;      /* a cell's side, mm, 20..1000; default 100 */
     uint16_t reach_mm;     /* readings mark cells out to this distance from the robot's
-                              centre, mm, at most 40 000; default 2000 */
+                              centre, mm, at most 40 000; no farther than a reading at the
+                              sonar's range clears (its range and offset less 3/4 cell and
+                              noise_pct): a larger value marks as that; default 2000 */
     uint16_t look_mm;      /* the sub-goal lies this far along the plan, mm; default 1000 */
     uint16_t jump_mm;      /* a plan longer by this than the last tick's clears the escape
                               memory (the way it was following is closed), mm; default 1000 */
