@@ -48,7 +48,8 @@ class Robot:
         self._prob = prob
 
     def probabilistic_policy(self):
-        """The probabilistic policy hand-tuned for this robot (its profile's k_goal, k_safe)."""
+        """The probabilistic policy hand-tuned for this robot: its profile's k_goal, and k_safe
+        (given, or range_max_m / safe_m and at least 4)."""
         return Policy("prob", self._prob.copy())
 
     def __repr__(self):

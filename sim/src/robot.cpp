@@ -65,6 +65,12 @@ static void parse_motion(const TomlReader &r, RobotProfile &p) {
 }
 
 // [sonar], then the optional [noise] and [probabilistic].
+// The least k_safe a profile's safe_m gives: P_safe at the sonar's range at least
+// 1 - e^-4 = 0.98. Below it a short sonar's open paths lose speed (the speed is the
+// quality): a 1.5 m TekBot summed 557.7 at k_safe 2.4, 565.7 at 4 (docs/architecture.md,
+// "The safety scale in metres").
+static constexpr double kOpenPathKSafe = 4.0;
+
 static void parse_sensing(const TomlReader &r, RobotProfile &p) {
     const toml::table &root = r.root();
     const toml::table &sonar = r.table(root, "sonar");
@@ -87,9 +93,23 @@ static void parse_sensing(const TomlReader &r, RobotProfile &p) {
 
     if (root.get("probabilistic")) {
         const toml::table &prob = r.table(root, "probabilistic");
-        r.only_keys(prob, {"k_goal", "k_safe", "keep"});
+        r.only_keys(prob, {"k_goal", "k_safe", "safe_m", "keep"});
         p.prob_k_goal = r.number(prob, "k_goal", 1.0 / 256.0, 64.0);
-        p.prob_k_safe = r.number(prob, "k_safe", 1.0 / 256.0, 64.0);
+        // P_safe's steepness, the paper's k_safe, is per sonar range (P_safe = 1 - e^(-k_safe
+        // ell/(L-1)), ell/(L-1) the reading over range_max_m); safe_m gives it in metres,
+        // k_safe = range_max_m / safe_m, but at least kOpenPathKSafe: a path open as far as
+        // the sonar sees counts as safe. A profile whose range changes keeps its tuning
+        // (docs/architecture.md, "The safety scale in metres").
+        if (prob.get("safe_m")) {
+            if (prob.get("k_safe"))
+                r.fail(*prob.get("k_safe"), "give 'k_safe' or 'safe_m', not both (k_safe = range_max_m / safe_m)");
+            const double safe_m = r.number(prob, "safe_m", p.range_max_m / 64.0, 256.0 * p.range_max_m);
+            p.prob_k_safe = std::max(p.range_max_m / safe_m, kOpenPathKSafe);
+        } else if (prob.get("k_safe")) {
+            p.prob_k_safe = r.number(prob, "k_safe", 1.0 / 256.0, 64.0);
+        } else {
+            r.fail(prob, "missing key 'safe_m' (or the paper's 'k_safe')");
+        }
         if (prob.get("keep")) p.prob_keep = r.number(prob, "keep", 0.0, 1.0);
     }
 }

@@ -127,12 +127,21 @@ static void test_bad_robot_profiles_are_refused(void **state) {
     assert_true(starts_with(msg, "bad.toml:"));
     assert_true(one_line(msg));
     std::string t5 = good;
-    const std::size_t k_safe = t5.find("k_safe = ");  // whatever the profile's value
-    assert_true(k_safe != std::string::npos);
-    t5.replace(k_safe, t5.find_first_of(" \n", k_safe + 9) - k_safe, "k_safe = 0.0");
+    const std::size_t safe = t5.find("\nsafe_m = ") + 1;  // whatever the profile's value
+    assert_true(safe != std::string::npos + 1);
+    t5.replace(safe, t5.find_first_of(" \n", safe + 9) - safe, "safe_m = 0.0");
     assert_int_equal(parse_robot(t5, &msg), QNAV_SIM_E_PARSE);
-    assert_true(msg.find("k_safe") != std::string::npos);
+    assert_true(msg.find("'safe_m' = 0 is outside") != std::string::npos);
     assert_true(one_line(msg));
+    std::string t5b = good;  // the paper's k_safe and the metres both: which one is meant?
+    t5b.insert(t5b.find("\nk_goal = ") + 1, "k_safe = 5.0\n");
+    assert_int_equal(parse_robot(t5b, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("give 'k_safe' or 'safe_m', not both") != std::string::npos);
+    assert_true(one_line(msg));
+    std::string t5c = good;
+    t5c.erase(safe, t5c.find('\n', safe) - safe + 1);
+    assert_int_equal(parse_robot(t5c, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("missing key 'safe_m' (or the paper's 'k_safe')") != std::string::npos);
     // every quantity the board needs is in the profile: none has a silent default
     std::string t6 = good;
     t6.replace(t6.find("tick_ms = 100"), 13, "tick_ms = 50 ");
@@ -203,6 +212,38 @@ static void test_profile_carries_its_tuned_probabilistic_policy(void **state) {
     qnav_policy_prob_default(&d);
     qnav_sim_robot_prob_policy(nullptr, &p);
     assert_int_equal(p.u.prob.k_safe, d.u.prob.k_safe);
+}
+
+/* P_safe's scale is in metres (safe_m): a sonar of twice the range doubles the paper's
+ * k_safe, so a reading 1 m away is as safe as before, and a shorter one keeps k_safe 4 at
+ * least; a profile giving the paper's k_safe keeps it whatever the range
+ * (docs/architecture.md, "The safety scale in metres"). */
+static qnav_q8_8_t profile_k_safe(const std::string &text) {
+    char err[QNAV_SIM_ERRLEN] = "";
+    qnav_sim_robot_t *robot = nullptr;
+    qnav_policy_t p;
+    assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "ks.toml", &robot, err, sizeof err),
+                     QNAV_SIM_OK);
+    qnav_sim_robot_prob_policy(robot, &p);
+    qnav_sim_robot_free(robot);
+    return p.u.prob.k_safe;
+}
+
+static void test_the_safety_scale_follows_the_sonar_range(void **state) {
+    (void)state;
+    std::string t = read_data("robots/tekbot.toml");
+    assert_int_equal(profile_k_safe(t), 1024);  // 2.5 m / 0.625 m = 4
+    std::string shorter = t;
+    t.replace(t.find("range_max_m = 2.5"), 17, "range_max_m = 5.0");
+    assert_int_equal(profile_k_safe(t), 2048);
+    /* a 1.5 m sonar: 2.4 by the metres, but a path open to the range stays safe (k >= 4) */
+    shorter.replace(shorter.find("range_max_m = 2.5"), 17, "range_max_m = 1.5");
+    assert_int_equal(profile_k_safe(shorter), 1024);
+    std::string paper = t;
+    paper.replace(paper.find("\nsafe_m = 0.625") + 1, 14, "k_safe = 4.0");
+    assert_int_equal(profile_k_safe(paper), 1024);
+    std::string p = read_data("robots/pioneer3dx.toml");
+    assert_int_equal(profile_k_safe(p), 1280);  // 5 m / 1 m = 5
 }
 
 static void test_missing_file_is_an_io_error_naming_it(void **state) {
@@ -492,6 +533,7 @@ int main(void) {
         cmocka_unit_test(test_start_zone_inside_an_obstacle_is_refused_with_its_line),
         cmocka_unit_test(test_bad_robot_profiles_are_refused),
         cmocka_unit_test(test_profile_carries_its_tuned_probabilistic_policy),
+        cmocka_unit_test(test_the_safety_scale_follows_the_sonar_range),
         cmocka_unit_test(test_profile_sets_the_speed_at_full_quality),
         cmocka_unit_test(test_missing_file_is_an_io_error_naming_it),
         cmocka_unit_test(test_impossible_parameters_are_refused_by_field),

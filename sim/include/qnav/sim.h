@@ -124,8 +124,9 @@ typedef struct {
 void qnav_sim_robot_info(const qnav_sim_robot_t *robot, qnav_sim_robot_info_t *info);
 
 /* The probabilistic policy hand-tuned for this robot (the paper tunes it "to the robot"):
- * the profile's [probabilistic] k_goal and k_safe rounded to Q8.8, or libqnav's
- * qnav_policy_prob_default() when the profile has none. */
+ * the profile's [probabilistic] k_goal and k_safe (given, or range_max_m / safe_m and at
+ * least 4) rounded to Q8.8, or libqnav's qnav_policy_prob_default() when the profile has
+ * none. */
 void qnav_sim_robot_prob_policy(const qnav_sim_robot_t *robot, qnav_policy_t *policy);
 
 /* What a loaded environment says (read-only view). */
