@@ -64,13 +64,13 @@ static void parse_motion(const TomlReader &r, RobotProfile &p) {
     p.slip_lateral_s = r.number(slip, "lateral_s", 0.0, 1.0);
 }
 
-// [sonar], then the optional [noise] and [probabilistic].
 // The least k_safe a profile's safe_m gives: P_safe at the sonar's range at least
 // 1 - e^-4 = 0.98. Below it a short sonar's open paths lose speed (the speed is the
 // quality): a 1.5 m TekBot summed 557.7 at k_safe 2.4, 565.7 at 4 (docs/architecture.md,
 // "The safety scale in metres").
 static constexpr double kOpenPathKSafe = 4.0;
 
+// [sonar], then the optional [noise] and [probabilistic].
 static void parse_sensing(const TomlReader &r, RobotProfile &p) {
     const toml::table &root = r.root();
     const toml::table &sonar = r.table(root, "sonar");
