@@ -27,7 +27,7 @@ class FamilyEval(unittest.TestCase):
     def test_one_world_per_family(self):
         r = tool("--worlds", "1", "--episodes", "2", "-j", "2")
         self.assertEqual(r.returncode, 0, r.stderr)
-        rows = [ROW.match(l) for l in r.stdout.splitlines()[2:]]
+        rows = [ROW.match(l) for l in r.stdout.splitlines()[2:8]]
         self.assertEqual([m.group(1) for m in rows if m],
                          ["clutter", "gaps", "corridor", "pocket", "rooms", "shelves"], r.stdout)
         for m in rows:
@@ -41,6 +41,16 @@ class FamilyEval(unittest.TestCase):
         # interval padded inside its bracket, "[ 0.0,", used to add one below 10 %)
         counts = {len(l.split()) for l in r.stdout.splitlines()[2:7]}
         self.assertEqual(counts, {10}, r.stdout)
+        # the sum line adds up the rows above it (what docs/results.md quotes)
+        total = re.search(r"^sum over the 6 families: arrival % ([\d.]+) at the limit \(([\d.]+) at "
+                          r"twice it\), worlds with no arrival (\d+)/6, collisions an episode "
+                          r"([\d.]+), recovery ticks an episode ([\d.]+)$", r.stdout, re.M)
+        self.assertTrue(total, r.stdout)
+        ms = [m for m in rows if m]
+        self.assertAlmostEqual(float(total.group(1)), sum(float(m.group(2)) for m in ms), delta=0.31)
+        self.assertAlmostEqual(float(total.group(2)), sum(float(m.group(5)) for m in ms), delta=0.31)
+        self.assertEqual(int(total.group(3)), sum(int(m.group(8)) for m in ms))
+        self.assertAlmostEqual(float(total.group(4)), sum(float(m.group(10)) for m in ms), delta=0.004)
 
     def test_an_interval_is_two_fields_at_any_value(self):
         sys.path.insert(0, os.environ["QNAV_TOOLS_DIR"])
@@ -146,9 +156,10 @@ class FamilyEval(unittest.TestCase):
         lines = r.stdout.splitlines()
         rows = {m.group(1): m for m in map(ROW.match, lines[2:4]) if m}
         self.assertEqual(sorted(rows), ["corridor", "rooms"], r.stdout)
-        self.assertTrue(lines[4].startswith("episodes that missed the limit"), r.stdout)
+        self.assertTrue(lines[4].startswith("sum over the 2 families:"), r.stdout)
+        self.assertTrue(lines[5].startswith("episodes that missed the limit"), r.stdout)
         late = {}
-        for l in lines[6:8]:
+        for l in lines[7:9]:
             m = re.match(r"^(\w+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\S+) \|\s+(\S+)"
                          r"\s+(\S+) \|\s+(\S+)$", l)
             self.assertTrue(m, l)
