@@ -61,6 +61,7 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->sight = 1u;
     cfg->escape_grow = 1u;
     cfg->near_cost = 10u;
+    cfg->unknown_cost = 0u;
     cfg->refuse_ticks = 30u;
     cfg->refuse_life_ticks = 200u;
     cfg->compact = 0u;
@@ -200,10 +201,12 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
         ctrl->n_sectors == 0u || ctrl->n_sectors > QNAV_MAX_SECTORS || ctrl->max_range_mm == 0u) {
         return QNAV_E_MAP;
     }
-    /* the compact layout blocks occupied cells only, and has no bits for near costs (nor
-     * for refusals: it marks refused cells occupied, refuse_compact) */
+    /* a step costs at most STEP_DIAG + 255 (the queue's buckets); the compact layout blocks
+     * occupied cells only, and has no bits for near or unknown costs (nor for refusals: it
+     * marks refused cells occupied, refuse_compact) */
     if (cfg->compact > 1u ||
-        (cfg->compact && (cfg->near_cost != 0u ||
+        (uint32_t)cfg->near_cost + cfg->unknown_cost > 255u ||
+        (cfg->compact && (cfg->near_cost != 0u || cfg->unknown_cost != 0u ||
                           (uint32_t)ctrl->body_radius_mm + ctrl->safety_mm >= cfg->cell_mm ||
                           (width_mm + cfg->cell_mm - 1u) / cfg->cell_mm >
                               8u * QNAV_CMAP_ROW_BYTES_MAX))) {
@@ -710,7 +713,7 @@ static void plan_start(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
     /* every cost QNAV_MAP_UNREACHED, every cell NOT_QUEUED: both all ones */
     memset(m->cost, 0xFF, (size_t)n * sizeof m->cost[0]);
     memset(m->prev, 0xFF, (size_t)n * sizeof m->prev[0]);
-    m->q_count = (uint16_t)(STEP_DIAG + m->cfg.near_cost + 1u);
+    m->q_count = (uint16_t)(STEP_DIAG + m->cfg.near_cost + m->cfg.unknown_cost + 1u);
     for (c = 0; c < m->q_count; ++c) {
         m->q_head[c] = QUEUE_END;
     }
@@ -728,15 +731,17 @@ static int settled(const qnav_map_t *m, uint32_t c)
     return m->cost[c] != QNAV_MAP_UNREACHED && m->prev[c] == NOT_QUEUED;
 }
 
-/* Lower cell 'to''s cost to 'here' + step (+ near_cost beside a wall) when that is less,
- * and queue it; a blocked cell is never entered. */
+/* Lower cell 'to''s cost to 'here' + step (+ near_cost beside a wall, + unknown_cost when
+ * no reading has marked it) when that is less, and queue it; a blocked cell is never
+ * entered. */
 static inline void relax(qnav_map_t *m, uint32_t here, uint32_t to, uint32_t step)
 {
     uint32_t nc;
     if (m->blocked[to] == BLOCKED) {
         return;
     }
-    nc = here + step + (m->blocked[to] == NEAR ? m->cfg.near_cost : 0u);
+    nc = here + step + (m->blocked[to] == NEAR ? m->cfg.near_cost : 0u) +
+         (m->evidence[to] == 0 ? m->cfg.unknown_cost : 0u);
     if (nc >= m->cost[to]) {
         return;
     }

@@ -159,7 +159,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         const toml::table &mp = r.table(root, "map");
         r.only_keys(mp, {"on", "cell_m", "reach_m", "look_m", "plan_s", "near_m", "near_cost", "arc_deg", "sight",
                          "escape_grow", "refuse_s", "refuse_life_s", "pass_m", "compact", "grow_steps", "bytes",
-                         "noise", "forget_reach_m", "opening_m"});
+                         "noise", "forget_reach_m", "opening_m", "unknown_cost"});
         bool on = true;
         if (const toml::node *o = mp.get("on")) {
             if (!o->is_boolean()) r.fail(*o, "'on' must be true or false");
@@ -175,6 +175,9 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         p.map_plan_s = r.number(mp, "plan_s", 0.1, 25.5, true, p.map_plan_s);
         p.map_near_m = r.number(mp, "near_m", 0.0, 65.0, true, p.map_near_m);
         p.map_near_cost = r.number(mp, "near_cost", 0.0, 25.5, true, p.map_near_cost);
+        p.map_unknown_cost = r.number(mp, "unknown_cost", 0.0, 25.5, true, p.map_unknown_cost);
+        if (p.map_near_cost + p.map_unknown_cost > 25.5)
+            r.fail(*mp.get("unknown_cost"), "'near_cost' + 'unknown_cost' must be at most 25.5 cell sides");
         p.map_arc_deg = r.number(mp, "arc_deg", 0.0, 360.0, true, p.map_arc_deg);
         p.map_forget_reach_m = r.number(mp, "forget_reach_m", 0.0, 65.0, true, p.map_forget_reach_m);
         p.map_opening_m = r.number(mp, "opening_m", 0.0, 65.0, true, p.map_opening_m);
@@ -195,6 +198,8 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
             if (const toml::node *n = mp.get("near_cost"); n && n->value_or(0.0) != 0.0)
                 r.fail(*n, "'near_cost' must be 0 in a compact map (it has no bits for it)");
             p.map_near_cost = 0.0;
+            if (const toml::node *n = mp.get("unknown_cost"); n && n->value_or(0.0) != 0.0)
+                r.fail(*n, "'unknown_cost' must be 0 in a compact map (its plan counts steps only)");
             if (!mp.get("refuse_s")) p.map_refuse_s = 0.0;  // a compact map refuses only when told to
             if (mp.get("grow_steps"))
                 p.map_grow_steps = static_cast<std::uint8_t>(r.integer(mp, "grow_steps", 0, 255));

@@ -289,6 +289,47 @@ static void test_a_reach_beyond_the_sonar_keeps_what_it_cannot_see(void **state)
     assert_int_equal(qnav_map_evidence(&m, 2550, 1550), 0); /* 1.45 m: unknown */
 }
 
+/* unknown_cost: a cell no reading has marked costs that much more to enter, so the plan
+ * prefers a way seen open; a cell seen free costs a step as before. 2 m straight along x
+ * (20 cells of 100 mm) in an empty world, before and after the robot has looked along it. */
+static void test_unknown_cells_cost_more_until_seen(void **state)
+{
+    qnav_map_t m;
+    qnav_map_config_t mc;
+    qnav_mm_t ranges[N];
+    const qnav_map_pose_t p = {3050, 3050, 0};
+    int k;
+    (void)state;
+    qnav_map_config_default(&mc);
+    mc.unknown_cost = 30;
+    map_from(&m, &mc);
+    qnav_map_plan(&m, 5050, 3050);
+    assert_int_equal(qnav_map_cost(&m, 3050, 3050), 20 * (10 + 30));
+    for (k = 0; k < N; ++k) {
+        ranges[k] = 2500; /* nothing within range: every cell within the reach seen free */
+    }
+    qnav_map_observe(&m, ranges, &p);
+    qnav_map_plan(&m, 5050, 3050);
+    assert_int_equal(qnav_map_cost(&m, 3050, 3050), 20 * 10 + 30); /* the robot's own cell
+                                                                     no reading marks */
+    /* without it, unknown cells cost a step like any other */
+    mc.unknown_cost = 0;
+    map_from(&m, &mc);
+    qnav_map_plan(&m, 5050, 3050);
+    assert_int_equal(qnav_map_cost(&m, 3050, 3050), 20 * 10);
+    /* a compact map has no costs to add: refused */
+    mc.unknown_cost = 30;
+    mc.compact = 1;
+    mc.near_cost = 0;
+    mc.cell_mm = 200;
+    {
+        qnav_ctrl_config_t cc;
+        sensor_config(&cc);
+        assert_int_equal(qnav_map_init(&m, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
+                         QNAV_E_MAP);
+    }
+}
+
 /* The robot drives along y = 1500 facing the wall and observes it, then plans. */
 static void observe_the_wall(qnav_map_t *m)
 {
@@ -1148,6 +1189,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_a_reading_frees_its_wedge_and_marks_its_arc),
         cmocka_unit_test(test_a_reach_beyond_the_sonar_keeps_what_it_cannot_see),
+        cmocka_unit_test(test_unknown_cells_cost_more_until_seen),
         cmocka_unit_test(test_arcs_are_marked_in_the_central_part_of_the_wedge),
         cmocka_unit_test(test_a_wide_wedge_marks_only_the_default_arc),
         cmocka_unit_test(test_a_far_range_peak_in_a_wide_wedge_marks_no_arc),

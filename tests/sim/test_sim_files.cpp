@@ -161,6 +161,11 @@ static void test_bad_robot_profiles_are_refused(void **state) {
              t9.find('\n', t9.find("full_speed_quality")) - t9.find("full_speed_quality") + 1);
     assert_int_equal(parse_robot(t9, &msg), QNAV_SIM_E_PARSE);
     assert_true(msg.find("missing key 'full_speed_quality'") != std::string::npos);
+    std::string t11 = good;  // a compact plan counts steps: no cost for unknown cells
+    t11.insert(t11.find("\ncompact = true") + 1, "unknown_cost = 3.0\n");
+    assert_int_equal(parse_robot(t11, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("'unknown_cost' must be 0 in a compact map") != std::string::npos);
+    assert_true(one_line(msg));
     std::string t10 = good;
     t10.replace(t10.find("full_speed_quality = 0.9"), 24, "full_speed_quality = 0.0");
     assert_int_equal(parse_robot(t10, &msg), QNAV_SIM_E_PARSE);

@@ -93,6 +93,11 @@ typedef struct {
                               walls ahead); it still clears the cells short of it, mm. 0:
                               every reading marks; default 0 (docs/architecture.md, "A
                               reading that may be an opening") */
+    uint8_t unknown_cost;  /* extra plan cost of a cell no reading has marked yet (10: one
+                              more cell side): the plan prefers a way seen open to one merely
+                              not seen shut (docs/architecture.md, "Unknown cells cost more").
+                              Full layout only (compact: 0); near_cost + unknown_cost at most
+                              255; default 0 */
 } qnav_map_config_t;
 
 /* The robot's pose in the destination's frame. */
