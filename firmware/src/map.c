@@ -133,6 +133,18 @@ static uint16_t peak_range(uint16_t opening_mm, uint16_t n_sectors)
     return (uint16_t)(r > 65535u ? 65535u : (r == 0u ? 1u : r));
 }
 
+/* How far readings clear and mark (qnav_map_t.seen_mm): the reach, but no farther than a
+ * reading at the sonar's range clears (as any reading: 3/4 cell and its noise short of
+ * it). That reading clears its wedge out to the reach, and beyond it would clear cells no
+ * reading saw, forgetting walls marked from nearer (docs/architecture.md, "A reach beyond
+ * the sonar"). */
+static uint16_t seen_range(const qnav_map_config_t *cfg, const qnav_ctrl_config_t *ctrl)
+{
+    int32_t seen = (int32_t)ctrl->max_range_mm + (int32_t)ctrl->sensor_offset_mm;
+    seen -= (int32_t)cfg->cell_mm * 3 / 4 + seen * (int32_t)cfg->noise_pct / 100;
+    return (uint16_t)(seen < 0 ? 0 : (seen < (int32_t)cfg->reach_mm ? seen : (int32_t)cfg->reach_mm));
+}
+
 static int32_t abs32(int32_t v)
 {
     return v < 0 ? -v : v;
@@ -227,6 +239,7 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
                                    ? 65535u
                                    : (uint32_t)ctrl->body_radius_mm + ctrl->safety_mm);
     m->peak_mm = peak_range(cfg->opening_mm, ctrl->n_sectors);
+    m->seen_mm = seen_range(cfg, ctrl);
     m->x0_mm = x0_mm;
     m->y0_mm = y0_mm;
     m->nx = (uint16_t)((width_mm + cfg->cell_mm - 1u) / cfg->cell_mm);
@@ -548,13 +561,7 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
     memset(&last, 0, sizeof last);
     last.k = UINT16_MAX;
     three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
-    /* no farther than a reading at the sonar's range clears (as any reading: 3/4 cell and
-     * its noise short of it): that reading clears its wedge out to the reach, and beyond
-     * it would clear cells no reading saw, forgetting walls marked from nearer
-     * (docs/architecture.md, "A reach beyond the sonar") */
-    reach = (int32_t)m->max_range_mm + (int32_t)m->offset_mm;
-    reach -= three_quarters + reach * (int32_t)m->cfg.noise_pct / 100;
-    reach = reach < 0 ? 0 : (reach < (int32_t)m->cfg.reach_mm ? reach : (int32_t)m->cfg.reach_mm);
+    reach = (int32_t)m->seen_mm;
     reach2 = (uint32_t)reach * (uint32_t)reach;
     mark_reach = marks_within(m);
     band_pct = m->cfg.noise_pct < OCCUPIED_BAND_PCT ? (int32_t)m->cfg.noise_pct : OCCUPIED_BAND_PCT;

@@ -114,6 +114,10 @@ typedef struct {
     qnav_mm_t max_range_mm;
     qnav_mm_t offset_mm;      /* sensor offset: a reading r lies r + offset from the centre */
     uint16_t inflate_mm;      /* body radius + safety distance */
+    uint16_t seen_mm;         /* readings clear and mark cells this far from the centre:
+                                 cfg.reach_mm, or nearer where a reading at the sonar's
+                                 range stops clearing (its range and offset less 3/4 cell
+                                 and noise_pct) */
     uint16_t peak_mm;         /* a range peak this far or farther marks no arc (cfg.opening_mm
                                  over the half-wedge's sine); 0: none is left out */
     int32_t x0_mm, y0_mm;     /* the world corner of cell (0, 0) */
