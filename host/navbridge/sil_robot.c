@@ -406,6 +406,8 @@ static int start(robot_t *r, const options_t *o, qnav_sim_robot_t **robot,
         scfg.sensor_noise = o->noise;
         scfg.actuation_noise = o->noise;
         scfg.seed = (uint64_t)o->seed;
+        scfg.map_frame_deg = 0.0; /* the simulator's own map guides nothing here: the board
+                                     core's does, in the frame of the robot's start */
         if (qnav_sim_create(*robot, *env, &scfg, &r->sim, err, sizeof err) != QNAV_SIM_OK ||
             qnav_sim_reset(r->sim, (uint64_t)o->episode) != QNAV_SIM_OK ||
             (o->have_start && qnav_sim_place(r->sim, o->start_x, o->start_y,

@@ -255,6 +255,7 @@ void qnav_sim_config_default(qnav_sim_config_t *cfg) {
     cfg->seed = 1;
     cfg->episode_limit_s = 0.0;
     cfg->fitness = QNAV_SIM_FITNESS_PROGRESS;
+    cfg->map_frame_deg = -1.0;
 }
 
 qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_env_t *env,
@@ -278,6 +279,8 @@ qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_
     if (!std::isfinite(cfg->episode_limit_s) || cfg->episode_limit_s < 0 || cfg->episode_limit_s > 36000)
         return bad("episode_limit_s: must be in [0, 36000] (0 = environment's)");
     if (!qnav_sim_fitness_rule_name(cfg->fitness)) return bad("fitness: not a qnav_sim_fitness_rule_t");
+    if (std::isnan(cfg->map_frame_deg) || cfg->map_frame_deg >= 360)
+        return bad("map_frame_deg: must be in [0, 360), or negative (drawn per episode)");
     return guarded(err, errlen, [&] {
         qnav::check_clearance(env->env, robot->profile.radius_m);
         qnav::SimConfig sc;
@@ -287,6 +290,7 @@ qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_
         sc.seed = cfg->seed;
         sc.episode_limit_s = cfg->episode_limit_s;
         sc.fitness = cfg->fitness;
+        sc.map_frame_deg = cfg->map_frame_deg < 0 ? -1.0 : cfg->map_frame_deg;
         auto s = std::make_unique<qnav_sim>();
         s->sim = std::make_unique<qnav::Simulation>(robot->profile, env->env, sc);
         *out = s.release();

@@ -107,16 +107,35 @@ void Simulation::init_map() {
         map_mem_.assign((robot_.map_bytes + 1) / 2, 0);
         return;
     }
-    map_mem_.assign((qnav_map_size(&mc, mm(env_.width_m), mm(env_.height_m)) + 1) / 2, 0);
+    // over the arena, or with its grid turned (any turn but none) the square that holds the
+    // arena turned any way about its centre
+    double w = env_.width_m, h = env_.height_m, x0 = 0, y0 = 0;
+    if (cfg_.map_frame_deg != 0) {
+        w = h = std::hypot(env_.width_m, env_.height_m);
+        x0 = (env_.width_m - w) / 2;
+        y0 = (env_.height_m - h) / 2;
+    }
+    map_mem_.assign((qnav_map_size(&mc, mm(w), mm(h)) + 1) / 2, 0);
     const qnav_ctrl_config_t &cc = map_ctrl_;
-    const qnav_status_t st = qnav_map_init(&map_, &mc, &cc, 0, 0, mm(env_.width_m), mm(env_.height_m),
+    const qnav_status_t st = qnav_map_init(&map_, &mc, &cc, map_mm(x0), map_mm(y0), mm(w), mm(h),
                                            map_mem_.data(), map_mem_.size() * 2);
     if (st != QNAV_OK) {
         std::ostringstream why;
         why << robot_.name << ": [map] cell_m " << robot_.map_cell_m << " for a " << env_.width_m << " x "
-            << env_.height_m << " m arena: " << qnav_status_str(st);
+            << env_.height_m << " m arena";
+        if (w != env_.width_m) why << " (its grid turned any way: a " << w << " m square; --map-frame 0: the arena)";
+        why << ": " << qnav_status_str(st);
         throw SimError(QNAV_SIM_E_PARAM, why.str());
     }
+}
+
+// A point turned by `by` about the arena's centre: the world's into the map's frame (by
+// map_turn_) and back (by -map_turn_). No turn leaves a point exactly as it is.
+Vec2 Simulation::turned(Vec2 p, double by) const {
+    if (by == 0) return p;
+    const double cx = env_.width_m / 2, cy = env_.height_m / 2, c = std::cos(by), s = std::sin(by);
+    const double dx = p.x - cx, dy = p.y - cy;
+    return Vec2{cx + c * dx - s * dy, cy + s * dx + c * dy};
 }
 
 // A board with [map] bytes of memory for its map starts it afresh at each goal over the
@@ -126,8 +145,9 @@ void Simulation::place_map() {
     map_ = qnav_map_t{};
     std::int32_t x0 = 0, y0 = 0;
     std::uint32_t side = 0;
-    if (!qnav_map_place(&map_cfg_, robot_.map_bytes, map_mm(pos_.x), map_mm(pos_.y), map_mm(env_.dest_x_m),
-                        map_mm(env_.dest_y_m), &x0, &y0, &side))
+    const Vec2 at = turned(pos_, map_turn_), dest = turned(Vec2{env_.dest_x_m, env_.dest_y_m}, map_turn_);
+    if (!qnav_map_place(&map_cfg_, robot_.map_bytes, map_mm(at.x), map_mm(at.y), map_mm(dest.x), map_mm(dest.y),
+                        &x0, &y0, &side))
         return;
     const qnav_status_t st =
         qnav_map_init(&map_, &map_cfg_, &map_ctrl_, x0, y0, side, side, map_mem_.data(), robot_.map_bytes);
@@ -189,6 +209,9 @@ void Simulation::reset(std::uint64_t episode_seed) {
     rng_sensor_ = Rng::stream(cfg_.seed, episode_seed, 2);
     rng_act_ = Rng::stream(cfg_.seed, episode_seed, 3);
     rng_odom_ = Rng::stream(cfg_.seed, episode_seed, 4);
+    // the map's grid against the world's for the episode (stream 5: no other draw moves)
+    map_turn_ = cfg_.map_frame_deg < 0 ? Rng::stream(cfg_.seed, episode_seed, 5).uniform(0, 2 * kPi)
+                                       : cfg_.map_frame_deg * kPi / 180.0;
     // Start zone weighted by area (equal weights when all are points or lines).
     double total = 0;
     for (const auto &z : env_.start_zones) total += z.w_m * z.h_m;
@@ -303,18 +326,21 @@ void Simulation::compute_scan() {
 
 // The map marks what this scan saw from the robot's pose and gives the controller the
 // plan's sub-goal. The pose is the true one, or with odometry errors in the profile the
-// odometry's (docs/architecture.md, "The map's pose"); the plan's bearing is turned into
+// odometry's (docs/architecture.md, "The map's pose"), in the map's frame: the world's
+// turned by this episode's map_turn_ (docs/sim.md, "The map's grid"); the plan's bearing is turned into
 // the robot's frame with the heading the map knows: the sensed one on the true pose, the
 // odometry's own in its frame.
 void Simulation::guide_scan() {
     if (odom_on_) odometry();
-    const Vec2 at = odom_on_ ? odom_pos_ : pos_;
-    const double hd = odom_on_ ? odom_heading_ : heading_;
+    const Vec2 odom_at = odom_on_ ? odom_pos_ : pos_;
+    const double odom_hd = odom_on_ ? odom_heading_ : heading_;
+    const Vec2 goal = turned(odom_on_ ? anchor_goal(odom_at, odom_hd) : Vec2{env_.dest_x_m, env_.dest_y_m}, map_turn_);
+    const Vec2 at = turned(odom_at, map_turn_);
+    const double hd = odom_hd + map_turn_;
     const qnav_map_pose_t pose{map_mm(at.x), map_mm(at.y), to_cdeg(hd)};
-    const Vec2 goal = odom_on_ ? anchor_goal(at, hd) : Vec2{env_.dest_x_m, env_.dest_y_m};
     if (robot_.map_bytes > 0) qnav_map_follow(&map_, &pose, map_mm(goal.x), map_mm(goal.y));  // as the board's
     qnav_map_observe(&map_, scan_.ranges_mm, &pose);
-    const qnav_map_pose_t seen{pose.x_mm, pose.y_mm, odom_on_ ? pose.heading_cdeg : to_cdeg(sensed_heading_)};
+    const qnav_map_pose_t seen{pose.x_mm, pose.y_mm, odom_on_ ? pose.heading_cdeg : to_cdeg(sensed_heading_ + map_turn_)};
     qnav_ctrl_input_t in{};
     in.goal_bearing_cdeg = scan_.goal_bearing_cdeg;
     in.goal_range_mm = scan_.goal_range_mm;

@@ -29,6 +29,10 @@ struct SimConfig {
     std::uint64_t seed = 1;
     double episode_limit_s = 0;     // 0 = environment's
     qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS;
+    // The map's grid against the world's walls, degrees in [0, 360): a board's grid is its
+    // heading sensor's frame, at no particular angle to a room's walls; negative: drawn
+    // per episode (qnav_sim_config_t.map_frame_deg; docs/sim.md, "The map's grid").
+    double map_frame_deg = -1;
 };
 
 // Where time went (only counted when profiling is on), seconds.
@@ -87,6 +91,8 @@ public:
     const SimConfig &config() const { return cfg_; }
     // The profile's map (qnav/map.h) in its frame, or null when the profile has none.
     const qnav_map_t *map() const { return map_mem_.empty() ? nullptr : &map_; }
+    // A point of the map's frame in the world's (the episode's turn of the grid undone).
+    Vec2 map_to_world(Vec2 p) const { return turned(p, -map_turn_); }
     std::uint16_t max_range_mm() const { return max_range_mm_; }
     double sonar_cone_rad() const { return sonar_.cone(); }
 
@@ -133,6 +139,9 @@ private:
     double odom_scale_ = 0, odom_turn_ = 0, odom_curve_ = 0;  // this episode's errors
     void odometry();
     Vec2 anchor_goal(Vec2 at, double heading);
+    // the map's grid turned against the world's by map_turn_ (rad) about the arena's centre
+    double map_turn_ = 0;
+    Vec2 turned(Vec2 p, double by) const;
     bool started_ = false, done_ = false, reached_ = false;
     std::uint32_t tick_ = 0, tau_c_ = 0, collisions_ = 0;
     std::uint32_t recovery_left_ = 0;

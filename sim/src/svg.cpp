@@ -76,13 +76,14 @@ void draw_obstacles_and_destination(std::ostream &o, const Mapper &m, const Envi
       << env.dest_radius_m * kScale << "\" fill=\"#ff8c00\" fill-opacity=\"0.5\" stroke=\"#d35400\" stroke-width=\"2\"/>\n";
 }
 
-// The map's occupied cells (translucent red squares) at the sonar's tick.
+// The map's occupied cells (translucent red squares, turned as its grid is) at the sonar's tick.
 void draw_map(std::ostream &o, const Mapper &m, const EpisodePicture &ep) {
-    const double side = ep.map_cell_m * kScale;
     o << "<g fill=\"#d62728\" fill-opacity=\"0.35\">\n";
-    for (const Vec2 &c : ep.map_occupied)
-        o << "<rect x=\"" << m.x(c.x) << "\" y=\"" << m.y(c.y + ep.map_cell_m) << "\" width=\"" << side
-          << "\" height=\"" << side << "\"/>\n";
+    for (const std::array<Vec2, 4> &c : ep.map_occupied) {
+        o << "<polygon points=\"";
+        for (std::size_t k = 0; k < c.size(); ++k) o << (k ? " " : "") << m.x(c[k].x) << "," << m.y(c[k].y);
+        o << "\"/>\n";
+    }
     o << "</g>\n";
 }
 
@@ -154,7 +155,7 @@ std::string render_svg(const Environment &env, double robot_r, const EpisodePict
     draw_direct_lines(o, m, env, env.obstacle_shapes(), robot_r);
     draw_obstacles_and_destination(o, m, env);
     if (ep) {
-        if (ep->map_cell_m > 0) draw_map(o, m, *ep);
+        if (ep->map_drawn) draw_map(o, m, *ep);
         if (!ep->sonar_ranges_m.empty()) draw_sonar(o, m, *ep, robot_r);
         draw_episode(o, m, *ep, robot_r, hpx);
     }

@@ -3,6 +3,7 @@
 // (path, collision points, the sonar sectors at one tick), as SVG text.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -23,10 +24,10 @@ struct EpisodePicture {
     std::vector<double> sonar_ranges_m;   // reported ranges (from the body surface), m
     double range_max_m = 0;
     double cone_rad = 0;                  // each sector's wedge, rad (0: 2*pi/N)
-    // The map at that tick (drawn when map_cell_m > 0): the lower-left corners of its
-    // occupied cells, m, in the map's frame (the world's on the true pose).
-    double map_cell_m = 0;
-    std::vector<Vec2> map_occupied;
+    // The map at that tick (drawn when map_drawn): the corners of each occupied cell in the
+    // world, m (the map's grid may be turned against the world's, and its pose drift).
+    bool map_drawn = false;
+    std::vector<std::array<Vec2, 4>> map_occupied;
     std::string caption;
 };
 

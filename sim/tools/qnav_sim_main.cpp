@@ -94,7 +94,8 @@ void load(Loaded &l, const std::string &robot, const std::string &env) {
 }
 
 void make_sim(Loaded &l, int sectors, double ps, double pa, std::uint64_t seed,
-              qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS, double limit_factor = 1.0) {
+              qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS, double limit_factor = 1.0,
+              double map_frame_deg = -1.0) {
     char err[QNAV_SIM_ERRLEN] = "";
     qnav_sim_config_t cfg;
     qnav_sim_config_default(&cfg);
@@ -108,6 +109,7 @@ void make_sim(Loaded &l, int sectors, double ps, double pa, std::uint64_t seed,
     cfg.sensor_noise = ps;
     cfg.actuation_noise = pa;
     cfg.seed = seed;
+    cfg.map_frame_deg = map_frame_deg;
     check(qnav_sim_create(l.robot, l.env, &cfg, &l.sim, err, sizeof err), err);
 }
 
@@ -211,6 +213,7 @@ struct RunOpts {
     std::uint64_t seed = 1, episode = 0;
     unsigned episodes = 1;
     double limit_factor = 1.0;  // times the environment's episode time limit
+    double map_frame = -1;      // the map's grid against the walls, deg; < 0: drawn per episode
     bool table = false;
     std::string controller = "body";  // a name in libqnav's controller table (qnav/nav.h)
     long svg_tick = -1;
@@ -253,21 +256,22 @@ struct EpisodeRecord {
         }
     }
 
-    // The map's occupied cells now, for the picture (the map covers the arena from (0, 0)).
+    // The map's occupied cells now, for the picture: each cell's corners in the world (the
+    // map's grid may be turned against it: docs/sim.md, "The map's grid").
     void snapshot_map() {
         const qnav_map_t *m = sim.map();
         if (!m) return;
-        const double cell = sim.robot().map_cell_m;
-        const auto nx = static_cast<long>(std::ceil(sim.env().width_m / cell - 1e-9));
-        const auto ny = static_cast<long>(std::ceil(sim.env().height_m / cell - 1e-9));
-        pic.map_cell_m = cell;
+        const double cell = m->cfg.cell_mm / 1000.0, x0 = m->x0_mm / 1000.0, y0 = m->y0_mm / 1000.0;
+        pic.map_drawn = true;
         pic.map_occupied.clear();
-        for (long j = 0; j < ny; ++j)
-            for (long i = 0; i < nx; ++i) {
-                const double x = (static_cast<double>(i) + 0.5) * cell, y = (static_cast<double>(j) + 0.5) * cell;
-                if (qnav_map_evidence(m, static_cast<std::int32_t>(std::lround(x * 1000)),
-                                      static_cast<std::int32_t>(std::lround(y * 1000))) >= QNAV_MAP_OCCUPIED)
-                    pic.map_occupied.push_back({x - 0.5 * cell, y - 0.5 * cell});
+        for (long j = 0; j < m->ny; ++j)
+            for (long i = 0; i < m->nx; ++i) {
+                const double x = x0 + static_cast<double>(i) * cell, y = y0 + static_cast<double>(j) * cell;
+                if (qnav_map_evidence(m, static_cast<std::int32_t>(std::lround((x + 0.5 * cell) * 1000)),
+                                      static_cast<std::int32_t>(std::lround((y + 0.5 * cell) * 1000))) < QNAV_MAP_OCCUPIED)
+                    continue;
+                pic.map_occupied.push_back({sim.map_to_world({x, y}), sim.map_to_world({x + cell, y}),
+                                            sim.map_to_world({x + cell, y + cell}), sim.map_to_world({x, y + cell})});
             }
     }
 };
@@ -325,7 +329,7 @@ int cmd_run(const RunOpts &o) {
     if (qnav_sim_fitness_rule_parse(o.fitness.c_str(), &rule) != QNAV_SIM_OK)
         throw SimError(QNAV_SIM_E_PARAM, "--fitness: '" + o.fitness + "' is not one of " +
                                              qnav_sim_fitness_rule_names());
-    make_sim(l, o.sectors, ps, pa, o.seed, rule, o.limit_factor);
+    make_sim(l, o.sectors, ps, pa, o.seed, rule, o.limit_factor, o.map_frame);
     qnav::Simulation &sim = *l.sim->sim;
     const qnav_policy_t pol = read_policy(o.policy, l.robot);
     std::vector<qnav_qkey_t> tbuf;
@@ -565,6 +569,10 @@ static CLI::App *add_run(CLI::App &app, RunOpts &o) {
     run->add_option("--limit-factor", o.limit_factor,
                     "episode time limit as a multiple of the environment's (2: judge escapes at twice it)")
         ->check(qnav::cli::finite_range(0.1, 100.0))->capture_default_str();
+    run->add_option("--map-frame", o.map_frame,
+                    "a profile's [map]: its grid's angle to the arena's walls, deg in [0, 360) (default: drawn "
+                    "per episode, as a board's heading sensor lies to a room; 0: aligned, the figures before 0.18)")
+        ->check(qnav::cli::finite_range(0.0, 359.999999));
     run->add_option("--svg", o.svg, "write the first episode's picture here");
     run->add_option("--trace", o.trace, "write the first episode's trajectory here (CSV, one row per tick)");
     run->add_option("--svg-tick", o.svg_tick, "tick whose sonar sectors are drawn (default 0; past the end: the last tick)")->check(CLI::NonNegativeNumber);

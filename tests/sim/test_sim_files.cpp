@@ -392,8 +392,21 @@ static void test_cli_runs_an_episode_and_writes_a_complete_picture(void **state)
     rmdir(dir);
 }
 
+// The first map cell drawn in picture text: its first edge's length and direction in the
+// picture (pixels; degrees, the picture's y downward).
+static void first_cell_edge(const std::string &svg_text, double *len, double *deg) {
+    const std::string tag = "<polygon points=\"";
+    const std::size_t at = svg_text.find(tag, svg_text.find("fill=\"#d62728\" fill-opacity=\"0.35\""));
+    assert_true(at != std::string::npos);
+    double x0, y0, x1, y1;
+    assert_int_equal(std::sscanf(svg_text.c_str() + at + tag.size(), "%lf,%lf %lf,%lf", &x0, &y0, &x1, &y1), 4);
+    *len = std::hypot(x1 - x0, y1 - y0);
+    *deg = std::atan2(y1 - y0, x1 - x0) * 180.0 / std::acos(-1.0);
+}
+
 // With a profile's [map], the picture also draws the map's occupied cells at its tick (one
-// translucent red square each); without one, none.
+// translucent red square each, turned as the map's grid is against the arena: --map-frame);
+// without one, none.
 static void test_the_picture_draws_the_maps_cells(void **state) {
     (void)state;
     char dir[] = "/tmp/qnav_sim_test_XXXXXX";
@@ -409,10 +422,17 @@ static void test_the_picture_draws_the_maps_cells(void **state) {
     const std::string rest = " --env " + std::string(QNAV_TEST_DATA_DIR) +
                              "/envs/dense.toml --sectors 16 --sensor-noise 0 --actuation-noise 0 --svg " + svg +
                              " --svg-tick 40";
-    const std::string cell = "<g fill=\"#d62728\" fill-opacity=\"0.35\">\n<rect ";
     std::string out;
-    assert_int_equal(run_tool("run --robot " + robot + rest, &out), 0);
-    assert_true(read_text_file(svg).find(cell) != std::string::npos);
+    double len = 0, deg = 0;
+    assert_int_equal(run_tool("run --robot " + robot + rest + " --map-frame 0", &out), 0);
+    first_cell_edge(read_text_file(svg), &len, &deg);
+    assert_true(std::fabs(len - 6.0) < 0.05 && std::fabs(deg) < 0.5);  // 0.1 m at 60 px/m, along x
+    assert_int_equal(run_tool("run --robot " + robot + rest + " --map-frame 30", &out), 0);
+    first_cell_edge(read_text_file(svg), &len, &deg);
+    assert_true(std::fabs(len - 6.0) < 0.05 && std::fabs(deg - 30.0) < 0.5);  // turned back: -30 deg, y down
+    assert_int_equal(run_tool("run --robot " + robot + rest, &out), 0);  // a turn drawn per episode
+    first_cell_edge(read_text_file(svg), &len, &deg);
+    assert_true(std::fabs(len - 6.0) < 0.05);
     assert_int_equal(run_tool("run --robot tekbot-map" + rest, &out), 0);
     assert_true(read_text_file(svg).find("#d62728") == std::string::npos);
     std::remove(svg.c_str());

@@ -45,7 +45,7 @@ struct WallSim {
     qnav_sim_env_t *env = nullptr;
     qnav_sim_t *sim = nullptr;
     qnav_ctrl_t ctrl;
-    explicit WallSim(const std::string &profile, double sensor_noise = 0.05) {
+    explicit WallSim(const std::string &profile, double sensor_noise = 0.05, double map_frame_deg = -1.0) {
         char err[QNAV_SIM_ERRLEN] = "";
         if (qnav_sim_robot_parse(profile.data(), profile.size(), "tekbot-map.toml", &robot, err,
                                  sizeof err) != QNAV_SIM_OK)
@@ -58,6 +58,7 @@ struct WallSim {
         cfg.sensor_noise = sensor_noise;
         cfg.actuation_noise = 0.01;
         cfg.seed = 3;
+        cfg.map_frame_deg = map_frame_deg;
         if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK) fail_with("sim", err);
         qnav_ctrl_config_t cc;
         qnav_sim_ctrl_config(sim, &cc);
@@ -73,9 +74,9 @@ struct WallSim {
 };
 
 // Episodes 0..n-1 of the probabilistic policy with this profile text in kWall, at this
-// sensor noise.
-Run run(const std::string &profile, unsigned n, double sensor_noise = 0.05) {
-    WallSim w(profile, sensor_noise);
+// sensor noise, the map's grid at this angle to the walls (negative: drawn per episode).
+Run run(const std::string &profile, unsigned n, double sensor_noise = 0.05, double map_frame_deg = -1.0) {
+    WallSim w(profile, sensor_noise, map_frame_deg);
     Run r;
     for (uint64_t e = 0; e < n; ++e) {
         qnav_sim_result_t res;
@@ -95,6 +96,30 @@ void test_the_map_finds_the_gap_the_policy_alone_misses(void **) {
     assert_true(with.reached >= 9);
     assert_true(with.reached >= without.reached + 3);
     assert_int_equal(with.collisions, 0);
+}
+
+// A board's map lies in its heading sensor's frame, at no particular angle to a room's
+// walls: the simulator turns the map's grid by an angle drawn per episode (or the one
+// given), and the robot finds the far gap at any turn. The turn reaches the map: the same
+// episodes with the grid aligned and turned 30 deg are not the same.
+void test_the_maps_grid_is_turned_against_the_walls(void **) {
+    const std::string fine = tekbot_with("[map]\ncell_m = 0.1\n");
+    unsigned turns = 0;
+    uint32_t aligned_ticks = 0;
+    for (const double deg : {0.0, 30.0, 45.0, -1.0}) {
+        const Run r = run(fine, 10, 0.05, deg);
+        print_message("wall with a far gap, the map's grid %s%g deg: %u/10 arrive, %u ticks, %u collisions\n",
+                      deg < 0 ? "drawn per episode, not " : "at ", deg < 0 ? 0.0 : deg, r.reached, r.ticks,
+                      r.collisions);
+        assert_true(r.reached >= 9);
+        assert_int_equal(r.collisions, 0);
+        if (deg == 0.0) aligned_ticks = r.ticks;
+        else turns += r.ticks != aligned_ticks ? 1u : 0u;
+    }
+    assert_int_equal(turns, 3u);
+    // the turn drawn per episode is the episode's: the same context and episodes, the same run
+    const Run a = run(fine, 4), b = run(fine, 4);
+    assert_int_equal(a.ticks, b.ticks);
 }
 
 // In an empty arena a map changes nothing: the TekBot with its compact map arrives in every
@@ -363,6 +388,7 @@ void test_the_maps_opening_comes_from_the_profile(void **) {
 int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_the_map_finds_the_gap_the_policy_alone_misses),
+        cmocka_unit_test(test_the_maps_grid_is_turned_against_the_walls),
         cmocka_unit_test(test_an_empty_arena_with_the_compact_map_is_no_dead_end),
         cmocka_unit_test(test_the_step_api_carries_what_the_map_did_to_the_escape),
         cmocka_unit_test(test_odometry_errors_move_the_maps_pose_only_when_drawn),

@@ -175,10 +175,14 @@ typedef struct {
                                   (seed, episode_seed), never on earlier episodes */
     double episode_limit_s;    /* episode time limit, s; 0 = the environment's */
     qnav_sim_fitness_rule_t fitness;  /* how R is computed (qnav_sim_result_t.R) */
+    double map_frame_deg;      /* a profile's [map]: its grid's angle to the world's walls,
+                                  deg in [0, 360) (0: aligned with the arena's walls, which a
+                                  board's heading sensor never is); < 0: drawn per episode
+                                  from (seed, episode_seed), the default */
 } qnav_sim_config_t;
 
 /* Defaults: profile's sectors, no noise, seed 1, the environment's limit, fitness
- * QNAV_SIM_FITNESS_PROGRESS. */
+ * QNAV_SIM_FITNESS_PROGRESS, the map's grid at an angle drawn per episode. */
 void qnav_sim_config_default(qnav_sim_config_t *cfg);
 
 /*
