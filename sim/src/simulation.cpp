@@ -91,6 +91,10 @@ Simulation::Simulation(const RobotProfile &robot, const Environment &env, const 
     scan_.n_sectors = cfg_.n_sectors;
     scan_.max_range_mm = max_range_mm_;
     if (robot_.map_cell_m > 0) init_map();
+    // the world's key: its name, arena and destination
+    world_key_ = qnav_fnv1a64(env_.name.data(), env_.name.size(), QNAV_FNV1A64_BASIS);
+    for (const double v : {env_.width_m, env_.height_m, env_.dest_x_m, env_.dest_y_m})
+        world_key_ = qnav_fnv1a64(&v, sizeof v, world_key_);
     odom_on_ = !map_mem_.empty() && has_odometry_errors(robot_);
 }
 
@@ -209,8 +213,9 @@ void Simulation::reset(std::uint64_t episode_seed) {
     rng_sensor_ = Rng::stream(cfg_.seed, episode_seed, 2);
     rng_act_ = Rng::stream(cfg_.seed, episode_seed, 3);
     rng_odom_ = Rng::stream(cfg_.seed, episode_seed, 4);
-    // the map's grid against the world's for the episode (stream 5: no other draw moves)
-    map_turn_ = cfg_.map_frame_deg < 0 ? Rng::stream(cfg_.seed, episode_seed, 5).uniform(0, 2 * kPi)
+    // the map's grid against the world's for the episode, drawn from the world as well (the
+    // same episode seed in two worlds: two turns) on stream 5 (no other draw moves)
+    map_turn_ = cfg_.map_frame_deg < 0 ? Rng::stream(cfg_.seed ^ world_key_, episode_seed, 5).uniform(0, 2 * kPi)
                                        : cfg_.map_frame_deg * kPi / 180.0;
     // Start zone weighted by area (equal weights when all are points or lines).
     double total = 0;

@@ -141,6 +141,7 @@ private:
     Vec2 anchor_goal(Vec2 at, double heading);
     // the map's grid turned against the world's by map_turn_ (rad) about the arena's centre
     double map_turn_ = 0;
+    std::uint64_t world_key_ = 0;  // a hash of the world: turns differ between worlds
     Vec2 turned(Vec2 p, double by) const;
     bool started_ = false, done_ = false, reached_ = false;
     std::uint32_t tick_ = 0, tau_c_ = 0, collisions_ = 0;

@@ -433,6 +433,13 @@ static void test_the_picture_draws_the_maps_cells(void **state) {
     assert_int_equal(run_tool("run --robot " + robot + rest, &out), 0);  // a turn drawn per episode
     first_cell_edge(read_text_file(svg), &len, &deg);
     assert_true(std::fabs(len - 6.0) < 0.05);
+    // ... and per world: episode 0 of another world, another turn
+    double other = 0;
+    std::string in_cluttered = rest;
+    in_cluttered.replace(in_cluttered.find("dense.toml"), 10, "cluttered.toml");
+    assert_int_equal(run_tool("run --robot " + robot + in_cluttered, &out), 0);
+    first_cell_edge(read_text_file(svg), &len, &other);
+    assert_true(std::fabs(std::fmod(deg - other + 360.0, 90.0)) > 0.5);
     assert_int_equal(run_tool("run --robot tekbot-map" + rest, &out), 0);
     assert_true(read_text_file(svg).find("#d62728") == std::string::npos);
     std::remove(svg.c_str());

@@ -10,6 +10,7 @@
 #ifndef QNAV_RNG_H
 #define QNAV_RNG_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #ifdef __cplusplus
@@ -24,6 +25,20 @@ static inline uint64_t qnav_splitmix64(uint64_t *state)
     z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
     z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
     return z ^ (z >> 31);
+}
+
+/* 64-bit FNV-1a of len bytes at data, continuing from h (start: QNAV_FNV1A64_BASIS):
+ * fingerprints, and labels turned into seeds. */
+#define QNAV_FNV1A64_BASIS 1469598103934665603ull
+static inline uint64_t qnav_fnv1a64(const void *data, size_t len, uint64_t h)
+{
+    const unsigned char *p = (const unsigned char *)data;
+    size_t i;
+    for (i = 0; i < len; ++i) {
+        h ^= p[i];
+        h *= 1099511628211ull;
+    }
+    return h;
 }
 
 /* x rotated left by k bits, 0 < k < 64. */

@@ -1,5 +1,6 @@
 /*
- * simevo's seed derivation (mix_seed) and byte hash (fnv1a64), on the shared splitmix64.
+ * simevo's seed derivation (mix_seed) and byte hash (fnv1a64), on the shared splitmix64
+ * and FNV-1a (qnav/rng.h).
  */
 #include "rng.h"
 
@@ -15,12 +16,7 @@ uint64_t mix_seed(uint64_t a, uint64_t b)
 
 uint64_t fnv1a64(const void *data, std::size_t len, uint64_t h)
 {
-    const unsigned char *p = static_cast<const unsigned char *>(data);
-    for (std::size_t i = 0; i < len; ++i) {
-        h ^= p[i];
-        h *= 1099511628211ull;
-    }
-    return h;
+    return qnav_fnv1a64(data, len, h);
 }
 
 } // namespace qnav

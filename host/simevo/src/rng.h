@@ -18,7 +18,7 @@ namespace qnav {
 uint64_t mix_seed(uint64_t a, uint64_t b);
 
 /* 64-bit FNV-1a of a byte string (fingerprints, labels to seeds). */
-uint64_t fnv1a64(const void *data, std::size_t len, uint64_t h = 1469598103934665603ull);
+uint64_t fnv1a64(const void *data, std::size_t len, uint64_t h = QNAV_FNV1A64_BASIS);
 
 } // namespace qnav
 
