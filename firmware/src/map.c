@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "escape.h"
+#include "map_align.h"
 #include "map_compact.h"
 #include "qnav/trig.h"
 
@@ -62,6 +63,7 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->escape_grow = 1u;
     cfg->near_cost = 10u;
     cfg->unknown_cost = 0u;
+    cfg->align_samples = 0u;
     cfg->refuse_ticks = 30u;
     cfg->refuse_life_ticks = 200u;
     cfg->compact = 0u;
@@ -244,6 +246,7 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
     m->y0_mm = y0_mm;
     m->nx = (uint16_t)((width_mm + cfg->cell_mm - 1u) / cfg->cell_mm);
     m->ny = (uint16_t)(cells / m->nx);
+    qnav_align_start(m, x0_mm + (int32_t)(width_mm / 2u), y0_mm + (int32_t)(height_mm / 2u));
     if (cfg->compact) {
         qnav_cmap_attach(m, buf);
     } else {
@@ -352,13 +355,17 @@ static int32_t cells_between(int32_t a, int32_t b, int32_t cell)
     return d >= 0 ? (d + cell / 2) / cell : -((-d + cell / 2) / cell);
 }
 
-int qnav_map_follow(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
+int qnav_map_follow(qnav_map_t *m, const qnav_map_pose_t *at, int32_t goal_x_mm,
                     int32_t goal_y_mm)
 {
     int32_t cell, edge, ri, rj, x0, y0, di, dj;
-    if (!ready(m) || pose == NULL) {
+    qnav_map_pose_t in_grid;
+    const qnav_map_pose_t *pose = &in_grid;
+    if (!ready(m) || at == NULL) {
         return 0;
     }
+    in_grid = qnav_align_pose(m, at);
+    qnav_align_point(m, &goal_x_mm, &goal_y_mm);
     cell = (int32_t)m->cfg.cell_mm;
     edge = edge_cells(&m->cfg);
     ri = index_along(pose->x_mm, m->x0_mm, cell);
@@ -550,14 +557,20 @@ static void read_sector(const qnav_map_t *m, const qnav_mm_t *ranges_mm, uint16_
  * is at most 41 000 mm along each axis, and the squared distance of a cell within reach at
  * most 2 x 41 000^2 < 2^32. A distance beyond the reach is compared as such, not squared.
  */
-void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *pose)
+void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
 {
     int32_t i0, i1, j0, j1, i, j, reach, mark_reach, three_quarters, heading, arc_half, band_pct;
     uint32_t reach2;
     reading_t last;
-    if (!ready(m) || ranges_mm == NULL || pose == NULL) {
+    qnav_map_pose_t in_grid;
+    const qnav_map_pose_t *pose = &in_grid;
+    if (!ready(m) || ranges_mm == NULL || at == NULL) {
         return;
     }
+    if (qnav_align_observe(m, ranges_mm, at)) {
+        qnav_map_reset(m); /* what the old grid held, forgotten: its cells lie another way */
+    }
+    in_grid = qnav_align_pose(m, at);
     memset(&last, 0, sizeof last);
     last.k = UINT16_MAX;
     three_quarters = (int32_t)m->cfg.cell_mm * 3 / 4;
@@ -904,6 +917,7 @@ void qnav_map_plan(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
     if (!ready(m)) {
         return;
     }
+    qnav_align_point(m, &goal_x_mm, &goal_y_mm);
     plan_start(m, goal_x_mm, goal_y_mm);
     settle_all(m);
 }
@@ -1155,15 +1169,19 @@ static uint16_t plan_growth(qnav_map_t *m, uint32_t mm, uint32_t straight_mm)
     return 0u;
 }
 
-int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm,
+int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *at, int32_t goal_x_mm,
                    int32_t goal_y_mm, qnav_ctrl_input_t *in)
 {
     int32_t i, j, ri, rj, steps, sx, sy;
     uint32_t cost, mm, sub, straight_mm;
     int jumped, direct = 0;
-    if (!ready(m) || pose == NULL || in == NULL) {
+    qnav_map_pose_t in_grid;
+    const qnav_map_pose_t *pose = &in_grid;
+    if (!ready(m) || at == NULL || in == NULL) {
         return 0;
     }
+    in_grid = qnav_align_pose(m, at);
+    qnav_align_point(m, &goal_x_mm, &goal_y_mm);
     if (m->refused_ticks > 0u && --m->refused_ticks == 0u) {
         refusal_lapses(m);
     }
@@ -1228,11 +1246,15 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
            (jumped ? QNAV_MAP_ESCAPE_CLEARED : (m->grown_mm != 0u ? QNAV_MAP_ESCAPE_GROWN : 0));
 }
 
-/* The index of the cell holding (x, y); -1 outside the map. */
+/* The index of the cell holding pose-frame point (x, y); -1 outside the map. */
 static int32_t index_of(const qnav_map_t *m, int32_t x_mm, int32_t y_mm)
 {
     int32_t i, j;
-    if (!ready(m) || x_mm < m->x0_mm || y_mm < m->y0_mm) {
+    if (!ready(m)) {
+        return -1;
+    }
+    qnav_align_point(m, &x_mm, &y_mm);
+    if (x_mm < m->x0_mm || y_mm < m->y0_mm) {
         return -1;
     }
     i = (x_mm - m->x0_mm) / (int32_t)m->cfg.cell_mm;

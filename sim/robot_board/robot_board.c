@@ -69,14 +69,16 @@ static void put_map(FILE *out, const qnav_sim_robot_t *robot, const char *up)
             "        .plan_ticks = %u, .noise_pct = %u, .near_cost = %u, .near_mm = %u, \\\n"
             "        .arc_cdeg = %u, .sight = %u, .escape_grow = %u, .refuse_ticks = %u, \\\n"
             "        .refuse_life_ticks = %u, .compact = %u, .grow_steps = %u, \\\n"
-            "        .forget_reach_mm = %u, .opening_mm = %u, .unknown_cost = %u \\\n"
+            "        .forget_reach_mm = %u, .opening_mm = %u, .unknown_cost = %u, \\\n"
+            "        .align_samples = %u \\\n"
             "    }\n\n",
             up, (unsigned)mc.cell_mm, (unsigned)mc.reach_mm, (unsigned)mc.look_mm,
             (unsigned)mc.jump_mm, (unsigned)mc.plan_ticks, (unsigned)mc.noise_pct,
             (unsigned)mc.near_cost, (unsigned)mc.near_mm, (unsigned)mc.arc_cdeg,
             (unsigned)mc.sight, (unsigned)mc.escape_grow, (unsigned)mc.refuse_ticks,
             (unsigned)mc.refuse_life_ticks, (unsigned)mc.compact, (unsigned)mc.grow_steps,
-            (unsigned)mc.forget_reach_mm, (unsigned)mc.opening_mm, (unsigned)mc.unknown_cost);
+            (unsigned)mc.forget_reach_mm, (unsigned)mc.opening_mm, (unsigned)mc.unknown_cost,
+            (unsigned)mc.align_samples);
     if (qnav_sim_robot_map_bytes(robot) != 0u) {
         fprintf(out,
                 "/* The profile's [map] bytes: the board's memory for that map, the largest\n"

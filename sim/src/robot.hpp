@@ -77,6 +77,7 @@ struct RobotProfile {
     double map_near_m = 0.2;        // cells this much beyond the body's reach of a wall...
     double map_near_cost = 1.0;     // ...cost this much more to cross, in cell sides
     double map_unknown_cost = 0.0;  // a cell not yet seen costs this much more, cell sides
+    std::uint8_t map_align_samples = 0;  // wall readings before the grid turns to the walls; 0: never
     double map_noise = -1.0;        // [map] noise: the range noise the map allows for (its
                                     // noise_pct); < 0: [noise] sensor
     double map_arc_deg = 22.5;      // arcs marked within this angle about the wedge's centre

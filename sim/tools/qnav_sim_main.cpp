@@ -257,21 +257,26 @@ struct EpisodeRecord {
     }
 
     // The map's occupied cells now, for the picture: each cell's corners in the world (the
-    // map's grid may be turned against it: docs/sim.md, "The map's grid").
+    // map's grid is turned against the world by the simulator, docs/sim.md "The map's
+    // grid", and may turn itself to the walls: [map] align_samples).
     void snapshot_map() {
         const qnav_map_t *m = sim.map();
         if (!m) return;
-        const double cell = m->cfg.cell_mm / 1000.0, x0 = m->x0_mm / 1000.0, y0 = m->y0_mm / 1000.0;
+        const std::int32_t cell = m->cfg.cell_mm;
+        // grid-frame point (x, y), mm, in the world, m
+        const auto world = [&](std::int32_t x, std::int32_t y) {
+            qnav_map_grid_to_pose(m, &x, &y);
+            return sim.map_to_world({x / 1000.0, y / 1000.0});
+        };
         pic.map_drawn = true;
         pic.map_occupied.clear();
-        for (long j = 0; j < m->ny; ++j)
-            for (long i = 0; i < m->nx; ++i) {
-                const double x = x0 + static_cast<double>(i) * cell, y = y0 + static_cast<double>(j) * cell;
-                if (qnav_map_evidence(m, static_cast<std::int32_t>(std::lround((x + 0.5 * cell) * 1000)),
-                                      static_cast<std::int32_t>(std::lround((y + 0.5 * cell) * 1000))) < QNAV_MAP_OCCUPIED)
-                    continue;
-                pic.map_occupied.push_back({sim.map_to_world({x, y}), sim.map_to_world({x + cell, y}),
-                                            sim.map_to_world({x + cell, y + cell}), sim.map_to_world({x, y + cell})});
+        for (std::int32_t j = 0; j < m->ny; ++j)
+            for (std::int32_t i = 0; i < m->nx; ++i) {
+                const std::int32_t x = m->x0_mm + i * cell, y = m->y0_mm + j * cell;
+                std::int32_t cx = x + cell / 2, cy = y + cell / 2;
+                qnav_map_grid_to_pose(m, &cx, &cy);
+                if (qnav_map_evidence(m, cx, cy) < QNAV_MAP_OCCUPIED) continue;
+                pic.map_occupied.push_back({world(x, y), world(x + cell, y), world(x + cell, y + cell), world(x, y + cell)});
             }
     }
 };

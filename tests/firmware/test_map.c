@@ -330,6 +330,87 @@ static void test_unknown_cells_cost_more_until_seen(void **state)
     }
 }
 
+/* A room: the world's four sides and the wall with its gap. */
+static const box_t room[] = {{0, 0, WORLD_MM, 100},         {0, WORLD_MM - 100, WORLD_MM, WORLD_MM},
+                             {0, 0, 100, WORLD_MM},         {WORLD_MM - 100, 0, WORLD_MM, WORLD_MM},
+                             {0, 2950, 4500, 3050},         {5300, 2950, WORLD_MM, 3050}};
+
+/* World point (x, y) in a pose frame turned turn_cdeg against the world about its centre
+ * (a heading sensor's frame lies at no particular angle to a room). */
+static void turned(int32_t turn_cdeg, int32_t *x, int32_t *y)
+{
+    int16_t c, s;
+    const int32_t dx = *x - WORLD_MM / 2, dy = *y - WORLD_MM / 2;
+    qnav_cos_sin_q14(turn_cdeg, &c, &s);
+    *x = WORLD_MM / 2 + (c * dx - s * dy) / 16384;
+    *y = WORLD_MM / 2 + (s * dx + c * dy) / 16384;
+}
+
+/* The robot looks round at 24 points of the room (9 headings each), its map given its pose
+ * in a frame turned turn_cdeg against the room; the map aligns after `samples` readings. */
+static void look_round_the_room(qnav_map_t *m, int32_t turn_cdeg, uint8_t samples)
+{
+    qnav_map_config_t mc;
+    qnav_mm_t ranges[N];
+    int a, b, h;
+    qnav_map_config_default(&mc);
+    mc.align_samples = samples;
+    map_from(m, &mc);
+    for (b = 0; b < 4; ++b) {
+        for (a = 0; a < 6; ++a) {
+            for (h = 0; h < 9; ++h) {
+                qnav_map_pose_t world = {700 + a * 900, b < 2 ? 700 + b * 900 : 3700 + (b - 2) * 900, 0};
+                qnav_map_pose_t seen;
+                world.heading_cdeg = h * 3917 + a * 1231 + b * 577;
+                scan(room, sizeof room / sizeof room[0], &world, ranges);
+                seen = world;
+                turned(turn_cdeg, &seen.x_mm, &seen.y_mm);
+                seen.heading_cdeg += turn_cdeg;
+                qnav_map_observe(m, ranges, &seen);
+            }
+        }
+    }
+}
+
+/* align_samples: the grid turns to the room's walls, at right angles in a frame turned 30
+ * deg (or 0, or -40) against them, to within 2 deg; then a wall's cell is occupied where
+ * the wall lies in the pose's frame, and the gap's is not. Without it, or in a frame along
+ * the walls, the grid stays in the pose's frame. */
+static void test_the_grid_turns_to_the_walls(void **state)
+{
+    static const int32_t turns[] = {0, 1500, -4000, 3000};
+    qnav_map_t m;
+    size_t t;
+    (void)state;
+    for (t = 0; t < sizeof turns / sizeof turns[0]; ++t) {
+        int32_t x = 2000, y = 3000, gx = 4900, gy = 3000, off;
+        look_round_the_room(&m, turns[t], 40);
+        off = (m.grid_cdeg - turns[t]) % 9000; /* walls at right angles: modulo 90 deg */
+        off += off < -4500 ? 9000 : (off >= 4500 ? -9000 : 0);
+        print_message("room turned %d cdeg: the grid turned %d cdeg (%u readings, their mean %d)\n",
+                      (int)turns[t], (int)m.grid_cdeg, (unsigned)m.align_n,
+                      (int)qnav_atan2_cdeg(m.align_s / 1024, m.align_c / 1024, NULL) / 4);
+        assert_true(off >= -200 && off <= 200);
+        assert_true(turns[t] != 0 || m.grid_cdeg == 0);
+        turned(turns[t], &x, &y);
+        turned(turns[t], &gx, &gy);
+        assert_true(qnav_map_evidence(&m, x, y) >= QNAV_MAP_OCCUPIED);
+        assert_true(qnav_map_evidence(&m, gx, gy) < QNAV_MAP_OCCUPIED);
+        {
+            /* the grid's point a cell to the right of the map's centre, in the pose's frame:
+             * as far from the centre, the grid's turn round from the pose's x axis */
+            int32_t px = m.pivot_x_mm + 100, py = m.pivot_y_mm;
+            int16_t c, s;
+            qnav_map_grid_to_pose(&m, &px, &py);
+            qnav_cos_sin_q14(m.grid_cdeg, &c, &s);
+            assert_true(px - (m.pivot_x_mm + 100 * c / 16384) >= -1 && px - (m.pivot_x_mm + 100 * c / 16384) <= 1);
+            assert_true(py - (m.pivot_y_mm + 100 * s / 16384) >= -1 && py - (m.pivot_y_mm + 100 * s / 16384) <= 1);
+        }
+    }
+    look_round_the_room(&m, 3000, 0);
+    assert_int_equal(m.grid_cdeg, 0);
+}
+
 /* The robot drives along y = 1500 facing the wall and observes it, then plans. */
 static void observe_the_wall(qnav_map_t *m)
 {
@@ -1190,6 +1271,7 @@ int main(void)
         cmocka_unit_test(test_a_reading_frees_its_wedge_and_marks_its_arc),
         cmocka_unit_test(test_a_reach_beyond_the_sonar_keeps_what_it_cannot_see),
         cmocka_unit_test(test_unknown_cells_cost_more_until_seen),
+        cmocka_unit_test(test_the_grid_turns_to_the_walls),
         cmocka_unit_test(test_arcs_are_marked_in_the_central_part_of_the_wedge),
         cmocka_unit_test(test_a_wide_wedge_marks_only_the_default_arc),
         cmocka_unit_test(test_a_far_range_peak_in_a_wide_wedge_marks_no_arc),

@@ -98,6 +98,15 @@ typedef struct {
                               not seen shut (docs/architecture.md, "Unknown cells cost more").
                               Full layout only (compact: 0); near_cost + unknown_cost at most
                               255; default 0 */
+    uint8_t align_samples; /* the grid turns to the walls it sees: once this many readings
+                              nearer than 2 m and nearer than both neighbouring sectors' (a
+                              wall's nearest point, its normal along the sector) agree on
+                              walls at right angles (their directions modulo 90 deg), the map
+                              turns its grid to them, as far as 5 deg or more, and begins
+                              again; a pose's frame (a heading sensor's) lies at no particular
+                              angle to a room's walls, and a passage along a grid's diagonal
+                              closes sooner (docs/architecture.md, "A grid turned to the
+                              walls"). 0: the grid stays in the pose's frame; default 0 */
 } qnav_map_config_t;
 
 /* The robot's pose in the destination's frame. */
@@ -120,7 +129,14 @@ typedef struct {
                                  and noise_pct) */
     uint16_t peak_mm;         /* a range peak this far or farther marks no arc (cfg.opening_mm
                                  over the half-wedge's sine); 0: none is left out */
-    int32_t x0_mm, y0_mm;     /* the world corner of cell (0, 0) */
+    int32_t x0_mm, y0_mm;     /* the corner of cell (0, 0) in the grid's frame: the pose's
+                                 turned by grid_cdeg about (pivot_x_mm, pivot_y_mm) */
+    int32_t pivot_x_mm, pivot_y_mm; /* the map's centre when it was made, pose frame */
+    int16_t grid_cdeg;        /* the grid's turn against the pose's frame, 0.01 deg */
+    int16_t grid_cos, grid_sin; /* its cosine and sine, Q2.14 */
+    uint16_t align_n;         /* readings of walls' nearest points counted ... */
+    int32_t align_c, align_s; /* ... and the sums of the cosine and sine (Q2.14) of four
+                                 times their directions (walls at right angles agree) */
     uint16_t nx, ny;
     /* the full layout (cfg.compact 0), in the caller's memory; NULL in the compact one */
     int8_t *evidence;         /* per cell: < 0 seen free, >= QNAV_MAP_OCCUPIED occupied */
@@ -253,11 +269,17 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
  * for a caller that keeps the memory elsewhere than the input it gave (qnav_escape_grow). */
 uint16_t qnav_map_grown_mm(const qnav_map_t *m);
 
-/* A cell's evidence (< 0 free, >= QNAV_MAP_OCCUPIED occupied) and plan cost; for tests
- * and pictures. Out of the map: 0 and QNAV_MAP_UNREACHED. qnav_map_cost first finishes
- * the plan qnav_map_guide() settled only as far as it needed. */
+/* The evidence (< 0 free, >= QNAV_MAP_OCCUPIED occupied) and plan cost of the cell holding
+ * pose-frame point (x, y); for tests and pictures. Out of the map: 0 and
+ * QNAV_MAP_UNREACHED. qnav_map_cost first finishes the plan qnav_map_guide() settled only
+ * as far as it needed. */
 int8_t qnav_map_evidence(const qnav_map_t *m, int32_t x_mm, int32_t y_mm);
 uint16_t qnav_map_cost(qnav_map_t *m, int32_t x_mm, int32_t y_mm);
+
+/* The pose-frame point of grid-frame point (*x, *y) (cell (i, j)'s corner is x0_mm + i
+ * cell_mm, y0_mm + j cell_mm in the grid's frame), in place; for pictures of a turned grid
+ * (qnav_map_config_t.align_samples). */
+void qnav_map_grid_to_pose(const qnav_map_t *m, int32_t *x_mm, int32_t *y_mm);
 
 #ifdef __cplusplus
 }

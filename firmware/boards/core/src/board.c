@@ -106,7 +106,7 @@ void qnav_board_map_info(const qnav_map_config_t *cfg, uint32_t bytes,
                          qnav_board_map_info_t *info)
 {
     /* every field, little-endian, in the struct's order: the CRC's bytes */
-    uint8_t b[26];
+    uint8_t b[28];
     uint8_t *p = b;
     if (info == NULL) {
         return;
@@ -137,6 +137,8 @@ void qnav_board_map_info(const qnav_map_config_t *cfg, uint32_t bytes,
     *p++ = cfg->grow_steps;
     p = put_le16(p, cfg->forget_reach_mm);
     p = put_le16(p, cfg->opening_mm);
+    *p++ = cfg->unknown_cost;
+    *p++ = cfg->align_samples;
     info->crc = qnav_link_crc16(QNAV_LINK_CRC16_INIT, b, (uint16_t)(p - b));
 }
 
