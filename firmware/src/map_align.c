@@ -98,14 +98,31 @@ static int agreed(const qnav_map_t *m, int32_t *dir)
            (len << shift) >= (uint32_t)AGREE_PCT * 16384u / 100u * m->align_n;
 }
 
+/* Cosine and sine (Q2.14) of a, 0.01 deg, 0..35999: a multiple of 45 deg exactly (four
+ * times a sector's direction at 4, 8, 16 or 32 sectors), else by the CORDIC. */
+static void of_angle(int32_t a, int16_t *c, int16_t *s)
+{
+    static const int16_t eighths[8] = {16384, 11585, 0, -11585, -16384, -11585, 0, 11585};
+    if (a % 4500 == 0) {
+        *c = eighths[a / 4500];
+        *s = eighths[(a / 4500 + 6) % 8];
+        return;
+    }
+    qnav_cos_sin_q14(a, c, s);
+}
+
 int qnav_align_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *pose)
 {
     const uint16_t n = m->n_sectors;
+    const uint16_t before = m->align_n;
     uint16_t k, counted = 0u;
-    int32_t est, off;
+    int32_t est, off, tc = 0, ts = 0;
+    int16_t hc, hs;
     if (m->cfg.align_samples == 0u || n < 3u) {
         return 0;
     }
+    /* this tick's readings in the robot's frame (four times their directions), then turned
+     * by four times the heading once: a CORDIC is thousands of an AVR's cycles */
     for (k = 0; k < n; ++k) {
         const qnav_mm_t r = ranges_mm[k], right = ranges_mm[k + 1u == n ? 0u : k + 1u];
         uint32_t at = (uint32_t)k * 2u; /* half sectors */
@@ -120,19 +137,30 @@ int qnav_align_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map
             }
             ++at;
         }
-        /* four times the reading's direction, wrapped: sector k's centre is k 36000 / n */
-        qnav_cos_sin_q14(4 * (qnav_wrap_cdeg(pose->heading_cdeg) + (int32_t)(at * 18000u / n)) % 36000,
-                         &c, &s);
-        m->align_c += c;
-        m->align_s += s;
+        of_angle((int32_t)(4u * (at * 18000u / n) % 36000u), &c, &s); /* sector k: k 36000 / n */
+        tc += c;
+        ts += s;
         ++counted;
-        if (++m->align_n >= COUNT_MAX) {
-            m->align_c /= 2;
-            m->align_s /= 2;
-            m->align_n /= 2u;
-        }
     }
-    if (counted == 0u || !agreed(m, &est)) {
+    if (counted == 0u) {
+        return 0;
+    }
+    qnav_cos_sin_q14(4 * (int32_t)qnav_wrap_cdeg(pose->heading_cdeg) % 36000, &hc, &hs);
+    if (tc > -65536 && tc < 65536 && ts > -65536 && ts < 65536) { /* products below 2^30 */
+        m->align_c += ((int32_t)hc * tc - (int32_t)hs * ts) / 16384;
+        m->align_s += ((int32_t)hs * tc + (int32_t)hc * ts) / 16384;
+    } else { /* more than 4 readings a tick (more than 8 sectors): 64 bits */
+        m->align_c += (int32_t)(((int64_t)hc * tc - (int64_t)hs * ts) / 16384);
+        m->align_s += (int32_t)(((int64_t)hs * tc + (int64_t)hc * ts) / 16384);
+    }
+    m->align_n = (uint16_t)(m->align_n + counted);
+    if (m->align_n >= COUNT_MAX) {
+        m->align_c /= 2;
+        m->align_s /= 2;
+        m->align_n /= 2u;
+    }
+    /* whether the readings agree, every 8 counted (an arctangent a tick is most of the cost) */
+    if (m->align_n / 8u == before / 8u || !agreed(m, &est)) {
         return 0;
     }
     off = est - m->grid_cdeg; /* both in -4500..4499: off in -8999..8999, modulo 9000 */
