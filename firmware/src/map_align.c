@@ -42,9 +42,9 @@ void qnav_align_start(qnav_map_t *m, int32_t x_mm, int32_t y_mm)
 }
 
 /* (x, y) turned about the pivot by the angle whose cosine is the grid's and sine s, Q2.14.
- * Within 2^16 mm of the pivot (every pose a map of at most 192 cells of 1 m can hold) each
+ * Within 2^16 mm of the pivot (any pose on a board's map: 11.2 m for the TekBot's) each
  * product is below 2^30 and 32 bits do (an AVR's 64-bit product costs a thousand cycles);
- * farther, 64. */
+ * farther (a map of 1 m cells spans up to 192 m), 64. */
 static void turn(const qnav_map_t *m, int32_t *x_mm, int32_t *y_mm, int32_t s)
 {
     const int32_t c = m->grid_cos, dx = *x_mm - m->pivot_x_mm, dy = *y_mm - m->pivot_y_mm;
