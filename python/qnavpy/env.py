@@ -51,7 +51,9 @@ class Env:
     ``robot``: a profile name or file; ``sectors``: sonar sectors (0: the robot's default);
     ``sensor_noise``/``actuation_noise``: p in [0, 1] (None: the profile's typical, as
     qnav-sim); ``seed``: the context seed; ``episode_limit_s`` (0: the world's);
-    ``fitness``: "progress" or "paper". ``controller``/``policy``/``table``: the controller
+    ``fitness``: "progress" or "paper"; ``map_frame_deg``: a profile's map's grid against the
+    world's walls, deg in [0, 360) (None: drawn per episode, as ``qnav-sim run --map-frame``'s
+    default; docs/sim.md, "The map's grid"). ``controller``/``policy``/``table``: the controller
     that decides when :meth:`step` is given no action (default: the robot's tuned
     probabilistic policy on the "body" controller).
 
@@ -68,12 +70,13 @@ class Env:
     metadata = {"render_modes": []}
 
     def __init__(self, world="dense", robot="pioneer3dx", *, sectors=0, sensor_noise=None, actuation_noise=None,
-                 seed=1, episode_limit_s=0.0, fitness="progress", controller="body", policy=None, table=False):
+                 seed=1, episode_limit_s=0.0, fitness="progress", controller="body", policy=None, table=False,
+                 map_frame_deg=None):
         handle = ctypes.c_void_p()
         _lib.call(lib.qpy_env_create, encode(robot), encode(world), int(sectors),
                   -1.0 if sensor_noise is None else float(sensor_noise),
                   -1.0 if actuation_noise is None else float(actuation_noise), int(seed), float(episode_limit_s),
-                  encode(fitness), ctypes.byref(handle))
+                  encode(fitness), -1.0 if map_frame_deg is None else float(map_frame_deg), ctypes.byref(handle))
         self._handle = handle
         self.world = World(world)
         self.robot = Robot(robot)

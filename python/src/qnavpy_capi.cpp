@@ -12,6 +12,7 @@
 #include <cstring>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -289,7 +290,8 @@ int qpy_policy_write(const char *path, int32_t kind, int32_t hidden, int32_t inp
 }
 
 int qpy_env_create(const char *robot, const char *world, int32_t sectors, double sensor_noise,
-                   double actuation_noise, uint64_t seed, double limit_s, const char *fitness, qpy_env_t **out,
+                   double actuation_noise, uint64_t seed, double limit_s, const char *fitness,
+                   double map_frame_deg, qpy_env_t **out,
                    char *err, size_t errlen) {
     *out = nullptr;
     return guarded(err, errlen, [&] {
@@ -315,6 +317,13 @@ int qpy_env_create(const char *robot, const char *world, int32_t sectors, double
         cfg.seed = seed;
         cfg.episode_limit_s = limit_s;
         cfg.fitness = rule;
+        if (map_frame_deg >= 360.0 || std::isnan(map_frame_deg)) {  // qnav-sim run --map-frame's line
+            std::ostringstream got;
+            got << map_frame_deg;
+            return fail(err, errlen, "--map-frame: expected a number in [0, 360), got '" + got.str() + "'",
+                        QNAV_SIM_E_PARAM);
+        }
+        cfg.map_frame_deg = map_frame_deg;
         st = qnav_sim_create(e->robot, e->world, &cfg, &e->sim, err, errlen);
         if (st != QNAV_SIM_OK) return static_cast<int>(st);
         qnav_ctrl_config_t cc;

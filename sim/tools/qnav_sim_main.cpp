@@ -577,7 +577,14 @@ static CLI::App *add_run(CLI::App &app, RunOpts &o) {
     run->add_option("--map-frame", o.map_frame,
                     "a profile's [map]: its grid's angle to the arena's walls, deg in [0, 360) (default: drawn "
                     "per episode, as a board's heading sensor lies to a room; 0: aligned, the figures before 0.18)")
-        ->check(qnav::cli::finite_range(0.0, 359.999999));
+        ->check(CLI::Validator(
+            [](std::string &s) -> std::string {
+                double v = 0.0;
+                return CLI::detail::lexical_cast(s, v) && std::isfinite(v) && v >= 0.0 && v < 360.0
+                           ? std::string()
+                           : "expected a number in [0, 360), got '" + s + "'";
+            },
+            "NUMBER in [0 - 360)"));
     run->add_option("--svg", o.svg, "write the first episode's picture here");
     run->add_option("--trace", o.trace, "write the first episode's trajectory here (CSV, one row per tick)");
     run->add_option("--svg-tick", o.svg_tick, "tick whose sonar sectors are drawn (default 0; past the end: the last tick)")->check(CLI::NonNegativeNumber);

@@ -109,6 +109,20 @@ class SteppedEpisodeEqualsQnavSimRun(unittest.TestCase):
         self.assertEqual(mine, rows)
         self.assertEqual(episode_line(1, result), line)
 
+    def test_the_maps_grid_turned_as_qnav_sim_turns_it(self):
+        for frame in (None, 30):
+            with self.subTest(map_frame_deg=frame):
+                extra = () if frame is None else ("--map-frame", str(frame))
+                rows, line = qnav_sim_trace(self.work, "--env", "gen:rooms:4", "--robot", "tekbot", "--seed", "3",
+                                            "--episode", "1", *extra)
+                env = qnavpy.Env("gen:rooms:4", "tekbot", seed=3, map_frame_deg=frame)
+                mine, _, _, result = stepped_rows(env, 1)
+                self.assertEqual(mine, rows)
+                self.assertEqual(episode_line(1, result), line)
+        turned, _ = qnav_sim_trace(self.work, "--env", "gen:rooms:4", "--robot", "tekbot", "--seed", "3",
+                                   "--episode", "1", "--map-frame", "0")
+        self.assertNotEqual(turned, rows)  # the turn reaches the episode
+
     def test_python_controller_deciding_from_observations_is_the_c_step(self):
         # the controller stepped on each observation from Python, its decision given back
         # as (heading, speed): every decision must equal the one qnav-sim run made (VFH+
@@ -315,6 +329,7 @@ class BadInputRaisesTheToolsLine(unittest.TestCase):
             (dict(controller="bug2"), ["--controller", "bug2"]),
             (dict(policy=bad_file), ["--policy", bad_file]),
             (dict(fitness="fast"), ["--fitness", "fast"]),
+            (dict(map_frame_deg=400), ["--map-frame", "400"]),
         ]
         for kwargs, args in cases:
             with self.subTest(args=args):
