@@ -163,14 +163,17 @@ void qnav_fx_write_map_trace(const char *root, const char *out_dir, const char *
     fprintf(f, "}\n/* The board's memory for the map ([map] bytes) */\n#define QNAV_BENCH_MAP_BYTES %lu\n\n",
             (unsigned long)most);
     fprintf(f, "/* The profile's map and the controller fields it reads (qnav/map.h) */\n");
-    fprintf(f, "#define QNAV_BENCH_MAP_CONFIG {%u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u, %u}\n",
-            (unsigned)mc.cell_mm, (unsigned)mc.reach_mm, (unsigned)mc.look_mm,
-            (unsigned)mc.jump_mm, (unsigned)mc.plan_ticks, (unsigned)mc.noise_pct,
-            (unsigned)mc.near_cost, (unsigned)mc.near_mm, (unsigned)mc.arc_cdeg,
-            (unsigned)mc.sight, (unsigned)mc.escape_grow, (unsigned)mc.refuse_ticks,
-            (unsigned)mc.refuse_life_ticks, (unsigned)mc.compact, (unsigned)mc.grow_steps,
-            (unsigned)mc.forget_reach_mm, (unsigned)mc.opening_mm, (unsigned)mc.unknown_cost,
-            (unsigned)mc.align_samples);
+    {
+#define MAP_FIELD_VALUE(name, bits) (unsigned)mc.name,
+        const unsigned values[] = {QNAV_MAP_CONFIG_FIELDS(MAP_FIELD_VALUE)};
+#undef MAP_FIELD_VALUE
+        size_t k;
+        fprintf(f, "#define QNAV_BENCH_MAP_CONFIG {");
+        for (k = 0; k < sizeof values / sizeof values[0]; ++k) {
+            fprintf(f, "%s%u", k ? ", " : "", values[k]);
+        }
+        fprintf(f, "}\n");
+    }
     fprintf(f, "#define QNAV_BENCH_MAP_SECTORS %u\n#define QNAV_BENCH_MAP_RANGE_MM %u\n"
                "#define QNAV_BENCH_MAP_OFFSET_MM %u\n#define QNAV_BENCH_MAP_RADIUS_MM %u\n"
                "#define QNAV_BENCH_MAP_SAFETY_MM %u\n\n#endif\n",

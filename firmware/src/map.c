@@ -43,6 +43,21 @@ typedef struct {
     char c;
     uint16_t u;
 } u16_alignment_t;
+/* QNAV_MAP_CONFIG_FIELDS lays out as qnav_map_config_t: a struct of the list's fields has
+ * the same size, and each field the same place and size (a field the list leaves out moves
+ * the ones after it, or on the ATmega128 the size). */
+#define MIRROR_FIELD(name, bits) uint##bits##_t name;
+typedef struct {
+    QNAV_MAP_CONFIG_FIELDS(MIRROR_FIELD)
+} config_mirror_t;
+#define SAME_PLACE(name, bits)                                                              \
+    &&offsetof(config_mirror_t, name) == offsetof(qnav_map_config_t, name) &&             \
+        sizeof(((const config_mirror_t *)0)->name) == sizeof(((const qnav_map_config_t *)0)->name)
+typedef char config_fields_listed[sizeof(config_mirror_t) == sizeof(qnav_map_config_t)
+                                          QNAV_MAP_CONFIG_FIELDS(SAME_PLACE)
+                                      ? 1
+                                      : -1];
+
 /* Buckets of the plan's queue: the largest step (14 + near_cost) + 1. */
 #define BUCKETS 270u
 

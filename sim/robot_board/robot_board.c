@@ -60,25 +60,32 @@ static void put_map(FILE *out, const qnav_sim_robot_t *robot, const char *up)
     if (!qnav_sim_robot_map_config(robot, &mc)) {
         return;
     }
-    fprintf(out,
-            "/* The profile's [map], on: the map the board places at each position goal\n"
-            " * (qnav_board_place_maps), a qnav_map_config_t. */\n"
-            "#define QNAV_ROBOT_%s_MAP_CONFIG \\\n"
-            "    { \\\n"
-            "        .cell_mm = %u, .reach_mm = %u, .look_mm = %u, .jump_mm = %u, \\\n"
-            "        .plan_ticks = %u, .noise_pct = %u, .near_cost = %u, .near_mm = %u, \\\n"
-            "        .arc_cdeg = %u, .sight = %u, .escape_grow = %u, .refuse_ticks = %u, \\\n"
-            "        .refuse_life_ticks = %u, .compact = %u, .grow_steps = %u, \\\n"
-            "        .forget_reach_mm = %u, .opening_mm = %u, .unknown_cost = %u, \\\n"
-            "        .align_samples = %u \\\n"
-            "    }\n\n",
-            up, (unsigned)mc.cell_mm, (unsigned)mc.reach_mm, (unsigned)mc.look_mm,
-            (unsigned)mc.jump_mm, (unsigned)mc.plan_ticks, (unsigned)mc.noise_pct,
-            (unsigned)mc.near_cost, (unsigned)mc.near_mm, (unsigned)mc.arc_cdeg,
-            (unsigned)mc.sight, (unsigned)mc.escape_grow, (unsigned)mc.refuse_ticks,
-            (unsigned)mc.refuse_life_ticks, (unsigned)mc.compact, (unsigned)mc.grow_steps,
-            (unsigned)mc.forget_reach_mm, (unsigned)mc.opening_mm, (unsigned)mc.unknown_cost,
-            (unsigned)mc.align_samples);
+    {
+#define MAP_FIELD_ENTRY(name, bits) {#name, (unsigned)mc.name},
+        const struct {
+            const char *name;
+            unsigned value;
+        } fields[] = {QNAV_MAP_CONFIG_FIELDS(MAP_FIELD_ENTRY)};
+#undef MAP_FIELD_ENTRY
+        size_t k, col = 0u;
+        fprintf(out,
+                "/* The profile's [map], on: the map the board places at each position goal\n"
+                " * (qnav_board_place_maps), a qnav_map_config_t. */\n"
+                "#define QNAV_ROBOT_%s_MAP_CONFIG \\\n"
+                "    { \\\n",
+                up);
+        for (k = 0; k < sizeof fields / sizeof fields[0]; ++k) {
+            char one[64];
+            const int len = snprintf(one, sizeof one, ".%s = %u%s", fields[k].name, fields[k].value,
+                                     k + 1u < sizeof fields / sizeof fields[0] ? "," : "");
+            if (col != 0u && col + 1u + (size_t)len > 86u) { /* the line's end: a continuation */
+                fputs(" \\\n", out);
+                col = 0u;
+            }
+            col += (size_t)fprintf(out, "%s%s", col == 0u ? "        " : " ", one);
+        }
+        fputs(" \\\n    }\n\n", out);
+    }
     if (qnav_sim_robot_map_bytes(robot) != 0u) {
         fprintf(out,
                 "/* The profile's [map] bytes: the board's memory for that map, the largest\n"

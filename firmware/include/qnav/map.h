@@ -109,6 +109,18 @@ typedef struct {
                               walls"). 0: the grid stays in the pose's frame; default 0 */
 } qnav_map_config_t;
 
+/* Every field of qnav_map_config_t in its order, with its width in bits: the one list that
+ * whatever copies a configuration field by field walks (the board's CRC of it, and the
+ * robot headers and map bench trace the tools write). map.c checks at build time that the
+ * list lays out as the struct does (on the ATmega128, with no padding, byte for byte): a
+ * field added to the struct is added here, or the build fails. */
+#define QNAV_MAP_CONFIG_FIELDS(X)                                                            \
+    X(cell_mm, 16) X(reach_mm, 16) X(look_mm, 16) X(jump_mm, 16) X(plan_ticks, 8)            \
+    X(noise_pct, 8) X(near_cost, 8) X(near_mm, 16) X(arc_cdeg, 16) X(sight, 8)               \
+    X(escape_grow, 8) X(refuse_ticks, 8) X(refuse_life_ticks, 16) X(compact, 8)              \
+    X(grow_steps, 8) X(forget_reach_mm, 16) X(opening_mm, 16) X(unknown_cost, 8)             \
+    X(align_samples, 8)
+
 /* The robot's pose in the destination's frame. */
 typedef struct {
     int32_t x_mm;

@@ -102,11 +102,22 @@ static uint8_t *put_le16(uint8_t *p, uint16_t v)
     return p + 2;
 }
 
+/* v at p; the byte after it. */
+static uint8_t *put_le8(uint8_t *p, uint8_t v)
+{
+    p[0] = v;
+    return p + 1;
+}
+
+/* A map configuration's field in the CRC's bytes, and how many it takes. */
+#define PUT_MAP_FIELD(name, bits) p = put_le##bits(p, cfg->name);
+#define MAP_FIELD_BYTES(name, bits) +(bits) / 8
+
 void qnav_board_map_info(const qnav_map_config_t *cfg, uint32_t bytes,
                          qnav_board_map_info_t *info)
 {
     /* every field, little-endian, in the struct's order: the CRC's bytes */
-    uint8_t b[28];
+    uint8_t b[0 QNAV_MAP_CONFIG_FIELDS(MAP_FIELD_BYTES)];
     uint8_t *p = b;
     if (info == NULL) {
         return;
@@ -120,25 +131,7 @@ void qnav_board_map_info(const qnav_map_config_t *cfg, uint32_t bytes,
     info->cell_mm = cfg->cell_mm;
     info->reach_mm = cfg->reach_mm;
     info->compact = cfg->compact;
-    p = put_le16(p, cfg->cell_mm);
-    p = put_le16(p, cfg->reach_mm);
-    p = put_le16(p, cfg->look_mm);
-    p = put_le16(p, cfg->jump_mm);
-    *p++ = cfg->plan_ticks;
-    *p++ = cfg->noise_pct;
-    *p++ = cfg->near_cost;
-    p = put_le16(p, cfg->near_mm);
-    p = put_le16(p, cfg->arc_cdeg);
-    *p++ = cfg->sight;
-    *p++ = cfg->escape_grow;
-    *p++ = cfg->refuse_ticks;
-    p = put_le16(p, cfg->refuse_life_ticks);
-    *p++ = cfg->compact;
-    *p++ = cfg->grow_steps;
-    p = put_le16(p, cfg->forget_reach_mm);
-    p = put_le16(p, cfg->opening_mm);
-    *p++ = cfg->unknown_cost;
-    *p++ = cfg->align_samples;
+    QNAV_MAP_CONFIG_FIELDS(PUT_MAP_FIELD)
     info->crc = qnav_link_crc16(QNAV_LINK_CRC16_INIT, b, (uint16_t)(p - b));
 }
 
