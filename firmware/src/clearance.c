@@ -97,6 +97,27 @@ static uint8_t enlarge_deg(uint32_t margin_mm, uint32_t d_mm)
     return 90;
 }
 
+/* A reading placed on the central part of its wedge (wedge_pct) leaves its wedge's edges
+ * free, where the obstacle may lie: safe only while its enlargement covers that edge by the
+ * time the robot must brake for it, so the edge left free is at most the enlargement at the
+ * distance the speed guard needs from full speed, r + d_s + 2 v T + v^2 / (2 a) (a reaction
+ * tick, and a tick more: the robot is anywhere within v T of that distance on the first
+ * tick that sees it nearer), in degrees; 90 without the guard. At the profiles' default
+ * sectors it does not bind; a Pioneer at 8 sectors (45 deg wedges, the 16-sector placement)
+ * touched something in 0.43 of its episodes (docs/architecture.md, "Wedge placement"). */
+static uint8_t wedge_cover_deg(const qnav_ctrl_config_t *cfg)
+{
+    const uint32_t v = cfg->v_max_mm_s, a = cfg->decel_mm_s2;
+    uint32_t d;
+    if (v == 0u || a == 0u) {
+        return 90u;
+    }
+    /* v, a < 2^16: v^2 < 2^32 */
+    d = (uint32_t)cfg->body_radius_mm + cfg->safety_mm + 2u * v * QNAV_GUARD_REACTION_MS / 1000u +
+        v * v / (2u * a);
+    return enlarge_deg((uint32_t)cfg->body_radius_mm + cfg->pass_mm, d > 65535u ? 65535u : d);
+}
+
 /*
  * The enlargement of one reading: the smallest whole degree g with sin g >= margin / D, D the
  * reading's own distance from the centre (range + sensor offset, at most 65535 mm), the same
@@ -268,12 +289,15 @@ qnav_status_t qnav_clearance_setup(qnav_clearance_t *c, const qnav_ctrl_config_t
         return QNAV_E_WEDGE;
     }
     /* paths left out at each edge of a sector: (100 - pct)% of half its 360/N wedge, at
-     * most so many that its middle path stays */
+     * most so many that its middle path stays, and with the speed guard on at most what a
+     * reading's enlargement covers from where the robot must brake (wedge_cover_deg) */
     {
         uint16_t shrink = (uint16_t)(((uint32_t)(100u - cfg->wedge_pct) * QNAV_PATHS) /
                                      (200u * cfg->n_sectors));
         uint16_t keep = (uint16_t)((c->sector_paths - 1u) / 2u);
-        c->wedge_shrink = (uint8_t)(shrink < keep ? shrink : keep);
+        uint8_t cover = wedge_cover_deg(cfg);
+        shrink = shrink < keep ? shrink : keep;
+        c->wedge_shrink = (uint8_t)(shrink < cover ? shrink : cover);
     }
     c->wedge_near_level = qnav_clearance_level_of(
         c, cfg->wedge_near_mm < cfg->max_range_mm ? cfg->wedge_near_mm : cfg->max_range_mm);

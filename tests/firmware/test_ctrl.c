@@ -1209,18 +1209,14 @@ static void test_plain_step_stops_when_not_ready(void **state)
     qnav_ctrl_step_plain(&c, &in, NULL, NULL); /* no output: nothing to write, no crash */
 }
 
-static void reference_levels_wedge(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
-                                   unsigned pct, qnav_mm_t near_mm, uint8_t *lvl);
+static void reference_levels_wedge(const qnav_ctrl_t *c, const qnav_ctrl_config_t *cfg,
+                                   const qnav_mm_t *ranges, uint16_t n, unsigned pct,
+                                   qnav_mm_t near_mm, uint8_t *lvl);
 
-/* The enlargement of one reading as defined (clearance.h): the smallest whole degree g with
- * sin g >= (r + d_s) / D, D the reading's own distance from the centre (range + sensor
- * offset, at most 65535 mm), sin in units of 2^-15 as the library tabulates it; 90 when no
- * degree below 90 suffices, 0 without a margin. Computed here from the configuration, not
- * from the library's per-level table: the level's floor is not the reading. */
-static int reference_gamma(const qnav_ctrl_t *c, qnav_mm_t range_mm)
+/* The smallest whole degree g with sin g >= margin / d (sin in units of 2^-15, d at most
+ * 65535 mm); 0 without a margin. */
+static int reference_asin_deg(unsigned long margin, unsigned long d)
 {
-    unsigned long margin = (unsigned long)c->clr.margin_mm;
-    unsigned long d = (unsigned long)range_mm + c->clr.sensor_offset_mm;
     if (margin == 0u) {
         return 0;
     }
@@ -1239,6 +1235,17 @@ static int reference_gamma(const qnav_ctrl_t *c, qnav_mm_t range_mm)
     return 90;
 }
 
+/* The enlargement of one reading as defined (clearance.h): the smallest whole degree g with
+ * sin g >= (r + d_s) / D, D the reading's own distance from the centre (range + sensor
+ * offset, at most 65535 mm), sin in units of 2^-15 as the library tabulates it; 90 when no
+ * degree below 90 suffices, 0 without a margin. Computed here from the configuration, not
+ * from the library's per-level table: the level's floor is not the reading. */
+static int reference_gamma(const qnav_ctrl_t *c, qnav_mm_t range_mm)
+{
+    return reference_asin_deg((unsigned long)c->clr.margin_mm,
+                              (unsigned long)range_mm + c->clr.sensor_offset_mm);
+}
+
 /* The first path whose levels differ (the arrays are known to differ). */
 static unsigned first_difference(const uint8_t *got, const uint8_t *want)
 {
@@ -1254,7 +1261,7 @@ static unsigned first_difference(const uint8_t *got, const uint8_t *want)
 static void reference_levels(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
                              uint8_t *lvl)
 {
-    reference_levels_wedge(c, ranges, n, 100u, 0u, lvl);
+    reference_levels_wedge(c, NULL, ranges, n, 100u, 0u, lvl); /* no edge left free */
 }
 
 /* The step paints each piece only where no neighbour already covers it at a level no
@@ -1311,16 +1318,28 @@ static void test_path_levels_equal_painting_every_sector(void **state)
 /* Wedge placement as defined in words (ctrl.h, wedge_pct): a reading nearer than
  * wedge_near_mm blocks its whole wedge; a farther one leaves shrink paths free at each edge
  * of its sector (shrink = (100 - pct)% of half the 360/N wedge, at most so many that the
- * middle path stays), so path p is placed when the paths shrink either side of it are still
- * in its sector; then each placed path is widened by its reading's gamma. */
-static void reference_levels_wedge(const qnav_ctrl_t *c, const qnav_mm_t *ranges, uint16_t n,
-                                   unsigned pct, qnav_mm_t near_mm, uint8_t *lvl)
+ * middle path stays, and with the speed guard on at most the enlargement asin((r + pass) /
+ * D) at D = r + d_s + 2 v T + v^2 / (2 a), where the robot must brake), so path p is placed
+ * when the paths shrink either side of it are still in its sector; then each placed path
+ * is widened by its reading's gamma. */
+static void reference_levels_wedge(const qnav_ctrl_t *c, const qnav_ctrl_config_t *cfg,
+                                   const qnav_mm_t *ranges, uint16_t n, unsigned pct,
+                                   qnav_mm_t near_mm, uint8_t *lvl)
 {
     unsigned shrink = ((100u - pct) * 360u) / (200u * n);
     unsigned keep = (360u / n - 1u) / 2u;
     uint8_t near_level = qnav_ctrl_level(c, near_mm);
     if (shrink > keep) {
         shrink = keep;
+    }
+    if (cfg != NULL && cfg->v_max_mm_s != 0u && cfg->decel_mm_s2 != 0u) {
+        const double v = cfg->v_max_mm_s, a = cfg->decel_mm_s2;
+        double brake = cfg->body_radius_mm + cfg->safety_mm + 2.0 * v * 0.1 + v * v / (2.0 * a);
+        unsigned cover;
+        brake = floor(brake) > 65535.0 ? 65535.0 : floor(brake);
+        cover = (unsigned)reference_asin_deg((unsigned long)cfg->body_radius_mm + cfg->pass_mm,
+                                             (unsigned long)brake);
+        shrink = shrink < cover ? shrink : cover;
     }
     for (unsigned p = 0; p < QNAV_PATHS; ++p) {
         lvl[p] = QNAV_DIST_LEVELS - 1;
@@ -1376,7 +1395,7 @@ static void test_wedge_placement_equals_its_definition(void **state)
             structured_scan(ranges, n, 4000, k, &goal);
         }
         assert_int_equal(qnav_ctrl_path_levels(&c, ranges, got) & QNAV_FLAG_NOT_READY, 0);
-        reference_levels_wedge(&c, ranges, n, pct, near_mm, want);
+        reference_levels_wedge(&c, &cfg, ranges, n, pct, near_mm, want);
         if (memcmp(got, want, sizeof got) != 0) {
             unsigned q = first_difference(got, want);
             fail_msg("scan %u (N = %u, pct %u, near %u): path %u level %u, definition %u", k, n,

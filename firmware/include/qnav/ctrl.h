@@ -113,8 +113,11 @@ typedef struct {
                                          enlargement: the central wedge_pct % of its 360/N
                                          wedge, 0..100 (100: the whole wedge, the most
                                          cautious; 0: the middle path). Per robot and
-                                         sensor (docs/architecture.md, "Wedge placement");
-                                         default 100 */
+                                         sensor (docs/architecture.md, "Wedge placement").
+                                         With the speed guard on, the edge a placement
+                                         leaves free is at most the enlargement at the
+                                         distance the robot needs to brake from v_max
+                                         (r + d_s + 2 v T + v^2 / (2 a)); default 100 */
     qnav_mm_t wedge_near_mm;          /* readings nearer than this block their whole wedge
                                          whatever wedge_pct says, mm; default 0 */
     uint8_t escape_stall_ticks;       /* ticks without progress toward the destination
