@@ -43,6 +43,7 @@ typedef struct {
     char c;
     uint16_t u;
 } u16_alignment_t;
+
 /* QNAV_MAP_CONFIG_FIELDS lays out as qnav_map_config_t: a struct of the list's fields has
  * the same size, and each field the same place and size (a field the list leaves out moves
  * the ones after it, or on the ATmega128 the size). */
@@ -57,6 +58,8 @@ typedef char config_fields_listed[sizeof(config_mirror_t) == sizeof(qnav_map_con
                                           QNAV_MAP_CONFIG_FIELDS(SAME_PLACE)
                                       ? 1
                                       : -1];
+#undef SAME_PLACE
+#undef MIRROR_FIELD
 
 /* Buckets of the plan's queue: the largest step (14 + near_cost) + 1. */
 #define BUCKETS 270u
