@@ -2,8 +2,9 @@
 sense (arrival at twice the limit never below arrival at the limit), several policies
 compared on the same worlds (the summary agrees with the rows it summarizes), the listing
 of failed episodes (its commands draw an episode that missed the limit), a robot profile
-file of a robot not in data/robots (worlds sized for it, its own sector count), and its
-one-line errors for a bad family, a missing profile and a missing simulator."""
+file of a robot not in data/robots (worlds sized for it, its own sector count), the note
+on a sonar noisier than its map allows for, and its one-line errors for a bad family, a
+missing profile and a missing simulator."""
 import os
 import re
 import shlex
@@ -252,6 +253,24 @@ class FamilyEval(unittest.TestCase):
             self.assertNotEqual(r.returncode, 0)
             self.assertIn(words, r.stderr)
             self.assertNotIn("Traceback", r.stderr)
+
+    def test_a_sonar_noisier_than_its_map_allows_for_is_noted(self):
+        # the TekBot's map allows for 0.10 (its [map] noise): 0.15 is noted, once, and the
+        # table follows; the profile's own noise, a map set to allow for it, and a robot
+        # without a map are not
+        base = ("--worlds", "1", "--episodes", "1", "--families", "pocket", "-j", "1")
+        r = tool(*base, "--sensor-noise", "0.15")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        notes = [l for l in r.stderr.splitlines() if "allows for" in l]
+        self.assertEqual(len(notes), 1, r.stderr)
+        self.assertIn("0.15", notes[0])
+        self.assertIn("0.1 ", notes[0])
+        self.assertTrue(ROW.match(r.stdout.splitlines()[2]), r.stdout)
+        for args in (("--sensor-noise", "0.05"), ("--sensor-noise", "0.15", "--set", "map.noise=0.15"),
+                     ("--sensor-noise", "0.15", "--robot", "tekbot-map")):
+            r = tool(*base, *args)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertNotIn("allows for", r.stderr, args)
 
     def test_missing_simulator(self):
         r = subprocess.run([sys.executable, TOOL, "--sim", "/no/such/qnav-sim"],
