@@ -98,11 +98,12 @@ static uint8_t enlarge_deg(uint32_t margin_mm, uint32_t d_mm)
 }
 
 /* A reading placed on the central part of its wedge (wedge_pct) leaves its wedge's edges
- * free, where the obstacle may lie: safe only while its enlargement covers that edge by the
- * time the robot must brake for it, so the edge left free is at most the enlargement at the
- * distance the speed guard needs from full speed, r + d_s + 2 v T + v^2 / (2 a) (a reaction
- * tick, and a tick more: the robot is anywhere within v T of that distance on the first
- * tick that sees it nearer), in degrees; 90 without the guard. At the profiles' default
+ * unpainted, where the obstacle may lie: safe only while its enlargement covers that edge by
+ * the time the robot must brake for it, so the edge left unpainted is at most the
+ * enlargement at the distance the speed guard needs from full speed,
+ * r + d_s + 2 v T + v^2 / (2 a) (a reaction tick, and a tick more: the robot is anywhere
+ * within v T of that distance on the first tick that sees it nearer), in degrees; 90
+ * without the guard. At the profiles' default
  * sectors it does not bind; a Pioneer at 8 sectors (45 deg wedges, the 16-sector placement)
  * touched something in 0.43 of its episodes (docs/architecture.md, "Wedge placement"). */
 static uint8_t wedge_cover_deg(const qnav_ctrl_config_t *cfg)

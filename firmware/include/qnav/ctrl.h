@@ -115,8 +115,8 @@ typedef struct {
                                          cautious; 0: the middle path). Per robot and
                                          sensor (docs/architecture.md, "Wedge placement").
                                          With the speed guard on, the edge a placement
-                                         leaves free is at most the enlargement at the
-                                         distance the robot needs to brake from v_max
+                                         leaves unpainted is at most the enlargement at
+                                         the distance the robot needs to brake from v_max
                                          (r + d_s + 2 v T + v^2 / (2 a)); default 100 */
     qnav_mm_t wedge_near_mm;          /* readings nearer than this block their whole wedge
                                          whatever wedge_pct says, mm; default 0 */

@@ -281,7 +281,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *pose, int32_t goal_x_mm
  * for a caller that keeps the memory elsewhere than the input it gave (qnav_escape_grow). */
 uint16_t qnav_map_grown_mm(const qnav_map_t *m);
 
-/* The evidence (< 0 free, >= QNAV_MAP_OCCUPIED occupied) and plan cost of the cell holding
+/* The evidence (< 0 seen open, >= QNAV_MAP_OCCUPIED occupied) and plan cost of the cell holding
  * pose-frame point (x, y); for tests and pictures. Out of the map: 0 and
  * QNAV_MAP_UNREACHED. qnav_map_cost first finishes the plan qnav_map_guide() settled only
  * as far as it needed. */
