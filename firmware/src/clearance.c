@@ -231,6 +231,9 @@ void qnav_clearance_init(qnav_clearance_t *c, const qnav_ctrl_config_t *cfg)
     c->v_max_mm_s = cfg->v_max_mm_s;
     c->decel_mm_s2 = cfg->decel_mm_s2;
     c->guard_min_level = qnav_clearance_level_of(c, cfg->range_min_mm);
+    c->range_min_mm = cfg->range_min_mm;
+    /* a sonar with no minimum range reads the obstacle's own distance */
+    c->dead_zone_deg = cfg->range_min_mm == 0u ? 0u : enlarge_deg(cfg->body_radius_mm, c->margin_mm);
     for (level = 0; level < QNAV_DIST_LEVELS; ++level) {
         c->enlarge_deg[level] = enlarge_deg(pass, level_distance_mm(c, level));
     }
@@ -503,11 +506,24 @@ uint16_t qnav_clearance_reach_sector(const qnav_clearance_t *c, const qnav_ctrl_
     return k;
 }
 
-/* A sector's enlargement: its reading's own (reading_gamma); none for a sector that saw
- * nothing within range, which is never painted. */
+/*
+ * A sector's enlargement: its reading's own (reading_gamma); none for a sector that saw
+ * nothing within range, which is never painted. A reading at the sonar's minimum range says
+ * only that the obstacle is that near or nearer: as near as the safety distance the robot
+ * keeps, r + d_s from the centre, where the paths that would touch it (pass within r) lie
+ * within asin(r / (r + d_s)) of it (dead_zone_deg: 68 deg for the Pioneer 3-DX, whose
+ * sonar reads 0.1 m for anything nearer from its rim). Where the minimum range lies within
+ * r + d_s of the centre the reading's own enlargement is already at least that, and nothing
+ * changes (docs/architecture.md, "A reading at the sonar's minimum range").
+ */
 static inline uint8_t gamma_of(const qnav_clearance_t *c, qnav_mm_t range_mm, uint8_t level)
 {
-    return level == QNAV_DIST_LEVELS - 1u ? 0u : reading_gamma(c, range_mm, level);
+    uint8_t g;
+    if (level == QNAV_DIST_LEVELS - 1u) {
+        return 0u;
+    }
+    g = reading_gamma(c, range_mm, level);
+    return range_mm <= c->range_min_mm && g < c->dead_zone_deg ? c->dead_zone_deg : g;
 }
 
 /* Every path at the farthest level. On AVR four bytes per iteration: avr-libc's memset

@@ -341,6 +341,79 @@ static void test_reading_gamma_equals_the_walk_for_every_range(void **state)
     }
 }
 
+/* Paths painted by a lone reading at 360 sectors (2 gamma + 1, or none). */
+static unsigned lone_reading_paths(const qnav_clearance_t *c, qnav_mm_t max_mm, qnav_mm_t range_mm)
+{
+    static qnav_mm_t ranges[QNAV_MAX_SECTORS];
+    uint8_t lvl[QNAV_PATHS];
+    unsigned painted = 0;
+    for (uint16_t i = 0; i < QNAV_MAX_SECTORS; ++i) {
+        ranges[i] = max_mm;
+    }
+    ranges[0] = range_mm;
+    qnav_clearance_levels(c, ranges, c->n_sectors, lvl);
+    for (uint16_t p = 0; p < QNAV_PATHS; ++p) {
+        painted += lvl[p] != QNAV_DIST_LEVELS - 1u;
+    }
+    return painted;
+}
+
+/* A reading at the sonar's minimum range (or below: it never reads less) says the obstacle is
+ * that near or nearer, down to the safety distance the robot keeps: it blocks at least the
+ * paths within asin(r / (r + d_s)) of it, which would touch an obstacle r + d_s from the
+ * centre. A reading above the minimum keeps its own enlargement, and so does every reading
+ * of a sonar without a minimum range or one whose minimum lies within r + d_s. The Pioneer
+ * 3-DX (sonar on its 0.26 m rim, 0.1 m minimum, d_s 0.02 m): 2 x 69 + 1 paths at 0.1 m
+ * (asin(0.26 / 0.28) = 68.2 deg), 2 x 51 + 1 at 0.101 m (asin(0.28 / 0.361)). */
+static void test_a_reading_at_the_minimum_range_blocks_what_it_may_touch(void **state)
+{
+    (void)state;
+    static const uint16_t body_mm[] = {0, 120, 260, 400};
+    static const uint16_t safety_mm[] = {0, 20, 50};
+    static const qnav_mm_t offset_mm[] = {0, 120, 260};
+    static const qnav_mm_t min_mm[] = {0, 30, 100, 200};
+    qnav_ctrl_config_t cfg;
+    qnav_clearance_t c;
+    qnav_ctrl_config_default(&cfg);
+    cfg.n_sectors = QNAV_MAX_SECTORS;
+    cfg.max_range_mm = 5000u;
+    cfg.body_radius_mm = 260u;
+    cfg.safety_mm = 20u;
+    cfg.pass_mm = 20u;
+    cfg.sensor_offset_mm = 260u;
+    cfg.range_min_mm = 100u;
+    assert_int_equal(qnav_clearance_setup(&c, &cfg), QNAV_OK);
+    assert_int_equal(lone_reading_paths(&c, cfg.max_range_mm, 100u), 2u * 69u + 1u);
+    assert_int_equal(lone_reading_paths(&c, cfg.max_range_mm, 101u), 2u * 51u + 1u);
+    for (unsigned b = 0; b < sizeof body_mm / sizeof body_mm[0]; ++b) {
+        for (unsigned s = 0; s < sizeof safety_mm / sizeof safety_mm[0]; ++s) {
+            for (unsigned o = 0; o < sizeof offset_mm / sizeof offset_mm[0]; ++o) {
+                for (unsigned m = 0; m < sizeof min_mm / sizeof min_mm[0]; ++m) {
+                    const uint8_t touch = ref_enlarge(body_mm[b], (uint32_t)body_mm[b] + safety_mm[s]);
+                    cfg.body_radius_mm = body_mm[b];
+                    cfg.safety_mm = safety_mm[s];
+                    cfg.pass_mm = (uint16_t)(safety_mm[s] / 2u);
+                    cfg.sensor_offset_mm = offset_mm[o];
+                    cfg.range_min_mm = min_mm[m];
+                    assert_int_equal(qnav_clearance_setup(&c, &cfg), QNAV_OK);
+                    for (uint32_t r = 0; r <= min_mm[m] + 40u; ++r) {
+                        uint8_t g = ref_reading_gamma(&cfg, (qnav_mm_t)r);
+                        if (min_mm[m] != 0u && r <= min_mm[m] && g < touch) {
+                            g = touch;
+                        }
+                        if (lone_reading_paths(&c, cfg.max_range_mm, (qnav_mm_t)r) != 2u * g + 1u) {
+                            fail_msg("body %u mm, safety %u mm, offset %u mm, minimum %u mm, range "
+                                     "%u mm: want %u paths", (unsigned)body_mm[b],
+                                     (unsigned)safety_mm[s], (unsigned)offset_mm[o],
+                                     (unsigned)min_mm[m], (unsigned)r, 2u * g + 1u);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 /* The two distances do one job each: pass_mm alone decides the enlargement (what a reading
  * paints), safety_mm alone what the speed guard leaves to stop in (a TekBot with a map:
  * safety 50 mm, pass 10 mm; docs/architecture.md, "Passing distance"). */
@@ -391,6 +464,7 @@ int main(void)
         cmocka_unit_test(test_speed_cap_equals_the_computation_for_every_level),
         cmocka_unit_test(test_speed_cap_is_zero_at_the_level_of_the_minimum_range),
         cmocka_unit_test(test_reading_gamma_equals_the_walk_for_every_range),
+        cmocka_unit_test(test_a_reading_at_the_minimum_range_blocks_what_it_may_touch),
         cmocka_unit_test(test_pass_sets_the_enlargement_and_safety_the_guard),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

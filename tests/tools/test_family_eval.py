@@ -137,7 +137,8 @@ class FamilyEval(unittest.TestCase):
 
     def test_failures_are_listed_with_commands_that_draw_them(self):
         # fixed seeds: the TekBot without a map misses the limit in these rooms, and one
-        # without its safety distance, speed guard and passing distance (--set: the listed
+        # without its safety distance, speed guard, passing distance and sonar minimum range
+        # (a reading at the minimum range blocks what it may touch; --set: the listed
         # commands drive the edited copy) touches something in denser clutter
         kinds, _ = self.listed("rooms", 2, "--seed-base", "5000007", "--robot", "tekbot-map")
         self.assertTrue({"arrived late", "did not arrive at twice the limit"} <= kinds, kinds)
@@ -145,6 +146,7 @@ class FamilyEval(unittest.TestCase):
             _, touches = self.listed("clutter", 3, "--seed-base", "3000000", "--difficulty", "0.8",
                                      "--set", "clearance.safety_m=0.0",
                                      "--set", "clearance.speed_guard=false", "--set", "map.pass_m=0.0",
+                                     "--set", "sonar.range_min_m=0.0",
                                      env=dict(os.environ, TMPDIR=tmp))
         self.assertGreater(touches, 0)
 

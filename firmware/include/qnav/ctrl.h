@@ -150,7 +150,10 @@ typedef struct {
                                          so the speed guard takes a distance level that
                                          holds it as an obstacle at the transducers (no
                                          room to stop: cap 0 whenever sensor_offset_mm <=
-                                         body_radius_mm + safety_mm). Default 0 */
+                                         body_radius_mm + safety_mm), and the painter
+                                         enlarges a reading at it by at least
+                                         asin(r / (r + d_s)): the paths that would touch an
+                                         obstacle at the safety distance. Default 0 (none) */
 } qnav_ctrl_config_t;
 
 /* The escape memory: what the robot remembers between ticks to leave dead ends
@@ -291,12 +294,16 @@ typedef struct {
     uint8_t guard_full_level;         /* speed guard: levels from here on leave it uncapped */
     uint8_t guard_min_level;          /* speed guard: levels up to this one hold the sonar's
                                          minimum range and are taken as range 0 */
+    uint8_t dead_zone_deg;            /* least enlargement of a reading at the sonar's
+                                         minimum range: asin(r / (r + d_s)); 0 with none */
     uint8_t esc_stall_ticks;          /* escape: ticks without progress; 0: off */
     uint8_t esc_free_level;           /* escape: lowest level of a free path */
     uint16_t esc_follow_ticks;        /* escape: first follow's length, ticks */
     uint16_t margin_mm;               /* body radius + safety distance (speed guard, escape) */
     uint16_t pass_margin_mm;          /* body radius + passing distance (enlargement) */
     qnav_mm_t sensor_offset_mm;
+    qnav_mm_t range_min_mm;           /* the sonar's minimum range: it reads this for anything
+                                         nearer */
     uint16_t v_max_mm_s;
     uint16_t decel_mm_s2;
 } qnav_clearance_t;
