@@ -152,6 +152,18 @@ static uint8_t ref_reading_gamma(const qnav_ctrl_config_t *cfg, qnav_mm_t range_
 
 /* ---- tests ------------------------------------------------------------------------------ */
 
+/* A Pioneer 3-DX's body and sonar (5 m, from its 0.26 m rim) with safety distance safety_mm. */
+static void pioneer_config(qnav_ctrl_config_t *cfg, uint16_t safety_mm)
+{
+    qnav_ctrl_config_default(cfg);
+    cfg->max_range_mm = 5000u;
+    cfg->body_radius_mm = 260u;
+    cfg->safety_mm = safety_mm;
+    cfg->sensor_offset_mm = 260u;
+    cfg->v_max_mm_s = 1000u;
+    cfg->decel_mm_s2 = 600u;
+}
+
 static void setup_range(qnav_clearance_t *c, qnav_mm_t max_range_mm)
 {
     qnav_ctrl_config_t cfg;
@@ -269,13 +281,7 @@ static void test_speed_cap_is_zero_at_the_level_of_the_minimum_range(void **stat
     qnav_clearance_t with_min;
     qnav_clearance_t without;
     uint8_t level;
-    qnav_ctrl_config_default(&cfg);
-    cfg.max_range_mm = 5000u;
-    cfg.body_radius_mm = 260u;
-    cfg.safety_mm = 50u;
-    cfg.sensor_offset_mm = 260u;
-    cfg.v_max_mm_s = 1000u;
-    cfg.decel_mm_s2 = 600u;
+    pioneer_config(&cfg, 50u);
     assert_int_equal(qnav_clearance_setup(&without, &cfg), QNAV_OK);
     cfg.range_min_mm = 100u;
     assert_int_equal(qnav_clearance_setup(&with_min, &cfg), QNAV_OK);
@@ -374,13 +380,9 @@ static void test_a_reading_at_the_minimum_range_blocks_what_it_may_touch(void **
     static const qnav_mm_t min_mm[] = {0, 30, 100, 200};
     qnav_ctrl_config_t cfg;
     qnav_clearance_t c;
-    qnav_ctrl_config_default(&cfg);
+    pioneer_config(&cfg, 20u);
     cfg.n_sectors = QNAV_MAX_SECTORS;
-    cfg.max_range_mm = 5000u;
-    cfg.body_radius_mm = 260u;
-    cfg.safety_mm = 20u;
     cfg.pass_mm = 20u;
-    cfg.sensor_offset_mm = 260u;
     cfg.range_min_mm = 100u;
     assert_int_equal(qnav_clearance_setup(&c, &cfg), QNAV_OK);
     assert_int_equal(lone_reading_paths(&c, cfg.max_range_mm, 100u), 2u * 69u + 1u);
