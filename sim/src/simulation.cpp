@@ -255,6 +255,8 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     mix_l_ = mix_r_ = 0;
     braking_ = false;
     cmd_heading_deg_ = cmd_speed_ = 0;
+    cmd_goal_cdeg_ = 0;
+    cmd_goal_mm_ = 0;
     escape_side_ = 0;
     have_prev_ = false;
     target_heading_ = heading_;
@@ -286,6 +288,8 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
 void Simulation::command(double heading_deg, double speed) {
     cmd_heading_deg_ = std::isfinite(heading_deg) ? heading_deg : 0.0;
     cmd_speed_ = std::isfinite(speed) ? std::clamp(speed, 0.0, 1.0) : 0.0;
+    cmd_goal_cdeg_ = scan_.goal_bearing_cdeg;
+    cmd_goal_mm_ = scan_.goal_range_mm;
     // The decision in the world, from the heading the robot sensed when it made it.
     prev_world_rad_ = sensed_heading_ + cmd_heading_deg_ * kPi / 180.0;
     have_prev_ = true;
@@ -709,6 +713,8 @@ qnav_sim_sample_t Simulation::sample() const {
     s.recovering = recovery_left_ > 0;
     s.collided = collided_this_tick_;
     s.escape_side = escape_side_;
+    s.goal_bearing_deg = cmd_goal_cdeg_ / 100.0;
+    s.goal_range_m = cmd_goal_mm_ / 1000.0;
     return s;
 }
 

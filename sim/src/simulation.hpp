@@ -157,6 +157,8 @@ private:
     double clearance_m_ = 0;            // centre to nearest surface after the last step, m
     bool body_stale_ = false;           // Box2D body not moved since free steps
     double cmd_heading_deg_ = 0, cmd_speed_ = 0;  // last command, as given
+    qnav_cdeg_t cmd_goal_cdeg_ = 0;                // the scan's destination it answered
+    qnav_mm_t cmd_goal_mm_ = 0;
     std::int8_t escape_side_ = 0;                 // the last step's escape side
     double sensed_heading_ = 0;   // heading (with sensor noise) of the current scan, rad
     double prev_world_rad_ = 0;   // last command's heading in the world, rad

@@ -227,7 +227,8 @@ struct EpisodeRecord {
     bool want_pic, want_trace;
     long svg_tick;
     qnav::EpisodePicture pic;
-    std::string csv = "tick,x_m,y_m,heading_rad,speed_mps,cmd_heading_deg,cmd_speed,recovering,collided,escape_side\n";
+    std::string csv = "tick,x_m,y_m,heading_rad,speed_mps,cmd_heading_deg,cmd_speed,recovering,collided,escape_side,"
+                      "goal_bearing_deg,goal_range_m\n";
     bool have_last = false;
     double last_heading = 0, turn_deg = 0;
 
@@ -239,9 +240,10 @@ struct EpisodeRecord {
         last_heading = smp.heading_rad;
         if (want_trace) {
             char line[256];
-            std::snprintf(line, sizeof line, "%u,%.6f,%.6f,%.6f,%.4f,%d,%.4f,%d,%d,%d\n", smp.tick, smp.x_m,
-                          smp.y_m, smp.heading_rad, smp.speed_mps, smp.cmd_heading_deg, smp.cmd_speed,
-                          smp.recovering ? 1 : 0, smp.collided ? 1 : 0, smp.escape_side);
+            std::snprintf(line, sizeof line, "%u,%.6f,%.6f,%.6f,%.4f,%d,%.4f,%d,%d,%d,%.2f,%.3f\n", smp.tick,
+                          smp.x_m, smp.y_m, smp.heading_rad, smp.speed_mps, smp.cmd_heading_deg, smp.cmd_speed,
+                          smp.recovering ? 1 : 0, smp.collided ? 1 : 0, smp.escape_side, smp.goal_bearing_deg,
+                          smp.goal_range_m);
             csv += line;
         }
         if (!want_pic) return;

@@ -37,14 +37,15 @@ def tool_line(stderr, program):
 
 def qnav_sim_trace(work, *args):
     """qnav-sim run's trajectory rows, without the controller's escape side (the controller's
-    memory, not the episode's: the decisions it led to are in the rows), and its episode line."""
+    memory, not the episode's: the decisions it led to are in the rows) and the destination
+    it was given (the map's sub-goal: its input, not the episode's), and its episode line."""
     path = os.path.join(work, "trace.csv")
     st, out, err = run_tool(QNAV_SIM, "run", "--trace", path, *args)
     assert st == 0, err
     with open(path) as f:
         lines = f.read().splitlines()
-    assert lines[0].endswith(",escape_side"), lines[0]
-    rows = [line.rsplit(",", 1)[0] for line in lines[1:]]
+    assert lines[0].endswith(",escape_side,goal_bearing_deg,goal_range_m"), lines[0]
+    rows = [line.rsplit(",", 3)[0] for line in lines[1:]]
     episode = next(line for line in out.splitlines() if line.startswith("episode "))
     return rows, episode
 

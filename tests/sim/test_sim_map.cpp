@@ -9,6 +9,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 
 namespace {
@@ -86,6 +88,61 @@ Run run(const std::string &profile, unsigned n, double sensor_noise = 0.05, doub
         r.collisions += res.collisions;
     }
     return r;
+}
+
+// What the trace's samples say of the destination the controller was given, over one
+// episode in kWall: the largest planned distance beyond the straight one from the pose the
+// command was made at (the sample before), and how far the given range and bearing stray
+// from the straight line's when the map is off.
+struct GoalSeen {
+    double longest_detour_m = 0;   // max over ticks of given range - straight distance
+    double worst_range_err_m = 0;  // without a map: |given - straight|
+    double worst_bearing_err_deg = 0;
+    double last_x = 0, last_y = 0, last_heading = 0;
+    bool have_last = false;
+    unsigned ticks = 0;
+};
+
+void see_goal(void *user, const qnav_sim_sample_t *s) {
+    GoalSeen &g = *static_cast<GoalSeen *>(user);
+    if (g.have_last && s->tick > 0) {
+        const double dx = 3.0 - g.last_x, dy = 8.5 - g.last_y;  // kWall's destination
+        const double straight = std::hypot(dx, dy);
+        double bearing = (std::atan2(dy, dx) - g.last_heading) * 180.0 / M_PI;
+        bearing = std::remainder(bearing, 360.0);
+        g.longest_detour_m = std::max(g.longest_detour_m, s->goal_range_m - straight);
+        g.worst_range_err_m = std::max(g.worst_range_err_m, std::fabs(s->goal_range_m - straight));
+        g.worst_bearing_err_deg =
+            std::max(g.worst_bearing_err_deg, std::fabs(std::remainder(s->goal_bearing_deg - bearing, 360.0)));
+        ++g.ticks;
+    }
+    g.last_x = s->x_m;
+    g.last_y = s->y_m;
+    g.last_heading = s->heading_rad;
+    g.have_last = true;
+}
+
+GoalSeen goal_seen(const std::string &profile) {
+    WallSim w(profile, 0.0, 0.0);
+    GoalSeen g;
+    qnav_sim_result_t res;
+    assert_int_equal(qnav_sim_run_episode(w.sim, &w.ctrl, 0, &res, see_goal, &g), QNAV_SIM_OK);
+    return g;
+}
+
+// The trace carries the destination each command answered: without a map the straight one
+// (to the scan's mm and its heading's noise-free 0.01 deg), with one the plan's way round
+// the wall, metres longer than the straight line once the wall is seen.
+void test_the_trace_carries_the_destination_the_controller_was_given(void **) {
+    const GoalSeen without = goal_seen(tekbot_with(""));
+    const GoalSeen with = goal_seen(tekbot_with("[map]\ncell_m = 0.1\n"));
+    print_message("trace: without a map range error %.4f m, bearing error %.3f deg over %u ticks; with "
+                  "one the longest detour %.2f m\n",
+                  without.worst_range_err_m, without.worst_bearing_err_deg, without.ticks, with.longest_detour_m);
+    assert_true(without.ticks > 10);
+    assert_true(without.worst_range_err_m < 0.002);
+    assert_true(without.worst_bearing_err_deg < 0.02);
+    assert_true(with.longest_detour_m > 1.0);
 }
 
 void test_the_map_finds_the_gap_the_policy_alone_misses(void **) {
@@ -388,6 +445,7 @@ void test_the_maps_opening_comes_from_the_profile(void **) {
 int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_the_map_finds_the_gap_the_policy_alone_misses),
+        cmocka_unit_test(test_the_trace_carries_the_destination_the_controller_was_given),
         cmocka_unit_test(test_the_maps_grid_is_turned_against_the_walls),
         cmocka_unit_test(test_an_empty_arena_with_the_compact_map_is_no_dead_end),
         cmocka_unit_test(test_the_step_api_carries_what_the_map_did_to_the_escape),

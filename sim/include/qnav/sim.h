@@ -261,6 +261,10 @@ typedef struct {
     bool collided;             /* a new collision started this tick */
     int8_t escape_side;        /* the controller's escape after this tick's step: 0 none,
                                   +1 / -1 following a boundary on the right / left */
+    double goal_bearing_deg;   /* the destination the command answered, as the controller
+                                  was given it: robot frame, deg; with a map, the plan's
+                                  sub-goal (0 before the first command) */
+    double goal_range_m;       /* its range, m: with a map, the planned distance */
 } qnav_sim_sample_t;
 
 /* Called once per sample; user is passed through. */
