@@ -39,6 +39,11 @@ int qnav_drive_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_
     return brakes(forward_part(magnitude(heading_deg), speed), rolling);
 }
 
+int qnav_drive_servo_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t rolling)
+{
+    return magnitude(heading_deg) >= 90 && rolling > QNAV_DRIVE_STOPPED;
+}
+
 void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling,
                     uint16_t turn_full_deg, qnav_q1_15_t *left, qnav_q1_15_t *right)
 {

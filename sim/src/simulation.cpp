@@ -502,12 +502,13 @@ static BoardDecision board_decision(double heading_rad, double speed, double rol
 }
 
 // [drive] model "mix": the decision as the board turns it into wheel speeds, held for the
-// tick. Model "heading": whether this tick brakes before it turns, as the mix would.
+// tick. Model "heading": whether this tick brakes before it turns back (a servo brakes and
+// turns at once otherwise).
 void Simulation::drive_targets(double heading_rad, double speed) {
     const BoardDecision d =
         board_decision(heading_rad, speed, (wheel_l_ + wheel_r_) / 2 / robot_.v_max_mps);
     if (!robot_.drive_mix) {
-        braking_ = robot_.brake_first && qnav_drive_brakes_first(d.deg, d.speed, d.rolling) != 0;
+        braking_ = robot_.brake_first && qnav_drive_servo_brakes_first(d.deg, d.rolling) != 0;
         return;
     }
     qnav_q1_15_t l = 0, r = 0;

@@ -133,6 +133,23 @@ static void test_the_turn_is_full_at_turn_full_deg(void **state)
     assert_int_equal(l90, 32767 * 30 / 360);
 }
 
+/* qnav_drive_servo_brakes_first(): a turn back (90 deg and beyond either way) while the
+ * robot rolls faster than QNAV_DRIVE_STOPPED, and nothing else, whatever the speed asked. */
+static void test_a_servo_brakes_first_only_to_turn_back(void **state)
+{
+    static const int rolls[] = {-32767, 0, QNAV_DRIVE_STOPPED, QNAV_DRIVE_STOPPED + 1, 32767};
+    int h, k, braked = 0;
+    (void)state;
+    for (h = -180; h <= 180; ++h) {
+        for (k = 0; k < (int)(sizeof rolls / sizeof rolls[0]); ++k) {
+            const int b = qnav_drive_servo_brakes_first((qnav_deg_t)h, (qnav_q1_15_t)rolls[k]);
+            assert_int_equal(b, (h >= 90 || h <= -90) && rolls[k] > QNAV_DRIVE_STOPPED);
+            braked += b;
+        }
+    }
+    assert_int_equal(braked, 2 * 182); /* 91 headings each side, two rolling speeds */
+}
+
 /* qnav_drive_brakes_first() is the mixer's own brake: for every heading, several speeds
  * and rolling speeds either side of QNAV_DRIVE_STOPPED, it says 1 exactly when the mixer
  * stops both wheels of a robot that rolls, and never for one that does not. */
@@ -190,6 +207,7 @@ int main(void)
         cmocka_unit_test(test_at_a_wheels_limit_the_arc_is_kept),
         cmocka_unit_test(test_a_turn_in_place_brakes_first_while_the_robot_rolls),
         cmocka_unit_test(test_brakes_first_is_when_the_mixer_brakes),
+        cmocka_unit_test(test_a_servo_brakes_first_only_to_turn_back),
         cmocka_unit_test(test_the_turn_is_full_at_turn_full_deg),
         cmocka_unit_test(test_rolling_is_the_travel_as_a_fraction_of_full_speed),
     };

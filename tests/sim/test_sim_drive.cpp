@@ -240,6 +240,21 @@ static void test_the_pioneer_brakes_before_a_turn_in_place(void **state) {
     assert_true(c.y_m > 2.05);
 }
 
+// A stop the speed guard asks with the way on 30 deg to one side is no turn back: the
+// Pioneer's servo brakes at 0.6 m/s^2 and turns toward it at once (separate translational
+// and rotational profiles, qnav_drive_servo_brakes_first), curving away from the line it
+// braked along before (0.19.0; docs/sim.md, "Brake, then turn").
+static void test_the_pioneer_brakes_and_turns_at_once_for_a_small_turn(void **state) {
+    (void)state;
+    TestSim t;
+    pioneer_at_full_speed(t, "brake_first = true", "brake_first = true");
+    const qnav_sim_state_t a = drive(t.sim, 30.0, 0.0, 3);
+    print_message("a stop with the way 30 deg left: %.3f m/s, heading %.3f rad after 0.3 s\n", a.speed_mps,
+                  a.heading_rad);
+    assert_true(std::fabs(a.speed_mps - (1.0 - 3 * 0.06)) < 0.02);  // braking at its deceleration
+    assert_true(a.heading_rad > 0.05);                              // and turning already
+}
+
 // The mixer's full turn comes from the profile (qnav_sim_robot_info().turn_full_deg): the
 // TekBot's 90 deg; twice its v_max on the same track, 180 (the same turn rate for a degree
 // of heading); a slower one keeps 90 (never a full turn short of it); the Pioneer 116.
@@ -317,6 +332,7 @@ int main(void) {
         cmocka_unit_test(test_body_limits_brake_at_decel_while_turning),
         cmocka_unit_test(test_the_tekbot_drives_as_its_board_mixes),
         cmocka_unit_test(test_the_pioneer_brakes_before_a_turn_in_place),
+        cmocka_unit_test(test_the_pioneer_brakes_and_turns_at_once_for_a_small_turn),
         cmocka_unit_test(test_the_mixers_full_turn_keeps_the_turn_rate_per_degree),
         cmocka_unit_test(test_limits_key_is_checked),
     };

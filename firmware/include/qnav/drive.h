@@ -45,10 +45,22 @@ void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rol
  * rounds to nothing) while the robot still rolls forward faster than QNAV_DRIVE_STOPPED.
  * The drive then holds its heading and brakes to a stop, and turns on a later tick: a
  * robot that turned while it rolled on would carry its momentum toward the side it turns
- * to (docs/sim.md, "Brake, then turn"). qnav_drive_mix() applies it; a drive that servoes
- * a heading (the simulator's model "heading", a Pioneer's ARCOS) asks it each tick.
+ * to (docs/sim.md, "Brake, then turn"). qnav_drive_mix() applies it (a drive that servoes
+ * its speed and turn apart asks qnav_drive_servo_brakes_first()).
  */
 int qnav_drive_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling);
+
+/*
+ * The same question for a drive that servoes its forward speed and its turn on separate
+ * profiles (the simulator's model "heading", as a Pioneer's ARCOS drives): it can brake and
+ * turn at once, so only a decision 90 deg or more off (a turn back) waits until the robot
+ * rolls slower than QNAV_DRIVE_STOPPED; a decision at speed 0 nearer ahead (the speed
+ * guard's stop) brakes while it turns toward it. A turn back while rolling would carry the
+ * robot's momentum toward the side it turns to; a small turn while braking leads it away
+ * from what made it stop (docs/sim.md, "Brake, then turn"). The wheel mixer cannot brake
+ * and turn at once and keeps qnav_drive_brakes_first().
+ */
+int qnav_drive_servo_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t rolling);
 
 /* The forward speed of travel_um (the mean of the two wheels' travel, micrometres) over
  * one tick of tick_ms, as a Q1.15 fraction of v_max_mm_s, saturated to +-32767 (0 when
