@@ -41,7 +41,7 @@ int qnav_drive_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_
 
 int qnav_drive_servo_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t rolling)
 {
-    return magnitude(heading_deg) >= 90 && rolling > QNAV_DRIVE_STOPPED;
+    return magnitude(heading_deg) >= 90 && brakes(0, rolling); /* a turn back has no forward part */
 }
 
 void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling,
