@@ -82,6 +82,7 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->near_cost = 10u;
     cfg->unknown_cost = 0u;
     cfg->align_samples = 0u;
+    cfg->turn_back_ticks = 0u;
     cfg->refuse_ticks = 30u;
     cfg->refuse_life_ticks = 200u;
     cfg->compact = 0u;
@@ -313,6 +314,7 @@ void qnav_map_reset(qnav_map_t *m)
     m->grown_mm = 0u;
     m->stall_best_mm = 0u;
     m->stall_ticks = 0u;
+    m->turn_back = 0u;
     m->refused_ticks = 0u;
     m->forgot = 0u;
 }
@@ -1011,6 +1013,7 @@ static int plan_when_due(qnav_map_t *m, int32_t goal_x_mm, int32_t goal_y_mm)
     const int new_goal = m->goal_x_mm != goal_x_mm || m->goal_y_mm != goal_y_mm;
     if (new_goal) {
         m->forgot = 0u; /* marked from afar again until the next forget */
+        m->turn_back = 0u;
         m->replan_owed = 0u; /* the last goal's plan owes a new goal's escape nothing */
     }
     if (!m->planned || new_goal) {
@@ -1135,14 +1138,19 @@ static void refuse_when_stalled(qnav_map_t *m, int32_t ri, int32_t rj, uint16_t 
  * straight part makes the distance shrink as the robot drives within a cell: a cell's own
  * cost stands still across it (a 0.4 m cell is a second of driving), and the escape took
  * that for a stall (docs/architecture.md, "The planned distance"). */
+/* The signed bearing of (x, y) from the pose, robot frame, 0.01 deg; *d its distance, mm. */
+static int32_t bearing_to(const qnav_map_pose_t *pose, int32_t x_mm, int32_t y_mm, uint32_t *d)
+{
+    return qnav_wrap_cdeg((int32_t)qnav_atan2_cdeg(y_mm - pose->y_mm, x_mm - pose->x_mm, d) -
+                          qnav_wrap_cdeg(pose->heading_cdeg));
+}
+
 static void aim(qnav_ctrl_input_t *in, const qnav_map_pose_t *pose, int32_t x_mm, int32_t y_mm,
                 uint32_t via_mm)
 {
     uint32_t d = 0u;
     if (x_mm != pose->x_mm || y_mm != pose->y_mm) {
-        in->goal_bearing_cdeg =
-            qnav_wrap_cdeg((int32_t)qnav_atan2_cdeg(y_mm - pose->y_mm, x_mm - pose->x_mm, &d) -
-                           qnav_wrap_cdeg(pose->heading_cdeg));
+        in->goal_bearing_cdeg = (qnav_cdeg_t)bearing_to(pose, x_mm, y_mm, &d);
     }
     d += via_mm;
     in->goal_range_mm = (qnav_mm_t)(d == 0u ? 1u : (d > 65535u ? 65535u : d));
@@ -1185,6 +1193,70 @@ static uint16_t plan_growth(qnav_map_t *m, uint32_t mm, uint32_t straight_mm)
         return (uint16_t)(mm - straight_mm);
     }
     return 0u;
+}
+
+/* A sub-goal lies behind the robot beyond this, ahead within AHEAD_CDEG (0.01 deg). */
+#define BEHIND_CDEG 9000
+#define AHEAD_CDEG 6000
+
+static int32_t bearing_off(const qnav_ctrl_input_t *in)
+{
+    return in->goal_bearing_cdeg < 0 ? -(int32_t)in->goal_bearing_cdeg : in->goal_bearing_cdeg;
+}
+
+/* How far (x, y) lies off the pose's heading, 0.01 deg, 0..18000. */
+static int32_t off_heading(const qnav_map_pose_t *pose, int32_t x_mm, int32_t y_mm)
+{
+    uint32_t d;
+    const int32_t b = bearing_to(pose, x_mm, y_mm, &d);
+    return b < 0 ? -b : b;
+}
+
+/* 1 while the last sub-goal stands against this tick's plan, in: a plan longer by more than
+ * jump_mm whose sub-goal lies behind the robot while the last lay ahead waits
+ * cfg.turn_back_ticks guided ticks (this one the first), once until a sub-goal lies ahead
+ * again (docs/architecture.md, "A turn back waits a second"). */
+static int turn_back_waits(qnav_map_t *m, const qnav_map_pose_t *pose, const qnav_ctrl_input_t *in)
+{
+    if (m->cfg.turn_back_ticks == 0u) {
+        return 0;
+    }
+    if (m->turn_back == QNAV_MAP_TURNED_BACK) {
+        if (bearing_off(in) < AHEAD_CDEG) {
+            m->turn_back = 0u;
+        }
+        return 0;
+    }
+    if (m->turn_back == 0u) {
+        if (m->last_mm == 0u || bearing_off(in) <= BEHIND_CDEG ||
+            in->goal_range_mm <= (uint32_t)m->last_mm + m->cfg.jump_mm ||
+            off_heading(pose, m->sub_x_mm, m->sub_y_mm) >= AHEAD_CDEG) {
+            return 0;
+        }
+        m->turn_back = m->cfg.turn_back_ticks;
+    }
+    if (--m->turn_back == 0u) {
+        m->turn_back = QNAV_MAP_TURNED_BACK;
+    }
+    return 1;
+}
+
+/* The input aimed at this tick's sub-goal (x, y), via_mm from the destination, direct its
+ * QNAV_MAP_DIRECT or 0, which becomes the map's last sub-goal; or at the last, which stands
+ * while a turn back waits. The aimed sub-goal's direct flag. */
+static int aim_sub_goal(qnav_map_t *m, const qnav_map_pose_t *pose, qnav_ctrl_input_t *in,
+                        int32_t x_mm, int32_t y_mm, uint16_t via_mm, int direct)
+{
+    aim(in, pose, x_mm, y_mm, via_mm);
+    if (turn_back_waits(m, pose, in)) {
+        aim(in, pose, m->sub_x_mm, m->sub_y_mm, m->sub_mm);
+        return m->sub_direct;
+    }
+    m->sub_x_mm = x_mm;
+    m->sub_y_mm = y_mm;
+    m->sub_mm = via_mm;
+    m->sub_direct = (uint8_t)direct;
+    return direct;
 }
 
 int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *at, int32_t goal_x_mm,
@@ -1246,11 +1318,7 @@ int qnav_map_guide(qnav_map_t *m, const qnav_map_pose_t *at, int32_t goal_x_mm,
     }
     sub = sub * m->cfg.cell_mm / STEP_SIDE;
     sub = sub > 65535u ? 65535u : sub;
-    aim(in, pose, sx, sy, sub);
-    m->sub_x_mm = sx;
-    m->sub_y_mm = sy;
-    m->sub_mm = (uint16_t)sub;
-    m->sub_direct = (uint8_t)direct;
+    direct = aim_sub_goal(m, pose, in, sx, sy, (uint16_t)sub, direct);
     mm = in->goal_range_mm;
     jumped = m->last_mm != 0u && mm > (uint32_t)m->last_mm + m->cfg.jump_mm;
     m->grown_mm = plan_growth(m, mm, straight_mm);

@@ -159,7 +159,8 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         const toml::table &mp = r.table(root, "map");
         r.only_keys(mp, {"on", "cell_m", "reach_m", "look_m", "plan_s", "near_m", "near_cost", "arc_deg", "sight",
                          "escape_grow", "refuse_s", "refuse_life_s", "pass_m", "compact", "grow_steps", "bytes",
-                         "noise", "forget_reach_m", "opening_m", "unknown_cost", "align_samples"});
+                         "noise", "forget_reach_m", "opening_m", "unknown_cost", "align_samples",
+                         "turn_back_s"});
         bool on = true;
         if (const toml::node *o = mp.get("on")) {
             if (!o->is_boolean()) r.fail(*o, "'on' must be true or false");
@@ -181,6 +182,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         p.map_arc_deg = r.number(mp, "arc_deg", 0.0, 360.0, true, p.map_arc_deg);
         if (mp.get("align_samples"))
             p.map_align_samples = static_cast<std::uint8_t>(r.integer(mp, "align_samples", 0, 255));
+        p.map_turn_back_s = r.number(mp, "turn_back_s", 0.0, 25.5, true, p.map_turn_back_s);
         p.map_forget_reach_m = r.number(mp, "forget_reach_m", 0.0, 65.0, true, p.map_forget_reach_m);
         p.map_opening_m = r.number(mp, "opening_m", 0.0, 65.0, true, p.map_opening_m);
         if (mp.get("noise")) p.map_noise = r.number(mp, "noise", 0.0, 1.0);

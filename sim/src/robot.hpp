@@ -78,6 +78,7 @@ struct RobotProfile {
     double map_near_cost = 1.0;     // ...cost this much more to cross, in cell sides
     double map_unknown_cost = 0.0;  // a cell not yet seen costs this much more, cell sides
     std::uint8_t map_align_samples = 0;  // wall readings before the grid turns to the walls; 0: never
+    double map_turn_back_s = 0.0;   // a plan turned back is followed after this long; 0: at once
     double map_noise = -1.0;        // [map] noise: the range noise the map allows for (its
                                     // noise_pct); < 0: [noise] sensor
     double map_arc_deg = 22.5;      // arcs marked within this angle about the wedge's centre

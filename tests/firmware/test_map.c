@@ -947,6 +947,68 @@ static void test_a_compact_map_refuses_a_way_by_marking_it_occupied(void **state
     assert_int_equal(ticks_until_refused_in(400, 0, wall_with_two_gaps, 3, &m, &in, &got), -1);
 }
 
+/* A lane up to the wall, shut at its far end: the way to (1500, 5000) from inside it is
+ * back down the lane and round through the gap. */
+static const box_t lane_to_the_wall[] = {{0, 2950, 4500, 3050},   {5300, 2950, WORLD_MM, 3050},
+                                         {1000, 1800, 1100, 2950}, {1900, 1800, 2000, 2950}};
+
+/* The guided bearing and flags at (1500, 2500) facing the wall (+y), toward (1500, 5000), one
+ * tick after another: the map sees nothing, then the lane shut ahead. */
+static void guide_into_the_lane(uint8_t turn_back_ticks, int32_t *bearing, int *got, int ticks)
+{
+    qnav_map_t m;
+    qnav_map_config_t mc;
+    qnav_ctrl_input_t in;
+    qnav_mm_t ranges[N];
+    const qnav_map_pose_t p = {1500, 2500, 9000};
+    int32_t y;
+    int t;
+    qnav_map_config_default(&mc);
+    mc.plan_ticks = 1;
+    mc.turn_back_ticks = turn_back_ticks;
+    map_from(&m, &mc);
+    memset(&in, 0, sizeof in);
+    assert_int_equal(qnav_map_guide(&m, &p, 1500, 5000, &in), QNAV_MAP_GUIDED);
+    assert_true(in.goal_bearing_cdeg > -500 && in.goal_bearing_cdeg < 500); /* straight on */
+    for (y = 1900; y <= 2700; y += 200) {
+        const qnav_map_pose_t at = {1500, y, 9000};
+        scan(lane_to_the_wall, 4, &at, ranges);
+        qnav_map_observe(&m, ranges, &at);
+    }
+    for (t = 0; t < ticks; ++t) {
+        in.escape.side = 1;
+        got[t] = qnav_map_guide(&m, &p, 1500, 5000, &in);
+        bearing[t] = in.goal_bearing_cdeg;
+        print_message("tick %d: bearing %d, %u mm, flags %d\n", t, (int)bearing[t],
+                      in.goal_range_mm, got[t]);
+    }
+}
+
+/* turn_back_ticks: a new plan that turns the robot back (its lane shut ahead in the map) is
+ * followed only after that many ticks, the last sub-goal standing until then and the escape
+ * memory kept; once only; 0 turns back at once, as before. */
+static void test_a_turn_back_waits_its_ticks_once(void **state)
+{
+    int32_t bearing[6];
+    int got[6];
+    int t;
+    (void)state;
+    guide_into_the_lane(0, bearing, got, 2);
+    assert_true(bearing[0] > 9000 || bearing[0] < -9000); /* back down the lane at once */
+    assert_int_equal(got[0], QNAV_MAP_GUIDED | QNAV_MAP_ESCAPE_CLEARED);
+    guide_into_the_lane(3, bearing, got, 6);
+    for (t = 0; t < 3; ++t) {
+        assert_true(bearing[t] > -500 && bearing[t] < 500); /* the last sub-goal stands */
+        assert_int_equal(got[t], QNAV_MAP_GUIDED);
+    }
+    assert_true(bearing[3] > 9000 || bearing[3] < -9000);
+    assert_int_equal(got[3], QNAV_MAP_GUIDED | QNAV_MAP_ESCAPE_CLEARED);
+    for (t = 4; t < 6; ++t) { /* no second wait while the way lies behind */
+        assert_true(bearing[t] > 9000 || bearing[t] < -9000);
+        assert_int_equal(got[t], QNAV_MAP_GUIDED);
+    }
+}
+
 static void test_a_way_the_robot_cannot_take_is_refused_for_a_while(void **state)
 {
     qnav_map_t m;
@@ -1288,6 +1350,7 @@ int main(void)
         cmocka_unit_test(test_a_map_that_closed_every_way_forgets_what_it_marked),
         cmocka_unit_test(test_after_a_forget_only_near_readings_mark),
         cmocka_unit_test(test_a_way_the_robot_cannot_take_is_refused_for_a_while),
+        cmocka_unit_test(test_a_turn_back_waits_its_ticks_once),
         cmocka_unit_test(test_the_plan_is_settled_as_far_as_the_robot_needs),
         cmocka_unit_test(test_a_map_reaches_toward_a_goal_too_far_for_it),
         cmocka_unit_test(test_a_placed_map_follows_the_robot),

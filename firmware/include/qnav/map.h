@@ -107,6 +107,15 @@ typedef struct {
                               angle to a room's walls, and a passage along a grid's diagonal
                               closes sooner (docs/architecture.md, "A grid turned to the
                               walls"). 0: the grid stays in the pose's frame; default 0 */
+    uint8_t turn_back_ticks; /* a new plan longer by more than jump_mm (the way followed shut
+                              in the map) whose sub-goal lies behind the robot (more than 90
+                              deg off its heading) while the last one lies ahead (within 60
+                              deg) is followed only after this many guided ticks: until then
+                              the last sub-goal stands. What shut the way is often the
+                              robot's own arcs over a lane narrower than two cells, which its
+                              sonar shows open ahead; a way really shut the controller does
+                              not take whatever the sub-goal (docs/architecture.md, "A turn
+                              back waits a second"). 0: at once; default 0 */
 } qnav_map_config_t;
 
 /* Every field of qnav_map_config_t in its order, with its width in bits: the one list that
@@ -119,7 +128,7 @@ typedef struct {
     X(noise_pct, 8) X(near_cost, 8) X(near_mm, 16) X(arc_cdeg, 16) X(sight, 8)               \
     X(escape_grow, 8) X(refuse_ticks, 8) X(refuse_life_ticks, 16) X(compact, 8)              \
     X(grow_steps, 8) X(forget_reach_mm, 16) X(opening_mm, 16) X(unknown_cost, 8)             \
-    X(align_samples, 8)
+    X(align_samples, 8) X(turn_back_ticks, 8)
 
 /* The robot's pose in the destination's frame. */
 typedef struct {
@@ -178,6 +187,9 @@ typedef struct {
     uint16_t stall_ticks;     /* guided ticks since it last shrank by a cell */
     uint16_t refused_ticks;   /* ticks the refused cells have left; 0: none */
     uint8_t forgot;           /* forgot what closed every way since the destination was set */
+    uint8_t turn_back;        /* guided ticks the last sub-goal still stands against a plan that
+                                 turned back (cfg.turn_back_ticks); QNAV_MAP_TURNED_BACK once the
+                                 robot follows it, until a plan's sub-goal lies ahead again */
     uint8_t replan_owed;      /* a plan began since the last guided tick: a compact plan may reach
                                  the robot ticks after it begins, and is new on the tick it does */
     /* The plan's queue, kept between ticks: a plan settles cells only until the robot's
@@ -187,6 +199,9 @@ typedef struct {
     uint32_t q_cost;          /* the least cost still queued may be this */
     uint32_t q_queued;        /* cells queued */
 } qnav_map_t;
+
+/* qnav_map_t.turn_back after a wait: no other until a sub-goal lies ahead again. */
+#define QNAV_MAP_TURNED_BACK 0xFFu
 
 /* Evidence at or above this marks a cell occupied. */
 #define QNAV_MAP_OCCUPIED 2

@@ -57,7 +57,8 @@
         .plan_ticks = 10, .noise_pct = 1, .near_cost = 0, .near_mm = 200, \
         .arc_cdeg = 2250, .sight = 1, .escape_grow = 1, .refuse_ticks = 20, \
         .refuse_life_ticks = 200, .compact = 1, .grow_steps = 16, \
-        .forget_reach_mm = 0, .opening_mm = 0, .unknown_cost = 0, .align_samples = 40 \
+        .forget_reach_mm = 0, .opening_mm = 0, .unknown_cost = 0, .align_samples = 40, \
+        .turn_back_ticks = 10 \
     }
 
 /* The profile's [map] bytes: the board's memory for that map, the largest

@@ -58,7 +58,7 @@
         .arc_cdeg = 1800, .sight = 1, .escape_grow = 1, .refuse_ticks = 30, \
         .refuse_life_ticks = 200, .compact = 1, .grow_steps = 16, \
         .forget_reach_mm = 1000, .opening_mm = 270, .unknown_cost = 0, \
-        .align_samples = 40 \
+        .align_samples = 40, .turn_back_ticks = 10 \
     }
 
 /* The profile's [map] bytes: the board's memory for that map, the largest
