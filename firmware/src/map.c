@@ -1133,11 +1133,6 @@ static void refuse_when_stalled(qnav_map_t *m, int32_t ri, int32_t rj, uint16_t 
     m->stall_ticks = 0u;
 }
 
-/* The input's goal bearing and planned distance: toward (x, y), a sub-goal whose own way
- * to the destination is via_mm, seen from pose (the bearing unchanged when there). The
- * straight part makes the distance shrink as the robot drives within a cell: a cell's own
- * cost stands still across it (a 0.4 m cell is a second of driving), and the escape took
- * that for a stall (docs/architecture.md, "The planned distance"). */
 /* The signed bearing of (x, y) from the pose, robot frame, 0.01 deg; *d its distance, mm. */
 static int32_t bearing_to(const qnav_map_pose_t *pose, int32_t x_mm, int32_t y_mm, uint32_t *d)
 {
@@ -1145,6 +1140,11 @@ static int32_t bearing_to(const qnav_map_pose_t *pose, int32_t x_mm, int32_t y_m
                           qnav_wrap_cdeg(pose->heading_cdeg));
 }
 
+/* The input's goal bearing and planned distance: toward (x, y), a sub-goal whose own way
+ * to the destination is via_mm, seen from pose (the bearing unchanged when there). The
+ * straight part makes the distance shrink as the robot drives within a cell: a cell's own
+ * cost stands still across it (a 0.4 m cell is a second of driving), and the escape took
+ * that for a stall (docs/architecture.md, "The planned distance"). */
 static void aim(qnav_ctrl_input_t *in, const qnav_map_pose_t *pose, int32_t x_mm, int32_t y_mm,
                 uint32_t via_mm)
 {
