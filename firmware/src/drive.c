@@ -28,10 +28,10 @@ static int32_t magnitude(qnav_deg_t heading_deg)
     return h < 0 ? -h : h;
 }
 
-/* No forward part while the robot rolls: brake, then turn. */
+/* No forward part while the robot rolls forward at all: brake to a stop, then turn. */
 static int brakes(int32_t fwd, qnav_q1_15_t rolling)
 {
-    return fwd == 0 && rolling > QNAV_DRIVE_STOPPED;
+    return fwd == 0 && rolling > 0;
 }
 
 int qnav_drive_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling)
@@ -41,7 +41,7 @@ int qnav_drive_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_
 
 int qnav_drive_servo_brakes_first(qnav_deg_t heading_deg, qnav_q1_15_t rolling)
 {
-    return magnitude(heading_deg) >= 90 && brakes(0, rolling); /* a turn back has no forward part */
+    return magnitude(heading_deg) >= 90 && rolling > QNAV_DRIVE_STOPPED;
 }
 
 void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rolling,

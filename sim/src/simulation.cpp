@@ -3,6 +3,7 @@
 #include "simulation.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <sstream>
 #include <cmath>
 
@@ -252,6 +253,8 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     collided_this_tick_ = false;
     l_m_ = 0;
     wheel_l_ = wheel_r_ = 0;
+    travel_l_m_ = travel_r_m_ = 0;
+    counts_l_ = counts_r_ = 0;
     mix_l_ = mix_r_ = 0;
     braking_ = false;
     cmd_heading_deg_ = cmd_speed_ = 0;
@@ -485,8 +488,7 @@ void Simulation::recovery_wheels() {
 }
 
 // The decision (robot-frame heading, rad; speed fraction) in whole degrees and Q1.15 as a
-// board receives it, and the rolling speed the board's encoders measure, here the wheels'
-// own (the board's is counts over a tick).
+// board receives it, and the rolling speed the board's encoders measured over the last tick.
 struct BoardDecision {
     qnav_deg_t deg;
     qnav_q1_15_t speed, rolling;
@@ -496,17 +498,33 @@ static qnav_q1_15_t q15(double f) {
     return static_cast<qnav_q1_15_t>(std::lround(std::clamp(f, -1.0, 1.0) * 32767.0));
 }
 
-static BoardDecision board_decision(double heading_rad, double speed, double rolling_frac) {
+static BoardDecision board_decision(double heading_rad, double speed, qnav_q1_15_t rolling) {
     const long deg = std::lround(wrap_pi(heading_rad) * 180.0 / kPi);
-    return {static_cast<qnav_deg_t>(deg <= -180 ? deg + 360 : deg), q15(std::max(speed, 0.0)), q15(rolling_frac)};
+    return {static_cast<qnav_deg_t>(deg <= -180 ? deg + 360 : deg), q15(std::max(speed, 0.0)), rolling};
+}
+
+// The robot's forward speed as its board measures it (qnav_board's dead reckoning): the two
+// wheels' encoder counts over the last tick ([odometry] um_per_count a count), their mean
+// travel as a fraction of v_max (qnav_drive_rolling). A robot that creeps slower than a count
+// a tick reads 0 on some ticks and a count on others, as the board's does; the wheels' own
+// speed, which the simulator used before 0.20.1, is what no board knows.
+qnav_q1_15_t Simulation::encoder_rolling() {
+    const double per_count_m = robot_.um_per_count * 1e-6;
+    const auto cl = static_cast<std::int64_t>(std::floor(travel_l_m_ / per_count_m));
+    const auto cr = static_cast<std::int64_t>(std::floor(travel_r_m_ / per_count_m));
+    const std::int64_t counts = (cl - counts_l_) + (cr - counts_r_);
+    counts_l_ = cl;
+    counts_r_ = cr;
+    const std::int64_t step_um = std::clamp<std::int64_t>(counts * robot_.um_per_count / 2, INT32_MIN, INT32_MAX);
+    return qnav_drive_rolling(static_cast<std::int32_t>(step_um), static_cast<std::uint16_t>(std::lround(QNAV_SIM_TICK_S * 1000.0)),
+                              static_cast<std::uint16_t>(std::lround(robot_.v_max_mps * 1000.0)));
 }
 
 // [drive] model "mix": the decision as the board turns it into wheel speeds, held for the
 // tick. Model "heading": whether this tick brakes before it turns back (a servo brakes and
 // turns at once otherwise).
 void Simulation::drive_targets(double heading_rad, double speed) {
-    const BoardDecision d =
-        board_decision(heading_rad, speed, (wheel_l_ + wheel_r_) / 2 / robot_.v_max_mps);
+    const BoardDecision d = board_decision(heading_rad, speed, encoder_rolling());
     if (!robot_.drive_mix) {
         braking_ = robot_.brake_first && qnav_drive_servo_brakes_first(d.deg, d.rolling) != 0;
         return;
@@ -594,6 +612,8 @@ void Simulation::drive_substep(double dt) {
         heading_wheels(dt);
     const double vmax = robot_.v_max_mps;
     const double v = 0.5 * (wheel_l_ + wheel_r_);
+    travel_l_m_ += wheel_l_ * dt;  // what the encoders count: the wheels' own travel, slip or not
+    travel_r_m_ += wheel_r_ * dt;
     const double omega = (wheel_r_ - wheel_l_) / robot_.wheel_base_m;
     // Slip: turning loses some of its rate at speed, and the body skids outwards.
     const double omega_a = omega * (1.0 - robot_.slip_turn * std::min(1.0, std::fabs(v) / vmax));

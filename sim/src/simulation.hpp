@@ -110,6 +110,7 @@ private:
     void recovery_wheels();
     void heading_wheels(double dt);
     void drive_targets(double heading_rad, double speed);
+    qnav_q1_15_t encoder_rolling();
     void move_body(double omega_a, double v_lat, double dt);
     bool touching(Vec2 *contact);
     void start_recovery(Vec2 contact);
@@ -153,6 +154,8 @@ private:
     Vec2 start_{}, pos_{};
     double start_heading_ = 0, heading_ = 0;
     double wheel_l_ = 0, wheel_r_ = 0;  // wheel surface speeds, m/s
+    double travel_l_m_ = 0, travel_r_m_ = 0;     // each wheel's travel this episode, m
+    std::int64_t counts_l_ = 0, counts_r_ = 0;   // their encoder counts at the last tick
     Vec2 vel_{};                        // body velocity, world frame, m/s
     double clearance_m_ = 0;            // centre to nearest surface after the last step, m
     bool body_stale_ = false;           // Box2D body not moved since free steps

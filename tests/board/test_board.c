@@ -337,6 +337,11 @@ static void test_a_turn_in_place_brakes_while_the_encoders_say_the_robot_rolls(v
     assert_int_equal(g.sim.drive_rolling, 0);
     assert_true(g.sim.right > 0);
     assert_int_equal(g.sim.left, -g.sim.right);
+    g.sim.left_counts += 1; /* a count forward in a tick, far below 1/8 of v_max: it brakes */
+    offboard_commands(120, 0, 1);
+    assert_true(g.sim.drive_rolling > 0 && g.sim.drive_rolling < QNAV_DRIVE_STOPPED);
+    assert_int_equal(g.sim.left, 0);
+    assert_int_equal(g.sim.right, 0);
 }
 
 static void test_corrupted_goal_is_not_acted_on(void **state)

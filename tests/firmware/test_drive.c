@@ -86,8 +86,9 @@ static void test_at_a_wheels_limit_the_arc_is_kept(void **state)
     }
 }
 
-/* A turn in place while the robot still rolls forward brakes both wheels first, then
- * turns once it has slowed to QNAV_DRIVE_STOPPED; rolling backward does not brake. */
+/* A turn in place while the robot still rolls forward at all brakes both wheels first,
+ * then turns once it has stopped; rolling backward does not brake. Slower than the servo's
+ * QNAV_DRIVE_STOPPED is not stopped: a robot that brakes slowly crept on (0.20.1). */
 static void test_a_turn_in_place_brakes_first_while_the_robot_rolls(void **state)
 {
     qnav_q1_15_t l, r;
@@ -99,6 +100,12 @@ static void test_a_turn_in_place_brakes_first_while_the_robot_rolls(void **state
     assert_int_equal(l, 0);
     assert_int_equal(r, 0);
     mix(-45, 0, QNAV_DRIVE_STOPPED, &l, &r);
+    assert_int_equal(l, 0);
+    assert_int_equal(r, 0);
+    mix(-45, 0, 1, &l, &r); /* the least a board's encoders count */
+    assert_int_equal(l, 0);
+    assert_int_equal(r, 0);
+    mix(-45, 0, 0, &l, &r);
     assert_true(l > 0);
     assert_int_equal(l, -r);
     mix(120, 0, -20000, &l, &r);
@@ -151,12 +158,12 @@ static void test_a_servo_brakes_first_only_to_turn_back(void **state)
 }
 
 /* qnav_drive_brakes_first() is the mixer's own brake: for every heading, several speeds
- * and rolling speeds either side of QNAV_DRIVE_STOPPED, it says 1 exactly when the mixer
- * stops both wheels of a robot that rolls, and never for one that does not. */
+ * and rolling speeds either side of a stop, it says 1 exactly when the mixer stops both
+ * wheels of a robot that rolls, and never for one that does not. */
 static void test_brakes_first_is_when_the_mixer_brakes(void **state)
 {
     static const int speeds[] = {0, 1, 2, 100, 12000, 32767};
-    static const int rolls[] = {-32767, 0, QNAV_DRIVE_STOPPED, QNAV_DRIVE_STOPPED + 1, 32767};
+    static const int rolls[] = {-32767, 0, 1, QNAV_DRIVE_STOPPED, 32767};
     int h, s, k, braked = 0;
     qnav_q1_15_t l, r;
     (void)state;
@@ -166,7 +173,7 @@ static void test_brakes_first_is_when_the_mixer_brakes(void **state)
                 const int b = qnav_drive_brakes_first((qnav_deg_t)h, (qnav_q1_15_t)speeds[s],
                                                       (qnav_q1_15_t)rolls[k]);
                 mix(h, speeds[s], rolls[k], &l, &r);
-                if (rolls[k] > QNAV_DRIVE_STOPPED) {
+                if (rolls[k] > 0) {
                     assert_int_equal(b, l == 0 && r == 0);
                 } else {
                     assert_int_equal(b, 0);
@@ -175,10 +182,10 @@ static void test_brakes_first_is_when_the_mixer_brakes(void **state)
             }
         }
     }
-    /* at both rolling speeds above the threshold: the 182 headings at 90 deg and beyond at
+    /* at the three rolling speeds forward: the 182 headings at 90 deg and beyond at
      * every speed; the 179 others at speed 0; at speed 1 those but straight ahead (1 x cos
      * rounds to nothing); at speed 2 the 58 beyond 60 deg (cos below one half) */
-    assert_int_equal(braked, 2 * (182 * 6 + 179 + 178 + 58));
+    assert_int_equal(braked, 3 * (182 * 6 + 179 + 178 + 58));
 }
 
 static void test_rolling_is_the_travel_as_a_fraction_of_full_speed(void **state)

@@ -6,6 +6,7 @@
  */
 #include "sim_test_util.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "qnav/drive.h"
@@ -170,8 +171,8 @@ static void test_body_limits_brake_at_decel_while_turning(void **state) {
 // (30 deg left at full speed) gives the wheels qnav_drive_mix()'s speeds, so the robot
 // circles at the forward part and turns at the wheels' difference; a turn in place at
 // speed 0 turns without moving; and a decision to turn 168 deg at speed 0 from full speed
-// brakes both wheels at decel first and turns only once the robot has slowed below
-// QNAV_DRIVE_STOPPED, as the board's does (docs/sim.md, "Drive model").
+// brakes both wheels at decel first and turns only once the encoders count no travel
+// forward in a tick, as the board's does (docs/sim.md, "Drive model").
 static void test_the_tekbot_drives_as_its_board_mixes(void **state) {
     (void)state;
     TestSim t;
@@ -196,7 +197,7 @@ static void test_the_tekbot_drives_as_its_board_mixes(void **state) {
     assert_true(b.heading_rad > 0.3);
     assert_true(std::hypot(b.x_m - 5.0, b.y_m - 5.0) < 1e-6);
     // from 0.5 m/s straight, a turn of 168 deg at speed 0: both wheels brake at 2 m/s^2
-    // (0.5, 0.3, 0.1 m/s: rolling until below 1/8 of v_max), then it turns in place
+    // (0.5, 0.3, 0.1, 0 m/s), then it turns in place where it stopped
     assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
     assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
     b = drive(t.sim, 0.0, 1.0, 10);
@@ -207,9 +208,56 @@ static void test_the_tekbot_drives_as_its_board_mixes(void **state) {
     assert_true(std::fabs(b.speed_mps - (0.5 - 2.0 * 0.1)) < 0.01);
     assert_true(std::fabs(std::remainder(b.heading_rad - h0, 2 * kPiD)) < 0.01);  // not turning yet
     b = drive(t.sim, 168.0, 0.0, 2);
-    assert_true(b.speed_mps < 0.0625);
-    b = drive(t.sim, 168.0, 0.0, 3);
-    assert_true(std::remainder(b.heading_rad - h0, 2 * kPiD) > 0.3);  // stopped: now it turns
+    assert_true(std::fabs(b.speed_mps) < 1e-9);
+    assert_true(std::fabs(std::remainder(b.heading_rad - h0, 2 * kPiD)) < 0.01);
+    const qnav_sim_state_t at = b;
+    b = drive(t.sim, 168.0, 0.0, 5);
+    assert_true(std::remainder(b.heading_rad - h0, 2 * kPiD) > 0.5);  // stopped: now it turns
+    assert_true(std::hypot(b.x_m - at.x_m, b.y_m - at.y_m) < 1e-6);   // where it stopped
+}
+
+// A TekBot whose wheels slew at 0.5 m/s^2 both ways (a robot that brakes slowly), creeping
+// at 0.06 m/s, told to turn 150 deg at speed 0: it brakes to a stop and only then turns, and
+// does not move while it turns. Until 0.20.1 the mixer turned at once, the robot rolling
+// slower than QNAV_DRIVE_STOPPED (0.0625 m/s here), and with wheels that slew at equal rates
+// a turn in place keeps the forward speed it starts from: the robot crept on into what it
+// turned from (docs/sim.md, "A robot that brakes slowly").
+static void test_a_slowly_braking_tekbot_stops_before_it_turns_in_place(void **state) {
+    (void)state;
+    std::string text = read_text_file(QNAV_TEST_DATA_DIR "/robots/tekbot.toml");
+    for (const char *key : {"accel_mps2 = ", "decel_mps2 = "}) {
+        const size_t at = text.find(key);
+        assert_true(at != std::string::npos);
+        text.replace(at, text.find('#', at) - at, std::string(key) + "0.5 ");
+    }
+    TestSim t;
+    char err[QNAV_SIM_ERRLEN];
+    const std::string et = test_env_text("");
+    assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "r.toml", &t.robot, err, sizeof err), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_env_parse(et.data(), et.size(), "e.toml", &t.env, err, sizeof err), QNAV_SIM_OK);
+    qnav_sim_config_t cfg;
+    qnav_sim_config_default(&cfg);
+    assert_int_equal(qnav_sim_create(t.robot, t.env, &cfg, &t.sim, err, sizeof err), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
+    qnav_sim_state_t b = drive(t.sim, 0.0, 0.08, 20);  // creeping on at 0.04 m/s
+    assert_true(std::fabs(b.speed_mps - 0.04) < 1e-3);
+    bool turning = false;
+    double x0 = 0, y0 = 0, crept = 0, turned = 0, h = b.heading_rad;
+    for (int i = 0; i < 20; ++i) {
+        b = drive(t.sim, 150.0, 0.0, 1);
+        turned += std::remainder(b.heading_rad - h, 2 * kPiD);
+        h = b.heading_rad;
+        if (!turning && turned > 1.0 * kPiD / 180.0) {
+            turning = true;  // its first degree: where it stood when the turn began
+            x0 = b.x_m;
+            y0 = b.y_m;
+        }
+        if (turning) crept = std::max(crept, std::hypot(b.x_m - x0, b.y_m - y0));
+    }
+    print_message("slow brakes: turned %.2f rad, moved %.4f m while turning\n", turned, crept);
+    assert_true(turned > 1.5);
+    assert_true(crept < 0.005);
 }
 
 // The heading model brakes before a turn in place as the mixer does ([drive] brake_first,
@@ -331,6 +379,7 @@ int main(void) {
         cmocka_unit_test(test_slipping_robot_turns_less_at_speed_and_skids_outwards),
         cmocka_unit_test(test_body_limits_brake_at_decel_while_turning),
         cmocka_unit_test(test_the_tekbot_drives_as_its_board_mixes),
+        cmocka_unit_test(test_a_slowly_braking_tekbot_stops_before_it_turns_in_place),
         cmocka_unit_test(test_the_pioneer_brakes_before_a_turn_in_place),
         cmocka_unit_test(test_the_pioneer_brakes_and_turns_at_once_for_a_small_turn),
         cmocka_unit_test(test_the_mixers_full_turn_keeps_the_turn_rate_per_degree),

@@ -15,8 +15,9 @@
 extern "C" {
 #endif
 
-/* A robot rolling forward slower than this (Q1.15 of full wheel speed: 1/8) counts as
- * stopped: a turn in place may begin. */
+/* A servo drive rolling forward slower than this (Q1.15 of full wheel speed: 1/8) counts as
+ * stopped: a turn back may begin (qnav_drive_servo_brakes_first). The wheel mixer waits for
+ * a stop (qnav_drive_brakes_first). */
 #define QNAV_DRIVE_STOPPED ((qnav_q1_15_t)4096)
 
 /*
@@ -28,8 +29,11 @@ extern "C" {
  * 0 is taken as 1. When the two together would run a wheel past full speed both
  * shrink by one factor, so the robot drives the arc the decision asked for, slower. A
  * decision without a forward part (a turn in place) while the robot still rolls forward
- * faster than QNAV_DRIVE_STOPPED brakes both wheels to 0 first: spinning one wheel
- * forward would keep the robot rolling toward what made it stop. rolling is the forward
+ * at all (rolling > 0) brakes both wheels to 0 first: spinning one wheel forward would
+ * keep the robot rolling toward what made it stop. Not just slower than a threshold: with
+ * wheels that slew at equal rates a turn in place keeps the forward speed it starts from,
+ * and a robot that brakes slowly crept on into what it turned from (until 0.20.1 the
+ * threshold was QNAV_DRIVE_STOPPED; docs/sim.md, "A robot that brakes slowly"). rolling is the forward
  * speed the wheels have now (the mean of the two, Q1.15 of full wheel speed; a board's
  * from its encoders over the last tick, qnav_drive_rolling(); 0 when unknown). left and
  * right are Q1.15 fractions of full wheel speed, signed, forward positive; a
@@ -42,7 +46,7 @@ void qnav_drive_mix(qnav_deg_t heading_deg, qnav_q1_15_t speed, qnav_q1_15_t rol
 /*
  * 1 when a drive must brake before it carries out this decision: the decision has no
  * forward part (a turn in place: |heading| >= 90 deg, or speed 0, or a forward part that
- * rounds to nothing) while the robot still rolls forward faster than QNAV_DRIVE_STOPPED.
+ * rounds to nothing) while the robot still rolls forward (rolling > 0).
  * The drive then holds its heading and brakes to a stop, and turns on a later tick: a
  * robot that turned while it rolled on would carry its momentum toward the side it turns
  * to (docs/sim.md, "Brake, then turn"). qnav_drive_mix() applies it (a drive that servoes
