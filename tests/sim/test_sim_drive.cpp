@@ -108,13 +108,9 @@ static void test_slipping_robot_turns_less_at_speed_and_skids_outwards(void **st
     assert_true(lat_slip < lat_grip);
 }
 
-// The Pioneer's profile with its line `line` replaced by `by`, placed at (1, 2) facing +x and
-// brought up to 1 m/s.
-static void pioneer_at_full_speed(TestSim &t, const std::string &line, const std::string &by) {
-    std::string text = read_text_file(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml");
-    const size_t at = text.find(line);
-    assert_true(at != std::string::npos);
-    text.replace(at, line.size(), by);
+// A simulator of the robot profile `text` in the empty test arena, no noise, placed at
+// (x, y) facing +x.
+static void sim_of_profile(TestSim &t, const std::string &text, double x, double y) {
     char err[QNAV_SIM_ERRLEN];
     const std::string et = test_env_text("");
     assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "r.toml", &t.robot, err, sizeof err), QNAV_SIM_OK);
@@ -123,7 +119,17 @@ static void pioneer_at_full_speed(TestSim &t, const std::string &line, const std
     qnav_sim_config_default(&cfg);
     assert_int_equal(qnav_sim_create(t.robot, t.env, &cfg, &t.sim, err, sizeof err), QNAV_SIM_OK);
     assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
-    assert_int_equal(qnav_sim_place(t.sim, 1.0, 2.0, 0.0), QNAV_SIM_OK);
+    assert_int_equal(qnav_sim_place(t.sim, x, y, 0.0), QNAV_SIM_OK);
+}
+
+// The Pioneer's profile with its line `line` replaced by `by`, placed at (1, 2) facing +x and
+// brought up to 1 m/s.
+static void pioneer_at_full_speed(TestSim &t, const std::string &line, const std::string &by) {
+    std::string text = read_text_file(QNAV_TEST_DATA_DIR "/robots/pioneer3dx.toml");
+    const size_t at = text.find(line);
+    assert_true(at != std::string::npos);
+    text.replace(at, line.size(), by);
+    sim_of_profile(t, text, 1.0, 2.0);
     const qnav_sim_state_t st = drive(t.sim, 0.0, 1.0, 40);
     assert_true(std::fabs(st.speed_mps - 1.0) < 1e-3);
 }
@@ -231,15 +237,7 @@ static void test_a_slowly_braking_tekbot_stops_before_it_turns_in_place(void **s
         text.replace(at, text.find('#', at) - at, std::string(key) + "0.5 ");
     }
     TestSim t;
-    char err[QNAV_SIM_ERRLEN];
-    const std::string et = test_env_text("");
-    assert_int_equal(qnav_sim_robot_parse(text.data(), text.size(), "r.toml", &t.robot, err, sizeof err), QNAV_SIM_OK);
-    assert_int_equal(qnav_sim_env_parse(et.data(), et.size(), "e.toml", &t.env, err, sizeof err), QNAV_SIM_OK);
-    qnav_sim_config_t cfg;
-    qnav_sim_config_default(&cfg);
-    assert_int_equal(qnav_sim_create(t.robot, t.env, &cfg, &t.sim, err, sizeof err), QNAV_SIM_OK);
-    assert_int_equal(qnav_sim_reset(t.sim, 1), QNAV_SIM_OK);
-    assert_int_equal(qnav_sim_place(t.sim, 5.0, 5.0, 0.0), QNAV_SIM_OK);
+    sim_of_profile(t, text, 5.0, 5.0);
     qnav_sim_state_t b = drive(t.sim, 0.0, 0.08, 20);  // creeping on at 0.04 m/s
     assert_true(std::fabs(b.speed_mps - 0.04) < 1e-3);
     bool turning = false;
