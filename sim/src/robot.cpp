@@ -122,7 +122,18 @@ static void parse_controller_settings(const TomlReader &r, RobotProfile &p) {
     p.safety_m = r.number(cl, "safety_m", 0.0, 10.0);
     if (cl.get("wedge_pct"))
         p.wedge_pct = static_cast<std::uint8_t>(r.integer(cl, "wedge_pct", 0, 100));
-    p.wedge_near_m = r.number(cl, "wedge_near_m", 0.0, 65.0, true, p.wedge_near_m);
+    const toml::node *near = cl.get("wedge_near_m");
+    if (near && near->is_string()) {
+        if (r.string(cl, "wedge_near_m") != "stopping")
+            r.fail(*near, "'wedge_near_m' must be a distance in m or \"stopping\"");
+        // the robot's stopping distance from full speed, a tick to react and then braking at
+        // decel_mps2: a reading nearer than that at a wedge's edge is one the robot could not
+        // stop for once it turned out to lie on its way (docs/sim.md, "A robot that brakes
+        // slowly")
+        p.wedge_near_m = std::min(65.0, p.v_max_mps * QNAV_SIM_TICK_S + p.v_max_mps * p.v_max_mps / (2.0 * p.decel_mps2));
+    } else {
+        p.wedge_near_m = r.number(cl, "wedge_near_m", 0.0, 65.0, true, p.wedge_near_m);
+    }
     const toml::node *guard = cl.get("speed_guard");
     if (!guard) r.fail(cl, "missing 'speed_guard' (true or false)");
     if (!guard->is_boolean()) r.fail(*guard, "'speed_guard' must be true or false");

@@ -173,6 +173,38 @@ static void test_bad_robot_profiles_are_refused(void **state) {
     assert_true(one_line(msg));
 }
 
+/* `[clearance] wedge_near_m = "stopping"` (the TekBot's profile) is the robot's stopping
+ * distance from v_max, v T + v^2 / (2 decel), and follows the profile's drive: 0.1125 m at
+ * the TekBot's 0.5 m/s and 2 m/s^2, 0.30 m at 0.5 m/s^2; any other string is refused by
+ * name on one line. */
+static void test_whole_wedges_within_the_stopping_distance(void **state) {
+    (void)state;
+    char err[QNAV_SIM_ERRLEN] = "";
+    std::string t = read_data("robots/tekbot.toml");
+    assert_true(t.find("wedge_near_m = \"stopping\"") != std::string::npos);
+    const std::size_t at = t.find("decel_mps2 = ");
+    static const struct {
+        const char *decel;
+        qnav_mm_t near_mm;
+    } want[] = {{"2.0", 112}, {"0.5", 300}, {"0.25", 550}};
+    for (const auto &w : want) {
+        std::string u = t;
+        u.replace(at, u.find('#', at) - at, std::string("decel_mps2 = ") + w.decel + " ");
+        qnav_sim_robot_t *robot = nullptr;
+        qnav_ctrl_config_t cfg;
+        assert_int_equal(qnav_sim_robot_parse(u.data(), u.size(), "d.toml", &robot, err, sizeof err), QNAV_SIM_OK);
+        qnav_sim_robot_ctrl_config(robot, 0, &cfg);
+        assert_true(std::abs(static_cast<int>(cfg.wedge_near_mm) - static_cast<int>(w.near_mm)) <= 1);
+        qnav_sim_robot_free(robot);
+    }
+    std::string bad = t;
+    bad.replace(bad.find("\"stopping\""), 10, "\"braking\"");
+    std::string msg;
+    assert_int_equal(parse_robot(bad, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("'wedge_near_m' must be a distance in m or \"stopping\"") != std::string::npos);
+    assert_true(one_line(msg));
+}
+
 /* The quality commanded at v_max is the profile's (both robots: the paper's 0.9), not a
  * default of libqnav's: a copy of the TekBot's profile with another value gives it. */
 static void test_profile_sets_the_speed_at_full_quality(void **state) {
@@ -567,6 +599,7 @@ int main(void) {
         cmocka_unit_test(test_profile_carries_its_tuned_probabilistic_policy),
         cmocka_unit_test(test_the_safety_scale_follows_the_sonar_range),
         cmocka_unit_test(test_profile_sets_the_speed_at_full_quality),
+        cmocka_unit_test(test_whole_wedges_within_the_stopping_distance),
         cmocka_unit_test(test_missing_file_is_an_io_error_naming_it),
         cmocka_unit_test(test_impossible_parameters_are_refused_by_field),
         cmocka_unit_test(test_mismatched_controller_is_refused),

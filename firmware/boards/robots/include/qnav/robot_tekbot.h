@@ -33,7 +33,7 @@
         .ctrl.decel_mm_s2 = 2000, \
         .ctrl.rank = 1, \
         .ctrl.wedge_pct = 25, \
-        .ctrl.wedge_near_mm = 0, \
+        .ctrl.wedge_near_mm = 113, \
         .ctrl.escape_stall_ticks = 20, \
         .ctrl.escape_follow_mm = 500, \
         .ctrl.escape_follow_s = 20, \
