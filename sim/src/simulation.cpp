@@ -255,6 +255,7 @@ void Simulation::place(double x_m, double y_m, double heading_rad) {
     wheel_l_ = wheel_r_ = 0;
     travel_l_m_ = travel_r_m_ = 0;
     counts_l_ = counts_r_ = 0;
+    rolling_ = 0;
     mix_l_ = mix_r_ = 0;
     braking_ = false;
     cmd_heading_deg_ = cmd_speed_ = 0;
@@ -524,7 +525,7 @@ qnav_q1_15_t Simulation::encoder_rolling() {
 // tick. Model "heading": whether this tick brakes before it turns back (a servo brakes and
 // turns at once otherwise).
 void Simulation::drive_targets(double heading_rad, double speed) {
-    const BoardDecision d = board_decision(heading_rad, speed, encoder_rolling());
+    const BoardDecision d = board_decision(heading_rad, speed, rolling_);
     if (!robot_.drive_mix) {
         braking_ = robot_.brake_first && qnav_drive_servo_brakes_first(d.deg, d.rolling) != 0;
         return;
@@ -643,6 +644,7 @@ void Simulation::advance() {
     Clock::time_point t0;
     if (profiling_) t0 = Clock::now();
     const bool recovering = recovery_left_ > 0;
+    rolling_ = encoder_rolling();  // every tick, as the board's dead reckoning counts
     if (!recovering) {
         double he = cmd_heading_deg_ * kPi / 180.0, sp = cmd_speed_;
         const double pa = cfg_.actuation_noise;

@@ -156,6 +156,7 @@ private:
     double wheel_l_ = 0, wheel_r_ = 0;  // wheel surface speeds, m/s
     double travel_l_m_ = 0, travel_r_m_ = 0;     // each wheel's travel this episode, m
     std::int64_t counts_l_ = 0, counts_r_ = 0;   // their encoder counts at the last tick
+    qnav_q1_15_t rolling_ = 0;                   // the forward speed they gave over the last tick
     Vec2 vel_{};                        // body velocity, world frame, m/s
     double clearance_m_ = 0;            // centre to nearest surface after the last step, m
     bool body_stale_ = false;           // Box2D body not moved since free steps
