@@ -37,6 +37,7 @@ void qnav_ctrl_config_default(qnav_ctrl_config_t *cfg)
     cfg->escape_follow_s = 20u;
     cfg->keep_pct = 0u;
     cfg->range_min_mm = 0u;
+    cfg->quality_full_speed = 0;
 }
 
 void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg)
@@ -53,9 +54,21 @@ void qnav_ctrl_config_literal(qnav_ctrl_config_t *cfg)
     cfg->keep_pct = 0u;
 }
 
+/* The speed law for the controller's rank: full speed from cfg->quality_full_speed when
+ * keys rank by quality and it is set, else from full_speed_quality. Called again once a
+ * policy or a table has fixed the rank. */
+static void full_speed_at(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg)
+{
+    const qnav_q1_15_t q = ctrl->rank == (uint8_t)QNAV_RANK_QUALITY && cfg->quality_full_speed > 0
+                               ? cfg->quality_full_speed
+                               : cfg->full_speed_quality;
+    const uint32_t q_full = (uint32_t)q;
+    ctrl->full_speed_quality = q;
+    ctrl->speed_scale = ((uint32_t)32768u * 32768u + q_full / 2u) / q_full;
+}
+
 static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cfg)
 {
-    uint32_t q_full;
     qnav_status_t st;
     if (ctrl == 0) {
         return QNAV_E_NULL;
@@ -71,7 +84,7 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     if (st != QNAV_OK) {
         return st;
     }
-    if (cfg->full_speed_quality <= 0) {
+    if (cfg->full_speed_quality <= 0 || cfg->quality_full_speed < 0) {
         return QNAV_E_SPEED;
     }
     if (cfg->rank != (uint8_t)QNAV_RANK_QUALITY && cfg->rank != (uint8_t)QNAV_RANK_PREACT) {
@@ -80,15 +93,13 @@ static qnav_status_t init_common(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     if (cfg->keep_pct > 100u) {
         return QNAV_E_KEEP;
     }
-    q_full = (uint32_t)cfg->full_speed_quality;
-    ctrl->full_speed_quality = cfg->full_speed_quality;
-    ctrl->speed_scale = ((uint32_t)32768u * 32768u + q_full / 2u) / q_full;
+    ctrl->rank = cfg->rank;
+    full_speed_at(ctrl, cfg);
     ctrl->kind = QNAV_CTRL_KIND_TABLE; /* until a policy's init sets its kind */
     ctrl->p.net.table = 0;
     ctrl->hidden = 0u;
     ctrl->inputs = 0u;
     ctrl->p.net.out_bias_z = 0;
-    ctrl->rank = cfg->rank;
     ctrl->keep_pct = cfg->keep_pct;
     ctrl->shapes_carried = 0u;
     return QNAV_OK;
@@ -140,6 +151,7 @@ static qnav_status_t init_policy(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *cf
     case QNAV_POLICY_PROB:
 #if QNAV_WITH_PROB
         ctrl->rank = (uint8_t)QNAV_RANK_QUALITY; /* a product of probabilities: no saturation */
+        full_speed_at(ctrl, cfg);
         qnav_prob_eval_init(ctrl, &policy->u.prob);
 #endif
         break;
@@ -208,6 +220,7 @@ qnav_status_t qnav_ctrl_init_table(qnav_ctrl_t *ctrl, const qnav_ctrl_config_t *
     }
     ctrl->p.net.table = table;
     ctrl->rank = (uint8_t)rank;
+    full_speed_at(ctrl, cfg);
     table_shapes(ctrl);
     ctrl->kind = QNAV_CTRL_KIND_TABLE;
     ctrl->magic = QNAV_CTRL_MAGIC;
@@ -636,7 +649,7 @@ const char *qnav_status_str(qnav_status_t status)
     case QNAV_E_RANGE:
         return "max_range_mm is 0, or range_min_mm not below it";
     case QNAV_E_SPEED:
-        return "full_speed_quality outside (0, 1)";
+        return "full_speed_quality outside (0, 1), or quality_full_speed negative";
     case QNAV_E_POLICY_KIND:
         return "unknown policy kind (or no policy to compile)";
     case QNAV_E_HIDDEN:

@@ -93,7 +93,7 @@ static void parse_sensing(const TomlReader &r, RobotProfile &p) {
 
     if (root.get("probabilistic")) {
         const toml::table &prob = r.table(root, "probabilistic");
-        r.only_keys(prob, {"k_goal", "k_safe", "safe_m", "keep"});
+        r.only_keys(prob, {"k_goal", "k_safe", "safe_m", "keep", "full_speed_quality"});
         p.prob_k_goal = r.number(prob, "k_goal", 1.0 / 256.0, 64.0);
         // P_safe's steepness, the paper's k_safe, is per sonar range (P_safe = 1 - e^(-k_safe
         // ell/(L-1)), ell/(L-1) the reading over range_max_m); safe_m gives it in metres,
@@ -111,6 +111,10 @@ static void parse_sensing(const TomlReader &r, RobotProfile &p) {
             r.fail(prob, "missing key 'safe_m' (or the paper's 'k_safe')");
         }
         if (prob.get("keep")) p.prob_keep = r.number(prob, "keep", 0.0, 1.0);
+        // its own speed law: a product of probabilities sits lower than a network's output
+        // (docs/architecture.md, "The speed at full quality"); absent: [drive]'s
+        if (prob.get("full_speed_quality"))
+            p.prob_full_speed_quality = r.number(prob, "full_speed_quality", 0.01, 1.0);
     }
 }
 

@@ -116,6 +116,7 @@ struct RobotProfile {
     double prob_k_goal = 0.0;               // P_goal steepness, (0, 64]
     double prob_k_safe = 0.0;               // P_safe steepness, (0, 64]
     double prob_keep = 0.0;                 // holding the heading: margin of quality, [0, 1]
+    double prob_full_speed_quality = 0.0;   // its quality at v_max; 0: [drive] full_speed_quality
 };
 
 // Whether the profile draws odometry errors (the map's pose is then dead-reckoned).

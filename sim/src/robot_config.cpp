@@ -39,6 +39,8 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->escape_follow_mm = to_mm(p.escape_follow_m);
     cfg->escape_follow_s = static_cast<std::uint8_t>(std::lround(p.escape_follow_s));
     cfg->keep_pct = static_cast<std::uint8_t>(std::lround(p.prob_keep * 100.0));
+    cfg->quality_full_speed = static_cast<qnav_q1_15_t>(
+        std::min(32767L, std::lround(p.prob_full_speed_quality * 32768.0)));
 }
 
 namespace {

@@ -986,7 +986,7 @@ static void test_board_reports_its_robot_configuration_field_by_field(void **sta
     n = qnav_link_config_pack(&m, p, sizeof p);
     assert_true(n > 0);
     assert_int_equal(qnav_link_config_unpack(p, (uint16_t)n, &back), QNAV_LINK_OK);
-    assert_int_equal(back.n, 21);
+    assert_int_equal(back.n, 22);
     assert_int_equal(back.key[0], 1);
     assert_int_equal(back.value[0], bc.ctrl.n_sectors);
     assert_int_equal(back.key[1], 2);

@@ -476,6 +476,74 @@ static void test_speed_is_linear_in_quality_up_to_full(void **state)
     assert_false(out.flags & QNAV_FLAG_FULL_SPEED);
 }
 
+/* One clear scan's output with this rank and quality_full_speed, in policy (compiled: table)
+ * mode. The network's quality is the constant sigmoid(0) = 0.5 on every path. */
+static qnav_ctrl_output_t constant_half_step(uint8_t rank, qnav_q1_15_t quality_full_speed, int compiled)
+{
+    static qnav_qkey_t table[QNAV_QTABLE_ENTRIES];
+    qnav_ctrl_t c;
+    qnav_ctrl_config_t cfg;
+    qnav_policy_t p;
+    qnav_mm_t ranges[1] = {5000};
+    qnav_ctrl_input_t in = {ranges, 0};
+    qnav_ctrl_output_t out;
+    qnav_policy_net_zero(&p, 1);
+    qnav_ctrl_config_default(&cfg);
+    cfg.n_sectors = 1;
+    cfg.rank = rank;
+    cfg.quality_full_speed = quality_full_speed;
+    assert_int_equal(compiled ? qnav_ctrl_init_compiled(&c, &cfg, &p, table) : qnav_ctrl_init(&c, &cfg, &p),
+                     QNAV_OK);
+    qnav_ctrl_step(&c, &in, &out, NULL);
+    assert_int_equal(out.quality, 16384);
+    return out;
+}
+
+/* Keys ranked by quality (the probabilistic policy's, always) reach full speed at their own
+ * quality_full_speed when it is set, in policy and table mode alike; pre-activation keys
+ * keep full_speed_quality; a negative value is refused. */
+static void test_quality_ranked_keys_reach_full_speed_at_their_own_quality(void **state)
+{
+    qnav_ctrl_t c;
+    qnav_ctrl_config_t cfg;
+    qnav_policy_t p;
+    qnav_mm_t ranges[16];
+    qnav_ctrl_output_t at_own, at_drive;
+    qnav_ctrl_input_t in = {ranges, 4500};
+    int compiled;
+    (void)state;
+    for (compiled = 0; compiled <= 1; ++compiled) {
+        qnav_ctrl_output_t o = constant_half_step(QNAV_RANK_QUALITY, 16384, compiled);
+        assert_int_equal(o.speed, QNAV_Q1_15_MAX); /* 0.5 >= 0.5: full */
+        assert_true(o.flags & QNAV_FLAG_FULL_SPEED);
+        o = constant_half_step(QNAV_RANK_QUALITY, 0, compiled);
+        assert_in_range(o.speed, 18200, 18206); /* 0.5 / 0.9, as before */
+        o = constant_half_step(QNAV_RANK_PREACT, 16384, compiled);
+        assert_in_range(o.speed, 18200, 18206); /* not this rank's value */
+        o = constant_half_step(QNAV_RANK_QUALITY, 29491, compiled);
+        assert_in_range(o.speed, 18200, 18206); /* the same value as full_speed_quality */
+    }
+    /* the probabilistic policy ranks by quality whatever cfg.rank says */
+    qnav_policy_prob_default(&p);
+    qnav_ctrl_config_default(&cfg);
+    cfg.rank = (uint8_t)QNAV_RANK_PREACT;
+    fill(ranges, 16, 600);
+    assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_OK);
+    qnav_ctrl_step(&c, &in, &at_drive, NULL);
+    print_message("probabilistic policy: quality %d, speed %d at 0.9\n", at_drive.quality, at_drive.speed);
+    cfg.quality_full_speed = 16384;
+    assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_OK);
+    qnav_ctrl_step(&c, &in, &at_own, NULL);
+    assert_int_equal(at_own.heading_deg, at_drive.heading_deg);
+    assert_int_equal(at_own.quality, at_drive.quality);
+    assert_true(at_own.quality < 16384);
+    /* quality / 0.5 against quality / 0.9: 1.8 times as fast, to a count's rounding */
+    assert_in_range((int32_t)at_own.speed * 10, (int32_t)at_drive.speed * 18 - 40,
+                    (int32_t)at_drive.speed * 18 + 40);
+    cfg.quality_full_speed = -1;
+    assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_E_SPEED);
+}
+
 static void test_equal_qualities_choose_the_goal_direction(void **state)
 {
     (void)state;
@@ -1615,6 +1683,7 @@ int main(void)
         cmocka_unit_test(test_ctrl_prefers_goal_over_far_obstacle),
         cmocka_unit_test(test_a_wall_beyond_the_destination_does_not_block_the_way_to_it),
         cmocka_unit_test(test_speed_is_linear_in_quality_up_to_full),
+        cmocka_unit_test(test_quality_ranked_keys_reach_full_speed_at_their_own_quality),
         cmocka_unit_test(test_equal_qualities_choose_the_goal_direction),
         cmocka_unit_test(test_ranges_beyond_max_are_clipped_and_flagged),
         cmocka_unit_test(test_all_zero_quality_stops_and_flags),

@@ -148,10 +148,13 @@ void test_the_trace_carries_the_destination_the_controller_was_given(void **) {
 void test_the_map_finds_the_gap_the_policy_alone_misses(void **) {
     const Run without = run(tekbot_with(""), 10);
     const Run with = run(tekbot_with("[map]\ncell_m = 0.1\n"), 10);
-    print_message("wall with a far gap: %u/10 arrive with the map (%u collisions), %u/10 without\n",
-                  with.reached, with.collisions, without.reached);
+    print_message("wall with a far gap: %u/10 arrive with the map (%u collisions, %u ticks), %u/10 without (%u ticks)\n",
+                  with.reached, with.collisions, with.ticks, without.reached, without.ticks);
     assert_true(with.reached >= 9);
-    assert_true(with.reached >= without.reached + 3);
+    assert_true(with.reached >= without.reached);
+    // the plan leads to the gap; alone, the policy searches along the wall: at least a fifth
+    // fewer ticks over the ten (the time-outs counted at the limit)
+    assert_true(5u * with.ticks < 4u * without.ticks);
     assert_int_equal(with.collisions, 0);
 }
 

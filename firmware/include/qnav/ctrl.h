@@ -31,7 +31,7 @@ typedef enum {
     QNAV_E_NULL = -1,         /* a required pointer was null */
     QNAV_E_SECTORS = -2,      /* n_sectors outside 1..QNAV_MAX_SECTORS */
     QNAV_E_RANGE = -3,        /* max_range_mm is 0, or range_min_mm not below it */
-    QNAV_E_SPEED = -4,        /* full_speed_quality outside (0, 1) */
+    QNAV_E_SPEED = -4,        /* full_speed_quality outside (0, 1), quality_full_speed < 0 */
     QNAV_E_POLICY_KIND = -5,  /* policy kind unknown */
     QNAV_E_HIDDEN = -6,       /* hidden units outside 1..QNAV_MAX_HIDDEN */
     QNAV_E_PROB_PARAM = -7,   /* a probabilistic parameter outside (0, 64] */
@@ -154,6 +154,13 @@ typedef struct {
                                          enlarges a reading at it by at least
                                          asin(r / (r + d_s)): the paths that would touch an
                                          obstacle at the safety distance. Default 0 (none) */
+    qnav_q1_15_t quality_full_speed;  /* the quality giving full speed when keys rank by
+                                         quality (QNAV_RANK_QUALITY: the probabilistic
+                                         policy always, its tables), Q1.15 in (0, 1); 0:
+                                         full_speed_quality, as for every other rank. A
+                                         product of probabilities sits lower than a
+                                         network's saturating output (docs/architecture.md,
+                                         "The speed at full quality"). Default 0 */
 } qnav_ctrl_config_t;
 
 /* The escape memory: what the robot remembers between ticks to leave dead ends

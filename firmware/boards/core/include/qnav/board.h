@@ -94,6 +94,7 @@ typedef struct {
     X(15, keep_pct, ctrl.keep_pct)                                                          \
     X(16, range_min_mm, ctrl.range_min_mm)                                                  \
     X(17, pass_mm, ctrl.pass_mm)                                                            \
+    X(18, quality_full_speed, ctrl.quality_full_speed)                                      \
     X(32, tick_ms, tick_ms)                                                                 \
     X(33, track_mm, track_mm)                                                               \
     X(34, um_per_count, um_per_count)                                                       \

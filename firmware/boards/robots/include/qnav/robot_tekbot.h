@@ -40,6 +40,7 @@
         .ctrl.keep_pct = 15, \
         .ctrl.range_min_mm = 30, \
         .ctrl.pass_mm = 10, \
+        .ctrl.quality_full_speed = 22938, \
         .tick_ms = 100, \
         .track_mm = 180, \
         .um_per_count = 6872, \
