@@ -206,20 +206,43 @@ static void test_whole_wedges_within_the_stopping_distance(void **state) {
 }
 
 /* The quality commanded at v_max is the profile's (both robots: the paper's 0.9), not a
- * default of libqnav's: a copy of the TekBot's profile with another value gives it. */
+ * default of libqnav's: a copy of the TekBot's profile with another value gives it. The
+ * probabilistic policy's own value ([probabilistic] full_speed_quality: the TekBot's 0.7,
+ * none for the Pioneer) reaches libqnav as quality_full_speed, 0 when absent; a value
+ * outside (0, 1] is refused on one line naming the key. */
 static void test_profile_sets_the_speed_at_full_quality(void **state) {
     (void)state;
     char err[QNAV_SIM_ERRLEN] = "";
     static const struct {
         const char *robot;
         qnav_q1_15_t q;
-    } want[] = {{"tekbot", 29491}, {"pioneer3dx", 29491}};
+        qnav_q1_15_t prob_q;
+    } want[] = {{"tekbot", 29491, 22938}, {"pioneer3dx", 29491, 0}};
     for (const auto &w : want) {
         qnav_sim_robot_t *robot = nullptr;
         qnav_ctrl_config_t cfg;
         assert_int_equal(qnav_sim_robot_load(w.robot, &robot, err, sizeof err), QNAV_SIM_OK);
         qnav_sim_robot_ctrl_config(robot, 0, &cfg);
         assert_int_equal(cfg.full_speed_quality, w.q);
+        assert_int_equal(cfg.quality_full_speed, w.prob_q);
+        qnav_sim_robot_free(robot);
+    }
+    {
+        std::string u = read_data("robots/tekbot.toml");
+        const std::size_t at = u.find("full_speed_quality = 0.7");
+        assert_true(at != std::string::npos);
+        std::string bad = u;
+        bad.replace(at, 24, "full_speed_quality = 1.5");
+        std::string msg;
+        assert_int_equal(parse_robot(bad, &msg), QNAV_SIM_E_PARSE);
+        assert_true(msg.find("full_speed_quality") != std::string::npos);
+        assert_true(one_line(msg));
+        u.erase(at, u.find('\n', at) - at + 1);
+        qnav_sim_robot_t *robot = nullptr;
+        qnav_ctrl_config_t cfg;
+        assert_int_equal(qnav_sim_robot_parse(u.data(), u.size(), "p.toml", &robot, err, sizeof err), QNAV_SIM_OK);
+        qnav_sim_robot_ctrl_config(robot, 0, &cfg);
+        assert_int_equal(cfg.quality_full_speed, 0);
         qnav_sim_robot_free(robot);
     }
     std::string t = read_data("robots/tekbot.toml");
