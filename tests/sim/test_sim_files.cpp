@@ -208,7 +208,7 @@ static void test_whole_wedges_within_the_stopping_distance(void **state) {
 /* The quality commanded at v_max is the profile's (both robots: the paper's 0.9), not a
  * default of libqnav's: a copy of the TekBot's profile with another value gives it. The
  * probabilistic policy's own value ([probabilistic] full_speed_quality: the TekBot's 0.7,
- * none for the Pioneer) reaches libqnav as quality_full_speed, 0 when absent; a value
+ * the Pioneer's 0.8) reaches libqnav as quality_full_speed, 0 when absent; a value
  * outside (0, 1] is refused on one line naming the key. */
 static void test_profile_sets_the_speed_at_full_quality(void **state) {
     (void)state;
@@ -217,7 +217,7 @@ static void test_profile_sets_the_speed_at_full_quality(void **state) {
         const char *robot;
         qnav_q1_15_t q;
         qnav_q1_15_t prob_q;
-    } want[] = {{"tekbot", 29491, 22938}, {"pioneer3dx", 29491, 0}};
+    } want[] = {{"tekbot", 29491, 22938}, {"pioneer3dx", 29491, 26214}};
     for (const auto &w : want) {
         qnav_sim_robot_t *robot = nullptr;
         qnav_ctrl_config_t cfg;

@@ -40,7 +40,7 @@
         .ctrl.keep_pct = 15, \
         .ctrl.range_min_mm = 100, \
         .ctrl.pass_mm = 20, \
-        .ctrl.quality_full_speed = 0, \
+        .ctrl.quality_full_speed = 26214, \
         .tick_ms = 100, \
         .track_mm = 330, \
         .um_per_count = 485, \
