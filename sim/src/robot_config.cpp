@@ -13,6 +13,11 @@ static std::uint16_t to_mm(double m) {
     return static_cast<std::uint16_t>(std::min(65535.0, std::round(m * 1000.0)));
 }
 
+// A fraction as libqnav's Q1.15, at most 32767 (1.0 is not representable).
+static qnav_q1_15_t to_q1_15(double f) {
+    return static_cast<qnav_q1_15_t>(std::min(32767L, std::lround(f * 32768.0)));
+}
+
 void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl_config_t *cfg) {
     qnav_ctrl_config_default(cfg);
     cfg->n_sectors = n_sectors ? n_sectors : p.default_sectors;
@@ -30,8 +35,7 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->sensor_offset_mm = to_mm(p.sonar_offset_m);
     cfg->range_min_mm = to_mm(p.range_min_m);
     cfg->v_max_mm_s = to_mm(p.v_max_mps);
-    cfg->full_speed_quality = static_cast<qnav_q1_15_t>(
-        std::min(32767L, std::lround(p.full_speed_quality * 32768.0)));
+    cfg->full_speed_quality = to_q1_15(p.full_speed_quality);
     cfg->decel_mm_s2 = p.speed_guard ? to_mm(p.decel_mps2) : 0;
     cfg->wedge_pct = p.wedge_pct;
     cfg->wedge_near_mm = to_mm(p.wedge_near_m);
@@ -39,8 +43,7 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->escape_follow_mm = to_mm(p.escape_follow_m);
     cfg->escape_follow_s = static_cast<std::uint8_t>(std::lround(p.escape_follow_s));
     cfg->keep_pct = static_cast<std::uint8_t>(std::lround(p.prob_keep * 100.0));
-    cfg->quality_full_speed = static_cast<qnav_q1_15_t>(
-        std::min(32767L, std::lround(p.prob_full_speed_quality * 32768.0)));
+    cfg->quality_full_speed = to_q1_15(p.prob_full_speed_quality);
 }
 
 namespace {
