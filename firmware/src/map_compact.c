@@ -171,19 +171,93 @@ void qnav_cmap_plan_start(qnav_map_t *m, uint32_t c)
     m->q_queued = 1u; /* the last step count reached a cell: the plan may grow */
 }
 
-/* One row's cells as the growth reads them, a byte of 8 cells each, with an empty byte at
- * both ends: the cells labelled with the last step count, and the passable ones (not
- * occupied, and on the map). */
+/* The growth reads and writes a row a word of cells at a time: elsewhere than on AVR a
+ * 64-bit word (little-endian: cell i of a row in bit i % 64 of word i / 64, the planes'
+ * own order), so a TekBot's 32-cell row is one word; on AVR a byte, the planes' bytes
+ * themselves. The same operations either way, so both grow the same plan (the map bench
+ * checks the ATmega128's against the host's). */
+#if !defined(__AVR__) && defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define QNAV_CMAP_WIDE 1
+typedef uint64_t cword_t;
+#else
+#define QNAV_CMAP_WIDE 0
+typedef uint8_t cword_t;
+#endif
+#define CWORD_BYTES ((uint16_t)sizeof(cword_t))
+#define CWORD_TOP (8u * sizeof(cword_t) - 1u) /* a word's last cell's bit */
+#define ROW_WORDS_MAX ((QNAV_CMAP_ROW_BYTES_MAX + sizeof(cword_t) - 1u) / sizeof(cword_t))
+
+/* Words of a row of n bytes. */
+static inline uint16_t row_words(uint16_t n)
+{
+    return (uint16_t)((n + CWORD_BYTES - 1u) / CWORD_BYTES);
+}
+
+/* Word w of a row of n bytes at p; the bytes past the row read 0. Elsewhere than on AVR
+ * in fixed-size loads (a variable memcpy is a call): a word's last bytes short of 8 as a
+ * second 4-byte load ending at the row's end, overlapping the first. */
+static inline cword_t word_at(const uint8_t *p, uint16_t w, uint16_t n)
+{
+#if !QNAV_CMAP_WIDE
+    (void)n;
+    return p[w];
+#else
+    const uint16_t at = (uint16_t)(w * CWORD_BYTES), len = (uint16_t)(n - at);
+    cword_t v = 0u;
+    if (len >= CWORD_BYTES) {
+        memcpy(&v, p + at, CWORD_BYTES);
+    } else if (len >= 4u) {
+        uint32_t a, b;
+        memcpy(&a, p + at, 4u);
+        memcpy(&b, p + at + len - 4u, 4u);
+        v = (cword_t)a | (cword_t)b << (8u * (len - 4u));
+    } else {
+        uint16_t k;
+        for (k = 0; k < len; ++k) {
+            v |= (cword_t)p[at + k] << (8u * k);
+        }
+    }
+    return v;
+#endif
+}
+
+/* Word w of a row of n bytes at p |= v (v holds no cell past the row). */
+static inline void word_or(uint8_t *p, uint16_t w, uint16_t n, cword_t v)
+{
+#if !QNAV_CMAP_WIDE
+    (void)n;
+    p[w] = (uint8_t)(p[w] | v);
+#else
+    const uint16_t at = (uint16_t)(w * CWORD_BYTES), len = (uint16_t)(n - at);
+    v |= word_at(p, w, n);
+    if (len >= CWORD_BYTES) {
+        memcpy(p + at, &v, CWORD_BYTES);
+    } else if (len >= 4u) {
+        const uint32_t a = (uint32_t)v, b = (uint32_t)(v >> (8u * (len - 4u)));
+        memcpy(p + at, &a, 4u);
+        memcpy(p + at + len - 4u, &b, 4u);
+    } else {
+        uint16_t k;
+        for (k = 0; k < len; ++k) {
+            p[at + k] = (uint8_t)(v >> (8u * k));
+        }
+    }
+#endif
+}
+
+/* One row's cells as the growth reads them, a word each, with an empty word at both ends:
+ * the cells labelled with the last step count, and the passable ones (not occupied, and
+ * on the map). */
 typedef struct {
-    uint8_t last[QNAV_CMAP_ROW_BYTES_MAX + 2u];
-    uint8_t pass[QNAV_CMAP_ROW_BYTES_MAX + 2u];
+    cword_t last[ROW_WORDS_MAX + 2u];
+    cword_t pass[ROW_WORDS_MAX + 2u];
 } row_t;
 
 static void load_row(const qnav_map_t *m, int32_t j, unsigned t, row_t *r)
 {
-    const uint16_t n = m->row_bytes;
-    uint16_t b;
-    r->last[0] = r->pass[0] = r->last[n + 1u] = r->pass[n + 1u] = 0u;
+    const uint16_t n = m->row_bytes, nw = row_words(n);
+    uint16_t w;
+    r->last[0] = r->pass[0] = r->last[nw + 1u] = r->pass[nw + 1u] = 0u;
     if (j < 0 || j >= (int32_t)m->ny) {
         memset(r, 0, sizeof *r);
         return;
@@ -191,21 +265,58 @@ static void load_row(const qnav_map_t *m, int32_t j, unsigned t, row_t *r)
     {
         const uint8_t *lo = plane(m, PLAN_LO, j), *hi = plane(m, PLAN_HI, j);
         const uint8_t *sl = plane(m, SEEN_LO, j), *sh = plane(m, SEEN_HI, j);
-        const uint8_t flip_lo = (t & 1u) ? 0u : 0xFFu, flip_hi = (t & 2u) ? 0u : 0xFFu;
-        for (b = 0; b < n; ++b) {
-            r->last[b + 1u] = (uint8_t)((lo[b] ^ flip_lo) & (hi[b] ^ flip_hi));
-            r->pass[b + 1u] = (uint8_t)(sl[b] | (uint8_t)~sh[b]);
+        const cword_t flip_lo = (t & 1u) ? 0u : (cword_t)~(cword_t)0u;
+        const cword_t flip_hi = (t & 2u) ? 0u : (cword_t)~(cword_t)0u;
+        for (w = 0; w < nw; ++w) {
+            r->last[w + 1u] = (cword_t)((word_at(lo, w, n) ^ flip_lo) & (word_at(hi, w, n) ^ flip_hi));
+            r->pass[w + 1u] = (cword_t)(word_at(sl, w, n) | (cword_t)~word_at(sh, w, n));
         }
     }
-    if ((m->nx & 7u) != 0u) {
-        r->pass[n] &= (uint8_t)((1u << (m->nx & 7u)) - 1u); /* no cell beyond the row */
+    if ((m->nx & CWORD_TOP) != 0u) { /* no cell beyond the row */
+        const cword_t all = (cword_t)~(cword_t)0u;
+        r->pass[nw] &= (cword_t)~(cword_t)(all << (m->nx & CWORD_TOP));
     }
 }
 
-/* Byte b of a row_t array seen one cell over: cell i takes cell i - 1's bit (WEST) or
+/* Word w of a row_t array seen one cell over: cell i takes cell i - 1's bit (WEST) or
  * i + 1's (EAST). */
-#define WEST(v, b) ((uint8_t)((uint8_t)((v)[b] << 1) | ((v)[(b) - 1u] >> 7)))
-#define EAST(v, b) ((uint8_t)(((v)[b] >> 1) | (uint8_t)((v)[(b) + 1u] << 7)))
+#define WEST(v, w) ((cword_t)((cword_t)((v)[w] << 1) | ((v)[(w) - 1u] >> CWORD_TOP)))
+#define EAST(v, w) ((cword_t)(((v)[w] >> 1) | (cword_t)((v)[(w) + 1u] << CWORD_TOP)))
+
+/* Row j's new cells, those a step from the last count's cells in the rows up, here and
+ * down, labelled next; a row with any becomes the last count's last (and, the first
+ * such, its first), and *any is set. */
+static inline void grow_row(qnav_map_t *m, int32_t j, const row_t *up, const row_t *here,
+                            const row_t *down, unsigned next, uint8_t *any)
+{
+    uint8_t *lo = plane(m, PLAN_LO, j), *hi = plane(m, PLAN_HI, j);
+    const cword_t *ul = up->last, *up_ = up->pass, *hl = here->last, *hp = here->pass;
+    const cword_t *dl = down->last, *dp = down->pass;
+    const uint16_t n = m->row_bytes, nw = row_words(n);
+    uint16_t w;
+    for (w = 1; w <= nw; ++w) {
+        const cword_t pw = WEST(hp, w), pe = EAST(hp, w);
+        const uint16_t at = (uint16_t)(w - 1u); /* the plane's word */
+        cword_t r = (cword_t)(WEST(hl, w) | EAST(hl, w) | ul[w] | dl[w]);
+        cword_t add;
+        r |= (cword_t)(((WEST(ul, w) & pw) | (EAST(ul, w) & pe)) & up_[w]);
+        r |= (cword_t)(((WEST(dl, w) & pw) | (EAST(dl, w) & pe)) & dp[w]);
+        add = (cword_t)(r & hp[w] & (cword_t)~(word_at(lo, at, n) | word_at(hi, at, n)));
+        if (add != 0u) {
+            if (next & 1u) {
+                word_or(lo, at, n, add);
+            }
+            if (next & 2u) {
+                word_or(hi, at, n, add);
+            }
+            if (!*any) {
+                m->rows_from = (uint16_t)j;
+            }
+            m->rows_to = (uint16_t)j;
+            *any = 1u;
+        }
+    }
+}
 
 /* One more step count: every passable cell not yet reached a step from the last count's
  * cells takes the next count (8 neighbours; a diagonal only past the two cells beside it,
@@ -217,45 +328,20 @@ static int grow(qnav_map_t *m)
     row_t rows[3];
     row_t *up = &rows[0], *here = &rows[1], *down = &rows[2];
     const unsigned t = label_of(m->layer), next = label_of(m->layer + 1u);
-    const uint16_t n = m->row_bytes;
     const int32_t first = m->rows_from > 0u ? (int32_t)m->rows_from - 1 : 0;
     const int32_t last = (int32_t)m->rows_to + 1 < (int32_t)m->ny ? (int32_t)m->rows_to + 1
                                                                    : (int32_t)m->ny - 1;
     uint8_t any = 0u;
     int32_t j;
-    uint16_t b;
     if (!m->q_queued) {
         return 0;
     }
     load_row(m, first - 1, t, up);
     load_row(m, first, t, here);
     for (j = first; j <= last; ++j) {
-        uint8_t *lo = plane(m, PLAN_LO, j), *hi = plane(m, PLAN_HI, j);
-        const uint8_t *ul = up->last, *up_ = up->pass, *hl = here->last, *hp = here->pass;
-        const uint8_t *dl = down->last, *dp = down->pass;
         row_t *spare = up;
         load_row(m, j + 1, t, down);
-        for (b = 1; b <= n; ++b) {
-            const uint8_t pw = WEST(hp, b), pe = EAST(hp, b);
-            uint8_t r = (uint8_t)(WEST(hl, b) | EAST(hl, b) | ul[b] | dl[b]);
-            uint8_t add;
-            r |= (uint8_t)(((WEST(ul, b) & pw) | (EAST(ul, b) & pe)) & up_[b]);
-            r |= (uint8_t)(((WEST(dl, b) & pw) | (EAST(dl, b) & pe)) & dp[b]);
-            add = (uint8_t)(r & hp[b] & (uint8_t)~(lo[b - 1u] | hi[b - 1u]));
-            if (add != 0u) {
-                if (next & 1u) {
-                    lo[b - 1u] |= add;
-                }
-                if (next & 2u) {
-                    hi[b - 1u] |= add;
-                }
-                if (!any) {
-                    m->rows_from = (uint16_t)j;
-                }
-                m->rows_to = (uint16_t)j;
-                any = 1u;
-            }
-        }
+        grow_row(m, j, up, here, down, next, &any);
         up = here;
         here = down;
         down = spare;
