@@ -969,7 +969,7 @@ static int in_sight(const qnav_map_t *m, int32_t i0, int32_t j0, int32_t i1, int
 
 /* The cost of cell (i, j), or from the nearest reachable cell within two (the robot's
  * own cell may be blocked: it stands near a wall). QNAV_MAP_UNREACHED: none. */
-static uint32_t cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi, int32_t *bj)
+static uint32_t cost_near(qnav_map_t *m, int32_t i, int32_t j, int32_t *bi, int32_t *bj)
 {
     uint32_t best = QNAV_MAP_UNREACHED;
     int32_t a, b;

@@ -58,15 +58,24 @@ static void set2(const qnav_map_t *m, unsigned lo, int32_t i, int32_t j, unsigne
     *p1 = (uint8_t)((v & 2u) ? (*p1 | bit) : (*p1 & (uint8_t)~bit));
 }
 
+/* A label, a cell's occupancy or the plan's growth changed: the cost last found near a
+ * cell (qnav_cmap_cost_near) may differ now. */
+static void ways_changed(qnav_map_t *m)
+{
+    m->way_from = UINT16_MAX;
+}
+
 void qnav_cmap_attach(qnav_map_t *m, void *buf)
 {
     m->planes = (uint8_t *)buf;
     m->row_bytes = (uint16_t)((m->nx + 7u) / 8u);
+    ways_changed(m);
 }
 
 void qnav_cmap_reset(qnav_map_t *m)
 {
     memset(m->planes, 0, qnav_cmap_bytes(m->nx, m->ny));
+    ways_changed(m);
 }
 
 int8_t qnav_cmap_evidence(const qnav_map_t *m, int32_t i, int32_t j)
@@ -79,6 +88,7 @@ void qnav_cmap_clear(qnav_map_t *m, int32_t i, int32_t j)
 {
     if (bit2(m, SEEN_LO, i, j) == SEEN_OCCUPIED) {
         m->dirty = 1u;
+        ways_changed(m);
     }
     set2(m, SEEN_LO, i, j, SEEN_FREE);
 }
@@ -87,6 +97,7 @@ void qnav_cmap_occupy(qnav_map_t *m, int32_t i, int32_t j)
 {
     set2(m, SEEN_LO, i, j, SEEN_OCCUPIED);
     m->dirty = 1u;
+    ways_changed(m);
 }
 
 void qnav_cmap_arc(qnav_map_t *m, int32_t i, int32_t j)
@@ -95,6 +106,9 @@ void qnav_cmap_arc(qnav_map_t *m, int32_t i, int32_t j)
     if (v == SEEN_UNKNOWN || v == SEEN_ONCE) {
         set2(m, SEEN_LO, i, j, v + 1u);
         m->dirty = (uint8_t)(m->dirty | (v == SEEN_ONCE));
+        if (v == SEEN_ONCE) {
+            ways_changed(m);
+        }
     }
 }
 
@@ -136,6 +150,7 @@ void qnav_cmap_shift(qnav_map_t *m, int32_t di, int32_t dj)
             memcpy(plane(m, k, j), row, m->row_bytes);
         }
     }
+    ways_changed(m);
 }
 
 void qnav_cmap_forget_occupied(qnav_map_t *m)
@@ -148,6 +163,7 @@ void qnav_cmap_forget_occupied(qnav_map_t *m)
         lo[b] = hi[b] = (uint8_t)(lo[b] & hi[b]);
     }
     m->dirty = 1u;
+    ways_changed(m);
 }
 
 int qnav_cmap_blocked(const qnav_map_t *m, int32_t i, int32_t j)
@@ -167,6 +183,7 @@ void qnav_cmap_plan_start(qnav_map_t *m, uint32_t c)
     set2(m, PLAN_LO, (int32_t)(c % m->nx), (int32_t)(c / m->nx), label_of(0u));
     m->goal_cell = (uint16_t)c;
     m->layer = 0u;
+    ways_changed(m);
     m->rows_from = m->rows_to = (uint16_t)(c / m->nx);
     m->q_queued = 1u; /* the last step count reached a cell: the plan may grow */
 }
@@ -348,6 +365,7 @@ static int grow(qnav_map_t *m)
     }
     m->layer++;
     m->q_queued = any;
+    ways_changed(m);
     return any;
 }
 
@@ -417,6 +435,14 @@ void qnav_cmap_settle(qnav_map_t *m, int32_t ri, int32_t rj)
     }
 }
 
+/* Cell i's 2-bit value in the row whose two planes' bytes are lo and hi. */
+static inline unsigned bits_in(const uint8_t *lo, const uint8_t *hi, int32_t i)
+{
+    const unsigned b = (unsigned)i >> 3;
+    const uint8_t bit = bit_of[(unsigned)i & 7u];
+    return ((lo[b] & bit) != 0u ? 1u : 0u) | ((hi[b] & bit) != 0u ? 2u : 0u);
+}
+
 int qnav_cmap_descend(const qnav_map_t *m, int32_t *i, int32_t *j)
 {
     const int32_t gi = (int32_t)(m->goal_cell % m->nx), gj = (int32_t)(m->goal_cell / m->nx);
@@ -427,11 +453,19 @@ int qnav_cmap_descend(const qnav_map_t *m, int32_t *i, int32_t *j)
     if (here == 0u || qnav_map_at(m, *i, *j) == m->goal_cell) {
         return 0;
     }
+    /* a row's plane pointers once (not a cell's each time): the walk of every tick's way */
     for (b = -1; b <= 1; ++b) {
+        const int32_t tj = *j + b;
+        const uint8_t *lo, *hi;
+        if (tj < 0 || tj >= (int32_t)m->ny) {
+            continue;
+        }
+        lo = plane(m, PLAN_LO, tj);
+        hi = plane(m, PLAN_HI, tj);
         for (a = -1; a <= 1; ++a) {
-            const int32_t ti = *i + a, tj = *j + b;
+            const int32_t ti = *i + a;
             int32_t d2;
-            if ((a == 0 && b == 0) || !qnav_map_in(m, ti, tj) || plan_label(m, ti, tj) != want) {
+            if ((a == 0 && b == 0) || ti < 0 || ti >= (int32_t)m->nx || bits_in(lo, hi, ti) != want) {
                 continue;
             }
             if (a != 0 && b != 0 && (qnav_cmap_blocked(m, ti, *j) || qnav_cmap_blocked(m, *i, tj))) {
@@ -489,7 +523,8 @@ static uint32_t chebyshev(const qnav_map_t *m, int32_t i, int32_t j)
     return ai > aj ? ai : aj;
 }
 
-uint32_t qnav_cmap_cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi, int32_t *bj)
+static uint32_t cost_near_walked(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi,
+                                 int32_t *bj)
 {
     uint32_t best = QNAV_MAP_UNREACHED, visited = 0u;
     int32_t a, b;
@@ -534,4 +569,24 @@ uint32_t qnav_cmap_cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t 
             *bj = j + nj;
         }
     }
+}
+
+/* The guide asks every tick from the robot's cell, and the walk is the plan's way: kept
+ * until something it depends on changes (ways_changed), so a robot that stays in its cell
+ * between plans walks it once (a TekBot crosses a 0.35 m cell in about 7 ticks). */
+uint32_t qnav_cmap_cost_near(qnav_map_t *m, int32_t i, int32_t j, int32_t *bi, int32_t *bj)
+{
+    const uint16_t c = (uint16_t)qnav_map_at(m, i, j);
+    uint32_t cost;
+    if (m->way_from == c) {
+        *bi = m->way_i;
+        *bj = m->way_j;
+        return m->way_cost;
+    }
+    cost = cost_near_walked(m, i, j, bi, bj);
+    m->way_from = c;
+    m->way_cost = (uint16_t)cost;
+    m->way_i = (uint8_t)*bi;
+    m->way_j = (uint8_t)*bj;
+    return cost;
 }

@@ -69,7 +69,7 @@ void qnav_cmap_occupy(qnav_map_t *m, int32_t i, int32_t j);
  * (i, j) is not settled and is blocked or the plan is whole, from the best settled cell
  * within two (*bi, *bj: that cell); QNAV_MAP_UNREACHED when none is (or the plan is still
  * growing toward an open cell). */
-uint32_t qnav_cmap_cost_near(const qnav_map_t *m, int32_t i, int32_t j, int32_t *bi,
+uint32_t qnav_cmap_cost_near(qnav_map_t *m, int32_t i, int32_t j, int32_t *bi,
                              int32_t *bj);
 /* One step along the plan from settled cell (*i, *j) toward the destination; 0 at the
  * destination's cell or when (*i, *j) is not settled. */

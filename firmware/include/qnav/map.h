@@ -174,6 +174,11 @@ typedef struct {
     uint16_t layer;           /* the plan's last settled step count (compact) */
     uint16_t goal_cell;       /* the destination's cell (compact) */
     uint16_t rows_from, rows_to; /* the rows holding the last step count's cells (compact) */
+    uint16_t way_from;        /* the cell the last cost near it was found for, while no label,
+                                 no cell's occupancy and no growth changed since (compact);
+                                 UINT16_MAX: none */
+    uint16_t way_cost;        /* ... that cost */
+    uint8_t way_i, way_j;     /* ... and the cell its way starts from */
     int32_t sub_x_mm, sub_y_mm; /* the last guided tick's sub-goal */
     uint16_t sub_mm;          /* ... its own way to the destination, mm */
     uint8_t sub_direct;       /* ... was the destination (QNAV_MAP_DIRECT) */
