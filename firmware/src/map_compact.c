@@ -69,7 +69,6 @@ void qnav_cmap_attach(qnav_map_t *m, void *buf)
 {
     m->planes = (uint8_t *)buf;
     m->row_bytes = (uint16_t)((m->nx + 7u) / 8u);
-    ways_changed(m);
 }
 
 void qnav_cmap_reset(qnav_map_t *m)

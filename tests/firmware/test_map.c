@@ -13,6 +13,7 @@
 
 #include <cmocka.h>
 
+#include "map_compact.h"
 #include "qnav/map.h"
 #include "qnav/trig.h"
 
@@ -643,6 +644,95 @@ static void test_the_compact_layout_marks_as_the_full_one_and_plans_breadth_firs
     print_message("%d of %d cells reached, %d not (occupied, or walled in)\n", reached, n * n,
                   n * n - reached);
     assert_true(reached > n * n / 2 && reached < n * n);
+}
+
+/* The compact map keeps the cost it found near the robot's cell (qnav_map_t.way_from) until
+ * a label, a cell's occupancy or the plan's growth changes. Two maps see the same drive
+ * among the boxes (walls appearing, plans growing 2 steps a tick, the robot crossing
+ * cells); one forgets the kept cost before every guide. Every tick's guidance is the same,
+ * and the kept cost was used on some ticks. Fails when a change that the walk depends on
+ * leaves the kept cost standing (a ways_changed() call left out). */
+static void test_a_compact_map_keeps_the_cost_near_the_robot_only_while_it_holds(void **state)
+{
+    static qnav_map_t kept, fresh;
+    static uint16_t mem_kept[2000], mem_fresh[2000];
+    qnav_map_config_t mc;
+    qnav_ctrl_config_t cc;
+    qnav_mm_t ranges[N];
+    int32_t t, used = 0;
+    (void)state;
+    qnav_map_config_default(&mc);
+    make_compact(&mc, 300, 3, 2);
+    sensor_config(&cc);
+    assert_int_equal(qnav_map_init(&kept, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem_kept,
+                                   sizeof mem_kept),
+                     QNAV_OK);
+    assert_int_equal(qnav_map_init(&fresh, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem_fresh,
+                                   sizeof mem_fresh),
+                     QNAV_OK);
+    for (t = 0; t < 240; ++t) {
+        /* slowly round the pillar and along the wall: several ticks in each cell */
+        const qnav_map_pose_t p = {900 + (t % 80) * 50, 700 + (t / 80) * 500, t * 900};
+        qnav_ctrl_input_t a, b;
+        int ga, gb;
+        memset(&a, 0, sizeof a);
+        memset(&b, 0, sizeof b);
+        scan(among, sizeof among / sizeof among[0], &p, ranges);
+        qnav_map_observe(&kept, ranges, &p);
+        qnav_map_observe(&fresh, ranges, &p);
+        used += kept.way_from != UINT16_MAX;
+        fresh.way_from = UINT16_MAX;
+        ga = qnav_map_guide(&kept, &p, 3 * 300 + 100, 17 * 300 + 100, &a);
+        gb = qnav_map_guide(&fresh, &p, 3 * 300 + 100, 17 * 300 + 100, &b);
+        assert_int_equal(ga, gb);
+        assert_int_equal(a.goal_bearing_cdeg, b.goal_bearing_cdeg);
+        assert_int_equal(a.goal_range_mm, b.goal_range_mm);
+    }
+    print_message("a kept cost stood at %d of 240 guides\n", used);
+    assert_true(used > 20);
+}
+
+/* The same, change by change: each change a way depends on (a cell becoming occupied by
+ * a second arc or a refusal, an occupied cell seen free, a forget, the map moving, a new
+ * plan, a plan's growth, a reset) drops the kept cost, a new map keeps none, and a first arc (not yet occupied) keeps it;
+ * the cost then found is the fresh walk's, and a new plan's, not the old one's. */
+static void test_every_change_a_way_depends_on_drops_the_kept_cost(void **state)
+{
+    qnav_map_t m;
+    int32_t bi, bj;
+    uint32_t before, after;
+    (void)state;
+    memset(&m, 0, sizeof m); /* a caller's zeroed map: cell 0 must not look kept */
+    compact_map(&m, 300, 1, 0);
+    assert_int_equal(m.way_from, UINT16_MAX);
+    qnav_map_plan(&m, 15 * 300 + 150, 15 * 300 + 150); /* the diagonal from (2, 2) on */
+#define KEPT_THEN(change)                                                                    \
+    do {                                                                                     \
+        (void)qnav_cmap_cost_near(&m, 2, 2, &bi, &bj);                                       \
+        assert_int_equal(m.way_from, qnav_map_at(&m, 2, 2));                                 \
+        change;                                                                              \
+        assert_int_equal(m.way_from, UINT16_MAX);                                            \
+    } while (0)
+    before = qnav_cmap_cost_near(&m, 2, 2, &bi, &bj);
+    assert_int_equal(before, 13u * 14u); /* 13 diagonal steps */
+    qnav_cmap_arc(&m, 3, 2); /* one arc: not occupied, the way and the kept cost stand */
+    assert_int_equal(m.way_from, qnav_map_at(&m, 2, 2));
+    KEPT_THEN(qnav_cmap_arc(&m, 3, 2)); /* occupied beside the first diagonal step */
+    after = qnav_cmap_cost_near(&m, 2, 2, &bi, &bj);
+    m.way_from = UINT16_MAX;
+    assert_int_equal(qnav_cmap_cost_near(&m, 2, 2, &bi, &bj), after);
+    KEPT_THEN(qnav_cmap_clear(&m, 3, 2));
+    KEPT_THEN(qnav_cmap_occupy(&m, 2, 3));
+    KEPT_THEN(qnav_cmap_forget_occupied(&m));
+    KEPT_THEN(qnav_cmap_shift(&m, 0, 0));
+    KEPT_THEN(qnav_cmap_plan_start(&m, qnav_map_at(&m, 15, 15)));
+    /* a new plan has settled only its destination: no cost near (2, 2) yet, not the old */
+    assert_int_equal(qnav_cmap_cost_near(&m, 2, 2, &bi, &bj), QNAV_MAP_UNREACHED);
+    qnav_cmap_settle(&m, -1, -1);
+    assert_int_equal(m.way_from, UINT16_MAX);
+    assert_int_equal(qnav_cmap_cost_near(&m, 2, 2, &bi, &bj), before);
+    KEPT_THEN(qnav_map_reset(&m));
+#undef KEPT_THEN
 }
 
 /* Left of the gap, the destination straight beyond the wall: once the wall is seen the way
@@ -1342,6 +1432,8 @@ int main(void)
         cmocka_unit_test(test_the_compact_plan_leads_round_the_wall_to_its_gap),
         cmocka_unit_test(test_a_compact_plan_grown_a_few_steps_a_tick_holds_its_last_sub_goal),
         cmocka_unit_test(test_the_compact_layout_marks_as_the_full_one_and_plans_breadth_first),
+        cmocka_unit_test(test_a_compact_map_keeps_the_cost_near_the_robot_only_while_it_holds),
+        cmocka_unit_test(test_every_change_a_way_depends_on_drops_the_kept_cost),
         cmocka_unit_test(test_the_sub_goal_is_not_behind_a_corner),
         cmocka_unit_test(test_a_longer_plan_grows_the_escape_memory),
         cmocka_unit_test(test_a_longer_plan_that_reaches_the_robot_late_grows_the_escape_memory),
