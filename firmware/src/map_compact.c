@@ -225,8 +225,11 @@ static inline cword_t word_at(const uint8_t *p, uint16_t w, uint16_t n)
     } else if (len >= 4u) {
         uint32_t a, b;
         memcpy(&a, p + at, 4u);
-        memcpy(&b, p + at + len - 4u, 4u);
-        v = (cword_t)a | (cword_t)b << (8u * (len - 4u));
+        v = a;
+        if (len > 4u) { /* a 32-cell row (both profiles') is one such load */
+            memcpy(&b, p + at + len - 4u, 4u);
+            v |= (cword_t)b << (8u * (len - 4u));
+        }
     } else {
         uint16_t k;
         for (k = 0; k < len; ++k) {
@@ -251,7 +254,9 @@ static inline void word_or(uint8_t *p, uint16_t w, uint16_t n, cword_t v)
     } else if (len >= 4u) {
         const uint32_t a = (uint32_t)v, b = (uint32_t)(v >> (8u * (len - 4u)));
         memcpy(p + at, &a, 4u);
-        memcpy(p + at + len - 4u, &b, 4u);
+        if (len > 4u) {
+            memcpy(p + at + len - 4u, &b, 4u);
+        }
     } else {
         uint16_t k;
         for (k = 0; k < len; ++k) {
