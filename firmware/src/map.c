@@ -253,13 +253,15 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
         memset(m, 0, sizeof *m);
         m->cfg = keep;
     }
-    m->n_sectors = ctrl->n_sectors;
+    m->scan_sectors = ctrl->n_sectors;
+    m->n_sectors = cfg->compact && ctrl->n_sectors > QNAV_MAP_WEDGES_MAX ? (uint16_t)QNAV_MAP_WEDGES_MAX
+                                                                         : ctrl->n_sectors;
     m->max_range_mm = ctrl->max_range_mm;
     m->offset_mm = ctrl->sensor_offset_mm;
     m->inflate_mm = (uint16_t)((uint32_t)ctrl->body_radius_mm + ctrl->safety_mm > 65535u
                                    ? 65535u
                                    : (uint32_t)ctrl->body_radius_mm + ctrl->safety_mm);
-    m->peak_mm = peak_range(cfg->opening_mm, ctrl->n_sectors);
+    m->peak_mm = peak_range(cfg->opening_mm, m->n_sectors);
     m->seen_mm = seen_range(cfg, ctrl);
     m->x0_mm = x0_mm;
     m->y0_mm = y0_mm;
@@ -577,16 +579,66 @@ static void read_sector(const qnav_map_t *m, const qnav_mm_t *ranges_mm, uint16_
  * is at most 41 000 mm along each axis, and the squared distance of a cell within reach at
  * most 2 x 41 000^2 < 2^32. A distance beyond the reach is compared as such, not squared.
  */
+static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at);
+
+/* The scan's scan_sectors readings as the map's n_sectors wedges (fewer): wedge w, centred
+ * on w * 360 / n_sectors degrees, takes the least reading of the sectors whose centres lie
+ * within half a wedge of its centre, a sector on the boundary in both. A wedge narrower
+ * than a cell judges each cell by the one sector through its centre, which along a wall
+ * seen at a slant reads far past the wall's own cell and carves it free for good; wedges
+ * whose reading is their nearest point, as a 16- or 32-sector sonar's is, do not (measured:
+ * docs/results.md, "A compact map's wedges"). Out of line, so that its array is on the
+ * stack only for such a scan. */
+#if defined(__AVR__)
+__attribute__((noinline))
+#endif
+static void observe_grouped(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
+{
+    qnav_mm_t wedge[QNAV_MAP_WEDGES_MAX];
+    /* 16-bit throughout: n <= 360 and g <= 32, so a turn is at most 11 520 units */
+    const uint16_t n = m->scan_sectors, g = m->n_sectors, turn = (uint16_t)(n * g);
+    uint16_t k, w;
+    for (w = 0; w < g; ++w) {
+        wedge[w] = m->max_range_mm;
+    }
+    for (k = 0; k < n; ++k) {
+        /* sector k's centre is k * g and wedge w's w * n, in 1 / (n * g) of a turn; the
+         * nearest wedge and the ones beside it may hold it (on a boundary, two do) */
+        const uint16_t near = (uint16_t)((uint16_t)((uint16_t)(k * g * 2u) + n) / (uint16_t)(2u * n));
+        for (w = (uint16_t)(near + g - 1u); w <= near + g + 1u; ++w) {
+            const uint16_t ww = (uint16_t)(w % g);
+            int16_t d = (int16_t)((uint16_t)(k * g + turn - ww * n) % turn); /* [0, turn) */
+            if (d > (int16_t)(turn / 2u)) {
+                d = (int16_t)(d - (int16_t)turn);
+            }
+            if ((uint16_t)(2 * (d < 0 ? -d : d)) <= n && ranges_mm[k] < wedge[ww]) {
+                wedge[ww] = ranges_mm[k];
+            }
+        }
+    }
+    observe_wedges(m, wedge, at);
+}
+
 void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
+{
+    if (!ready(m) || ranges_mm == NULL || at == NULL) {
+        return;
+    }
+    if (m->scan_sectors > m->n_sectors) {
+        observe_grouped(m, ranges_mm, at);
+        return;
+    }
+    observe_wedges(m, ranges_mm, at);
+}
+
+/* qnav_map_observe() for a scan of the map's own n_sectors wedges. */
+static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
 {
     int32_t i0, i1, j0, j1, i, j, reach, mark_reach, three_quarters, heading, arc_half, band_pct;
     uint32_t reach2;
     reading_t last;
     qnav_map_pose_t in_grid;
     const qnav_map_pose_t *pose = &in_grid;
-    if (!ready(m) || ranges_mm == NULL || at == NULL) {
-        return;
-    }
     if (qnav_align_observe(m, ranges_mm, at)) {
         qnav_map_reset(m); /* what the old grid held, forgotten: its cells lie another way */
     }

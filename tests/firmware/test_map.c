@@ -78,14 +78,15 @@ static int inside(const box_t *boxes, size_t n, int32_t x, int32_t y)
 
 /* Each sector's reading from pose: the nearest box point on 24 rays across its wedge,
  * marched in 5 mm steps, less the sensor offset, clipped to the range. */
-static void scan(const box_t *boxes, size_t n, const qnav_map_pose_t *p, qnav_mm_t *ranges)
+static void scan_of(const box_t *boxes, size_t n, const qnav_map_pose_t *p, qnav_mm_t *ranges,
+                    int sectors)
 {
     int k, r;
-    for (k = 0; k < N; ++k) {
+    for (k = 0; k < sectors; ++k) {
         int32_t best = 2500 + 120;
         for (r = 0; r < 24; ++r) {
-            const int32_t a = p->heading_cdeg + k * 36000 / N - 36000 / N / 2 +
-                              (36000 / N) * r / 23;
+            const int32_t a = p->heading_cdeg + k * 36000 / sectors - 36000 / sectors / 2 +
+                              (36000 / sectors) * r / 23;
             int16_t c, s;
             int32_t d;
             qnav_cos_sin_q14(a, &c, &s);
@@ -98,6 +99,11 @@ static void scan(const box_t *boxes, size_t n, const qnav_map_pose_t *p, qnav_mm
         }
         ranges[k] = (qnav_mm_t)(best - 120 > 2500 ? 2500 : (best < 120 ? 0 : best - 120));
     }
+}
+
+static void scan(const box_t *boxes, size_t n, const qnav_map_pose_t *p, qnav_mm_t *ranges)
+{
+    scan_of(boxes, n, p, ranges, N);
 }
 
 /* Every sector clear but the one straight ahead, which reads ahead_mm. */
@@ -733,6 +739,59 @@ static void test_every_change_a_way_depends_on_drops_the_kept_cost(void **state)
     assert_int_equal(qnav_cmap_cost_near(&m, 2, 2, &bi, &bj), before);
     KEPT_THEN(qnav_map_reset(&m));
 #undef KEPT_THEN
+}
+
+/* A compact map reads a scan of more sectors than QNAV_MAP_WEDGES_MAX as that many wedges,
+ * each the least reading of the sectors whose centres lie within it (a sector on the
+ * boundary in both): fed 64 sectors along a drive among the boxes, it holds what the map
+ * of a 32-sector sonar fed those wedges holds, cell for cell. A full-layout map reads every
+ * sector. Fails when a boundary sector is left to one wedge, or the wedges are centred off
+ * the map's sectors. */
+static void test_a_compact_map_reads_a_finer_scan_as_its_wedges(void **state)
+{
+    static qnav_map_t fine, wedges, full;
+    static uint16_t mem_fine[2000], mem_wedges[2000];
+    qnav_map_config_t mc;
+    qnav_ctrl_config_t cc;
+    qnav_mm_t r64[64], r32[32];
+    int32_t t, w, i, j, marked = 0;
+    (void)state;
+    qnav_map_config_default(&mc);
+    make_compact(&mc, 300, 1, 0);
+    sensor_config(&cc);
+    cc.n_sectors = 64;
+    assert_int_equal(qnav_map_init(&fine, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem_fine,
+                                   sizeof mem_fine),
+                     QNAV_OK);
+    assert_int_equal(fine.n_sectors, QNAV_MAP_WEDGES_MAX);
+    cc.n_sectors = 32;
+    assert_int_equal(qnav_map_init(&wedges, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem_wedges,
+                                   sizeof mem_wedges),
+                     QNAV_OK);
+    for (t = 0; t < 120; ++t) {
+        const qnav_map_pose_t p = {900 + (t % 40) * 110, 700 + (t / 40) * 600, t * 1700};
+        scan_of(among, sizeof among / sizeof among[0], &p, r64, 64);
+        for (w = 0; w < 32; ++w) { /* sectors 2w - 1, 2w and 2w + 1: centres within 5.625 deg */
+            const qnav_mm_t a = r64[(2 * w + 63) % 64], b = r64[2 * w], c = r64[2 * w + 1];
+            r32[w] = a < b ? (a < c ? a : c) : (b < c ? b : c);
+        }
+        qnav_map_observe(&fine, r64, &p);
+        qnav_map_observe(&wedges, r32, &p);
+    }
+    for (j = 0; j < WORLD_MM / 300; ++j) {
+        for (i = 0; i < WORLD_MM / 300; ++i) {
+            const int8_t a = qnav_map_evidence(&fine, i * 300 + 150, j * 300 + 150);
+            assert_int_equal(a, qnav_map_evidence(&wedges, i * 300 + 150, j * 300 + 150));
+            marked += a >= QNAV_MAP_OCCUPIED;
+        }
+    }
+    print_message("%d cells occupied, the same in both\n", marked);
+    assert_true(marked > 10);
+    mc.compact = 0;
+    cc.n_sectors = 64;
+    assert_int_equal(qnav_map_init(&full, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
+                     QNAV_OK);
+    assert_int_equal(full.n_sectors, 64);
 }
 
 /* Left of the gap, the destination straight beyond the wall: once the wall is seen the way
@@ -1434,6 +1493,7 @@ int main(void)
         cmocka_unit_test(test_the_compact_layout_marks_as_the_full_one_and_plans_breadth_first),
         cmocka_unit_test(test_a_compact_map_keeps_the_cost_near_the_robot_only_while_it_holds),
         cmocka_unit_test(test_every_change_a_way_depends_on_drops_the_kept_cost),
+        cmocka_unit_test(test_a_compact_map_reads_a_finer_scan_as_its_wedges),
         cmocka_unit_test(test_the_sub_goal_is_not_behind_a_corner),
         cmocka_unit_test(test_a_longer_plan_grows_the_escape_memory),
         cmocka_unit_test(test_a_longer_plan_that_reaches_the_robot_late_grows_the_escape_memory),

@@ -130,6 +130,10 @@ typedef struct {
     X(grow_steps, 8) X(forget_reach_mm, 16) X(opening_mm, 16) X(unknown_cost, 8)             \
     X(align_samples, 8) X(turn_back_ticks, 8)
 
+/* A compact map reads a scan of more sectors as this many wedges, each the least reading of
+ * the sectors whose centres lie within it (docs/architecture.md, "A compact map's wedges"). */
+#define QNAV_MAP_WEDGES_MAX 32u
+
 /* The robot's pose in the destination's frame. */
 typedef struct {
     int32_t x_mm;
@@ -140,7 +144,9 @@ typedef struct {
 /* One map. Private fields: read them through the functions below. */
 typedef struct {
     qnav_map_config_t cfg;
-    uint16_t n_sectors;
+    uint16_t n_sectors;       /* the wedges the map reads the scan as: the sonar's sectors, at
+                                 most QNAV_MAP_WEDGES_MAX in a compact map */
+    uint16_t scan_sectors;    /* the sonar's sectors (the scan's length) */
     qnav_mm_t max_range_mm;
     qnav_mm_t offset_mm;      /* sensor offset: a reading r lies r + offset from the centre */
     uint16_t inflate_mm;      /* body radius + safety distance */
