@@ -254,8 +254,12 @@ qnav_status_t qnav_map_init(qnav_map_t *m, const qnav_map_config_t *cfg,
         m->cfg = keep;
     }
     m->scan_sectors = ctrl->n_sectors;
-    m->n_sectors = cfg->compact && ctrl->n_sectors > QNAV_MAP_WEDGES_MAX ? (uint16_t)QNAV_MAP_WEDGES_MAX
-                                                                         : ctrl->n_sectors;
+    /* a compact map reads 64 sectors or more as 32 wedges; between 33 and 63 sectors as
+     * many (as 32 wedges, or as fewer centred on sectors, 36 and 40 sectors lost 11 to 28
+     * points: docs/architecture.md, "A compact map's wedges") */
+    m->n_sectors = cfg->compact && ctrl->n_sectors >= 2u * QNAV_MAP_WEDGES_MAX
+                       ? (uint16_t)QNAV_MAP_WEDGES_MAX
+                       : ctrl->n_sectors;
     m->max_range_mm = ctrl->max_range_mm;
     m->offset_mm = ctrl->sensor_offset_mm;
     m->inflate_mm = (uint16_t)((uint32_t)ctrl->body_radius_mm + ctrl->safety_mm > 65535u

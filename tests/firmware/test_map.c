@@ -741,12 +741,12 @@ static void test_every_change_a_way_depends_on_drops_the_kept_cost(void **state)
 #undef KEPT_THEN
 }
 
-/* A compact map reads a scan of more sectors than QNAV_MAP_WEDGES_MAX as that many wedges,
- * each the least reading of the sectors whose centres lie within it (a sector on the
- * boundary in both): fed 64 sectors along a drive among the boxes, it holds what the map
- * of a 32-sector sonar fed those wedges holds, cell for cell. A full-layout map reads every
- * sector. Fails when a boundary sector is left to one wedge, or the wedges are centred off
- * the map's sectors. */
+/* A compact map reads a scan of twice QNAV_MAP_WEDGES_MAX sectors or more as that many
+ * wedges, each the least reading of the sectors whose centres lie within it (a sector on
+ * the boundary in both): fed 64 sectors along a drive among the boxes, it holds what the
+ * map of a 32-sector sonar fed those wedges holds, cell for cell. 63 sectors, and a
+ * full-layout map, are read sector by sector. Fails when a boundary sector is left to one
+ * wedge, or the wedges are centred off the map's sectors. */
 static void test_a_compact_map_reads_a_finer_scan_as_its_wedges(void **state)
 {
     static qnav_map_t fine, wedges, full;
@@ -787,6 +787,11 @@ static void test_a_compact_map_reads_a_finer_scan_as_its_wedges(void **state)
     }
     print_message("%d cells occupied, the same in both\n", marked);
     assert_true(marked > 10);
+    cc.n_sectors = 63;
+    assert_int_equal(qnav_map_init(&wedges, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem_wedges,
+                                   sizeof mem_wedges),
+                     QNAV_OK);
+    assert_int_equal(wedges.n_sectors, 63);
     mc.compact = 0;
     cc.n_sectors = 64;
     assert_int_equal(qnav_map_init(&full, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),

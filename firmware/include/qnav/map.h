@@ -130,8 +130,9 @@ typedef struct {
     X(grow_steps, 8) X(forget_reach_mm, 16) X(opening_mm, 16) X(unknown_cost, 8)             \
     X(align_samples, 8) X(turn_back_ticks, 8)
 
-/* A compact map reads a scan of more sectors as this many wedges, each the least reading of
- * the sectors whose centres lie within it (docs/architecture.md, "A compact map's wedges"). */
+/* A compact map reads a scan of twice this many sectors or more as this many wedges, each
+ * the least reading of the sectors whose centres lie within it (docs/architecture.md, "A
+ * compact map's wedges"). */
 #define QNAV_MAP_WEDGES_MAX 32u
 
 /* The robot's pose in the destination's frame. */
