@@ -577,12 +577,6 @@ static void read_sector(const qnav_map_t *m, const qnav_mm_t *ranges_mm, uint16_
     r->marks = r->rc <= mark_reach && may_mark(m, ranges_mm, k, r->rc);
 }
 
-/*
- * Squares are unsigned 32-bit (a 64-bit product costs an AVR hundreds of cycles): with
- * reach_mm at most MAX_REACH_MM and cells at most 1 000 mm, a cell's offset from the robot
- * is at most 41 000 mm along each axis, and the squared distance of a cell within reach at
- * most 2 x 41 000^2 < 2^32. A distance beyond the reach is compared as such, not squared.
- */
 static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at);
 
 /* The scan's scan_sectors readings as the map's n_sectors wedges (fewer): wedge w, centred
@@ -635,7 +629,13 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
     observe_wedges(m, ranges_mm, at);
 }
 
-/* qnav_map_observe() for a scan of the map's own n_sectors wedges. */
+/* qnav_map_observe() for a scan of the map's own n_sectors wedges.
+ *
+ * Squares are unsigned 32-bit (a 64-bit product costs an AVR hundreds of cycles): with
+ * reach_mm at most MAX_REACH_MM and cells at most 1 000 mm, a cell's offset from the robot
+ * is at most 41 000 mm along each axis, and the squared distance of a cell within reach at
+ * most 2 x 41 000^2 < 2^32. A distance beyond the reach is compared as such, not squared.
+ */
 static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
 {
     int32_t i0, i1, j0, j1, i, j, reach, mark_reach, three_quarters, heading, arc_half, band_pct;
