@@ -365,7 +365,7 @@ void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
         assert_int_equal(on.compact, 1);
         assert_int_equal(on.grow_steps, 16);
         assert_int_equal(on.near_cost, 0);
-        assert_int_equal(on.refuse_ticks, tekbot ? 30 : 20); /* the TekBot's 3 s, the Pioneer's 2 s (a compact map refuses only when told to) */
+        assert_int_equal(on.refuse_ticks, tekbot ? 30 : 10); /* the TekBot's 3 s, the Pioneer's 1 s (a compact map refuses only when told to) */
         assert_true(on.cell_mm == plain_map.cell_mm && on.compact == plain_map.compact);
         assert_int_equal(with.safety_mm, without.safety_mm);
         assert_int_equal(with.n_sectors, without.n_sectors);
