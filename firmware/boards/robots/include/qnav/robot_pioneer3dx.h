@@ -34,7 +34,7 @@
         .ctrl.rank = 1, \
         .ctrl.wedge_pct = 10, \
         .ctrl.wedge_near_mm = 0, \
-        .ctrl.escape_stall_ticks = 20, \
+        .ctrl.escape_stall_ticks = 40, \
         .ctrl.escape_follow_mm = 800, \
         .ctrl.escape_follow_s = 20, \
         .ctrl.keep_pct = 15, \
