@@ -442,11 +442,13 @@ static void finish_table(void)
     }
 }
 
-/* A restart of the board (a power cycle: storage and table area kept). */
+/* A restart of the board (a power cycle: storage and table area kept); the bench hears
+ * its frames numbered from the start again, as the bridge does. */
 static void restart(void)
 {
     qnav_board_config_t cfg = g.bot.cfg;
     assert_int_equal(qnav_board_init(&g.bot, &cfg, &g.hal), QNAV_BOARD_OK);
+    qnav_link_rx_reset_seq(&g.brx);
 }
 
 /* Table mode on the board (qnav/board.h): an uploaded 2-input network is compiled into the
@@ -533,6 +535,101 @@ static void test_an_uploaded_network_is_compiled_into_the_table_area(void **stat
     assert_int_equal(g.bot.stats.table_writes_failed, 1);
     assert_true(g.bot.ctrl_ready);
     assert_true(moving());
+}
+
+/* A 2-input network of H hidden units whose weights follow seed. */
+static void some_network(qnav_policy_t *net, uint8_t hidden, unsigned seed)
+{
+    uint16_t k;
+    qnav_policy_net_zero(net, hidden);
+    for (k = 0; k < QNAV_NET_WEIGHTS(hidden); ++k) {
+        *qnav_net_weight(&net->u.net, k) = (qnav_q8_8_t)((int)((k * seed) % 3001u) - 1500);
+    }
+}
+
+/* The area holds net's table, key for key. */
+static void assert_area_holds(const qnav_policy_t *net)
+{
+    static qnav_qkey_t want[QNAV_QTABLE_ENTRIES];
+    qnav_ctrl_t ref;
+    qnav_ctrl_config_t cc;
+    qnav_nav_config(qnav_nav_find("body"), &g.bot.cfg.ctrl, &cc);
+    assert_int_equal(qnav_ctrl_init(&ref, &cc, net), QNAV_OK);
+    assert_int_equal(qnav_ctrl_build_table(&ref, want), QNAV_OK);
+    assert_memory_equal(g.sim.table, want, sizeof want);
+}
+
+/* An upload and a table build share one buffer (qnav/board.h, qnav_board_t.buf): an upload
+ * that arrives mid-build takes it, and the build starts again when the upload ends,
+ * whether its commit is taken, refused, or never comes (the link lost). No table is
+ * built from a page the upload wrote over. */
+static void test_an_upload_mid_build_takes_the_buffer_and_the_build_starts_again(void **state)
+{
+    qnav_policy_t a, b;
+    qnav_link_policy_chunk_t c = {0};
+    uint8_t p[QNAV_LINK_CHUNK_MAX_BYTES];
+    uint16_t k;
+    (void)state;
+    bench_start_with(16, 1);
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    some_network(&a, 12, 733u);
+    some_network(&b, 8, 911u);
+    upload(&a, 0);
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    assert_int_equal(g.last_ack.status, QNAV_LINK_ACK_OK);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_BUILDING);
+    assert_true(g.bot.table_at > 0u && g.bot.table_at < QNAV_BOARD_TABLE_BYTES);
+
+    /* b arrives mid-build: taken, and its table built from the start */
+    upload(&b, 0);
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    assert_int_equal(g.acks, 2);
+    assert_int_equal(g.last_ack.status, QNAV_LINK_ACK_OK);
+    assert_int_equal(g.bot.policy.u.net.hidden, 8);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_BUILDING);
+    finish_table();
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_IN_USE);
+    assert_int_equal(g.bot.stats.tables_built, 1); /* a's was never finished */
+    assert_area_holds(&b);
+
+    /* a commit refused mid-build: the build starts again */
+    g.sim.table[2 * 1000 + 1] ^= 0x40u;
+    restart();
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    for (k = 0; k < 40u; ++k) {
+        assert_int_equal(qnav_board_table_work(&g.bot), 1);
+    }
+    upload(&a, 1);
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    assert_int_equal(g.last_ack.status, QNAV_LINK_ACK_BAD_CRC);
+    assert_int_equal(g.bot.policy.u.net.hidden, 8);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_BUILDING);
+    finish_table();
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_IN_USE);
+    assert_area_holds(&b);
+
+    /* an upload's first chunk, then nothing: the build waits for the link's loss */
+    g.sim.table[2 * 1000 + 1] ^= 0x40u;
+    restart();
+    heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
+    run_ms(100);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_BUILDING);
+    c.total = 40;
+    c.len = 20;
+    memset(c.data, 0x5A, c.len);
+    to_board(QNAV_LINK_MSG_POLICY_CHUNK, p, qnav_link_policy_chunk_pack(&c, p, sizeof p));
+    run_ms(100);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_NONE);
+    run_ms(g.bot.cfg.link_timeout_ms + 100u);
+    assert_int_equal(g.bot.stats.link_lost, 1);
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_BUILDING);
+    finish_table();
+    assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_IN_USE);
+    assert_area_holds(&b);
 }
 
 /* Only a 2-input network is compiled: the built-in policy and a 3-input network leave the
@@ -1013,6 +1110,7 @@ int main(void)
         cmocka_unit_test(test_uploaded_policy_is_used_and_a_bad_one_is_refused),
         cmocka_unit_test(test_an_uploaded_network_takes_the_row_shapes_it_carries),
         cmocka_unit_test(test_an_uploaded_network_is_compiled_into_the_table_area),
+        cmocka_unit_test(test_an_upload_mid_build_takes_the_buffer_and_the_build_starts_again),
         cmocka_unit_test(test_only_a_two_input_network_uses_the_table_area),
         cmocka_unit_test(test_board_ignores_a_bridge_of_another_protocol_version),
         cmocka_unit_test(test_pose_integrates_wheel_travel_along_the_heading),

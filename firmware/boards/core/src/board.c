@@ -196,7 +196,7 @@ qnav_board_status_t qnav_board_init(qnav_board_t *bot, const qnav_board_config_t
     bot->hal = *hal;
     qnav_link_rx_init(&bot->rx);
     qnav_link_tx_init(&bot->tx);
-    qnav_link_upload_init(&bot->upload);
+    qnav_link_upload_init(&bot->buf.upload);
     bot->cmd.flags = QNAV_LINK_CMD_STOP;
     bot->hal.drive(bot->hal.ctx, 0, 0, bot->rolling);
     load_policy(bot);
@@ -233,11 +233,11 @@ static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm
     qnav_link_policy_ack_t ack;
     uint8_t p[QNAV_LINK_POLICY_ACK_BYTES];
     uint16_t crc;
-    int8_t status = qnav_link_upload_commit(&bot->upload, cm, &fresh);
+    int8_t status = qnav_link_upload_commit(&bot->buf.upload, cm, &fresh);
 
     if (status == QNAV_LINK_ACK_OK) {
         bot->hal.drive(bot->hal.ctx, 0, 0, bot->rolling);
-        if (init_carried(bot, &fresh, qnav_link_blob_shapes(bot->upload.blob, cm->total)) ==
+        if (init_carried(bot, &fresh, qnav_link_blob_shapes(bot->buf.upload.blob, cm->total)) ==
             QNAV_OK) {
             bot->policy = fresh;
             bot->policy_crc = qnav_link_policy_crc(&fresh);
@@ -260,6 +260,7 @@ static void commit_upload(qnav_board_t *bot, const qnav_link_policy_commit_t *cm
     }
     if (status != QNAV_LINK_ACK_OK) {
         bot->stats.uploads_refused++;
+        qnav_board_table_resume(bot);
     }
     ack.status = status;
     ack.reserved = 0;
@@ -320,13 +321,15 @@ static void on_frame(qnav_board_t *bot, const qnav_link_frame_t *f, uint32_t now
     case QNAV_LINK_MSG_POLICY_CHUNK: {
         qnav_link_policy_chunk_t c;
         if (qnav_link_policy_chunk_unpack(f->payload, f->len, &c) == QNAV_LINK_OK) {
-            (void)qnav_link_upload_chunk(&bot->upload, &c);
+            qnav_board_table_yield(bot);
+            (void)qnav_link_upload_chunk(&bot->buf.upload, &c);
         }
         break;
     }
     case QNAV_LINK_MSG_POLICY_COMMIT: {
         qnav_link_policy_commit_t cm;
         if (qnav_link_policy_commit_unpack(f->payload, f->len, &cm) == QNAV_LINK_OK) {
+            qnav_board_table_yield(bot);
             commit_upload(bot, &cm);
         }
         break;
@@ -611,7 +614,11 @@ void qnav_board_tick(qnav_board_t *bot)
     if (was_ok && !bot->link_ok) {
         bot->stats.link_lost++;
         qnav_link_rx_reset_seq(&bot->rx); /* the bridge may come back restarted */
-        qnav_link_upload_init(&bot->upload);
+        if (qnav_board_table_state(bot) != QNAV_BOARD_TABLE_BUILDING) {
+            /* (a build owns the shared buffer, and dropped any upload when it began) */
+            qnav_link_upload_init(&bot->buf.upload);
+            qnav_board_table_resume(bot);
+        }
     }
 
     if ((bot->link_ok && !was_ok) || bot->stats.ticks % CONFIG_EVERY == 0u) {

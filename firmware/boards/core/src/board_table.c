@@ -104,6 +104,7 @@ void qnav_board_table_start(qnav_board_t *bot)
 {
     qnav_ctrl_t *ctrl = network_ctrl(bot);
     bot->table_state = QNAV_BOARD_TABLE_NONE;
+    bot->table_stopped = 0;
     bot->table_at = 0;
     bot->table_done = 0;
     bot->table_crc = QNAV_LINK_CRC16_INIT;
@@ -115,7 +116,24 @@ void qnav_board_table_start(qnav_board_t *bot)
         use_area(bot, ctrl);
         return;
     }
+    qnav_link_upload_init(&bot->buf.upload); /* the build owns the buffer now */
     bot->table_state = QNAV_BOARD_TABLE_BUILDING;
+}
+
+void qnav_board_table_yield(qnav_board_t *bot)
+{
+    if (bot->table_state == QNAV_BOARD_TABLE_BUILDING) {
+        bot->table_state = QNAV_BOARD_TABLE_NONE;
+        bot->table_stopped = 1;
+        qnav_link_upload_init(&bot->buf.upload); /* its counts lay under the page */
+    }
+}
+
+void qnav_board_table_resume(qnav_board_t *bot)
+{
+    if (bot->table_stopped) {
+        qnav_board_table_start(bot);
+    }
 }
 
 /* The next word of the area as the build writes it (keys, then the record, then 0xFF)
@@ -123,7 +141,7 @@ void qnav_board_table_start(qnav_board_t *bot)
 static uint8_t make_word(qnav_board_t *bot, const qnav_ctrl_t *ctrl)
 {
     const uint16_t at = bot->table_at;
-    uint8_t *out = &bot->table_page[at % bot->hal.table_page_bytes];
+    uint8_t *out = &bot->buf.table_page[at % bot->hal.table_page_bytes];
     uint16_t w = 0xFFFFu;
     uint8_t key = 0;
     if (at < QNAV_BOARD_TABLE_KEY_BYTES) {
@@ -178,7 +196,7 @@ uint8_t qnav_board_table_work(qnav_board_t *bot)
     }
     if (!bot->hal.table_write_page(bot->hal.ctx,
                                    (uint16_t)(bot->table_at / bot->hal.table_page_bytes - 1u),
-                                   bot->table_page)) {
+                                   bot->buf.table_page)) {
         bot->stats.table_writes_failed++;
         bot->table_state = QNAV_BOARD_TABLE_NONE;
         return 0;

@@ -11,4 +11,12 @@
  * build (a 2-input network and an area), else leave the area alone. */
 void qnav_board_table_start(qnav_board_t *bot);
 
+/* An upload's chunk or commit arrived: a build under way gives the shared buffer up (qnav/board.h,
+ * qnav_board_t.buf) and waits for qnav_board_table_resume. */
+void qnav_board_table_yield(qnav_board_t *bot);
+
+/* The upload ended (a commit, refused or not, or the link lost): a build it stopped starts
+ * again. */
+void qnav_board_table_resume(qnav_board_t *bot);
+
 #endif /* QNAV_BOARD_TABLE_H */

@@ -179,7 +179,15 @@ typedef struct {
     qnav_board_hal_t hal;
     qnav_link_rx_t rx;
     qnav_link_tx_t tx;
-    qnav_link_upload_t upload;
+    /* An upload's chunks and the page a table build fills share one buffer, never in use
+     * together: a build owns it while table_state is BUILDING (qnav_board_table_start drops
+     * an upload under way), an upload's chunk stops a build, and a build so stopped starts
+     * again when the upload ends (a commit, refused or not, or the link lost). The 256
+     * bytes so saved are the TekBot's map's (docs/hil.md, "RAM on the ATmega128"). */
+    union {
+        qnav_link_upload_t upload;
+        uint8_t table_page[QNAV_BOARD_TABLE_PAGE_MAX]; /* the page being built */
+    } buf;
     qnav_nav_t nav;              /* the chosen controller (cfg.controller) and its state */
     qnav_policy_t policy;        /* the policy nav was made from (if it takes one) */
     qnav_ctrl_carry_t carry;     /* the escape memory (cleared with every new goal) and the
@@ -204,7 +212,8 @@ typedef struct {
     uint16_t table_at;           /* the next byte of the area the build makes */
     uint16_t table_done;         /* bytes of the area written so far */
     uint16_t table_crc;          /* CRC-16 of the key bytes built so far */
-    uint8_t table_page[QNAV_BOARD_TABLE_PAGE_MAX]; /* the page being built */
+    uint8_t table_stopped;       /* an upload stopped the build: it starts again when the
+                                    upload ends */
     uint8_t mode;                /* QNAV_LINK_MODE_* last requested by the bridge (0 none) */
     uint8_t hold_stop;           /* a stop was commanded and not yet cleared */
     uint8_t link_ok;             /* a good frame arrived within link_timeout_ms */
