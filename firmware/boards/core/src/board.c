@@ -588,6 +588,18 @@ static void map_tick(void *board, qnav_ctrl_input_t *in, uint32_t *dist_mm, qnav
     }
 }
 
+/* The link went quiet: the bridge may come back restarted, and an upload under way ends. */
+static void on_link_lost(qnav_board_t *bot)
+{
+    bot->stats.link_lost++;
+    qnav_link_rx_reset_seq(&bot->rx);
+    if (qnav_board_table_state(bot) != QNAV_BOARD_TABLE_BUILDING) {
+        /* (a build owns the shared buffer, and dropped any upload when it began) */
+        qnav_link_upload_init(&bot->buf.upload);
+        qnav_board_table_resume(bot);
+    }
+}
+
 void qnav_board_tick(qnav_board_t *bot)
 {
     qnav_link_command_t tel;
@@ -612,13 +624,7 @@ void qnav_board_tick(qnav_board_t *bot)
     was_ok = bot->link_ok;
     bot->link_ok = (uint8_t)(bot->heard && (now - bot->last_rx_ms) <= bot->cfg.link_timeout_ms);
     if (was_ok && !bot->link_ok) {
-        bot->stats.link_lost++;
-        qnav_link_rx_reset_seq(&bot->rx); /* the bridge may come back restarted */
-        if (qnav_board_table_state(bot) != QNAV_BOARD_TABLE_BUILDING) {
-            /* (a build owns the shared buffer, and dropped any upload when it began) */
-            qnav_link_upload_init(&bot->buf.upload);
-            qnav_board_table_resume(bot);
-        }
+        on_link_lost(bot);
     }
 
     if ((bot->link_ok && !was_ok) || bot->stats.ticks % CONFIG_EVERY == 0u) {
