@@ -21,7 +21,7 @@ static uint16_t map_mem[(QNAV_BENCH_MAP_BYTES + 1u) / 2u];
 static qnav_map_t map;
 /* a tick's cycles / 16 in each call for the medians (at most 300 ticks a world); the
  * tick's are their sums (a third array would leave the stack too little of the 4 KB beside
- * the board's 512-byte map) */
+ * the board's map, the profile's [map] bytes) */
 static uint16_t obs_c[300], guide_c[300];
 static uint32_t overhead;
 

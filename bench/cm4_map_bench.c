@@ -4,7 +4,7 @@
  * scans in generated worlds of three families) replayed through qnav_map_follow(),
  * qnav_map_observe() and qnav_map_guide() as a board does each tick, twice:
  *
- *   compact  the board's map (the profile's [map] in its 512 bytes, placed as the trace
+ *   compact  the board's map (the profile's [map] in its [map] bytes, placed as the trace
  *            says); every tick checked against the host's (MISMATCH line, exit status 1)
  *   full     the full layout at 0.1 m in 128 KB, placed and following by the same rule:
  *            what a board with that RAM would run (docs/results.md, "A map with room");

@@ -129,7 +129,7 @@ static void test_a_map_that_differs_is_named_by_its_field(void **state)
     qnav_board_config_report(&g_tekbot, &m);
     qnav_board_map_report(&board, &m);
     assert_int_equal(qnav_robot_board_diff(&m, &g_tekbot, &profile, line, sizeof line), 1);
-    assert_string_equal(line, "map_cell_mm 400 != 350");
+    assert_string_equal(line, "map_cell_mm 400 != 300");
     /* a field without a name of its own: the CRC differs */
     other_map = header_map;
     other_map.look_mm = (uint16_t)(header_map.look_mm + 100u);
@@ -144,7 +144,7 @@ static void test_a_map_that_differs_is_named_by_its_field(void **state)
     qnav_board_config_report(&g_tekbot, &m);
     qnav_board_map_report(&board, &m);
     assert_int_equal(qnav_robot_board_diff(&m, &g_tekbot, &profile, line, sizeof line), 1);
-    assert_string_equal(line, "map_bytes 2048 != 512");
+    assert_string_equal(line, "map_bytes 2048 != 768");
     qnav_board_map_info(NULL, 0u, &board);
     qnav_board_config_report(&g_tekbot, &m);
     qnav_board_map_report(&board, &m);

@@ -257,9 +257,9 @@ static void pocket_trial(const char *robot, const char *mode, const char *log)
     assert_true(read_text(f.sil_out, text, sizeof text) > 0);
     print_message("%s: %s", mode, text);
     assert_non_null(strstr(text, "reached yes"));
-    /* the TekBot's map as its board runs it: the profile's 512 bytes, placed at the goal */
+    /* the TekBot's map as its board runs it: the profile's 768 bytes, placed at the goal */
     assert_true(read_text(f.sil_err, text, sizeof text) > 0);
-    assert_non_null(strstr(text, "the board core places a map of 350 mm cells in 512 bytes"));
+    assert_non_null(strstr(text, "the board core places a map of 300 mm cells in 768 bytes"));
 }
 
 /* Issues 17 and 18: in a U-pocket facing the start, the offboard robot leaves the dead end

@@ -345,7 +345,7 @@ void test_the_map_is_told_the_profiles_sensor_noise(void **) {
 }
 
 // Both robots' profiles run their maps (on = true: the compact map their ATmega128 holds,
-// the TekBot's of 0.35 m cells, the Pioneer's of 0.5 m). NAME+map switches the profile's own
+// the TekBot's of 0.3 m cells, the Pioneer's of 0.5 m). NAME+map switches the profile's own
 // map on, as written, and nothing else; NAME-map switches it off (the robot of the paper's
 // experiments). A profile with no [map] has nothing to switch on: refused naming the file;
 // NAME-map of it is the profile itself. 'on' takes only true or false.
@@ -356,14 +356,14 @@ void test_name_plus_map_switches_on_the_profiles_own_map(void **) {
         qnav_ctrl_config_t plain, with, without;
         uint32_t bytes = 0, off_bytes = 1;
         assert_int_equal(loaded_map(robot, &plain_map, &plain, &bytes), 1);
-        assert_int_equal(bytes, 512); /* placed as the board places it */
+        assert_int_equal(bytes, tekbot ? 768 : 512); /* placed as the board places it */
         assert_int_equal(loaded_map((std::string(robot) + "-map").c_str(), &off, &without, &off_bytes), 0);
         assert_int_equal(off_bytes, 0);
         assert_int_equal(loaded_map((std::string(robot) + "+map").c_str(), &on, &with), 1);
-        /* the map their ATmega128 holds: 4 bits a cell of 0.35 m (TekBot) or 0.5 m */
-        assert_int_equal(on.cell_mm, tekbot ? 350 : 500);
+        /* the map their ATmega128 holds: 4 bits a cell of 0.3 m (TekBot) or 0.5 m */
+        assert_int_equal(on.cell_mm, tekbot ? 300 : 500);
         assert_int_equal(on.compact, 1);
-        assert_int_equal(on.grow_steps, 16);
+        assert_int_equal(on.grow_steps, tekbot ? 10 : 16);
         assert_int_equal(on.near_cost, 0);
         assert_int_equal(on.refuse_ticks, tekbot ? 30 : 10); /* the TekBot's 3 s, the Pioneer's 1 s (a compact map refuses only when told to) */
         assert_true(on.cell_mm == plain_map.cell_mm && on.compact == plain_map.compact);

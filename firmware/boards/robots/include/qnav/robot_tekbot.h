@@ -54,16 +54,16 @@
  * (qnav_board_place_maps), a qnav_map_config_t. */
 #define QNAV_ROBOT_TEKBOT_MAP_CONFIG \
     { \
-        .cell_mm = 350, .reach_mm = 2000, .look_mm = 1000, .jump_mm = 1000, \
+        .cell_mm = 300, .reach_mm = 2000, .look_mm = 1000, .jump_mm = 1000, \
         .plan_ticks = 10, .noise_pct = 10, .near_cost = 0, .near_mm = 200, \
         .arc_cdeg = 1800, .sight = 1, .escape_grow = 1, .refuse_ticks = 30, \
-        .refuse_life_ticks = 200, .compact = 1, .grow_steps = 16, \
+        .refuse_life_ticks = 200, .compact = 1, .grow_steps = 10, \
         .forget_reach_mm = 1000, .opening_mm = 270, .unknown_cost = 0, \
         .align_samples = 40, .turn_back_ticks = 10 \
     }
 
 /* The profile's [map] bytes: the board's memory for that map, the largest
  * square of its cells they hold placed at each goal (qnav_map_place). */
-#define QNAV_ROBOT_TEKBOT_MAP_BYTES 512u
+#define QNAV_ROBOT_TEKBOT_MAP_BYTES 768u
 
 #endif /* QNAV_ROBOT_TEKBOT_H */
