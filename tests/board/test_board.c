@@ -451,6 +451,28 @@ static void restart(void)
     qnav_link_rx_reset_seq(&g.brx);
 }
 
+/* A 2-input network of H hidden units whose weights follow seed. */
+static void some_network(qnav_policy_t *net, uint8_t hidden, unsigned seed)
+{
+    uint16_t k;
+    qnav_policy_net_zero(net, hidden);
+    for (k = 0; k < QNAV_NET_WEIGHTS(hidden); ++k) {
+        *qnav_net_weight(&net->u.net, k) = (qnav_q8_8_t)((int)((k * seed) % 3001u) - 1500);
+    }
+}
+
+/* The area holds net's table, key for key. */
+static void assert_area_holds(const qnav_policy_t *net)
+{
+    static qnav_qkey_t want[QNAV_QTABLE_ENTRIES];
+    qnav_ctrl_t ref;
+    qnav_ctrl_config_t cc;
+    qnav_nav_config(qnav_nav_find("body"), &g.bot.cfg.ctrl, &cc);
+    assert_int_equal(qnav_ctrl_init(&ref, &cc, net), QNAV_OK);
+    assert_int_equal(qnav_ctrl_build_table(&ref, want), QNAV_OK);
+    assert_memory_equal(g.sim.table, want, sizeof want);
+}
+
 /* Table mode on the board (qnav/board.h): an uploaded 2-input network is compiled into the
  * HAL's table area a page at a time between ticks, then the controller reads it. The
  * area's keys are qnav_ctrl_build_table()'s and the decisions the network's; a restart
@@ -458,7 +480,6 @@ static void restart(void)
  * it again; a failed page write leaves the network step driving. */
 static void test_an_uploaded_network_is_compiled_into_the_table_area(void **state)
 {
-    static qnav_qkey_t want[QNAV_QTABLE_ENTRIES];
     qnav_policy_t net;
     qnav_ctrl_t ref;
     qnav_ctrl_config_t cc;
@@ -471,10 +492,7 @@ static void test_an_uploaded_network_is_compiled_into_the_table_area(void **stat
     heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
     run_ms(100);
     assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_NONE); /* built-in */
-    qnav_policy_net_zero(&net, 12);
-    for (k = 0; k < QNAV_NET_WEIGHTS(12); ++k) {
-        *qnav_net_weight(&net.u.net, k) = (qnav_q8_8_t)((int)((k * 733u) % 3001u) - 1500);
-    }
+    some_network(&net, 12, 733u);
     upload(&net, 0);
     heartbeat(QNAV_LINK_MODE_ONBOARD, 0);
     run_ms(100);
@@ -490,10 +508,9 @@ static void test_an_uploaded_network_is_compiled_into_the_table_area(void **stat
     assert_int_equal(g.sim.table_pages_written, SIM_HAL_TABLE_PAGES);
     assert_true(moving());
 
+    assert_area_holds(&net);
     qnav_nav_config(qnav_nav_find("body"), &g.bot.cfg.ctrl, &cc);
     assert_int_equal(qnav_ctrl_init(&ref, &cc, &net), QNAV_OK);
-    assert_int_equal(qnav_ctrl_build_table(&ref, want), QNAV_OK);
-    assert_memory_equal(g.sim.table, want, sizeof want);
     in.ranges_mm = g.last_scan.ranges_mm;
     in.goal_bearing_cdeg = g.last_scan.goal_bearing_cdeg;
     in.prev_heading_cdeg = tel_prev_heading();
@@ -523,7 +540,7 @@ static void test_an_uploaded_network_is_compiled_into_the_table_area(void **stat
     finish_table();
     assert_int_equal(qnav_board_table_state(&g.bot), QNAV_BOARD_TABLE_IN_USE);
     assert_int_equal(g.sim.table_pages_written, pages + SIM_HAL_TABLE_PAGES);
-    assert_memory_equal(g.sim.table, want, sizeof want);
+    assert_area_holds(&net);
 
     g.sim.table[0] ^= 0x01u;
     g.sim.table_fail_after = g.sim.table_pages_written + 3u;
@@ -535,28 +552,6 @@ static void test_an_uploaded_network_is_compiled_into_the_table_area(void **stat
     assert_int_equal(g.bot.stats.table_writes_failed, 1);
     assert_true(g.bot.ctrl_ready);
     assert_true(moving());
-}
-
-/* A 2-input network of H hidden units whose weights follow seed. */
-static void some_network(qnav_policy_t *net, uint8_t hidden, unsigned seed)
-{
-    uint16_t k;
-    qnav_policy_net_zero(net, hidden);
-    for (k = 0; k < QNAV_NET_WEIGHTS(hidden); ++k) {
-        *qnav_net_weight(&net->u.net, k) = (qnav_q8_8_t)((int)((k * seed) % 3001u) - 1500);
-    }
-}
-
-/* The area holds net's table, key for key. */
-static void assert_area_holds(const qnav_policy_t *net)
-{
-    static qnav_qkey_t want[QNAV_QTABLE_ENTRIES];
-    qnav_ctrl_t ref;
-    qnav_ctrl_config_t cc;
-    qnav_nav_config(qnav_nav_find("body"), &g.bot.cfg.ctrl, &cc);
-    assert_int_equal(qnav_ctrl_init(&ref, &cc, net), QNAV_OK);
-    assert_int_equal(qnav_ctrl_build_table(&ref, want), QNAV_OK);
-    assert_memory_equal(g.sim.table, want, sizeof want);
 }
 
 /* An upload and a table build share one buffer (qnav/board.h, qnav_board_t.buf): an upload
