@@ -1341,6 +1341,33 @@ static void test_a_map_reaches_toward_a_goal_too_far_for_it(void **state)
     assert_int_equal(qnav_map_place(&mc, len, 0, 0, 1000, 0, &x0, &y0, &side), 1);
 }
 
+/* A goal nearly a square away along an axis: midway would leave the robot a cell inside
+ * the map, where a way on past the edge is no way at all; the map keeps it three cells
+ * inside, the goal in its edge cell or past it. */
+static void test_a_map_keeps_the_robot_three_cells_inside(void **state)
+{
+    qnav_map_config_t mc;
+    int32_t x0, y0;
+    uint32_t side;
+    const size_t len = 512u;
+    (void)state;
+    qnav_map_config_default(&mc);
+    mc.cell_mm = 400;
+    mc.compact = 1;
+    /* 12 m apart in a 12.8 m square: midway is a corner at -400, the robot a cell in */
+    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 12000, 0, &x0, &y0, &side), 1);
+    assert_int_equal(side, 12800);
+    assert_int_equal(x0, -3 * 400);
+    assert_int_equal(y0, -6400); /* the other axis midway, as before */
+    assert_int_equal(qnav_map_place(&mc, len, 0, 0, -12000, 0, &x0, &y0, &side), 1);
+    assert_int_equal(x0, 3 * 400 - 12800);
+    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 0, 12000, &x0, &y0, &side), 1);
+    assert_int_equal(y0, -3 * 400);
+    /* nearer goals: midway, the robot farther in than three cells */
+    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 8000, 0, &x0, &y0, &side), 1);
+    assert_int_equal(x0, 4000 - 6400);
+}
+
 /* Where a board places its map, and the map following the robot: what it saw stays where
  * it was in the world, and what moved in is unknown, in either layout. */
 static void placed_map_follows(uint8_t compact)
@@ -1510,6 +1537,7 @@ int main(void)
         cmocka_unit_test(test_a_turn_back_waits_its_ticks_once),
         cmocka_unit_test(test_the_plan_is_settled_as_far_as_the_robot_needs),
         cmocka_unit_test(test_a_map_reaches_toward_a_goal_too_far_for_it),
+        cmocka_unit_test(test_a_map_keeps_the_robot_three_cells_inside),
         cmocka_unit_test(test_a_placed_map_follows_the_robot),
         cmocka_unit_test(test_bad_maps_are_refused),
     };
