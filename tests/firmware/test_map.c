@@ -1318,6 +1318,14 @@ static void evidence_grid(const qnav_map_t *m, int32_t x0, int32_t y0, int32_t x
 /* A goal too far for the square: the robot the readings' reach and a cell (6 cells of
  * 400 mm) inside it, the rest toward the goal; too few bytes, or a square too small to keep
  * the robot that far in: no map. */
+/* The placement tests' map: compact, 0.4 m cells (32 x 32 of them in 512 bytes). */
+static void placing_config(qnav_map_config_t *mc)
+{
+    qnav_map_config_default(mc);
+    mc->cell_mm = 400;
+    mc->compact = 1;
+}
+
 static void test_a_map_reaches_toward_a_goal_too_far_for_it(void **state)
 {
     qnav_map_config_t mc;
@@ -1325,9 +1333,7 @@ static void test_a_map_reaches_toward_a_goal_too_far_for_it(void **state)
     uint32_t side;
     const size_t len = 512u;
     (void)state;
-    qnav_map_config_default(&mc);
-    mc.cell_mm = 400;
-    mc.compact = 1;
+    placing_config(&mc);
     assert_int_equal(qnav_map_place(&mc, len, 0, 0, 12001, 0, &x0, &y0, &side), 1);
     assert_int_equal(side, 12800);
     assert_int_equal(x0, -2400);
@@ -1351,9 +1357,7 @@ static void test_a_map_keeps_the_robot_three_cells_inside(void **state)
     uint32_t side;
     const size_t len = 512u;
     (void)state;
-    qnav_map_config_default(&mc);
-    mc.cell_mm = 400;
-    mc.compact = 1;
+    placing_config(&mc);
     /* 12 m apart in a 12.8 m square: midway is a corner at -400, the robot a cell in */
     assert_int_equal(qnav_map_place(&mc, len, 0, 0, 12000, 0, &x0, &y0, &side), 1);
     assert_int_equal(side, 12800);
