@@ -178,16 +178,16 @@ static int32_t edge_cells(const qnav_map_config_t *cfg)
     return ((int32_t)cfg->reach_mm + (int32_t)cfg->cell_mm - 1) / (int32_t)cfg->cell_mm;
 }
 
-/* Cells a placed map keeps between its edge and the robot at least, even midway to a goal
- * nearly a square away: the plan has no way outside the map, and a robot in its edge cell
- * whose way on lies past that edge finds none, forgets, and finds the same again (a closed
- * aisle at difficulty 1; docs/architecture.md, "The board's map: placed, and following the
- * robot"). */
-#define ROBOT_IN_CELLS 3
+/* What a placed map keeps between its edge and the robot at least, mm, in whole cells, even
+ * midway to a goal nearly a square away: the plan has no way outside the map, and a robot
+ * in its edge cell whose way on lies past that edge finds none, forgets, and finds the same
+ * again (a closed aisle at difficulty 1; docs/architecture.md, "The board's map: placed,
+ * and following the robot"). 3 cells of the TekBot's 0.30 m, 2 of the Pioneer's 0.5 m. */
+#define ROBOT_IN_MM 900
 
 /* The placement rule along one axis: the corner of a map side_mm across midway between the
  * robot at r and the goal at g when both lie a cell inside it, moved so that the robot
- * lies ROBOT_IN_CELLS inside (the goal then in the edge cell or past it); else the robot a
+ * lies ROBOT_IN_MM inside (the goal then in the edge cell or past it); else the robot a
  * cell more than the readings' reach inside it and the rest toward the goal (the plan then
  * leads to the edge cell nearest the goal, and the map follows the robot there). 0 when
  * the map is too small to keep the robot that far in. */
@@ -196,7 +196,7 @@ static int place_axis(const qnav_map_config_t *cfg, int32_t r, int32_t g, int32_
 {
     const int32_t cell = (int32_t)cfg->cell_mm, in = (edge_cells(cfg) + 1) * cell;
     if (abs32(g - r) <= side - 2 * cell) {
-        const int32_t keep = ROBOT_IN_CELLS * cell;
+        const int32_t keep = (ROBOT_IN_MM + cell - 1) / cell * cell;
         int32_t c = r / 2 + g / 2 - side / 2;
         if (2 * keep <= side && c > r - keep) {
             c = r - keep;

@@ -1348,9 +1348,9 @@ static void test_a_map_reaches_toward_a_goal_too_far_for_it(void **state)
 }
 
 /* A goal nearly a square away along an axis: midway would leave the robot a cell inside
- * the map, where a way on past the edge is no way at all; the map keeps it three cells
- * inside, the goal in its edge cell or past it. */
-static void test_a_map_keeps_the_robot_three_cells_inside(void **state)
+ * the map, where a way on past the edge is no way at all; the map keeps it 0.9 m inside in
+ * whole cells (three of 0.4 m, two of 0.5 m), the goal in its edge cell or past it. */
+static void test_a_map_keeps_the_robot_a_metre_inside(void **state)
 {
     qnav_map_config_t mc;
     int32_t x0, y0;
@@ -1370,6 +1370,11 @@ static void test_a_map_keeps_the_robot_three_cells_inside(void **state)
     /* nearer goals: midway, the robot farther in than three cells */
     assert_int_equal(qnav_map_place(&mc, len, 0, 0, 8000, 0, &x0, &y0, &side), 1);
     assert_int_equal(x0, 4000 - 6400);
+    /* 0.5 m cells (16 m): two of them, 15 m apart */
+    mc.cell_mm = 500;
+    assert_int_equal(qnav_map_place(&mc, len, 0, 0, 15000, 0, &x0, &y0, &side), 1);
+    assert_int_equal(side, 16000);
+    assert_int_equal(x0, -2 * 500);
 }
 
 /* Where a board places its map, and the map following the robot: what it saw stays where
@@ -1541,7 +1546,7 @@ int main(void)
         cmocka_unit_test(test_a_turn_back_waits_its_ticks_once),
         cmocka_unit_test(test_the_plan_is_settled_as_far_as_the_robot_needs),
         cmocka_unit_test(test_a_map_reaches_toward_a_goal_too_far_for_it),
-        cmocka_unit_test(test_a_map_keeps_the_robot_three_cells_inside),
+        cmocka_unit_test(test_a_map_keeps_the_robot_a_metre_inside),
         cmocka_unit_test(test_a_placed_map_follows_the_robot),
         cmocka_unit_test(test_bad_maps_are_refused),
     };
