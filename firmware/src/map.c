@@ -77,6 +77,7 @@ void qnav_map_config_default(qnav_map_config_t *cfg)
     cfg->noise_pct = 5u;
     cfg->near_mm = 200u;
     cfg->arc_cdeg = 2250u;
+    cfg->arc_width_mm = 0u;
     cfg->sight = 1u;
     cfg->escape_grow = 1u;
     cfg->near_cost = 10u;
@@ -579,6 +580,21 @@ typedef struct {
                       far range peak (may_mark) */
 } reading_t;
 
+/* 9 000 / pi, rounded: a width w across at range r is a half-angle of w / 2 / r radians,
+ * w * CDEG_PER_RAD_HALF / r in 0.01 deg. */
+#define CDEG_PER_RAD_HALF 2865u
+
+/* 1 when a cell off_cdeg off reading r's centre line lies on its arc: within arc_half, and
+ * within the arc's width at r's range, off_cdeg <= width_k / rc with width_k =
+ * arc_width_mm * CDEG_PER_RAD_HALF (0: no bound), compared as a product (no division on
+ * an AVR): off_cdeg <= 18 000 and rc < 2^17 (a range and the sonar's offset, each below
+ * 2^16), so the product is below 2^32. */
+static int on_arc(int32_t off_cdeg, const reading_t *r, int32_t arc_half, uint32_t width_k)
+{
+    return off_cdeg <= arc_half &&
+           (width_k == 0u || (uint32_t)off_cdeg * (uint32_t)r->rc <= width_k);
+}
+
 static void read_sector(const qnav_map_t *m, const qnav_mm_t *ranges_mm, uint16_t k,
                         int32_t three_quarters, int32_t band_pct, int32_t mark_reach,
                         reading_t *r)
@@ -655,6 +671,7 @@ static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav
 {
     int32_t i0, i1, j0, j1, i, j, reach, mark_reach, three_quarters, heading, arc_half, band_pct;
     uint32_t reach2;
+    const uint32_t width_k = (uint32_t)m->cfg.arc_width_mm * CDEG_PER_RAD_HALF; /* < 2^28 */
     reading_t last;
     qnav_map_pose_t in_grid;
     const qnav_map_pose_t *pose = &in_grid;
@@ -715,7 +732,7 @@ static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav
                         d2 <= (uint32_t)(last.rc + three_quarters) * (uint32_t)(last.rc + three_quarters)) &&
                        (last.band <= 0 ||
                         (last.band <= reach && d2 >= (uint32_t)last.band * (uint32_t)last.band)) &&
-                       off_centre(rel, last.centre) <= arc_half) {
+                       on_arc(off_centre(rel, last.centre), &last, arc_half, width_k)) {
                 mark_arc(m, i, j);
             }
         }

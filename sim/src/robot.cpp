@@ -172,10 +172,10 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
 
     if (root.get("map")) {
         const toml::table &mp = r.table(root, "map");
-        r.only_keys(mp, {"on", "cell_m", "reach_m", "look_m", "plan_s", "near_m", "near_cost", "arc_deg", "sight",
-                         "escape_grow", "refuse_s", "refuse_life_s", "pass_m", "compact", "grow_steps", "bytes",
-                         "noise", "forget_reach_m", "opening_m", "unknown_cost", "align_samples",
-                         "turn_back_s"});
+        r.only_keys(mp, {"on", "cell_m", "reach_m", "look_m", "plan_s", "near_m", "near_cost", "arc_deg",
+                         "arc_width_m", "sight", "escape_grow", "refuse_s", "refuse_life_s", "pass_m", "compact",
+                         "grow_steps", "bytes", "noise", "forget_reach_m", "opening_m", "unknown_cost",
+                         "align_samples", "turn_back_s"});
         bool on = true;
         if (const toml::node *o = mp.get("on")) {
             if (!o->is_boolean()) r.fail(*o, "'on' must be true or false");
@@ -195,6 +195,7 @@ static void parse_escape_and_recovery(const TomlReader &r, RobotProfile &p) {
         if (p.map_near_cost + p.map_unknown_cost > 25.5)
             r.fail(*mp.get("unknown_cost"), "'near_cost' + 'unknown_cost' must be at most 25.5 cell sides");
         p.map_arc_deg = r.number(mp, "arc_deg", 0.0, 360.0, true, p.map_arc_deg);
+        p.map_arc_width_m = r.number(mp, "arc_width_m", 0.0, 65.0, true, p.map_arc_width_m);
         if (mp.get("align_samples"))
             p.map_align_samples = static_cast<std::uint8_t>(r.integer(mp, "align_samples", 0, 255));
         p.map_turn_back_s = r.number(mp, "turn_back_s", 0.0, 25.5, true, p.map_turn_back_s);

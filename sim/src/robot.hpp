@@ -82,6 +82,7 @@ struct RobotProfile {
     double map_noise = -1.0;        // [map] noise: the range noise the map allows for (its
                                     // noise_pct); < 0: [noise] sensor
     double map_arc_deg = 22.5;      // arcs marked within this angle about the wedge's centre
+    double map_arc_width_m = 0.0;   // ...and within this width across at the reading's range; 0: any
     double map_forget_reach_m = 0.0;  // after a forget, only readings this near mark; 0: all
     double map_opening_m = 0.0;       // a range peak whose wedge spans more than twice this marks no arc; 0: all mark
     bool map_sight = true;          // the sub-goal kept in a straight line's sight

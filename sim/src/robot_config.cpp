@@ -70,6 +70,7 @@ void robot_map_config(const RobotProfile &p, qnav_map_config_t *cfg) {
     cfg->turn_back_ticks =
         static_cast<std::uint8_t>(std::clamp(std::lround(p.map_turn_back_s / QNAV_SIM_TICK_S), 0L, 255L));
     cfg->arc_cdeg = static_cast<std::uint16_t>(std::lround(p.map_arc_deg * 100.0));
+    cfg->arc_width_mm = to_mm(p.map_arc_width_m);
     cfg->sight = p.map_sight ? 1 : 0;
     cfg->escape_grow = p.map_escape_grow ? 1 : 0;
     cfg->refuse_ticks = static_cast<std::uint8_t>(std::clamp(std::lround(p.map_refuse_s / QNAV_SIM_TICK_S), 0L, 255L));

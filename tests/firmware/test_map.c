@@ -167,6 +167,40 @@ static void test_a_wide_wedge_marks_only_the_default_arc(void **state)
     assert_int_equal(qnav_map_evidence(&m, 4150, 3350), 1);
 }
 
+/* arc_width_mm: a reading marks only the cells within that width of its centre line at its
+ * range. 250 mm across is +-6.4 deg at 1 120 mm (10 deg off, inside the 22.5 deg arc, is
+ * left unmarked) and +-11.6 deg at 620 mm (9.5 deg off is marked); 100 mm is +-4.6 deg
+ * there (not marked). */
+static void test_a_far_reading_marks_an_arc_no_wider_than_set(void **state)
+{
+    qnav_map_t m;
+    qnav_map_config_t mc;
+    qnav_mm_t ranges[N];
+    const qnav_map_pose_t p = {3050, 3050, 0};
+    (void)state;
+    qnav_map_config_default(&mc);
+    clear_but_ahead(ranges, 1000); /* 1 120 mm from the centre */
+    mc.arc_width_mm = 250;
+    map_from(&m, &mc);
+    qnav_map_observe(&m, ranges, &p);
+    assert_int_equal(qnav_map_evidence(&m, 4170, 3050), 1); /* dead ahead */
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3250), 0); /* 10 deg off: not marked */
+    mc.arc_width_mm = 0;                                   /* no limit */
+    map_from(&m, &mc);
+    qnav_map_observe(&m, ranges, &p);
+    assert_int_equal(qnav_map_evidence(&m, 4150, 3250), 1);
+    clear_but_ahead(ranges, 500); /* 620 mm from the centre */
+    mc.arc_width_mm = 250;
+    map_from(&m, &mc);
+    qnav_map_observe(&m, ranges, &p);
+    assert_int_equal(qnav_map_evidence(&m, 3650, 3050), 1); /* dead ahead */
+    assert_int_equal(qnav_map_evidence(&m, 3650, 3150), 1); /* 9.5 deg off: marked */
+    mc.arc_width_mm = 100;
+    map_from(&m, &mc);
+    qnav_map_observe(&m, ranges, &p);
+    assert_int_equal(qnav_map_evidence(&m, 3650, 3150), 0);
+}
+
 /* A map for a ring of n sectors, every reading clear but ahead (sector 0) and its two
  * neighbours, observed once from the centre facing +x. */
 static void observe_ahead(qnav_map_t *m, uint16_t n, uint16_t opening_mm, qnav_mm_t ahead_mm,
@@ -1526,6 +1560,7 @@ int main(void)
         cmocka_unit_test(test_the_grid_turns_to_the_walls),
         cmocka_unit_test(test_arcs_are_marked_in_the_central_part_of_the_wedge),
         cmocka_unit_test(test_a_wide_wedge_marks_only_the_default_arc),
+        cmocka_unit_test(test_a_far_reading_marks_an_arc_no_wider_than_set),
         cmocka_unit_test(test_a_far_range_peak_in_a_wide_wedge_marks_no_arc),
         cmocka_unit_test(test_a_noisy_reading_keeps_its_arc_thin),
         cmocka_unit_test(test_the_plan_leads_round_the_wall_to_its_gap),

@@ -433,6 +433,11 @@ void test_the_maps_arc_is_an_angle_from_the_profile(void **) {
     assert_int_equal(map_config_of(tekbot_with("[map]\ncell_m = 0.1\narc_deg = 11.25\n")).arc_cdeg, 1125);
     assert_true(refusal(tekbot_with("[map]\ncell_m = 0.1\narc_pct = 50\n")).find("arc_pct") != std::string::npos);
     assert_true(refusal(tekbot_with("[map]\ncell_m = 0.1\narc_deg = 361\n")).find("arc_deg") != std::string::npos);
+    // arc_width_m, the arc's width across at its range, in mm (default 0: no limit)
+    assert_int_equal(map_config_of(tekbot_with("[map]\ncell_m = 0.1\n")).arc_width_mm, 0);
+    assert_int_equal(map_config_of(tekbot_with("[map]\ncell_m = 0.1\narc_width_m = 0.21\n")).arc_width_mm, 210);
+    assert_true(refusal(tekbot_with("[map]\ncell_m = 0.1\narc_width_m = -0.1\n")).find("arc_width_m") !=
+                std::string::npos);
 }
 
 // [map] opening_m reaches the map in mm (default 0: every reading marks); a negative one is

@@ -53,6 +53,12 @@ typedef struct {
                               narrower), 0.01 deg, 0..36000; default 2250: a wider wedge's
                               reading says little about where across it the obstacle is
                               (measured: docs/architecture.md, "The arc a reading marks") */
+    uint16_t arc_width_mm; /* ...and at most the arc cells within arc_width_mm / 2 across the
+                              wedge at the reading's range, mm; 0: no limit (default). A far
+                              reading says least about where across its wedge the obstacle
+                              is: one that marks only its central cells leaves a gap seen
+                              from afar open until nearer readings close it (measured:
+                              docs/architecture.md, "An arc no wider than a cell") */
     uint8_t sight;         /* 1: the sub-goal stops where the straight line to it from the
                               robot's cell would cross a blocked cell; default 1 */
     uint8_t escape_grow;   /* 1: when a new plan is longer where the robot is (by less than
@@ -125,8 +131,8 @@ typedef struct {
  * field added to the struct is added here, or the build fails. */
 #define QNAV_MAP_CONFIG_FIELDS(X)                                                            \
     X(cell_mm, 16) X(reach_mm, 16) X(look_mm, 16) X(jump_mm, 16) X(plan_ticks, 8)            \
-    X(noise_pct, 8) X(near_cost, 8) X(near_mm, 16) X(arc_cdeg, 16) X(sight, 8)               \
-    X(escape_grow, 8) X(refuse_ticks, 8) X(refuse_life_ticks, 16) X(compact, 8)              \
+    X(noise_pct, 8) X(near_cost, 8) X(near_mm, 16) X(arc_cdeg, 16) X(arc_width_mm, 16)       \
+    X(sight, 8) X(escape_grow, 8) X(refuse_ticks, 8) X(refuse_life_ticks, 16) X(compact, 8)  \
     X(grow_steps, 8) X(forget_reach_mm, 16) X(opening_mm, 16) X(unknown_cost, 8)             \
     X(align_samples, 8) X(turn_back_ticks, 8)
 

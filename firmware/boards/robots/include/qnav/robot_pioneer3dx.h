@@ -56,8 +56,8 @@
     { \
         .cell_mm = 500, .reach_mm = 3000, .look_mm = 1500, .jump_mm = 1000, \
         .plan_ticks = 10, .noise_pct = 1, .near_cost = 0, .near_mm = 200, \
-        .arc_cdeg = 2250, .sight = 1, .escape_grow = 1, .refuse_ticks = 10, \
-        .refuse_life_ticks = 200, .compact = 1, .grow_steps = 16, \
+        .arc_cdeg = 2250, .arc_width_mm = 0, .sight = 1, .escape_grow = 1, \
+        .refuse_ticks = 10, .refuse_life_ticks = 200, .compact = 1, .grow_steps = 16, \
         .forget_reach_mm = 0, .opening_mm = 0, .unknown_cost = 0, .align_samples = 40, \
         .turn_back_ticks = 10 \
     }
