@@ -56,7 +56,7 @@
     { \
         .cell_mm = 300, .reach_mm = 2000, .look_mm = 1000, .jump_mm = 1000, \
         .plan_ticks = 5, .noise_pct = 10, .near_cost = 0, .near_mm = 200, \
-        .arc_cdeg = 1800, .arc_width_mm = 210, .sight = 1, .escape_grow = 1, \
+        .arc_cdeg = 1800, .arc_width_mm = 0, .sight = 1, .escape_grow = 1, \
         .refuse_ticks = 30, .refuse_life_ticks = 200, .compact = 1, .grow_steps = 10, \
         .forget_reach_mm = 1000, .opening_mm = 270, .unknown_cost = 0, \
         .align_samples = 40, .turn_back_ticks = 10 \
