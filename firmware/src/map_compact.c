@@ -551,6 +551,7 @@ int qnav_cmap_descend(const qnav_map_t *m, int32_t *i, int32_t *j)
     const unsigned want = here == 1u ? 3u : here - 1u;
     int32_t best = INT32_MAX; /* squared cells: at most 2 x 192^2 */
     int32_t a, b, ni = *i, nj = *j;
+    const uint8_t *seen_lo = plane(m, SEEN_LO, *j), *seen_hi = plane(m, SEEN_HI, *j);
     if (here == 0u || qnav_map_at(m, *i, *j) == m->goal_cell) {
         return 0;
     }
@@ -569,7 +570,9 @@ int qnav_cmap_descend(const qnav_map_t *m, int32_t *i, int32_t *j)
             if ((a == 0 && b == 0) || ti < 0 || ti >= (int32_t)m->nx || bits_in(lo, hi, ti) != want) {
                 continue;
             }
-            if (a != 0 && b != 0 && (qnav_cmap_blocked(m, ti, *j) || qnav_cmap_blocked(m, *i, tj))) {
+            if (a != 0 && b != 0 &&
+                (bits_in(seen_lo, seen_hi, ti) == SEEN_OCCUPIED ||
+                 bits_in(plane(m, SEEN_LO, tj), plane(m, SEEN_HI, tj), *i) == SEEN_OCCUPIED)) {
                 continue; /* no corner cutting, as the plan grew */
             }
             /* of the cells a step nearer, the one nearest the destination: a straight way */
