@@ -660,6 +660,27 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
     observe_wedges(m, ranges_mm, at);
 }
 
+/* Which of cells 8b .. 8b + 7 of row j a reading may change, cell 8b + k in bit k (the
+ * bits of cells past the row's end say nothing): not free at its floor, nor refused.
+ * *arcs: which may take an arc's evidence (never seen free). */
+static uint8_t unsettled(const qnav_map_t *m, int32_t b, int32_t j, uint8_t *arcs)
+{
+    uint8_t todo = 0u, k;
+    if (m->cfg.compact) {
+        *arcs = (uint8_t)~qnav_cmap_free_bits(m, b, j);
+        return *arcs;
+    }
+    *arcs = 0u;
+    for (k = 0; k < 8u && b * 8 + k < (int32_t)m->nx; ++k) {
+        const int8_t c = m->evidence[qnav_map_at(m, b * 8 + k, j)];
+        if (c != EVIDENCE_FREE_MIN && c != EVIDENCE_REFUSED) {
+            todo = (uint8_t)(todo | (1u << k));
+            *arcs = (uint8_t)(*arcs | (c >= 0 ? 1u << k : 0u));
+        }
+    }
+    return todo;
+}
+
 /* qnav_map_observe() for a scan of the map's own n_sectors wedges.
  *
  * Squares are unsigned 32-bit (a 64-bit product costs an AVR hundreds of cycles): with
@@ -697,16 +718,21 @@ static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav
         const int32_t dy = centre_y(m, j) - pose->y_mm;
         const uint32_t dy2 = (uint32_t)(dy < 0 ? -dy : dy) * (uint32_t)(dy < 0 ? -dy : dy);
         int32_t dx = centre_x(m, i0) - pose->x_mm - (int32_t)m->cfg.cell_mm;
+        uint8_t todo = 0u, arcs = 0u; /* cells i.. of i's byte (unsettled), cell i in bit 0 */
         if (dy2 > reach2) {
             continue;
         }
-        for (i = i0; i <= i1; ++i) {
+        for (i = i0; i <= i1; ++i, todo >>= 1, arcs >>= 1) {
             uint32_t d2;
-            const int8_t c = evidence_at(m, i, j);
             uint16_t k;
             int32_t rel;
             dx += (int32_t)m->cfg.cell_mm;
-            if (c == EVIDENCE_FREE_MIN || c == EVIDENCE_REFUSED) {
+            if (i == i0 || (i & 7) == 0) {
+                /* a byte's cells at once: a compact map's without a call each */
+                todo = (uint8_t)(unsettled(m, i >> 3, j, &arcs) >> (i & 7));
+                arcs = (uint8_t)(arcs >> (i & 7));
+            }
+            if ((todo & 1u) == 0u) {
                 continue; /* no reading changes it: free at its floor, or refused */
             }
             d2 = (uint32_t)(dx < 0 ? -dx : dx) * (uint32_t)(dx < 0 ? -dx : dx) + dy2;
@@ -727,7 +753,7 @@ static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav
             }
             if (last.lo > 0 && (last.lo > reach || d2 < (uint32_t)last.lo * (uint32_t)last.lo)) {
                 mark_clear(m, i, j);
-            } else if (last.marks && c >= 0 && c < EVIDENCE_REFUSED &&
+            } else if (last.marks && (arcs & 1u) != 0u &&
                        (last.rc + three_quarters > reach ||
                         d2 <= (uint32_t)(last.rc + three_quarters) * (uint32_t)(last.rc + three_quarters)) &&
                        (last.band <= 0 ||

@@ -83,6 +83,11 @@ int8_t qnav_cmap_evidence(const qnav_map_t *m, int32_t i, int32_t j)
     return v == SEEN_FREE ? (int8_t)QNAV_MAP_FREE_FLOOR : (int8_t)v;
 }
 
+uint8_t qnav_cmap_free_bits(const qnav_map_t *m, int32_t b, int32_t j)
+{
+    return (uint8_t)(plane(m, SEEN_LO, j)[b] & plane(m, SEEN_HI, j)[b]);
+}
+
 void qnav_cmap_clear(qnav_map_t *m, int32_t i, int32_t j)
 {
     if (bit2(m, SEEN_LO, i, j) == SEEN_OCCUPIED) {
@@ -339,6 +344,91 @@ static inline void grow_row(qnav_map_t *m, int32_t j, const row_t *up, const row
     }
 }
 
+#if QNAV_CMAP_WIDE
+/* A row of n bytes, 4 <= n <= 8, at p as one word (word_at's, without its cases): two
+ * 4-byte loads, the second ending at the row's end; and its store. */
+static inline cword_t one_word_at(const uint8_t *p, uint16_t n)
+{
+    uint32_t a, b;
+    memcpy(&a, p, 4u);
+    memcpy(&b, p + n - 4u, 4u);
+    return (cword_t)a | (cword_t)b << (8u * (n - 4u));
+}
+
+static inline void one_word_set(uint8_t *p, uint16_t n, cword_t v)
+{
+    const uint32_t a = (uint32_t)v, b = (uint32_t)(v >> (8u * (n - 4u)));
+    memcpy(p, &a, 4u);
+    memcpy(p + n - 4u, &b, 4u);
+}
+
+/* Row j as one word each (load_row's): its cells labelled t (flips as load_row's), and its
+ * passable ones (on_map: the row's cells). p: the planes, stride bytes apart. */
+static inline void row_word(const qnav_map_t *m, const uint8_t *p, size_t stride, int32_t j,
+                            cword_t flip_lo, cword_t flip_hi, cword_t on_map, cword_t *last,
+                            cword_t *pass)
+{
+    const uint16_t n = m->row_bytes;
+    if (j < 0 || j >= (int32_t)m->ny) {
+        *last = *pass = 0u;
+        return;
+    }
+    p += (size_t)j * n;
+    *last = (cword_t)((one_word_at(p + PLAN_LO * stride, n) ^ flip_lo) &
+                      (one_word_at(p + PLAN_HI * stride, n) ^ flip_hi));
+    *pass = (cword_t)((one_word_at(p + SEEN_LO * stride, n) | (cword_t)~one_word_at(p + SEEN_HI * stride, n)) &
+                      on_map);
+}
+
+/* grow()'s rows first..last for rows of 4 to 8 bytes (25 to 64 cells: both profiles'
+ * maps), a row one word, the rows up, here and down in registers: grow_row's rule without
+ * the rows' arrays; 1 when any cell took the next count. */
+static uint8_t grow_rows_one_word(qnav_map_t *m, int32_t first, int32_t last, unsigned t,
+                                  unsigned next)
+{
+    const uint16_t n = m->row_bytes;
+    const size_t stride = (size_t)m->ny * n;
+    uint8_t *const planes = m->planes;
+    const cword_t all = (cword_t)~(cword_t)0u;
+    const cword_t flip_lo = (t & 1u) ? 0u : all, flip_hi = (t & 2u) ? 0u : all;
+    const cword_t on_map = (m->nx & CWORD_TOP) != 0u ? (cword_t)~(all << (m->nx & CWORD_TOP)) : all;
+    cword_t ul, up, hl, hp, dl, dp;
+    uint8_t any = 0u;
+    int32_t j;
+    row_word(m, planes, stride, first - 1, flip_lo, flip_hi, on_map, &ul, &up);
+    row_word(m, planes, stride, first, flip_lo, flip_hi, on_map, &hl, &hp);
+    for (j = first; j <= last; ++j) {
+        uint8_t *lo = planes + PLAN_LO * stride + (size_t)j * n, *hi = lo + stride;
+        const cword_t pw = (cword_t)(hp << 1), pe = hp >> 1;
+        const cword_t lw = one_word_at(lo, n), hw = one_word_at(hi, n);
+        cword_t r, add;
+        row_word(m, planes, stride, j + 1, flip_lo, flip_hi, on_map, &dl, &dp);
+        r = (cword_t)((cword_t)(hl << 1) | (hl >> 1) | ul | dl);
+        r |= (cword_t)((((cword_t)(ul << 1) & pw) | ((ul >> 1) & pe)) & up);
+        r |= (cword_t)((((cword_t)(dl << 1) & pw) | ((dl >> 1) & pe)) & dp);
+        add = (cword_t)(r & hp & (cword_t)~(lw | hw));
+        if (add != 0u) {
+            if (next & 1u) {
+                one_word_set(lo, n, lw | add);
+            }
+            if (next & 2u) {
+                one_word_set(hi, n, hw | add);
+            }
+            if (!any) {
+                m->rows_from = (uint16_t)j;
+            }
+            m->rows_to = (uint16_t)j;
+            any = 1u;
+        }
+        ul = hl;
+        up = hp;
+        hl = dl;
+        hp = dp;
+    }
+    return any;
+}
+#endif
+
 /* One more step count: every passable cell not yet reached a step from the last count's
  * cells takes the next count (8 neighbours; a diagonal only past the two cells beside it,
  * both passable). 0 when none did (the plan is whole). Rows are read a row ahead, so a
@@ -357,15 +447,22 @@ static int grow(qnav_map_t *m)
     if (!m->q_queued) {
         return 0;
     }
-    load_row(m, first - 1, t, up);
-    load_row(m, first, t, here);
-    for (j = first; j <= last; ++j) {
-        row_t *spare = up;
-        load_row(m, j + 1, t, down);
-        grow_row(m, j, up, here, down, next, &any);
-        up = here;
-        here = down;
-        down = spare;
+#if QNAV_CMAP_WIDE
+    if (m->row_bytes >= 4u && m->row_bytes <= CWORD_BYTES) {
+        any = grow_rows_one_word(m, first, last, t, next);
+    } else
+#endif
+    {
+        load_row(m, first - 1, t, up);
+        load_row(m, first, t, here);
+        for (j = first; j <= last; ++j) {
+            row_t *spare = up;
+            load_row(m, j + 1, t, down);
+            grow_row(m, j, up, here, down, next, &any);
+            up = here;
+            here = down;
+            down = spare;
+        }
     }
     m->layer++;
     m->q_queued = any;
@@ -454,6 +551,7 @@ int qnav_cmap_descend(const qnav_map_t *m, int32_t *i, int32_t *j)
     const unsigned want = here == 1u ? 3u : here - 1u;
     int32_t best = INT32_MAX; /* squared cells: at most 2 x 192^2 */
     int32_t a, b, ni = *i, nj = *j;
+    const uint8_t *seen_lo = plane(m, SEEN_LO, *j), *seen_hi = plane(m, SEEN_HI, *j);
     if (here == 0u || qnav_map_at(m, *i, *j) == m->goal_cell) {
         return 0;
     }
@@ -472,7 +570,9 @@ int qnav_cmap_descend(const qnav_map_t *m, int32_t *i, int32_t *j)
             if ((a == 0 && b == 0) || ti < 0 || ti >= (int32_t)m->nx || bits_in(lo, hi, ti) != want) {
                 continue;
             }
-            if (a != 0 && b != 0 && (qnav_cmap_blocked(m, ti, *j) || qnav_cmap_blocked(m, *i, tj))) {
+            if (a != 0 && b != 0 &&
+                (bits_in(seen_lo, seen_hi, ti) == SEEN_OCCUPIED ||
+                 bits_in(plane(m, SEEN_LO, tj), plane(m, SEEN_HI, tj), *i) == SEEN_OCCUPIED)) {
                 continue; /* no corner cutting, as the plan grew */
             }
             /* of the cells a step nearer, the one nearest the destination: a straight way */

@@ -40,6 +40,9 @@ void qnav_cmap_reset(qnav_map_t *m);
 /* A cell's evidence as the full layout would hold it: 0 unknown, 1 one arc, 2 occupied,
  * QNAV_MAP_FREE_FLOOR seen free. */
 int8_t qnav_cmap_evidence(const qnav_map_t *m, int32_t i, int32_t j);
+/* Which of cells 8b .. 8b + 7 of row j were seen free: cell 8b + k in bit k (0 past the
+ * row's end). */
+uint8_t qnav_cmap_free_bits(const qnav_map_t *m, int32_t b, int32_t j);
 /* Seen free; one more arc's evidence (occupied at the second). Both set m->dirty when the
  * cell became or stopped being occupied. */
 void qnav_cmap_clear(qnav_map_t *m, int32_t i, int32_t j);
