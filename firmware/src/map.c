@@ -199,10 +199,12 @@ static int place_axis(const qnav_map_config_t *cfg, int32_t r, int32_t g, int32_
     if (abs32(g - r) <= side - 2 * cell) {
         const int32_t keep = (ROBOT_IN_MM + cell - 1) / cell * cell;
         int32_t c = r / 2 + g / 2 - side / 2;
-        if (2 * keep <= side && c > r - keep) {
-            c = r - keep;
-        } else if (2 * keep <= side && c < r + keep - side) {
-            c = r + keep - side;
+        if (2 * keep <= side) { /* a square too small to keep it that far in: midway */
+            if (c > r - keep) {
+                c = r - keep;
+            } else if (c < r + keep - side) {
+                c = r + keep - side;
+            }
         }
         *corner = c;
         return 1;

@@ -1349,9 +1349,6 @@ static void evidence_grid(const qnav_map_t *m, int32_t x0, int32_t y0, int32_t x
     }
 }
 
-/* A goal too far for the square: the robot the readings' reach and a cell (6 cells of
- * 400 mm) inside it, the rest toward the goal; too few bytes, or a square too small to keep
- * the robot that far in: no map. */
 /* The placement tests' map: compact, 0.4 m cells (32 x 32 of them in 512 bytes). */
 static void placing_config(qnav_map_config_t *mc)
 {
@@ -1360,6 +1357,9 @@ static void placing_config(qnav_map_config_t *mc)
     mc->compact = 1;
 }
 
+/* A goal too far for the square: the robot the readings' reach and a cell (6 cells of
+ * 400 mm) inside it, the rest toward the goal; too few bytes, or a square too small to keep
+ * the robot that far in: no map. */
 static void test_a_map_reaches_toward_a_goal_too_far_for_it(void **state)
 {
     qnav_map_config_t mc;
