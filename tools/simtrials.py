@@ -56,10 +56,14 @@ def profile_file(prog, robot):
     return os.path.normpath(path)
 
 
+# Keys that say one thing two ways (a profile gives one): setting either drops the other.
+ONE_OF = {("clearance", "wedge_pct"): "wedge_deg", ("clearance", "wedge_deg"): "wedge_pct"}
+
+
 def set_value(lines, edit):
     """lines with one --set SECTION.KEY=VALUE applied: the key's value replaced (its comment
-    kept), or the key added at the top of its section, after the header's comment.
-    ValueError says what is wrong."""
+    kept), or the key added at the top of its section, after the header's comment; a key
+    ONE_OF pairs with it is dropped. ValueError says what is wrong."""
     m = re.fullmatch(r"([A-Za-z0-9_]+)\.([A-Za-z0-9_]+)=(.+)", edit)
     if not m:
         raise ValueError(f"--set {edit}: expected SECTION.KEY=VALUE, e.g. map.cell_m=0.3")
@@ -68,6 +72,14 @@ def set_value(lines, edit):
     if head is None:
         raise ValueError(f"--set {edit}: the profile has no [{section}] section")
     end = next((i for i in range(head + 1, len(lines)) if lines[i].startswith("[")), len(lines))
+    other = ONE_OF.get((section, key))
+    for i in range(head + 1, end):
+        if other and re.match(rf"{other}\s*=", lines[i]):
+            # the other way of saying it, and its comment's further lines, give way
+            j = i + 1
+            while j < end and re.match(r"\s+#", lines[j]):
+                j += 1
+            return lines[:i] + [f"{key} = {value}"] + lines[j:]
     for i in range(head + 1, end):
         k = re.match(rf"({key}\s*=\s*)(.*?)(\s+#.*)?$", lines[i])
         if k:

@@ -122,10 +122,17 @@ static void parse_sensing(const TomlReader &r, RobotProfile &p) {
 static void parse_controller_settings(const TomlReader &r, RobotProfile &p) {
     const toml::table &root = r.root();
     const toml::table &cl = r.table(root, "clearance");
-    r.only_keys(cl, {"safety_m", "speed_guard", "wedge_pct", "wedge_near_m"});
+    r.only_keys(cl, {"safety_m", "speed_guard", "wedge_pct", "wedge_deg", "wedge_near_m"});
     p.safety_m = r.number(cl, "safety_m", 0.0, 10.0);
     if (cl.get("wedge_pct"))
         p.wedge_pct = static_cast<std::uint8_t>(r.integer(cl, "wedge_pct", 0, 100));
+    // the same placement as an angle: a wedge's share of it follows the sector count
+    // (docs/architecture.md, "A reading's core as an angle")
+    if (const toml::node *deg = cl.get("wedge_deg")) {
+        if (cl.get("wedge_pct"))
+            r.fail(*deg, "'wedge_deg' and 'wedge_pct' both place a reading on its wedge: give one");
+        p.wedge_deg = r.number(cl, "wedge_deg", 0.0, 360.0);
+    }
     const toml::node *near = cl.get("wedge_near_m");
     if (near && near->is_string()) {
         if (r.string(cl, "wedge_near_m") != "stopping")

@@ -61,6 +61,8 @@ struct RobotProfile {
     bool speed_guard = true;        // cap the speed at what the path's clearance stops in
     std::uint8_t wedge_pct = 100;   // a reading blocks the central wedge_pct % of its
                                     // sector's wedge before enlargement (docs/architecture.md)
+    double wedge_deg = -1.0;        // or the central wedge_deg of it, whatever the sector
+                                    // count (wedge_pct from it per count); < 0: wedge_pct
     double wedge_near_m = 0.0;      // nearer readings block their whole wedge, m
     // leaving dead ends (libqnav's escape; docs/architecture.md, "Leaving dead ends")
     double escape_stall_s = 2.0;    // time without progress before following a boundary,

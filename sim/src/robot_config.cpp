@@ -18,6 +18,15 @@ static qnav_q1_15_t to_q1_15(double f) {
     return static_cast<qnav_q1_15_t>(std::min(32767L, std::lround(f * 32768.0)));
 }
 
+// The share of each wedge a reading blocks at n_sectors: the profile's wedge_pct, or its wedge_deg
+// of that count's wedge.
+static std::uint8_t robot_wedge_pct(const RobotProfile &p, std::uint16_t n_sectors) {
+    if (p.wedge_deg < 0.0) return p.wedge_pct;
+    // wedge_deg of an n-sector wedge's 360 / n degrees, in whole percent, at most all of it
+    const long pct = std::lround(p.wedge_deg * static_cast<double>(n_sectors) * 100.0 / 360.0);
+    return static_cast<std::uint8_t>(std::clamp(pct, 0L, 100L));
+}
+
 void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl_config_t *cfg) {
     qnav_ctrl_config_default(cfg);
     cfg->n_sectors = n_sectors ? n_sectors : p.default_sectors;
@@ -37,7 +46,7 @@ void robot_ctrl_config(const RobotProfile &p, std::uint16_t n_sectors, qnav_ctrl
     cfg->v_max_mm_s = to_mm(p.v_max_mps);
     cfg->full_speed_quality = to_q1_15(p.full_speed_quality);
     cfg->decel_mm_s2 = p.speed_guard ? to_mm(p.decel_mps2) : 0;
-    cfg->wedge_pct = p.wedge_pct;
+    cfg->wedge_pct = robot_wedge_pct(p, cfg->n_sectors);
     cfg->wedge_near_mm = to_mm(p.wedge_near_m);
     cfg->escape_stall_ticks = static_cast<std::uint8_t>(std::lround(p.escape_stall_s * 10.0));
     cfg->escape_follow_mm = to_mm(p.escape_follow_m);

@@ -205,6 +205,44 @@ static void test_whole_wedges_within_the_stopping_distance(void **state) {
     assert_true(one_line(msg));
 }
 
+/* `[clearance] wedge_deg` places a reading over that angle of its wedge at every sector
+ * count: the TekBot's 5.625 deg is libqnav's wedge_pct 25 at its 16 sectors, 13 at 8 (12.5
+ * rounded), 50 at 32 and all of a wedge from 64 on; `wedge_pct` stays a share of each wedge
+ * whatever the count; a profile giving both is refused on one line naming both. */
+static void test_a_wedge_placement_in_degrees_follows_the_sector_count(void **state) {
+    (void)state;
+    char err[QNAV_SIM_ERRLEN] = "";
+    const std::string t = read_data("robots/tekbot.toml");
+    const std::size_t at = t.find("wedge_deg = 5.625");
+    assert_true(at != std::string::npos);
+    static const struct {
+        std::uint16_t n;
+        std::uint8_t pct;
+    } want[] = {{0, 25}, {16, 25}, {8, 13}, {12, 19}, {32, 50}, {64, 100}, {180, 100}, {1, 2}};
+    qnav_sim_robot_t *robot = nullptr;
+    qnav_ctrl_config_t cfg;
+    assert_int_equal(qnav_sim_robot_parse(t.data(), t.size(), "d.toml", &robot, err, sizeof err), QNAV_SIM_OK);
+    for (const auto &w : want) {
+        qnav_sim_robot_ctrl_config(robot, w.n, &cfg);
+        assert_int_equal(cfg.wedge_pct, w.pct);
+    }
+    qnav_sim_robot_free(robot);
+    std::string pct = t;
+    pct.replace(at, 17, "wedge_pct = 25   ");
+    assert_int_equal(qnav_sim_robot_parse(pct.data(), pct.size(), "p.toml", &robot, err, sizeof err), QNAV_SIM_OK);
+    for (std::uint16_t n : {8, 16, 32}) {
+        qnav_sim_robot_ctrl_config(robot, n, &cfg);
+        assert_int_equal(cfg.wedge_pct, 25);
+    }
+    qnav_sim_robot_free(robot);
+    std::string both = t;
+    both.insert(at, "wedge_pct = 25\n");
+    std::string msg;
+    assert_int_equal(parse_robot(both, &msg), QNAV_SIM_E_PARSE);
+    assert_true(msg.find("'wedge_deg' and 'wedge_pct'") != std::string::npos);
+    assert_true(one_line(msg));
+}
+
 /* The quality commanded at v_max is the profile's (both robots: the paper's 0.9), not a
  * default of libqnav's: a copy of the TekBot's profile with another value gives it. The
  * probabilistic policy's own value ([probabilistic] full_speed_quality: the TekBot's 0.7,
@@ -623,6 +661,7 @@ int main(void) {
         cmocka_unit_test(test_the_safety_scale_follows_the_sonar_range),
         cmocka_unit_test(test_profile_sets_the_speed_at_full_quality),
         cmocka_unit_test(test_whole_wedges_within_the_stopping_distance),
+        cmocka_unit_test(test_a_wedge_placement_in_degrees_follows_the_sector_count),
         cmocka_unit_test(test_missing_file_is_an_io_error_naming_it),
         cmocka_unit_test(test_impossible_parameters_are_refused_by_field),
         cmocka_unit_test(test_mismatched_controller_is_refused),

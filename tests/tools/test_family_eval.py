@@ -1,6 +1,7 @@
 """tools/family-eval against the built qnav-sim: one world per family, its table's shape and
 sense (arrival at twice the limit never below arrival at the limit), several policies
-compared on the same worlds (the summary agrees with the rows it summarizes), the listing
+compared on the same worlds (the summary agrees with the rows it summarizes), --set on a key
+a profile gives another way, the listing
 of failed episodes (its commands draw an episode that missed the limit), a robot profile
 file of a robot not in data/robots (worlds sized for it, its own sector count), the note
 on a sonar noisier than its map allows for, and its one-line errors for a bad family, a
@@ -206,6 +207,29 @@ class FamilyEval(unittest.TestCase):
         self.assertRegex(copy, r"(?m)^\[map\] .*\n( +#.*\n)*look_m = 1.0\ncompact = true ")
         with open(src, encoding="utf-8") as f:
             self.assertEqual(f.read(), before)
+
+    def test_set_replaces_a_key_that_says_the_same_another_way(self):
+        # the TekBot places a reading by wedge_deg; --set clearance.wedge_pct drops it (a
+        # profile gives one of the two): 25 % of 16 sectors is its 5.625 deg, the same
+        # episodes; at 8 sectors 25 % is not 5.625 deg of 45 (13 %), other episodes
+        with tempfile.TemporaryDirectory() as tmp:
+            env = dict(os.environ, TMPDIR=tmp)
+            args = ("--worlds", "2", "--episodes", "2", "-j", "2", "--families", "clutter,shelves",
+                    "--seed-base", "5000011")
+            as_pct = tool(*args, "--set", "clearance.wedge_pct=25", env=env)
+            as_deg = tool(*args)
+            self.assertEqual(as_pct.returncode, 0, as_pct.stderr)
+            self.assertEqual(as_deg.returncode, 0, as_deg.stderr)
+            self.assertEqual(as_pct.stdout.splitlines()[1:], as_deg.stdout.splitlines()[1:])
+            prof = re.match(r"^robot (\S+), worlds sized for tekbot,", as_pct.stdout).group(1)
+            with open(prof, encoding="utf-8") as f:
+                copy = f.read()
+            self.assertRegex(copy, r"(?m)^speed_guard = .*\n( +#.*\n)*wedge_pct = 25\nwedge_near_m = ")
+            self.assertNotIn("wedge_deg", copy)
+            eight = [tool(*args, "--sectors", "8", *extra, env=env)
+                     for extra in ((), ("--set", "clearance.wedge_pct=25"))]
+            self.assertEqual([r.returncode for r in eight], [0, 0], eight[1].stderr)
+            self.assertNotEqual(eight[0].stdout.splitlines()[1:], eight[1].stdout.splitlines()[1:])
 
     def test_a_profile_file_sizes_its_worlds_and_keeps_its_sectors(self):
         # a robot not in data/robots: its worlds are sized from the file, and qnav-sim run is
