@@ -73,13 +73,13 @@ def set_value(lines, edit):
         raise ValueError(f"--set {edit}: the profile has no [{section}] section")
     end = next((i for i in range(head + 1, len(lines)) if lines[i].startswith("[")), len(lines))
     other = ONE_OF.get((section, key))
-    for i in range(head + 1, end):
-        if other and re.match(rf"{other}\s*=", lines[i]):
-            # the other way of saying it, and its comment's further lines, give way
-            j = i + 1
-            while j < end and re.match(r"\s+#", lines[j]):
-                j += 1
-            return lines[:i] + [f"{key} = {value}"] + lines[j:]
+    at = next((i for i in range(head + 1, end) if other and re.match(rf"{other}\s*=", lines[i])), None)
+    if at is not None:
+        # the other way of saying it, and its comment's further lines, give way
+        j = at + 1
+        while j < end and re.match(r"\s+#", lines[j]):
+            j += 1
+        return lines[:at] + [f"{key} = {value}"] + lines[j:]
     for i in range(head + 1, end):
         k = re.match(rf"({key}\s*=\s*)(.*?)(\s+#.*)?$", lines[i])
         if k:
