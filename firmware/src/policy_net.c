@@ -35,6 +35,10 @@ static int32_t div_round(int32_t num, int32_t den)
     return (num >= 0) ? (num + den / 2) / den : -((-num + den / 2) / den);
 }
 
+/* A pre-activation below this gives the sigmoid's 0, at or above UNIT_TOP_FROM its top. */
+#define UNIT_ZERO_BELOW ((int32_t)QNAV_SIGMOID_LAST_ZERO * 256 + 128)
+#define UNIT_TOP_FROM ((int32_t)QNAV_SIGMOID_FIRST_TOP * 256 - 128)
+
 /*
  * One hidden unit's share of the output pre-activation, in units of 2^-15.
  * z is the unit's pre-activation in units of 2^-19 (|z| < 2^29).
@@ -42,10 +46,6 @@ static int32_t div_round(int32_t num, int32_t den)
  * [-16, 16); out (Q8.8) times h (Q1.15) is below 2^30; >> 8 leaves units of 2^-15, below
  * 2^22 per unit, so 32 units sum below 2^27.
  */
-/* A pre-activation below this gives the sigmoid's 0, at or above UNIT_TOP_FROM its top. */
-#define UNIT_ZERO_BELOW ((int32_t)QNAV_SIGMOID_LAST_ZERO * 256 + 128)
-#define UNIT_TOP_FROM ((int32_t)QNAV_SIGMOID_FIRST_TOP * 256 - 128)
-
 static inline int32_t unit_share(int32_t z, int16_t out)
 {
     int16_t h;
@@ -192,8 +192,8 @@ static void eval_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *
             int16_t out = u->out;
 #if !defined(__AVR__)
             /* On hosts a unit on one flat end of the sigmoid over the whole piece is taken at
-             * once: z steps evenly, so it lies between its first and last values. (On AVR
-             * the two tests' 32-bit products would cost more than they save in the step.) */
+             * once: z steps evenly, so it lies between its first and last values. The AVR's
+             * step keeps its loop (not measured with the tests). */
             const int32_t z_last = z + step * (int32_t)(n - 1u);
             if (z < UNIT_ZERO_BELOW && z_last < UNIT_ZERO_BELOW) {
                 continue; /* every share 0 */
