@@ -345,6 +345,8 @@ static inline void grow_row(qnav_map_t *m, int32_t j, const row_t *up, const row
 }
 
 #if QNAV_CMAP_WIDE
+typedef struct rows rows_t;
+
 /* A row of n bytes, 4 <= n <= 8, at p as one word (word_at's, without its cases): two
  * 4-byte loads, the second ending at the row's end; and its store. */
 static inline cword_t one_word_at(const uint8_t *p, uint16_t n)
@@ -362,57 +364,86 @@ static inline void one_word_set(uint8_t *p, uint16_t n, cword_t v)
     memcpy(p + n - 4u, &b, 4u);
 }
 
-/* Row j as one word each (load_row's): its cells labelled t (flips as load_row's), and its
- * passable ones (on_map: the row's cells). p: the planes, stride bytes apart. */
-static inline void row_word(const qnav_map_t *m, const uint8_t *p, size_t stride, int32_t j,
-                            cword_t flip_lo, cword_t flip_hi, cword_t on_map, cword_t *last,
-                            cword_t *pass)
+/* Maps of rows of 4 to 8 bytes (25 to 64 cells: both profiles' maps) and at most this many
+ * rows grow from struct rows; others from the planes' bytes (load_row). */
+#define WORD_ROWS_MAX 128u
+
+/* The plan's rows, a word each, while qnav_cmap_settle() grows it: read from the planes
+ * once, not once a step count, and written through to them, so the planes stay the plan.
+ * Nothing but the growth changes the planes during a settle, so which cells are passable
+ * (pass) holds throughout. Row j at j + 1, between two empty rows (no cell labelled, none
+ * passable), so the rows beyond the map need no test. */
+struct rows {
+    cword_t lo[WORD_ROWS_MAX + 2u], hi[WORD_ROWS_MAX + 2u]; /* the plan's two planes */
+    cword_t pass[WORD_ROWS_MAX + 2u];                       /* not occupied, and on the map */
+};
+
+/* rows with every row of the map, or NULL when the map's rows are not one word each. */
+static rows_t *load_rows(const qnav_map_t *m, rows_t *rows)
 {
     const uint16_t n = m->row_bytes;
-    if (j < 0 || j >= (int32_t)m->ny) {
-        *last = *pass = 0u;
-        return;
+    const size_t stride = (size_t)m->ny * n;
+    const cword_t all = (cword_t)~(cword_t)0u;
+    const cword_t on_map = (m->nx & CWORD_TOP) != 0u ? (cword_t)~(all << (m->nx & CWORD_TOP)) : all;
+    const uint8_t *p = m->planes;
+    uint16_t j;
+    if (n < 4u || n > CWORD_BYTES || m->ny > WORD_ROWS_MAX) {
+        return NULL;
     }
-    p += (size_t)j * n;
-    *last = (cword_t)((one_word_at(p + PLAN_LO * stride, n) ^ flip_lo) &
-                      (one_word_at(p + PLAN_HI * stride, n) ^ flip_hi));
-    *pass = (cword_t)((one_word_at(p + SEEN_LO * stride, n) | (cword_t)~one_word_at(p + SEEN_HI * stride, n)) &
-                      on_map);
+    rows->lo[0] = rows->hi[0] = rows->pass[0] = 0u;
+    for (j = 1; j <= m->ny; ++j, p += n) {
+        rows->lo[j] = one_word_at(p + PLAN_LO * stride, n);
+        rows->hi[j] = one_word_at(p + PLAN_HI * stride, n);
+        rows->pass[j] = (cword_t)((one_word_at(p + SEEN_LO * stride, n) | (cword_t)~one_word_at(p + SEEN_HI * stride, n)) &
+                                  on_map);
+    }
+    rows->lo[j] = rows->hi[j] = rows->pass[j] = 0u;
+    return rows;
 }
 
-/* grow()'s rows first..last for rows of 4 to 8 bytes (25 to 64 cells: both profiles'
- * maps), a row one word, the rows up, here and down in registers: grow_row's rule without
- * the rows' arrays; 1 when any cell took the next count. */
-static uint8_t grow_rows_one_word(qnav_map_t *m, int32_t first, int32_t last, unsigned t,
-                                  unsigned next)
+/* Row j of rows as the growth reads it, -1 <= j <= ny: its cells labelled t (flips as
+ * load_row's; a label is never 0, so an empty row has none), and its passable ones. */
+static inline void row_word(const rows_t *rows, int32_t j, cword_t flip_lo, cword_t flip_hi,
+                            cword_t *last, cword_t *pass)
+{
+    *last = (cword_t)((rows->lo[j + 1] ^ flip_lo) & (rows->hi[j + 1] ^ flip_hi));
+    *pass = rows->pass[j + 1];
+}
+
+/* grow()'s rows first..last from rows (load_rows()), a row one word, the rows up, here
+ * and down in registers: grow_row's rule without the rows' arrays; 1 when any cell took
+ * the next count. */
+static uint8_t grow_rows_one_word(qnav_map_t *m, rows_t *rows, int32_t first, int32_t last,
+                                  unsigned t, unsigned next)
 {
     const uint16_t n = m->row_bytes;
     const size_t stride = (size_t)m->ny * n;
     uint8_t *const planes = m->planes;
     const cword_t all = (cword_t)~(cword_t)0u;
     const cword_t flip_lo = (t & 1u) ? 0u : all, flip_hi = (t & 2u) ? 0u : all;
-    const cword_t on_map = (m->nx & CWORD_TOP) != 0u ? (cword_t)~(all << (m->nx & CWORD_TOP)) : all;
     cword_t ul, up, hl, hp, dl, dp;
     uint8_t any = 0u;
     int32_t j;
-    row_word(m, planes, stride, first - 1, flip_lo, flip_hi, on_map, &ul, &up);
-    row_word(m, planes, stride, first, flip_lo, flip_hi, on_map, &hl, &hp);
+    row_word(rows, first - 1, flip_lo, flip_hi, &ul, &up);
+    row_word(rows, first, flip_lo, flip_hi, &hl, &hp);
     for (j = first; j <= last; ++j) {
-        uint8_t *lo = planes + PLAN_LO * stride + (size_t)j * n, *hi = lo + stride;
         const cword_t pw = (cword_t)(hp << 1), pe = hp >> 1;
-        const cword_t lw = one_word_at(lo, n), hw = one_word_at(hi, n);
+        const cword_t lw = rows->lo[j + 1], hw = rows->hi[j + 1];
         cword_t r, add;
-        row_word(m, planes, stride, j + 1, flip_lo, flip_hi, on_map, &dl, &dp);
+        row_word(rows, j + 1, flip_lo, flip_hi, &dl, &dp);
         r = (cword_t)((cword_t)(hl << 1) | (hl >> 1) | ul | dl);
         r |= (cword_t)((((cword_t)(ul << 1) & pw) | ((ul >> 1) & pe)) & up);
         r |= (cword_t)((((cword_t)(dl << 1) & pw) | ((dl >> 1) & pe)) & dp);
         add = (cword_t)(r & hp & (cword_t)~(lw | hw));
         if (add != 0u) {
+            uint8_t *lo = planes + PLAN_LO * stride + (size_t)j * n;
             if (next & 1u) {
+                rows->lo[j + 1] = lw | add;
                 one_word_set(lo, n, lw | add);
             }
             if (next & 2u) {
-                one_word_set(hi, n, hw | add);
+                rows->hi[j + 1] = hw | add;
+                one_word_set(lo + stride, n, hw | add);
             }
             if (!any) {
                 m->rows_from = (uint16_t)j;
@@ -429,12 +460,22 @@ static uint8_t grow_rows_one_word(qnav_map_t *m, int32_t first, int32_t last, un
 }
 #endif
 
+/* On hosts the growth also takes the plan's rows as words (struct rows, or NULL); on AVR
+ * it reads the planes' bytes and takes nothing more, as before. */
+#if QNAV_CMAP_WIDE
+#define WORDS_PARAM , rows_t *words
+#define WORDS_ARG(w) , (w)
+#else
+#define WORDS_PARAM
+#define WORDS_ARG(w)
+#endif
+
 /* One more step count: every passable cell not yet reached a step from the last count's
  * cells takes the next count (8 neighbours; a diagonal only past the two cells beside it,
  * both passable). 0 when none did (the plan is whole). Rows are read a row ahead, so a
  * row's new cells (label next, not t) do not change what the rows after it see. Only the
  * rows next to the last count's rows (m->rows_from..rows_to) can take new cells. */
-static int grow(qnav_map_t *m)
+static int grow(qnav_map_t *m WORDS_PARAM)
 {
     row_t rows[3];
     row_t *up = &rows[0], *here = &rows[1], *down = &rows[2];
@@ -448,8 +489,8 @@ static int grow(qnav_map_t *m)
         return 0;
     }
 #if QNAV_CMAP_WIDE
-    if (m->row_bytes >= 4u && m->row_bytes <= CWORD_BYTES) {
-        any = grow_rows_one_word(m, first, last, t, next);
+    if (words != NULL) {
+        any = grow_rows_one_word(m, words, first, last, t, next);
     } else
 #endif
     {
@@ -495,7 +536,7 @@ int qnav_cmap_needs_growth(const qnav_map_t *m, int32_t ri, int32_t rj)
 }
 
 /* grow(), while *budget lasts (0: none left; a budget of 0 from the start: no bound). */
-static int grow_within(qnav_map_t *m, uint16_t *budget, int bounded)
+static int grow_within(qnav_map_t *m WORDS_PARAM, uint16_t *budget, int bounded)
 {
     if (bounded) {
         if (*budget == 0u) {
@@ -503,7 +544,7 @@ static int grow_within(qnav_map_t *m, uint16_t *budget, int bounded)
         }
         --*budget;
     }
-    return grow(m);
+    return grow(m WORDS_ARG(words));
 }
 
 void qnav_cmap_settle(qnav_map_t *m, int32_t ri, int32_t rj)
@@ -511,8 +552,14 @@ void qnav_cmap_settle(qnav_map_t *m, int32_t ri, int32_t rj)
     uint16_t budget = m->cfg.grow_steps;
     const int bounded = ri >= 0 && budget != 0u;
     int k;
+#if QNAV_CMAP_WIDE
+    rows_t buf, *rows = NULL;
+    if (ri < 0 || plan_label(m, ri, rj) == 0u) {
+        rows = m->q_queued ? load_rows(m, &buf) : NULL; /* no growth: nothing to read */
+    }
+#endif
     if (ri < 0) {
-        while (grow(m)) {
+        while (grow(m WORDS_ARG(rows))) {
         }
         return;
     }
@@ -520,7 +567,7 @@ void qnav_cmap_settle(qnav_map_t *m, int32_t ri, int32_t rj)
         return;
     }
     if (!qnav_cmap_blocked(m, ri, rj)) {
-        while (plan_label(m, ri, rj) == 0u && grow_within(m, &budget, bounded)) {
+        while (plan_label(m, ri, rj) == 0u && grow_within(m WORDS_ARG(rows), &budget, bounded)) {
         }
         return;
     }
@@ -530,9 +577,9 @@ void qnav_cmap_settle(qnav_map_t *m, int32_t ri, int32_t rj)
     if (window_settled(m, ri, rj)) {
         return;
     }
-    while (!window_settled(m, ri, rj) && grow_within(m, &budget, bounded)) {
+    while (!window_settled(m, ri, rj) && grow_within(m WORDS_ARG(rows), &budget, bounded)) {
     }
-    for (k = 0; k < 2 && grow_within(m, &budget, bounded); ++k) {
+    for (k = 0; k < 2 && grow_within(m WORDS_ARG(rows), &budget, bounded); ++k) {
     }
 }
 

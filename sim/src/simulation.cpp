@@ -138,7 +138,12 @@ void Simulation::init_map() {
 // map_turn_) and back (by -map_turn_). No turn leaves a point exactly as it is.
 Vec2 Simulation::turned(Vec2 p, double by) const {
     if (by == 0) return p;
-    const double cx = env_.width_m / 2, cy = env_.height_m / 2, c = std::cos(by), s = std::sin(by);
+    if (by != turned_by_) {
+        turned_by_ = by;
+        turned_cos_ = std::cos(by);
+        turned_sin_ = std::sin(by);
+    }
+    const double cx = env_.width_m / 2, cy = env_.height_m / 2, c = turned_cos_, s = turned_sin_;
     const double dx = p.x - cx, dy = p.y - cy;
     return Vec2{cx + c * dx - s * dy, cy + s * dx + c * dy};
 }

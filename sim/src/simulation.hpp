@@ -144,6 +144,8 @@ private:
     double map_turn_ = 0;
     std::uint64_t world_key_ = 0;  // a hash of the world: turns differ between worlds
     Vec2 turned(Vec2 p, double by) const;
+    // cos and sin of the last angle turned() turned by: the map turns every tick by the same
+    mutable double turned_by_ = 0, turned_cos_ = 1, turned_sin_ = 0;
     bool started_ = false, done_ = false, reached_ = false;
     std::uint32_t tick_ = 0, tau_c_ = 0, collisions_ = 0;
     std::uint32_t recovery_left_ = 0;

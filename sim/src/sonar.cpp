@@ -148,9 +148,8 @@ void SonarRing::measure_wide(Vec2 pos, double heading, double *dist) const {
 
 
 // The arena walls' readings (every sector starts from them).
-void SonarRing::measure_walls(Vec2 pos, double heading, double *dist) const {
+void SonarRing::measure_walls(Vec2 pos, double heading, double ch, double sh, double *dist) const {
     std::fill(dist, dist + n_, kInf);
-    const double ch = std::cos(heading), sh = std::sin(heading);
     // Arena walls: perpendicular feet (walls at angles 0, pi/2, pi, -pi/2 from the robot)...
     const double wall_d[4] = {width_m_ - pos.x, height_m_ - pos.y, pos.x, pos.y};
     for (int w = 0; w < 4; ++w) {
@@ -180,8 +179,8 @@ void SonarRing::measure(Vec2 pos, double heading, double *dist) const {
         measure_plain(pos, heading, dist);
         return;
     }
-    measure_walls(pos, heading, dist);
     const double ch = std::cos(heading), sh = std::sin(heading);
+    measure_walls(pos, heading, ch, sh, dist);
     if (end - c <= kShortList) {
         // Few shapes: testing each is cheaper than deciding which to skip.
         for (; c != end; ++c) {
@@ -289,8 +288,8 @@ void SonarRing::measure_plain(Vec2 pos, double heading, double *dist) const {
         measure_wide(pos, heading, dist);
         return;
     }
-    measure_walls(pos, heading, dist);
     const double ch = std::cos(heading), sh = std::sin(heading);
+    measure_walls(pos, heading, ch, sh, dist);
     for (const Shape &s : shapes_) {
         const Vec2 dc = s.c - pos;
         const double bound = s.r + reach_;

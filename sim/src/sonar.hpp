@@ -111,7 +111,8 @@ private:
     void build_grid();
     void build_cell(std::size_t cell, int i, int j) const;
     bool hidden(const Candidate &c, double heading_sectors, double lower, const double *dist) const;
-    void measure_walls(Vec2 pos, double heading, double *dist) const;
+    // ch, sh: cos and sin of heading (the caller turns the boundary rays with them too)
+    void measure_walls(Vec2 pos, double heading, double ch, double sh, double *dist) const;
     double apply_shape(const Shape &s, Vec2 pos, double heading, double ch, double sh, double *dist) const;
     double width_m_, height_m_;
     std::uint16_t n_;
