@@ -285,6 +285,32 @@ static void naive_comparison(void)
 }
 
 
+/* What a decision that stood twice the stall time and stands again adds (a reading at
+ * 1 mm straight ahead: every path's speed cap is 0): sent into a free window
+ * (docs/architecture.md, "A robot that stands"), the same step with the count at 255
+ * against 0, on scan r toward goal_cdeg. */
+static uint32_t stood_cost(const qnav_ctrl_t *c, qnav_mm_t *r, qnav_cdeg_t goal_cdeg)
+{
+    const qnav_mm_t ahead = r[0];
+    uint32_t fresh, stood;
+    qnav_ctrl_input_t in = {0};
+    qnav_ctrl_output_t out;
+    in.ranges_mm = r;
+    in.goal_bearing_cdeg = goal_cdeg;
+    in.prev_heading_cdeg = QNAV_BENCH_PREV_CDEG;
+    in.goal_range_mm = 3000u;
+    r[0] = 1u;
+    qnav_avr_timer_start();
+    qnav_ctrl_step(c, &in, &out, 0);
+    fresh = qnav_avr_timer_stop() - overhead;
+    in.escape.stood = 255u;
+    qnav_avr_timer_start();
+    qnav_ctrl_step(c, &in, &out, 0);
+    stood = qnav_avr_timer_stop() - overhead;
+    r[0] = ahead;
+    return stood > fresh ? stood - fresh : 0u;
+}
+
 /* What the escape memory (docs/architecture.md, "Leaving dead ends") adds to a step: the
  * probabilistic policy on every 32-sector scan, the step without a distance (escape off)
  * against the same step while following a boundary (the skirt search every tick) and on
@@ -295,7 +321,7 @@ static void escape_cost(void)
     qnav_ctrl_t *c = qnav_bench_scratch_ctrl();
     qnav_policy_t *p = qnav_bench_scratch_policy();
     qnav_ctrl_config_t cfg;
-    uint32_t follow_max = 0, enter_max = 0, follow_sum = 0;
+    uint32_t follow_max = 0, enter_max = 0, follow_sum = 0, unstand_max = 0;
     uint8_t n = 0;
     uint16_t s;
     qnav_policy_prob_default(p);
@@ -308,7 +334,7 @@ static void escape_cost(void)
         qnav_ctrl_input_t in = {0};
         qnav_ctrl_output_t out;
         uint8_t type, k;
-        uint32_t off, follow, enter;
+        uint32_t off, follow, enter, t;
         if (qnav_bench_load_scan(s, r, &in.goal_bearing_cdeg, &type, &k) != 32u) {
             continue;
         }
@@ -331,6 +357,8 @@ static void escape_cost(void)
         qnav_avr_timer_start();
         qnav_ctrl_step(c, &in, &out, 0);
         enter = qnav_avr_timer_stop() - overhead;
+        t = stood_cost(c, r, in.goal_bearing_cdeg);
+        unstand_max = t > unstand_max ? t : unstand_max;
         follow = follow > off ? follow - off : 0u;
         enter = enter > off ? enter - off : 0u;
         follow_sum += follow;
@@ -346,6 +374,8 @@ static void escape_cost(void)
     qnav_target_put_u32(follow_max);
     PUT(" cycles; the tick a follow begins adds max ");
     qnav_target_put_u32(enter_max);
+    PUT(" cycles; a decision that stood twice the stall time, sent into a free window, max ");
+    qnav_target_put_u32(unstand_max);
     PUT(" cycles; sizeof(qnav_escape_t) ");
     qnav_target_put_u32(sizeof(qnav_escape_t));
     PUT(" bytes\n");

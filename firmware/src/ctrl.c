@@ -521,6 +521,7 @@ static inline void decide(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uint16_t 
         out->quality = 0;
         out->flags = (uint8_t)(flags | QNAV_FLAG_NO_PATH);
         qnav_escape_keep_moving(&ctrl->clr, lvl, &out->escape, goal, out);
+        qnav_escape_unstand(&ctrl->clr, lvl, prev, out);
         qnav_escape_hold_turn(prev, out);
         return;
     }
@@ -540,6 +541,7 @@ static inline void decide(const qnav_ctrl_t *ctrl, const uint8_t *lvl, uint16_t 
     out->quality = quality;
     out->flags = flags;
     qnav_escape_keep_moving(&ctrl->clr, lvl, &out->escape, goal, out);
+    qnav_escape_unstand(&ctrl->clr, lvl, prev, out);
     qnav_escape_hold_turn(prev, out);
 }
 

@@ -279,7 +279,9 @@ void qnav_escape_follow_plan(qnav_escape_t *e, int clear, uint16_t grow_mm)
         return;
     }
     if (clear) {
+        const uint8_t stood = e->stood; /* a new plan does not move the robot */
         qnav_escape_clear(e);
+        e->stood = stood;
     } else {
         qnav_escape_grow(e, grow_mm);
     }
@@ -293,6 +295,7 @@ void qnav_escape_clear(qnav_escape_t *e)
     e->side = 0;
     e->last_side = 0;
     e->tries = 0u;
+    e->stood = 0u;
     e->stall_mm = 0u;
     e->near_mm = 0u;
     e->loop_mm = 0u;
@@ -543,5 +546,91 @@ void qnav_escape_hold_turn(uint16_t prev, qnav_ctrl_output_t *out)
         out->heading_deg = 179;
     } else if (p < 0 && h > 90 && h - p > 180) {
         out->heading_deg = -179;
+    }
+}
+
+/* Half the width of the free window a robot that stood is sent into, degrees: a way at a
+ * free run's very edge is one the robot faces only after a turn its drive may not make
+ * (a degree or two), with the blocked paths beside it straight ahead. */
+#define QNAV_ESCAPE_UNSTAND_HALF_DEG 5
+
+/* The path nearest ref (0..359) whose paths within QNAV_ESCAPE_UNSTAND_HALF_DEG either side
+ * are all free, the lower on a tie, in *path; 0 when no run of free paths is that wide. One
+ * walk round the circle, from a blocked path, run by run. */
+static uint8_t free_window(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t ref,
+                           uint16_t *path)
+{
+    const int16_t h = QNAV_ESCAPE_UNSTAND_HALF_DEG;
+    int16_t from = -1; /* a blocked path to start at */
+    int16_t k;
+    int16_t run = 0;
+    uint16_t best_d = 0xFFFFu;
+    for (k = 0; k < (int16_t)QNAV_PATHS; ++k) {
+        if (blocked(c, lvl, k)) {
+            from = k;
+            break;
+        }
+    }
+    if (from < 0) {
+        *path = ref; /* all free */
+        return 1u;
+    }
+    /* paths from + 1 .. from + 360 (the last is from itself, blocked: it ends the last run) */
+    for (k = 1; k <= (int16_t)QNAV_PATHS; ++k) {
+        if (!blocked(c, lvl, (int16_t)(from + k))) {
+            ++run;
+            continue;
+        }
+        if (run >= 2 * h + 1) {
+            /* candidates: the run's paths at least h inside both its ends */
+            const int16_t lo = (int16_t)(from + k - run + h);
+            const int16_t hi = (int16_t)(from + k - 1 - h);
+            int16_t d_lo = (int16_t)wrap((int16_t)((int16_t)ref - lo)); /* ref above lo by */
+            int16_t p;
+            uint16_t d;
+            if (d_lo <= hi - lo) {
+                p = (int16_t)(lo + d_lo); /* ref inside the candidates */
+            } else {
+                /* outside: the nearer of the two ends */
+                const uint16_t to_lo = (uint16_t)(360 - d_lo);
+                const uint16_t to_hi = (uint16_t)(d_lo - (hi - lo));
+                p = to_lo <= to_hi ? lo : hi;
+            }
+            d = qnav_angle_dist_deg(wrap(p), ref);
+            if (d < best_d) {
+                best_d = d;
+                *path = wrap(p);
+            }
+        }
+        run = 0;
+    }
+    return (uint8_t)(best_d != 0xFFFFu);
+}
+
+void qnav_escape_stood(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t prev,
+                       qnav_ctrl_output_t *out)
+{
+    qnav_escape_t *e = &out->escape;
+    uint16_t path;
+    qnav_q1_15_t cap;
+    if (e->stood < 255u) {
+        ++e->stood;
+    }
+    if (c->esc_stall_ticks == 0u || e->stood <= 2u * (uint16_t)c->esc_stall_ticks) {
+        /* the escape's own stall (after one stall time) acts first */
+        return;
+    }
+    /* stood a stall's time: the way in the middle of a free window nearest the last
+     * decision (the robot turns on toward one way: a new one each tick kept it turning to
+     * and fro); none: stand (it turns in place) */
+    if (!free_window(c, lvl, prev, &path)) {
+        return;
+    }
+    out->heading_deg = qnav_signed_deg(path);
+    out->flags = (uint8_t)(out->flags & (uint8_t)~QNAV_FLAG_NO_PATH);
+    cap = qnav_clearance_turn_cap(c, lvl, path);
+    out->speed = QNAV_ESCAPE_CRAWL < cap ? QNAV_ESCAPE_CRAWL : cap; /* 0 until it faces it */
+    if (out->quality < out->speed) {
+        out->quality = out->speed;
     }
 }

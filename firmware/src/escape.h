@@ -19,7 +19,7 @@
  * space on its other hand, is given up for the other side, each try twice as long or far. While following, a step whose policy would stand still crawls along the
  * boundary or turns in place, so no policy freezes.
  *
- * The memory (qnav_escape_t, 23 bytes) is the caller's: it comes in with the step's input
+ * The memory (qnav_escape_t, 24 bytes) is the caller's: it comes in with the step's input
  * and goes out with its output; the step itself keeps nothing.
  */
 #ifndef QNAV_ESCAPE_H
@@ -61,5 +61,31 @@ void qnav_escape_keep_moving(const qnav_clearance_t *c, const uint8_t *lvl,
  * turns, can be sent left and right on alternate ticks and stand where it is.
  */
 void qnav_escape_hold_turn(uint16_t prev, qnav_ctrl_output_t *out);
+
+/*
+ * A robot that stands does not stand for ever. A decision whose speed is 0 counts a tick in
+ * out->escape.stood; a moving one halves it, so that a robot that drives clears it within
+ * a few ticks and one that twitches now and then does not. Past twice escape_stall_ticks
+ * (the escape's own stall acts after one; a stand lasts past two when a map's plans keep
+ * clearing the escape memory or a follow turns in place: whatever
+ * a map's plans did meanwhile, they do not move the robot) the decision becomes the middle
+ * of a free window: the path nearest the last decision (prev, whole degrees 0..359 in this
+ * tick's frame, so that the robot turns on toward one way) with every path within 5
+ * degrees either side free; at a crawl once the robot faces it and straight ahead is clear,
+ * turning in place until then. Without such a window the robot turns in place as decided.
+ * Called after every other rule of the decision but the turn's way round
+ * (qnav_escape_hold_turn).
+ */
+void qnav_escape_stood(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t prev,
+                       qnav_ctrl_output_t *out);
+static inline void qnav_escape_unstand(const qnav_clearance_t *c, const uint8_t *lvl,
+                                       uint16_t prev, qnav_ctrl_output_t *out)
+{
+    if (out->speed != 0) {
+        out->escape.stood = (uint8_t)(out->escape.stood >> 1); /* a twitch is no drive */
+    } else {
+        qnav_escape_stood(c, lvl, prev, out); /* the rare case, out of line */
+    }
+}
 
 #endif /* QNAV_ESCAPE_H */

@@ -264,6 +264,7 @@ void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ct
         stop(out, (uint8_t)(flags | QNAV_FLAG_NO_PATH));
         out->escape = esc;
         qnav_escape_keep_moving(&vfh->clr, lvl, &esc, goal, out);
+        qnav_escape_unstand(&vfh->clr, lvl, qnav_whole_deg(in->prev_heading_cdeg), out);
         qnav_escape_hold_turn(qnav_whole_deg(in->prev_heading_cdeg), out);
         return;
     }
@@ -294,5 +295,6 @@ void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ct
     out->flags = flags;
     out->escape = esc;
     qnav_escape_keep_moving(&vfh->clr, lvl, &esc, goal, out);
+    qnav_escape_unstand(&vfh->clr, lvl, qnav_whole_deg(in->prev_heading_cdeg), out);
     qnav_escape_hold_turn(qnav_whole_deg(in->prev_heading_cdeg), out);
 }

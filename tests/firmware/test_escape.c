@@ -707,6 +707,65 @@ static void test_a_follow_goes_at_its_speed_cap(void **state)
     }
 }
 
+/* A robot that stands does not stand for ever, whatever a map's plans do. A wall so near
+ * ahead that no decision may move (the speed cap of straight ahead is 0), and a plan that
+ * jumps every 5 ticks (qnav_escape_follow_plan clears the memory: no stall ever builds up,
+ * no follow starts): the decisions count the ticks they stand, and past twice the stall
+ * time the decision is the middle of a free window (every path within 5 degrees either side free)
+ * and stays there while the robot turns toward it. A decision that moves halves the count. */
+static void test_a_robot_that_stands_turns_to_a_free_window(void **state)
+{
+    bot_t b;
+    qnav_ctrl_input_t fresh;
+    qnav_ctrl_output_t decided;
+    uint8_t lvl[QNAV_PATHS];
+    int16_t first = 0;
+    unsigned t;
+    (void)state;
+    qnav_policy_prob_default(&b.p);
+    facing_wall(&b, 20, 120, 3000);
+    (void)qnav_ctrl_path_levels(&b.c, b.r, lvl);
+    assert_int_equal(qnav_clearance_turn_cap(&b.c.clr, lvl, 90), 0);
+    for (t = 1; t <= 60; ++t) {
+        if (t % 5 == 0) {
+            qnav_escape_follow_plan(&b.in.escape, 1, 0);
+        }
+        fresh = b.in; /* the same tick by a robot that has not stood */
+        fresh.escape.stood = 0u;
+        qnav_ctrl_step(&b.c, &fresh, &decided, NULL);
+        tick(&b.c, &b.in, &b.out);
+        assert_int_equal(b.out.escape.side, 0);
+        assert_int_equal(b.out.speed, 0);
+        assert_int_equal(b.out.escape.stood, t);
+        if (t <= 40u) {
+            assert_int_equal(b.out.heading_deg, decided.heading_deg); /* as decided */
+        } else {
+            const int16_t h = b.out.heading_deg;
+            const uint16_t p = (uint16_t)(h < 0 ? h + QNAV_PATHS : h);
+            int k;
+            for (k = -5; k <= 5; ++k) {
+                assert_true(lvl[(p + QNAV_PATHS + (uint16_t)(k + 5) - 5u) % QNAV_PATHS] >=
+                            b.c.clr.esc_free_level);
+            }
+            if (t == 41u) {
+                first = h;
+            }
+            assert_int_equal(h, first); /* one way, not a new one each tick */
+        }
+    }
+    for (t = 0; t < N; ++t) {
+        b.r[t] = MAX_MM; /* it has turned and faces open space: it drives */
+    }
+    tick(&b.c, &b.in, &b.out);
+    assert_true(b.out.speed > 0);
+    assert_int_equal(b.out.escape.stood, 30);
+    tick(&b.c, &b.in, &b.out);
+    assert_int_equal(b.out.escape.stood, 15);
+    /* the memory's own clear (a new destination) forgets it */
+    qnav_escape_clear(&b.out.escape);
+    assert_int_equal(b.out.escape.stood, 0);
+}
+
 /* Without a distance to the destination (0) there is no escape, and the memory stays 0. */
 static void test_no_range_no_escape(void **state)
 {
@@ -740,6 +799,7 @@ int main(void)
         cmocka_unit_test(test_a_new_obstacle_chooses_its_side_afresh),
         cmocka_unit_test(test_a_policy_of_zeros_does_not_freeze),
         cmocka_unit_test(test_a_follow_goes_at_its_speed_cap),
+        cmocka_unit_test(test_a_robot_that_stands_turns_to_a_free_window),
         cmocka_unit_test(test_no_range_no_escape),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
