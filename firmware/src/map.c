@@ -783,8 +783,9 @@ static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav
 /* What sector k's reading does to a cell d2 (squared mm) from the robot's centre, as
  * observe_wedges' tests decide it: the cell is seen clear when d2 < clear_below, else it
  * may take an arc's evidence when arc_from <= d2 <= arc_to (none when arc_from > arc_to)
- * and on_arc() holds. The squares are those observe_wedges compares, or UINT32_MAX / 0
- * where it decides by the distance alone (a d2 within reach is below 2^32 - 1). */
+ * and on_arc() holds for r (of which only rc and centre are set). The squares are those
+ * observe_wedges compares, or UINT32_MAX / 0 where it decides by the distance alone (a d2
+ * within reach is below 2^32 - 1). */
 typedef struct {
     uint32_t clear_below, arc_from, arc_to;
     reading_t r;
@@ -792,35 +793,53 @@ typedef struct {
 
 #define RULES_MAX 64u
 
+/* read_sector()'s reading of sector k as a rule. */
 static void rule_of(const qnav_map_t *m, const qnav_mm_t *ranges_mm, uint16_t k,
                     int32_t three_quarters, int32_t band_pct, int32_t mark_reach, int32_t reach,
                     wedge_rule_t *w)
 {
-    int32_t top;
-    read_sector(m, ranges_mm, k, three_quarters, band_pct, mark_reach, &w->r);
+    const int32_t rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
+    int32_t lo, band, top;
     w->arc_from = UINT32_MAX;
     w->arc_to = 0u;
     if (ranges_mm[k] >= m->max_range_mm) {
         w->clear_below = UINT32_MAX; /* nothing in the wedge: free out to the reach */
         return;
     }
-    w->clear_below = w->r.lo <= 0 ? 0u
-                     : w->r.lo > reach ? UINT32_MAX
-                                       : (uint32_t)w->r.lo * (uint32_t)w->r.lo;
-    if (!w->r.marks || w->r.band > reach) {
+    lo = rc - three_quarters - rc * (int32_t)m->cfg.noise_pct / 100;
+    band = rc - three_quarters - rc * band_pct / 100;
+    w->clear_below = lo <= 0 ? 0u : lo > reach ? UINT32_MAX : (uint32_t)lo * (uint32_t)lo;
+    if (rc > mark_reach || band > reach || !may_mark(m, ranges_mm, k, rc)) {
         return;
     }
-    top = w->r.rc + three_quarters;
+    top = rc + three_quarters;
     w->arc_to = top > reach ? UINT32_MAX : (uint32_t)top * (uint32_t)top;
-    w->arc_from = w->r.band <= 0 ? 0u : (uint32_t)w->r.band * (uint32_t)w->r.band;
+    w->arc_from = band <= 0 ? 0u : (uint32_t)band * (uint32_t)band;
+    w->r.rc = rc;
+    w->r.centre = (int32_t)((uint32_t)k * 36000u / m->n_sectors);
 }
 
-/* observe_wedges() with the same marks, on hosts: each row's cells within reach found at
- * its ends, the unsettled ones among them taken by their set bits, and every sector's tests
- * worked out once a scan (a row's cells change sector every cell or two). */
+/* direction_cdeg()'s octants, o = (y < 0) * 4 + (x < 0) * 2 + (|y| > |x|): the direction is
+ * OCTANT_AT[o] + OCTANT_TURN[o] * a modulo 36 000, a = the octant's own angle (0..4500). */
+static const int32_t OCTANT_AT[8] = {0, 9000, 18000, 9000, 0, 27000, 18000, 27000};
+static const int32_t OCTANT_TURN[8] = {1, -1, -1, 1, -1, 1, 1, -1};
+
+/* A cell dx (mm) across from the robot is within reach on a row that leaves rem (mm^2). */
+static int in_reach(int32_t dx, uint32_t rem)
+{
+    const uint32_t a = (uint32_t)(dx < 0 ? -dx : dx);
+    return a * a <= rem;
+}
+
+/* observe_wedges() with the same marks, on hosts: each row's cells within reach found from
+ * the last row's, the unsettled ones among them taken by their set bits, every sector's
+ * tests worked out once a scan (a row's cells change sector every cell or two), and a
+ * cell's direction less the heading (direction_cdeg()'s) from its octant's start less the
+ * heading, worked out once a scan. */
 static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
 {
-    int32_t i0, i1, j0, j1, j, reach, mark_reach, three_quarters, heading, arc_half, band_pct;
+    int32_t i0, i1, j0, j1, j, ia, ib, reach, mark_reach, three_quarters, heading, arc_half, band_pct;
+    int32_t from[8]; /* OCTANT_AT less the heading, 0..35999 */
     uint32_t reach2;
     const int32_t cell = (int32_t)m->cfg.cell_mm;
     const uint32_t width_k = (uint32_t)m->cfg.arc_width_mm * CDEG_PER_RAD_HALF; /* < 2^28 */
@@ -849,31 +868,55 @@ static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_m
     for (k = 0; k < m->n_sectors; ++k) {
         rule_of(m, ranges_mm, k, three_quarters, band_pct, mark_reach, reach, &rules[k]);
     }
+    for (k = 0; k < 8u; ++k) { /* heading in [-18000, 18000) */
+        const int32_t f = OCTANT_AT[k] - heading;
+        from[k] = f < 0 ? f + INT32_C(36000) : (f >= INT32_C(36000) ? f - INT32_C(36000) : f);
+    }
     cell_of(m, pose->x_mm - reach, pose->y_mm - reach, &i0, &j0);
     cell_of(m, pose->x_mm + reach, pose->y_mm + reach, &i1, &j1);
+    ia = i0;
+    ib = i1;
     for (j = j0; j <= j1; ++j) {
         const int32_t dy = centre_y(m, j) - pose->y_mm;
         const uint32_t ady = (uint32_t)(dy < 0 ? -dy : dy), dy2 = ady * ady;
         const int32_t dx0 = centre_x(m, i0) - pose->x_mm; /* cell i0's */
-        int32_t ia = i0, ib = i1, b;
+        const int32_t *row_from = dy < 0 ? from + 4 : from;
+        const int32_t *row_turn = dy < 0 ? OCTANT_TURN + 4 : OCTANT_TURN;
+        int32_t b;
         uint32_t rem;
         if (dy2 > reach2) {
             continue;
         }
-        rem = reach2 - dy2; /* a cell is within reach when dx^2 <= rem: an interval of i */
-        for (;; ++ia) {
-            const int32_t dx = dx0 + (ia - i0) * cell;
-            if (ia > ib || (uint32_t)(dx < 0 ? -dx : dx) * (uint32_t)(dx < 0 ? -dx : dx) <= rem) {
-                break;
+        /* a cell is within reach when dx^2 <= rem: an interval of i, moved from the last
+         * row's (or from i0 .. i1) to this row's ends */
+        rem = reach2 - dy2;
+        if (ia > ib) { /* the last row had none: from this row's cell nearest the robot */
+            ia = ib = dx0 >= 0 ? i0 : (-dx0 / cell > i1 - i0 ? i1 : i0 + -dx0 / cell);
+        }
+        if (in_reach(dx0 + (ia - i0) * cell, rem)) {
+            while (ia > i0 && in_reach(dx0 + (ia - 1 - i0) * cell, rem)) {
+                --ia;
+            }
+        } else {
+            while (ia <= i1 && !in_reach(dx0 + (ia - i0) * cell, rem)) {
+                ++ia;
             }
         }
-        for (; ib >= ia; --ib) {
-            const int32_t dx = dx0 + (ib - i0) * cell;
-            if ((uint32_t)(dx < 0 ? -dx : dx) * (uint32_t)(dx < 0 ? -dx : dx) <= rem) {
-                break;
+        if (ia > i1) {
+            ib = ia - 1; /* none */
+        } else {
+            ib = ib < ia ? ia : ib;
+            if (in_reach(dx0 + (ib - i0) * cell, rem)) {
+                while (ib < i1 && in_reach(dx0 + (ib + 1 - i0) * cell, rem)) {
+                    ++ib;
+                }
+            } else {
+                while (!in_reach(dx0 + (ib - i0) * cell, rem)) { /* ends at latest at ia */
+                    --ib;
+                }
             }
         }
-        for (b = ia >> 3; ia <= ib && b <= ib >> 3; ++b) {
+        for (b = ia >> 3; b <= ib >> 3 && ia <= ib; ++b) {
             uint8_t arcs, todo = unsettled(m, b, j, &arcs);
             if (b == ia >> 3) {
                 todo = (uint8_t)(todo & (0xFFu << (ia & 7)));
@@ -886,13 +929,18 @@ static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_m
                 const int32_t i = b * 8 + (int32_t)bit;
                 const int32_t dx = dx0 + (i - i0) * cell;
                 const uint32_t adx = (uint32_t)(dx < 0 ? -dx : dx), d2 = adx * adx + dy2;
+                const unsigned o = (dx < 0 ? 2u : 0u) | (ady > adx ? 1u : 0u);
+                const uint32_t hi = ady > adx ? ady : adx, lo = ady > adx ? adx : ady;
                 const wedge_rule_t *w;
+                uint32_t t, a;
                 int32_t rel;
                 todo = (uint8_t)(todo & (todo - 1u));
                 if (d2 == 0u) {
                     continue;
                 }
-                rel = direction_cdeg(dx, dy) - heading;
+                t = (lo << 15) / hi;                                        /* direction_cdeg's */
+                a = (4500u * t + ((1564u * t) >> 15) * (32768u - t)) >> 15; /* 0..4500 */
+                rel = row_from[o] + row_turn[o] * (int32_t)a;
                 rel += rel < 0 ? INT32_C(36000) : (rel >= INT32_C(36000) ? -INT32_C(36000) : 0);
                 w = &rules[sector_of(m, rel)];
                 if (d2 < w->clear_below) {
