@@ -21,6 +21,7 @@
 #include "escape.h"
 #include "map_align.h"
 #include "map_compact.h"
+#include "map_plain.h"
 #include "qnav/trig.h"
 
 #define EVIDENCE_FREE_MIN QNAV_MAP_FREE_FLOOR
@@ -618,10 +619,14 @@ static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav
     defined(__GNUC__)
 #define HOST_MARK 1
 static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at);
-#define OBSERVE observe_fast
+#define OBSERVE(m, r, at, plain) ((plain) ? observe_wedges(m, r, at) : observe_fast(m, r, at))
+#define PLAIN_PARAM , int plain
+#define PLAIN_ARG(p) , (p)
 #else
 #define HOST_MARK 0
-#define OBSERVE observe_wedges
+#define OBSERVE(m, r, at, plain) observe_wedges(m, r, at)
+#define PLAIN_PARAM
+#define PLAIN_ARG(p)
 #endif
 
 /* The scan's scan_sectors readings as the map's n_sectors wedges (fewer): wedge w, centred
@@ -635,7 +640,8 @@ static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_m
 #if defined(__AVR__)
 __attribute__((noinline))
 #endif
-static void observe_grouped(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
+static void observe_grouped(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at
+                            PLAIN_PARAM)
 {
     qnav_mm_t wedge[QNAV_MAP_WEDGES_MAX];
     /* 16-bit throughout: n <= 360 and g <= 32, so a turn is at most 11 520 units */
@@ -659,7 +665,7 @@ static void observe_grouped(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qna
             }
         }
     }
-    OBSERVE(m, wedge, at);
+    OBSERVE(m, wedge, at, plain);
 }
 
 void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
@@ -668,11 +674,25 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
         return;
     }
     if (m->scan_sectors > m->n_sectors) {
-        observe_grouped(m, ranges_mm, at);
+        observe_grouped(m, ranges_mm, at PLAIN_ARG(0));
         return;
     }
-    OBSERVE(m, ranges_mm, at);
+    OBSERVE(m, ranges_mm, at, 0);
 }
+
+#if HOST_MARK
+void qnav_map_observe_plain(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
+{
+    if (!ready(m) || ranges_mm == NULL || at == NULL) {
+        return;
+    }
+    if (m->scan_sectors > m->n_sectors) {
+        observe_grouped(m, ranges_mm, at, 1);
+        return;
+    }
+    observe_wedges(m, ranges_mm, at);
+}
+#endif
 
 /* Which of cells 8b .. 8b + 7 of row j a reading may change, cell 8b + k in bit k (the
  * bits of cells past the row's end say nothing): not free at its floor, nor refused.
