@@ -851,19 +851,110 @@ static int in_reach(int32_t dx, uint32_t rem)
     return a * a <= rem;
 }
 
+/* A row's cells i0 .. i1 within reach, *ia .. *ib (none: *ia > *ib), moved there from the
+ * last row's (or from i0 .. i1). Cell i lies dx0 + (i - i0) * cell across from the robot
+ * and is within reach when dx^2 <= rem: every row's cells within reach are those whose
+ * |dx| is at most a bound, intervals about one column that hold each other. */
+static void row_ends(int32_t dx0, int32_t cell, uint32_t rem, int32_t i0, int32_t i1, int32_t *ia,
+                     int32_t *ib)
+{
+    int32_t a = *ia, b = *ib;
+    if (a > b) { /* the last row had none: from this row's cell nearest the robot */
+        a = b = dx0 >= 0 ? i0 : (-dx0 / cell > i1 - i0 ? i1 : i0 + -dx0 / cell);
+    }
+    if (in_reach(dx0 + (a - i0) * cell, rem)) {
+        while (a > i0 && in_reach(dx0 + (a - 1 - i0) * cell, rem)) {
+            --a;
+        }
+    } else {
+        while (a <= i1 && !in_reach(dx0 + (a - i0) * cell, rem)) {
+            ++a;
+        }
+    }
+    if (a > i1) {
+        b = a - 1; /* none */
+    } else {
+        b = b < a ? a : b;
+        if (in_reach(dx0 + (b - i0) * cell, rem)) {
+            while (b < i1 && in_reach(dx0 + (b + 1 - i0) * cell, rem)) {
+                ++b;
+            }
+        } else {
+            while (!in_reach(dx0 + (b - i0) * cell, rem)) { /* ends at latest at a */
+                --b;
+            }
+        }
+    }
+    *ia = a;
+    *ib = b;
+}
+
+/* What observe_fast works out once a scan. */
+typedef struct {
+    wedge_rule_t rules[RULES_MAX];
+    int32_t from[8]; /* OCTANT_AT less the heading, 0..35999 */
+    int32_t arc_half;
+    uint32_t width_k;
+} scan_rules_t;
+
+/* Row j's unsettled cells ia .. ib marked: cell i lies dx0 + (i - i0) * cell across from
+ * the robot and dy along, dy2 = dy^2. */
+static void mark_row(qnav_map_t *m, const scan_rules_t *s, int32_t j, int32_t dy, uint32_t dy2,
+                     int32_t dx0, int32_t i0, int32_t ia, int32_t ib)
+{
+    const int32_t cell = (int32_t)m->cfg.cell_mm;
+    const uint32_t ady = (uint32_t)(dy < 0 ? -dy : dy);
+    const int32_t *row_from = dy < 0 ? s->from + 4 : s->from;
+    const int32_t *row_turn = dy < 0 ? OCTANT_TURN + 4 : OCTANT_TURN;
+    int32_t b;
+    for (b = ia >> 3; b <= ib >> 3 && ia <= ib; ++b) {
+        uint8_t arcs, todo = unsettled(m, b, j, &arcs);
+        if (b == ia >> 3) {
+            todo = (uint8_t)(todo & (0xFFu << (ia & 7)));
+        }
+        if (b == ib >> 3) {
+            todo = (uint8_t)(todo & (0xFFu >> (7 - (ib & 7))));
+        }
+        while (todo != 0u) {
+            const unsigned bit = (unsigned)__builtin_ctz(todo);
+            const int32_t i = b * 8 + (int32_t)bit;
+            const int32_t dx = dx0 + (i - i0) * cell;
+            const uint32_t adx = (uint32_t)(dx < 0 ? -dx : dx), d2 = adx * adx + dy2;
+            const unsigned o = (dx < 0 ? 2u : 0u) | (ady > adx ? 1u : 0u);
+            const uint32_t hi = ady > adx ? ady : adx, lo = ady > adx ? adx : ady;
+            const wedge_rule_t *w;
+            uint32_t t, a;
+            int32_t rel;
+            todo = (uint8_t)(todo & (todo - 1u));
+            if (d2 == 0u) {
+                continue;
+            }
+            t = (lo << 15) / hi;                                        /* direction_cdeg's */
+            a = (4500u * t + ((1564u * t) >> 15) * (32768u - t)) >> 15; /* 0..4500 */
+            rel = row_from[o] + row_turn[o] * (int32_t)a;
+            rel += rel < 0 ? INT32_C(36000) : (rel >= INT32_C(36000) ? -INT32_C(36000) : 0);
+            w = &s->rules[sector_of(m, rel)];
+            if (d2 < w->clear_below) {
+                mark_clear(m, i, j);
+            } else if ((arcs >> bit & 1u) != 0u && d2 >= w->arc_from && d2 <= w->arc_to &&
+                       on_arc(off_centre(rel, w->r.centre), &w->r, s->arc_half, s->width_k)) {
+                mark_arc(m, i, j);
+            }
+        }
+    }
+}
+
 /* observe_wedges() with the same marks, on hosts: each row's cells within reach found from
- * the last row's, the unsettled ones among them taken by their set bits, every sector's
- * tests worked out once a scan (a row's cells change sector every cell or two), and a
- * cell's direction less the heading (direction_cdeg()'s) from its octant's start less the
- * heading, worked out once a scan. */
+ * the last row's (row_ends), the unsettled ones among them taken by their set bits, every
+ * sector's tests worked out once a scan (a row's cells change sector every cell or two),
+ * and a cell's direction less the heading (direction_cdeg()'s) from its octant's start
+ * less the heading, worked out once a scan. */
 static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
 {
-    int32_t i0, i1, j0, j1, j, ia, ib, reach, mark_reach, three_quarters, heading, arc_half, band_pct;
-    int32_t from[8]; /* OCTANT_AT less the heading, 0..35999 */
+    int32_t i0, i1, j0, j1, j, ia, ib, reach, mark_reach, three_quarters, heading, band_pct;
     uint32_t reach2;
     const int32_t cell = (int32_t)m->cfg.cell_mm;
-    const uint32_t width_k = (uint32_t)m->cfg.arc_width_mm * CDEG_PER_RAD_HALF; /* < 2^28 */
-    wedge_rule_t rules[RULES_MAX];
+    scan_rules_t s;
     qnav_map_pose_t in_grid;
     const qnav_map_pose_t *pose = &in_grid;
     uint16_t k;
@@ -881,16 +972,17 @@ static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_m
     mark_reach = marks_within(m);
     band_pct = m->cfg.noise_pct < OCCUPIED_BAND_PCT ? (int32_t)m->cfg.noise_pct : OCCUPIED_BAND_PCT;
     heading = qnav_wrap_cdeg(pose->heading_cdeg);
-    arc_half = INT32_C(18000) / (int32_t)m->n_sectors;
-    if ((int32_t)m->cfg.arc_cdeg / 2 < arc_half) {
-        arc_half = (int32_t)m->cfg.arc_cdeg / 2;
+    s.width_k = (uint32_t)m->cfg.arc_width_mm * CDEG_PER_RAD_HALF; /* < 2^28 */
+    s.arc_half = INT32_C(18000) / (int32_t)m->n_sectors;
+    if ((int32_t)m->cfg.arc_cdeg / 2 < s.arc_half) {
+        s.arc_half = (int32_t)m->cfg.arc_cdeg / 2;
     }
     for (k = 0; k < m->n_sectors; ++k) {
-        rule_of(m, ranges_mm, k, three_quarters, band_pct, mark_reach, reach, &rules[k]);
+        rule_of(m, ranges_mm, k, three_quarters, band_pct, mark_reach, reach, &s.rules[k]);
     }
     for (k = 0; k < 8u; ++k) { /* heading in [-18000, 18000) */
         const int32_t f = OCTANT_AT[k] - heading;
-        from[k] = f < 0 ? f + INT32_C(36000) : (f >= INT32_C(36000) ? f - INT32_C(36000) : f);
+        s.from[k] = f < 0 ? f + INT32_C(36000) : (f >= INT32_C(36000) ? f - INT32_C(36000) : f);
     }
     cell_of(m, pose->x_mm - reach, pose->y_mm - reach, &i0, &j0);
     cell_of(m, pose->x_mm + reach, pose->y_mm + reach, &i1, &j1);
@@ -900,77 +992,11 @@ static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_m
         const int32_t dy = centre_y(m, j) - pose->y_mm;
         const uint32_t ady = (uint32_t)(dy < 0 ? -dy : dy), dy2 = ady * ady;
         const int32_t dx0 = centre_x(m, i0) - pose->x_mm; /* cell i0's */
-        const int32_t *row_from = dy < 0 ? from + 4 : from;
-        const int32_t *row_turn = dy < 0 ? OCTANT_TURN + 4 : OCTANT_TURN;
-        int32_t b;
-        uint32_t rem;
         if (dy2 > reach2) {
             continue;
         }
-        /* a cell is within reach when dx^2 <= rem: an interval of i, moved from the last
-         * row's (or from i0 .. i1) to this row's ends */
-        rem = reach2 - dy2;
-        if (ia > ib) { /* the last row had none: from this row's cell nearest the robot */
-            ia = ib = dx0 >= 0 ? i0 : (-dx0 / cell > i1 - i0 ? i1 : i0 + -dx0 / cell);
-        }
-        if (in_reach(dx0 + (ia - i0) * cell, rem)) {
-            while (ia > i0 && in_reach(dx0 + (ia - 1 - i0) * cell, rem)) {
-                --ia;
-            }
-        } else {
-            while (ia <= i1 && !in_reach(dx0 + (ia - i0) * cell, rem)) {
-                ++ia;
-            }
-        }
-        if (ia > i1) {
-            ib = ia - 1; /* none */
-        } else {
-            ib = ib < ia ? ia : ib;
-            if (in_reach(dx0 + (ib - i0) * cell, rem)) {
-                while (ib < i1 && in_reach(dx0 + (ib + 1 - i0) * cell, rem)) {
-                    ++ib;
-                }
-            } else {
-                while (!in_reach(dx0 + (ib - i0) * cell, rem)) { /* ends at latest at ia */
-                    --ib;
-                }
-            }
-        }
-        for (b = ia >> 3; b <= ib >> 3 && ia <= ib; ++b) {
-            uint8_t arcs, todo = unsettled(m, b, j, &arcs);
-            if (b == ia >> 3) {
-                todo = (uint8_t)(todo & (0xFFu << (ia & 7)));
-            }
-            if (b == ib >> 3) {
-                todo = (uint8_t)(todo & (0xFFu >> (7 - (ib & 7))));
-            }
-            while (todo != 0u) {
-                const unsigned bit = (unsigned)__builtin_ctz(todo);
-                const int32_t i = b * 8 + (int32_t)bit;
-                const int32_t dx = dx0 + (i - i0) * cell;
-                const uint32_t adx = (uint32_t)(dx < 0 ? -dx : dx), d2 = adx * adx + dy2;
-                const unsigned o = (dx < 0 ? 2u : 0u) | (ady > adx ? 1u : 0u);
-                const uint32_t hi = ady > adx ? ady : adx, lo = ady > adx ? adx : ady;
-                const wedge_rule_t *w;
-                uint32_t t, a;
-                int32_t rel;
-                todo = (uint8_t)(todo & (todo - 1u));
-                if (d2 == 0u) {
-                    continue;
-                }
-                t = (lo << 15) / hi;                                        /* direction_cdeg's */
-                a = (4500u * t + ((1564u * t) >> 15) * (32768u - t)) >> 15; /* 0..4500 */
-                rel = row_from[o] + row_turn[o] * (int32_t)a;
-                rel += rel < 0 ? INT32_C(36000) : (rel >= INT32_C(36000) ? -INT32_C(36000) : 0);
-                w = &rules[sector_of(m, rel)];
-                if (d2 < w->clear_below) {
-                    mark_clear(m, i, j);
-                } else if ((arcs >> bit & 1u) != 0u && d2 >= w->arc_from && d2 <= w->arc_to &&
-                           on_arc(off_centre(rel, w->r.centre), &w->r, arc_half, width_k)) {
-                    mark_arc(m, i, j);
-                }
-            }
-        }
+        row_ends(dx0, cell, reach2 - dy2, i0, i1, &ia, &ib);
+        mark_row(m, &s, j, dy, dy2, dx0, i0, ia, ib);
     }
 }
 #endif
