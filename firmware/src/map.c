@@ -936,7 +936,7 @@ static void mark_row(qnav_map_t *m, const scan_rules_t *s, int32_t j, int32_t dy
             w = &s->rules[sector_of(m, rel)];
             if (d2 < w->clear_below) {
                 mark_clear(m, i, j);
-            } else if ((arcs >> bit & 1u) != 0u && d2 >= w->arc_from && d2 <= w->arc_to &&
+            } else if (((unsigned)arcs >> bit & 1u) != 0u && d2 >= w->arc_from && d2 <= w->arc_to &&
                        on_arc(off_centre(rel, w->r.centre), &w->r, s->arc_half, s->width_k)) {
                 mark_arc(m, i, j);
             }
