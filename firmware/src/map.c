@@ -21,6 +21,7 @@
 #include "escape.h"
 #include "map_align.h"
 #include "map_compact.h"
+#include "map_plain.h"
 #include "qnav/trig.h"
 
 #define EVIDENCE_FREE_MIN QNAV_MAP_FREE_FLOOR
@@ -612,6 +613,22 @@ static void read_sector(const qnav_map_t *m, const qnav_mm_t *ranges_mm, uint16_
 
 static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at);
 
+/* On hosts the marking takes a shorter way to the same marks (observe_fast); the ATmega128
+ * and the Cortex-M4 keep observe_wedges, whose stack and cycles their benches measure. */
+#if !defined(__AVR__) && !(defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M') &&          \
+    defined(__GNUC__)
+#define HOST_MARK 1
+static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at);
+#define OBSERVE(m, r, at, plain) ((plain) ? observe_wedges(m, r, at) : observe_fast(m, r, at))
+#define PLAIN_PARAM , int plain
+#define PLAIN_ARG(p) , (p)
+#else
+#define HOST_MARK 0
+#define OBSERVE(m, r, at, plain) observe_wedges(m, r, at)
+#define PLAIN_PARAM
+#define PLAIN_ARG(p)
+#endif
+
 /* The scan's scan_sectors readings as the map's n_sectors wedges (fewer): wedge w, centred
  * on w * 360 / n_sectors degrees, takes the least reading of the sectors whose centres lie
  * within half a wedge of its centre, a sector on the boundary in both. A wedge narrower
@@ -623,7 +640,8 @@ static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav
 #if defined(__AVR__)
 __attribute__((noinline))
 #endif
-static void observe_grouped(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
+static void observe_grouped(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at
+                            PLAIN_PARAM)
 {
     qnav_mm_t wedge[QNAV_MAP_WEDGES_MAX];
     /* 16-bit throughout: n <= 360 and g <= 32, so a turn is at most 11 520 units */
@@ -647,7 +665,7 @@ static void observe_grouped(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qna
             }
         }
     }
-    observe_wedges(m, wedge, at);
+    OBSERVE(m, wedge, at, plain);
 }
 
 void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
@@ -656,11 +674,25 @@ void qnav_map_observe(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_
         return;
     }
     if (m->scan_sectors > m->n_sectors) {
-        observe_grouped(m, ranges_mm, at);
+        observe_grouped(m, ranges_mm, at PLAIN_ARG(0));
+        return;
+    }
+    OBSERVE(m, ranges_mm, at, 0);
+}
+
+#if HOST_MARK
+void qnav_map_observe_plain(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
+{
+    if (!ready(m) || ranges_mm == NULL || at == NULL) {
+        return;
+    }
+    if (m->scan_sectors > m->n_sectors) {
+        observe_grouped(m, ranges_mm, at, 1);
         return;
     }
     observe_wedges(m, ranges_mm, at);
 }
+#endif
 
 /* Which of cells 8b .. 8b + 7 of row j a reading may change, cell 8b + k in bit k (the
  * bits of cells past the row's end say nothing): not free at its floor, nor refused.
@@ -766,6 +798,208 @@ static void observe_wedges(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav
         }
     }
 }
+
+#if HOST_MARK
+/* What sector k's reading does to a cell d2 (squared mm) from the robot's centre, as
+ * observe_wedges' tests decide it: the cell is seen clear when d2 < clear_below, else it
+ * may take an arc's evidence when arc_from <= d2 <= arc_to (none when arc_from > arc_to)
+ * and on_arc() holds for r (of which only rc and centre are set). The squares are those
+ * observe_wedges compares, or UINT32_MAX / 0 where it decides by the distance alone (a d2
+ * within reach is below 2^32 - 1). */
+typedef struct {
+    uint32_t clear_below, arc_from, arc_to;
+    reading_t r;
+} wedge_rule_t;
+
+#define RULES_MAX 64u
+
+/* read_sector()'s reading of sector k as a rule. */
+static void rule_of(const qnav_map_t *m, const qnav_mm_t *ranges_mm, uint16_t k,
+                    int32_t three_quarters, int32_t band_pct, int32_t mark_reach, int32_t reach,
+                    wedge_rule_t *w)
+{
+    const int32_t rc = (int32_t)ranges_mm[k] + (int32_t)m->offset_mm;
+    int32_t lo, band, top;
+    w->arc_from = UINT32_MAX;
+    w->arc_to = 0u;
+    if (ranges_mm[k] >= m->max_range_mm) {
+        w->clear_below = UINT32_MAX; /* nothing in the wedge: free out to the reach */
+        return;
+    }
+    lo = rc - three_quarters - rc * (int32_t)m->cfg.noise_pct / 100;
+    band = rc - three_quarters - rc * band_pct / 100;
+    w->clear_below = lo <= 0 ? 0u : lo > reach ? UINT32_MAX : (uint32_t)lo * (uint32_t)lo;
+    if (rc > mark_reach || band > reach || !may_mark(m, ranges_mm, k, rc)) {
+        return;
+    }
+    top = rc + three_quarters;
+    w->arc_to = top > reach ? UINT32_MAX : (uint32_t)top * (uint32_t)top;
+    w->arc_from = band <= 0 ? 0u : (uint32_t)band * (uint32_t)band;
+    w->r.rc = rc;
+    w->r.centre = (int32_t)((uint32_t)k * 36000u / m->n_sectors);
+}
+
+/* direction_cdeg()'s octants, o = (y < 0) * 4 + (x < 0) * 2 + (|y| > |x|): the direction is
+ * OCTANT_AT[o] + OCTANT_TURN[o] * a modulo 36 000, a = the octant's own angle (0..4500). */
+static const int32_t OCTANT_AT[8] = {0, 9000, 18000, 9000, 0, 27000, 18000, 27000};
+static const int32_t OCTANT_TURN[8] = {1, -1, -1, 1, -1, 1, 1, -1};
+
+/* A cell dx (mm) across from the robot is within reach on a row that leaves rem (mm^2). */
+static int in_reach(int32_t dx, uint32_t rem)
+{
+    const uint32_t a = (uint32_t)(dx < 0 ? -dx : dx);
+    return a * a <= rem;
+}
+
+/* A row's cells i0 .. i1 within reach, *ia .. *ib (none: *ia > *ib), moved there from the
+ * last row's (or from i0 .. i1). Cell i lies dx0 + (i - i0) * cell across from the robot
+ * and is within reach when dx^2 <= rem: every row's cells within reach are those whose
+ * |dx| is at most a bound, intervals about one column that hold each other. */
+static void row_ends(int32_t dx0, int32_t cell, uint32_t rem, int32_t i0, int32_t i1, int32_t *ia,
+                     int32_t *ib)
+{
+    int32_t a = *ia, b = *ib;
+    if (a > b) { /* the last row had none: from this row's cell nearest the robot */
+        a = b = dx0 >= 0 ? i0 : (-dx0 / cell > i1 - i0 ? i1 : i0 + -dx0 / cell);
+    }
+    if (in_reach(dx0 + (a - i0) * cell, rem)) {
+        while (a > i0 && in_reach(dx0 + (a - 1 - i0) * cell, rem)) {
+            --a;
+        }
+    } else {
+        while (a <= i1 && !in_reach(dx0 + (a - i0) * cell, rem)) {
+            ++a;
+        }
+    }
+    if (a > i1) {
+        b = a - 1; /* none */
+    } else {
+        b = b < a ? a : b;
+        if (in_reach(dx0 + (b - i0) * cell, rem)) {
+            while (b < i1 && in_reach(dx0 + (b + 1 - i0) * cell, rem)) {
+                ++b;
+            }
+        } else {
+            while (!in_reach(dx0 + (b - i0) * cell, rem)) { /* ends at latest at a */
+                --b;
+            }
+        }
+    }
+    *ia = a;
+    *ib = b;
+}
+
+/* What observe_fast works out once a scan. */
+typedef struct {
+    wedge_rule_t rules[RULES_MAX];
+    int32_t from[8]; /* OCTANT_AT less the heading, 0..35999 */
+    int32_t arc_half;
+    uint32_t width_k;
+} scan_rules_t;
+
+/* Row j's unsettled cells ia .. ib marked: cell i lies dx0 + (i - i0) * cell across from
+ * the robot and dy along, dy2 = dy^2. */
+static void mark_row(qnav_map_t *m, const scan_rules_t *s, int32_t j, int32_t dy, uint32_t dy2,
+                     int32_t dx0, int32_t i0, int32_t ia, int32_t ib)
+{
+    const int32_t cell = (int32_t)m->cfg.cell_mm;
+    const uint32_t ady = (uint32_t)(dy < 0 ? -dy : dy);
+    const int32_t *row_from = dy < 0 ? s->from + 4 : s->from;
+    const int32_t *row_turn = dy < 0 ? OCTANT_TURN + 4 : OCTANT_TURN;
+    int32_t b;
+    for (b = ia >> 3; b <= ib >> 3 && ia <= ib; ++b) {
+        uint8_t arcs, todo = unsettled(m, b, j, &arcs);
+        if (b == ia >> 3) {
+            todo = (uint8_t)(todo & (0xFFu << (ia & 7)));
+        }
+        if (b == ib >> 3) {
+            todo = (uint8_t)(todo & (0xFFu >> (7 - (ib & 7))));
+        }
+        while (todo != 0u) {
+            const unsigned bit = (unsigned)__builtin_ctz(todo);
+            const int32_t i = b * 8 + (int32_t)bit;
+            const int32_t dx = dx0 + (i - i0) * cell;
+            const uint32_t adx = (uint32_t)(dx < 0 ? -dx : dx), d2 = adx * adx + dy2;
+            const unsigned o = (dx < 0 ? 2u : 0u) | (ady > adx ? 1u : 0u);
+            const uint32_t hi = ady > adx ? ady : adx, lo = ady > adx ? adx : ady;
+            const wedge_rule_t *w;
+            uint32_t t, a;
+            int32_t rel;
+            todo = (uint8_t)(todo & (todo - 1u));
+            if (d2 == 0u) {
+                continue;
+            }
+            t = (lo << 15) / hi;                                        /* direction_cdeg's */
+            a = (4500u * t + ((1564u * t) >> 15) * (32768u - t)) >> 15; /* 0..4500 */
+            rel = row_from[o] + row_turn[o] * (int32_t)a;
+            rel += rel < 0 ? INT32_C(36000) : (rel >= INT32_C(36000) ? -INT32_C(36000) : 0);
+            w = &s->rules[sector_of(m, rel)];
+            if (d2 < w->clear_below) {
+                mark_clear(m, i, j);
+            } else if (((unsigned)arcs >> bit & 1u) != 0u && d2 >= w->arc_from && d2 <= w->arc_to &&
+                       on_arc(off_centre(rel, w->r.centre), &w->r, s->arc_half, s->width_k)) {
+                mark_arc(m, i, j);
+            }
+        }
+    }
+}
+
+/* observe_wedges() with the same marks, on hosts: each row's cells within reach found from
+ * the last row's (row_ends), the unsettled ones among them taken by their set bits, every
+ * sector's tests worked out once a scan (a row's cells change sector every cell or two),
+ * and a cell's direction less the heading (direction_cdeg()'s) from its octant's start
+ * less the heading, worked out once a scan. */
+static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_map_pose_t *at)
+{
+    int32_t i0, i1, j0, j1, j, ia, ib, reach, mark_reach, three_quarters, heading, band_pct;
+    uint32_t reach2;
+    const int32_t cell = (int32_t)m->cfg.cell_mm;
+    scan_rules_t s;
+    qnav_map_pose_t in_grid;
+    const qnav_map_pose_t *pose = &in_grid;
+    uint16_t k;
+    if (m->n_sectors > RULES_MAX) {
+        observe_wedges(m, ranges_mm, at);
+        return;
+    }
+    if (qnav_align_observe(m, ranges_mm, at)) {
+        qnav_map_reset(m); /* what the old grid held, forgotten: its cells lie another way */
+    }
+    in_grid = qnav_align_pose(m, at);
+    three_quarters = cell * 3 / 4;
+    reach = (int32_t)m->seen_mm;
+    reach2 = (uint32_t)reach * (uint32_t)reach;
+    mark_reach = marks_within(m);
+    band_pct = m->cfg.noise_pct < OCCUPIED_BAND_PCT ? (int32_t)m->cfg.noise_pct : OCCUPIED_BAND_PCT;
+    heading = qnav_wrap_cdeg(pose->heading_cdeg);
+    s.width_k = (uint32_t)m->cfg.arc_width_mm * CDEG_PER_RAD_HALF; /* < 2^28 */
+    s.arc_half = INT32_C(18000) / (int32_t)m->n_sectors;
+    if ((int32_t)m->cfg.arc_cdeg / 2 < s.arc_half) {
+        s.arc_half = (int32_t)m->cfg.arc_cdeg / 2;
+    }
+    for (k = 0; k < m->n_sectors; ++k) {
+        rule_of(m, ranges_mm, k, three_quarters, band_pct, mark_reach, reach, &s.rules[k]);
+    }
+    for (k = 0; k < 8u; ++k) { /* heading in [-18000, 18000) */
+        const int32_t f = OCTANT_AT[k] - heading;
+        s.from[k] = f < 0 ? f + INT32_C(36000) : (f >= INT32_C(36000) ? f - INT32_C(36000) : f);
+    }
+    cell_of(m, pose->x_mm - reach, pose->y_mm - reach, &i0, &j0);
+    cell_of(m, pose->x_mm + reach, pose->y_mm + reach, &i1, &j1);
+    ia = i0;
+    ib = i1;
+    for (j = j0; j <= j1; ++j) {
+        const int32_t dy = centre_y(m, j) - pose->y_mm;
+        const uint32_t ady = (uint32_t)(dy < 0 ? -dy : dy), dy2 = ady * ady;
+        const int32_t dx0 = centre_x(m, i0) - pose->x_mm; /* cell i0's */
+        if (dy2 > reach2) {
+            continue;
+        }
+        row_ends(dx0, cell, reach2 - dy2, i0, i1, &ia, &ib);
+        mark_row(m, &s, j, dy, dy2, dx0, i0, ia, ib);
+    }
+}
+#endif
 
 /*
  * Dijkstra's queue: Dial's buckets. Every step costs at most STEP_DIAG + near_cost, so the

@@ -14,6 +14,7 @@
 #include <cmocka.h>
 
 #include "map_compact.h"
+#include "map_plain.h"
 #include "qnav/map.h"
 #include "qnav/trig.h"
 
@@ -1551,6 +1552,75 @@ static void test_bad_maps_are_refused(void **state)
     assert_string_not_equal(qnav_status_str(QNAV_E_MAP), "unknown status");
 }
 
+static uint16_t mem_plain[CELLS_MAX * 4];
+
+/* lo..hi (inclusive) from a fixed-seed linear congruential stream: the same draws every run. */
+static int32_t draw(int32_t lo, int32_t hi)
+{
+    static uint32_t state = 12345u;
+    state = state * 1664525u + 1013904223u;
+    return lo + (int32_t)((state >> 8) % (uint32_t)(hi - lo + 1));
+}
+
+/* Maps marked by qnav_map_observe() (on hosts its shortcuts: observe_fast) and by the plain
+ * marking, from the same random scans and poses (some off the map, headings all round),
+ * hold the same cells after every scan: compact and full layouts, 8 to 72 sectors (a
+ * compact map groups 72 into 32 wedges), an arc's width bound, range peaks, a grid turned
+ * to the walls. */
+static void test_the_fast_marking_marks_as_the_plain_one(void **state)
+{
+    static const struct {
+        uint8_t compact;
+        uint16_t cell_mm, sectors, arc_width_mm, opening_mm, align_samples;
+        uint8_t noise_pct;
+    } cases[] = {
+        {1, 300, 16, 0, 270, 40, 10}, {1, 200, 16, 0, 0, 0, 5},   {1, 300, 8, 200, 0, 0, 5},
+        {1, 300, 72, 0, 270, 0, 10},  {0, 100, 16, 0, 270, 40, 10}, {0, 100, 32, 200, 0, 0, 5},
+        {0, 200, 72, 0, 0, 0, 5},
+    };
+    size_t c;
+    (void)state;
+    for (c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        qnav_map_t fast, plain;
+        qnav_map_config_t mc;
+        qnav_ctrl_config_t cc;
+        qnav_mm_t ranges[72];
+        size_t bytes;
+        int t, k;
+        qnav_map_config_default(&mc);
+        mc.compact = cases[c].compact;
+        mc.near_cost = cases[c].compact ? 0u : mc.near_cost; /* a compact map has no near cost */
+        mc.cell_mm = cases[c].cell_mm;
+        mc.arc_width_mm = cases[c].arc_width_mm;
+        mc.opening_mm = cases[c].opening_mm;
+        mc.align_samples = cases[c].align_samples;
+        mc.noise_pct = cases[c].noise_pct;
+        sensor_config(&cc);
+        cc.n_sectors = cases[c].sectors;
+        bytes = qnav_map_size(&mc, WORLD_MM, WORLD_MM);
+        assert_true(bytes > 0u && bytes <= sizeof mem);
+        memset(mem, 0, sizeof mem); /* what the maps leave unwritten alike in both */
+        memset(mem_plain, 0, sizeof mem_plain);
+        assert_int_equal(qnav_map_init(&fast, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem, sizeof mem),
+                         QNAV_OK);
+        assert_int_equal(qnav_map_init(&plain, &mc, &cc, 0, 0, WORLD_MM, WORLD_MM, mem_plain,
+                                       sizeof mem_plain),
+                         QNAV_OK);
+        for (t = 0; t < 300; ++t) {
+            const qnav_map_pose_t p = {draw(-600, WORLD_MM + 600), draw(-600, WORLD_MM + 600),
+                                       draw(-36000, 36000)};
+            for (k = 0; k < cases[c].sectors; ++k) {
+                ranges[k] = (qnav_mm_t)(draw(0, 2) == 0 ? 2500 : draw(0, 2499));
+            }
+            qnav_map_observe(&fast, ranges, &p);
+            qnav_map_observe_plain(&plain, ranges, &p);
+            assert_memory_equal(mem, mem_plain, bytes);
+            assert_int_equal(fast.dirty, plain.dirty);
+            fast.dirty = plain.dirty = 0u;
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1584,6 +1654,7 @@ int main(void)
         cmocka_unit_test(test_a_map_keeps_the_robot_a_metre_inside),
         cmocka_unit_test(test_a_placed_map_follows_the_robot),
         cmocka_unit_test(test_bad_maps_are_refused),
+        cmocka_unit_test(test_the_fast_marking_marks_as_the_plain_one),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
