@@ -555,8 +555,9 @@ void qnav_escape_hold_turn(uint16_t prev, qnav_ctrl_output_t *out)
 #define QNAV_ESCAPE_UNSTAND_HALF_DEG 5
 
 /* The path nearest ref (0..359) whose paths within QNAV_ESCAPE_UNSTAND_HALF_DEG either side
- * are all free, the lower on a tie, in *path; 0 when no run of free paths is that wide. One
- * walk round the circle, from a blocked path, run by run. */
+ * are all free, in *path (on a tie the first found walking up from the lowest blocked path,
+ * and a run's lower end); 0 when no run of free paths is that wide. One walk round the
+ * circle, from a blocked path, run by run. */
 static uint8_t free_window(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t ref,
                            uint16_t *path)
 {
@@ -620,7 +621,7 @@ void qnav_escape_stood(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t p
         /* the escape's own stall (after one stall time) acts first */
         return;
     }
-    /* stood a stall's time: the way in the middle of a free window nearest the last
+    /* stood twice the stall time: the way in the middle of a free window nearest the last
      * decision (the robot turns on toward one way: a new one each tick kept it turning to
      * and fro); none: stand (it turns in place) */
     if (!free_window(c, lvl, prev, &path)) {

@@ -66,15 +66,15 @@ void qnav_escape_hold_turn(uint16_t prev, qnav_ctrl_output_t *out);
  * A robot that stands does not stand for ever. A decision whose speed is 0 counts a tick in
  * out->escape.stood; a moving one halves it, so that a robot that drives clears it within
  * a few ticks and one that twitches now and then does not. Past twice escape_stall_ticks
- * (the escape's own stall acts after one; a stand lasts past two when a map's plans keep
- * clearing the escape memory or a follow turns in place: whatever
- * a map's plans did meanwhile, they do not move the robot) the decision becomes the middle
- * of a free window: the path nearest the last decision (prev, whole degrees 0..359 in this
- * tick's frame, so that the robot turns on toward one way) with every path within 5
- * degrees either side free; at a crawl once the robot faces it and straight ahead is clear,
- * turning in place until then. Without such a window the robot turns in place as decided.
- * Called after every other rule of the decision but the turn's way round
- * (qnav_escape_hold_turn).
+ * the decision becomes the middle of a free window: the path nearest the last decision
+ * (prev, whole degrees 0..359 in this tick's frame, so that the robot turns on toward one
+ * way) with every path within 5 degrees either side free; at a crawl once the robot faces
+ * it and straight ahead is clear, turning in place until then. Without such a window the
+ * robot turns in place as decided. The escape's own stall acts after one stall time; a
+ * robot stands past two when a map's plans keep clearing the memory (a new plan does not
+ * move it) or a follow turns in place. qnav_escape_unstand is called after every other rule
+ * of the decision but the turn's way round (qnav_escape_hold_turn); qnav_escape_stood is
+ * its out-of-line part, for a decision that stands.
  */
 void qnav_escape_stood(const qnav_clearance_t *c, const uint8_t *lvl, uint16_t prev,
                        qnav_ctrl_output_t *out);

@@ -181,9 +181,9 @@ typedef struct {
                            sides; one 4 (r + d_s) nearer chooses afresh); 0: none yet */
     uint8_t tries;      /* follows given up for the other side since the last progress */
     uint8_t stood;      /* ticks the decision stood still (speed 0), to 255, halved by a
-                           decision that moves; kept
-                           when a map's plan clears the rest (the robot stands whatever the
-                           plan says: docs/architecture.md, "A robot that stands") */
+                           decision that moves; kept when a map's plan clears the rest (a
+                           new plan does not move the robot: docs/architecture.md, "A robot
+                           that stands") */
     uint16_t stall_mm;  /* nearest the robot had come to the destination when the last
                            follow began, mm (a new stall no nearer means that follow led
                            back: the other side); 0: none yet */
