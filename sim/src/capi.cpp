@@ -256,6 +256,7 @@ void qnav_sim_config_default(qnav_sim_config_t *cfg) {
     cfg->episode_limit_s = 0.0;
     cfg->fitness = QNAV_SIM_FITNESS_PROGRESS;
     cfg->map_frame_deg = -1.0;
+    cfg->survey_m = 0.0;
 }
 
 qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_env_t *env,
@@ -281,6 +282,10 @@ qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_
     if (!qnav_sim_fitness_rule_name(cfg->fitness)) return bad("fitness: not a qnav_sim_fitness_rule_t");
     if (std::isnan(cfg->map_frame_deg) || cfg->map_frame_deg >= 360)
         return bad("map_frame_deg: must be in [0, 360), or negative (drawn per episode)");
+    if (!(cfg->survey_m == 0 || (cfg->survey_m >= 0.05 && cfg->survey_m <= 10)))
+        return bad("survey_m: must be 0 (off) or in [0.05, 10] m");
+    if (cfg->survey_m > 0 && robot->profile.map_cell_m <= 0.0)
+        return bad("survey_m: the robot profile has no [map] to survey into");
     return guarded(err, errlen, [&] {
         qnav::check_clearance(env->env, robot->profile.radius_m);
         qnav::SimConfig sc;
@@ -291,6 +296,7 @@ qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_
         sc.episode_limit_s = cfg->episode_limit_s;
         sc.fitness = cfg->fitness;
         sc.map_frame_deg = cfg->map_frame_deg < 0 ? -1.0 : cfg->map_frame_deg;
+        sc.survey_m = cfg->survey_m;
         auto s = std::make_unique<qnav_sim>();
         s->sim = std::make_unique<qnav::Simulation>(robot->profile, env->env, sc);
         *out = s.release();

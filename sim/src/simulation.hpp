@@ -33,6 +33,9 @@ struct SimConfig {
     // heading sensor's frame, at no particular angle to a room's walls; negative: drawn
     // per episode (qnav_sim_config_t.map_frame_deg; docs/sim.md, "The map's grid").
     double map_frame_deg = -1;
+    // > 0: each episode's map starts surveyed from a grid of points this far apart
+    // (qnav_sim_config_t.survey_m; docs/sim.md, "A known world"); 0: off.
+    double survey_m = 0;
 };
 
 // Where time went (only counted when profiling is on), seconds.
@@ -105,6 +108,8 @@ private:
     void compute_scan();
     void init_map();
     void place_map();
+    void survey_map();
+    qnav_mm_t reading_mm(double range_m) const;
     void guide_scan();
     void drive_substep(double dt);
     void recovery_wheels();

@@ -95,7 +95,7 @@ void load(Loaded &l, const std::string &robot, const std::string &env) {
 
 void make_sim(Loaded &l, int sectors, double ps, double pa, std::uint64_t seed,
               qnav_sim_fitness_rule_t fitness = QNAV_SIM_FITNESS_PROGRESS, double limit_factor = 1.0,
-              double map_frame_deg = -1.0) {
+              double map_frame_deg = -1.0, double survey_m = 0.0) {
     char err[QNAV_SIM_ERRLEN] = "";
     qnav_sim_config_t cfg;
     qnav_sim_config_default(&cfg);
@@ -110,6 +110,10 @@ void make_sim(Loaded &l, int sectors, double ps, double pa, std::uint64_t seed,
     cfg.actuation_noise = pa;
     cfg.seed = seed;
     cfg.map_frame_deg = map_frame_deg;
+    cfg.survey_m = survey_m;
+    qnav_map_config_t mc;
+    if (survey_m > 0 && !qnav_sim_robot_map_config(l.robot, &mc))
+        throw SimError(QNAV_SIM_E_PARAM, "--survey: the robot profile has no [map] to start surveyed");
     check(qnav_sim_create(l.robot, l.env, &cfg, &l.sim, err, sizeof err), err);
 }
 
@@ -214,6 +218,7 @@ struct RunOpts {
     unsigned episodes = 1;
     double limit_factor = 1.0;  // times the environment's episode time limit
     double map_frame = -1;      // the map's grid against the walls, deg; < 0: drawn per episode
+    double survey = 0;          // > 0: each episode's map starts surveyed from a grid this far apart, m
     bool table = false;
     std::string controller = "body";  // a name in libqnav's controller table (qnav/nav.h)
     long svg_tick = -1;
@@ -336,7 +341,7 @@ int cmd_run(const RunOpts &o) {
     if (qnav_sim_fitness_rule_parse(o.fitness.c_str(), &rule) != QNAV_SIM_OK)
         throw SimError(QNAV_SIM_E_PARAM, "--fitness: '" + o.fitness + "' is not one of " +
                                              qnav_sim_fitness_rule_names());
-    make_sim(l, o.sectors, ps, pa, o.seed, rule, o.limit_factor, o.map_frame);
+    make_sim(l, o.sectors, ps, pa, o.seed, rule, o.limit_factor, o.map_frame, o.survey);
     qnav::Simulation &sim = *l.sim->sim;
     const qnav_policy_t pol = read_policy(o.policy, l.robot);
     std::vector<qnav_qkey_t> tbuf;
@@ -587,6 +592,10 @@ static CLI::App *add_run(CLI::App &app, RunOpts &o) {
                            : "expected a number in [0, 360), got '" + s + "'";
             },
             "NUMBER in [0 - 360)"));
+    run->add_option("--survey", o.survey,
+                    "a profile's [map]: start each episode's map with what the sonar shows from every point of a "
+                    "grid this many metres apart (a known world: what a miss owes to exploring; docs/sim.md)")
+        ->check(qnav::cli::finite_range(0.05, 10.0));
     run->add_option("--svg", o.svg, "write the first episode's picture here");
     run->add_option("--trace", o.trace, "write the first episode's trajectory here (CSV, one row per tick)");
     run->add_option("--svg-tick", o.svg_tick, "tick whose sonar sectors are drawn (default 0; past the end: the last tick)")->check(CLI::NonNegativeNumber);

@@ -47,7 +47,8 @@ struct WallSim {
     qnav_sim_env_t *env = nullptr;
     qnav_sim_t *sim = nullptr;
     qnav_ctrl_t ctrl;
-    explicit WallSim(const std::string &profile, double sensor_noise = 0.05, double map_frame_deg = -1.0) {
+    explicit WallSim(const std::string &profile, double sensor_noise = 0.05, double map_frame_deg = -1.0,
+                     double survey_m = 0.0) {
         char err[QNAV_SIM_ERRLEN] = "";
         if (qnav_sim_robot_parse(profile.data(), profile.size(), "tekbot-map.toml", &robot, err,
                                  sizeof err) != QNAV_SIM_OK)
@@ -61,6 +62,7 @@ struct WallSim {
         cfg.actuation_noise = 0.01;
         cfg.seed = 3;
         cfg.map_frame_deg = map_frame_deg;
+        cfg.survey_m = survey_m;
         if (qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err) != QNAV_SIM_OK) fail_with("sim", err);
         qnav_ctrl_config_t cc;
         qnav_sim_ctrl_config(sim, &cc);
@@ -272,6 +274,78 @@ std::string refusal(const std::string &profile) {
     return err;
 }
 
+// The first command's planned distance beyond the straight line to kWall's destination, and
+// the episode's ticks, with each episode's map surveyed from a survey_m grid (0: none).
+struct FirstPlan {
+    double detour_m = -1;  // < 0 until the first command's sample
+    double last_x = 0, last_y = 0;
+    bool have_last = false;
+};
+
+void see_first_plan(void *user, const qnav_sim_sample_t *s) {
+    FirstPlan &f = *static_cast<FirstPlan *>(user);
+    if (f.have_last && s->tick > 0 && f.detour_m < 0)
+        f.detour_m = s->goal_range_m - std::hypot(3.0 - f.last_x, 8.5 - f.last_y);
+    f.last_x = s->x_m;
+    f.last_y = s->y_m;
+    f.have_last = true;
+}
+
+FirstPlan first_plan(const std::string &profile, double survey_m, uint32_t *ticks) {
+    WallSim w(profile, 0.05, -1.0, survey_m);
+    FirstPlan f;
+    qnav_sim_result_t res;
+    assert_int_equal(qnav_sim_run_episode(w.sim, &w.ctrl, 0, &res, see_first_plan, &f), QNAV_SIM_OK);
+    assert_true(res.reached);
+    assert_int_equal(res.collisions, 0);
+    *ticks = res.ticks;
+    return f;
+}
+
+// A known world (qnav_sim_config_t.survey_m): the wall lies 3.5 m ahead of the start, beyond
+// the TekBot's sonar, so a map that starts empty plans straight at it, and a surveyed one
+// plans round by the far gap from the first command and arrives sooner, in both layouts.
+void test_a_surveyed_map_knows_the_wall_before_the_sonar_sees_it(void **) {
+    for (const char *map : {"[map]\ncell_m = 0.1\n", "[map]\ncompact = true\nbytes = 768\ncell_m = 0.3\n"}) {
+        uint32_t plain_ticks = 0, known_ticks = 0;
+        const FirstPlan plain = first_plan(tekbot_with(map), 0.0, &plain_ticks);
+        const FirstPlan known = first_plan(tekbot_with(map), 0.4, &known_ticks);
+        print_message("%s: first plan's detour %.2f m unknown, %.2f m surveyed; arrived in %u / %u ticks\n",
+                      map[6] == 'c' ? "compact" : "full", plain.detour_m, known.detour_m, plain_ticks,
+                      known_ticks);
+        assert_true(plain.detour_m >= 0 && plain.detour_m < 1.5);  // near-wall costs, cells
+        assert_true(known.detour_m > plain.detour_m + 4.0);          // by the gap at x 8.5..10
+        assert_true(known_ticks < plain_ticks);
+    }
+}
+
+// A survey needs a map to fill and a grid step it can walk.
+void test_a_survey_is_refused_without_a_map_or_a_sane_step(void **) {
+    const std::string no_map = tekbot_with(""), map = tekbot_with("[map]\ncell_m = 0.1\n");
+    const struct {
+        const std::string *profile;
+        double survey_m;
+    } bad[] = {{&no_map, 0.4}, {&map, 0.01}, {&map, 11.0}, {&map, -1.0}, {&map, NAN}};
+    for (const auto &b : bad) {
+        char err[QNAV_SIM_ERRLEN] = "";
+        qnav_sim_robot_t *robot = nullptr;
+        qnav_sim_env_t *env = nullptr;
+        qnav_sim_t *sim = nullptr;
+        assert_int_equal(qnav_sim_robot_parse(b.profile->data(), b.profile->size(), "p.toml", &robot, err, sizeof err),
+                         QNAV_SIM_OK);
+        assert_int_equal(qnav_sim_env_parse(kWall, std::strlen(kWall), "wall.toml", &env, err, sizeof err),
+                         QNAV_SIM_OK);
+        qnav_sim_config_t cfg;
+        qnav_sim_config_default(&cfg);
+        cfg.survey_m = b.survey_m;
+        assert_int_equal(qnav_sim_create(robot, env, &cfg, &sim, err, sizeof err), QNAV_SIM_E_PARAM);
+        assert_null(sim);
+        assert_true(std::string(err).rfind("survey_m: ", 0) == 0);
+        qnav_sim_env_free(env);
+        qnav_sim_robot_free(robot);
+    }
+}
+
 void test_bad_odometry_settings_are_refused_by_field(void **) {
     const std::string err = refusal(tekbot_with("[map]\ncell_m = 0.1\n", "err_turn_pct = -1\n"));
     assert_true(err.find("err_turn_pct") != std::string::npos);
@@ -464,6 +538,8 @@ int main() {
         cmocka_unit_test(test_the_map_is_told_the_profiles_sensor_noise),
         cmocka_unit_test(test_the_maps_arc_is_an_angle_from_the_profile),
         cmocka_unit_test(test_the_maps_opening_comes_from_the_profile),
+        cmocka_unit_test(test_a_surveyed_map_knows_the_wall_before_the_sonar_sees_it),
+        cmocka_unit_test(test_a_survey_is_refused_without_a_map_or_a_sane_step),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

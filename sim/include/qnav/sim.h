@@ -179,17 +179,23 @@ typedef struct {
                                   deg in [0, 360) (0: aligned with the arena's walls, which a
                                   board's heading sensor never is); < 0: drawn per episode
                                   from (seed, episode_seed), the default */
+    double survey_m;           /* a profile's [map]: > 0 starts every episode's map with what
+                                  the sonar shows, noiseless, from every point of a grid this
+                                  many metres apart where the body fits (a known world: what
+                                  a miss owes to exploring; docs/sim.md, "A known world");
+                                  0: off, the default; else 0.05..10 */
 } qnav_sim_config_t;
 
 /* Defaults: profile's sectors, no noise, seed 1, the environment's limit, fitness
- * QNAV_SIM_FITNESS_PROGRESS, the map's grid at an angle drawn per episode. */
+ * QNAV_SIM_FITNESS_PROGRESS, the map's grid at an angle drawn per episode, no survey. */
 void qnav_sim_config_default(qnav_sim_config_t *cfg);
 
 /*
  * Create a context for (robot, env, cfg); the context keeps its own copies, so robot and
  * env may be freed afterwards. Returns QNAV_SIM_OK and *out, or QNAV_SIM_E_NULL,
  * QNAV_SIM_E_PARAM (n_sectors > 360, noise outside [0, 1] or not finite, limit outside
- * [0, 36000] s, fitness not a qnav_sim_fitness_rule_t) with a "FIELD: problem" line in err, QNAV_SIM_E_WORLD (a start zone closer
+ * [0, 36000] s, fitness not a qnav_sim_fitness_rule_t, survey_m outside 0.05..10 or without
+ * a [map] in the profile) with a "FIELD: problem" line in err, QNAV_SIM_E_WORLD (a start zone closer
  * than the robot's radius to an obstacle or wall: "FILE:LINE: ...") or QNAV_SIM_E_NOMEM.
  */
 QNAV_CHECK_RESULT qnav_sim_status_t qnav_sim_create(const qnav_sim_robot_t *robot, const qnav_sim_env_t *env,
