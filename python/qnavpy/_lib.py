@@ -56,7 +56,7 @@ _SIGNATURES = {
     "qpy_policy_read": (c_int32, [c_char_p, _P, _P, _P, _P, _P] + _ERR),
     "qpy_policy_write": (c_int32, [c_char_p, c_int32, c_int32, c_int32, _P, c_int32, c_char_p] + _ERR),
     "qpy_env_create": (c_int32, [c_char_p, c_char_p, c_int32, c_double, c_double, c_uint64, c_double,
-                                 c_char_p, c_double, POINTER(c_void_p)] + _ERR),
+                                 c_char_p, c_double, c_double, POINTER(c_void_p)] + _ERR),
     "qpy_env_free": (None, [c_void_p]),
     "qpy_env_params": (None, [c_void_p, _P]),
     "qpy_env_reset": (c_int32, [c_void_p, c_uint64, c_void_p, _P, _P, _P] + _ERR),

@@ -53,7 +53,10 @@ class Env:
     qnav-sim); ``seed``: the context seed; ``episode_limit_s`` (0: the world's);
     ``fitness``: "progress" or "paper"; ``map_frame_deg``: a profile's map's grid against the
     world's walls, deg in [0, 360) (None: drawn per episode, as ``qnav-sim run --map-frame``'s
-    default; docs/sim.md, "The map's grid"). ``controller``/``policy``/``table``: the controller
+    default; docs/sim.md, "The map's grid"); ``survey_m``: a profile's map starts each episode
+    with what the sonar shows from every point of a grid this many metres apart (0: not, the
+    default; ``qnav-sim run --survey``; docs/sim.md, "A known world").
+    ``controller``/``policy``/``table``: the controller
     that decides when :meth:`step` is given no action (default: the robot's tuned
     probabilistic policy on the "body" controller).
 
@@ -71,12 +74,13 @@ class Env:
 
     def __init__(self, world="dense", robot="pioneer3dx", *, sectors=0, sensor_noise=None, actuation_noise=None,
                  seed=1, episode_limit_s=0.0, fitness="progress", controller="body", policy=None, table=False,
-                 map_frame_deg=None):
+                 map_frame_deg=None, survey_m=0.0):
         handle = ctypes.c_void_p()
         _lib.call(lib.qpy_env_create, encode(robot), encode(world), int(sectors),
                   -1.0 if sensor_noise is None else float(sensor_noise),
                   -1.0 if actuation_noise is None else float(actuation_noise), int(seed), float(episode_limit_s),
-                  encode(fitness), -1.0 if map_frame_deg is None else float(map_frame_deg), ctypes.byref(handle))
+                  encode(fitness), -1.0 if map_frame_deg is None else float(map_frame_deg), float(survey_m),
+                  ctypes.byref(handle))
         self._handle = handle
         self.world = World(world)
         self.robot = Robot(robot)

@@ -291,7 +291,7 @@ int qpy_policy_write(const char *path, int32_t kind, int32_t hidden, int32_t inp
 
 int qpy_env_create(const char *robot, const char *world, int32_t sectors, double sensor_noise,
                    double actuation_noise, uint64_t seed, double limit_s, const char *fitness,
-                   double map_frame_deg, qpy_env_t **out,
+                   double map_frame_deg, double survey_m, qpy_env_t **out,
                    char *err, size_t errlen) {
     *out = nullptr;
     return guarded(err, errlen, [&] {
@@ -324,6 +324,7 @@ int qpy_env_create(const char *robot, const char *world, int32_t sectors, double
                         QNAV_SIM_E_PARAM);
         }
         cfg.map_frame_deg = map_frame_deg;
+        cfg.survey_m = survey_m;
         st = qnav_sim_create(e->robot, e->world, &cfg, &e->sim, err, errlen);
         if (st != QNAV_SIM_OK) return static_cast<int>(st);
         qnav_ctrl_config_t cc;

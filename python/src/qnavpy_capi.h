@@ -64,10 +64,11 @@ int qpy_policy_write(const char *path, int32_t kind, int32_t hidden, int32_t inp
                      const int16_t *w, int32_t nw, const char *comment, char *err, size_t errlen);
 
 /* A simulation context as `qnav-sim run` makes it (noise < 0: the profile's typical;
- * map_frame_deg < 0: the map's grid turned per episode, as --map-frame's default). */
+ * map_frame_deg < 0: the map's grid turned per episode, as --map-frame's default;
+ * survey_m > 0: each episode's map starts surveyed, as --survey; 0: not). */
 int qpy_env_create(const char *robot, const char *world, int32_t sectors, double sensor_noise,
                    double actuation_noise, uint64_t seed, double limit_s, const char *fitness,
-                   double map_frame_deg, qpy_env_t **out, char *err, size_t errlen);
+                   double map_frame_deg, double survey_m, qpy_env_t **out, char *err, size_t errlen);
 void qpy_env_free(qpy_env_t *env);
 /* n_sectors, max_range_mm, limit ticks, sensor noise, actuation noise as used. */
 void qpy_env_params(const qpy_env_t *env, double *params);

@@ -124,6 +124,18 @@ class SteppedEpisodeEqualsQnavSimRun(unittest.TestCase):
                                    "--episode", "1", "--map-frame", "0")
         self.assertNotEqual(turned, rows)  # the turn reaches the episode
 
+    def test_a_known_world_as_qnav_sim_surveys_it(self):
+        args = ("--env", "gen:rooms:4", "--robot", "tekbot", "--seed", "3", "--episode", "1")
+        plain, _ = qnav_sim_trace(self.work, *args)
+        rows, line = qnav_sim_trace(self.work, *args, "--survey", "0.4")
+        env = qnavpy.Env("gen:rooms:4", "tekbot", seed=3, survey_m=0.4)
+        mine, _, _, result = stepped_rows(env, 1)
+        self.assertEqual(mine, rows)
+        self.assertEqual(episode_line(1, result), line)
+        self.assertNotEqual(rows, plain)  # the survey reaches the episode
+        with self.assertRaisesRegex(qnavpy.QnavError, "survey_m"):
+            qnavpy.Env("gen:rooms:4", "tekbot", survey_m=0.01)
+
     def test_python_controller_deciding_from_observations_is_the_c_step(self):
         # the controller stepped on each observation from Python, its decision given back
         # as (heading, speed): every decision must equal the one qnav-sim run made (VFH+
