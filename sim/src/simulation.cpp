@@ -354,13 +354,20 @@ qnav_mm_t Simulation::reading_mm(double range_m) const {
 // (docs/sim.md, "A known world"). A map that follows the robot keeps what its square holds.
 void Simulation::survey_map() {
     std::vector<qnav_mm_t> ranges(cfg_.n_sectors);
-    const double step = cfg_.survey_m, half_sector = kPi / cfg_.n_sectors;
+    const std::vector<Shape> shapes = env_.obstacle_shapes();
+    const double step = cfg_.survey_m, half_sector = kPi / cfg_.n_sectors, r = robot_.radius_m;
+    // the body fits at p: inside the walls, and no obstacle nearer than its radius (a point
+    // inside one is at distance 0)
+    const auto fits = [&](Vec2 p) {
+        if (p.x < r || p.y < r || p.x > env_.width_m - r || p.y > env_.height_m - r) return false;
+        Vec2 q;
+        return std::none_of(shapes.begin(), shapes.end(), [&](const Shape &s) { return nearest_point(s, p, &q) < r; });
+    };
     for (double y = step / 2; y < env_.height_m; y += step) {
         for (double x = step / 2; x < env_.width_m; x += step) {
+            if (!fits(Vec2{x, y})) continue;
             for (const double hd : {0.0, half_sector}) {
                 sonar_.measure(Vec2{x, y}, hd, true_dist_.data());
-                const double nearest = *std::min_element(true_dist_.begin(), true_dist_.begin() + cfg_.n_sectors);
-                if (nearest < robot_.radius_m) break;  // the body does not fit here
                 for (std::uint16_t k = 0; k < cfg_.n_sectors; ++k)
                     ranges[k] = reading_mm(true_dist_[k] - robot_.sonar_offset_m);
                 const Vec2 at = turned(Vec2{x, y}, map_turn_);

@@ -311,7 +311,7 @@ void test_a_surveyed_map_knows_the_wall_before_the_sonar_sees_it(void **) {
         const FirstPlan plain = first_plan(tekbot_with(map), 0.0, &plain_ticks);
         const FirstPlan known = first_plan(tekbot_with(map), 0.4, &known_ticks);
         print_message("%s: first plan's detour %.2f m unknown, %.2f m surveyed; arrived in %u / %u ticks\n",
-                      map[6] == 'c' ? "compact" : "full", plain.detour_m, known.detour_m, plain_ticks,
+                      std::strstr(map, "compact") ? "compact" : "full", plain.detour_m, known.detour_m, plain_ticks,
                       known_ticks);
         assert_true(plain.detour_m >= 0 && plain.detour_m < 1.5);  // near-wall costs, cells
         assert_true(known.detour_m > plain.detour_m + 4.0);          // by the gap at x 8.5..10
