@@ -111,9 +111,6 @@ void make_sim(Loaded &l, int sectors, double ps, double pa, std::uint64_t seed,
     cfg.seed = seed;
     cfg.map_frame_deg = map_frame_deg;
     cfg.survey_m = survey_m;
-    qnav_map_config_t mc;
-    if (survey_m > 0 && !qnav_sim_robot_map_config(l.robot, &mc))
-        throw SimError(QNAV_SIM_E_PARAM, "--survey: the robot profile has no [map] to start surveyed");
     check(qnav_sim_create(l.robot, l.env, &cfg, &l.sim, err, sizeof err), err);
 }
 
@@ -335,6 +332,9 @@ int cmd_run(const RunOpts &o) {
     load(l, o.robot, o.env);
     qnav_sim_robot_info_t ri;
     qnav_sim_robot_info(l.robot, &ri);
+    qnav_map_config_t mc;
+    if (o.survey > 0 && !qnav_sim_robot_map_config(l.robot, &mc))
+        throw SimError(QNAV_SIM_E_PARAM, o.robot + ": --survey: the profile has no [map] (or its [map] is off) to survey into");
     const double ps = o.ps >= 0 ? o.ps : ri.sensor_noise;
     const double pa = o.pa >= 0 ? o.pa : ri.actuation_noise;
     qnav_sim_fitness_rule_t rule;
