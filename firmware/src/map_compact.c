@@ -460,6 +460,14 @@ static uint8_t grow_rows_one_word(qnav_map_t *m, rows_t *rows, int32_t first, in
 }
 #endif
 
+#if QNAV_CMAP_FREE_ROWS
+uint64_t qnav_cmap_free_row(const qnav_map_t *m, int32_t j)
+{
+    const uint16_t n = m->row_bytes;
+    return one_word_at(plane(m, SEEN_LO, j), n) & one_word_at(plane(m, SEEN_HI, j), n);
+}
+#endif
+
 /* On hosts the growth also takes the plan's rows as words (struct rows, or NULL); on AVR
  * it reads the planes' bytes and takes nothing more, as before. */
 #if QNAV_CMAP_WIDE
