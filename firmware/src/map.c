@@ -897,18 +897,62 @@ typedef struct {
     uint32_t width_k;
 } scan_rules_t;
 
-/* Row j's unsettled cells ia .. ib marked: cell i lies dx0 + (i - i0) * cell across from
- * the robot and dy along, dy2 = dy^2. */
-static void mark_row(qnav_map_t *m, const scan_rules_t *s, int32_t j, int32_t dy, uint32_t dy2,
-                     int32_t dx0, int32_t i0, int32_t ia, int32_t ib)
+/* A row's cells as mark_cell() needs them: dy along from the robot (ady = |dy|, dy2 = dy^2),
+ * cell i0 dx0 across, and the octants' starts and turns on dy's side. */
+typedef struct {
+    int32_t j, dx0, i0;
+    uint32_t ady, dy2;
+    const int32_t *from, *turn;
+} mark_row_t;
+
+/* Cell i of row r, unsettled, marked; may_arc: it may take an arc's evidence. */
+static inline void mark_cell(qnav_map_t *m, const scan_rules_t *s, const mark_row_t *r, int32_t i,
+                             unsigned may_arc)
 {
-    const int32_t cell = (int32_t)m->cfg.cell_mm;
-    const uint32_t ady = (uint32_t)(dy < 0 ? -dy : dy);
-    const int32_t *row_from = dy < 0 ? s->from + 4 : s->from;
-    const int32_t *row_turn = dy < 0 ? OCTANT_TURN + 4 : OCTANT_TURN;
+    const int32_t dx = r->dx0 + (i - r->i0) * (int32_t)m->cfg.cell_mm;
+    const uint32_t adx = (uint32_t)(dx < 0 ? -dx : dx), d2 = adx * adx + r->dy2;
+    const unsigned o = (dx < 0 ? 2u : 0u) | (r->ady > adx ? 1u : 0u);
+    const uint32_t hi = r->ady > adx ? r->ady : adx, lo = r->ady > adx ? adx : r->ady;
+    const wedge_rule_t *w;
+    uint32_t t, a;
+    int32_t rel;
+    if (d2 == 0u) {
+        return;
+    }
+    t = (lo << 15) / hi;                                        /* direction_cdeg's */
+    a = (4500u * t + ((1564u * t) >> 15) * (32768u - t)) >> 15; /* 0..4500 */
+    rel = r->from[o] + r->turn[o] * (int32_t)a;
+    rel += rel < 0 ? INT32_C(36000) : (rel >= INT32_C(36000) ? -INT32_C(36000) : 0);
+    w = &s->rules[sector_of(m, rel)];
+    if (d2 < w->clear_below) {
+        mark_clear(m, i, r->j);
+    } else if (may_arc && d2 >= w->arc_from && d2 <= w->arc_to &&
+               on_arc(off_centre(rel, w->r.centre), &w->r, s->arc_half, s->width_k)) {
+        mark_arc(m, i, r->j);
+    }
+}
+
+/* Row r's unsettled cells ia .. ib marked. A compact map's rows of 4 to 8 bytes on hosts are
+ * one word: their cells not seen free are taken from it by their set bits, without a loop
+ * over its bytes (a compact map's unsettled cells are those that may take an arc). */
+static void mark_row(qnav_map_t *m, const scan_rules_t *s, const mark_row_t *r, int32_t ia,
+                     int32_t ib)
+{
     int32_t b;
+#if QNAV_CMAP_FREE_ROWS
+    if (m->cfg.compact && m->row_bytes >= 4u && m->row_bytes <= 8u && ia <= ib) {
+        uint64_t todo = ~qnav_cmap_free_row(m, r->j) & (~UINT64_C(0) << ia) &
+                        (~UINT64_C(0) >> (63 - ib));
+        while (todo != 0u) {
+            const int32_t i = __builtin_ctzll(todo);
+            todo &= todo - 1u;
+            mark_cell(m, s, r, i, 1u);
+        }
+        return;
+    }
+#endif
     for (b = ia >> 3; b <= ib >> 3 && ia <= ib; ++b) {
-        uint8_t arcs, todo = unsettled(m, b, j, &arcs);
+        uint8_t arcs, todo = unsettled(m, b, r->j, &arcs);
         if (b == ia >> 3) {
             todo = (uint8_t)(todo & (0xFFu << (ia & 7)));
         }
@@ -917,29 +961,8 @@ static void mark_row(qnav_map_t *m, const scan_rules_t *s, int32_t j, int32_t dy
         }
         while (todo != 0u) {
             const unsigned bit = (unsigned)__builtin_ctz(todo);
-            const int32_t i = b * 8 + (int32_t)bit;
-            const int32_t dx = dx0 + (i - i0) * cell;
-            const uint32_t adx = (uint32_t)(dx < 0 ? -dx : dx), d2 = adx * adx + dy2;
-            const unsigned o = (dx < 0 ? 2u : 0u) | (ady > adx ? 1u : 0u);
-            const uint32_t hi = ady > adx ? ady : adx, lo = ady > adx ? adx : ady;
-            const wedge_rule_t *w;
-            uint32_t t, a;
-            int32_t rel;
             todo = (uint8_t)(todo & (todo - 1u));
-            if (d2 == 0u) {
-                continue;
-            }
-            t = (lo << 15) / hi;                                        /* direction_cdeg's */
-            a = (4500u * t + ((1564u * t) >> 15) * (32768u - t)) >> 15; /* 0..4500 */
-            rel = row_from[o] + row_turn[o] * (int32_t)a;
-            rel += rel < 0 ? INT32_C(36000) : (rel >= INT32_C(36000) ? -INT32_C(36000) : 0);
-            w = &s->rules[sector_of(m, rel)];
-            if (d2 < w->clear_below) {
-                mark_clear(m, i, j);
-            } else if (((unsigned)arcs >> bit & 1u) != 0u && d2 >= w->arc_from && d2 <= w->arc_to &&
-                       on_arc(off_centre(rel, w->r.centre), &w->r, s->arc_half, s->width_k)) {
-                mark_arc(m, i, j);
-            }
+            mark_cell(m, s, r, b * 8 + (int32_t)bit, (unsigned)arcs >> bit & 1u);
         }
     }
 }
@@ -955,6 +978,7 @@ static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_m
     uint32_t reach2;
     const int32_t cell = (int32_t)m->cfg.cell_mm;
     scan_rules_t s;
+    mark_row_t r;
     qnav_map_pose_t in_grid;
     const qnav_map_pose_t *pose = &in_grid;
     uint16_t k;
@@ -988,15 +1012,20 @@ static void observe_fast(qnav_map_t *m, const qnav_mm_t *ranges_mm, const qnav_m
     cell_of(m, pose->x_mm + reach, pose->y_mm + reach, &i1, &j1);
     ia = i0;
     ib = i1;
+    r.i0 = i0;
+    r.dx0 = centre_x(m, i0) - pose->x_mm; /* cell i0's */
     for (j = j0; j <= j1; ++j) {
         const int32_t dy = centre_y(m, j) - pose->y_mm;
-        const uint32_t ady = (uint32_t)(dy < 0 ? -dy : dy), dy2 = ady * ady;
-        const int32_t dx0 = centre_x(m, i0) - pose->x_mm; /* cell i0's */
-        if (dy2 > reach2) {
+        r.j = j;
+        r.ady = (uint32_t)(dy < 0 ? -dy : dy);
+        r.dy2 = r.ady * r.ady;
+        r.from = dy < 0 ? s.from + 4 : s.from;
+        r.turn = dy < 0 ? OCTANT_TURN + 4 : OCTANT_TURN;
+        if (r.dy2 > reach2) {
             continue;
         }
-        row_ends(dx0, cell, reach2 - dy2, i0, i1, &ia, &ib);
-        mark_row(m, &s, j, dy, dy2, dx0, i0, ia, ib);
+        row_ends(r.dx0, cell, reach2 - r.dy2, i0, i1, &ia, &ib);
+        mark_row(m, &s, &r, ia, ib);
     }
 }
 #endif

@@ -460,6 +460,14 @@ static uint8_t grow_rows_one_word(qnav_map_t *m, rows_t *rows, int32_t first, in
 }
 #endif
 
+#if QNAV_CMAP_FREE_ROWS
+uint64_t qnav_cmap_free_row(const qnav_map_t *m, int32_t j)
+{
+    const uint16_t n = m->row_bytes;
+    return one_word_at(plane(m, SEEN_LO, j), n) & one_word_at(plane(m, SEEN_HI, j), n);
+}
+#endif
+
 /* On hosts the growth also takes the plan's rows as words (struct rows, or NULL); on AVR
  * it reads the planes' bytes and takes nothing more, as before. */
 #if QNAV_CMAP_WIDE
@@ -603,7 +611,7 @@ static inline unsigned bits_in(const uint8_t *lo, const uint8_t *hi, int32_t i)
 /* qnav_cmap_descend() for rows of 4 to 8 bytes (both profiles' maps), on hosts: the three
  * rows' cells a step nearer as words, so only those cells are looked at, in the same order
  * (row by row, then along the row) and with the same tests. */
-static int descend_words(const qnav_map_t *m, int32_t *i, int32_t *j)
+static inline int descend_words(const qnav_map_t *m, int32_t *i, int32_t *j)
 {
     const int32_t gi = (int32_t)(m->goal_cell % m->nx), gj = (int32_t)(m->goal_cell / m->nx);
     const uint16_t n = m->row_bytes;
@@ -718,6 +726,17 @@ int qnav_cmap_descend(const qnav_map_t *m, int32_t *i, int32_t *j)
 /* The plan's cost from settled cell (i, j): its way to the destination, 10 a side and 14 a
  * diagonal. A way cut by a cell that became occupied since the plan (the next plan mends
  * it) counts the rest as the straight octile distance. */
+#if DESCEND_WORDS
+/* A way's step on hosts: the walk by words inlined into the walk of the way (up to the
+ * plan's step count of them), so that what does not change between steps (the
+ * destination's cell, the rows' size) is worked out once a way, not once a step. */
+#define WAY_STEP(m, i, j)                                                                    \
+    ((m)->row_bytes >= 4u && (m)->row_bytes <= CWORD_BYTES ? descend_words(m, i, j)         \
+                                                           : qnav_cmap_descend(m, i, j))
+#else
+#define WAY_STEP(m, i, j) qnav_cmap_descend(m, i, j)
+#endif
+
 static uint32_t way_cost(const qnav_map_t *m, int32_t i, int32_t j)
 {
     const int32_t gi = (int32_t)(m->goal_cell % m->nx), gj = (int32_t)(m->goal_cell / m->nx);
@@ -726,7 +745,7 @@ static uint32_t way_cost(const qnav_map_t *m, int32_t i, int32_t j)
      * can show a cell two steps further as one nearer, so the walk is bounded */
     for (steps = 0u; steps <= m->layer; ++steps) {
         const int32_t pi = i, pj = j;
-        if (!qnav_cmap_descend(m, &i, &j)) {
+        if (!WAY_STEP(m, &i, &j)) {
             break;
         }
         cost += (pi != i && pj != j) ? STEP_DIAG : STEP_SIDE;

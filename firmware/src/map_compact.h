@@ -43,6 +43,16 @@ int8_t qnav_cmap_evidence(const qnav_map_t *m, int32_t i, int32_t j);
 /* Which of cells 8b .. 8b + 7 of row j were seen free: cell 8b + k in bit k (0 past the
  * row's end). */
 uint8_t qnav_cmap_free_bits(const qnav_map_t *m, int32_t b, int32_t j);
+/* On hosts (little-endian, neither the ATmega128 nor a Cortex-M, whose benches measure the
+ * byte at a time): which cells of row j were seen free, cell i in bit i, for rows of 4 to 8
+ * bytes (0 past the row's end). */
+#if !defined(__AVR__) && !(defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M') &&          \
+    defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define QNAV_CMAP_FREE_ROWS 1
+uint64_t qnav_cmap_free_row(const qnav_map_t *m, int32_t j);
+#else
+#define QNAV_CMAP_FREE_ROWS 0
+#endif
 /* Seen free; one more arc's evidence (occupied at the second). Both set m->dirty when the
  * cell became or stopped being occupied. */
 void qnav_cmap_clear(qnav_map_t *m, int32_t i, int32_t j);

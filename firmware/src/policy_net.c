@@ -221,6 +221,69 @@ static void eval_run(const qnav_ctrl_t *ctrl, const qnav_run_t *r, qnav_best_t *
     }
 }
 
+/* On hosts a table's row takes each unit's flat ends as ranges of paths (add_unit_row);
+ * the ATmega128 and the Cortex-M4 keep eval_run's row, whose cycles their benches measure. */
+#if !defined(__AVR__) && !(defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M')
+/* The first k in 0..n - 1 at which z0 + k * s (s >= 0) reaches bound, or n. */
+static int32_t first_reaching(int32_t z0, int32_t s, int32_t bound, int32_t n)
+{
+    int32_t k;
+    if (z0 >= bound) {
+        return 0;
+    }
+    if (s == 0) {
+        return n;
+    }
+    k = (bound - z0 + s - 1) / s;
+    return k < n ? k : n;
+}
+
+/* Unit u's shares of paths dtheta 0..n - 1 (pre-activation z0 + dtheta * per_deg, the
+ * same integers as eval_run's) added to acc: z moves one way, so the paths on the flat
+ * ends are two ranges, found by a division each, and only those between read the table
+ * (unit_share's values: there the rounded z needs no saturation). */
+static void add_unit_row(const qnav_ctrl_unit_t *u, uint8_t level, int32_t *acc, int32_t n)
+{
+    const int32_t z0 = unit_base(u, level), s = u->per_deg;
+    const int32_t top = unit_share(UNIT_TOP_FROM, u->out);
+    int32_t a, b, k, z, top_from, top_to; /* paths a .. b - 1 lie between the flat ends */
+    if (s >= 0) { /* 0 below a, the top from b */
+        a = first_reaching(z0, s, UNIT_ZERO_BELOW, n);
+        b = first_reaching(z0, s, UNIT_TOP_FROM, n);
+        top_from = b;
+        top_to = n;
+    } else { /* -z rises: the top below a, 0 from b */
+        a = first_reaching(-z0, -s, 1 - UNIT_TOP_FROM, n);
+        b = first_reaching(-z0, -s, 1 - UNIT_ZERO_BELOW, n);
+        top_from = 0;
+        top_to = a;
+    }
+    for (k = top_from; k < top_to; ++k) {
+        acc[k] += top;
+    }
+    for (k = a, z = z0 + a * s; k < b; ++k, z += s) {
+        const int16_t h = qnav_sigmoid_q5_11_between((int16_t)((z + 128) >> 8));
+        acc[k] += ((int32_t)u->out * h + 128) >> 8;
+    }
+}
+
+void qnav_net_eval_row(const qnav_ctrl_t *ctrl, uint8_t level, qnav_qkey_t *row)
+{
+    int32_t acc[QNAV_DTHETA_MAX + 1];
+    int32_t k;
+    uint8_t j;
+    QNAV_COUNT_EVALS(ctrl, (uint16_t)(QNAV_DTHETA_MAX + 1u) * ctrl->hidden);
+    for (k = 0; k <= QNAV_DTHETA_MAX; ++k) {
+        acc[k] = ctrl->p.net.out_bias_z;
+    }
+    for (j = 0; j < ctrl->hidden; ++j) {
+        add_unit_row(&ctrl->p.net.unit[j], level, acc, QNAV_DTHETA_MAX + 1);
+    }
+    for (k = 0; k <= QNAV_DTHETA_MAX; ++k) {
+        row[k] = net_key_of(ctrl, acc[k]);
+    }
+}
+#else
 void qnav_net_eval_row(const qnav_ctrl_t *ctrl, uint8_t level, qnav_qkey_t *row)
 {
     /* a row is a run of dtheta 0..180: the same integers, by addition */
@@ -236,6 +299,7 @@ void qnav_net_eval_row(const qnav_ctrl_t *ctrl, uint8_t level, qnav_qkey_t *row)
     ignore.heading = 0;
     eval_run(ctrl, &r, &ignore, row);
 }
+#endif
 
 /* The shape of every row (init time): each row evaluated in pieces by eval_run, the same
  * integers as the step. @par Cost: 181 * QNAV_DIST_LEVELS paths of H units (ATmega128:

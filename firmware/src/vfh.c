@@ -6,9 +6,11 @@
  * its thresholds tau_low / tau_high are distances here. Integer arithmetic only.
  */
 #include "qnav/vfh.h"
+#include <string.h>
 #include "clearance.h"
 #include "ctrl_internal.h"
 #include "escape.h"
+#include "vfh_plain.h"
 
 #if !QNAV_WITH_VFH
 #error "vfh.c is left out of the build when QNAV_WITH_VFH is 0 (qnav/qnav_config.h)"
@@ -124,27 +126,78 @@ static void set_blocked(qnav_vfh_state_t *st, uint16_t k, uint8_t b)
                                       : (st->blocked[k >> 3] & (uint8_t)~bit));
 }
 
+/* The least level (densest) of the n paths from p on (p < 720: wrapping past 359). */
+static uint8_t least_level(const uint8_t *lvl, uint16_t p, uint8_t n)
+{
+    uint8_t low = (uint8_t)(QNAV_DIST_LEVELS - 1u);
+    uint8_t i;
+    for (i = 0; i < n; ++i) {
+        uint8_t l = lvl[wrap360(p)];
+        if (l < low) {
+            low = l;
+        }
+        ++p;
+    }
+    return low;
+}
+
+/* On x86 hosts a sector's least level takes sixteen levels an instruction (least_level16),
+ * from the levels with their first 32 repeated after path 359 so that no window wraps;
+ * qnav_vfh_histogram_plain() keeps least_level() there for the tests, and the other
+ * targets have only it. */
+#if defined(QNAV_LEVELS_SSE2)
+/* Bytes t >= n of a window loaded at past_n + 16 - n are 0xFF (nothing under min), the
+ * others 0 (nothing under max). */
+static const uint8_t past_n[32] = {
+    0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+    0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF,
+};
+
+/* least_level() of the n paths (1..30) from ext + p on, ext the levels and their first 32
+ * again: one window of 16 with the bytes past n raised to 0xFF, or two that overlap
+ * (taking a level twice leaves the least as it was). */
+static uint8_t least_level16(const uint8_t *ext, uint16_t p, uint8_t n)
+{
+    const uint8_t *q = ext + (p >= QNAV_PATHS ? p - QNAV_PATHS : p);
+    __m128i v = n >= 16u ? _mm_min_epu8(qnav_levels16(q), qnav_levels16(q + n - 16u))
+                         : _mm_max_epu8(qnav_levels16(q), qnav_levels16(past_n + 16u - n));
+    uint8_t low;
+    v = _mm_min_epu8(v, _mm_srli_si128(v, 8));
+    v = _mm_min_epu8(v, _mm_srli_si128(v, 4));
+    v = _mm_min_epu8(v, _mm_srli_si128(v, 2));
+    v = _mm_min_epu8(v, _mm_srli_si128(v, 1));
+    low = (uint8_t)_mm_cvtsi128_si32(v);
+    return low < QNAV_DIST_LEVELS - 1u ? low : (uint8_t)(QNAV_DIST_LEVELS - 1u);
+}
+#define LEAST_LEVEL(lvl, ext, p, n, plain)                                                   \
+    ((plain) ? least_level(lvl, p, n) : least_level16(ext, p, n))
+#define PLAIN_PARAM , int plain
+#define PLAIN_ARG(p) , (p)
+#else
+#define LEAST_LEVEL(lvl, ext, p, n, plain) least_level(lvl, p, n)
+#define PLAIN_PARAM
+#define PLAIN_ARG(p)
+#endif
+
 /*
  * The binary histogram: sector k (centred on k * alpha) takes the lowest level (densest)
  * of its alpha paths; below level_blocked it is blocked, at or above level_clear free, in
  * between as last tick. Returns the number of blocked sectors.
  */
-static uint16_t binary_histogram(const qnav_vfh_t *v, qnav_vfh_state_t *st, const uint8_t *lvl)
+static uint16_t binary_histogram(const qnav_vfh_t *v, qnav_vfh_state_t *st, const uint8_t *lvl
+                                 PLAIN_PARAM)
 {
     uint16_t k;
     uint16_t n_blocked = 0;
     uint16_t half = (uint16_t)(v->sector_deg / 2u);
+#if defined(QNAV_LEVELS_SSE2)
+    uint8_t ext[QNAV_PATHS + 32u];
+    memcpy(ext, lvl, QNAV_PATHS);
+    memcpy(ext + QNAV_PATHS, lvl, 32u);
+#endif
     for (k = 0; k < v->n_hist; ++k) {
         uint16_t p = (uint16_t)((uint16_t)(k * v->sector_deg) + QNAV_PATHS - half);
-        uint8_t low = (uint8_t)(QNAV_DIST_LEVELS - 1u);
-        uint8_t i;
-        for (i = 0; i < v->sector_deg; ++i) {
-            uint8_t l = lvl[wrap360(p)]; /* p < 720 */
-            if (l < low) {
-                low = l;
-            }
-            ++p;
-        }
+        uint8_t low = LEAST_LEVEL(lvl, ext, p, v->sector_deg, plain);
         if (low < v->level_blocked) {
             set_blocked(st, k, 1u);
         } else if (low >= v->level_clear) {
@@ -154,6 +207,18 @@ static uint16_t binary_histogram(const qnav_vfh_t *v, qnav_vfh_state_t *st, cons
     }
     return n_blocked;
 }
+
+#if defined(QNAV_LEVELS_SSE2)
+uint16_t qnav_vfh_histogram(const qnav_vfh_t *v, qnav_vfh_state_t *st, const uint8_t *lvl)
+{
+    return binary_histogram(v, st, lvl, 0);
+}
+
+uint16_t qnav_vfh_histogram_plain(const qnav_vfh_t *v, qnav_vfh_state_t *st, const uint8_t *lvl)
+{
+    return binary_histogram(v, st, lvl, 1);
+}
+#endif
 
 /* The candidate of least cost so far. */
 typedef struct {
@@ -259,7 +324,7 @@ void qnav_vfh_step(const qnav_vfh_t *vfh, qnav_vfh_state_t *state, const qnav_ct
     }
     flags = qnav_clearance_input_levels(&vfh->clr, in, lvl);
     goal = qnav_escape_goal(&vfh->clr, lvl, in, &esc);
-    n_blocked = binary_histogram(vfh, state, lvl);
+    n_blocked = binary_histogram(vfh, state, lvl PLAIN_ARG(0));
     if (n_blocked == vfh->n_hist) {
         stop(out, (uint8_t)(flags | QNAV_FLAG_NO_PATH));
         out->escape = esc;

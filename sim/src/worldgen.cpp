@@ -33,11 +33,12 @@ public:
         : w_(w), h_(h), clear_(clearance), cell_(cell),
           nx_(std::max(1, static_cast<int>(std::ceil(w / cell)))),
           ny_(std::max(1, static_cast<int>(std::ceil(h / cell)))),
-          blocked_(cell_index(nx_ * ny_), 0) {
+          blocked_(cell_index(nx_ * ny_), 0),
+          free_(blocked_.size(), 1) {
         for (int j = 0; j < ny_; ++j)
             for (int i = 0; i < nx_; ++i) {
                 const double x = (i + 0.5) * cell_, y = (j + 0.5) * cell_;
-                if (x < clear_ || y < clear_ || x > w_ - clear_ || y > h_ - clear_) ++at(i, j);
+                if (x < clear_ || y < clear_ || x > w_ - clear_ || y > h_ - clear_) change(i, j, +1);
             }
     }
     void add(const Shape &s, int delta) {
@@ -49,7 +50,7 @@ public:
         Vec2 q;
         for (int j = j0; j <= j1; ++j)
             for (int i = i0; i <= i1; ++i)
-                if (nearest_point(s, {(i + 0.5) * cell_, (j + 0.5) * cell_}, &q) < clear_) at(i, j) += delta;
+                if (nearest_point(s, {(i + 0.5) * cell_, (j + 0.5) * cell_}, &q) < clear_) change(i, j, delta);
     }
     // Add s unless it cuts a start zone off from the destination (then leave the grid as
     // it was and return false). Most obstacles are settled locally: in a window two cells
@@ -93,10 +94,8 @@ public:
     }
     // Longest BFS distance (m) from the destination disc to a zone centre; -1 if one is cut off.
     double path_m(const Environment &env) const {
-        std::vector<char> free(blocked_.size());
-        for (std::size_t k = 0; k < free.size(); ++k) free[k] = blocked_[k] == 0;
         int worst = 0;
-        for (const int steps : zone_steps(env, free, nx_, ny_, cell_, false)) {
+        for (const int steps : zone_steps(env, free_, nx_, ny_, cell_, false)) {
             if (steps < 0) return -1;
             worst = std::max(worst, steps);
         }
@@ -104,7 +103,13 @@ public:
     }
 
 private:
-    int &at(int i, int j) { return blocked_[cell_index(j * nx_ + i)]; }
+    // A cell's count changed by delta, and whether it is free with it: the flood reads the
+    // free cells as they are, without a pass over the grid to find them each time.
+    void change(int i, int j, int delta) {
+        const std::size_t k = cell_index(j * nx_ + i);
+        blocked_[k] += delta;
+        free_[k] = blocked_[k] == 0;
+    }
     // Components of the free cells of the window [i0, i1] x [j0, j1] (4-connected,
     // inside the window only); -1 for blocked cells.
     std::vector<int> local_labels(int i0, int i1, int j0, int j1) const {
@@ -144,6 +149,7 @@ private:
     double w_, h_, clear_, cell_;
     int nx_, ny_;
     std::vector<int> blocked_;
+    std::vector<char> free_;  // blocked_ == 0, kept with it
 };
 
 // ---- what every builder shares --------------------------------------------------------

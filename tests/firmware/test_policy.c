@@ -14,6 +14,7 @@
 #include "qnav/ctrl.h"
 #include "qnav/fixed_host.h"
 #include "qnav/policy.h"
+#include "test_rng.h"
 
 static void test_validate_accepts_defaults_and_names_each_broken_rule(void **state)
 {
@@ -172,6 +173,37 @@ static void test_q1_15_literal_rounds_negative_values_away_from_zero(void **stat
     assert_true(QNAV_Q1_15_TO_REAL(16384) == 0.5);
 }
 
+/* A table's rows are built a row at a time (on hosts by each unit's flat ranges, elsewhere
+ * by eval_run); each key must be the one the step evaluates for that single path. Random
+ * networks of every width and of weights from small to the Q8.8 limits, so that units lie
+ * on either flat end, between them, or cross them along a row either way. */
+static void test_every_table_key_is_the_single_paths_key(void **state)
+{
+    static const int32_t scales[] = {64, 512, 4096, 32767};
+    static qnav_qkey_t table[QNAV_QTABLE_ENTRIES];
+    qnav_ctrl_config_t cfg;
+    qnav_policy_t p;
+    qnav_ctrl_t c;
+    (void)state;
+    qnav_ctrl_config_default(&cfg);
+    for (unsigned k = 0; k < 40u; ++k) {
+        const uint8_t hidden = (uint8_t)(1u + k % QNAV_MAX_HIDDEN);
+        qnav_policy_net_zero_inputs(&p, hidden, QNAV_NET_INPUTS_PAPER);
+        for (uint16_t w = 0; w < qnav_net_weight_count(&p.u.net); ++w) {
+            const int32_t s = scales[k % 4u];
+            *qnav_net_weight(&p.u.net, w) = (qnav_q8_8_t)rng_range(-s, s);
+        }
+        assert_int_equal(qnav_ctrl_init(&c, &cfg, &p), QNAV_OK);
+        assert_int_equal(qnav_ctrl_build_table(&c, table), QNAV_OK);
+        for (uint16_t level = 0; level < QNAV_DIST_LEVELS; ++level) {
+            for (uint16_t d = 0; d <= QNAV_DTHETA_MAX; ++d) {
+                assert_int_equal(table[level * (QNAV_DTHETA_MAX + 1u) + d],
+                                 qnav_ctrl_key(&c, (uint8_t)level, (uint8_t)d));
+            }
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -182,6 +214,7 @@ int main(void)
         cmocka_unit_test(test_two_input_network_ignores_the_previous_heading),
         cmocka_unit_test(test_three_input_network_has_no_table_but_network_mode_with_qualities_agrees),
         cmocka_unit_test(test_q1_15_literal_rounds_negative_values_away_from_zero),
+        cmocka_unit_test(test_every_table_key_is_the_single_paths_key),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
