@@ -263,9 +263,9 @@ std::vector<int> zone_steps(const Environment &env, const std::vector<char> &fre
     return out;
 }
 
-int first_walled_in_zone(const Environment &env, double clearance_m, double cell_m) {
-    const int nx = static_cast<int>(std::ceil(env.width_m / cell_m));
-    const int ny = static_cast<int>(std::ceil(env.height_m / cell_m));
+std::vector<char> free_cells(const Environment &env, double clearance_m, double cell_m, int *nx_out, int *ny_out) {
+    const int nx = *nx_out = static_cast<int>(std::ceil(env.width_m / cell_m));
+    const int ny = *ny_out = static_cast<int>(std::ceil(env.height_m / cell_m));
     const std::vector<Shape> obs = env.obstacle_shapes();
     std::vector<char> free(cell_index(nx * ny), 0);
     for (int j = 0; j < ny; ++j) {
@@ -291,6 +291,12 @@ int first_walled_in_zone(const Environment &env, double clearance_m, double cell
                 if (f && nearest_point(s, {(i + 0.5) * cell_m, (j + 0.5) * cell_m}, &q) < clearance_m) f = 0;
             }
     }
+    return free;
+}
+
+int first_walled_in_zone(const Environment &env, double clearance_m, double cell_m) {
+    int nx = 0, ny = 0;
+    const std::vector<char> free = free_cells(env, clearance_m, cell_m, &nx, &ny);
     const std::vector<int> steps = zone_steps(env, free, nx, ny, cell_m, true);
     for (std::size_t z = 0; z < steps.size(); ++z)
         if (steps[z] < 0) return static_cast<int>(z);

@@ -69,6 +69,11 @@ std::string environment_to_toml(const Environment &env);
 // zone to the destination (cells of cell_m).
 bool environment_connected(const Environment &env, double clearance_m, double cell_m = 0.1);
 
+// The cells of cell_m from the origin (nx = ceil(width / cell_m) by ny, cell (i, j) at
+// [j * nx + i]) whose centre a disc of radius clearance_m fits on: inside the walls by
+// clearance_m, and no obstacle nearer than that.
+std::vector<char> free_cells(const Environment &env, double clearance_m, double cell_m, int *nx, int *ny);
+
 // The index of the first start zone that such a disc cannot leave for the destination,
 // or -1 when every zone is connected.
 int first_walled_in_zone(const Environment &env, double clearance_m, double cell_m = 0.1);

@@ -350,27 +350,23 @@ qnav_mm_t Simulation::reading_mm(double range_m) const {
 // sonar shows without noise from every point of a survey_m grid over the arena where the
 // body fits, at two headings half a sector apart, so each wedge's centre line is seen
 // twice as densely. The episode then drives a map that knows the world as well as this
-// sonar and map can, and a miss is owed to the controller and the plan, not to exploring
+// sonar and map can (the points: free_cells, where the world generator checks a body fits),
+// and a miss is owed to the controller and the plan, not to exploring
 // (docs/sim.md, "A known world"). A map that follows the robot keeps what its square holds.
 void Simulation::survey_map() {
     std::vector<qnav_mm_t> ranges(cfg_.n_sectors);
-    const std::vector<Shape> shapes = env_.obstacle_shapes();
-    const double step = cfg_.survey_m, half_sector = kPi / cfg_.n_sectors, r = robot_.radius_m;
-    // the body fits at p: inside the walls, and no obstacle nearer than its radius (a point
-    // inside one is at distance 0)
-    const auto fits = [&](Vec2 p) {
-        if (p.x < r || p.y < r || p.x > env_.width_m - r || p.y > env_.height_m - r) return false;
-        Vec2 q;
-        return std::none_of(shapes.begin(), shapes.end(), [&](const Shape &s) { return nearest_point(s, p, &q) < r; });
-    };
-    for (double y = step / 2; y < env_.height_m; y += step) {
-        for (double x = step / 2; x < env_.width_m; x += step) {
-            if (!fits(Vec2{x, y})) continue;
+    const double step = cfg_.survey_m, half_sector = kPi / cfg_.n_sectors;
+    int nx = 0, ny = 0;
+    const std::vector<char> fits = free_cells(env_, robot_.radius_m, step, &nx, &ny);
+    for (int j = 0; j < ny; ++j) {
+        for (int i = 0; i < nx; ++i) {
+            if (!fits[cell_index(j * nx + i)]) continue;
+            const Vec2 p{(i + 0.5) * step, (j + 0.5) * step};
             for (const double hd : {0.0, half_sector}) {
-                sonar_.measure(Vec2{x, y}, hd, true_dist_.data());
+                sonar_.measure(p, hd, true_dist_.data());
                 for (std::uint16_t k = 0; k < cfg_.n_sectors; ++k)
                     ranges[k] = reading_mm(true_dist_[k] - robot_.sonar_offset_m);
-                const Vec2 at = turned(Vec2{x, y}, map_turn_);
+                const Vec2 at = turned(p, map_turn_);
                 const qnav_map_pose_t pose{map_mm(at.x), map_mm(at.y), to_cdeg(hd + map_turn_)};
                 qnav_map_observe(&map_, ranges.data(), &pose);
             }
